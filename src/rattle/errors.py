@@ -1,0 +1,51 @@
+"""Errors and status values.
+
+``ConfigError`` is bad input (command-line exit status 2), ``ConvergenceError`` a numerical
+failure that could not be recovered (exit status 1). Long computations report how they ended
+with a :class:`Status` value; the front ends raise on failure when ``throw=True``.
+"""
+
+from __future__ import annotations
+
+import enum
+
+
+class RattleError(Exception):
+    """Base class of every error rattle raises on purpose."""
+
+
+class ConfigError(RattleError, ValueError):
+    """Bad input: a configuration key or an argument breaks a rule (exit status 2)."""
+
+
+class ConvergenceError(RattleError, RuntimeError):
+    """A numerical failure that could not be recovered (exit status 1).
+
+    ``partial`` holds what was computed before the failure (e.g. a FrequencyResponse), or None.
+    """
+
+    def __init__(self, message: str, partial: object | None = None) -> None:
+        super().__init__(message)
+        self.partial = partial
+
+
+class Status(enum.Enum):
+    """How a continuation run ended. ``.message`` explains, ``.success`` tells if it is complete."""
+
+    SUCCESS = "the branch was followed across the whole frequency range"
+    RETURNED = "the branch turned back and left the range at the side it started from"
+    MAX_STEPS = "the maximum number of continuation steps was reached before the end of the range"
+    MAX_TIME = "the time budget was used up before the end of the range"
+    STEP_TOO_SMALL = "the corrector failed even at the smallest allowed step"
+    START_FAILED = "no periodic solution could be found at the start of the range"
+
+    @property
+    def message(self) -> str:
+        return self.value
+
+    @property
+    def success(self) -> bool:
+        return self in (Status.SUCCESS, Status.RETURNED)
+
+
+__all__ = ["RattleError", "ConfigError", "ConvergenceError", "Status"]

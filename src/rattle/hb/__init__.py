@@ -1,0 +1,11 @@
+"""Harmonic balance: Fourier basis, AFT residual with analytic Jacobians, Newton corrector."""
+
+from ._basis import FourierBasis
+from ._newton import NewtonResult, solve_harmonic_balance
+from ._options import HBOptions, NewtonOptions, default_samples
+from ._residual import HarmonicBalance
+
+__all__ = [
+    "FourierBasis", "HarmonicBalance", "HBOptions", "NewtonOptions", "NewtonResult",
+    "solve_harmonic_balance", "default_samples",
+]

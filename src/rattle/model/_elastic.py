@@ -1,0 +1,258 @@
+"""Elastic laws f(δ): continuous, piecewise linear, f(0) = 0.
+
+Every law is stored as breakpoints d_1 < … < d_k and k + 1 slopes s_0 … s_k (relative to the
+stiffness K of the unit-slope stage). On stage j (d_j ≤ δ < d_{j+1}, with d_0 = −∞,
+d_{k+1} = +∞)
+
+    f(δ) = s_j δ + e_j,
+
+with offsets e_j fixed by continuity at the breakpoints and by f(0) = 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from .._typing import FloatArray, IntArray
+
+
+def _check_real(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise TypeError(f"`{name}` must be a real number, got {value!r} ({type(value).__name__})")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"`{name}` must be finite, got {value!r}")
+    return value
+
+
+def _check_real_sequence(name: str, values: object) -> tuple[float, ...]:
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise TypeError(f"`{name}` must be a list of real numbers, got {values!r}")
+    return tuple(_check_real(f"{name}[{i}]", v) for i, v in enumerate(values))  # type: ignore[union-attr]
+
+
+@dataclass(frozen=True, slots=True)
+class Stages:
+    """Breakpoints, slopes and continuity offsets of a piecewise-linear law."""
+
+    breakpoints: FloatArray  # (k,)
+    slopes: FloatArray  # (k+1,)
+    offsets: FloatArray  # (k+1,)
+
+
+def _stages(breakpoints: tuple[float, ...], slopes: tuple[float, ...]) -> Stages:
+    d = np.asarray(breakpoints, dtype=float)
+    s = np.asarray(slopes, dtype=float)
+    e = np.zeros_like(s)
+    # e_{j+1} = e_j + (s_j − s_{j+1}) d_j (continuity at d_j); then shift so that f(0) = 0.
+    for j in range(len(d)):
+        e[j + 1] = e[j] + (s[j] - s[j + 1]) * d[j]
+    j0 = int(np.searchsorted(d, 0.0, side="right"))
+    e -= e[j0]
+    for arr in (d, s, e):
+        arr.setflags(write=False)
+    return Stages(d, s, e)
+
+
+class AbstractElastic:
+    """Base class of the elastic laws: pure data, vectorised ``force`` and ``stiffness``."""
+
+    name: ClassVar[str] = "abstract"
+
+    @property
+    def _stage_data(self) -> Stages:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    @property
+    def stages(self) -> Stages:
+        """Breakpoints, slopes and offsets of the law as read-only arrays."""
+        return self._stage_data
+
+    def stage(self, delta: FloatArray | float) -> IntArray:
+        """Index j of the stage holding δ (d_j ≤ δ < d_{j+1}); same shape as ``delta``."""
+        return np.searchsorted(self._stage_data.breakpoints, delta, side="right")
+
+    def force(self, delta: FloatArray | float) -> FloatArray:
+        """f(δ) = s_j δ + e_j, elementwise."""
+        st = self._stage_data
+        j = np.searchsorted(st.breakpoints, delta, side="right")
+        return st.slopes[j] * delta + st.offsets[j]
+
+    def stiffness(self, delta: FloatArray | float) -> FloatArray:
+        """∂f/∂δ = s_j, elementwise (right derivative at a breakpoint)."""
+        st = self._stage_data
+        return st.slopes[np.searchsorted(st.breakpoints, delta, side="right")]
+
+    def force_and_stiffness(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """f(δ) and ∂f/∂δ with one stage look-up."""
+        st = self._stage_data
+        j = np.searchsorted(st.breakpoints, delta, side="right")
+        s = st.slopes[j]
+        return s * delta + st.offsets[j], s
+
+    def to_dict(self) -> dict[str, object]:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Linear(AbstractElastic):
+    """The reference linear law f(δ) = δ.
+
+    ::
+
+        f |      /
+          |    /
+        --+--/------ δ
+          |/
+    """
+
+    name: ClassVar[str] = "linear"
+    _data: Stages = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_data", _stages((), (1.0,)))
+
+    @property
+    def _stage_data(self) -> Stages:
+        return self._data
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "linear"}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Backlash(AbstractElastic):
+    """Gear-pair or spline backlash of half-gap ``b`` (rad): f = 0 for |δ| ≤ b, δ ∓ b outside.
+
+    ::
+
+        f |        /
+          |       /
+        --+-=====-----  δ      (dead zone −b … b)
+          /
+    """
+
+    name: ClassVar[str] = "backlash"
+    b: float
+    _data: Stages = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        b = _check_real("b", self.b)
+        if b <= 0:
+            raise ValueError(f"`b` (backlash) must be > 0 rad, got {b!r}")
+        object.__setattr__(self, "b", b)
+        object.__setattr__(self, "_data", _stages((-b, b), (1.0, 0.0, 1.0)))
+
+    @property
+    def _stage_data(self) -> Stages:
+        return self._data
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "backlash", "b": self.b}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Clutch(AbstractElastic):
+    """Two-stage clutch damper: f = α δ for |δ| ≤ b, δ − (1 − α) b sign δ outside (0 < α < 1).
+
+    ::
+
+        f |         /     slope 1
+          |     _.-'      slope α inside ±b
+        --+--.-'-------  δ
+         /
+    """
+
+    name: ClassVar[str] = "clutch"
+    alpha: float
+    b: float
+    _data: Stages = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        alpha = _check_real("alpha", self.alpha)
+        b = _check_real("b", self.b)
+        if not 0.0 < alpha < 1.0:
+            raise ValueError(
+                f"`alpha` (clutch first-stage slope) must satisfy 0 < alpha < 1, got {alpha!r}; "
+                "use type = \"backlash\" for alpha = 0 or type = \"piecewise\" for other laws"
+            )
+        if b <= 0:
+            raise ValueError(f"`b` (clutch first-stage half-width) must be > 0 rad, got {b!r}")
+        object.__setattr__(self, "alpha", alpha)
+        object.__setattr__(self, "b", b)
+        object.__setattr__(self, "_data", _stages((-b, b), (1.0, alpha, 1.0)))
+
+    @property
+    def _stage_data(self) -> Stages:
+        return self._data
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "clutch", "alpha": self.alpha, "b": self.b}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Piecewise(AbstractElastic):
+    """General continuous piecewise-linear law with f(0) = 0 (multi-stage, asymmetric).
+
+    ``breakpoints`` d_1 < … < d_k (rad) and ``slopes`` s_0 … s_k (k + 1 values, ≥ 0, the two
+    outer ones > 0 so that the law confines the motion).
+
+    ::
+
+        f |            /  s_k
+          |      __.--'
+        --+--.--'-------- δ
+          |/  s_0      (d_1 … d_k)
+    """
+
+    name: ClassVar[str] = "piecewise"
+    breakpoints: tuple[float, ...]
+    slopes: tuple[float, ...]
+    _data: Stages = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        d = _check_real_sequence("breakpoints", self.breakpoints)
+        s = _check_real_sequence("slopes", self.slopes)
+        if len(s) != len(d) + 1:
+            raise ValueError(
+                f"`slopes` must have one more entry than `breakpoints` ({len(d)} breakpoints "
+                f"need {len(d) + 1} slopes), got {len(s)}"
+            )
+        for i in range(len(d) - 1):
+            if not d[i] < d[i + 1]:
+                raise ValueError(
+                    f"`breakpoints` must be strictly increasing, got {list(d)!r} "
+                    f"(breakpoints[{i}] = {d[i]} is not < breakpoints[{i + 1}] = {d[i + 1]})"
+                )
+        for i, v in enumerate(s):
+            if v < 0:
+                raise ValueError(f"`slopes[{i}]` must be >= 0, got {v!r}")
+        if s[0] <= 0 or s[-1] <= 0:
+            raise ValueError(
+                f"the outer `slopes` (first and last) must be > 0 so that the law confines the "
+                f"motion, got {list(s)!r}"
+            )
+        object.__setattr__(self, "breakpoints", d)
+        object.__setattr__(self, "slopes", s)
+        object.__setattr__(self, "_data", _stages(d, s))
+
+    @property
+    def _stage_data(self) -> Stages:
+        return self._data
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "piecewise", "breakpoints": list(self.breakpoints), "slopes": list(self.slopes)}
+
+
+ELASTIC_LAWS: dict[str, type[AbstractElastic]] = {
+    "linear": Linear,
+    "backlash": Backlash,
+    "clutch": Clutch,
+    "piecewise": Piecewise,
+}
+
+__all__ = ["Stages", "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "ELASTIC_LAWS"]

@@ -1,0 +1,125 @@
+"""The sub-system model: one equation in the relative angle δ = θ1 − θ2.
+
+    δ'' + (C/I) δ' + (K/I) f(δ) = F_m + Σ_n F_pn cos(n Ω t + φ_n)
+
+with I the effective inertia I1 I2 / (I1 + I2), C the viscous damping, K the stiffness of the
+unit-slope stage and f the elastic law (see ``_elastic``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ._elastic import AbstractElastic, _check_real
+from ._excitation import Excitation
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Model:
+    """Frozen, validated model: ``inertia`` I > 0, ``damping`` C ≥ 0, ``stiffness`` K > 0,
+    ``elastic`` law and ``excitation``."""
+
+    inertia: float
+    damping: float
+    stiffness: float
+    elastic: AbstractElastic
+    excitation: Excitation
+
+    def __post_init__(self) -> None:
+        inertia = _check_real("inertia", self.inertia)
+        damping = _check_real("damping", self.damping)
+        stiffness = _check_real("stiffness", self.stiffness)
+        if inertia <= 0:
+            raise ValueError(f"`inertia` must be > 0, got {inertia!r}")
+        if damping < 0:
+            raise ValueError(f"`damping` must be >= 0, got {damping!r}")
+        if stiffness <= 0:
+            raise ValueError(f"`stiffness` must be > 0, got {stiffness!r}")
+        if not isinstance(self.elastic, AbstractElastic):
+            raise TypeError(f"`elastic` must be an elastic law (Linear, Backlash, Clutch, Piecewise), got {self.elastic!r}")
+        if not isinstance(self.excitation, Excitation):
+            raise TypeError(f"`excitation` must be an Excitation, got {self.excitation!r}")
+        object.__setattr__(self, "inertia", inertia)
+        object.__setattr__(self, "damping", damping)
+        object.__setattr__(self, "stiffness", stiffness)
+
+    # --- coefficients of the equation -------------------------------------------------------
+    @property
+    def c(self) -> float:
+        """Damping coefficient per inertia C/I (1/s)."""
+        return self.damping / self.inertia
+
+    @property
+    def k(self) -> float:
+        """Stiffness per inertia K/I (1/s²) of the unit-slope stage."""
+        return self.stiffness / self.inertia
+
+    @property
+    def natural_frequency(self) -> float:
+        """ω_n = sqrt(K/I) (rad/s) of the unit-slope stage."""
+        return math.sqrt(self.k)
+
+    @property
+    def zeta(self) -> float:
+        """Damping ratio ζ = C / (2 sqrt(K I))."""
+        return self.damping / (2.0 * math.sqrt(self.stiffness * self.inertia))
+
+    def restoring(self, delta: np.ndarray) -> np.ndarray:
+        """(K/I) f(δ), elementwise."""
+        return self.k * self.elastic.force(delta)
+
+    def static_equilibrium(self) -> float:
+        """δ_s solving (K/I) f(δ_s) = F_m (unique on a stage with positive slope).
+
+        When F_m balances a zero-slope stage exactly (a backlash with F_m = 0), the middle of
+        that stage is returned.
+        """
+        st = self.elastic.stages
+        target = self.excitation.mean / self.k
+        edges = np.concatenate(([-np.inf], st.breakpoints, [np.inf]))
+        for j, (s, e) in enumerate(zip(st.slopes, st.offsets)):
+            lo, hi = edges[j], edges[j + 1]
+            if s > 0:
+                x = (target - e) / s
+                if lo <= x <= hi:
+                    return float(x)
+            elif abs(target - e) <= 1e-15 * max(1.0, abs(target)):
+                return float(0.5 * (lo + hi)) if np.isfinite(lo + hi) else float(lo if np.isfinite(lo) else hi)
+        raise AssertionError("unreachable: a monotone law with positive outer slopes has an equilibrium")
+
+    def length_scale(self) -> float:
+        """A characteristic angle L (rad) for scaling: the static deflection, the breakpoints and
+        the quasi-static dynamic amplitude, whichever is largest."""
+        st = self.elastic.stages
+        s_pos = st.slopes[st.slopes > 0]
+        dyn = self.excitation.amplitude_scale / (self.k * float(np.min(s_pos)))
+        bp = float(np.max(np.abs(st.breakpoints))) if st.breakpoints.size else 0.0
+        return max(abs(self.static_equilibrium()), bp, dyn, 1e-300)
+
+    def force_scale(self) -> float:
+        """A characteristic force per inertia for residual scaling: |F_m| + Σ |F_pn|."""
+        return max(abs(self.excitation.mean) + self.excitation.amplitude_scale, 1e-300)
+
+    # --- I/O delegates --------------------------------------------------------------------
+    @classmethod
+    def from_toml(cls, path: str | Path) -> "Model":
+        """Read the ``[model]`` and ``[excitation]`` tables of a SPEC §2 TOML file."""
+        from ..io import load_config
+
+        return load_config(path).model
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "inertia": self.inertia,
+            "damping": self.damping,
+            "stiffness": self.stiffness,
+            "elastic": self.elastic.to_dict(),
+            "excitation": self.excitation.to_dict(),
+        }
+
+
+__all__ = ["Model"]
