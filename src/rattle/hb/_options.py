@@ -6,14 +6,14 @@ from dataclasses import dataclass
 
 
 def default_samples(harmonics: int) -> int:
-    """Default AFT time samples per solution period: the power of two ≥ 32 (H + 1), at least 512.
+    """Default AFT time samples per solution period: the power of two ≥ 32 H, at least 512.
 
     The restoring force of a piecewise-linear law has a kink wherever δ(t) crosses a breakpoint,
     so its samples carry an aliasing (quadrature) error O(N⁻²) in the balanced harmonics. With
-    N ≥ 32 (H + 1) that error is far below the HB truncation error and doubling N no longer
-    changes the response (tested).
+    N ≥ 32 H (1024 for H = 32) the rms along the reference case's whole branch changes by less
+    than 1e-4 (relative) when N is doubled, ten times below the 0.1 % accuracy target (tested).
     """
-    n = max(512, 32 * (harmonics + 1))
+    n = max(512, 32 * harmonics)
     return 1 << (n - 1).bit_length()
 
 

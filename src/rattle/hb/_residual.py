@@ -26,6 +26,39 @@ from ._basis import FourierBasis
 from ._options import HBOptions
 
 
+def _jacobian_gather_tables(H: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Index and sign tables with J[r, c] = s1 V[i1] + s2 V[i2], V = [Re G_m, Im G_m], m = −2H … 2H.
+
+    From the complex product rule (g δ)_k = Σ_j G_{k−j} Q_j in the real basis:
+    row a_0: G0, ½(Gr_{−j} + Gr_j), ½(Gi_{−j} − Gi_j); row cos k: 2Gr_k, Gr_{k−j} + Gr_{k+j},
+    Gi_{k−j} − Gi_{k+j}; row sin k: −2Gi_k, −(Gi_{k−j} + Gi_{k+j}), Gr_{k−j} − Gr_{k+j}.
+    """
+    n = 2 * H + 1
+    off = 2 * H
+    im = 4 * H + 1  # start of the imaginary parts in V
+    i1 = np.zeros((n, n), dtype=np.intp)
+    i2 = np.zeros((n, n), dtype=np.intp)
+    s1 = np.zeros((n, n))
+    s2 = np.zeros((n, n))
+    k = np.arange(1, H + 1)
+    K, J = np.meshgrid(k, k, indexing="ij")
+    a = slice(1, H + 1)
+    b = slice(H + 1, n)
+    # row a_0
+    i1[0, 0], s1[0, 0] = off, 1.0
+    i1[0, a], s1[0, a], i2[0, a], s2[0, a] = off - k, 0.5, off + k, 0.5
+    i1[0, b], s1[0, b], i2[0, b], s2[0, b] = im + off - k, 0.5, im + off + k, -0.5
+    # rows cos k
+    i1[a, 0], s1[a, 0] = off + k, 2.0
+    i1[a, a], s1[a, a], i2[a, a], s2[a, a] = off + K - J, 1.0, off + K + J, 1.0
+    i1[a, b], s1[a, b], i2[a, b], s2[a, b] = im + off + K - J, 1.0, im + off + K + J, -1.0
+    # rows sin k
+    i1[b, 0], s1[b, 0] = im + off + k, -2.0
+    i1[b, a], s1[b, a], i2[b, a], s2[b, a] = im + off + K - J, -1.0, im + off + K + J, -1.0
+    i1[b, b], s1[b, b], i2[b, b], s2[b, b] = off + K - J, 1.0, off + K + J, -1.0
+    return i1, s1, i2, s2
+
+
 class HarmonicBalance:
     """The discretised problem R(q, Ω) = 0 for one model, harmonic count and period multiple."""
 
@@ -46,10 +79,8 @@ class HarmonicBalance:
         self.basis = FourierBasis(options.harmonics, options.n_samples)
         H = options.harmonics
         self._k2 = self.basis.k**2
-        kmj, kpj = self.basis.galerkin_matrix_indices()
-        self._idx_minus = kmj + 2 * H
-        self._idx_plus = kpj + 2 * H
-        self._rows = np.arange(H + 1)
+        self._gather = _jacobian_gather_tables(H)
+        self._diag = np.arange(1, H + 1)
         self.length_scale = model.length_scale()
         self.force_scale = model.force_scale()
         # Excitation coefficients: F_m at a_0, F_pn cos(nΩt + φ) at harmonic n·p.
@@ -121,25 +152,14 @@ class HarmonicBalance:
 
     def force_jacobian_from_stiffness(self, g: FloatArray) -> FloatArray:
         """Γ* diag(g) Γ for stiffness samples g (length N), assembled from the DFT of g."""
+        return self._jacobian_from_spectrum(np.fft.rfft(g))
+
+    def _jacobian_from_spectrum(self, spec: np.ndarray) -> FloatArray:
         H = self.basis.harmonics
-        G = np.fft.rfft(g)[: 2 * H + 1] / self.basis.samples
-        Gfull = np.concatenate((np.conj(G[:0:-1]), G))  # m = −2H … 2H
-        Gm = Gfull[self._idx_minus]  # G_{k−j}, (H+1, H)
-        Gp = Gfull[self._idx_plus]  # G_{k+j}
-        dA0 = G[: H + 1]  # ∂H_k/∂a_0
-        dA = 0.5 * (Gm + Gp)  # ∂H_k/∂a_j
-        dB = 0.5j * (Gp - Gm)  # ∂H_k/∂b_j
-        J = np.empty((2 * H + 1, 2 * H + 1))
-        J[0, 0] = dA0[0].real
-        J[0, 1 : H + 1] = dA[0].real
-        J[0, H + 1 :] = dB[0].real
-        J[1 : H + 1, 0] = 2.0 * dA0[1:].real
-        J[1 : H + 1, 1 : H + 1] = 2.0 * dA[1:].real
-        J[1 : H + 1, H + 1 :] = 2.0 * dB[1:].real
-        J[H + 1 :, 0] = -2.0 * dA0[1:].imag
-        J[H + 1 :, 1 : H + 1] = -2.0 * dA[1:].imag
-        J[H + 1 :, H + 1 :] = -2.0 * dB[1:].imag
-        return J
+        G = spec[: 2 * H + 1] / self.basis.samples
+        V = np.concatenate((G.real[:0:-1], G.real, -G.imag[:0:-1], G.imag))  # Re, Im of G_m, m = −2H … 2H
+        i1, s1, i2, s2 = self._gather
+        return s1 * V[i1] + s2 * V[i2]
 
     # --- residual and Jacobians ------------------------------------------------------------
     def residual(self, q: FloatArray, omega: float) -> FloatArray:
@@ -150,11 +170,21 @@ class HarmonicBalance:
     def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """R, ∂R/∂q (2H+1, 2H+1) and ∂R/∂Ω (2H+1,) in one AFT pass."""
         w = self.base_frequency(omega)
-        delta = self.basis.synthesize(q)
+        basis = self.basis
+        H = basis.harmonics
+        delta = basis.synthesize(q)
         f, g = self._force_samples(delta)
-        R = self._linear_part(q, w) + self._kstiff * self.basis.analyze(f) - self.forcing
-        Rq = self.linear_matrix(omega)
-        Rq += self._kstiff * self.force_jacobian_from_stiffness(g)
+        spec = np.fft.rfft(np.stack((f, g)), axis=1)  # one FFT call for force and stiffness
+        R = self._linear_part(q, w) + self._kstiff * basis.from_complex(spec[0, : H + 1] / basis.samples) - self.forcing
+        Rq = self._jacobian_from_spectrum(spec[1])
+        Rq *= self._kstiff
+        # Add the linear (inertia, damping) blocks on their diagonals.
+        i = self._diag
+        kw = basis.k * w
+        Rq[i, i] -= kw**2
+        Rq[i + H, i + H] -= kw**2
+        Rq[i, i + H] += self._c * kw
+        Rq[i + H, i] -= self._c * kw
         Rw = self._linear_part_dw(q, w) / self.period
         return R, Rq, Rw
 

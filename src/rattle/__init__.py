@@ -1,0 +1,36 @@
+"""rattle — non-linear frequency response of drivetrain rattle.
+
+Harmonic balance (alternating frequency–time, analytic Jacobians), pseudo-arclength
+continuation in the forcing frequency with self-adjusting steps, Floquet stability and
+bifurcation labels for torsional sub-systems with clearance non-linearities:
+
+    δ'' + (C/I) δ' + (K/I) f(δ) = F_m + Σ_n F_pn cos(n Ω t + φ_n).
+
+>>> import rattle
+>>> model = rattle.reference_case()
+>>> frf = rattle.frequency_response(model, omega=(0.1, 3.0), harmonics=32)
+"""
+
+from __future__ import annotations
+
+from importlib.metadata import PackageNotFoundError, version
+
+from .analysis import frequency_response
+from .continuation import ContinuationOptions
+from .errors import ConfigError, ConvergenceError, RattleError, Status
+from .hb import HBOptions, NewtonOptions
+from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
+from .results import FrequencyResponse, LinearResponse, SpecialPoint, linear_frequency_response
+
+try:
+    __version__ = version("rattle")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0.1.0"
+
+__all__ = [
+    "__version__",
+    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "reference_case", "backlash_case",
+    "frequency_response", "FrequencyResponse", "SpecialPoint", "LinearResponse", "linear_frequency_response",
+    "HBOptions", "NewtonOptions", "ContinuationOptions",
+    "Status", "RattleError", "ConfigError", "ConvergenceError",
+]

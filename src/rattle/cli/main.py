@@ -1,0 +1,343 @@
+"""The ``rattle`` command line (SPEC §3): a thin layer over the library.
+
+Exit status: 0 success, 2 bad input (configuration, options, output path), 1 a numerical
+failure that could not be recovered. Errors are one line on stderr, ``rattle: error: …``.
+
+Every input is validated before the solver is imported, and nothing is created in the output
+directory until there is something to write; every file is written atomically.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import os
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ConfigError, ConvergenceError, RattleError
+from ..io import (
+    AnalysisSettings,
+    atomic_path,
+    load_config,
+    model_to_toml_dict,
+    rattle_version,
+    rename_keys,
+    write_metadata,
+)
+from ..model import Model
+
+__all__ = ["cli", "main", "EXIT_OK", "EXIT_NUMERICAL", "EXIT_BAD_INPUT", "DEFAULT_OUTPUT"]
+
+EXIT_OK = 0
+EXIT_NUMERICAL = 1
+EXIT_BAD_INPUT = 2
+#: Output directory when ``-o`` is not given.
+DEFAULT_OUTPUT = "rattle-out"
+
+_NoArgsIsHelpError: Any = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
+
+def _error(message: str) -> None:
+    click.echo(f"rattle: error: {message}", err=True)
+
+
+def _warning(message: str) -> None:
+    click.echo(f"rattle: warning: {message}", err=True)
+
+
+class RattleGroup(click.Group):
+    """A click group that turns every failure into one ``rattle: error: …`` line and an exit status.
+
+    Works the same under ``main()`` (console script, ``python -m rattle``) and under
+    ``click.testing.CliRunner``, both of which call :meth:`main`.
+    """
+
+    def main(  # type: ignore[override]
+        self,
+        args: Sequence[str] | None = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        **extra: Any,
+    ) -> Any:
+        code = self._run(args, prog_name, complete_var, **extra)
+        if standalone_mode:
+            sys.exit(code)
+        return code
+
+    def _run(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None, **extra: Any) -> int:
+        try:
+            rv = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except _NoArgsIsHelpError as exc:  # bare `rattle`: show the help, as click does
+            exc.show()
+            return int(exc.exit_code)
+        except click.UsageError as exc:
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            _error(exc.format_message() + hint)
+            return int(exc.exit_code)
+        except click.ClickException as exc:
+            _error(exc.format_message())
+            return int(exc.exit_code)
+        except click.Abort:
+            _error("aborted")
+            return EXIT_NUMERICAL
+        except ConfigError as exc:
+            _error(str(exc))
+            return EXIT_BAD_INPUT
+        except ConvergenceError as exc:
+            _error(f"numerical failure: {exc}")
+            return EXIT_NUMERICAL
+        except RattleError as exc:
+            _error(str(exc))
+            return EXIT_NUMERICAL
+        return rv if isinstance(rv, int) else EXIT_OK
+
+
+def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    if value and not ctx.resilient_parsing:
+        click.echo(f"rattle {rattle_version()}")
+        ctx.exit(EXIT_OK)
+
+
+@click.group(cls=RattleGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+              help="Show the version and exit.")
+@click.option("-v", "--verbose", is_flag=True, help="Report progress on stderr.")
+def cli(verbose: bool) -> None:
+    """Non-linear frequency response of drivetrain rattle (harmonic balance + continuation).
+
+    Exit status: 0 success, 2 bad input, 1 numerical failure.
+    """
+    if verbose:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("rattle: %(message)s"))
+        logger = logging.getLogger("rattle")
+        logger.addHandler(handler)
+        logger.setLevel(logging.INFO)
+
+
+_output_option = click.option(
+    "-o", "--output", "output", type=click.Path(path_type=Path), default=DEFAULT_OUTPUT,
+    show_default=True, help="Directory for the output files (created if needed).",
+)
+
+
+# --------------------------------------------------------------------------------------------
+# Input checks (all before any computation)
+# --------------------------------------------------------------------------------------------
+def override_analysis(base: AnalysisSettings, **options: Any) -> AnalysisSettings:
+    """``base`` with the command-line options that were given (not None) replacing its fields.
+
+    Parameters
+    ----------
+    base : AnalysisSettings
+        Settings from the configuration file.
+    **options
+        ``harmonics``, ``omega_min``, ``omega_max``; None means "not given".
+
+    Returns
+    -------
+    AnalysisSettings
+
+    Raises
+    ------
+    ConfigError
+        If the combination breaks a rule; the message names the option (``--omega-min``) or the
+        file key (``analysis.omega[1]``) each value came from.
+    """
+    given = {name: value for name, value in options.items() if value is not None}
+    names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics"}
+    names.update({name: "--" + name.replace("_", "-") for name in given})
+    try:
+        return dataclasses.replace(base, **given)
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(rename_keys(str(exc), names)) from exc
+
+
+def check_output_dir(output: Path) -> None:
+    """Refuse an output path that cannot become a writable directory, without creating anything.
+
+    Raises
+    ------
+    ConfigError
+        If ``output`` is an existing file, lies below a file, or its nearest existing ancestor
+        is not writable.
+    """
+    if output.exists() and not output.is_dir():
+        raise ConfigError(
+            f"`--output` must be a directory, got {str(output)!r}, which is an existing file; "
+            "choose another path"
+        )
+    ancestor = output
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise ConfigError(
+            f"`--output` {str(output)!r} cannot be created because {str(ancestor)!r} is a file, "
+            "not a directory; choose another path"
+        )
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise ConfigError(
+            f"`--output` {str(output)!r}: no permission to write in {str(ancestor)!r}; "
+            "choose a writable directory"
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# Running and writing
+# --------------------------------------------------------------------------------------------
+def _save_plot(result: Any, path: Path) -> bool:
+    """Draw ``result`` with its ``.plot()`` and save it atomically as PNG; False without matplotlib."""
+    try:
+        import matplotlib
+    except ImportError:
+        _warning(f"matplotlib is not installed, so {path.name} was not written (pip install matplotlib)")
+        return False
+    matplotlib.use("Agg")  # never open a window from the command line
+    import matplotlib.pyplot as plt
+
+    fig, _ax = result.plot()
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=150)
+    finally:
+        plt.close(fig)
+    return True
+
+
+def _write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: float) -> list[str]:
+    """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output``; return the names written.
+
+    The data files come first so that they exist even if drawing the figure fails.
+    """
+    written: list[str] = []
+    try:
+        output.mkdir(parents=True, exist_ok=True)
+        result.to_csv(output / "frf.csv")
+        written.append("frf.csv")
+        meta = dict(result.metadata())
+        timings = dict(meta.pop("timings", None) or {})
+        timings["cli_wall_time"] = time.perf_counter() - t_start
+        write_metadata(output / "frf.json", **{**meta, **sections, "timings": timings})
+        written.append("frf.json")
+        if _save_plot(result, output / "frf.png"):
+            written.append("frf.png")
+    except OSError as exc:
+        where = f"{exc.filename}" if exc.filename else str(output)
+        raise click.ClickException(f"cannot write {where}: {exc.strerror or exc}") from exc
+    return written
+
+
+def run_frf(model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any]) -> None:
+    """Compute the frequency response, write the three files and print the summary.
+
+    Parameters
+    ----------
+    model : Model
+    analysis : AnalysisSettings
+        Frequency range and harmonics.
+    output : pathlib.Path
+        Output directory (checked with :func:`check_output_dir` beforehand).
+    sections : dict
+        Extra metadata sections for ``frf.json`` (``config``, ``command``, …).
+
+    Raises
+    ------
+    ConvergenceError
+        When the continuation failed; the points computed before the failure are written first
+        when the error carries them in ``.partial``.
+    """
+    t_start = time.perf_counter()
+    from ..analysis import frequency_response  # only now: all input has been validated
+
+    try:
+        result = frequency_response(model, omega=analysis.omega, harmonics=analysis.harmonics, throw=True)
+    except ConvergenceError as exc:
+        partial = getattr(exc, "partial", None)
+        if partial is None:
+            raise
+        written = _write_frf(partial, output, sections, t_start)
+        click.echo(partial.summary())
+        raise ConvergenceError(
+            f"{exc}; the points computed before the failure were written to "
+            f"{', '.join(str(output / name) for name in written)}",
+            partial=partial,
+        ) from exc
+    written = _write_frf(result, output, sections, t_start)
+    click.echo(result.summary())
+    click.echo(f"wrote {', '.join(written)} to {output}")
+
+
+# --------------------------------------------------------------------------------------------
+# Commands
+# --------------------------------------------------------------------------------------------
+@cli.command("frf", short_help="Frequency response of the model in a configuration file.")
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--harmonics", type=int, default=None, metavar="H",
+              help="Harmonics kept in the harmonic balance (>= 1); overrides analysis.harmonics.")
+@click.option("--omega-min", type=float, default=None, metavar="X",
+              help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega[0].")
+@click.option("--omega-max", type=float, default=None, metavar="Y",
+              help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].")
+def frf_command(
+    config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None
+) -> None:
+    """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT."""
+    run_config = load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    check_output_dir(output)
+    options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max}
+    run_frf(
+        run_config.model, analysis, output,
+        {
+            "command": "frf",
+            "config_file": os.fspath(config),
+            "config": run_config.source,
+            "options": {k: v for k, v in options.items() if v is not None},
+            "analysis": analysis.to_dict(),
+        },
+    )
+
+
+@cli.command("demo", short_help="The paper's reference case end to end.")
+@_output_option
+def demo_command(output: Path) -> None:
+    """The paper's reference case end to end (clutch, Ω = 0.1 … 3.0 rad/s, 32 harmonics)."""
+    from ..model import reference_case
+
+    check_output_dir(output)
+    model = reference_case()
+    analysis = AnalysisSettings(omega_min=0.1, omega_max=3.0, harmonics=32)
+    click.echo(
+        "rattle demo: the paper's reference case — clutch alpha = 0.25, b = 10 deg, zeta = 0.025, "
+        f"F_m = 0.05, F_p1 = 0.03; Omega = {analysis.omega_min} … {analysis.omega_max} rad/s, "
+        f"H = {analysis.harmonics}"
+    )
+    run_frf(
+        model, analysis, output,
+        {"command": "demo", "config": model_to_toml_dict(model, analysis), "analysis": analysis.to_dict()},
+    )
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Console entry point ``rattle`` (and ``python -m rattle``); exits with status 0, 1 or 2.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments without the program name; default ``sys.argv[1:]``.
+    """
+    cli.main(args=list(argv) if argv is not None else None, prog_name="rattle")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

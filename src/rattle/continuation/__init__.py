@@ -1,0 +1,6 @@
+"""Pseudo-arclength continuation in the forcing frequency with self-adjusting steps."""
+
+from ._options import ContinuationOptions
+from ._stepper import BranchPoint, ContinuationStepper
+
+__all__ = ["ContinuationOptions", "ContinuationStepper", "BranchPoint"]

@@ -1,0 +1,259 @@
+"""Pseudo-arclength continuation of R(q, Ω) = 0 in the forcing frequency Ω.
+
+Keller's method in scaled variables y = (q / L, Ω / ω_s):
+
+* predictor along the unit tangent t (the null vector of [∂R/∂q L, ∂R/∂Ω ω_s]):
+  y_pred = y_i + Δs t;
+* corrector: Newton on the bordered system  R(y) = 0,  t·(y − y_pred) = 0;
+* step control: Δs is scaled by the ratio of the target to the actual number of Newton
+  iterations and by the ratio of the target to the actual turn of the tangent (angle between
+  successive tangents); a step whose corrector fails, or whose tangent turns by more than the
+  allowed angle, is rejected and retried with half the step, down to the minimum step.
+
+The stepper yields one accepted point per :meth:`ContinuationStepper.step`; the run ends when the
+branch leaves the frequency range (the last point is placed exactly on the bound), or with a
+:class:`~rattle.errors.Status` saying where and why it stopped.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+
+_gesv = scipy.linalg.lapack.dgesv
+
+from .._typing import FloatArray
+from ..errors import Status
+from ..hb import HarmonicBalance, NewtonOptions, solve_harmonic_balance
+from ._options import ContinuationOptions
+
+
+@dataclass(frozen=True, slots=True)
+class BranchPoint:
+    """An accepted solution: coefficients ``q``, frequency ``omega``, Newton ``iterations``,
+    scaled ``residual``, unit ``tangent`` (scaled variables) and the ``step`` that reached it."""
+
+    q: FloatArray
+    omega: float
+    iterations: int
+    residual: float
+    tangent: FloatArray
+    step: float
+
+
+@dataclass(slots=True)
+class _Corrected:
+    y: FloatArray
+    iterations: int
+    residual: float
+    Rq: FloatArray
+    Rw: FloatArray
+
+
+@dataclass(slots=True)
+class ContinuationStepper:
+    """Step-by-step pseudo-arclength continuation (the low-level API; see ``continue_branch``).
+
+    ``hb`` the discretised problem, ``q0`` a solution (or good guess) at ``omega0``, which must be
+    one end of ``omega_range``; the branch is followed into the range.
+    """
+
+    hb: HarmonicBalance
+    q0: FloatArray
+    omega0: float
+    omega_range: tuple[float, float]
+    options: ContinuationOptions = field(default_factory=ContinuationOptions)
+    newton: NewtonOptions = field(default_factory=NewtonOptions)
+    status: Status | None = None
+    message: str = ""
+    points: list[BranchPoint] = field(default_factory=list)
+    rejected: int = 0
+    _y: FloatArray = field(init=False, repr=False)
+    _t: FloatArray = field(init=False, repr=False)
+    _ds: float = field(init=False, repr=False)
+    _start_time: float = field(init=False, repr=False)
+    _scale: FloatArray = field(init=False, repr=False)
+    _direction: float = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        lo, hi = self.omega_range
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ValueError(f"`omega_range` must satisfy 0 < min < max, got {self.omega_range!r}")
+        if self.omega0 == lo:
+            self._direction = 1.0
+        elif self.omega0 == hi:
+            self._direction = -1.0
+        else:
+            raise ValueError(f"`omega0` must be one end of `omega_range` {self.omega_range}, got {self.omega0}")
+        self._start_time = time.perf_counter()
+        n = self.hb.size
+        self._scale = np.empty(n + 1)
+        self._scale[:n] = self.hb.length_scale
+        self._scale[n] = self.hb.model.natural_frequency
+        self._ds = self.options.initial_step
+
+    # --- helpers ---------------------------------------------------------------------------
+    def _unscale(self, y: FloatArray) -> tuple[FloatArray, float]:
+        q = y[:-1] * self._scale[:-1]
+        return q, float(y[-1] * self._scale[-1])
+
+    def _bordered_solve(self, Rq: FloatArray, Rw: FloatArray, t: FloatArray, rhs: FloatArray) -> FloatArray | None:
+        """Solve [∂R/∂q L, ∂R/∂Ω ω_s; tᵀ] x = rhs (LAPACK gesv; None if singular)."""
+        n = Rq.shape[0]
+        A = np.empty((n + 1, n + 1), order="F")
+        np.multiply(Rq, self._scale[0], out=A[:n, :n])
+        np.multiply(Rw, self._scale[n], out=A[:n, n])
+        A[n] = t
+        _, _, x, info = _gesv(A, rhs, overwrite_a=1, overwrite_b=0)
+        if info != 0 or not np.all(np.isfinite(x)):
+            return None
+        return x
+
+    def _tangent(self, Rq: FloatArray, Rw: FloatArray, t_prev: FloatArray) -> FloatArray | None:
+        rhs = np.zeros(Rq.shape[0] + 1)
+        rhs[-1] = 1.0
+        tau = self._bordered_solve(Rq, Rw, t_prev, rhs)
+        return None if tau is None else tau / np.linalg.norm(tau)
+
+    def _correct(self, y_pred: FloatArray, t: FloatArray) -> _Corrected | None:
+        hb, opts = self.hb, self.newton
+        Fs = hb.force_scale
+        y = y_pred.copy()
+        step_norm = np.inf
+        n = hb.size
+        rhs = np.empty(n + 1)
+        first_res = None
+        for it in range(opts.max_iterations + 1):
+            q, w = self._unscale(y)
+            if w <= 0:
+                return None
+            R, Rq, Rw = hb.residual_jacobian(q, w)
+            res = float(np.max(np.abs(R))) / Fs
+            if not math.isfinite(res):
+                return None
+            if first_res is None:
+                first_res = res
+            elif res > 1e4 * max(first_res, 1e-3):
+                return None  # diverging
+            if it > 0 and res <= opts.residual_tol and step_norm <= opts.step_tol:
+                return _Corrected(y, it, res, Rq, Rw)
+            if it == opts.max_iterations:
+                return None
+            rhs[:n] = -R
+            rhs[n] = -float(t @ (y - y_pred))
+            dy = self._bordered_solve(Rq, Rw, t, rhs)
+            if dy is None:
+                return None
+            y += dy
+            step_norm = float(np.max(np.abs(dy)))
+        return None  # pragma: no cover
+
+    def _finish(self, status: Status, message: str = "") -> None:
+        self.status = status
+        self.message = message or status.message
+
+    # --- public ----------------------------------------------------------------------------
+    def start(self) -> BranchPoint | None:
+        """Converge the first point at ``omega0`` and compute its tangent."""
+        res = solve_harmonic_balance(self.hb, self.q0, self.omega0, self.newton)
+        if not res.converged:
+            self._finish(
+                Status.START_FAILED,
+                f"Newton did not converge at Ω = {self.omega0:g} ({res.message}, scaled residual {res.residual:.3g})",
+            )
+            return None
+        R, Rq, Rw = self.hb.residual_jacobian(res.q, self.omega0)
+        e = np.zeros(self.hb.size + 1)
+        e[-1] = self._direction
+        t0 = self._tangent(Rq, Rw, e)
+        if t0 is None:
+            self._finish(Status.START_FAILED, f"singular Jacobian at the start Ω = {self.omega0:g}")
+            return None
+        self._t = t0
+        self._y = np.concatenate((res.q, [self.omega0])) / self._scale
+        pt = BranchPoint(res.q, self.omega0, res.iterations, res.residual, self._t.copy(), 0.0)
+        self.points.append(pt)
+        return pt
+
+    def step(self) -> BranchPoint | None:
+        """Advance by one accepted point; None once the run has ended (see ``status``)."""
+        if self.status is not None:
+            return None
+        if not self.points:
+            return self.start()
+        opts = self.options
+        if len(self.points) >= opts.max_points:
+            self._finish(Status.MAX_STEPS, f"{Status.MAX_STEPS.message} ({opts.max_points} points, last Ω = {self.points[-1].omega:.6g})")
+            return None
+        if opts.max_time is not None and time.perf_counter() - self._start_time > opts.max_time:
+            self._finish(Status.MAX_TIME, f"{Status.MAX_TIME.message} ({opts.max_time} s, last Ω = {self.points[-1].omega:.6g})")
+            return None
+        lo, hi = self.omega_range
+        while True:
+            ds = self._ds
+            y_pred = self._y + ds * self._t
+            corr = self._correct(y_pred, self._t)
+            t_new = None if corr is None else self._tangent(corr.Rq, corr.Rw, self._t)
+            if corr is not None and t_new is not None:
+                turn = math.acos(min(1.0, float(t_new @ self._t)))
+                if turn <= opts.max_turn or ds <= opts.min_step * 1.0000001:
+                    break
+            self.rejected += 1
+            if ds <= opts.min_step * 1.0000001:
+                q, w = self._unscale(self._y)
+                self._finish(
+                    Status.STEP_TOO_SMALL,
+                    f"{Status.STEP_TOO_SMALL.message}: Newton failed to converge beyond Ω = {w:.6g} "
+                    f"with step {ds:.3g} (after {len(self.points)} points)",
+                )
+                return None
+            self._ds = max(opts.min_step, 0.5 * ds)
+        q, w = self._unscale(corr.y)
+        # Leaving the range: place the last point exactly on the bound and end.
+        if w > hi or w < lo:
+            bound = hi if w > hi else lo
+            _, w_prev = self._unscale(self._y)
+            frac = (bound - w_prev) / (w - w_prev)
+            y_guess = self._y + frac * (corr.y - self._y)
+            end = solve_harmonic_balance(self.hb, self._unscale(y_guess)[0], bound, self.newton)
+            start_side = (bound == lo) == (self._direction > 0)
+            status = Status.RETURNED if start_side else Status.SUCCESS
+            if end.converged:
+                R, Rq, Rw = self.hb.residual_jacobian(end.q, bound)
+                t_end = self._tangent(Rq, Rw, self._t)
+                t_end = t_new if t_end is None else t_end
+                pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_end, ds * frac)
+                self.points.append(pt)
+                self._finish(status)
+                return pt
+            # Keep the point just outside rather than nothing.
+            pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds)
+            self.points.append(pt)
+            self._finish(status)
+            return pt
+        pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds)
+        self.points.append(pt)
+        self._y, self._t = corr.y, t_new
+        # Step control from the iteration count and the tangent's turn.
+        f_it = opts.target_iterations / max(corr.iterations, 1)
+        f_turn = opts.target_turn / max(turn, 1e-12)
+        factor = min(max(min(f_it, f_turn), 0.5), 2.0)
+        self._ds = min(opts.max_step, max(opts.min_step, ds * factor))
+        return pt
+
+    def run(self) -> list[BranchPoint]:
+        """Step until the run ends; returns all accepted points."""
+        while self.step() is not None:
+            pass
+        return self.points
+
+    @property
+    def elapsed(self) -> float:
+        return time.perf_counter() - self._start_time
+
+
+__all__ = ["BranchPoint", "ContinuationStepper"]

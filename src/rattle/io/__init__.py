@@ -1,0 +1,31 @@
+"""Input and output: the configuration file, CSV tables, run metadata and atomic writes.
+
+The numerical core never touches files; everything that reads or writes lives here.
+"""
+
+from ._atomic import atomic_path, atomic_write_bytes, atomic_write_text
+from ._config import (
+    DEFAULT_HARMONICS,
+    DEFAULT_OMEGA,
+    AnalysisSettings,
+    RunConfig,
+    config_from_dict,
+    dumps_toml,
+    load_config,
+    model_to_toml_dict,
+    rename_keys,
+)
+from ._csv import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, format_csv, read_csv, write_csv
+from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
+
+__all__ = [
+    # configuration
+    "load_config", "config_from_dict", "RunConfig", "AnalysisSettings",
+    "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "model_to_toml_dict", "dumps_toml", "rename_keys",
+    # csv
+    "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS", "write_csv", "read_csv", "format_csv",
+    # metadata
+    "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
+    # atomic writes
+    "atomic_write_text", "atomic_write_bytes", "atomic_path",
+]

@@ -1,0 +1,620 @@
+"""Strict reading of the SPEC §2 configuration file into a :class:`RunConfig`.
+
+Schema (every other key is refused)::
+
+    [model]              inertia, damping, stiffness      numbers, required
+    [model.elastic]      type                             "linear" | "backlash" | "clutch" | "piecewise"
+                         + the parameters of that type    backlash: b; clutch: alpha, b;
+                                                          piecewise: breakpoints, slopes
+    [excitation]         mean                             number, required
+                         amplitudes                       array of numbers, required, not empty
+                         phases                           array of numbers, optional (default 0)
+    [analysis]           omega                            [min, max] in rad/s, optional (default [0.1, 3.0])
+                         harmonics                        integer >= 1, optional (default 32)
+
+The ``[analysis]`` table holds numerical settings, not physics, so it may be left out: the
+defaults are the SPEC §2 example values and end up in the run metadata. Every physical
+quantity is required; nothing physical is defaulted.
+
+The value rules (positive inertia, increasing breakpoints, 0 < alpha < 1, …) live in the model
+dataclasses, the single source of truth; this module checks only what they cannot see (the
+table structure, unknown and missing keys, the TOML type of each value, the ``[analysis]``
+table) and re-raises their errors as :class:`~rattle.errors.ConfigError` with the full key.
+Every message names the key in backticks, shows the value received, states the rule and says
+the fix.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import datetime as _dt
+import difflib
+import json
+import math
+import os
+import re
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..model import ELASTIC_LAWS, AbstractElastic, Excitation, Model
+from ..model._elastic import _check_real
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+__all__ = [
+    "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "AnalysisSettings", "RunConfig",
+    "load_config", "config_from_dict", "model_to_toml_dict", "dumps_toml", "rename_keys",
+]
+
+#: Default forcing-frequency range ``analysis.omega`` (rad/s): the SPEC §2 example.
+DEFAULT_OMEGA: tuple[float, float] = (0.1, 3.0)
+#: Default number of harmonics ``analysis.harmonics``: the SPEC §2 example.
+DEFAULT_HARMONICS: int = 32
+
+_T = TypeVar("_T")
+
+
+# --------------------------------------------------------------------------------------------
+# Settings and the parsed configuration
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True, slots=True, kw_only=True)
+class AnalysisSettings:
+    """Frequency range and harmonic truncation of a frequency-response run.
+
+    Parameters
+    ----------
+    omega_min, omega_max : float
+        Forcing-frequency range Ω (rad/s), 0 < ``omega_min`` < ``omega_max``.
+    harmonics : int
+        Harmonics kept in the harmonic balance, >= 1.
+    """
+
+    omega_min: float = DEFAULT_OMEGA[0]
+    omega_max: float = DEFAULT_OMEGA[1]
+    harmonics: int = DEFAULT_HARMONICS
+
+    def __post_init__(self) -> None:
+        omega_min = _check_real("omega_min", self.omega_min)
+        omega_max = _check_real("omega_max", self.omega_max)
+        if omega_min <= 0:
+            raise ValueError(
+                f"`omega_min` must be > 0 rad/s (a forcing frequency), got {omega_min!r}; "
+                "start the range at a small positive frequency such as 0.1"
+            )
+        if not omega_min < omega_max:
+            raise ValueError(
+                f"`omega_min` must be < `omega_max`, got `omega_min` = {omega_min!r} and "
+                f"`omega_max` = {omega_max!r}: the frequency range is empty; "
+                "give the lower frequency first and make the upper one larger"
+            )
+        harmonics = self.harmonics
+        if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)):
+            raise TypeError(
+                f"`harmonics` must be an integer >= 1, got {harmonics!r} ({type(harmonics).__name__}); "
+                "write a whole number such as 32"
+            )
+        if harmonics < 1:
+            raise ValueError(f"`harmonics` must be an integer >= 1, got {int(harmonics)!r}; use e.g. 32")
+        object.__setattr__(self, "omega_min", omega_min)
+        object.__setattr__(self, "omega_max", omega_max)
+        object.__setattr__(self, "harmonics", int(harmonics))
+
+    @property
+    def omega(self) -> tuple[float, float]:
+        """The range ``(omega_min, omega_max)`` in rad/s."""
+        return (self.omega_min, self.omega_max)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``[analysis]`` table: ``{"omega": [min, max], "harmonics": h}``."""
+        return {"omega": [self.omega_min, self.omega_max], "harmonics": self.harmonics}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RunConfig:
+    """A validated configuration file.
+
+    Attributes
+    ----------
+    model : Model
+        The ``[model]`` and ``[excitation]`` tables.
+    analysis : AnalysisSettings
+        The ``[analysis]`` table, defaults filled in.
+    source : dict
+        The parsed TOML as read (a deep copy), for provenance in the run metadata.
+    source_name : str
+        Where it came from (the file path, or ``"<dict>"``), used in messages.
+    """
+
+    model: Model
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
+    source: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    source_name: str = field(default="<dict>", compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The resolved configuration (defaults filled in) as a TOML-shaped dict."""
+        return model_to_toml_dict(self.model, self.analysis)
+
+
+# --------------------------------------------------------------------------------------------
+# Schema
+# --------------------------------------------------------------------------------------------
+_TOP_KEYS = ("model", "excitation", "analysis")
+_MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
+_EXCITATION_KEYS = ("mean", "amplitudes", "phases")
+_ANALYSIS_KEYS = ("omega", "harmonics")
+
+# Example lines for "add e.g. ..." hints: the SPEC §2 example file.
+_EXAMPLES = {
+    "model": "[model] with inertia = 1.0, damping = 0.05, stiffness = 1.0",
+    "model.inertia": "inertia = 1.0",
+    "model.damping": "damping = 0.05",
+    "model.stiffness": "stiffness = 1.0",
+    "model.elastic": '[model.elastic] with type = "clutch", alpha = 0.25, b = 0.174533',
+    "model.elastic.type": 'type = "clutch"',
+    "model.elastic.alpha": "alpha = 0.25",
+    "model.elastic.b": "b = 0.174533",
+    "model.elastic.breakpoints": "breakpoints = [-0.3, -0.1, 0.05, 0.2]",
+    "model.elastic.slopes": "slopes = [1.0, 0.3, 0.05, 0.3, 1.0]",
+    "excitation": "[excitation] with mean = 0.05, amplitudes = [0.03]",
+    "excitation.mean": "mean = 0.05",
+    "excitation.amplitudes": "amplitudes = [0.03]",
+    "excitation.phases": "phases = [0.0]",
+    "analysis": "[analysis] with omega = [0.1, 3.0], harmonics = 32",
+    "analysis.omega": "omega = [0.1, 3.0]",
+    "analysis.harmonics": "harmonics = 32",
+}
+
+
+def _example(key: str) -> str:
+    return _EXAMPLES.get(key, f"{key.rsplit('.', 1)[-1]} = ...")
+
+
+def _law_params(law: type[AbstractElastic]) -> dict[str, tuple[str, bool]]:
+    """Constructor parameters of an elastic law: name -> (kind "number"/"array", required)."""
+    params = {}
+    for f in dataclasses.fields(law):  # type: ignore[arg-type]
+        if not f.init:
+            continue
+        kind = "array" if str(f.type).startswith(("tuple", "list", "Sequence")) else "number"
+        required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        params[f.name] = (kind, required)
+    return params
+
+
+# --------------------------------------------------------------------------------------------
+# Message helpers
+# --------------------------------------------------------------------------------------------
+def _show(value: Any) -> str:
+    """A value as it would be written in TOML."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, Mapping):
+        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_show(v) for v in value) + "]"
+    return str(value)
+
+
+def _kind(value: Any) -> str:
+    """The TOML type name of a value, with its article."""
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, np.integer)):
+        return "an integer"
+    if isinstance(value, (float, np.floating)):
+        return "a float"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, Mapping):
+        return "a table"
+    if isinstance(value, (list, tuple)):
+        return "an array"
+    if isinstance(value, (_dt.datetime, _dt.date, _dt.time)):
+        return "a date/time"
+    return f"a {type(value).__name__}"
+
+
+def _join(names: Sequence[str]) -> str:
+    return ", ".join(names) if names else "(none)"
+
+
+def _did_you_mean(word: str, choices: Sequence[str]) -> str:
+    lowered = {c.lower(): c for c in choices}
+    match = difflib.get_close_matches(word.lower(), list(lowered), n=1, cutoff=0.6)
+    return f"did you mean `{lowered[match[0]]}`? " if match else ""
+
+
+_BACKTICKED = re.compile(r"`([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)`")
+
+
+def rename_keys(message: str, names: Mapping[str, str]) -> str:
+    """Replace backticked field names in ``message`` by the names the user wrote.
+
+    ```inertia``` becomes ```model.inertia```, ```slopes[2]``` becomes
+    ```model.elastic.slopes[2]```: the dataclasses name their fields, the configuration
+    file and the command line name keys and options.
+
+    Parameters
+    ----------
+    message : str
+        An error message from a dataclass ``__post_init__``.
+    names : mapping of str to str
+        Field name -> user-facing key or option.
+
+    Returns
+    -------
+    str
+        The message with every known backticked name replaced.
+    """
+
+    def repl(m: re.Match[str]) -> str:
+        name, index = m.group(1), m.group(2)
+        return f"`{names[name]}{index}`" if name in names else m.group(0)
+
+    return _BACKTICKED.sub(repl, message)
+
+
+class _Checker:
+    """Validation of one configuration, with its source name for the messages."""
+
+    def __init__(self, source_name: str) -> None:
+        self.source_name = source_name
+
+    def error(self, message: str) -> ConfigError:
+        return ConfigError(f"{self.source_name}: {message}")
+
+    # --- structure ---------------------------------------------------------------------------
+    def table(self, parent: Mapping[str, Any], key: str, full: str) -> Mapping[str, Any]:
+        value = parent[key]
+        if not isinstance(value, Mapping):
+            raise self.error(
+                f"`{full}` must be a table, got {_show(value)} ({_kind(value)}); "
+                f"write it as a [{full}] section, e.g. {_example(full)}"
+            )
+        return value
+
+    def keys(
+        self,
+        table: Mapping[str, Any],
+        where: str,
+        allowed: Sequence[str],
+        required: Sequence[str],
+    ) -> None:
+        """Refuse unknown keys, then missing required ones."""
+        prefix = f"{where}." if where else ""
+        place = f"[{where}]" if where else "the top level"
+        for key in table:
+            if key not in allowed:
+                raise self.error(
+                    f"`{prefix}{key}` is not a known key: {place} allows only "
+                    f"{_join(allowed)}; {_did_you_mean(str(key), allowed)}"
+                    "remove it or correct its spelling"
+                )
+        for key in required:
+            if key not in table:
+                raise self.error(
+                    f"`{prefix}{key}` is missing: {place} requires {_join(required)}; "
+                    f"add e.g. {_example(prefix + key)}"
+                )
+
+    # --- TOML value types ----------------------------------------------------------------------
+    def number(self, value: Any, key: str) -> None:
+        """Check that ``value`` is a TOML number (not a boolean, string, array or table)."""
+        if isinstance(value, bool):
+            fix = "booleans are not numbers"
+        elif isinstance(value, (int, float, np.integer, np.floating)):
+            return  # finiteness and range are the dataclasses' rules
+        elif isinstance(value, str):
+            fix = "write the number without quotes"
+        elif isinstance(value, (list, tuple)):
+            fix = "give a single number, not an array"
+        else:
+            fix = "give a number"
+        raise self.error(
+            f"`{key}` must be a number, got {_show(value)} ({_kind(value)}); {fix}, "
+            f"e.g. {_example(key.split('[')[0])}"
+        )
+
+    def array(self, value: Any, key: str) -> None:
+        """Check that ``value`` is a TOML array of numbers."""
+        if not isinstance(value, (list, tuple)):
+            raise self.error(
+                f"`{key}` must be an array of numbers, got {_show(value)} ({_kind(value)}); "
+                f"write it in brackets, e.g. {_example(key)}"
+            )
+        for i, item in enumerate(value):
+            self.number(item, f"{key}[{i}]")
+
+    def integer(self, value: Any, key: str) -> None:
+        """Check that ``value`` is a TOML integer."""
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise self.error(
+                f"`{key}` must be an integer, got {_show(value)} ({_kind(value)}); "
+                f"write a whole number without quotes or decimal point, e.g. {_example(key)}"
+            )
+
+    # --- construction --------------------------------------------------------------------------
+    def build(self, factory: Callable[..., _T], names: Mapping[str, str], /, **kwargs: Any) -> _T:
+        """Call ``factory(**kwargs)``; re-raise its ValueError/TypeError with the full key names."""
+        try:
+            return factory(**kwargs)
+        except (ValueError, TypeError) as exc:
+            message = str(exc)
+            renamed = rename_keys(message, names)
+            if renamed == message:  # no field named: say which table it came from
+                renamed = f"`{next(iter(names.values())).rsplit('.', 1)[0]}`: {message}"
+            raise self.error(renamed) from exc
+
+
+# --------------------------------------------------------------------------------------------
+# Readers
+# --------------------------------------------------------------------------------------------
+def load_config(path: str | os.PathLike[str]) -> RunConfig:
+    """Read and validate a SPEC §2 configuration file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file.
+
+    Returns
+    -------
+    RunConfig
+        The model, the analysis settings (defaults filled in) and the parsed source.
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be read, is not TOML, or breaks a rule of the schema (see the module
+        docstring); the message names the key, the value, the rule and the fix.
+    """
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ConfigError(
+            f"configuration file {name!r} does not exist; check the path "
+            f"(relative paths start at {os.getcwd()!r})"
+        ) from None
+    except IsADirectoryError:
+        raise ConfigError(f"configuration file {name!r} is a directory; give the path of a .toml file") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"configuration file {name!r} is not UTF-8 text ({exc.reason} at byte {exc.start}); "
+            "save it with UTF-8 encoding"
+        ) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{name} is not valid TOML: {exc}; correct the syntax there") from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read configuration file {name!r}: {exc.strerror or exc}") from None
+    return config_from_dict(data, source_name=name)
+
+
+def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> RunConfig:
+    """Validate an already parsed configuration (the dict ``tomllib.load`` returns).
+
+    Parameters
+    ----------
+    data : mapping
+        Tables ``model`` (with ``elastic``), ``excitation`` and optionally ``analysis``.
+    source_name : str, default "<dict>"
+        Shown at the start of error messages.
+
+    Returns
+    -------
+    RunConfig
+
+    Raises
+    ------
+    ConfigError
+        On the first broken rule (structure first, then values).
+    """
+    check = _Checker(source_name)
+    if not isinstance(data, Mapping):
+        raise check.error(f"the configuration must be a table of tables, got {_kind(data)}")
+
+    # Structure of every table first, so that a misspelt key is reported before its values.
+    check.keys(data, "", _TOP_KEYS, required=("model", "excitation"))
+    model_t = check.table(data, "model", "model")
+    check.keys(model_t, "model", _MODEL_KEYS, required=_MODEL_KEYS)
+    elastic_t = check.table(model_t, "elastic", "model.elastic")
+    law, law_params = _elastic_structure(check, elastic_t)
+    excitation_t = check.table(data, "excitation", "excitation")
+    check.keys(excitation_t, "excitation", _EXCITATION_KEYS, required=("mean", "amplitudes"))
+    analysis_t: Mapping[str, Any] = {}
+    if "analysis" in data:
+        analysis_t = check.table(data, "analysis", "analysis")
+        check.keys(analysis_t, "analysis", _ANALYSIS_KEYS, required=())
+
+    # TOML value types.
+    for key in ("inertia", "damping", "stiffness"):
+        check.number(model_t[key], f"model.{key}")
+    for key, (kind, _) in law_params.items():
+        if key in elastic_t:
+            (check.array if kind == "array" else check.number)(elastic_t[key], f"model.elastic.{key}")
+    check.number(excitation_t["mean"], "excitation.mean")
+    check.array(excitation_t["amplitudes"], "excitation.amplitudes")
+    if "phases" in excitation_t:
+        check.array(excitation_t["phases"], "excitation.phases")
+
+    # Values: the dataclasses' own rules.
+    elastic = check.build(
+        law, {k: f"model.elastic.{k}" for k in law_params} or {"type": "model.elastic.type"},
+        **{k: elastic_t[k] for k in law_params if k in elastic_t},
+    )
+    excitation = check.build(
+        Excitation, {k: f"excitation.{k}" for k in _EXCITATION_KEYS},
+        **{k: excitation_t[k] for k in _EXCITATION_KEYS if k in excitation_t},
+    )
+    model = check.build(
+        Model, {k: f"model.{k}" for k in (*_MODEL_KEYS, "excitation")},
+        inertia=model_t["inertia"], damping=model_t["damping"], stiffness=model_t["stiffness"],
+        elastic=elastic, excitation=excitation,
+    )
+    analysis = _analysis(check, analysis_t)
+    return RunConfig(model=model, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name)
+
+
+def _elastic_structure(
+    check: _Checker, table: Mapping[str, Any]
+) -> tuple[type[AbstractElastic], dict[str, tuple[str, bool]]]:
+    """Resolve ``model.elastic.type`` through ELASTIC_LAWS and check the keys against its parameters."""
+    allowed_types = list(ELASTIC_LAWS)
+    if "type" not in table:
+        raise check.error(
+            f"`model.elastic.type` is missing: [model.elastic] needs type = one of "
+            f"{_join([json.dumps(t) for t in allowed_types])}; add e.g. {_example('model.elastic.type')}"
+        )
+    name = table["type"]
+    if not isinstance(name, str) or name not in ELASTIC_LAWS:
+        hint = _did_you_mean(name, allowed_types).replace("`", '"') if isinstance(name, str) else ""
+        raise check.error(
+            f"`model.elastic.type` must be one of {_join([json.dumps(t) for t in allowed_types])}, "
+            f"got {_show(name)} ({_kind(name)}); {hint}use one of these names"
+        )
+    law = ELASTIC_LAWS[name]
+    params = _law_params(law)
+    for key in table:
+        if key == "type" or key in params:
+            continue
+        users = [t for t, other in ELASTIC_LAWS.items() if key in _law_params(other)]
+        if users:
+            raise check.error(
+                f"`model.elastic.{key}` does not belong to type = {json.dumps(name)}, whose "
+                f"parameters are: {_join(list(params))}; remove it, or choose a type that uses it "
+                f"({_join([json.dumps(u) for u in users])})"
+            )
+        allowed = ["type", *params]
+        raise check.error(
+            f"`model.elastic.{key}` is not a known key: [model.elastic] with type = "
+            f"{json.dumps(name)} allows only {_join(allowed)}; {_did_you_mean(str(key), allowed)}"
+            "remove it or correct its spelling"
+        )
+    required = [k for k, (_, req) in params.items() if req]
+    for key in required:
+        if key not in table:
+            raise check.error(
+                f"`model.elastic.{key}` is missing: type = {json.dumps(name)} requires "
+                f"{_join(required)}; add e.g. {_example('model.elastic.' + key)}"
+            )
+    return law, params
+
+
+def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
+    omega = table.get("omega", list(DEFAULT_OMEGA))
+    check.array(omega, "analysis.omega")
+    if len(omega) != 2:
+        raise check.error(
+            f"`analysis.omega` must be a list of two numbers [min, max] (rad/s), got {_show(omega)} "
+            f"({len(omega)} numbers); write e.g. {_example('analysis.omega')}"
+        )
+    harmonics = table.get("harmonics", DEFAULT_HARMONICS)
+    check.integer(harmonics, "analysis.harmonics")
+    return check.build(
+        AnalysisSettings,
+        {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics"},
+        omega_min=omega[0], omega_max=omega[1], harmonics=harmonics,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Writers (round trip)
+# --------------------------------------------------------------------------------------------
+def model_to_toml_dict(model: Model, analysis: AnalysisSettings | None = None) -> dict[str, Any]:
+    """The SPEC §2 tables describing ``model`` (and ``analysis`` if given).
+
+    ``config_from_dict(model_to_toml_dict(m)).model == m`` for every valid model.
+
+    Parameters
+    ----------
+    model : Model
+    analysis : AnalysisSettings, optional
+        Adds an ``analysis`` table when given.
+
+    Returns
+    -------
+    dict
+        ``{"model": {..., "elastic": {...}}, "excitation": {...}[, "analysis": {...}]}``.
+    """
+    out: dict[str, Any] = {
+        "model": {
+            "inertia": model.inertia,
+            "damping": model.damping,
+            "stiffness": model.stiffness,
+            "elastic": model.elastic.to_dict(),
+        },
+        "excitation": model.excitation.to_dict(),
+    }
+    if analysis is not None:
+        out["analysis"] = analysis.to_dict()
+    return out
+
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.match(key) else json.dumps(key, ensure_ascii=False)
+
+
+def _toml_value(value: Any, key: str) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        x = float(value)
+        return repr(x) if math.isfinite(x) else ("nan" if math.isnan(x) else ("inf" if x > 0 else "-inf"))
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_toml_value(v, key) for v in value) + "]"
+    raise TypeError(f"`{key}`: cannot write {value!r} ({type(value).__name__}) as a TOML value")
+
+
+def dumps_toml(data: Mapping[str, Any]) -> str:
+    """Format nested tables of numbers, strings, booleans and arrays as TOML text.
+
+    Enough for configuration files (:func:`model_to_toml_dict`); arrays of tables and dates
+    are not supported.
+
+    Parameters
+    ----------
+    data : mapping
+        Nested mappings; leaves are scalars or arrays of scalars.
+
+    Returns
+    -------
+    str
+    """
+    lines: list[str] = []
+
+    def emit(table: Mapping[str, Any], path: list[str]) -> None:
+        scalars = [(k, v) for k, v in table.items() if not isinstance(v, Mapping)]
+        tables = [(k, v) for k, v in table.items() if isinstance(v, Mapping)]
+        if path and (scalars or not tables):
+            if lines:
+                lines.append("")
+            lines.append("[" + ".".join(_toml_key(p) for p in path) + "]")
+        for k, v in scalars:
+            lines.append(f"{_toml_key(str(k))} = {_toml_value(v, '.'.join([*path, str(k)]))}")
+        for k, v in tables:
+            emit(v, [*path, str(k)])
+
+    emit(data, [])
+    return "\n".join(lines) + "\n"
+

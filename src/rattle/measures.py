@@ -1,0 +1,178 @@
+"""Response measures of periodic solutions (SPEC §1), batched over many solutions.
+
+For a solution δ(t) = a_0 + Σ (a_k cos kωt + b_k sin kωt) of period T_p = 2π/ω:
+
+    mean = a_0,  rms² = a_0² + ½ Σ (a_k² + b_k²),  rms_ac² = ½ Σ (a_k² + b_k²)   (Parseval),
+    p2p = max δ − min δ,  acc_p2p = max δ'' − min δ'',
+
+with δ'' = F(t) − c δ' − k f(δ) taken from the equation of motion (exact for the orbit, and
+continuous, unlike the truncated series of δ''). Extremes are located on the N samples and
+polished: those of δ by Newton on δ' = 0 (δ is smooth there), those of δ'' on two nested local
+grids (resolution T_p / (64 N); δ'' has kinks at breakpoint crossings).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._typing import FloatArray
+from .model import Model
+
+REGIMES = ("no_impact", "single_sided", "double_sided")
+
+
+@dataclass(frozen=True, slots=True)
+class Measures:
+    """SPEC §1 measures, one entry per solution (arrays of shape (P,))."""
+
+    mean: FloatArray
+    rms: FloatArray
+    rms_ac: FloatArray
+    p2p: FloatArray
+    acc_p2p: FloatArray
+    delta_min: FloatArray
+    delta_max: FloatArray
+    regime: np.ndarray  # str
+
+
+def synthesize_batch(Q: FloatArray, samples: int) -> FloatArray:
+    """Samples (P, N) of the series rows Q (P, 2H+1) at t_j = j T_p / N."""
+    H = (Q.shape[1] - 1) // 2
+    spec = np.zeros((Q.shape[0], samples // 2 + 1), dtype=complex)
+    spec[:, 0] = Q[:, 0]
+    spec[:, 1 : H + 1] = 0.5 * (Q[:, 1 : H + 1] - 1j * Q[:, H + 1 :])
+    return np.fft.irfft(spec * samples, n=samples, axis=1)
+
+
+def evaluate_batch(Q: FloatArray, omega: FloatArray, t: FloatArray, derivative: int = 0) -> FloatArray:
+    """δ^(derivative)(t) for rows Q (P, 2H+1), base frequencies ω (P,), times t (P, m)."""
+    H = (Q.shape[1] - 1) // 2
+    kw = np.arange(1, H + 1)[None, None, :] * omega[:, None, None]
+    ph = kw * t[:, :, None]
+    a = Q[:, None, 1 : H + 1]
+    b = Q[:, None, H + 1 :]
+    c, s = np.cos(ph), np.sin(ph)
+    scale = kw**derivative
+    m = derivative % 4
+    if m == 0:
+        out = np.sum(scale * (c * a + s * b), axis=2)
+        return out + (Q[:, None, 0] if derivative == 0 else 0.0)
+    if m == 1:
+        return np.sum(scale * (c * b - s * a), axis=2)
+    if m == 2:
+        return np.sum(scale * (-c * a - s * b), axis=2)
+    return np.sum(scale * (-c * b + s * a), axis=2)
+
+
+def _position_velocity(Q: FloatArray, omega: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """δ(t) and δ'(t) from one evaluation of the trigonometric table, times t (P, m)."""
+    H = (Q.shape[1] - 1) // 2
+    kw = np.arange(1, H + 1)[None, :] * omega[:, None]  # (P, H)
+    ph = t[:, :, None] * kw[:, None, :]
+    c, s = np.cos(ph), np.sin(ph)
+    a, b = Q[:, None, 1 : H + 1], Q[:, None, H + 1 :]
+    delta = Q[:, None, 0] + np.einsum("pmh,pmh->pm", c, np.broadcast_to(a, c.shape)) + np.einsum("pmh,pmh->pm", s, np.broadcast_to(b, s.shape))
+    ka, kb = kw[:, None, :] * a, kw[:, None, :] * b
+    vel = np.einsum("pmh,pmh->pm", c, np.broadcast_to(kb, c.shape)) - np.einsum("pmh,pmh->pm", s, np.broadcast_to(ka, s.shape))
+    return delta, vel
+
+
+def acceleration_batch(model: Model, Q: FloatArray, omega: FloatArray, forcing_omega: FloatArray, t: FloatArray) -> FloatArray:
+    """δ''(t) = F(t) − c δ' − k f(δ) along the orbits (base frequencies ω, forcing Ω), times t (P, m)."""
+    delta, vel = _position_velocity(Q, omega, t)
+    F = model.excitation(t, forcing_omega[:, None])
+    return F - model.c * vel - model.k * model.elastic.force(delta)
+
+
+def _refine_grid(func, t_best: FloatArray, half_width: FloatArray, sign: float, levels: int = 2, points: int = 17) -> FloatArray:
+    """Maximum of sign·func near t_best by nested uniform grids over ±half_width (a kink-safe
+    search: δ'' has kinks where δ crosses a breakpoint). Returns the extreme values."""
+    u = np.linspace(-1.0, 1.0, points)
+    t, w = t_best, half_width
+    rows = np.arange(t.size)
+    val = np.full(t.shape, -np.inf)
+    for _ in range(levels):
+        grid = t[:, None] + w[:, None] * u[None, :]
+        v = sign * func(grid)
+        i = np.argmax(v, axis=1)
+        t, val = grid[rows, i], np.maximum(val, v[rows, i])
+        w = w * (2.0 / (points - 1))
+    return sign * val
+
+
+def _refine_smooth_extreme(Q: FloatArray, omega: FloatArray, t: FloatArray, dt: FloatArray) -> FloatArray:
+    """δ at the root of δ' near the sampled extreme t (within ±dt): Newton on δ' = 0 with
+    δ'' from the series (δ is C², its extremes are smooth), kept inside the bracket."""
+    lo, hi = t - dt, t + dt
+    for _ in range(6):
+        tt = t[:, None]
+        v = evaluate_batch(Q, omega, tt, derivative=1)[:, 0]
+        acc = evaluate_batch(Q, omega, tt, derivative=2)[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_new = t - v / acc
+        t = np.where(np.isfinite(t_new) & (t_new > lo) & (t_new < hi), t_new, t)
+    return evaluate_batch(Q, omega, t[:, None])[:, 0]
+
+
+def regime_of(model: Model, delta_min: FloatArray, delta_max: FloatArray) -> np.ndarray:
+    """``no_impact`` (one stage), ``single_sided`` (breakpoints crossed on one side of δ = 0
+    only) or ``double_sided``, for each (delta_min, delta_max)."""
+    d = model.elastic.stages.breakpoints
+    out = np.full(delta_min.shape, "no_impact", dtype=object)
+    if d.size == 0:
+        return out
+    crossed = (d[None, :] > delta_min[:, None]) & (d[None, :] < delta_max[:, None])
+    pos = np.any(crossed & (d[None, :] >= 0), axis=1)
+    neg = np.any(crossed & (d[None, :] < 0), axis=1)
+    out[pos ^ neg] = "single_sided"
+    out[pos & neg] = "double_sided"
+    return out
+
+
+def measures_batch(model: Model, Q: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: FloatArray) -> Measures:
+    """Measures of P solutions: rows Q (P, 2H+1), base frequencies ω (P,), forcing frequencies
+    Ω (P,) and their N samples (P, N)."""
+    H = (Q.shape[1] - 1) // 2
+    P, N = samples.shape
+    mean = Q[:, 0].copy()
+    ac2 = 0.5 * np.sum(Q[:, 1:] ** 2, axis=1)
+    rms = np.sqrt(mean**2 + ac2)
+    rms_ac = np.sqrt(ac2)
+    T = 2 * np.pi / omega
+    dt = T / N
+    rows = np.arange(P)
+    times = np.arange(N)[None, :] * dt[:, None]
+
+    # δ extremes: the sampled ones, polished by Newton on δ' = 0.
+    dmax = np.maximum(samples.max(axis=1), _refine_smooth_extreme(Q, omega, times[rows, np.argmax(samples, axis=1)], dt))
+    dmin = np.minimum(samples.min(axis=1), _refine_smooth_extreme(Q, omega, times[rows, np.argmin(samples, axis=1)], dt))
+
+    # δ'' = F − c δ' − k f(δ) on the samples (δ' from the derivative series), extremes refined
+    # on nested grids (kink-safe).
+    dQ = np.zeros_like(Q)
+    k = np.arange(1, H + 1)[None, :] * omega[:, None]
+    dQ[:, 1 : H + 1] = k * Q[:, H + 1 :]
+    dQ[:, H + 1 :] = -k * Q[:, 1 : H + 1]
+    vel = synthesize_batch(dQ, N)
+    acc = model.excitation(times, forcing_omega[:, None]) - model.c * vel - model.k * model.elastic.force(samples)
+
+    def acc_f(t: FloatArray) -> FloatArray:
+        return acceleration_batch(model, Q, omega, forcing_omega, t)
+
+    amax = np.maximum(acc.max(axis=1), _refine_grid(acc_f, times[rows, np.argmax(acc, axis=1)], dt, +1.0))
+    amin = np.minimum(acc.min(axis=1), _refine_grid(acc_f, times[rows, np.argmin(acc, axis=1)], dt, -1.0))
+    return Measures(
+        mean=mean,
+        rms=rms,
+        rms_ac=rms_ac,
+        p2p=dmax - dmin,
+        acc_p2p=amax - amin,
+        delta_min=dmin,
+        delta_max=dmax,
+        regime=regime_of(model, dmin, dmax),
+    )
+
+
+__all__ = ["Measures", "measures_batch", "synthesize_batch", "evaluate_batch", "acceleration_batch", "regime_of", "REGIMES"]

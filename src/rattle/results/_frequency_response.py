@@ -1,0 +1,189 @@
+"""Columnar results of a frequency-response computation."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray
+from ..errors import Status
+from ..measures import acceleration_batch, evaluate_batch
+from ..model import Model
+
+#: SPEC §3 column order of frf.csv.
+FRF_COLUMNS = (
+    "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min",
+    "delta_max", "regime", "stable", "bifurcation", "iterations", "residual",
+)
+
+
+@dataclass(frozen=True, slots=True)
+class SpecialPoint:
+    """A point where stability changes: ``kind`` (fold, period_doubling, neimark_sacker), the
+    row ``index`` of the computed point nearest the change (of the two around it, the one whose
+    critical multiplier is closer to the unit circle), its ``omega``, ``branch`` and the
+    ``multipliers`` there."""
+
+    kind: str
+    index: int
+    omega: float
+    branch: int
+    multipliers: ComplexArray
+
+
+@dataclass(frozen=True, slots=True)
+class LinearResponse:
+    """Closed-form response of the linear system (f = δ, same excitation) on a grid ``omega``."""
+
+    omega: FloatArray
+    mean: FloatArray
+    rms: FloatArray
+    rms_ac: FloatArray
+
+
+def linear_frequency_response(model: Model, omega: FloatArray) -> LinearResponse:
+    """δ = F_m/k + Σ_n Re[X_n e^{inΩt}], X_n = F_pn e^{iφ_n} / (k − (nΩ)² + i c nΩ)."""
+    omega = np.asarray(omega, dtype=float)
+    exc = model.excitation
+    mean = np.full(omega.shape, exc.mean / model.k)
+    ac2 = np.zeros(omega.shape)
+    for n, amp in zip(exc.orders, exc.amplitudes):
+        w = n * omega
+        ac2 += 0.5 * amp**2 / ((model.k - w**2) ** 2 + (model.c * w) ** 2)
+    return LinearResponse(omega, mean, np.sqrt(mean**2 + ac2), np.sqrt(ac2))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FrequencyResponse:
+    """Solutions along one or more branches, one row per point in continuation order.
+
+    Columns (numpy arrays of length P): SPEC §3 ``FRF_COLUMNS``. Also ``coefficients`` (P, 2H+1)
+    Fourier coefficients [a_0, a_1 … a_H, b_1 … b_H] of δ over the solution period, and
+    ``multipliers`` (P, 2) Floquet multipliers, largest modulus first.
+    """
+
+    model: Model
+    harmonics: int
+    branch: np.ndarray
+    period: np.ndarray
+    omega: FloatArray
+    mean: FloatArray
+    rms: FloatArray
+    rms_ac: FloatArray
+    p2p: FloatArray
+    acc_p2p: FloatArray
+    delta_min: FloatArray
+    delta_max: FloatArray
+    regime: np.ndarray
+    stable: np.ndarray
+    bifurcation: np.ndarray
+    iterations: np.ndarray
+    residual: FloatArray
+    coefficients: FloatArray
+    multipliers: ComplexArray
+    special_points: tuple[SpecialPoint, ...] = ()
+    status: Status = Status.SUCCESS
+    message: str = ""
+    settings: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    # --- container protocol ----------------------------------------------------------------
+    def __len__(self) -> int:
+        return int(self.omega.size)
+
+    def __getitem__(self, index: int) -> dict[str, Any]:
+        """Row ``index`` as a dict of the SPEC columns."""
+        return {name: getattr(self, name)[index] for name in FRF_COLUMNS}
+
+    def __repr__(self) -> str:
+        return (
+            f"FrequencyResponse({len(self)} points, {len(np.unique(self.branch))} branch(es), "
+            f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}, H = {self.harmonics}, "
+            f"{int(np.sum(~self.stable))} unstable, special points: "
+            f"{', '.join(f'{s.kind}@{s.omega:.4g}' for s in self.special_points) or 'none'}; "
+            f"status: {self.status.name})"
+        )
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The SPEC columns in order, as a dict of arrays."""
+        return {name: getattr(self, name) for name in FRF_COLUMNS}
+
+    def summary(self) -> str:
+        """A few lines for the terminal."""
+        lines = [
+            f"{len(self)} solution points over Ω = {self.omega.min():.4g} … {self.omega.max():.4g} "
+            f"(H = {self.harmonics}), {int(np.sum(~self.stable))} unstable",
+            f"status: {self.status.name.lower()} — {self.message or self.status.message}",
+        ]
+        if self.special_points:
+            lines.append("stability changes: " + ", ".join(f"{s.kind} at Ω = {s.omega:.5g}" for s in self.special_points))
+        i = int(np.argmax(self.rms))
+        lines.append(f"largest rms {self.rms[i]:.5g} rad at Ω = {self.omega[i]:.5g} ({self.regime[i]})")
+        if self.timings:
+            lines.append("time: " + ", ".join(f"{k} {v:.3g} s" for k, v in self.timings.items()))
+        return "\n".join(lines)
+
+    def metadata(self) -> dict[str, Any]:
+        """Settings, timings, status and special points, JSON-serialisable."""
+        return {
+            "settings": self.settings,
+            "timings": self.timings,
+            "status": self.status.name.lower(),
+            "message": self.message or self.status.message,
+            "points": len(self),
+            "special_points": [
+                {"kind": s.kind, "omega": s.omega, "branch": s.branch, "index": s.index,
+                 "multipliers": [[float(m.real), float(m.imag)] for m in s.multipliers]}
+                for s in self.special_points
+            ],
+        }
+
+    # --- derived quantities ----------------------------------------------------------------
+    def base_frequency(self, index: int) -> float:
+        """ω = Ω / period of point ``index``."""
+        return float(self.omega[index] / self.period[index])
+
+    def time_history(self, index: int, samples: int = 512, periods: int = 1) -> dict[str, FloatArray]:
+        """Time history of point ``index`` over ``periods`` solution periods:
+        dict with ``t``, ``delta``, ``velocity``, ``acceleration`` (arrays of length samples·periods + 1)."""
+        if not -len(self) <= index < len(self):
+            raise IndexError(f"`index` must be in [0, {len(self)}), got {index}")
+        w = np.array([self.base_frequency(index)])
+        Q = self.coefficients[index][None, :]
+        T = 2 * np.pi / w[0]
+        t = np.linspace(0.0, periods * T, samples * periods + 1)[None, :]
+        return {
+            "t": t[0],
+            "delta": evaluate_batch(Q, w, t)[0],
+            "velocity": evaluate_batch(Q, w, t, derivative=1)[0],
+            "acceleration": acceleration_batch(self.model, Q, w, self.omega[index : index + 1] if index >= 0 else self.omega[[index]], t)[0],
+        }
+
+    def linear_response(self, omega: FloatArray | None = None, points: int = 600) -> LinearResponse:
+        """The linear system's (f = δ) closed-form response, by default on a uniform grid."""
+        if omega is None:
+            omega = np.linspace(self.omega.min(), self.omega.max(), points)
+        return linear_frequency_response(self.model, omega)
+
+    # --- output delegates ------------------------------------------------------------------
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
+        from ..io import write_csv
+
+        write_csv(path, self.columns(), list(FRF_COLUMNS))
+        return Path(path)
+
+    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
+        """rms vs Ω (stable solid, unstable dashed, bifurcations marked, linear overlaid);
+        returns (figure, axes). See :func:`rattle.plotting.frequency_response_plot`."""
+        from ..plotting import frequency_response_plot
+
+        return frequency_response_plot(self, ax=ax, **kwargs)
+
+
+
+
+__all__ = ["FrequencyResponse", "SpecialPoint", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS"]

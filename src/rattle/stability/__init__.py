@@ -1,0 +1,13 @@
+"""Stability of periodic solutions: exact monodromy along the HB orbit, Hill's method, labels."""
+
+from ._classify import UNIT_CIRCLE_TOL, classify_loss, is_stable
+from ._floquet import (
+    crossing_times, crossing_times_batch, monodromy, monodromy_batch, multipliers_from_monodromy,
+    stage_transition,
+)
+from ._hill import hill_exponents, hill_multipliers
+
+__all__ = [
+    "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch", "multipliers_from_monodromy",
+    "hill_exponents", "hill_multipliers", "is_stable", "classify_loss", "UNIT_CIRCLE_TOL",
+]
