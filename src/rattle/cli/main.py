@@ -105,7 +105,7 @@ def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> 
         ctx.exit(EXIT_OK)
 
 
-@click.group(cls=RattleGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(name="rattle", cls=RattleGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
               help="Show the version and exit.")
 @click.option("-v", "--verbose", is_flag=True, help="Report progress on stderr.")
@@ -115,10 +115,12 @@ def cli(verbose: bool) -> None:
     Exit status: 0 success, 2 bad input, 1 numerical failure.
     """
     if verbose:
-        handler = logging.StreamHandler(sys.stderr)
-        handler.setFormatter(logging.Formatter("rattle: %(message)s"))
         logger = logging.getLogger("rattle")
-        logger.addHandler(handler)
+        if not any(h.get_name() == "rattle-cli" for h in logger.handlers):
+            handler = logging.StreamHandler(sys.stderr)
+            handler.set_name("rattle-cli")
+            handler.setFormatter(logging.Formatter("rattle: %(message)s"))
+            logger.addHandler(handler)
         logger.setLevel(logging.INFO)
 
 
@@ -262,7 +264,14 @@ def run_frf(model: Model, analysis: AnalysisSettings, output: Path, sections: di
         partial = getattr(exc, "partial", None)
         if partial is None:
             raise
-        written = _write_frf(partial, output, sections, t_start)
+        try:
+            written = _write_frf(partial, output, sections, t_start)
+        except click.ClickException as write_error:
+            raise ConvergenceError(
+                f"{exc}; the points computed before the failure could not be saved: "
+                f"{write_error.format_message()}",
+                partial=partial,
+            ) from exc
         click.echo(partial.summary())
         raise ConvergenceError(
             f"{exc}; the points computed before the failure were written to "

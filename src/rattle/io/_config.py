@@ -282,7 +282,7 @@ class _Checker:
         if not isinstance(value, Mapping):
             raise self.error(
                 f"`{full}` must be a table, got {_show(value)} ({_kind(value)}); "
-                f"write it as a [{full}] section, e.g. {_example(full)}"
+                f"write it as a section, e.g. {_example(full)}"
             )
         return value
 
@@ -313,20 +313,27 @@ class _Checker:
     # --- TOML value types ----------------------------------------------------------------------
     def number(self, value: Any, key: str) -> None:
         """Check that ``value`` is a TOML number (not a boolean, string, array or table)."""
+        example = _example(key.split("[")[0])
         if isinstance(value, bool):
-            fix = "booleans are not numbers"
-        elif isinstance(value, (int, float, np.integer, np.floating)):
-            return  # finiteness and range are the dataclasses' rules
+            fix = "booleans are not numbers; write a number"
+        elif isinstance(value, (int, np.integer)):
+            return  # the range is the dataclasses' rule
+        elif isinstance(value, (float, np.floating)):
+            if math.isfinite(value):
+                return
+            # TOML has nan/inf literals; no physical quantity or setting may take them.
+            raise self.error(
+                f"`{key}` must be a finite number, got {_show(float(value))} (TOML's "
+                f"{'not-a-number' if math.isnan(value) else 'infinity'} literal); "
+                f"write a finite value, e.g. {example}"
+            )
         elif isinstance(value, str):
-            fix = "write the number without quotes"
+            fix = "remove the quotes"
         elif isinstance(value, (list, tuple)):
             fix = "give a single number, not an array"
         else:
             fix = "give a number"
-        raise self.error(
-            f"`{key}` must be a number, got {_show(value)} ({_kind(value)}); {fix}, "
-            f"e.g. {_example(key.split('[')[0])}"
-        )
+        raise self.error(f"`{key}` must be a number, got {_show(value)} ({_kind(value)}); {fix}, e.g. {example}")
 
     def array(self, value: Any, key: str) -> None:
         """Check that ``value`` is a TOML array of numbers."""
@@ -520,7 +527,7 @@ def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
     if len(omega) != 2:
         raise check.error(
             f"`analysis.omega` must be a list of two numbers [min, max] (rad/s), got {_show(omega)} "
-            f"({len(omega)} numbers); write e.g. {_example('analysis.omega')}"
+            f"({len(omega)} number{'' if len(omega) == 1 else 's'}); write e.g. {_example('analysis.omega')}"
         )
     harmonics = table.get("harmonics", DEFAULT_HARMONICS)
     check.integer(harmonics, "analysis.harmonics")

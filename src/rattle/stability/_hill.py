@@ -11,7 +11,11 @@ itself has |Im λ| near ω/2 (period doubling) and when truncated copies cross o
 instead by the eigenvector (Lazarus & Thomas 2010; Guillot et al. 2020): the eigenvector of the
 copy shifted by m ω is the physical one shifted by m harmonics, so the physical copies are
 those whose harmonic energy |Y_k|² is centred on k = 0 — we take the 2 eigenvalues whose
-eigenvector centroid Σ k |Y_k|² / Σ |Y_k|² is closest to zero.
+eigenvector centroid Σ k |Y_k|² / Σ |Y_k|² is closest to zero. Taking the two best centroids
+is still fragile: a real multiplier's exponent and its conjugate are copies of each other
+(at period doubling both sit at centroid ±½). For the single-DOF equation we therefore take
+only the best-centred exponent λ_1 and obtain the other from Liouville's formula: every stage
+matrix has trace −c, so λ_1 + λ_2 = −c (mod iω) and μ_2 = e^{−cT} / μ_1 exactly.
 """
 
 from __future__ import annotations
@@ -23,8 +27,8 @@ from .._typing import ComplexArray, FloatArray
 from ..hb import HarmonicBalance
 
 
-def hill_exponents(hb: HarmonicBalance, q: FloatArray, omega: float, count: int = 2) -> ComplexArray:
-    """The ``count`` physical Floquet exponents λ of the HB orbit q at forcing frequency Ω."""
+def hill_exponents(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexArray:
+    """The two physical Floquet exponents λ of the HB orbit q at forcing frequency Ω."""
     H = hb.basis.harmonics
     n = hb.size
     w = hb.base_frequency(omega)
@@ -43,8 +47,8 @@ def hill_exponents(hb: HarmonicBalance, q: FloatArray, omega: float, count: int 
     k = np.arange(1, H + 1)[:, None]
     total = np.abs(Y[0]) ** 2 + np.sum(w_pos + w_neg, axis=0)
     centroid = np.sum(k * (w_pos - w_neg), axis=0) / total
-    pick = np.argsort(np.abs(centroid), kind="stable")[:count]
-    return lam[pick]
+    lam1 = lam[int(np.argmin(np.abs(centroid)))]
+    return np.array([lam1, -hb.model.c - lam1])
 
 
 def hill_multipliers(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexArray:
