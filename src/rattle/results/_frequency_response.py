@@ -10,15 +10,9 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
+from ..io._csv import FRF_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model
-
-#: SPEC §3 column order of frf.csv.
-FRF_COLUMNS = (
-    "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min",
-    "delta_max", "regime", "stable", "bifurcation", "iterations", "residual",
-)
-
 
 @dataclass(frozen=True, slots=True)
 class SpecialPoint:
