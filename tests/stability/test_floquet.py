@@ -73,13 +73,15 @@ def test_classification_of_crossings():
 def test_hill_agrees_with_monodromy_away_from_bifurcations(reference_frf):
     """Hill's method (eigenvector-centroid selection) vs the exact monodromy of the HB orbit.
 
-    Hill's truncated spectrum converges slowly for a stiffness that jumps in time, so the
-    agreement is ~1e-2 in the multipliers at H = 32; what must agree is the stability verdict
-    wherever the critical multiplier is not within that error of the unit circle."""
+    Hill's truncated spectrum converges slowly for a stiffness that jumps in time: against the
+    exact shooting orbits its multipliers are off by 2.7e-3 (median) and up to 3e-2 at H = 32,
+    twenty times the monodromy's error (1.4e-4 median) — which is why the monodromy is primary.
+    What must agree is the stability verdict wherever the critical multiplier is not within
+    that error of the unit circle, and the multipliers within it."""
     frf = reference_frf
     hb = HarmonicBalance(frf.model, HBOptions(harmonics=32))
     checked = 0
-    for i in range(0, len(frf), 9):
+    for i in range(0, len(frf), 18):
         mono = frf.multipliers[i]
         if abs(np.abs(mono[0]) - 1.0) < 0.05:
             continue
@@ -87,7 +89,7 @@ def test_hill_agrees_with_monodromy_away_from_bifurcations(reference_frf):
         assert (np.max(np.abs(hill)) < 1) == frf.stable[i], (frf.omega[i], mono, hill)
         assert set_distance(hill, mono) < 0.05
         checked += 1
-    assert checked > 50
+    assert checked > 25
 
 
 def test_monodromy_single_matches_batch(reference_frf):

@@ -32,6 +32,7 @@ of the stage transition matrices exp(A_j Δt_j) of its segments.
 
 from __future__ import annotations
 
+import cmath
 import math
 from dataclasses import dataclass, field
 from typing import Callable
@@ -271,9 +272,11 @@ class StageSolutions:
 # ---------------------------------------------------------------------------------------------
 def _bracketed_newton(
     fun: Callable[[float], tuple[float, float]], a: float, b: float, fa: float, fb: float, tol: float,
+    ftol: float = 0.0,
 ) -> float:
     """Root of ``fun`` in [a, b] (fa·fb ≤ 0) by Newton's method safeguarded by bisection
-    (Numerical Recipes' rtsafe); ``fun(x)`` returns (f, f'). Stops when the step is below ``tol``."""
+    (Numerical Recipes' rtsafe); ``fun(x)`` returns (f, f'). Stops when the step is below ``tol``
+    or |f| ≤ ``ftol`` (the round-off floor of f)."""
     if fa == 0.0:
         return a
     if fb == 0.0:
@@ -286,7 +289,7 @@ def _bracketed_newton(
     dx_old = dx = abs(b - a)
     f, df = fun(x)
     for _ in range(200):
-        if f == 0.0:
+        if abs(f) <= ftol:
             return x
         if ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0 or abs(2.0 * f) > abs(dx_old * df):
             dx_old, dx = dx, 0.5 * (hi - lo)
@@ -511,6 +514,83 @@ class Trajectory:
 
 
 # ---------------------------------------------------------------------------------------------
+# One segment of a trajectory (hot loop)
+# ---------------------------------------------------------------------------------------------
+class _Segment:
+    """The exact solution on stage j from (t_s, x_s), in modal form for fast evaluation:
+
+        δ(τ) = P + r τ + ½ a τ² + Re Σ_m A_m e^{μ_m τ},   τ = t − t_s,
+
+    the modes μ_m being the stage's eigenvalue(s) and i nΩ for the forcing harmonics (whose
+    phases at t_s are folded into A_m, so the local time τ carries no round-off of large t).
+    For an underdamped stage the form is as well conditioned as Φ(τ) h (|A| is the amplitude of
+    the free oscillation); near critical damping the two real modes nearly coincide and their
+    amplitudes blow up, so there the segment falls back to the transition-matrix form.
+    """
+
+    __slots__ = ("sol", "j", "ts", "h0", "h1", "P", "r", "a", "mu", "amp", "mu_l", "a0_l", "a1_l", "a2_l",
+                 "d_floor", "v_floor")
+
+    def __init__(self, sol: StageSolutions, j: int, ts: float, delta: float, velocity: float) -> None:
+        self.sol, self.j, self.ts = sol, j, ts
+        self.h0, self.h1 = h0, h1 = sol.homogeneous_start(j, ts, delta, velocity)
+        under, wd, gamma, lam1, lam2, _, _, self.P, self.r, self.a = sol._stage_l[j]
+        sigma = sol.sigma
+        if under:
+            mu = [complex(-sigma, wd)]
+            amp = [complex(h0, -(h1 + sigma * h0) / wd)]
+        elif gamma > 0.01 * sigma:
+            den = lam1 - lam2
+            mu = [complex(lam1), complex(lam2)]
+            amp = [complex((h1 - lam2 * h0) / den), complex((lam1 * h0 - h1) / den)]
+        else:
+            mu = None
+        if mu is None:
+            self.mu = None
+            self.d_floor = 8.0 * _EPS * (abs(delta) + abs(self.P) + abs(h0) + abs(h1) * sol.time_scale[j])
+            self.v_floor = 8.0 * _EPS * (abs(velocity) + abs(h0) / sol.time_scale[j] + abs(h1))
+            return
+        for (xr, xi), w in zip(sol._x_l[j], sol._nw_l):
+            mu.append(1j * w)
+            amp.append(complex(xr, xi) * cmath.exp(1j * w * ts))
+        self.mu_l, self.a0_l = mu, amp
+        self.a1_l = [m * x for m, x in zip(mu, amp)]
+        self.a2_l = [m * x for m, x in zip(mu, self.a1_l)]
+        self.mu = np.array(mu)
+        self.amp = np.array([amp, self.a1_l]).T  # (K, 2): δ and δ' amplitudes
+        # Round-off floors of δ and δ' (for the root finder's stopping test).
+        self.d_floor = 8.0 * _EPS * (abs(self.P) + sum(abs(x) for x in amp))
+        self.v_floor = 8.0 * _EPS * (abs(self.r) + sum(abs(x) for x in self.a1_l))
+
+    def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """δ and δ' at local times ``taus`` (vectorised)."""
+        if self.mu is None:
+            d, v = self.sol.evaluate(self.j, self.ts + taus, self.ts, self.h0, self.h1, order=1)
+            return d, v
+        z = np.exp(np.multiply.outer(taus, self.mu)) @ self.amp
+        d = z[:, 0].real + self.P
+        v = z[:, 1].real
+        if self.r != 0.0 or self.a != 0.0:
+            d += taus * (self.r + 0.5 * self.a * taus)
+            v += self.r + self.a * taus
+        return d, v
+
+    def state(self, tau: float) -> tuple[float, float, float]:
+        """(δ, δ', δ'') at local time ``tau``."""
+        if self.mu is None:
+            return self.sol.point(self.j, self.ts + tau, self.ts, self.h0, self.h1)
+        d = self.P + tau * (self.r + 0.5 * self.a * tau)
+        v = self.r + self.a * tau
+        acc = self.a
+        for m, x0, x1, x2 in zip(self.mu_l, self.a0_l, self.a1_l, self.a2_l):
+            e = cmath.exp(m * tau)
+            d += (x0 * e).real
+            v += (x1 * e).real
+            acc += (x2 * e).real
+        return d, v, acc
+
+
+# ---------------------------------------------------------------------------------------------
 # Integrator
 # ---------------------------------------------------------------------------------------------
 class ExactIntegrator:
@@ -541,7 +621,7 @@ class ExactIntegrator:
         self._cache: tuple[float, StageSolutions] | None = None
 
     def solutions(self, omega: float) -> StageSolutions:
-        """The closed-form stage solutions at forcing frequency ``omega`` (cached for the last one)."""
+        """The closed-form stage solutions at forcing frequency ``omega`` (the last one is cached)."""
         if self._cache is not None and self._cache[0] == omega:
             return self._cache[1]
         sol = StageSolutions(self.model, omega, self.samples_per_scale)
@@ -552,7 +632,7 @@ class ExactIntegrator:
         """Integrate exactly from state ``x0`` = (δ, δ') (rad, rad/s) at ``t0`` to ``t1`` ≥ t0 (s)
         at forcing frequency ``omega`` (rad/s).
 
-        Returns the :class:`Trajectory` (segments, final state and sensitivity ∂x(t1)/∂x0).
+        Returns the :class:`Trajectory`: its segments, final state and sensitivity ∂x(t1)/∂x0.
         """
         x0 = np.asarray(x0, dtype=float)
         if x0.shape != (2,) or not np.all(np.isfinite(x0)):
@@ -570,24 +650,23 @@ class ExactIntegrator:
         homog: list[tuple[float, float]] = []
         m11, m12, m21, m22 = 1.0, 0.0, 0.0, 1.0
         while True:
-            h0, h1 = sol.homogeneous_start(j, t, d, v)
-            tc, j_new = self._first_exit(sol, j, t, d, v, h0, h1, t1)
-            if tc > t or (j_new < 0 and not starts):  # zero-length segments (round-off) are dropped
+            seg = _Segment(sol, j, t, d, v)
+            tau_c, j_new, d_c, v_c = self._first_exit(seg, t1 - t)
+            if tau_c > 0.0 or (j_new < 0 and not starts):  # zero-length segments (round-off) are dropped
                 starts.append(t)
                 stages.append(j)
                 states.append((d, v))
-                homog.append((h0, h1))
-            f11, f12, f21, f22 = sol.transition_scalar(j, tc - t)
+                homog.append((seg.h0, seg.h1))
+            f11, f12, f21, f22 = sol.transition_scalar(j, tau_c)
             m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
                                   f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
-            d_new, v_new, _ = sol.point(j, tc, t, h0, h1)
             if j_new < 0:
-                d, v = d_new, v_new
+                d, v = d_c, v_c
                 break
             # Exactly on the breakpoint: snap δ (the root is located to round-off).
             d = float(sol.upper[j] if j_new > j else sol.lower[j])
-            v = v_new
-            j, t = j_new, tc
+            v = v_c
+            j, t = j_new, t + tau_c
             if len(starts) > self.max_segments:
                 raise ConvergenceError(
                     f"more than `max_segments` = {self.max_segments} segments between t0 = {t0!r} and "
@@ -603,85 +682,84 @@ class ExactIntegrator:
         )
 
     # --- crossing search -----------------------------------------------------------------------
-    def _first_exit(
-        self, sol: StageSolutions, j: int, ts: float, ds: float, vs: float, h0: float, h1: float, t_end: float,
-    ) -> tuple[float, int]:
-        """First time in (ts, t_end] where δ leaves stage j, and the stage entered (−1: none).
+    def _first_exit(self, seg: _Segment, tau_end: float) -> tuple[float, int, float, float]:
+        """First local time in (0, tau_end] where δ leaves the segment's stage: (τ, stage entered,
+        δ, δ' there); stage −1 and τ = tau_end when it stays.
 
-        The start point is inside the stage by construction (a crossing enters the new stage).
+        The segment start is inside the stage by construction (a crossing enters the new stage),
+        whatever round-off says of δ there.
         """
+        sol, j = seg.sol, seg.j
         lo, hi = float(sol.lower[j]), float(sol.upper[j])
-        if lo == -math.inf and hi == math.inf:
-            return t_end, -1
-        tau_end = t_end - ts
-        step = float(sol.grid_step[j])
-        if not math.isfinite(step):
-            step = max(tau_end, 1e-300) / self.samples_per_scale
-        tau_a, d_a, v_a = 0.0, ds, vs
-        chunk = _FIRST_CHUNK
-        while tau_a < tau_end:
-            n = max(1, min(chunk, math.ceil((tau_end - tau_a) / step)))
-            taus = tau_a + step * np.arange(1, n + 1)
-            if taus[-1] >= tau_end or n < chunk:
-                taus[-1] = tau_end
-            d, v = sol.evaluate(j, ts + taus, ts, h0, h1, order=1)
-            T = np.concatenate(([tau_a], taus))
-            D = np.concatenate(([d_a], d))
-            V = np.concatenate(([v_a], v))
-            outside = (D[1:] >= hi) | (D[1:] < lo)
-            vmax = (V[:-1] > 0.0) & (V[1:] <= 0.0)
-            vmin = (V[:-1] < 0.0) & (V[1:] >= 0.0)
-            # An extremum inside a cell can only reach a breakpoint if it lies within the cell's
-            # possible excursion (δ' passes through zero in the cell, |δ'| ≤ its end values;
-            # factor 2 for safety): refine only those.
-            excursion = 2.0 * np.diff(T) * np.maximum(np.abs(V[:-1]), np.abs(V[1:]))
-            near_hi = vmax & (np.maximum(D[:-1], D[1:]) + excursion >= hi)
-            near_lo = vmin & (np.minimum(D[:-1], D[1:]) - excursion <= lo)
-            for i in np.flatnonzero(outside | near_hi | near_lo):
-                hit = self._resolve_cell(sol, j, ts, h0, h1, lo, hi, float(T[i]), float(T[i + 1]),
-                                         float(D[i]), float(D[i + 1]), float(V[i]), float(V[i + 1]))
-                if hit is not None:
-                    tc, j_new = hit
-                    if tc >= t_end:
-                        return t_end, -1
-                    return tc, j_new
-            tau_a, d_a, v_a = float(T[-1]), float(D[-1]), float(V[-1])
-            chunk = min(2 * chunk, _MAX_CHUNK)
-        return t_end, -1
+        if lo > -math.inf or hi < math.inf:
+            step = float(sol.grid_step[j])
+            if not math.isfinite(step):
+                step = max(tau_end, 1e-300) / self.samples_per_scale
+            tau_a = 0.0
+            chunk = _FIRST_CHUNK
+            while tau_a < tau_end:
+                n = max(1, min(chunk, math.ceil((tau_end - tau_a) / step)))
+                taus = tau_a + step * np.arange(n + 1)  # the cell starts, then the last end
+                if n < chunk or taus[-1] >= tau_end:
+                    taus[-1] = tau_end
+                d, v = seg.scan(taus)
+                if tau_a == 0.0:
+                    d[0] = 0.5 * (lo + hi) if math.isfinite(lo + hi) else (hi - 1.0 if lo == -math.inf else lo + 1.0)
+                    d[0] = min(max(d[0], lo), hi)  # a stand-in inside the stage
+                outside = (d[1:] >= hi) | (d[1:] < lo)
+                i_out = int(outside.argmax()) if outside.any() else n
+                pos = v > 0.0
+                turns = np.flatnonzero(pos[:-1] != pos[1:])
+                for i in turns[turns < i_out].tolist() + ([i_out] if i_out < n else []):
+                    d_a, d_b, v_a, v_b = float(d[i]), float(d[i + 1]), float(v[i]), float(v[i + 1])
+                    if i != i_out:
+                        # An extremum inside a cell can only reach a breakpoint within the cell's
+                        # possible excursion (δ' passes through zero and |δ'| is at most about its
+                        # end values; factor 2 for safety): refine only those.
+                        excursion = 2.0 * float(taus[i + 1] - taus[i]) * max(abs(v_a), abs(v_b))
+                        if (max(d_a, d_b) + excursion < hi) if v_a > 0.0 else (min(d_a, d_b) - excursion > lo):
+                            continue
+                    if i == 0 and tau_a == 0.0:
+                        d_a = seg.state(0.0)[0]
+                    hit = self._resolve_cell(seg, lo, hi, float(taus[i]), float(taus[i + 1]), d_a, d_b, v_a, v_b,
+                                             at_start=(i == 0 and tau_a == 0.0))
+                    if hit is not None and hit[0] < tau_end:
+                        return hit
+                tau_a = float(taus[-1])
+                chunk = min(2 * chunk, _MAX_CHUNK)
+        d_end, v_end, _ = seg.state(tau_end)
+        return tau_end, -1, d_end, v_end
 
     @staticmethod
     def _resolve_cell(
-        sol: StageSolutions, j: int, ts: float, h0: float, h1: float, lo: float, hi: float,
-        tau_a: float, tau_b: float, d_a: float, d_b: float, v_a: float, v_b: float,
-    ) -> tuple[float, int] | None:
-        """The exit from stage j inside the grid cell [tau_a, tau_b] (local times), if any:
-        (crossing time, new stage), or None when δ stays inside or only grazes a breakpoint
+        seg: _Segment, lo: float, hi: float, tau_a: float, tau_b: float,
+        d_a: float, d_b: float, v_a: float, v_b: float, at_start: bool,
+    ) -> tuple[float, int, float, float] | None:
+        """The exit from the segment's stage inside the grid cell [tau_a, tau_b], if any:
+        (τ, stage entered, δ, δ' there); None when δ stays inside or only grazes a breakpoint
         (an excursion beyond it below round-off)."""
-
-        def delta_and_velocity(tau: float) -> tuple[float, float]:
-            d, v, _ = sol.point(j, ts + tau, ts, h0, h1)
-            return d, v
+        state = seg.state
 
         def velocity_and_acceleration(tau: float) -> tuple[float, float]:
-            _, v, a = sol.point(j, ts + tau, ts, h0, h1)
+            _, v, a = state(tau)
             return v, a
 
-        tol = 4.0 * _EPS * (abs(ts) + abs(tau_b)) + 1e-300
+        tol = 4.0 * _EPS * tau_b + 1e-300
         end_up, end_down = d_b >= hi, d_b < lo
         if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):
             # δ has an extremum in the cell: refine it (a tangential touch may hide inside).
             tau_e = tau_b if v_b == 0.0 else _bracketed_newton(
-                velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol)
-            d_e = delta_and_velocity(tau_e)[0]
-            graze = 16.0 * _EPS * max(abs(d_e), 1e-300)
-            if v_a > 0.0:  # maximum: beyond hi → cross before it; else maybe down after it
+                velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol, seg.v_floor)
+            d_e = state(tau_e)[0]
+            graze = seg.d_floor
+            if v_a > 0.0:  # a maximum: beyond hi, cross before it; else maybe down after it
                 if d_e - hi > graze or end_up:
                     up, a_, b_, d_a_, d_b_ = True, tau_a, tau_e, d_a, d_e
                 elif end_down:
                     up, a_, b_, d_a_, d_b_ = False, tau_e, tau_b, d_e, d_b
                 else:
                     return None
-            else:  # minimum
+            else:  # a minimum
                 if lo - d_e > graze or end_down:
                     up, a_, b_, d_a_, d_b_ = False, tau_a, tau_e, d_a, d_e
                 elif end_up:
@@ -695,16 +773,19 @@ class ExactIntegrator:
         bound = hi if up else lo
         fa, fb = d_a_ - bound, d_b_ - bound
         if (fa >= 0.0) if up else (fa < 0.0):
-            # Already at the breakpoint at the bracket's start (a round-off graze at a segment
-            # start): the crossing is there.
-            tc = a_
-        else:
+            if not (at_start and a_ == 0.0):
+                tau_c = a_  # round-off at a graze: the crossing is at the bracket's start
+            else:
+                fa = -1e-300 if up else 1e-300  # the segment start is inside by construction
+        if (fa < 0.0) if up else (fa >= 0.0):
+
             def gap(tau: float) -> tuple[float, float]:
-                d, v = delta_and_velocity(tau)
+                d, v, _ = state(tau)
                 return d - bound, v
 
-            tc = _bracketed_newton(gap, a_, b_, fa, fb, tol)
-        return ts + tc, j + 1 if up else j - 1
+            tau_c = _bracketed_newton(gap, a_, b_, fa, fb, tol, seg.d_floor)
+        _, v_c, _ = state(tau_c)
+        return tau_c, seg.j + 1 if up else seg.j - 1, bound, v_c
 
 
 __all__ = ["ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions"]
