@@ -287,23 +287,22 @@ def _bracketed_newton(
         lo, hi = a, b
     x = a - fa * (b - a) / (fb - fa)  # regula falsi start: good for a transversal crossing
     dx_old = dx = abs(b - a)
-    f, df = fun(x)
     for _ in range(200):
+        f, df = fun(x)
         if abs(f) <= ftol:
             return x
+        if f < 0.0:
+            lo = x
+        else:
+            hi = x
         if ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0 or abs(2.0 * f) > abs(dx_old * df):
-            dx_old, dx = dx, 0.5 * (hi - lo)
+            dx_old, dx = dx, 0.5 * (hi - lo)  # Newton leaves the bracket or converges slowly
             x = lo + dx
         else:
             dx_old, dx = dx, f / df
             x -= dx
         if abs(dx) <= tol:
             return x
-        f, df = fun(x)
-        if f < 0.0:
-            lo = x
-        else:
-            hi = x
     return x
 
 
@@ -338,7 +337,7 @@ def _vector_bracketed_newton(
 # ---------------------------------------------------------------------------------------------
 # Results
 # ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True, slots=True, kw_only=True)
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
 class StateSamples:
     """Exact samples of a trajectory: ``t`` (s), ``delta`` δ (rad), ``velocity`` δ' (rad/s),
     ``acceleration`` δ'' (rad/s², from the equation) and the ``stage`` index, all of t's shape."""
@@ -369,7 +368,7 @@ class ExactMeasures:
     acc_p2p: float
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
 class Trajectory:
     """An exact trajectory of δ'' + c δ' + k f(δ) = F(t) from ``t0`` to ``t1``.
 
@@ -559,15 +558,15 @@ class _Segment:
         self.mu = np.array(mu)
         self.amp = np.array([amp, self.a1_l]).T  # (K, 2): δ and δ' amplitudes
         # Round-off floors of δ and δ' (for the root finder's stopping test).
-        self.d_floor = 8.0 * _EPS * (abs(self.P) + sum(abs(x) for x in amp))
-        self.v_floor = 8.0 * _EPS * (abs(self.r) + sum(abs(x) for x in self.a1_l))
+        self.d_floor = 8.0 * _EPS * (abs(delta) + abs(self.P) + sum(map(abs, amp)))
+        self.v_floor = 8.0 * _EPS * (abs(self.r) + sum(map(abs, self.a1_l)))
 
     def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
         """δ and δ' at local times ``taus`` (vectorised)."""
         if self.mu is None:
             d, v = self.sol.evaluate(self.j, self.ts + taus, self.ts, self.h0, self.h1, order=1)
             return d, v
-        z = np.exp(np.multiply.outer(taus, self.mu)) @ self.amp
+        z = np.exp(taus[:, None] * self.mu) @ self.amp
         d = z[:, 0].real + self.P
         v = z[:, 1].real
         if self.r != 0.0 or self.a != 0.0:
@@ -703,14 +702,18 @@ class ExactIntegrator:
                 if n < chunk or taus[-1] >= tau_end:
                     taus[-1] = tau_end
                 d, v = seg.scan(taus)
-                if tau_a == 0.0:
-                    d[0] = 0.5 * (lo + hi) if math.isfinite(lo + hi) else (hi - 1.0 if lo == -math.inf else lo + 1.0)
-                    d[0] = min(max(d[0], lo), hi)  # a stand-in inside the stage
-                outside = (d[1:] >= hi) | (d[1:] < lo)
-                i_out = int(outside.argmax()) if outside.any() else n
+                if lo == -math.inf:
+                    outside = d[1:] >= hi
+                elif hi == math.inf:
+                    outside = d[1:] < lo
+                else:
+                    outside = (d[1:] >= hi) | (d[1:] < lo)
+                i_out = int(outside.argmax())
+                if not outside[i_out]:
+                    i_out = n
                 pos = v > 0.0
-                turns = np.flatnonzero(pos[:-1] != pos[1:])
-                for i in turns[turns < i_out].tolist() + ([i_out] if i_out < n else []):
+                turns = (pos[:-1] != pos[1:]).nonzero()[0].tolist()
+                for i in [i for i in turns if i < i_out] + ([i_out] if i_out < n else []):
                     d_a, d_b, v_a, v_b = float(d[i]), float(d[i + 1]), float(v[i]), float(v[i + 1])
                     if i != i_out:
                         # An extremum inside a cell can only reach a breakpoint within the cell's
@@ -719,8 +722,6 @@ class ExactIntegrator:
                         excursion = 2.0 * float(taus[i + 1] - taus[i]) * max(abs(v_a), abs(v_b))
                         if (max(d_a, d_b) + excursion < hi) if v_a > 0.0 else (min(d_a, d_b) - excursion > lo):
                             continue
-                    if i == 0 and tau_a == 0.0:
-                        d_a = seg.state(0.0)[0]
                     hit = self._resolve_cell(seg, lo, hi, float(taus[i]), float(taus[i + 1]), d_a, d_b, v_a, v_b,
                                              at_start=(i == 0 and tau_a == 0.0))
                     if hit is not None and hit[0] < tau_end:

@@ -23,7 +23,7 @@ from ._exact import ExactIntegrator, Trajectory
 _MAX_HALVINGS = 12
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
 class ShootingOrbit:
     """A periodic orbit found by shooting, with its exact stability and response measures.
 
