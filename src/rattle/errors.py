@@ -38,6 +38,7 @@ class Status(enum.Enum):
     MAX_TIME = "the time budget was used up before the end of the range"
     STEP_TOO_SMALL = "the corrector failed even at the smallest allowed step"
     START_FAILED = "no periodic solution could be found at the start of the range"
+    STOPPED = "the branch ended where it rejoined another branch"
 
     @property
     def message(self) -> str:
@@ -45,7 +46,7 @@ class Status(enum.Enum):
 
     @property
     def success(self) -> bool:
-        return self in (Status.SUCCESS, Status.RETURNED)
+        return self in (Status.SUCCESS, Status.RETURNED, Status.STOPPED)
 
 
 __all__ = ["RattleError", "ConfigError", "ConvergenceError", "Status"]

@@ -1,6 +1,7 @@
 """Pseudo-arclength continuation in the forcing frequency with self-adjusting steps."""
 
+from ._corrector import ArclengthCorrector, Corrected
 from ._options import ContinuationOptions
 from ._stepper import BranchPoint, ContinuationStepper
 
-__all__ = ["ContinuationOptions", "ContinuationStepper", "BranchPoint"]
+__all__ = ["ContinuationOptions", "ContinuationStepper", "BranchPoint", "ArclengthCorrector", "Corrected"]

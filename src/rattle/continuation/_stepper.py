@@ -1,9 +1,8 @@
 """Pseudo-arclength continuation of R(q, Ω) = 0 in the forcing frequency Ω.
 
-Keller's method in scaled variables y = (q / L, Ω / ω_s):
+Keller's method in scaled variables y = (q / L, Ω / ω_s) (see ``_corrector``):
 
-* predictor along the unit tangent t (the null vector of [∂R/∂q L, ∂R/∂Ω ω_s]):
-  y_pred = y_i + Δs t;
+* predictor along the unit tangent t: y_pred = y_i + Δs t;
 * corrector: Newton on the bordered system  R(y) = 0,  t·(y − y_pred) = 0;
 * step control: Δs is scaled by the ratio of the target to the actual number of Newton
   iterations and by the ratio of the target to the actual turn of the tangent (angle between
@@ -11,24 +10,23 @@ Keller's method in scaled variables y = (q / L, Ω / ω_s):
   allowed angle, is rejected and retried with half the step, down to the minimum step.
 
 The stepper yields one accepted point per :meth:`ContinuationStepper.step`; the run ends when the
-branch leaves the frequency range (the last point is placed exactly on the bound), or with a
-:class:`~rattle.errors.Status` saying where and why it stopped.
+branch leaves the frequency range (the last point is placed exactly on the bound), when an
+optional ``stop`` test fires, or with a :class:`~rattle.errors.Status` saying where and why.
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
-
-_gesv = scipy.linalg.lapack.dgesv
 
 from .._typing import FloatArray
 from ..errors import Status
 from ..hb import HarmonicBalance, NewtonOptions, solve_harmonic_balance
+from ._corrector import ArclengthCorrector
 from ._options import ContinuationOptions
 
 
@@ -46,20 +44,15 @@ class BranchPoint:
 
 
 @dataclass(slots=True)
-class _Corrected:
-    y: FloatArray
-    iterations: int
-    residual: float
-    Rq: FloatArray
-    Rw: FloatArray
-
-
-@dataclass(slots=True)
 class ContinuationStepper:
-    """Step-by-step pseudo-arclength continuation (the low-level API; see ``continue_branch``).
+    """Step-by-step pseudo-arclength continuation (the low-level API).
 
-    ``hb`` the discretised problem, ``q0`` a solution (or good guess) at ``omega0``, which must be
-    one end of ``omega_range``; the branch is followed into the range.
+    ``hb`` the discretised problem, ``q0`` a solution (or good guess) at ``omega0``. Without
+    ``tangent`` the start must be one end of ``omega_range`` and the branch is followed into
+    the range; with ``tangent`` (a direction in scaled variables, e.g. the critical eigenvector
+    at a branch point) the start may be anywhere in the range and the branch is followed along
+    that direction. ``stop(point) -> str | None`` may end the run (status ``STOPPED``) with the
+    returned reason.
     """
 
     hb: HarmonicBalance
@@ -68,89 +61,36 @@ class ContinuationStepper:
     omega_range: tuple[float, float]
     options: ContinuationOptions = field(default_factory=ContinuationOptions)
     newton: NewtonOptions = field(default_factory=NewtonOptions)
+    tangent: FloatArray | None = None
+    stop: Callable[[BranchPoint], str | None] | None = None
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
     rejected: int = 0
+    corrector: ArclengthCorrector = field(init=False, repr=False)
     _y: FloatArray = field(init=False, repr=False)
     _t: FloatArray = field(init=False, repr=False)
     _ds: float = field(init=False, repr=False)
     _start_time: float = field(init=False, repr=False)
-    _scale: FloatArray = field(init=False, repr=False)
     _direction: float = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         lo, hi = self.omega_range
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
             raise ValueError(f"`omega_range` must satisfy 0 < min < max, got {self.omega_range!r}")
-        if self.omega0 == lo:
+        if self.tangent is not None:
+            if not lo <= self.omega0 <= hi:
+                raise ValueError(f"`omega0` must lie in `omega_range` {self.omega_range}, got {self.omega0}")
+            self._direction = 0.0
+        elif self.omega0 == lo:
             self._direction = 1.0
         elif self.omega0 == hi:
             self._direction = -1.0
         else:
             raise ValueError(f"`omega0` must be one end of `omega_range` {self.omega_range}, got {self.omega0}")
         self._start_time = time.perf_counter()
-        n = self.hb.size
-        self._scale = np.empty(n + 1)
-        self._scale[:n] = self.hb.length_scale
-        self._scale[n] = self.hb.model.natural_frequency
+        self.corrector = ArclengthCorrector(self.hb, self.newton)
         self._ds = self.options.initial_step
-
-    # --- helpers ---------------------------------------------------------------------------
-    def _unscale(self, y: FloatArray) -> tuple[FloatArray, float]:
-        q = y[:-1] * self._scale[:-1]
-        return q, float(y[-1] * self._scale[-1])
-
-    def _bordered_solve(self, Rq: FloatArray, Rw: FloatArray, t: FloatArray, rhs: FloatArray) -> FloatArray | None:
-        """Solve [∂R/∂q L, ∂R/∂Ω ω_s; tᵀ] x = rhs (LAPACK gesv; None if singular)."""
-        n = Rq.shape[0]
-        A = np.empty((n + 1, n + 1), order="F")
-        np.multiply(Rq, self._scale[0], out=A[:n, :n])
-        np.multiply(Rw, self._scale[n], out=A[:n, n])
-        A[n] = t
-        _, _, x, info = _gesv(A, rhs, overwrite_a=1, overwrite_b=0)
-        if info != 0 or not np.all(np.isfinite(x)):
-            return None
-        return x
-
-    def _tangent(self, Rq: FloatArray, Rw: FloatArray, t_prev: FloatArray) -> FloatArray | None:
-        rhs = np.zeros(Rq.shape[0] + 1)
-        rhs[-1] = 1.0
-        tau = self._bordered_solve(Rq, Rw, t_prev, rhs)
-        return None if tau is None else tau / np.linalg.norm(tau)
-
-    def _correct(self, y_pred: FloatArray, t: FloatArray) -> _Corrected | None:
-        hb, opts = self.hb, self.newton
-        Fs = hb.force_scale
-        y = y_pred.copy()
-        step_norm = np.inf
-        n = hb.size
-        rhs = np.empty(n + 1)
-        first_res = None
-        for it in range(opts.max_iterations + 1):
-            q, w = self._unscale(y)
-            if w <= 0:
-                return None
-            R, Rq, Rw = hb.residual_jacobian(q, w)
-            res = float(np.max(np.abs(R))) / Fs
-            if not math.isfinite(res):
-                return None
-            if first_res is None:
-                first_res = res
-            elif res > 1e4 * max(first_res, 1e-3):
-                return None  # diverging
-            if it > 0 and res <= opts.residual_tol and step_norm <= opts.step_tol:
-                return _Corrected(y, it, res, Rq, Rw)
-            if it == opts.max_iterations:
-                return None
-            rhs[:n] = -R
-            rhs[n] = -float(t @ (y - y_pred))
-            dy = self._bordered_solve(Rq, Rw, t, rhs)
-            if dy is None:
-                return None
-            y += dy
-            step_norm = float(np.max(np.abs(dy)))
-        return None  # pragma: no cover
 
     def _finish(self, status: Status, message: str = "") -> None:
         self.status = status
@@ -167,14 +107,18 @@ class ContinuationStepper:
             )
             return None
         R, Rq, Rw = self.hb.residual_jacobian(res.q, self.omega0)
-        e = np.zeros(self.hb.size + 1)
-        e[-1] = self._direction
-        t0 = self._tangent(Rq, Rw, e)
+        if self.tangent is not None:
+            reference = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
+            t0: FloatArray | None = reference
+        else:
+            reference = np.zeros(self.hb.size + 1)
+            reference[-1] = self._direction
+            t0 = self.corrector.tangent(Rq, Rw, reference)
         if t0 is None:
             self._finish(Status.START_FAILED, f"singular Jacobian at the start Ω = {self.omega0:g}")
             return None
         self._t = t0
-        self._y = np.concatenate((res.q, [self.omega0])) / self._scale
+        self._y = self.corrector.to_scaled(res.q, self.omega0)
         pt = BranchPoint(res.q, self.omega0, res.iterations, res.residual, self._t.copy(), 0.0)
         self.points.append(pt)
         return pt
@@ -186,6 +130,7 @@ class ContinuationStepper:
         if not self.points:
             return self.start()
         opts = self.options
+        corr_ = self.corrector
         if len(self.points) >= opts.max_points:
             self._finish(Status.MAX_STEPS, f"{Status.MAX_STEPS.message} ({opts.max_points} points, last Ω = {self.points[-1].omega:.6g})")
             return None
@@ -196,15 +141,15 @@ class ContinuationStepper:
         while True:
             ds = self._ds
             y_pred = self._y + ds * self._t
-            corr = self._correct(y_pred, self._t)
-            t_new = None if corr is None else self._tangent(corr.Rq, corr.Rw, self._t)
+            corr = corr_.correct(y_pred, self._t)
+            t_new = None if corr is None else corr_.tangent(corr.Rq, corr.Rw, self._t)
             if corr is not None and t_new is not None:
                 turn = math.acos(min(1.0, float(t_new @ self._t)))
                 if turn <= opts.max_turn or ds <= opts.min_step * 1.0000001:
                     break
             self.rejected += 1
             if ds <= opts.min_step * 1.0000001:
-                q, w = self._unscale(self._y)
+                _, w = corr_.unscale(self._y)
                 self._finish(
                     Status.STEP_TOO_SMALL,
                     f"{Status.STEP_TOO_SMALL.message}: Newton failed to converge beyond Ω = {w:.6g} "
@@ -212,26 +157,22 @@ class ContinuationStepper:
                 )
                 return None
             self._ds = max(opts.min_step, 0.5 * ds)
-        q, w = self._unscale(corr.y)
+        q, w = corr_.unscale(corr.y)
         # Leaving the range: place the last point exactly on the bound and end.
         if w > hi or w < lo:
             bound = hi if w > hi else lo
-            _, w_prev = self._unscale(self._y)
+            _, w_prev = corr_.unscale(self._y)
             frac = (bound - w_prev) / (w - w_prev)
             y_guess = self._y + frac * (corr.y - self._y)
-            end = solve_harmonic_balance(self.hb, self._unscale(y_guess)[0], bound, self.newton)
-            start_side = (bound == lo) == (self._direction > 0)
+            end = solve_harmonic_balance(self.hb, corr_.unscale(y_guess)[0], bound, self.newton)
+            start_side = self._direction != 0.0 and (bound == lo) == (self._direction > 0)
             status = Status.RETURNED if start_side else Status.SUCCESS
             if end.converged:
                 R, Rq, Rw = self.hb.residual_jacobian(end.q, bound)
-                t_end = self._tangent(Rq, Rw, self._t)
-                t_end = t_new if t_end is None else t_end
-                pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_end, ds * frac)
-                self.points.append(pt)
-                self._finish(status)
-                return pt
-            # Keep the point just outside rather than nothing.
-            pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds)
+                t_end = corr_.tangent(Rq, Rw, self._t)
+                pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_new if t_end is None else t_end, ds * frac)
+            else:  # keep the point just outside rather than nothing
+                pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds)
             self.points.append(pt)
             self._finish(status)
             return pt
@@ -243,6 +184,10 @@ class ContinuationStepper:
         f_turn = opts.target_turn / max(turn, 1e-12)
         factor = min(max(min(f_it, f_turn), 0.5), 2.0)
         self._ds = min(opts.max_step, max(opts.min_step, ds * factor))
+        if self.stop is not None:
+            reason = self.stop(pt)
+            if reason:
+                self._finish(Status.STOPPED, reason)
         return pt
 
     def run(self) -> list[BranchPoint]:
