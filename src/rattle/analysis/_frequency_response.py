@@ -12,13 +12,14 @@ from typing import Literal
 import numpy as np
 
 from .._typing import FloatArray
-from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper
+from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
+from ..continuation._detect import LocatedPoint, locate_on_segment
 from ..errors import ConvergenceError, Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
 from ..measures import measures_batch, synthesize_batch
 from ..model import Model
 from ..results import FrequencyResponse, SpecialPoint
-from ..stability import classify_loss, hill_multipliers, monodromy_batch, multipliers_from_monodromy
+from ..stability import classify_loss, hill_multipliers, monodromy, monodromy_batch, multipliers_from_monodromy
 from ..stability._classify import UNIT_CIRCLE_TOL
 
 logger = logging.getLogger("rattle")
@@ -75,18 +76,80 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
     )
 
 
-def _bifurcations(stable: np.ndarray, mu: np.ndarray, branch: np.ndarray, omega: FloatArray) -> tuple[np.ndarray, list[SpecialPoint]]:
-    labels = np.full(stable.size, "", dtype=object)
-    special: list[SpecialPoint] = []
+def _test_function(kind: str, hb: HarmonicBalance, corrector: ArclengthCorrector):
+    """ψ(q, Ω, corrected, d) whose sign change marks a ``kind`` point (see continuation._detect)."""
+    model = hb.model
+    st = model.elastic.stages
+
+    def mono(q: FloatArray, omega: float) -> FloatArray:
+        return monodromy(hb.basis, q, omega / hb.period, st.breakpoints, model.k * st.slopes, model.c)
+
+    if kind == "fold":
+        def plus_one(q, w, corr, d):  # det(M − I)
+            M = mono(q, w)
+            return 1.0 - np.trace(M) + np.linalg.det(M)
+        return plus_one
+    if kind == "period_doubling":
+        def minus_one(q, w, corr, d):  # det(M + I)
+            M = mono(q, w)
+            return 1.0 + np.trace(M) + np.linalg.det(M)
+        return minus_one
+
+    def unit_modulus(q, w, corr, d):  # det M − 1: a complex pair on the unit circle
+        return np.linalg.det(mono(q, w)) - 1.0
+    return unit_modulus
+
+
+def _pad(q: FloatArray, H: int, H2: int) -> FloatArray:
+    """Coefficients of H harmonics written in a basis of H2 ≥ H harmonics (zeros above H)."""
+    out = np.zeros(2 * H2 + 1)
+    out[: H + 1] = q[: H + 1]
+    out[H2 + 1 : H2 + 1 + H] = q[H + 1 :]
+    return out
+
+
+def _locate_with(hb: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
+    corrector = ArclengthCorrector(hb, newton)
+    return locate_on_segment(corrector, qa, wa, qb, wb, _test_function(kind, hb, corrector))
+
+
+def _refine(hb: HarmonicBalance, hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
+    """Locate the same special point with the doubled harmonic count hb2: the end points are
+    first corrected onto the 2H branch (in the plane normal to the secant)."""
+    H, H2 = hb.basis.harmonics, hb2.basis.harmonics
+    corr2 = ArclengthCorrector(hb2, newton)
+    ya = corr2.to_scaled(_pad(qa, H, H2), wa)
+    yb = corr2.to_scaled(_pad(qb, H, H2), wb)
+    d = (yb - ya) / np.linalg.norm(yb - ya)
+    ca, cb = corr2.correct(ya, d), corr2.correct(yb, d)
+    if ca is None or cb is None:
+        return None
+    qa2, wa2 = corr2.unscale(ca.y)
+    qb2, wb2 = corr2.unscale(cb.y)
+    return _locate_with(hb2, newton, kind, qa2, wa2, qb2, wb2)
+
+
+def _locate_changes(
+    hb: HarmonicBalance, newton: NewtonOptions, Q: FloatArray, Om: FloatArray, mu: np.ndarray, stable: np.ndarray,
+    refine: bool,
+) -> list[tuple[int, str, LocatedPoint | None, float | None]]:
+    """For each change of stability between rows i−1 and i: (i, kind, located point or None,
+    Ω located again with 2H harmonics or None)."""
+    found = []
+    hb2 = None
     for i in range(1, stable.size):
-        if branch[i] != branch[i - 1] or stable[i] == stable[i - 1]:
+        if stable[i] == stable[i - 1]:
             continue
         kind = classify_loss(mu[i - 1], mu[i])
-        # Label the one of the two points whose critical multiplier is closer to the circle.
-        j = i if abs(np.max(np.abs(mu[i])) - 1.0) <= abs(np.max(np.abs(mu[i - 1])) - 1.0) else i - 1
-        labels[j] = kind
-        special.append(SpecialPoint(kind, j, float(omega[j]), int(branch[j]), mu[j].copy()))
-    return labels, special
+        loc = _locate_with(hb, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
+        omega2 = None
+        if loc is not None and refine:
+            if hb2 is None:
+                hb2 = HarmonicBalance(hb.model, HBOptions(harmonics=2 * hb.basis.harmonics), period=hb.period)
+            loc2 = _refine(hb, hb2, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
+            omega2 = None if loc2 is None else loc2.omega
+        found.append((i, kind, loc, omega2))
+    return found
 
 
 def frequency_response(
@@ -145,7 +208,7 @@ def frequency_response(
     status = stepper.status or Status.START_FAILED
     logger.info("continuation: %d points, %s (%s)", len(points), status.name, stepper.message)
     result = assemble(
-        model, hb, points, stability=stability, status=status, message=stepper.message,
+        model, hb, points, stability=stability, newton=newton_opts, status=status, message=stepper.message,
         settings={
             "omega": [lo, hi], "harmonics": harmonics, "samples": hb.basis.samples, "period": period,
             "start": start, "start_solution": how, "stability": stability,
@@ -159,6 +222,16 @@ def frequency_response(
     return result
 
 
+def _multipliers(model: Model, hb: HarmonicBalance, Q: FloatArray, Om: FloatArray, X: FloatArray, stability: StabilityMethod) -> np.ndarray:
+    P = Q.shape[0]
+    if P == 0:
+        return np.zeros((0, 2), dtype=complex)
+    if stability == "monodromy":
+        st = model.elastic.stages
+        return multipliers_from_monodromy(monodromy_batch(Q, Om / hb.period, X, st.breakpoints, model.k * st.slopes, model.c))
+    return np.array([hill_multipliers(hb, q, om) for q, om in zip(Q, Om)]).reshape(P, 2)
+
+
 def assemble(
     model: Model,
     hb: HarmonicBalance,
@@ -166,31 +239,74 @@ def assemble(
     *,
     branch_id: int = 0,
     stability: StabilityMethod = "monodromy",
+    locate: bool = True,
+    refine: bool = True,
+    newton: NewtonOptions | None = None,
     status: Status = Status.SUCCESS,
     message: str = "",
     settings: dict | None = None,
     timings: dict | None = None,
 ) -> FrequencyResponse:
-    """Stability, measures and labels for the points of one branch -> FrequencyResponse."""
+    """Stability, located special points, measures and labels for the points of one branch.
+
+    Where stability changes between two points, the special point is located on the branch
+    (``locate=True``; see ``continuation._detect``) and inserted between them as a row of its
+    own, labelled with its type; its ``stable`` is false (a multiplier sits on the unit circle).
+    Without ``locate`` (or if locating fails) the nearer of the two points is labelled.
+    With ``refine`` the special point is located once more with 2H harmonics: its
+    ``SpecialPoint.omega`` is that value and ``omega_error`` = |Ω(2H) − Ω(H)| estimates the
+    truncation error of the row's Ω (the row itself stays the H-harmonic solution).
+    """
     t0 = time.perf_counter()
+    newton = newton or NewtonOptions()
     P = len(points)
     n = hb.size
     Q = np.array([p.q for p in points]).reshape(P, n)
     Om = np.array([p.omega for p in points], dtype=float)
-    w = Om / hb.period
+    its = np.array([p.iterations for p in points], dtype=int)
+    res = np.array([p.residual for p in points], dtype=float)
     X = synthesize_batch(Q, hb.basis.samples) if P else np.zeros((0, hb.basis.samples))
-    if P == 0:
-        mu = np.zeros((0, 2), dtype=complex)
-    elif stability == "monodromy":
-        st = model.elastic.stages
-        mu = multipliers_from_monodromy(monodromy_batch(Q, w, X, st.breakpoints, model.k * st.slopes, model.c))
-    else:
-        mu = np.array([hill_multipliers(hb, q, om) for q, om in zip(Q, Om)]).reshape(P, 2)
-    t1 = time.perf_counter()
+    mu = _multipliers(model, hb, Q, Om, X, stability)
     stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL if P else np.zeros(0, dtype=bool)
-    branch = np.full(P, branch_id, dtype=int)
-    labels, special = _bifurcations(stable, mu, branch, Om)
-    meas = measures_batch(model, Q, w, Om, X) if P else None
+    labels = np.full(P, "", dtype=object)
+    changes = _locate_changes(hb, newton, Q, Om, mu, stable, refine) if locate and stability == "monodromy" else [
+        (i, classify_loss(mu[i - 1], mu[i]), None, None) for i in range(1, P) if stable[i] != stable[i - 1]
+    ]
+    # Insert the located points (in reverse so that the indices stay valid).
+    inserted = np.zeros(P, dtype=bool)
+    refined: dict[int, float] = {}
+    for i, kind, loc, omega2 in reversed(changes):
+        if loc is None:
+            j = i if abs(np.max(np.abs(mu[i])) - 1.0) <= abs(np.max(np.abs(mu[i - 1])) - 1.0) else i - 1
+            labels[j] = kind
+            continue
+        Q = np.insert(Q, i, loc.q, axis=0)
+        Om = np.insert(Om, i, loc.omega)
+        its = np.insert(its, i, loc.iterations)
+        res = np.insert(res, i, loc.residual)
+        labels = np.insert(labels, i, kind)
+        stable = np.insert(stable, i, False)
+        inserted = np.insert(inserted, i, True)
+        refined = {(k + 1 if k >= i else k): v for k, v in refined.items()}
+        if omega2 is not None:
+            refined[i] = omega2
+    if inserted.any():
+        X = synthesize_batch(Q, hb.basis.samples)
+        mu_new = _multipliers(model, hb, Q[inserted], Om[inserted], X[inserted], stability)
+        mu_full = np.empty((Q.shape[0], 2), dtype=complex)
+        mu_full[~inserted] = mu
+        mu_full[inserted] = mu_new
+        mu = mu_full
+    P = Q.shape[0]
+    special = [
+        SpecialPoint(
+            str(labels[j]), j, float(refined.get(j, Om[j])), branch_id, mu[j].copy(), located=bool(inserted[j]),
+            omega_error=abs(refined[j] - float(Om[j])) if j in refined else None,
+        )
+        for j in range(P) if labels[j]
+    ]
+    t1 = time.perf_counter()
+    meas = measures_batch(model, Q, Om / hb.period, Om, X) if P else None
     t2 = time.perf_counter()
     empty = np.zeros(0)
     timings = dict(timings or {})
@@ -198,7 +314,7 @@ def assemble(
     return FrequencyResponse(
         model=model,
         harmonics=hb.basis.harmonics,
-        branch=branch,
+        branch=np.full(P, branch_id, dtype=int),
         period=np.full(P, hb.period, dtype=int),
         omega=Om,
         mean=meas.mean if meas else empty,
@@ -211,8 +327,8 @@ def assemble(
         regime=meas.regime if meas else np.zeros(0, dtype=object),
         stable=stable,
         bifurcation=labels,
-        iterations=np.array([p.iterations for p in points], dtype=int),
-        residual=np.array([p.residual for p in points], dtype=float),
+        iterations=its,
+        residual=res,
         coefficients=Q,
         multipliers=mu,
         special_points=tuple(special),

@@ -16,16 +16,20 @@ from ..model import Model
 
 @dataclass(frozen=True, slots=True)
 class SpecialPoint:
-    """A point where stability changes: ``kind`` (fold, period_doubling, neimark_sacker), the
-    row ``index`` of the computed point nearest the change (of the two around it, the one whose
-    critical multiplier is closer to the unit circle), its ``omega``, ``branch`` and the
-    ``multipliers`` there."""
+    """A point where stability changes: ``kind`` (fold, period_doubling, neimark_sacker), its
+    row ``index`` in the result, ``omega``, ``branch`` and ``multipliers``. ``located`` is true
+    when the point was located on the branch by solving the test function (a row of its own);
+    otherwise it is the computed point nearest the change. When the location was repeated with
+    twice the harmonics, ``omega`` is that value and ``omega_error`` = |Ω(2H) − Ω(H)| estimates
+    the truncation error of the row's Ω."""
 
     kind: str
     index: int
     omega: float
     branch: int
     multipliers: ComplexArray
+    located: bool = False
+    omega_error: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -129,7 +133,7 @@ class FrequencyResponse:
             "message": self.message or self.status.message,
             "points": len(self),
             "special_points": [
-                {"kind": s.kind, "omega": s.omega, "branch": s.branch, "index": s.index,
+                {"kind": s.kind, "omega": s.omega, "branch": s.branch, "index": s.index, "located": s.located, "omega_error": s.omega_error,
                  "multipliers": [[float(m.real), float(m.imag)] for m in s.multipliers]}
                 for s in self.special_points
             ],

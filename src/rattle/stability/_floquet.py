@@ -112,8 +112,10 @@ def crossing_times_batch(
             t_new = ta - f / fp
         bad = ~np.isfinite(t_new) | (t_new <= a[active]) | (t_new >= b[active])
         t_new = np.where(bad, 0.5 * (a[active] + b[active]), t_new)
+        exact = f == 0.0  # landed on the root: keep it (the bracket test would move it)
+        t_new = np.where(exact, ta, t_new)
         t[active] = t_new
-        moving = (np.abs(t_new - ta) > tol[active]) & (f != 0)
+        moving = (np.abs(t_new - ta) > tol[active]) & ~exact
         active = active[moving]
         if active.size == 0:
             break
