@@ -27,3 +27,11 @@ def reference_frf(reference_model):
     from rattle import frequency_response
 
     return frequency_response(reference_model, omega=(0.1, 3.0), harmonics=32)
+
+
+@pytest.fixture(scope="session")
+def reference_frf_all(reference_model):
+    """The reference case with its period-doubled branches, computed once per test session."""
+    from rattle import frequency_response
+
+    return frequency_response(reference_model, omega=(0.1, 3.0), harmonics=32, subharmonics=True)

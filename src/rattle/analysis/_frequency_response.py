@@ -163,10 +163,16 @@ def frequency_response(
     stability: StabilityMethod = "monodromy",
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
+    subharmonics: bool = False,
+    max_period: int = 4,
     throw: bool = True,
     callback: Callable[[BranchPoint], None] | None = None,
 ) -> FrequencyResponse:
     """Non-linear frequency response of ``model`` over ``omega`` = (Ω_min, Ω_max) rad/s.
+
+    With ``subharmonics=True`` every period-doubling point found is followed onto the branch
+    of doubled period (branch switching), recursively up to solutions of period
+    ``max_period``; all branches are returned together (columns ``branch`` and ``period``).
 
     Harmonic balance with ``harmonics`` harmonics of the solution's base frequency Ω/``period``
     (AFT with ``samples`` time samples per period, default :func:`~rattle.hb.default_samples`),
@@ -217,6 +223,17 @@ def frequency_response(
         },
         timings={"continuation": t_cont - t_start},
     )
+    if subharmonics and status.success:
+        if isinstance(max_period, bool) or not isinstance(max_period, int) or max_period < 1:
+            raise ValueError(f"`max_period` must be an integer >= 1, got {max_period!r}")
+        from ._branches import period_doubling_branches
+
+        t_sub = time.perf_counter()
+        extra = period_doubling_branches(result, (lo, hi), max_period=max_period, continuation=cont_opts, newton=newton_opts)
+        timings = dict(result.timings)
+        timings["subharmonics"] = time.perf_counter() - t_sub
+        settings = dict(result.settings, subharmonics=True, max_period=max_period)
+        result = FrequencyResponse.concatenate([result, *extra], settings=settings, timings=timings)
     if throw and not status.success:
         raise ConvergenceError(f"frequency response incomplete: {stepper.message}", partial=result)
     return result
@@ -241,6 +258,7 @@ def assemble(
     stability: StabilityMethod = "monodromy",
     locate: bool = True,
     refine: bool = True,
+    branch_points: tuple[bool, bool] = (False, False),
     newton: NewtonOptions | None = None,
     status: Status = Status.SUCCESS,
     message: str = "",
@@ -256,6 +274,9 @@ def assemble(
     With ``refine`` the special point is located once more with 2H harmonics: its
     ``SpecialPoint.omega`` is that value and ``omega_error`` = |Ω(2H) − Ω(H)| estimates the
     truncation error of the row's Ω (the row itself stays the H-harmonic solution).
+    ``branch_points`` (first, last) marks end rows that are period-doubling points of another
+    branch (a branch born by period doubling): they are labelled so, and the change of
+    stability through them (the multiplier −1 of the parent is +1 here) is not reported again.
     """
     t0 = time.perf_counter()
     newton = newton or NewtonOptions()
@@ -269,9 +290,21 @@ def assemble(
     mu = _multipliers(model, hb, Q, Om, X, stability)
     stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL if P else np.zeros(0, dtype=bool)
     labels = np.full(P, "", dtype=object)
-    changes = _locate_changes(hb, newton, Q, Om, mu, stable, refine) if locate and stability == "monodromy" else [
-        (i, classify_loss(mu[i - 1], mu[i]), None, None) for i in range(1, P) if stable[i] != stable[i - 1]
+    # A branch-point end row takes the stability of its neighbour for the change detection.
+    stable_for_changes = stable.copy()
+    if P > 1 and branch_points[0]:
+        labels[0] = "period_doubling"
+        stable_for_changes[0] = stable[1]
+    if P > 1 and branch_points[1]:
+        labels[P - 1] = "period_doubling"
+        stable_for_changes[P - 1] = stable[P - 2]
+    changes = _locate_changes(hb, newton, Q, Om, mu, stable_for_changes, refine) if locate and stability == "monodromy" else [
+        (i, classify_loss(mu[i - 1], mu[i]), None, None) for i in range(1, P) if stable_for_changes[i] != stable_for_changes[i - 1]
     ]
+    if P > 1 and branch_points[0]:
+        stable[0] = False  # a multiplier on the unit circle
+    if P > 1 and branch_points[1]:
+        stable[P - 1] = False
     # Insert the located points (in reverse so that the indices stay valid).
     inserted = np.zeros(P, dtype=bool)
     refined: dict[int, float] = {}
@@ -298,9 +331,12 @@ def assemble(
         mu_full[inserted] = mu_new
         mu = mu_full
     P = Q.shape[0]
+    ends = {0} if P > 1 and branch_points[0] else set()
+    if P > 1 and branch_points[1]:
+        ends.add(P - 1)
     special = [
         SpecialPoint(
-            str(labels[j]), j, float(refined.get(j, Om[j])), branch_id, mu[j].copy(), located=bool(inserted[j]),
+            str(labels[j]), j, float(refined.get(j, Om[j])), branch_id, mu[j].copy(), located=bool(inserted[j]) or j in ends,
             omega_error=abs(refined[j] - float(Om[j])) if j in refined else None,
         )
         for j in range(P) if labels[j]

@@ -98,7 +98,19 @@ class ContinuationStepper:
 
     # --- public ----------------------------------------------------------------------------
     def start(self) -> BranchPoint | None:
-        """Converge the first point at ``omega0`` and compute its tangent."""
+        """Converge the first point at ``omega0`` and compute its tangent.
+
+        A start given with a ``tangent`` that already solves R = 0 (e.g. a located branch point,
+        where ∂R/∂q is singular and a Newton step would be ill-posed) is taken as it is.
+        """
+        if self.tangent is not None:
+            r0 = float(np.max(np.abs(self.hb.residual(self.q0, self.omega0)))) / self.hb.force_scale
+            if r0 <= self.newton.residual_tol:
+                self._t = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
+                self._y = self.corrector.to_scaled(np.asarray(self.q0, dtype=float), self.omega0)
+                pt = BranchPoint(np.array(self.q0, dtype=float), self.omega0, 0, r0, self._t.copy(), 0.0)
+                self.points.append(pt)
+                return pt
         res = solve_harmonic_balance(self.hb, self.q0, self.omega0, self.newton)
         if not res.converged:
             self._finish(

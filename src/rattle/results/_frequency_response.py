@@ -59,7 +59,8 @@ class FrequencyResponse:
     """Solutions along one or more branches, one row per point in continuation order.
 
     Columns (numpy arrays of length P): SPEC §3 ``FRF_COLUMNS``. Also ``coefficients`` (P, 2H+1)
-    Fourier coefficients [a_0, a_1 … a_H, b_1 … b_H] of δ over the solution period, and
+    Fourier coefficients [a_0, a_1 … a_H, b_1 … b_H] of δ over the solution period (base
+    frequency Ω/period; branches computed with fewer harmonics are padded with zeros), and
     ``multipliers`` (P, 2) Floquet multipliers, largest modulus first.
     """
 
@@ -138,6 +139,53 @@ class FrequencyResponse:
                 for s in self.special_points
             ],
         }
+
+    @classmethod
+    def concatenate(cls, parts: "list[FrequencyResponse]", *, status: Status | None = None, message: str = "",
+                    settings: dict[str, Any] | None = None, timings: dict[str, float] | None = None) -> "FrequencyResponse":
+        """Join results of one model (e.g. the primary and the sub-harmonic branches) row-wise;
+        coefficients are padded to the largest harmonic count, special points re-indexed."""
+        if not parts:
+            raise ValueError("`parts` must hold at least one FrequencyResponse")
+        model = parts[0].model
+        H = max(p.harmonics for p in parts)
+
+        def pad(p: "FrequencyResponse") -> FloatArray:
+            h = p.harmonics
+            out = np.zeros((len(p), 2 * H + 1))
+            out[:, : h + 1] = p.coefficients[:, : h + 1]
+            out[:, H + 1 : H + 1 + h] = p.coefficients[:, h + 1 :]
+            return out
+
+        offsets = np.cumsum([0] + [len(p) for p in parts[:-1]])
+        special = tuple(
+            SpecialPoint(sp.kind, sp.index + int(off), sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error)
+            for p, off in zip(parts, offsets) for sp in p.special_points
+        )
+        cat = {name: np.concatenate([getattr(p, name) for p in parts]) for name in (
+            "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max",
+            "regime", "stable", "bifurcation", "iterations", "residual", "multipliers")}
+        return cls(
+            model=model, harmonics=H, coefficients=np.concatenate([pad(p) for p in parts]), special_points=special,
+            status=status or parts[0].status, message=message or parts[0].message,
+            settings=dict(settings or parts[0].settings), timings=dict(timings or parts[0].timings), **cat,
+        )
+
+    def select(self, branch: int) -> "FrequencyResponse":
+        """The rows of one branch as a result of its own (special points re-indexed)."""
+        rows = np.nonzero(self.branch == branch)[0]
+        if rows.size == 0:
+            raise ValueError(f"`branch` {branch} is not in this result (branches: {sorted(set(self.branch.tolist()))})")
+        first = int(rows[0])
+        fields = {name: getattr(self, name)[rows] for name in (
+            "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max",
+            "regime", "stable", "bifurcation", "iterations", "residual", "multipliers", "coefficients")}
+        special = tuple(
+            SpecialPoint(sp.kind, sp.index - first, sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error)
+            for sp in self.special_points if sp.branch == branch
+        )
+        return type(self)(model=self.model, harmonics=self.harmonics, special_points=special, status=self.status,
+                          message=self.message, settings=self.settings, timings=self.timings, **fields)
 
     # --- derived quantities ----------------------------------------------------------------
     def base_frequency(self, index: int) -> float:

@@ -1,0 +1,86 @@
+"""Period doubling located against the exact reference; branch switching to period-2 branches."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.optimize
+
+from rattle.timeint import ExactIntegrator, shoot_periodic_orbit
+from test_crossval import _hb_state0, compare_with_shooting, check_stability
+
+
+def _exact_period_doubling(model, omega_guess, x0, integ, half_width=2e-3):
+    """Ω where the exact orbit's monodromy has a multiplier at −1: det(M + I) = 0, by Brent
+    on Ω with exact shooting (the period-1 orbit exists on both sides of a period doubling)."""
+
+    def psi(w):
+        orbit = shoot_periodic_orbit(model, w, x0, integrator=integ)
+        assert orbit.converged
+        M = orbit.monodromy
+        return 1.0 + np.trace(M) + np.linalg.det(M)
+
+    return scipy.optimize.brentq(psi, omega_guess - half_width, omega_guess + half_width, xtol=1e-13)
+
+
+def test_period_doublings_located_to_1e6_of_the_exact_reference(reference_frf):
+    frf = reference_frf
+    integ = ExactIntegrator(frf.model)
+    pds = [s for s in frf.special_points if s.kind == "period_doubling"]
+    assert len(pds) == 4  # two bound the region near 0.44, two the region above 1.2
+    for sp in pds:
+        assert sp.located and sp.omega_error is not None
+        exact = _exact_period_doubling(frf.model, sp.omega, _hb_state0(frf, sp.index), integ)
+        # Located with 2H = 64 harmonics: measured |ΔΩ| ≤ 2.6e-7 (the H = 32 location is within
+        # 2.2e-6, which omega_error reports).
+        assert abs(sp.omega - exact) < 1e-6, (sp.omega, exact)
+        assert abs(sp.multipliers[0] + 1.0) < 1e-6  # the row's multiplier sits at −1
+
+
+def test_fold_rows_sit_on_the_exact_folds(reference_frf):
+    """The located upper and lower folds of the primary resonance: an exact orbit exists within
+    1e-5 in Ω (measured ~1e-6), and none a little beyond (the branch has turned)."""
+    frf = reference_frf
+    integ = ExactIntegrator(frf.model)
+    folds = [s for s in frf.special_points if s.kind == "fold" and s.omega > 0.7]
+    assert len(folds) == 2
+    for sp in folds:
+        x0 = _hb_state0(frf, sp.index)
+        # Which side of the fold the branch lives on: the neighbours' Ω.
+        side = np.sign(frf.omega[sp.index - 1] - frf.omega[sp.index])
+        inside = shoot_periodic_orbit(frf.model, sp.omega + side * 1e-5, x0, integrator=integ)
+        assert inside.converged
+
+
+def test_period_doubled_branches_found_and_joined(reference_frf_all):
+    frf = reference_frf_all
+    p2 = sorted(set(frf.branch[frf.period == 2].tolist()))
+    assert len(p2) == 2  # one branch per period-doubling region, each found once
+    for b in p2:
+        sub = frf.select(b)
+        # Born at one period doubling of the primary branch and rejoining it at the other.
+        assert sub.bifurcation[0] == "period_doubling" and sub.bifurcation[-1] == "period_doubling"
+        ends = sorted([sub.omega[0], sub.omega[-1]])
+        assert (0.40 < ends[0] < 0.41 and 0.46 < ends[1] < 0.47) or (1.24 < ends[0] < 1.25 and 1.95 < ends[1] < 1.97)
+    b_high = [b for b in p2 if frf.select(b).omega.max() > 1.0][0]
+    sub = frf.select(b_high)
+    # The sub-harmonic resonance near Ω = 1.4 (the paper's point "B"): stable period-2 motion.
+    near = np.abs(sub.omega - 1.41) < 0.01
+    assert near.any() and sub.stable[near].any()
+
+
+@pytest.mark.slow
+def test_period_two_branches_against_period_two_shooting(reference_frf_all):
+    frf = reference_frf_all
+    rows = np.nonzero(frf.period == 2)[0]
+    idx = rows[::4]
+    err, mu = compare_with_shooting(frf, idx)
+    assert err.max() < 1e-3, err.max()
+    assert check_stability(frf, idx, mu, margin=1e-2) > 0.8 * len(idx)
+
+
+def test_no_neimark_sacker_on_any_branch(reference_frf_all):
+    # A single-DOF system has det M = exp(−c T) < 1 for every orbit (any period).
+    assert "neimark_sacker" not in set(reference_frf_all.bifurcation)
+    T = 2 * np.pi * reference_frf_all.period / reference_frf_all.omega
+    np.testing.assert_allclose(np.prod(reference_frf_all.multipliers, axis=1).real, np.exp(-0.05 * T), rtol=1e-9)
