@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import os
 import sys
 import time
@@ -335,6 +336,308 @@ def demo_command(output: Path) -> None:
         model, analysis, output,
         {"command": "demo", "config": model_to_toml_dict(model, analysis), "analysis": analysis.to_dict()},
     )
+
+
+# --------------------------------------------------------------------------------------------
+# Time-domain commands: sweep, orbit, compare
+# --------------------------------------------------------------------------------------------
+#: Largest period (multiple of the forcing period) that ``rattle orbit --period`` accepts.
+MAX_PERIOD = 8
+_DIRECTIONS = ("up", "down", "both")
+
+_harmonics_option = click.option(
+    "--harmonics", type=int, default=None, metavar="H",
+    help="Harmonics kept in the harmonic balance (>= 1); overrides analysis.harmonics.",
+)
+_omega_min_option = click.option(
+    "--omega-min", type=float, default=None, metavar="X",
+    help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega[0].",
+)
+_omega_max_option = click.option(
+    "--omega-max", type=float, default=None, metavar="Y",
+    help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].",
+)
+_quiet_option = click.option(
+    "-q", "--quiet", is_flag=True,
+    help="No progress bar (there is none anyway when stderr is not a terminal).",
+)
+
+
+def check_points(points: int) -> int:
+    """``--points`` N: an integer >= 2 (a sweep needs two frequencies)."""
+    if points < 2:
+        raise ConfigError(
+            f"`--points` must be an integer >= 2 (frequencies per sweep direction), got {points}; use e.g. 200"
+        )
+    return points
+
+
+def check_workers(workers: int) -> int:
+    """``--workers``: an integer >= 1 (2 runs the up and down sweeps at once)."""
+    if workers < 1:
+        raise ConfigError(f"`--workers` must be an integer >= 1, got {workers}; use 1 (serial) or 2")
+    return workers
+
+
+def check_omega(omega: float, option: str = "--omega") -> float:
+    """A forcing frequency given on the command line: finite and > 0 rad/s."""
+    if not (math.isfinite(omega) and omega > 0.0):
+        raise ConfigError(f"`{option}` must be a finite forcing frequency > 0 rad/s, got {omega!r}; use e.g. 0.8")
+    return omega
+
+
+def check_period(period: int, harmonics: int, forced: int) -> int:
+    """``--period`` N: an integer 1 … 8 that the harmonic balance can hold with ``harmonics``."""
+    if not 1 <= period <= MAX_PERIOD:
+        raise ConfigError(
+            f"`--period` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), got {period}; "
+            "use 1 for the primary response, n for a 1/n sub-harmonic"
+        )
+    if harmonics < forced * period:
+        raise ConfigError(
+            f"`--harmonics` must be >= {forced * period} to hold the excitation's harmonic {forced} at "
+            f"`--period` {period}, got {harmonics}; raise `--harmonics`"
+        )
+    return period
+
+
+def parse_at(text: str | None, omega_min: float, omega_max: float) -> list[float] | None:
+    """``--at W1,W2,…``: comma-separated frequencies within the analysis range (rad/s)."""
+    if text is None:
+        return None
+    parts = [p.strip() for p in text.split(",")]
+    if not parts or any(not p for p in parts):
+        raise ConfigError(f"`--at` must be a comma-separated list of frequencies such as 0.8,1.4, got {text!r}")
+    values = []
+    for part in parts:
+        try:
+            value = float(part)
+        except ValueError:
+            raise ConfigError(f"`--at` must hold numbers (rad/s), got {part!r} in {text!r}") from None
+        if not (math.isfinite(value) and omega_min <= value <= omega_max):
+            raise ConfigError(
+                f"`--at` frequencies must be finite and within the analysis range {omega_min:g} … "
+                f"{omega_max:g} rad/s, got {part!r}; choose frequencies inside the range or widen it"
+            )
+        values.append(value)
+    return values
+
+
+class _ProgressBar:
+    """``callback(done, total)`` drawing a tqdm bar on stderr; a no-op when stderr is not a
+    terminal, with ``--quiet``, or without tqdm. The library never draws one itself."""
+
+    def __init__(self, description: str, enabled: bool) -> None:
+        self.description = description
+        self.enabled = enabled and sys.stderr.isatty()
+        self._bar: Any = None
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled:
+            return
+        if self._bar is None:
+            try:
+                from tqdm import tqdm
+            except ImportError:  # pragma: no cover - tqdm is a dependency
+                self.enabled = False
+                return
+            self._bar = tqdm(total=total, desc=self.description, unit="Ω", file=sys.stderr, leave=False,
+                             dynamic_ncols=True)
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+
+def _write_outputs(output: Path, steps: list[tuple[str, Any]]) -> list[str]:
+    """Run each (file name, writer(path) -> bool | None) into ``output``; return the names written.
+
+    Data files should come first so that they exist even if drawing a figure fails; a writer
+    returning False wrote nothing (e.g. no matplotlib).
+    """
+    written: list[str] = []
+    try:
+        output.mkdir(parents=True, exist_ok=True)
+        for name, writer in steps:
+            if writer(output / name) is not False:
+                written.append(name)
+    except OSError as exc:
+        where = f"{exc.filename}" if exc.filename else str(output)
+        raise click.ClickException(f"cannot write {where}: {exc.strerror or exc}") from exc
+    return written
+
+
+def _metadata_writer(meta: dict[str, Any], sections: dict[str, Any], t_start: float) -> Any:
+    def write(path: Path) -> None:
+        doc = dict(meta)
+        timings = dict(doc.pop("timings", None) or {})
+        timings["cli_wall_time"] = time.perf_counter() - t_start
+        write_metadata(path, **{**doc, **sections, "timings": timings})
+
+    return write
+
+
+def _sections(command: str, config: Path, run_config: Any, analysis: AnalysisSettings, options: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "command": command,
+        "config_file": os.fspath(config),
+        "config": run_config.source,
+        "options": {k: v for k, v in options.items() if v is not None},
+        "analysis": analysis.to_dict(),
+    }
+
+
+@cli.command("sweep", short_help="Time-domain frequency sweep (steady state at each frequency).")
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--direction", type=click.Choice(_DIRECTIONS), default=None,
+              help="Required: sweep up (run-up), down (run-down) or both, the state carried from each "
+                   "frequency to the next.")
+@click.option("--points", type=int, default=200, show_default=True, metavar="N",
+              help="Equally spaced frequencies per direction (>= 2).")
+@click.option("--workers", type=int, default=1, show_default=True, metavar="W",
+              help="Processes: 2 runs the up and down sweeps of --direction both at once.")
+@_omega_min_option
+@_omega_max_option
+@_quiet_option
+def sweep_command(
+    config: Path, output: Path, direction: str | None, points: int, workers: int,
+    omega_min: float | None, omega_max: float | None, quiet: bool,
+) -> None:
+    """Time-domain frequency sweep of the model in CONFIG: sweep.csv, sweep.png, sweep.json in OUTPUT.
+
+    At N equally spaced frequencies the motion is simulated exactly until it settles (period
+    1 … 8 of the forcing period, or 0 when none is found), the state carried from one frequency
+    to the next as in a run-up or run-down.
+    """
+    if direction is None:  # checked here: click's own message for a missing choice spans lines
+        raise ConfigError("`--direction` is required: give --direction up, down or both")
+    run_config = load_config(config)
+    analysis = override_analysis(run_config.analysis, omega_min=omega_min, omega_max=omega_max)
+    check_points(points)
+    check_workers(workers)
+    check_output_dir(output)
+    t_start = time.perf_counter()
+    from ..analysis import time_sweep  # only now: all input has been validated
+
+    bar = _ProgressBar(f"sweep {direction}", enabled=not quiet)
+    try:
+        result = time_sweep(run_config.model, omega=analysis.omega, points=points, direction=direction,
+                            workers=workers, callback=bar)
+    finally:
+        bar.close()
+    sections = _sections("sweep", config, run_config, analysis, {
+        "direction": direction, "points": points, "workers": workers,
+        "omega_min": omega_min, "omega_max": omega_max,
+    })
+    written = _write_outputs(output, [
+        ("sweep.csv", result.to_csv),
+        ("sweep.json", _metadata_writer(result.metadata(), sections, t_start)),
+        ("sweep.png", lambda path: _save_plot(result, path)),
+    ])
+    click.echo(result.summary())
+    click.echo(f"wrote {', '.join(written)} to {output}")
+
+
+@cli.command("orbit", short_help="Every periodic orbit at one forcing frequency, against the simulation.")
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--omega", "omega", type=float, required=True, metavar="W",
+              help="Forcing frequency in rad/s (finite, > 0).")
+@click.option("--period", type=int, default=1, show_default=True, metavar="N",
+              help=f"Period of the orbit as a multiple of the forcing period, 1 … {MAX_PERIOD} (N: a 1/N sub-harmonic).")
+@_harmonics_option
+@_omega_min_option
+@_omega_max_option
+def orbit_command(
+    config: Path, output: Path, omega: float, period: int, harmonics: int | None,
+    omega_min: float | None, omega_max: float | None,
+) -> None:
+    """Periodic orbits at the forcing frequency W for the model in CONFIG: orbit.csv, orbit.png,
+    orbit.json in OUTPUT.
+
+    Every coexisting harmonic-balance solution at W is found (the primary branch is followed over
+    the analysis range, widened to include W; sub-harmonics are seeded from a simulation) and its
+    stability computed. orbit.csv holds t, delta, velocity, acceleration over one period of the
+    selected solution: the stable one closest in rms to the simulated steady state (preferring
+    the requested period); orbit.json lists them all.
+    """
+    run_config = load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    check_omega(omega)
+    check_period(period, analysis.harmonics, len(run_config.model.excitation.amplitudes))
+    check_output_dir(output)
+    t_start = time.perf_counter()
+    from ..analysis import periodic_orbit  # only now: all input has been validated
+
+    result = periodic_orbit(run_config.model, omega, period=period, harmonics=analysis.harmonics,
+                            search_range=analysis.omega)
+    sections = _sections("orbit", config, run_config, analysis, {
+        "omega": omega, "period": period, "harmonics": harmonics,
+        "omega_min": omega_min, "omega_max": omega_max,
+    })
+    written = _write_outputs(output, [
+        ("orbit.csv", result.to_csv),
+        ("orbit.json", _metadata_writer(result.metadata(), sections, t_start)),
+        ("orbit.png", lambda path: _save_plot(result, path)),
+    ])
+    click.echo(result.summary())
+    click.echo(f"wrote {', '.join(written)} to {output}")
+
+
+@cli.command("compare", short_help="Frequency response and time-domain sweep together.")
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--points", type=int, default=200, show_default=True, metavar="N",
+              help="Equally spaced frequencies per sweep direction (>= 2).")
+@click.option("--at", "at", type=str, default=None, metavar="W1,W2,...",
+              help="Frequencies (rad/s) for the time-history panels; default: picked automatically "
+                   "(one in the multi-valued region, one where the sweep is not period 1).")
+@click.option("--workers", type=int, default=1, show_default=True, metavar="W",
+              help="Processes for the sweep: 2 runs the up and down sweeps at once.")
+@_harmonics_option
+@_omega_min_option
+@_omega_max_option
+@_quiet_option
+def compare_command(
+    config: Path, output: Path, points: int, at: str | None, workers: int, harmonics: int | None,
+    omega_min: float | None, omega_max: float | None, quiet: bool,
+) -> None:
+    """Frequency response against the up/down time-domain sweep for the model in CONFIG:
+    compare.png, frf.csv, sweep.csv, compare.json in OUTPUT."""
+    run_config = load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    check_points(points)
+    check_workers(workers)
+    at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
+    check_output_dir(output)
+    t_start = time.perf_counter()
+    from ..analysis import compare  # only now: all input has been validated
+
+    bar = _ProgressBar("sweep up+down", enabled=not quiet)
+    try:
+        result = compare(run_config.model, omega=analysis.omega, harmonics=analysis.harmonics, points=points,
+                         at=at_values, workers=workers, callback=bar)
+    finally:
+        bar.close()
+    sections = _sections("compare", config, run_config, analysis, {
+        "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
+        "omega_min": omega_min, "omega_max": omega_max,
+    })
+    written = _write_outputs(output, [
+        ("frf.csv", result.frf.to_csv),
+        ("sweep.csv", result.sweep.to_csv),
+        ("compare.json", _metadata_writer(result.metadata(), sections, t_start)),
+        ("compare.png", lambda path: _save_plot(result, path)),
+    ])
+    click.echo(result.summary())
+    click.echo(f"wrote {', '.join(written)} to {output}")
 
 
 def main(argv: Sequence[str] | None = None) -> None:

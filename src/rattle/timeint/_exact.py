@@ -326,7 +326,8 @@ def _vector_bracketed_newton(
         hi[idx] = np.where(neg, hi[idx], x[idx])
         with np.errstate(divide="ignore", invalid="ignore"):
             newton = x[idx] - f / df
-        inside = np.isfinite(newton) & ((newton - lo[idx]) * (newton - hi[idx]) < 0.0)
+        # Closed bracket: a converged Newton step may land on the end just updated (round-off).
+        inside = np.isfinite(newton) & ((newton - lo[idx]) * (newton - hi[idx]) <= 0.0)
         x_new = np.where(inside, newton, 0.5 * (lo[idx] + hi[idx]))
         done = (f == 0.0) | (np.abs(x_new - x[idx]) <= tol[idx]) | (np.abs(hi[idx] - lo[idx]) <= tol[idx])
         x[idx] = np.where(f == 0.0, x[idx], x_new)
@@ -460,27 +461,51 @@ class Trajectory:
         return seg, t, cells
 
     def _extremes(self, order: int, per_scale: float) -> tuple[float, float]:
-        """Min and max of δ^(order) over [t0, t1]: at the segment ends and where δ^(order+1) = 0
-        inside a segment (sign changes on a fine grid, refined by bracketed Newton)."""
+        """Min and max of δ^(order) over [t0, t1] (see :meth:`_extremes_of`)."""
+        return self._extremes_of((order,), per_scale)[0]
+
+    def _extremes_of(self, orders: tuple[int, ...], per_scale: float) -> list[tuple[float, float]]:
+        """Min and max of δ^(order) over [t0, t1] for each of ``orders``: at the segment ends and
+        where δ^(order+1) = 0 inside a segment (sign changes on a fine grid, refined by bracketed
+        Newton, the roots of all orders at once).
+
+        The roots are located to 1e-9 of their grid cell: at an extremum the value is stationary,
+        so a location error ε changes it by ½|δ^(order+2)| ε², far below round-off.
+        """
+        top = max(orders) + 2
         seg, t, _ = self._segment_points(per_scale)
-        vals = self.derivatives(t, order + 2, segment=seg)
-        g, dg = vals[order], vals[order + 1]
+        vals = self.derivatives(t, top, segment=seg)
         same = seg[1:] == seg[:-1]
-        change = same & (((dg[:-1] > 0.0) & (dg[1:] <= 0.0)) | ((dg[:-1] < 0.0) & (dg[1:] >= 0.0)))
-        i = np.flatnonzero(change)
-        cands = [g]
-        if i.size:
-            s = seg[i]
+        brackets = []
+        for k, order in enumerate(orders):
+            dg = vals[order + 1]
+            change = same & (((dg[:-1] > 0.0) & (dg[1:] <= 0.0)) | ((dg[:-1] < 0.0) & (dg[1:] >= 0.0)))
+            i = np.flatnonzero(change)
+            brackets.append((np.full(i.size, k), i, dg[i], dg[i + 1]))
+        which = np.concatenate([b[0] for b in brackets])
+        cells = np.concatenate([b[1] for b in brackets])
+        roots = np.empty(0)
+        if cells.size:
+            fa = np.concatenate([b[2] for b in brackets])
+            fb = np.concatenate([b[3] for b in brackets])
+            s = seg[cells]
+            row = np.asarray(orders)[which] + 1  # δ^(order+1) vanishes; δ^(order+2) is its slope
 
             def fun(x: FloatArray, idx: IntArray) -> tuple[FloatArray, FloatArray]:
-                r = self.derivatives(x, order + 2, segment=s[idx])
-                return r[order + 1], r[order + 2]
+                r = np.asarray(self.derivatives(x, top, segment=s[idx]))
+                cols = np.arange(idx.size)
+                return r[row[idx], cols], r[row[idx] + 1, cols]
 
-            tol = 4.0 * _EPS * np.maximum(np.abs(t[i]), np.abs(t[i + 1]))
-            te = _vector_bracketed_newton(fun, t[i], t[i + 1], dg[i], dg[i + 1], tol)
-            cands.append(self.derivatives(te, order, segment=s)[order])
-        allv = np.concatenate(cands)
-        return float(np.min(allv)), float(np.max(allv))
+            a, b = t[cells], t[cells + 1]
+            tol = 1e-9 * (b - a) + 4.0 * _EPS * np.maximum(np.abs(a), np.abs(b))
+            te = _vector_bracketed_newton(fun, a, b, fa, fb, tol)
+            at_roots = self.derivatives(te, max(orders), segment=s)
+            roots = np.asarray(at_roots)[np.asarray(orders)[which], np.arange(te.size)]
+        out = []
+        for k, order in enumerate(orders):
+            allv = np.concatenate((vals[order], roots[which == k]))
+            out.append((float(np.min(allv)), float(np.max(allv))))
+        return out
 
     def measures(self) -> ExactMeasures:
         """Mean, rms, rms_ac, extremes and peak-to-peak values of δ and δ'' over [t0, t1].
@@ -504,8 +529,7 @@ class Trajectory:
         mean = float(np.sum(wq * dq)) / duration
         ms = float(np.sum(wq * dq * dq)) / duration
         ms_ac = float(np.sum(wq * (dq - mean) ** 2)) / duration
-        dmin, dmax = self._extremes(0, 40.0)
-        amin, amax = self._extremes(2, 40.0)
+        (dmin, dmax), (amin, amax) = self._extremes_of((0, 2), 40.0)
         return ExactMeasures(
             mean=mean, rms=math.sqrt(ms), rms_ac=math.sqrt(ms_ac), delta_min=dmin, delta_max=dmax,
             p2p=dmax - dmin, acc_min=amin, acc_max=amax, acc_p2p=amax - amin,
@@ -640,45 +664,61 @@ class ExactIntegrator:
         if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
             raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
         sol = self.solutions(omega)
-        d, v = float(x0[0]), float(x0[1])
-        j = sol.stage_of(t0, d, v)
-        t = t0
         starts: list[float] = []
         stages: list[int] = []
         states: list[tuple[float, float]] = []
         homog: list[tuple[float, float]] = []
-        m11, m12, m21, m22 = 1.0, 0.0, 0.0, 1.0
-        while True:
-            seg = _Segment(sol, j, t, d, v)
-            tau_c, j_new, d_c, v_c = self._first_exit(seg, t1 - t)
-            if tau_c > 0.0 or (j_new < 0 and not starts):  # zero-length segments (round-off) are dropped
-                starts.append(t)
-                stages.append(j)
-                states.append((d, v))
-                homog.append((seg.h0, seg.h1))
-            f11, f12, f21, f22 = sol.transition_scalar(j, tau_c)
-            m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
-                                  f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
-            if j_new < 0:
-                d, v = d_c, v_c
-                break
-            # Exactly on the breakpoint: snap δ (the root is located to round-off).
-            d = float(sol.upper[j] if j_new > j else sol.lower[j])
-            v = v_c
-            j, t = j_new, t + tau_c
-            if len(starts) > self.max_segments:
-                raise ConvergenceError(
-                    f"more than `max_segments` = {self.max_segments} segments between t0 = {t0!r} and "
-                    f"t1 = {t1!r}: raise `max_segments` or shorten the interval"
-                )
+        d, v, m = self._march(sol, float(x0[0]), float(x0[1]), t0, t1, (starts, stages, states, homog))
         t_start = np.asarray(starts)
         t_end = np.append(t_start[1:], t1)
         return Trajectory(
             omega=float(omega), t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
-            sensitivity=np.array([[m11, m12], [m21, m22]]), t_start=t_start, t_end=t_end,
+            sensitivity=np.array([[m[0], m[1]], [m[2], m[3]]]), t_start=t_start, t_end=t_end,
             stage=np.asarray(stages, dtype=np.int64), x_start=np.asarray(states, dtype=float).reshape(-1, 2),
             solutions=sol, homogeneous=np.asarray(homog, dtype=float).reshape(-1, 2),
         )
+
+    def _advance(self, delta: float, velocity: float, t0: float, t1: float, omega: float) -> tuple[float, float]:
+        """The state (δ, δ') at t1 only, from (δ, δ') at t0 (no checks, no record): the hot path of
+        a simulation that only needs its Poincaré points."""
+        d, v, _ = self._march(self.solutions(omega), delta, velocity, t0, t1, None)
+        return d, v
+
+    def _march(
+        self, sol: StageSolutions, d: float, v: float, t0: float, t1: float,
+        record: tuple[list, list, list, list] | None,
+    ) -> tuple[float, float, tuple[float, float, float, float]]:
+        """Segment by segment from (δ, δ') = (d, v) at t0 to t1: the final state and the
+        sensitivity (Φ11, Φ12, Φ21, Φ22); the segments are appended to ``record`` (starts,
+        stages, start states, homogeneous parts) when given."""
+        j = sol.stage_of(t0, d, v)
+        t = t0
+        n_seg = 0
+        m11, m12, m21, m22 = 1.0, 0.0, 0.0, 1.0
+        while True:
+            seg = _Segment(sol, j, t, d, v)
+            tau_c, j_new, d_c, v_c = self._first_exit(seg, t1 - t)
+            if tau_c > 0.0 or (j_new < 0 and n_seg == 0):  # zero-length segments (round-off) are dropped
+                n_seg += 1
+                if record is not None:
+                    record[0].append(t)
+                    record[1].append(j)
+                    record[2].append((d, v))
+                    record[3].append((seg.h0, seg.h1))
+            f11, f12, f21, f22 = sol.transition_scalar(j, tau_c)
+            m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
+                                  f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
+            if j_new < 0:
+                return d_c, v_c, (m11, m12, m21, m22)
+            # Exactly on the breakpoint: snap δ (the root is located to round-off).
+            d = float(sol.upper[j] if j_new > j else sol.lower[j])
+            v = v_c
+            j, t = j_new, t + tau_c
+            if n_seg > self.max_segments:
+                raise ConvergenceError(
+                    f"more than `max_segments` = {self.max_segments} segments between t0 = {t0!r} and "
+                    f"t1 = {t1!r}: raise `max_segments` or shorten the interval"
+                )
 
     # --- crossing search -----------------------------------------------------------------------
     def _first_exit(self, seg: _Segment, tau_end: float) -> tuple[float, int, float, float]:

@@ -31,7 +31,8 @@ class ShootingOrbit:
     the orbit's period as a multiple p of the forcing period 2π/Ω; ``monodromy`` the 2×2 matrix M =
     ∂x(T)/∂x(0); ``multipliers`` its eigenvalues sorted by modulus, largest first (their product
     is det M = exp(−c T)); ``converged``, ``iterations`` (Newton steps) and ``residual`` (scaled
-    ‖φ(x0) − x0‖∞, see :func:`shoot_periodic_orbit`); ``trajectory`` over [0, T]; and the measures
+    ‖φ(x0) − x0‖∞, see :func:`shoot_periodic_orbit`); ``evaluations`` the number of period maps
+    φ integrated (the work done); ``trajectory`` over [0, T]; and the measures
     of SPEC §1 over one orbit period (exact to round-off): ``mean``, ``rms``, ``rms_ac``,
     ``delta_min``, ``delta_max``, ``p2p``, ``acc_min``, ``acc_max``, ``acc_p2p``.
     """
@@ -54,6 +55,7 @@ class ShootingOrbit:
     acc_min: float
     acc_max: float
     acc_p2p: float
+    evaluations: int = 0
 
     @property
     def stable(self) -> bool:
@@ -131,10 +133,38 @@ def shoot_periodic_orbit(
     if integ.model is not model and integ.model != model:
         raise ValueError("`integrator` was built for a different model than `model`")
 
-    T = int(period) * 2.0 * math.pi / omega
-    scale = _state_scale(model, omega)
+    shot = _newton_shooting(integ, omega, x0, int(period), float(tol), int(max_iterations),
+                            _state_scale(model, omega))
+    return _orbit_from_shot(shot, omega, int(period), float(tol))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Shot:
+    """The outcome of a Newton shooting solve before measures: last iterate ``x``, its trajectory
+    over one orbit period, scaled ``residual``, Newton ``iterations`` and period-map ``evaluations``."""
+
+    x: FloatArray
+    trajectory: Trajectory
+    residual: float
+    iterations: int
+    evaluations: int
+
+    def multipliers(self) -> ComplexArray:
+        """Eigenvalues of the monodromy matrix, largest modulus first."""
+        mult = np.linalg.eigvals(self.trajectory.sensitivity).astype(complex)
+        return mult[np.argsort(-np.abs(mult), kind="stable")]
+
+
+def _newton_shooting(
+    integ: ExactIntegrator, omega: float, x0: FloatArray | tuple[float, float], period: int, tol: float,
+    max_iterations: int, scale: FloatArray, max_halvings: int = _MAX_HALVINGS,
+) -> _Shot:
+    """Newton's method on r(x0) = φ(x0; 0 → p·2π/Ω) − x0 with the exact monodromy (no measures:
+    the cheap core of :func:`shoot_periodic_orbit`, also used by ``steady_state``)."""
+    T = period * 2.0 * math.pi / omega
     x = np.asarray(x0, dtype=float).copy()
     traj = integ.propagate(x, 0.0, T, omega)
+    evaluations = 1
     r = traj.state1 - x
     res = float(np.max(np.abs(r / scale)))
     iterations = 0
@@ -146,9 +176,10 @@ def shoot_periodic_orbit(
         except np.linalg.LinAlgError:  # a multiplier exactly 1 (fold): least-squares step
             dx = np.linalg.lstsq(J, -r, rcond=None)[0]
         step = 1.0
-        for _ in range(_MAX_HALVINGS + 1):
+        for _ in range(max_halvings + 1):
             x_try = x + step * dx
             traj_try = integ.propagate(x_try, 0.0, T, omega)
+            evaluations += 1
             r_try = traj_try.state1 - x_try
             res_try = float(np.max(np.abs(r_try / scale)))
             if res_try < res:
@@ -157,17 +188,19 @@ def shoot_periodic_orbit(
         else:
             break  # no decrease along the Newton direction: give up (converged stays False)
         x, traj, r, res = x_try, traj_try, r_try, res_try
+    return _Shot(x=x, trajectory=traj, residual=res, iterations=iterations, evaluations=evaluations)
 
-    M = traj.sensitivity
-    mult = np.linalg.eigvals(M).astype(complex)
-    mult = mult[np.argsort(-np.abs(mult), kind="stable")]
+
+def _orbit_from_shot(shot: _Shot, omega: float, period: int, tol: float) -> ShootingOrbit:
+    """The :class:`ShootingOrbit` of a Newton solve: multipliers and exact measures."""
+    traj = shot.trajectory
     meas = traj.measures()
     return ShootingOrbit(
-        state0=x, omega=omega, period=int(period), monodromy=M, multipliers=mult,
-        converged=res <= tol, iterations=iterations, residual=res, trajectory=traj,
-        mean=meas.mean, rms=meas.rms, rms_ac=meas.rms_ac, delta_min=meas.delta_min,
-        delta_max=meas.delta_max, p2p=meas.p2p, acc_min=meas.acc_min, acc_max=meas.acc_max,
-        acc_p2p=meas.acc_p2p,
+        state0=shot.x, omega=omega, period=period, monodromy=traj.sensitivity,
+        multipliers=shot.multipliers(), converged=shot.residual <= tol, iterations=shot.iterations,
+        residual=shot.residual, trajectory=traj, mean=meas.mean, rms=meas.rms, rms_ac=meas.rms_ac,
+        delta_min=meas.delta_min, delta_max=meas.delta_max, p2p=meas.p2p, acc_min=meas.acc_min,
+        acc_max=meas.acc_max, acc_p2p=meas.acc_p2p, evaluations=shot.evaluations,
     )
 
 

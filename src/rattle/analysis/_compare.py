@@ -1,0 +1,294 @@
+"""compare(): the harmonic-balance frequency response against the time-domain sweep.
+
+The frequency response (every solution along the branch, stable or not) and the up/down
+stepped sweep (what a rig would measure) are computed over the same range. Where the FRF is
+multi-valued the two sweeps land on different branches and jump at different frequencies;
+where the primary orbit is unstable the sweep shows sub-harmonic or non-periodic motion. A few
+frequencies are then examined in detail: every HB orbit there (:func:`periodic_orbit`) next to
+the steady states that the up and the down sweep reached.
+
+Frequencies picked automatically (``at=None``), at most one per rule, on the sweep's grid:
+
+1. **multi-valued** — among the grid frequencies where the FRF has three or more solutions,
+   the one where the up and down sweeps differ most in rms (if they differ by more than 5 %
+   of the largest rms; else the middle of the widest multi-valued stretch);
+2. **sub-harmonic** — the middle of the longest run of sweep points (either direction) with a
+   period 2 … 8; if there is none, the middle of the longest run with period 0 (no period up
+   to 8 found);
+3. **resonance** — only when fewer than two were found above: the frequency of the largest
+   stable rms on the FRF (the grid point nearest to it).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..model import Model
+from ..results import FrequencyResponse, PeriodicOrbit, SweepResult
+from ..timeint import ExactIntegrator, SteadyState, SteadyStateOptions, steady_state
+from ._frequency_response import frequency_response
+from ._orbit import MAX_PERIOD, _check_range, periodic_orbit
+from ._time_sweep import time_sweep
+
+#: Automatic picks: the up/down sweeps must differ by this fraction of the largest rms for the
+#: multi-valued pick to go where they differ most.
+_HYSTERESIS_MIN = 0.05
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Comparison:
+    """The frequency response, the time-domain sweep and detailed orbits at a few frequencies.
+
+    Attributes
+    ----------
+    model : Model
+    frf : FrequencyResponse
+        Harmonic balance + continuation over the range.
+    sweep : SweepResult
+        The up and down time-domain sweeps over the same range.
+    at : tuple of float
+        The frequencies examined in detail (rad/s), increasing.
+    reasons : tuple of str
+        Why each frequency of ``at`` was chosen (``multi-valued``, ``sub-harmonic``,
+        ``non-periodic``, ``resonance`` or ``requested``).
+    orbits : tuple of PeriodicOrbit
+        Every HB orbit at each frequency of ``at`` (its ``simulation`` started from the up
+        sweep's state there).
+    simulations : tuple of dict
+        For each frequency of ``at``: direction (``up``/``down``) → the steady state that sweep
+        reaches there (started from its state at the nearest grid frequency).
+    settings, timings : dict
+        Provenance.
+    """
+
+    model: Model
+    frf: FrequencyResponse
+    sweep: SweepResult
+    at: tuple[float, ...]
+    reasons: tuple[str, ...]
+    orbits: tuple[PeriodicOrbit, ...]
+    simulations: tuple[dict[str, SteadyState], ...]
+    settings: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        picks = ", ".join(f"{w:.4g} ({r})" for w, r in zip(self.at, self.reasons)) or "none"
+        return (
+            f"Comparison(Ω = {self.frf.omega.min():.4g}…{self.frf.omega.max():.4g}: {len(self.frf)} FRF points, "
+            f"{len(self.sweep)} sweep points; orbits at {picks})"
+        )
+
+    def summary(self) -> str:
+        """A few lines for the terminal."""
+        lines = ["frequency response:", *("  " + s for s in self.frf.summary().splitlines())]
+        lines += ["time-domain sweep:", *("  " + s for s in self.sweep.summary().splitlines())]
+        for w, why, orbit, sims in zip(self.at, self.reasons, self.orbits, self.simulations):
+            hb = ", ".join(
+                f"P{s.period} rms {s.rms:.4g} {'stable' if s.stable else 'unstable'}" for s in orbit.solutions
+            )
+            sim = ", ".join(f"{d} sweep P{s.period} rms {s.rms:.4g}" for d, s in sims.items())
+            lines.append(f"Ω = {w:.5g} ({why}): HB {hb or 'none'}; simulation {sim or 'none'}")
+        return "\n".join(lines)
+
+    def metadata(self) -> dict[str, Any]:
+        """Settings, timings and the examined frequencies, JSON-serialisable."""
+        return {
+            "settings": self.settings,
+            "timings": self.timings,
+            "frf": self.frf.metadata(),
+            "sweep": self.sweep.metadata(),
+            "orbits": [
+                {"omega": w, "reason": why, **orbit.metadata(),
+                 "sweep_states": {d: {"period": s.period, "rms": s.rms} for d, s in sims.items()}}
+                for w, why, orbit, sims in zip(self.at, self.reasons, self.orbits, self.simulations)
+            ],
+        }
+
+    def to_csv(self, directory: str | Path) -> tuple[Path, Path]:
+        """Write ``frf.csv`` and ``sweep.csv`` (SPEC columns) into ``directory`` atomically."""
+        directory = Path(directory)
+        return self.frf.to_csv(directory / "frf.csv"), self.sweep.to_csv(directory / "sweep.csv")
+
+    def plot(self, fig: Any = None, *, samples: int = 256, title: str | None = None) -> tuple[Any, dict[str, Any]]:
+        """The FRF with the sweep points over it, and a row of time histories; returns
+        (figure, axes dict). See :func:`rattle.plotting.compare_plot`."""
+        from ..plotting import compare_plot
+
+        return compare_plot(self, fig=fig, samples=samples, title=title)
+
+
+# --------------------------------------------------------------------------------------------
+# Picking frequencies
+# --------------------------------------------------------------------------------------------
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    edges = np.diff(np.concatenate(([0], mask.astype(int), [0])))
+    return list(zip(np.nonzero(edges == 1)[0].tolist(), np.nonzero(edges == -1)[0].tolist()))
+
+
+def _solution_counts(frf: FrequencyResponse, grid: np.ndarray) -> np.ndarray:
+    """How many FRF solutions (all branches) each grid frequency has."""
+    counts = np.zeros(grid.size, dtype=int)
+    for b in np.unique(frf.branch):
+        om = frf.omega[frf.branch == b]
+        if om.size < 2:
+            continue
+        lo, hi = np.minimum(om[:-1], om[1:]), np.maximum(om[:-1], om[1:])
+        # half-open stretches, so that a point shared by two stretches counts once
+        counts += np.sum((grid[:, None] >= lo[None, :]) & (grid[:, None] < hi[None, :]), axis=1)
+    return counts
+
+
+def pick_frequencies(frf: FrequencyResponse, sweep: SweepResult) -> list[tuple[float, str]]:
+    """Frequencies worth a closer look, with the reason (rules in the module docstring)."""
+    picks: list[tuple[float, str]] = []
+    up = sweep.select("up") if "up" in sweep.directions else None
+    down = sweep.select("down") if "down" in sweep.directions else None
+    grid = np.unique(sweep.omega)
+    # 1. multi-valued region
+    multi = _solution_counts(frf, grid) >= 3
+    if np.any(multi) and up is not None and down is not None:
+        r_up = np.interp(grid, up.omega, up.rms)
+        r_down = np.interp(grid, down.omega[::-1], down.rms[::-1])
+        diff = np.where(multi, np.abs(r_up - r_down), -1.0)
+        i = int(np.argmax(diff))
+        if diff[i] > _HYSTERESIS_MIN * float(np.max(sweep.rms)):
+            picks.append((float(grid[i]), "multi-valued"))
+        else:
+            i0, i1 = max(_runs(multi), key=lambda r: r[1] - r[0])
+            picks.append((float(grid[(i0 + i1 - 1) // 2]), "multi-valued"))
+    elif np.any(multi):
+        i0, i1 = max(_runs(multi), key=lambda r: r[1] - r[0])
+        picks.append((float(grid[(i0 + i1 - 1) // 2]), "multi-valued"))
+    # 2. sub-harmonic (else non-periodic) motion in the sweep
+    for wanted, reason in ((lambda p: p >= 2, "sub-harmonic"), (lambda p: p == 0, "non-periodic")):
+        best: tuple[int, float] | None = None
+        for part in (up, down):
+            if part is None:
+                continue
+            for i0, i1 in _runs(np.array([wanted(int(p)) for p in part.period], dtype=bool)):
+                if best is None or i1 - i0 > best[0]:
+                    best = (i1 - i0, float(part.omega[(i0 + i1 - 1) // 2]))
+        if best is not None:
+            picks.append((best[1], reason))
+            break
+    # 3. resonance, when little else is of interest
+    if len(picks) < 2 and np.any(frf.stable):
+        i = int(np.argmax(np.where(frf.stable, frf.rms, -np.inf)))
+        w = float(grid[int(np.argmin(np.abs(grid - frf.omega[i])))])
+        if all(abs(w - p[0]) > 1e-12 for p in picks):
+            picks.append((w, "resonance"))
+    return sorted(picks)
+
+
+def _check_at(at: object, lo: float, hi: float) -> list[float]:
+    if isinstance(at, (str, bytes)) or not isinstance(at, Sequence | np.ndarray):
+        raise TypeError(f"`at` must be a sequence of frequencies in rad/s, got {at!r}")
+    out = []
+    for w in at:  # type: ignore[union-attr]
+        try:
+            x = float(w)
+        except (TypeError, ValueError):
+            raise TypeError(f"`at` must hold numbers (rad/s), got {w!r}") from None
+        if not (math.isfinite(x) and lo <= x <= hi):
+            raise ValueError(
+                f"`at` frequencies must be finite and within the range {lo:g} … {hi:g} rad/s, got {w!r}"
+            )
+        out.append(x)
+    if not out:
+        raise ValueError("`at` must hold at least one frequency (or be None to pick them automatically)")
+    return sorted(out)
+
+
+# --------------------------------------------------------------------------------------------
+# Front end
+# --------------------------------------------------------------------------------------------
+def compare(
+    model: Model,
+    omega: tuple[float, float] = (0.1, 3.0),
+    harmonics: int = 32,
+    points: int = 200,
+    at: Sequence[float] | None = None,
+    *,
+    options: SteadyStateOptions | None = None,
+    workers: int = 1,
+    callback: Callable[[int, int], None] | None = None,
+) -> Comparison:
+    """Frequency response and time-domain sweep over ``omega``, with orbits at a few frequencies.
+
+    Parameters
+    ----------
+    model : Model
+    omega : (float, float), default (0.1, 3.0)
+        Frequency range (rad/s).
+    harmonics : int, default 32
+        Harmonics of the harmonic balance.
+    points : int, default 200
+        Frequencies per sweep direction (≥ 2).
+    at : sequence of float, optional
+        Frequencies (rad/s, within ``omega``) to examine in detail; default: picked by the rules
+        in the module docstring.
+    options : SteadyStateOptions, optional
+        Settling settings of the simulations.
+    workers : int, default 1
+        Processes for the sweep (2: the up and down sweeps at once).
+    callback : callable, optional
+        ``callback(done, total)`` after each sweep frequency (for a progress bar).
+
+    Returns
+    -------
+    Comparison
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
+    lo, hi = _check_range("omega", omega)
+    chosen = None if at is None else _check_at(at, lo, hi)
+    t0 = time.perf_counter()
+    frf = frequency_response(model, omega=(lo, hi), harmonics=harmonics, throw=False)
+    t1 = time.perf_counter()
+    sweep = time_sweep(model, omega=(lo, hi), points=points, direction="both", options=options,
+                       workers=workers, callback=callback)
+    t2 = time.perf_counter()
+    picks = pick_frequencies(frf, sweep) if chosen is None else [(w, "requested") for w in chosen]
+    integ = ExactIntegrator(model)
+    grid = np.unique(sweep.omega)
+    spacing = float(np.min(np.diff(grid))) if grid.size > 1 else math.inf
+    orbits: list[PeriodicOrbit] = []
+    sims: list[dict[str, SteadyState]] = []
+    for w, _why in picks:
+        states: dict[str, SteadyState] = {}
+        for d in sweep.directions:
+            part = sweep.select(d)
+            i = int(np.argmin(np.abs(part.omega - w)))
+            if abs(part.omega[i] - w) <= 0.5 * spacing * (1 + 1e-9):
+                states[d] = steady_state(model, w, part.state0[i], options=options, integrator=integ)
+        sweep_periods = [s.period for s in states.values() if 2 <= s.period <= MAX_PERIOD]
+        period = sweep_periods[0] if sweep_periods else 1
+        x0 = None
+        for s in states.values():
+            if s.period == period:
+                x0 = s.state0
+                break
+        orbits.append(periodic_orbit(
+            model, w, period=period, harmonics=harmonics, frf=frf, search_range=(lo, hi),
+            x0=x0, steady_options=options,
+        ))
+        sims.append(states)
+    t3 = time.perf_counter()
+    return Comparison(
+        model=model, frf=frf, sweep=sweep,
+        at=tuple(w for w, _ in picks), reasons=tuple(r for _, r in picks),
+        orbits=tuple(orbits), simulations=tuple(sims),
+        settings={"omega": [lo, hi], "harmonics": harmonics, "points": points,
+                  "at": None if at is None else list(chosen or []), "workers": workers},
+        timings={"frequency_response": t1 - t0, "sweep": t2 - t1, "orbits": t3 - t2, "total": t3 - t0},
+    )
+
+
+__all__ = ["compare", "Comparison", "pick_frequencies"]

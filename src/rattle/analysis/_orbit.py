@@ -1,0 +1,530 @@
+"""periodic_orbit(): every harmonic-balance orbit at one forcing frequency, and the simulation.
+
+How the coexisting solutions at Ω = W are found
+-----------------------------------------------
+1. **Primary branch.** The period-1 frequency response is followed over a range containing W
+   (the given ``search_range``, widened to include W); every stretch of the branch whose end
+   points bracket W gives a start (linear interpolation of the coefficients), which Newton
+   polishes at exactly W. A branch that folds over W twice gives three solutions.
+2. **Simulation.** Continuation from the linear solution never leaves the primary branch: for
+   period N > 1 it would only find the primary motions written with base frequency Ω/N. So the
+   steady state is also simulated (exact piecewise-linear integration, from ``x0``, default
+   rest). When it settles on period n (1 ≤ n ≤ 8) its orbit is closed by exact shooting,
+   sampled at N_s equally spaced points over n forcing periods, transformed to Fourier
+   coefficients of base Ω/n and polished by Newton: the HB solution of period n that the
+   simulation found. If N > 1 was asked for and the simulation from rest settled elsewhere, it
+   is repeated from each unstable primary orbit, slightly perturbed.
+3. **Sub-harmonic branch.** A period-n solution (n > 1) from step 2 is continued in Ω in both
+   directions until the branch closes on itself (or one of its copies shifted by a forcing
+   period) or leaves the range; every other crossing of W on it is polished too. This finds,
+   e.g., the unstable sub-harmonic between two sub-harmonic folds.
+
+Every solution is reduced to its least period (a period-2 series whose odd harmonics vanish is
+a primary orbit) and polished again there; duplicates (the same orbit, also up to a shift by
+whole forcing periods) are dropped. Floquet multipliers come from the exact monodromy of the
+piecewise-linear linearisation about each orbit; measures from the series (see
+``rattle.measures``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
+from ..errors import ConvergenceError
+from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
+from ..measures import measures_batch, synthesize_batch
+from ..model import Model
+from ..results import FrequencyResponse
+from ..results._orbit import OrbitSolution, PeriodicOrbit
+from ..stability import UNIT_CIRCLE_TOL, monodromy_batch, multipliers_from_monodromy
+from ..timeint import ExactIntegrator, shoot_periodic_orbit
+from ..timeint._steady import SteadyState, SteadyStateOptions, steady_state
+from ._frequency_response import frequency_response
+
+logger = logging.getLogger("rattle")
+
+#: Largest period (multiple of the forcing period) that is searched for, as in the sweep.
+MAX_PERIOD = 8
+
+# Two solutions are the same orbit when their δ(t) differ by less than this fraction of the
+# model's length scale everywhere (Newton converges to ~1e-10 of it; distinct coexisting orbits
+# differ by far more, except arbitrarily close to a fold, where telling them apart is moot).
+_SAME_ORBIT_TOL = 1e-6
+# A series has a shorter period d | p when the harmonics that do not fit period d carry less
+# than this fraction of its amplitude.
+_REDUCE_TOL = 1e-7
+
+
+def _check_omega(omega: object) -> float:
+    if isinstance(omega, bool):
+        raise TypeError(f"`omega` must be a forcing frequency in rad/s (a number), got {omega!r}")
+    try:
+        w = float(omega)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise TypeError(f"`omega` must be a forcing frequency in rad/s (a number), got {omega!r}") from None
+    if not (math.isfinite(w) and w > 0.0):
+        raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}; use e.g. 0.8")
+    return w
+
+
+def _check_period(period: object) -> int:
+    if isinstance(period, bool) or not isinstance(period, (int, np.integer)):
+        raise TypeError(
+            f"`period` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), "
+            f"got {period!r} ({type(period).__name__})"
+        )
+    if not 1 <= int(period) <= MAX_PERIOD:
+        raise ValueError(
+            f"`period` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), got {int(period)}; "
+            "use 1 for the primary response, n for a 1/n sub-harmonic"
+        )
+    return int(period)
+
+
+def _check_range(name: str, value: object) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in value)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi):
+        raise ValueError(f"`{name}` must satisfy 0 < min < max (finite, rad/s), got {value!r}")
+    return lo, hi
+
+
+def default_search_range(model: Model, omega: float) -> tuple[float, float]:
+    """The range followed for the primary branch when none is given: 0.1 … 3 ω_n (ω_n = sqrt(K/I),
+    the SPEC example range for K = I = 1), widened to reach from W/2 to 1.5 W."""
+    wn = model.natural_frequency
+    return (min(0.1 * wn, 0.5 * omega), max(3.0 * wn, 1.5 * omega))
+
+
+# --------------------------------------------------------------------------------------------
+# Series helpers
+# --------------------------------------------------------------------------------------------
+def _resize(q: FloatArray, harmonics: int) -> FloatArray:
+    """``q`` truncated or zero-padded to ``harmonics`` harmonics."""
+    H0 = (q.size - 1) // 2
+    out = np.zeros(2 * harmonics + 1)
+    h = min(H0, harmonics)
+    out[0] = q[0]
+    out[1 : h + 1] = q[1 : h + 1]
+    out[harmonics + 1 : harmonics + 1 + h] = q[H0 + 1 : H0 + 1 + h]
+    return out
+
+
+def _shift(q: FloatArray, fraction: float) -> FloatArray:
+    """Coefficients of δ(t + fraction·T_p), T_p the series' own period."""
+    H = (q.size - 1) // 2
+    k = np.arange(1, H + 1)
+    c, s = np.cos(2 * np.pi * k * fraction), np.sin(2 * np.pi * k * fraction)
+    a, b = q[1 : H + 1], q[H + 1 :]
+    out = q.copy()
+    out[1 : H + 1] = a * c + b * s
+    out[H + 1 :] = b * c - a * s
+    return out
+
+
+def _least_period(q: FloatArray, period: int) -> int:
+    """The least d dividing ``period`` for which the series (base Ω/period) has period d·2π/Ω."""
+    H = (q.size - 1) // 2
+    amp = np.hypot(q[1 : H + 1], q[H + 1 :])
+    total = float(np.sqrt(np.sum(amp**2)))
+    if total == 0.0:
+        return 1
+    k = np.arange(1, H + 1)
+    for d in range(1, period):
+        if period % d:
+            continue
+        m = period // d
+        if float(np.sqrt(np.sum(amp[k % m != 0] ** 2))) <= _REDUCE_TOL * total:
+            return d
+    return period
+
+
+def _reduce(q: FloatArray, period: int, d: int) -> FloatArray:
+    """Series of base Ω/period with period d·2π/Ω, rewritten with base Ω/d (same H, zero-padded)."""
+    H = (q.size - 1) // 2
+    m = period // d
+    h = H // m
+    out = np.zeros_like(q)
+    out[0] = q[0]
+    out[1 : h + 1] = q[m : h * m + 1 : m]
+    out[H + 1 : H + 1 + h] = q[H + m : H + h * m + 1 : m]
+    return out
+
+
+@dataclass(slots=True)
+class _Candidate:
+    period: int
+    q: FloatArray
+    source: str
+    iterations: int
+    residual: float
+
+
+class _Solver:
+    """HB problems per period at one Ω, Newton polish, reduction and de-duplication."""
+
+    def __init__(self, model: Model, omega: float, harmonics: int, samples: int | None, newton: NewtonOptions) -> None:
+        self.model = model
+        self.omega = omega
+        self.harmonics = harmonics
+        self.samples = samples
+        self.newton = newton
+        self._hb: dict[int, HarmonicBalance] = {}
+        self.found: list[_Candidate] = []
+        self.scale = model.length_scale()
+
+    def hb(self, period: int) -> HarmonicBalance:
+        if period not in self._hb:
+            self._hb[period] = HarmonicBalance(
+                self.model, HBOptions(harmonics=self.harmonics, samples=self.samples), period=period
+            )
+        return self._hb[period]
+
+    def polish(self, q0: FloatArray, period: int, source: str) -> _Candidate | None:
+        """Newton at Ω from ``q0`` (base Ω/period), reduced to the least period; None on failure."""
+        res = solve_harmonic_balance(self.hb(period), q0, self.omega, self.newton)
+        if not res.converged:
+            logger.info("periodic_orbit: Newton from a %s start failed at Ω = %g (%s)", source, self.omega, res.message)
+            return None
+        d = _least_period(res.q, period)
+        if d < period:
+            res = solve_harmonic_balance(self.hb(d), _reduce(res.q, period, d), self.omega, self.newton)
+            if not res.converged:  # pragma: no cover - the reduced series is already a solution
+                return None
+            period = d
+        return _Candidate(period, res.q, source, res.iterations, res.residual)
+
+    def _samples(self, cand: _Candidate, periods: int, shift: int = 0) -> FloatArray:
+        """δ of a candidate on 64 points per forcing period over ``periods`` forcing periods,
+        time-shifted by ``shift`` forcing periods."""
+        hb = self.hb(cand.period)
+        Tf = 2 * np.pi / self.omega
+        t = (np.arange(64 * periods) / 64.0 + shift) * Tf
+        return hb.basis.evaluate(cand.q, self.omega / cand.period, t)
+
+    def same(self, a: _Candidate, b: _Candidate) -> bool:
+        """True when a and b are the same orbit (also up to a shift by whole forcing periods)."""
+        if a.period != b.period:
+            return False  # both are reduced to their least period
+        xa = self._samples(a, a.period)
+        tol = _SAME_ORBIT_TOL * max(self.scale, float(np.ptp(xa)))
+        return any(
+            float(np.max(np.abs(xa - self._samples(b, b.period, k)))) <= tol for k in range(b.period)
+        )
+
+    def add(self, cand: _Candidate | None) -> bool:
+        """Keep ``cand`` unless it duplicates one found before; True if it was new."""
+        if cand is None:
+            return False
+        if any(self.same(cand, c) for c in self.found):
+            return False
+        self.found.append(cand)
+        return True
+
+
+def _brackets(omega: FloatArray, W: float) -> list[tuple[int, float]]:
+    """(i, s) for every stretch i → i+1 of a point sequence whose Ω brackets W, with the
+    interpolation weight s ∈ [0, 1]."""
+    out = []
+    for i in range(omega.size - 1):
+        a, b = omega[i] - W, omega[i + 1] - W
+        if a * b <= 0.0 and not (a == 0.0 and b == 0.0):
+            s = 0.0 if a == b else a / (a - b)
+            out.append((i, float(min(max(s, 0.0), 1.0))))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Simulation seeds
+# --------------------------------------------------------------------------------------------
+def _simulation_seed(solver: _Solver, steady: Any, integrator: ExactIntegrator | None = None) -> _Candidate | None:
+    """HB solution of period n from a steady state that settled on period n (else None)."""
+    n = int(getattr(steady, "period", 0) or 0)
+    traj = getattr(steady, "trajectory", None)
+    if not 1 <= n <= MAX_PERIOD or traj is None:
+        return None
+    if solver.harmonics < n * len(solver.model.excitation.amplitudes):
+        logger.info("periodic_orbit: %d harmonics cannot hold a period-%d orbit; not seeded", solver.harmonics, n)
+        return None
+    W = solver.omega
+    Tf = 2 * np.pi / W
+    # A state at a whole forcing period, so that t = 0 of the orbit has the model's forcing phase.
+    ts = math.ceil(traj.t0 / Tf - 1e-9) * Tf
+    if ts > traj.t1:
+        ts = math.floor(traj.t1 / Tf + 1e-9) * Tf
+        if ts < traj.t0:
+            return None
+    state = traj.sample(min(max(ts, traj.t0), traj.t1))  # round-off may put ts just outside
+    x_s = np.array([float(state.delta), float(state.velocity)])
+    integ = ExactIntegrator(solver.model) if integrator is None else integrator
+    orbit = shoot_periodic_orbit(solver.model, W, x_s, period=n, integrator=integ)
+    path = orbit.trajectory if orbit.converged else integ.propagate(x_s, 0.0, n * Tf, W)
+    hb = solver.hb(n)
+    t = hb.basis.times(n * Tf)
+    q0 = hb.basis.analyze(np.asarray(path.sample(t).delta))
+    return solver.polish(q0, n, "simulation")
+
+
+def _follow_subharmonic(
+    solver: _Solver,
+    seed: _Candidate,
+    search_range: tuple[float, float],
+    continuation: ContinuationOptions,
+) -> None:
+    """Continue the branch through ``seed`` (period > 1) both ways; polish its other crossings of W."""
+    hb = solver.hb(seed.period)
+    W = solver.omega
+    corrector = ArclengthCorrector(hb, solver.newton)
+    _, Rq, Rw = hb.residual_jacobian(seed.q, W)
+    closed = False
+    for sign in (1.0, -1.0):
+        reference = np.zeros(hb.size + 1)
+        reference[-1] = sign
+        tangent = corrector.tangent(Rq, Rw, reference)
+        if tangent is None:
+            return
+        prev: list[BranchPoint] = []
+
+        def stop(pt: BranchPoint) -> str | None:
+            nonlocal closed
+            prev.append(pt)
+            if len(prev) < 3:  # the first stretch starts on W itself
+                return None
+            p0, p1 = prev[-2], prev[-1]
+            for _, s in _brackets(np.array([p0.omega, p1.omega]), W):
+                cand = solver.polish((1 - s) * p0.q + s * p1.q, seed.period, "subharmonic_branch")
+                if cand is None:
+                    continue
+                if solver.same(cand, seed):
+                    closed = True
+                    return "the sub-harmonic branch closed on itself"
+                solver.add(cand)
+            return None
+
+        stepper = ContinuationStepper(
+            hb, seed.q, W, search_range, continuation, solver.newton, tangent=tangent, stop=stop
+        )
+        stepper.run()
+        logger.info(
+            "periodic_orbit: sub-harmonic branch (period %d) %s after %d points: %s",
+            seed.period, "+Ω" if sign > 0 else "−Ω", len(stepper.points), stepper.message,
+        )
+        if closed:
+            return
+
+
+# --------------------------------------------------------------------------------------------
+# Front end
+# --------------------------------------------------------------------------------------------
+def periodic_orbit(
+    model: Model,
+    omega: float,
+    period: int = 1,
+    harmonics: int = 32,
+    *,
+    simulate: bool = True,
+    search_range: tuple[float, float] | None = None,
+    frf: FrequencyResponse | None = None,
+    x0: FloatArray | tuple[float, float] | None = None,
+    samples: int | None = None,
+    newton: NewtonOptions | None = None,
+    continuation: ContinuationOptions | None = None,
+    steady_options: SteadyStateOptions | None = None,
+) -> PeriodicOrbit:
+    """Every harmonic-balance periodic orbit at the forcing frequency ``omega``, with stability.
+
+    See the module docstring for how the coexisting solutions are found (primary branch through
+    Ω, simulation seed, sub-harmonic branch).
+
+    Parameters
+    ----------
+    model : Model
+    omega : float
+        Forcing frequency Ω (rad/s), finite and > 0.
+    period : int, default 1
+        The period asked for, as a multiple 1 … 8 of the forcing period 2π/Ω (n: a 1/n
+        sub-harmonic). Solutions of other periods that turn up (the primary orbits, or the
+        period the simulation settles on) are returned too, after those of this period.
+    harmonics : int, default 32
+        Harmonics H of each solution's base frequency Ω/period kept in the harmonic balance.
+    simulate : bool, default True
+        Also simulate the steady state (needed to find sub-harmonics). Without it only the
+        primary (period-1) orbits are found.
+    search_range : (float, float), optional
+        Frequency range (rad/s) over which the primary branch (and a sub-harmonic branch) is
+        followed; widened to include ``omega``. Default :func:`default_search_range`.
+    frf : FrequencyResponse, optional
+        An already computed period-1 frequency response through (or near) Ω to take the
+        primary branch from, instead of computing it.
+    x0 : (float, float), optional
+        Initial state (δ, δ') of the simulation (rad, rad/s); default rest (0, 0).
+    samples : int, optional
+        AFT samples per solution period (default :func:`rattle.hb.default_samples`).
+    newton, continuation : NewtonOptions, ContinuationOptions, optional
+        Corrector and continuation settings.
+    steady_options : SteadyStateOptions, optional
+        Settling tolerance and budget of the simulation.
+
+    Returns
+    -------
+    PeriodicOrbit
+        ``solutions`` (each with period, coefficients, stability, multipliers and measures), the
+        ``simulation`` (a ``SteadyState``, or None) and the ``selected`` solution.
+
+    Raises
+    ------
+    ValueError, TypeError
+        Bad arguments (the message names the argument).
+    ConvergenceError
+        If no periodic solution could be found at all.
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
+    W = _check_omega(omega)
+    period = _check_period(period)
+    HBOptions(harmonics=harmonics, samples=samples)  # validates `harmonics` and `samples`
+    forced = len(model.excitation.amplitudes)
+    if harmonics < forced * period:
+        raise ValueError(
+            f"`harmonics` must be >= {forced * period} to hold the excitation's harmonic {forced} at "
+            f"`period` {period} (harmonics count multiples of Ω/period), got {harmonics}"
+        )
+    if not isinstance(simulate, bool):
+        raise TypeError(f"`simulate` must be True or False, got {simulate!r}")
+    if frf is not None and not isinstance(frf, FrequencyResponse):
+        raise TypeError(f"`frf` must be a FrequencyResponse or None, got {type(frf).__name__}")
+    if newton is not None and not isinstance(newton, NewtonOptions):
+        raise TypeError(f"`newton` must be a NewtonOptions, got {newton!r}")
+    if continuation is not None and not isinstance(continuation, ContinuationOptions):
+        raise TypeError(f"`continuation` must be a ContinuationOptions, got {continuation!r}")
+    if steady_options is not None and not isinstance(steady_options, SteadyStateOptions):
+        raise TypeError(f"`steady_options` must be a SteadyStateOptions, got {steady_options!r}")
+    lo, hi = default_search_range(model, W) if search_range is None else _check_range("search_range", search_range)
+    lo, hi = min(lo, W), max(hi, W)
+    if x0 is None:
+        start_state = np.zeros(2)
+    else:
+        start_state = np.asarray(x0, dtype=float)
+        if start_state.shape != (2,) or not np.all(np.isfinite(start_state)):
+            raise ValueError(f"`x0` must be a finite state (delta, velocity) of shape (2,), got {x0!r}")
+    newton_opts = newton or NewtonOptions()
+    cont_opts = continuation or ContinuationOptions()
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    solver = _Solver(model, W, harmonics, samples, newton_opts)
+
+    # 1. Primary branch through W.
+    primary = frf
+    if primary is None:
+        primary = frequency_response(model, omega=(lo, hi), harmonics=harmonics, samples=samples, throw=False)
+    for b in np.unique(primary.branch):
+        sel = np.nonzero(primary.branch == b)[0]
+        p_branch = int(primary.period[sel[0]])
+        Q = primary.coefficients[sel]
+        for i, s in _brackets(primary.omega[sel], W):
+            q_start = _resize((1 - s) * Q[i] + s * Q[i + 1], harmonics)
+            solver.add(solver.polish(q_start, p_branch, "continuation"))
+    t1 = time.perf_counter()
+    timings["primary"] = t1 - t0
+
+    # 2. Simulation (and 3. the sub-harmonic branches of its sub-harmonics).
+    steady = None
+    if simulate:
+        integ = ExactIntegrator(model)
+
+        def simulate_from(x: FloatArray) -> SteadyState:
+            return steady_state(model, W, x, options=steady_options, integrator=integ)
+
+        steady = simulate_from(start_state)
+        runs = [steady]
+        if period > 1 and int(getattr(steady, "period", 0) or 0) != period:
+            # From rest the motion settled elsewhere: start next to each unstable primary orbit.
+            primaries = _assembled(model, solver, solver.found)
+            for cand, sol in zip(solver.found, primaries):
+                if sol.stable or cand.period != 1:
+                    continue
+                x_start = _state_at_zero(solver, cand)
+                x_start[0] += 1e-3 * solver.scale
+                runs.append(simulate_from(x_start))
+                if int(getattr(runs[-1], "period", 0) or 0) == period:
+                    break
+        timings["simulation"] = time.perf_counter() - t1
+        for run in runs:
+            seed = _simulation_seed(solver, run, integ)
+            if seed is None:
+                continue
+            new = solver.add(seed)
+            if new and seed.period > 1:
+                _follow_subharmonic(solver, seed, (lo, hi), cont_opts)
+        timings["subharmonics"] = time.perf_counter() - t1 - timings["simulation"]
+
+    if not solver.found:
+        raise ConvergenceError(
+            f"no periodic solution found at Ω = {W:g}: the primary branch over {lo:g} … {hi:g} rad/s "
+            "does not reach it and the simulation gave no start"
+        )
+    solutions = _assembled(model, solver, solver.found)
+    order = sorted(range(len(solutions)), key=lambda i: (solutions[i].period != period, solutions[i].period, -solutions[i].rms))
+    timings["total"] = time.perf_counter() - t0
+    return PeriodicOrbit(
+        model=model,
+        omega=W,
+        period=period,
+        harmonics=harmonics,
+        solutions=tuple(solutions[i] for i in order),
+        simulation=steady,
+        settings={
+            "omega": W, "period": period, "harmonics": harmonics, "simulate": simulate,
+            "search_range": [lo, hi], "x0": start_state.tolist(),
+            "samples": {p: hb.basis.samples for p, hb in solver._hb.items()},
+            "primary_branch_status": primary.status.name.lower(),
+        },
+        timings=timings,
+    )
+
+
+def _state_at_zero(solver: _Solver, cand: _Candidate) -> FloatArray:
+    basis = solver.hb(cand.period).basis
+    w = solver.omega / cand.period
+    return np.array([float(basis.evaluate(cand.q, w, 0.0)), float(basis.evaluate(cand.q, w, 0.0, derivative=1))])
+
+
+def _assembled(model: Model, solver: _Solver, cands: list[_Candidate]) -> list[OrbitSolution]:
+    """Floquet multipliers (exact monodromy of the linearisation about each orbit) and SPEC
+    measures of each candidate, batched per period."""
+    out: list[OrbitSolution | None] = [None] * len(cands)
+    st = model.elastic.stages
+    for p in sorted({c.period for c in cands}):
+        idx = [i for i, c in enumerate(cands) if c.period == p]
+        hb = solver.hb(p)
+        Q = np.array([cands[i].q for i in idx])
+        w = np.full(len(idx), solver.omega / p)
+        Om = np.full(len(idx), solver.omega)
+        X = synthesize_batch(Q, hb.basis.samples)
+        mu = multipliers_from_monodromy(monodromy_batch(Q, w, X, st.breakpoints, model.k * st.slopes, model.c))
+        stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL
+        meas = measures_batch(model, Q, w, Om, X)
+        for j, i in enumerate(idx):
+            out[i] = OrbitSolution(
+                omega=solver.omega, period=p, coefficients=Q[j].copy(),
+                stable=bool(stable[j]), multipliers=mu[j].copy(),
+                mean=float(meas.mean[j]), rms=float(meas.rms[j]), rms_ac=float(meas.rms_ac[j]),
+                p2p=float(meas.p2p[j]), acc_p2p=float(meas.acc_p2p[j]),
+                delta_min=float(meas.delta_min[j]), delta_max=float(meas.delta_max[j]),
+                regime=str(meas.regime[j]), source=cands[i].source,
+                iterations=int(cands[i].iterations), residual=float(cands[i].residual),
+            )
+    return [s for s in out if s is not None]
+
+
+__all__ = ["periodic_orbit", "default_search_range", "MAX_PERIOD"]

@@ -1,0 +1,147 @@
+"""Plot of a comparison: the frequency response with the time-domain sweep over it, and time
+histories (HB orbits vs simulation) at a few frequencies."""
+
+from __future__ import annotations
+
+import math
+import string
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ._frf import frequency_response_plot
+from ._orbit import window_periods
+from ._sweep import DIRECTION_STYLES, sweep_plot
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..analysis import Comparison
+
+
+def _steady_history(
+    state: Any, omega: float, periods: int, samples: int, shift: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """(t, δ(t + shift·2π/Ω)) of a SteadyState over ``periods`` forcing periods from t = 0 (its
+    trajectory starts at forcing phase 0; a periodic one is repeated, a non-periodic one cut)."""
+    traj = state.trajectory
+    Tf = 2.0 * math.pi / omega
+    t = np.linspace(0.0, periods * Tf, samples * periods + 1)
+    span = traj.t1 - traj.t0
+    if state.period >= 1:
+        local = np.mod(t + shift * Tf, state.period * Tf)
+    else:
+        t = t[t <= span]
+        local = t
+    local = np.clip(traj.t0 + local, traj.t0, traj.t1)
+    return t, np.asarray(traj.sample(local).delta)
+
+
+def _align(t: np.ndarray, x: np.ndarray, state: Any, orbit: Any, omega: float, samples: int) -> tuple[np.ndarray, int]:
+    """Shift a period-p simulation by the whole number k of forcing periods (0 ≤ k < p) that
+    best matches an HB orbit of the same period (a 1/p sub-harmonic has p copies shifted by a
+    forcing period: all the same motion). Returns the shifted δ samples and k."""
+    p = int(state.period)
+    refs = [i for i, s in enumerate(orbit.solutions) if s.period == p]
+    if p < 2 or not refs:
+        return x, 0
+    n_per = int(round(t[-1] * omega / (2.0 * math.pi)))
+    ref = orbit.time_history(refs[0], samples=samples, periods=n_per)["delta"]
+    if ref.size != x.size:
+        return x, 0
+    best_k, best = 0, np.inf
+    for k in range(p):
+        t_k, x_k = _steady_history(state, omega, n_per, samples, shift=k)
+        err = float(np.max(np.abs(x_k - ref)))
+        if err < best:
+            best_k, best, best_x = k, err, x_k
+    return best_x, best_k
+
+
+def compare_plot(
+    comparison: "Comparison",
+    fig: Any = None,
+    *,
+    samples: int = 256,
+    title: str | None = None,
+) -> tuple[Any, dict[str, Any]]:
+    """Draw the frequency response (stable solid, unstable dashed) with the up (▲) and down (▼)
+    sweep points over it, the examined frequencies marked (a), (b), …, and below it one panel
+    per examined frequency: δ(t) of every HB orbit there (solid stable, dashed unstable) and the
+    steady states the up and down sweeps reach there (▲/▼ markers).
+
+    Parameters
+    ----------
+    comparison : Comparison
+    fig : matplotlib.figure.Figure, optional
+        An empty figure to draw into (default: a new 13 × 9 in figure).
+    samples : int, default 256
+        Samples per forcing period of the time histories.
+    title : str, optional
+        Figure title (default none: the axes titles say what is shown).
+
+    Returns
+    -------
+    (figure, axes)
+        ``axes`` is a dict: ``frf`` (the top axes) and ``histories`` (list of the panel axes).
+    """
+    import matplotlib.pyplot as plt
+
+    n = len(comparison.at)
+    if fig is None:
+        fig = plt.figure(figsize=(13, 9 if n else 6), layout="constrained")
+    if n:
+        gs = fig.add_gridspec(2, n, height_ratios=(1.5, 1.0))
+        ax_frf = fig.add_subplot(gs[0, :])
+        panels = [fig.add_subplot(gs[1, j]) for j in range(n)]
+    else:
+        ax_frf = fig.add_subplot(1, 1, 1)
+        panels = []
+
+    frf, sweep = comparison.frf, comparison.sweep
+    frequency_response_plot(frf, ax=ax_frf, linear=False, title="")
+    sweep_plot(sweep, ax=ax_frf, lines=False, title="")
+    letters = string.ascii_lowercase
+    for j, w in enumerate(comparison.at):
+        ax_frf.axvline(w, color="0.35", lw=0.9, ls="-.", zorder=0)
+        ax_frf.annotate(f"({letters[j % 26]})", (w, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(3, -12), textcoords="offset points", fontsize=10, fontweight="bold")
+    ax_frf.set_title(
+        f"Frequency response: harmonic balance (H = {frf.harmonics}, lines) against the time-domain sweep "
+        f"({int(np.sum(sweep.direction == 'up'))} frequencies per direction)"
+    )
+    ax_frf.legend(fontsize=8, loc="upper right", ncol=2, framealpha=0.9)
+
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j, (ax, w, why, orbit, sims) in enumerate(
+        zip(panels, comparison.at, comparison.reasons, comparison.orbits, comparison.simulations)
+    ):
+        n_win = window_periods([s.period for s in orbit.solutions] + [s.period for s in sims.values()])
+        Tf = 2.0 * math.pi / w
+        for i, sol in enumerate(orbit.solutions):
+            h = orbit.time_history(i, samples=samples, periods=n_win)
+            ax.plot(h["t"], h["delta"], "-" if sol.stable else "--", color=colors[i % len(colors)],
+                    lw=1.8 if sol.stable else 1.2,
+                    label=f"HB P{sol.period} {'stable' if sol.stable else 'unstable'} (rms {sol.rms:.3g})")
+        step = max(1, samples // 24)
+        for d, state in sims.items():
+            marker, color, _ = DIRECTION_STYLES.get(d, ("o", "black", d))
+            t, x = _steady_history(state, w, n_win, samples)
+            x, k = _align(t, x, state, orbit, w, samples)
+            per = f"P{state.period}" if state.period else "no period ≤ 8"
+            moved = f", shifted {k}·2π/Ω" if k else ""
+            ax.plot(t[::step], x[::step], marker, color=color, mec="black", mew=0.4, ms=5, ls="none",
+                    label=f"{d} sweep: {per} (rms {state.rms:.3g}{moved})", zorder=5)
+        for m in range(1, n_win):
+            ax.axvline(m * Tf, color="0.85", lw=0.8, zorder=0)
+        ax.set_xlim(0.0, n_win * Tf)
+        ax.set_title(f"({letters[j % 26]}) Ω = {w:.4g} rad/s: {why}", fontsize=10)
+        ax.set_xlabel("time t (s)")
+        if j == 0:
+            ax.set_ylabel("δ (rad)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="best", framealpha=0.85)
+    if title is not None:
+        fig.suptitle(title)
+    return fig, {"frf": ax_frf, "histories": panels}
+
+
+__all__ = ["compare_plot"]

@@ -1,0 +1,194 @@
+"""Plot of the periodic orbits at one forcing frequency: time histories, phase portrait, spectrum."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..results import PeriodicOrbit
+
+#: Most forcing periods drawn (the least common multiple of the periods present, capped).
+MAX_WINDOW = 8
+#: Least number of forcing periods drawn when the simulation found no period.
+NONPERIODIC_WINDOW = 4
+#: Highest frequency of the spectrum panel, in multiples of Ω.
+SPECTRUM_ORDERS = 6
+
+
+def window_periods(periods: list[int]) -> int:
+    """Forcing periods to draw so that every orbit closes: the lcm of ``periods`` (0s ignored),
+    or their maximum when the lcm exceeds :data:`MAX_WINDOW`."""
+    ps = [int(p) for p in periods if p and p > 0] or [1]
+    lcm = 1
+    for p in ps:
+        lcm = lcm * p // math.gcd(lcm, p)
+    return lcm if lcm <= MAX_WINDOW else max(ps)
+
+
+def _solution_label(orbit: "PeriodicOrbit", i: int) -> str:
+    s = orbit.solutions[i]
+    text = f"HB {i}: period {s.period}, {'stable' if s.stable else 'unstable'}, rms {s.rms:.4g}"
+    return text + (" (selected)" if i == orbit.selected else "")
+
+
+def _amplitudes_from_samples(x: np.ndarray, periods: int, orders: int) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided amplitudes of samples x (one window of ``periods`` forcing periods, endpoint
+    excluded) at frequencies k Ω / periods up to ``orders`` Ω: (frequency / Ω, amplitude)."""
+    n = x.size
+    spec = np.fft.rfft(x) / n
+    amp = np.abs(spec)
+    amp[1:] *= 2.0
+    kmax = min(orders * periods, amp.size - 1)
+    k = np.arange(kmax + 1)
+    return k / periods, amp[: kmax + 1]
+
+
+def orbit_plot(
+    orbit: "PeriodicOrbit",
+    fig: Any = None,
+    *,
+    samples: int = 256,
+    periods: int | None = None,
+    title: str | None = None,
+) -> tuple[Any, dict[str, Any]]:
+    """Draw the HB orbits at one frequency against the simulated steady state.
+
+    Panels: δ(t), δ'(t) and δ''(t) over ``periods`` forcing periods (default: enough for every
+    orbit shown to close, at least 4 when the simulation found no period), the phase portrait (δ, δ'), and the amplitude spectrum of δ at the
+    harmonics of Ω/period (stems). HB solutions are drawn solid when stable and dashed when
+    unstable, the selected one thicker; the simulation as black dots (time histories, phase
+    portrait) and hollow circles (spectrum; a line over its whole recorded window when it found
+    no period). Breakpoints of the elastic law are dotted lines.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+    fig : matplotlib.figure.Figure, optional
+        An empty figure to draw into (default: a new 12 × 8 in figure).
+    samples : int, default 256
+        Samples per forcing period of each curve.
+    periods : int, optional
+        Forcing periods drawn.
+    title : str, optional
+        Figure title (default names Ω and H).
+
+    Returns
+    -------
+    (figure, axes)
+        ``axes`` is a dict with keys ``delta``, ``velocity``, ``acceleration``, ``phase`` and
+        ``spectrum``.
+    """
+    import matplotlib.pyplot as plt
+
+    if fig is None:
+        fig = plt.figure(figsize=(12, 8), layout="constrained")
+    gs = fig.add_gridspec(3, 2, width_ratios=(1.55, 1.0))
+    ax_d = fig.add_subplot(gs[0, 0])
+    ax_v = fig.add_subplot(gs[1, 0], sharex=ax_d)
+    ax_a = fig.add_subplot(gs[2, 0], sharex=ax_d)
+    ax_p = fig.add_subplot(gs[0:2, 1])
+    ax_s = fig.add_subplot(gs[2, 1])
+    axes = {"delta": ax_d, "velocity": ax_v, "acceleration": ax_a, "phase": ax_p, "spectrum": ax_s}
+
+    sim_period = orbit.simulated_period
+    n_win = periods if periods is not None else window_periods(
+        [s.period for s in orbit.solutions] + [orbit.period] + ([sim_period] if sim_period else [])
+    )
+    if periods is None and orbit.simulation is not None and not sim_period:
+        n_win = max(n_win, NONPERIODIC_WINDOW)  # show that the simulated motion does not repeat
+    Tf = 2.0 * math.pi / orbit.omega
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    selected = orbit.selected
+
+    # --- HB solutions --------------------------------------------------------------------
+    for i, sol in enumerate(orbit.solutions):
+        h = orbit.time_history(i, samples=samples, periods=n_win)
+        color = colors[i % len(colors)]
+        style = "-" if sol.stable else "--"
+        lw = 2.2 if i == selected else 1.3
+        label = _solution_label(orbit, i)
+        for ax, key in ((ax_d, "delta"), (ax_v, "velocity"), (ax_a, "acceleration")):
+            ax.plot(h["t"], h[key], style, color=color, lw=lw, label=label if key == "delta" else None)
+        one = orbit.time_history(i, samples=samples)  # one closed orbit for the phase portrait
+        ax_p.plot(one["delta"], one["velocity"], style, color=color, lw=lw, label=label)
+        f = np.arange(sol.harmonics + 1) / sol.period
+        amp = sol.amplitudes()
+        keep = f <= SPECTRUM_ORDERS + 1e-9
+        f, amp = f[keep], amp[keep]
+        offset = (i - (len(orbit.solutions) - 1) / 2) * 0.035  # side by side, not on top
+        floor = 1e-7
+        show = amp > floor
+        ax_s.vlines(f[show] + offset, floor, amp[show], color=color, lw=1.6, linestyles=style)
+        ax_s.plot(f[show] + offset, amp[show], "o", color=color, ms=4,
+                  mfc=color if sol.stable else "white", label=f"HB {i} (period {sol.period})")
+
+    # --- simulation --------------------------------------------------------------------------
+    sim = orbit.simulated_history(samples=samples, periods=n_win)
+    if sim is not None:
+        p = sim_period
+        sim_label = "simulation, " + (f"period {p}" if p else "no period ≤ 8")
+        step = max(1, samples // 32)
+        for ax, key in ((ax_d, "delta"), (ax_v, "velocity"), (ax_a, "acceleration")):
+            ax.plot(sim["t"][::step], sim[key][::step], "o", color="black", ms=2.6,
+                    label=sim_label if key == "delta" else None, zorder=5)
+        ax_p.plot(sim["delta"][::step], sim["velocity"][::step], "o", color="black", ms=2.2,
+                  label=sim_label, zorder=5)
+        if p:
+            n_sim = int(round(sim["t"][-1] / Tf))
+            f, amp = _amplitudes_from_samples(sim["delta"][:-1], n_sim, SPECTRUM_ORDERS)
+            show = amp > 1e-7 * max(float(np.max(amp)), 1e-300)
+            ax_s.plot(f[show], amp[show], "o", mfc="none", mec="black", ms=7, mew=1.2, label=sim_label)
+        else:  # not periodic: a continuous spectrum over the whole recorded window, as a line
+            whole = orbit.simulated_history(samples=64, periods=10**6)
+            if whole is not None:
+                n_sim = max(1, int(round(whole["t"][-1] / Tf)))
+                f, amp = _amplitudes_from_samples(whole["delta"][:-1], n_sim, SPECTRUM_ORDERS)
+                ax_s.plot(f, np.maximum(amp, 1e-12), "-", color="black", lw=0.8,
+                          label=f"{sim_label} ({n_sim} periods)")
+
+    # --- decoration ----------------------------------------------------------------------------
+    breakpoints = np.asarray(orbit.model.elastic.stages.breakpoints, dtype=float)
+    for k, b in enumerate(breakpoints):
+        ax_d.axhline(b, color="0.5", ls=":", lw=0.9, label="breakpoints" if k == 0 else None)
+        ax_p.axvline(b, color="0.5", ls=":", lw=0.9, label="breakpoints" if k == 0 else None)
+    for m in range(1, n_win):
+        for ax in (ax_d, ax_v, ax_a):
+            ax.axvline(m * Tf, color="0.8", lw=0.8, zorder=0)
+    ax_d.set_ylabel("δ (rad)")
+    ax_v.set_ylabel("δ' (rad/s)")
+    ax_a.set_ylabel("δ'' (rad/s²)")
+    ax_a.set_xlabel(f"time t (s); grey lines every forcing period 2π/Ω = {Tf:.4g} s")
+    ax_d.set_xlim(0.0, n_win * Tf)
+    plt.setp(ax_d.get_xticklabels(), visible=False)
+    plt.setp(ax_v.get_xticklabels(), visible=False)
+    ax_d.set_title("time histories", fontsize=10)
+    ax_p.set_xlabel("δ (rad)")
+    ax_p.set_ylabel("δ' (rad/s)")
+    ax_p.set_title("phase portrait", fontsize=10)
+    ax_s.set_yscale("log")
+    ax_s.set_xlabel("frequency / Ω")
+    ax_s.set_ylabel("amplitude of δ (rad)")
+    ax_s.set_title("amplitude spectrum of δ", fontsize=10)
+    ax_s.set_xlim(-0.25, SPECTRUM_ORDERS + 0.25)
+    ymax = max([float(np.max(s.amplitudes())) for s in orbit.solutions] + [1e-6])
+    ax_s.set_ylim(max(1e-7, ymax * 1e-6), ymax * 3.0)
+    for ax in axes.values():
+        ax.grid(True, alpha=0.3)
+    # One legend for the curves (they are the same in every panel), above the panels where it
+    # hides nothing; the spectrum keeps its own (its markers differ).
+    handles, labels = ax_d.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(3, max(1, len(labels))), fontsize=8.5,
+               frameon=False)
+    ax_s.legend(fontsize=7, loc="upper right", framealpha=0.85)
+    if title is None:
+        title = f"Periodic orbits at Ω = {orbit.omega:.5g} rad/s (H = {orbit.harmonics}, period {orbit.period} asked for)"
+        if not orbit.solutions:
+            title += ": no harmonic-balance solution found"
+    fig.suptitle(title)
+    return fig, axes
+
+
+__all__ = ["orbit_plot", "window_periods"]

@@ -1,0 +1,120 @@
+"""Plot of a time-domain frequency sweep: a response measure vs Ω, up and down sweeps apart."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..results import SweepResult
+
+#: Marker, colour and legend text of each sweep direction.
+DIRECTION_STYLES: dict[str, tuple[str, str, str]] = {
+    "up": ("^", "tab:blue", "sweep up (Ω increasing)"),
+    "down": ("v", "tab:orange", "sweep down (Ω decreasing)"),
+}
+#: Ring colours of the points whose period is not 1 (period 0: none up to 8 found).
+PERIOD_COLORS: dict[int, str] = {
+    0: "black", 2: "tab:red", 3: "tab:green", 4: "tab:purple", 5: "tab:brown",
+    6: "tab:pink", 7: "tab:olive", 8: "tab:cyan",
+}
+_QUANTITIES = {
+    "mean": "δ mean (rad)", "rms": "δ rms (rad)", "rms_ac": "δ rms about the mean (rad)",
+    "p2p": "δ peak-to-peak (rad)", "acc_p2p": "δ'' peak-to-peak (rad/s²)",
+}
+
+
+def _runs(values: np.ndarray) -> list[tuple[int, int]]:
+    """(start, stop) of runs of equal consecutive values, stop exclusive."""
+    if values.size == 0:
+        return []
+    cut = np.nonzero(values[1:] != values[:-1])[0] + 1
+    starts = np.concatenate(([0], cut))
+    stops = np.concatenate((cut, [values.size]))
+    return list(zip(starts.tolist(), stops.tolist()))
+
+
+def period_label(period: int) -> str:
+    """Legend text of a period: ``period n``, or ``no period ≤ 8`` for 0."""
+    return "no period ≤ 8 (quasi-periodic or chaotic)" if int(period) == 0 else f"period {int(period)}"
+
+
+def sweep_plot(
+    sweep: "SweepResult",
+    ax: Any = None,
+    *,
+    quantity: str = "rms",
+    annotate: bool = True,
+    lines: bool = True,
+    title: str | None = None,
+) -> tuple[Any, Any]:
+    """Draw ``quantity`` (default rms of δ) vs Ω for each sweep direction; returns (figure, axes).
+
+    The up sweep is drawn with ▲ markers, the down sweep with ▼ markers, each in its colour and
+    joined in sweep order, so that the jumps at the ends of a multi-valued region show as
+    vertical steps at different Ω. Points whose motion has a period other than 1 are ringed in
+    a colour per period, and each run of them is labelled with its period ("P2"); period 0
+    (no period up to 8: quasi-periodic or chaotic) is ringed in black and labelled "P0".
+
+    Parameters
+    ----------
+    sweep : SweepResult
+        Columns ``direction``, ``omega``, the measures and ``period``.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into (default: a new 8 × 5 in figure).
+    quantity : str, default "rms"
+        One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``.
+    annotate : bool, default True
+        Label each run of period ≠ 1 points with its period.
+    lines : bool, default True
+        Join the points of each direction (False: markers only, e.g. over a frequency response).
+    title : str, optional
+        Axes title.
+    """
+    import matplotlib.pyplot as plt
+
+    if quantity not in _QUANTITIES:
+        raise ValueError(f"`quantity` must be one of {sorted(_QUANTITIES)}, got {quantity!r}")
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
+    else:
+        fig = ax.figure
+    direction = np.asarray(sweep.direction).astype(str)
+    omega = np.asarray(sweep.omega, dtype=float)
+    y_all = np.asarray(getattr(sweep, quantity), dtype=float)
+    period = np.asarray(sweep.period, dtype=int)
+    names = [d for d in ("up", "down") if np.any(direction == d)] + sorted(set(direction) - {"up", "down"})
+    for name in names:  # the sweeps first, so that they lead the legend
+        marker, color, label = DIRECTION_STYLES.get(name, ("o", "tab:gray", f"sweep {name}"))
+        sel = np.nonzero(direction == name)[0]
+        if lines:
+            ax.plot(omega[sel], y_all[sel], "-", color=color, lw=0.9, alpha=0.7)
+        ax.plot(omega[sel], y_all[sel], marker, color=color, ms=4.5, ls="none", label=label)
+    for p in sorted(set(period.tolist()) - {1}):  # then a ring colour per period other than 1
+        m = period == p
+        ax.plot(omega[m], y_all[m], "o", ms=10, mfc="none", mec=PERIOD_COLORS.get(p, "tab:gray"), mew=1.4,
+                ls="none", label=period_label(p))
+    if annotate:
+        for name in names:
+            sel = np.nonzero(direction == name)[0]
+            om, y, per = omega[sel], y_all[sel], period[sel]
+            up = name != "down"
+            for i0, i1 in _runs(per):
+                if per[i0] == 1:
+                    continue
+                j = (i0 + i1 - 1) // 2
+                ax.annotate(
+                    f"P{int(per[i0])}", (om[j], y[j]), xytext=(0, 9 if up else -9),
+                    textcoords="offset points", ha="center", va="bottom" if up else "top",
+                    fontsize=8, color=PERIOD_COLORS.get(int(per[i0]), "tab:gray"), fontweight="bold",
+                )
+    ax.set_xlabel("forcing frequency Ω (rad/s)")
+    ax.set_ylabel(_QUANTITIES[quantity])
+    ax.set_title(title if title is not None else "Time-domain frequency sweep (steady state at each Ω)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    return fig, ax
+
+
+__all__ = ["sweep_plot", "period_label", "DIRECTION_STYLES", "PERIOD_COLORS"]

@@ -1,0 +1,224 @@
+"""Columnar result of a time-domain frequency sweep (``rattle sweep``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from .._typing import BoolArray, ComplexArray, FloatArray, IntArray
+from ..io._csv import SWEEP_COLUMNS
+from ..model import Model
+
+#: Sweep directions, in the order ``both`` runs them.
+SWEEP_DIRECTIONS: tuple[str, ...] = ("up", "down")
+
+
+class Jump(NamedTuple):
+    """An abrupt change of the rms between two consecutive frequencies of one sweep direction:
+    ``direction``, ``omega_before`` → ``omega_after`` (rad/s, in sweep order) and the rms on
+    either side (rad). A named tuple: unpacks in that order."""
+
+    direction: str
+    omega_before: float
+    omega_after: float
+    rms_before: float
+    rms_after: float
+
+    @property
+    def omega(self) -> float:
+        """The jump frequency: midway between ``omega_before`` and ``omega_after``."""
+        return 0.5 * (self.omega_before + self.omega_after)
+
+    @property
+    def kind(self) -> str:
+        """``up`` when the rms jumps up, ``down`` when it drops."""
+        return "up" if self.rms_after > self.rms_before else "down"
+
+
+@dataclass(frozen=True, slots=True, eq=False)  # arrays: identity equality
+class SweepResult:
+    """Steady states along a stepped frequency sweep, one row per frequency, in sweep order
+    (the up sweep first when both directions ran).
+
+    Columns (numpy arrays of length P): SPEC §3 ``SWEEP_COLUMNS`` — ``direction`` (``up`` or
+    ``down``), ``omega`` (rad/s), ``mean``, ``rms``, ``rms_ac``, ``p2p`` (rad), ``acc_p2p``
+    (rad/s²), ``period`` (multiple of the forcing period, 0 when none up to the detection limit
+    was found). Also ``delta_min``, ``delta_max`` (rad), ``settled`` (bool), ``method``
+    (``shooting``/``simulation``/``unsettled``), ``periods`` and ``shooting_periods`` (forcing
+    periods simulated and integrated by Newton shooting: the effort), ``state0`` (P, 2) the
+    orbit's state on the Poincaré section, ``final_state`` (P, 2) the state carried to the next
+    frequency, ``multipliers`` (P, 2) complex Floquet multipliers (NaN for period 0), and the
+    provenance: ``model``, ``settings`` and ``timings`` (s).
+    """
+
+    model: Model
+    direction: np.ndarray
+    omega: FloatArray
+    mean: FloatArray
+    rms: FloatArray
+    rms_ac: FloatArray
+    p2p: FloatArray
+    acc_p2p: FloatArray
+    period: IntArray
+    delta_min: FloatArray
+    delta_max: FloatArray
+    settled: BoolArray
+    method: np.ndarray
+    periods: IntArray
+    shooting_periods: IntArray
+    state0: FloatArray
+    final_state: FloatArray
+    multipliers: ComplexArray
+    settings: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    # --- container protocol ----------------------------------------------------------------
+    def __len__(self) -> int:
+        return int(self.omega.size)
+
+    def __getitem__(self, index: int) -> dict[str, Any]:
+        """Row ``index`` as a dict of the SPEC columns."""
+        return {name: getattr(self, name)[index] for name in SWEEP_COLUMNS}
+
+    @property
+    def directions(self) -> tuple[str, ...]:
+        """The directions present, in sweep order."""
+        return tuple(d for d in SWEEP_DIRECTIONS if np.any(self.direction == d))
+
+    def select(self, direction: str) -> "SweepResult":
+        """The rows of one ``direction`` (``up`` or ``down``) as a SweepResult."""
+        if direction not in SWEEP_DIRECTIONS:
+            raise ValueError(f"`direction` must be one of {', '.join(SWEEP_DIRECTIONS)}, got {direction!r}")
+        rows = np.flatnonzero(self.direction == direction)
+        values = {name: getattr(self, name)[rows] for name in _ROW_FIELDS}
+        return SweepResult(model=self.model, settings=self.settings, timings=self.timings, **values)
+
+    def __repr__(self) -> str:
+        parts = []
+        for d in self.directions:
+            m = self.direction == d
+            counts = np.bincount(self.period[m], minlength=1)
+            per = ", ".join(f"{int(c)}×P{p}" for p, c in enumerate(counts) if c)
+            parts.append(f"{d}: {int(np.sum(m))} points ({per})")
+        span = f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}" if len(self) else "empty"
+        return f"SweepResult({span}; {'; '.join(parts)}; jumps at {self._jump_text()})"
+
+    def _jump_text(self) -> str:
+        jumps = self.jumps()
+        if not jumps:
+            return "none"
+        return ", ".join(f"Ω ≈ {j.omega:.4g} ({j.direction} sweep, rms {j.kind})" for j in jumps)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The SPEC columns in order, as a dict of arrays."""
+        return {name: getattr(self, name) for name in SWEEP_COLUMNS}
+
+    def summary(self) -> str:
+        """A few lines for the terminal: points per direction, periods found, jumps, effort."""
+        lines = []
+        for d in self.directions:
+            m = self.direction == d
+            w = self.omega[m]
+            counts = np.bincount(self.period[m], minlength=1)
+            per = ", ".join(f"period {p}: {int(c)}" for p, c in enumerate(counts) if c and p)
+            if counts[0]:
+                per += (", " if per else "") + f"not periodic (period 0): {int(counts[0])}"
+            i = int(np.argmax(self.rms[m]))
+            lines.append(
+                f"{d} sweep: {int(np.sum(m))} frequencies over Ω = {w.min():.4g} … {w.max():.4g} ({per}); "
+                f"largest rms {self.rms[m][i]:.5g} rad at Ω = {w[i]:.5g}"
+            )
+        jumps = self.jumps()
+        if jumps:
+            lines.append("jumps: " + "; ".join(
+                f"{j.direction} sweep, rms {j.kind} {j.rms_before:.4g} → {j.rms_after:.4g} rad "
+                f"between Ω = {j.omega_before:.5g} and {j.omega_after:.5g}" for j in jumps))
+        else:
+            lines.append("jumps: none")
+        lines.append(
+            f"effort: {int(np.sum(self.periods))} forcing periods simulated, "
+            f"{int(np.sum(self.shooting_periods))} in Newton shooting"
+        )
+        if self.timings:
+            lines.append("time: " + ", ".join(f"{k} {v:.3g} s" for k, v in self.timings.items()))
+        return "\n".join(lines)
+
+    def jumps(self, threshold: float = 0.15) -> list[Jump]:
+        """Abrupt rms changes between consecutive frequencies of each direction.
+
+        A step from row i to i + 1 of one direction is a jump when the rms changes by more than
+        ``threshold`` times the larger of the two values, and by more than four times the larger
+        change over the neighbouring steps (so that a steep but smooth resonance flank is not
+        taken for a jump).
+
+        Parameters
+        ----------
+        threshold : float
+            Relative rms change (default 0.15).
+
+        Returns
+        -------
+        list of Jump
+            In sweep order; each unpacks as (direction, omega_before, omega_after, rms_before,
+            rms_after).
+        """
+        if not (isinstance(threshold, (int, float)) and not isinstance(threshold, bool) and threshold > 0):
+            raise ValueError(f"`threshold` must be a number > 0, got {threshold!r}")
+        out: list[Jump] = []
+        for d in self.directions:
+            rows = np.flatnonzero(self.direction == d)
+            r, w = self.rms[rows], self.omega[rows]
+            if r.size < 2:
+                continue
+            change = np.abs(np.diff(r))
+            rel = change / np.maximum(np.maximum(np.abs(r[:-1]), np.abs(r[1:])), 1e-300)
+            for i in np.flatnonzero(rel > threshold):
+                neighbours = np.concatenate((change[max(0, i - 2) : i], change[i + 1 : i + 3]))
+                if neighbours.size and change[i] <= 4.0 * float(np.max(neighbours)):
+                    continue
+                out.append(Jump(d, float(w[i]), float(w[i + 1]), float(r[i]), float(r[i + 1])))
+        return out
+
+    def metadata(self) -> dict[str, Any]:
+        """Settings, timings, effort, periods found and jumps, JSON-serialisable."""
+        return {
+            "settings": self.settings,
+            "timings": self.timings,
+            "points": len(self),
+            "directions": list(self.directions),
+            "periods_found": {str(int(p)): int(c) for p, c in zip(*np.unique(self.period, return_counts=True))},
+            "effort": {
+                "simulated_periods": int(np.sum(self.periods)),
+                "shooting_periods": int(np.sum(self.shooting_periods)),
+            },
+            "jumps": [
+                {"direction": j.direction, "omega_before": j.omega_before, "omega_after": j.omega_after,
+                 "rms_before": j.rms_before, "rms_after": j.rms_after}
+                for j in self.jumps()
+            ],
+        }
+
+    # --- output delegates ------------------------------------------------------------------
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
+        from ..io import write_csv
+
+        write_csv(path, self.columns(), list(SWEEP_COLUMNS))
+        return Path(path)
+
+    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
+        """rms vs Ω of each direction; see :func:`rattle.plotting.sweep_plot` (returns its handles)."""
+        from ..plotting import sweep_plot  # type: ignore[attr-defined]
+
+        return sweep_plot(self, ax=ax, **kwargs)
+
+
+_ROW_FIELDS: tuple[str, ...] = (
+    "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period", "delta_min", "delta_max",
+    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers",
+)
+
+__all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS"]

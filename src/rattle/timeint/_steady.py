@@ -1,0 +1,523 @@
+"""Steady state of δ'' + c δ' + k f(δ) = F(t) by simulation, with period detection (1 … 8).
+
+The state is integrated exactly (:class:`ExactIntegrator`) one forcing period T = 2π/Ω at a time,
+from t = 0 to T (F is T-periodic, so every period starts at forcing phase 0). The states at the
+period ends form the Poincaré sequence P_0 = x0, P_1, P_2, … of the stroboscopic map
+P_{i+1} = φ(P_i; 0 → T). Distances are measured in the scaled max-norm
+
+    ‖P_i − P_j‖ = max(|Δδ| / L, |Δδ'| / (L ν)),
+
+L the model's length scale and ν the larger of Ω and the stiffest stage's natural frequency (the
+scaling of :func:`shoot_periodic_orbit`), and d_n(i) = ‖P_i − P_{i−n}‖.
+
+Plain settling
+    The motion has settled on a period-n cycle (n·T-periodic) when d_n(k) ≤ ``tolerance`` for the
+    n + 1 latest k (every point of the cycle repeats), for the smallest such n ≤
+    ``max_period_multiple``. A cycle of period n is also one of period 2n; the smallest n is
+    taken, and n is refused while d_m (m a proper divisor of n) still shrinks — a period-m orbit
+    approached along a multiplier near −1 satisfies d_2m ≪ d_m long before d_m ≤ tolerance.
+
+Acceleration (``accelerate=True``)
+    Near a stable orbit with multiplier μ the sequence approaches it only like |μ|^i: with
+    |μ| = 0.95, some 400 periods from 0.1 to 1e-8. Once the sequence contracts towards a period-n
+    cycle (d_n small and shrinking, smallest such n), Newton shooting with period n (exact
+    monodromy, :func:`shoot_periodic_orbit`) polishes the orbit X* from the current state. It is
+    accepted only when
+
+    1. Newton converged (scaled residual ≤ ``shooting_tolerance``), and the orbit is stable
+       (every Floquet multiplier inside the unit circle);
+    2. it is the attractor being approached: the current section point P_i is within
+       ``capture_distance`` of X* (of one of the cycle's section points), and the simulation
+       behaves as the linearisation about X* predicts: after n more periods
+       ‖(P_{i+n} − X*) − M (P_i − X*)‖ ≤ 0.1 ‖P_i − X*‖ (M the monodromy matrix).
+
+    Inside that linear neighbourhood of a stable orbit the simulation converges to X*, so the
+    accelerated result is the attractor of the plain simulation, located exactly. Otherwise the
+    simulation simply goes on (a rejected orbit is retried with growing waits).
+
+Nothing settled within ``max_periods`` periods: period 0 (quasi-periodic, chaotic, or a period
+above ``max_period_multiple``), with the measures over ``record_periods`` further periods.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray
+from ..model import Model
+from ._exact import ExactIntegrator, ExactMeasures, Trajectory
+from ._shooting import _newton_shooting, _Shot, _state_scale
+
+_TWO_PI = 2.0 * math.pi
+_LINEAR_CHECK = 0.1  # relative mismatch allowed between the simulation and the linearisation
+_ROUNDOFF = 1e-12  # scaled distance treated as round-off in the linear check
+_SAME_POINT = 1e-6  # scaled distance under which φ^m(X*) = X*: the period is m, not n
+_MAX_WAIT = 128  # longest wait (forcing periods) between two acceleration attempts
+# Step halvings per Newton iteration: an attempt from too far away should fail cheaply (the
+# simulation goes on and a later attempt starts closer).
+_MAX_HALVINGS = 3
+
+METHODS: dict[str, str] = {
+    "shooting": "a stable periodic orbit approached by the simulation, polished by Newton shooting",
+    "simulation": "the Poincaré sequence of the plain simulation settled to the tolerance",
+    "unsettled": "nothing settled within `max_periods` forcing periods (period 0)",
+}
+
+
+def _check_int(name: str, value: object, low: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"`{name}` must be an integer, got {value!r} ({type(value).__name__})")
+    if value < low:
+        raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
+    return int(value)
+
+
+def _check_positive(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"`{name}` must be a real number, got {value!r} ({type(value).__name__})")
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SteadyStateOptions:
+    """Budget and tolerances of :func:`steady_state` (frozen; derive variants with
+    ``dataclasses.replace``).
+
+    Parameters
+    ----------
+    tolerance : float
+        Settling tolerance on the scaled Poincaré distance d_n = ‖P_i − P_{i−n}‖ (see the
+        module docstring; δ scaled by the model's length scale L, δ' by L ν). Default 1e-8.
+    max_periods : int
+        Bound on the forcing periods simulated while settling (default 1500).
+    max_period_multiple : int
+        Largest period detected, as a multiple of the forcing period (default 8, SPEC §1).
+    record_periods : int
+        Forcing periods over which the measures of an unsettled motion (period 0) are taken
+        (default 50).
+    accelerate : bool
+        Polish by Newton shooting once the simulation contracts towards a cycle, accepting the
+        orbit only when it is stable and is the attractor being approached (default True).
+        False: plain simulation only (slower, same answers to within the tolerance).
+    capture_distance : float
+        Scaled distance from a polished orbit within which the simulation is checked against the
+        orbit's linearisation (default 1e-2).
+    trigger_distance : float
+        Scaled d_n below which (and shrinking) a shooting attempt with period n is made
+        (default 0.1).
+    shooting_tolerance : float
+        Newton tolerance on the scaled shooting residual (default 1e-12).
+    shooting_iterations : int
+        Newton iteration budget per shooting attempt (default 10; Newton converges in 2–5
+        iterations from a state that is close enough).
+    section_points : int
+        Latest Poincaré points kept in the result (default 32).
+    """
+
+    tolerance: float = 1e-8
+    max_periods: int = 1500
+    max_period_multiple: int = 8
+    record_periods: int = 50
+    accelerate: bool = True
+    capture_distance: float = 1e-2
+    trigger_distance: float = 0.1
+    shooting_tolerance: float = 1e-12
+    shooting_iterations: int = 10
+    section_points: int = 32
+
+    def __post_init__(self) -> None:
+        for name in ("tolerance", "capture_distance", "trigger_distance", "shooting_tolerance"):
+            object.__setattr__(self, name, _check_positive(name, getattr(self, name)))
+        for name, low in (("max_periods", 1), ("max_period_multiple", 1), ("record_periods", 1),
+                          ("shooting_iterations", 0), ("section_points", 1)):
+            object.__setattr__(self, name, _check_int(name, getattr(self, name), low))
+        if not isinstance(self.accelerate, (bool, np.bool_)):
+            raise TypeError(f"`accelerate` must be True or False, got {self.accelerate!r}")
+        object.__setattr__(self, "accelerate", bool(self.accelerate))
+        if self.tolerance >= 1.0:
+            raise ValueError(f"`tolerance` must be < 1 (a scaled distance), got {self.tolerance!r}")
+
+    def to_dict(self) -> dict[str, object]:
+        """The options as a JSON-serialisable dict."""
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
+class SteadyState:
+    """The steady motion reached from an initial state at one forcing frequency.
+
+    Attributes
+    ----------
+    omega : float
+        Forcing frequency Ω (rad/s).
+    period : int
+        Period of the motion as a multiple of the forcing period 2π/Ω (1 … ``max_period_multiple``),
+        0 when none was found (quasi-periodic, chaotic or longer).
+    settled : bool
+        True when a periodic motion was found (period ≥ 1).
+    method : str
+        ``shooting``, ``simulation`` or ``unsettled`` (see :data:`METHODS`).
+    periods : int
+        Forcing periods simulated (settling, checks and, for period 0, the record).
+    shooting_periods : int
+        Forcing periods integrated inside the Newton shooting solves.
+    state0 : ndarray, shape (2,)
+        (δ, δ') (rad, rad/s) at the start of ``trajectory``, on the Poincaré section (forcing
+        phase 0): for a periodic motion, a point of the orbit.
+    final_state : ndarray, shape (2,)
+        The state on the Poincaré section to carry to the next frequency of a sweep.
+    cycle : ndarray, shape (period, 2)
+        The orbit's section points x(m·2π/Ω), m = 0 … period − 1 (empty for period 0).
+    poincare : ndarray, shape (m, 2)
+        The latest Poincaré points of the simulation, oldest first (for period 0, those of the
+        recorded window).
+    trajectory : Trajectory
+        Exact trajectory over one orbit period from ``state0`` (period·2π/Ω), or over the
+        ``record_periods`` window for period 0 (time starts at 0).
+    measures : ExactMeasures
+        SPEC §1 measures over ``trajectory``.
+    multipliers : ndarray, shape (2,), complex, or None
+        Floquet multipliers of the orbit (largest modulus first); None for period 0.
+    residual : float
+        Scaled shooting residual (``shooting``), settling distance d_n (``simulation``) or the
+        smallest d_n at the end (``unsettled``).
+    """
+
+    omega: float
+    period: int
+    settled: bool
+    method: str
+    periods: int
+    shooting_periods: int
+    state0: FloatArray
+    final_state: FloatArray
+    cycle: FloatArray
+    poincare: FloatArray
+    trajectory: Trajectory
+    measures: ExactMeasures
+    multipliers: ComplexArray | None
+    residual: float
+
+    # SPEC §1 measures, flat
+    @property
+    def mean(self) -> float:
+        return self.measures.mean
+
+    @property
+    def rms(self) -> float:
+        return self.measures.rms
+
+    @property
+    def rms_ac(self) -> float:
+        return self.measures.rms_ac
+
+    @property
+    def p2p(self) -> float:
+        return self.measures.p2p
+
+    @property
+    def acc_p2p(self) -> float:
+        return self.measures.acc_p2p
+
+    @property
+    def delta_min(self) -> float:
+        return self.measures.delta_min
+
+    @property
+    def delta_max(self) -> float:
+        return self.measures.delta_max
+
+    @property
+    def stable(self) -> bool | None:
+        """True when every Floquet multiplier is inside the unit circle; None for period 0."""
+        if self.multipliers is None:
+            return None
+        return bool(np.all(np.abs(self.multipliers) < 1.0))
+
+    @property
+    def regime(self) -> str:
+        """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) over ``trajectory``."""
+        crossed = self.trajectory.crossed_breakpoints
+        if crossed.size == 0:
+            return "no_impact"
+        if np.all(crossed > 0.0) or np.all(crossed < 0.0):
+            return "single_sided"
+        return "double_sided"
+
+    def __repr__(self) -> str:
+        return (
+            f"SteadyState(Ω = {self.omega:.6g}, period {self.period}, {self.method}, "
+            f"rms {self.rms:.6g}, {self.periods} periods simulated + {self.shooting_periods} shooting)"
+        )
+
+
+def _proper_divisors(n: int) -> list[int]:
+    return [m for m in range(1, n) if n % m == 0]
+
+
+@dataclass(slots=True)
+class _Candidate:
+    """A stable orbit found by shooting, waiting for the simulation to come close."""
+
+    shot: _Shot
+    period: int
+    cycle: FloatArray  # (n, 2) unscaled section points
+    created: int
+
+
+class _Settler:
+    """The settling loop of :func:`steady_state` (one call)."""
+
+    def __init__(self, model: Model, omega: float, x0: FloatArray, opts: SteadyStateOptions,
+                 integ: ExactIntegrator) -> None:
+        self.model, self.omega, self.opts, self.integ = model, omega, opts, integ
+        self.T = _TWO_PI / omega
+        self.scale = _state_scale(model, omega)
+        n_max = opts.max_periods
+        self.N = opts.max_period_multiple
+        self.X = np.empty((n_max + 1, 2))  # section states
+        self.P = np.empty((n_max + 1, 2))  # scaled
+        self.d = np.full((n_max + 1, self.N + 1), np.inf)  # d[i, n] = ‖P_i − P_{i−n}‖
+        self.X[0] = x0
+        self.P[0] = x0 / self.scale
+        self.i = 0
+        self.shooting_periods = 0
+        # acceleration state
+        self.candidate: _Candidate | None = None
+        self.pending: tuple[int, FloatArray, _Shot, int] | None = None
+        self.next_attempt = 1
+        self.failures = 0
+
+    # --- helpers --------------------------------------------------------------------------
+    def norm(self, dx: FloatArray) -> float:
+        return float(np.max(np.abs(dx / self.scale)))
+
+    def step(self) -> None:
+        i = self.i + 1
+        d, v = self.integ._advance(float(self.X[i - 1, 0]), float(self.X[i - 1, 1]), 0.0, self.T, self.omega)
+        self.X[i] = x = np.array([d, v])
+        self.P[i] = x / self.scale
+        n = min(self.N, i)
+        self.d[i, 1 : n + 1] = np.max(np.abs(self.P[i] - self.P[i - n : i][::-1]), axis=1)
+        self.i = i
+
+    def shoot(self, x: FloatArray, n: int) -> _Shot:
+        opts = self.opts
+        shot = _newton_shooting(self.integ, self.omega, x, n, opts.shooting_tolerance,
+                                opts.shooting_iterations, self.scale, _MAX_HALVINGS)
+        self.shooting_periods += shot.evaluations * n
+        return shot
+
+    def cycle_points(self, shot: _Shot, n: int) -> FloatArray:
+        if n == 1:
+            return shot.x[None, :].copy()
+        s = shot.trajectory.sample(np.arange(n) * self.T)
+        return np.column_stack((s.delta, s.velocity))
+
+    # --- plain detection --------------------------------------------------------------------
+    def plain_period(self) -> int:
+        i, d, tol = self.i, self.d, self.opts.tolerance
+        for n in range(1, self.N + 1):
+            if i < 2 * n:
+                break
+            if not (d[i, n] <= tol and np.all(d[i - n : i, n] <= tol)):
+                continue
+            if all(d[i, m] > 1e3 * tol and d[i, m] > 0.99 * d[i - n, m] for m in _proper_divisors(n)):
+                return n
+        return 0
+
+    # --- acceleration ------------------------------------------------------------------------
+    def trigger(self) -> int:
+        i, d = self.i, self.d
+        for n in range(1, min(self.N, i) + 1):
+            if d[i, n] <= self.opts.trigger_distance and (i < 2 * n or d[i, n] < d[i - n, n]):
+                return n
+        return 0
+
+    def stable_orbit(self, x: FloatArray, n: int) -> tuple[_Shot, int] | None:
+        """Newton shooting with period n from x; the orbit (with its minimal period) if it
+        converged and is stable, else None."""
+        shot = self.shoot(x, n)
+        if not shot.residual <= self.opts.shooting_tolerance:
+            return None
+        if not np.all(np.abs(shot.multipliers()) < 1.0):
+            return None
+        for m in _proper_divisors(n):
+            s = shot.trajectory.sample(np.array([m * self.T]))
+            if self.norm(np.array([s.delta[0], s.velocity[0]]) - shot.x) <= _SAME_POINT:
+                lower = self.shoot(shot.x, m)
+                if lower.residual <= self.opts.shooting_tolerance and np.all(np.abs(lower.multipliers()) < 1.0):
+                    return lower, m
+        return shot, n
+
+    def fail(self) -> None:
+        self.candidate = None
+        self.pending = None
+        self.failures += 1
+        self.next_attempt = self.i + min(2 ** (self.failures + 1), _MAX_WAIT)
+
+    def accelerate(self) -> SteadyState | None:
+        i = self.i
+        if self.pending is not None:
+            i0, e0, shot, n = self.pending
+            if i < i0 + n:
+                return None
+            e1 = self.X[i] - shot.x
+            mismatch = self.norm(e1 - shot.trajectory.sensitivity @ e0)
+            if mismatch <= _LINEAR_CHECK * self.norm(e0) + _ROUNDOFF:
+                return self.from_shot(shot, n)
+            self.fail()
+            return None
+        if self.candidate is None:
+            if i < self.next_attempt:
+                return None
+            n = self.trigger()
+            if n == 0:
+                return None
+            found = self.stable_orbit(self.X[i], n)
+            if found is None:
+                self.fail()
+                return None
+            shot, n = found
+            self.candidate = _Candidate(shot, n, self.cycle_points(shot, n), i)
+        cand = self.candidate
+        dist = np.max(np.abs((cand.cycle - self.X[i]) / self.scale), axis=1)
+        k = int(np.argmin(dist))
+        if dist[k] > self.opts.capture_distance:
+            if i - cand.created > max(64, 8 * cand.period):
+                self.candidate = None  # not approached: look again later
+            return None
+        shot = cand.shot
+        if k != 0:  # the simulation is at another phase of the cycle: re-base the orbit there
+            shot = self.shoot(cand.cycle[k], cand.period)
+            if not shot.residual <= self.opts.shooting_tolerance:
+                self.fail()
+                return None
+        e0 = self.X[i] - shot.x
+        if self.norm(e0) <= self.opts.tolerance:
+            return self.from_shot(shot, cand.period)
+        self.pending = (i, e0, shot, cand.period)
+        return None
+
+    # --- results ----------------------------------------------------------------------------
+    def poincare(self) -> FloatArray:
+        k = self.opts.section_points
+        return self.X[max(0, self.i + 1 - k) : self.i + 1].copy()
+
+    def from_shot(self, shot: _Shot, n: int) -> SteadyState:
+        traj = shot.trajectory
+        return SteadyState(
+            omega=self.omega, period=n, settled=True, method="shooting", periods=self.i,
+            shooting_periods=self.shooting_periods, state0=shot.x.copy(), final_state=shot.x.copy(),
+            cycle=self.cycle_points(shot, n), poincare=self.poincare(), trajectory=traj,
+            measures=traj.measures(), multipliers=shot.multipliers(), residual=shot.residual,
+        )
+
+    def from_simulation(self, n: int) -> SteadyState:
+        i = self.i
+        x = self.X[i].copy()
+        traj = self.integ.propagate(x, 0.0, n * self.T, self.omega)
+        mult = np.linalg.eigvals(traj.sensitivity).astype(complex)
+        mult = mult[np.argsort(-np.abs(mult), kind="stable")]
+        cycle = x[None, :] if n == 1 else np.column_stack(
+            [(s := traj.sample(np.arange(n) * self.T)).delta, s.velocity])
+        return SteadyState(
+            omega=self.omega, period=n, settled=True, method="simulation", periods=i + n,
+            shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
+            cycle=cycle, poincare=self.poincare(), trajectory=traj, measures=traj.measures(),
+            multipliers=mult, residual=float(np.max(self.d[i - n : i + 1, n])),
+        )
+
+    def unsettled(self) -> SteadyState:
+        i, rec = self.i, self.opts.record_periods
+        x = self.X[i].copy()
+        traj = self.integ.propagate(x, 0.0, rec * self.T, self.omega)
+        s = traj.sample(np.arange(rec + 1) * self.T)
+        section = np.column_stack((s.delta, s.velocity))[-self.opts.section_points :]
+        return SteadyState(
+            omega=self.omega, period=0, settled=False, method="unsettled", periods=i + rec,
+            shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
+            cycle=np.empty((0, 2)), poincare=section, trajectory=traj, measures=traj.measures(),
+            multipliers=None, residual=float(np.min(self.d[i, 1:])),
+        )
+
+    def run(self) -> SteadyState:
+        opts = self.opts
+        while self.i < opts.max_periods:
+            self.step()
+            n = self.plain_period()
+            if n:
+                if opts.accelerate:
+                    found = self.stable_orbit(self.X[self.i], n)
+                    if found is not None and self.norm(self.X[self.i] - found[0].x) <= opts.capture_distance:
+                        return self.from_shot(*found)
+                return self.from_simulation(n)
+            if opts.accelerate:
+                result = self.accelerate()
+                if result is not None:
+                    return result
+        return self.unsettled()
+
+
+def steady_state(
+    model: Model,
+    omega: float,
+    x0: FloatArray | tuple[float, float],
+    *,
+    options: SteadyStateOptions | None = None,
+    integrator: ExactIntegrator | None = None,
+) -> SteadyState:
+    """Steady motion of δ'' + c δ' + k f(δ) = F(t) reached from ``x0``, and its period.
+
+    Simulates exactly, one forcing period at a time, until the Poincaré sequence (the states at
+    t = m·2π/Ω) repeats with a period n·2π/Ω, n = 1 … ``max_period_multiple`` (smallest n), to the
+    scaled ``tolerance``; with ``accelerate`` the settling is shortened by Newton shooting,
+    accepting only the stable orbit the simulation is seen to converge to (module docstring).
+
+    Parameters
+    ----------
+    model : Model
+        The model (continuous piecewise-linear law).
+    omega : float
+        Forcing frequency Ω (rad/s), > 0.
+    x0 : array_like, shape (2,)
+        Initial state (δ, δ') (rad, rad/s) at t = 0 (forcing phase 0).
+    options : SteadyStateOptions, optional
+        Tolerances and budget (default ``SteadyStateOptions()``).
+    integrator : ExactIntegrator, optional
+        The exact integrator of ``model`` (reuse one across calls to share its cache).
+
+    Returns
+    -------
+    SteadyState
+        Period (0 when nothing settled within ``max_periods``), orbit, measures, multipliers and
+        the final state to carry to the next frequency.
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
+    if isinstance(omega, bool) or not isinstance(omega, (int, float, np.integer, np.floating)):
+        raise TypeError(f"`omega` must be a real number, got {omega!r}")
+    omega = float(omega)
+    if not (math.isfinite(omega) and omega > 0.0):
+        raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}")
+    x = np.asarray(x0, dtype=float)
+    if x.shape != (2,) or not np.all(np.isfinite(x)):
+        raise ValueError(f"`x0` must be a finite state (delta, velocity) of shape (2,), got {x0!r}")
+    opts = SteadyStateOptions() if options is None else options
+    if not isinstance(opts, SteadyStateOptions):
+        raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
+    integ = ExactIntegrator(model) if integrator is None else integrator
+    if not isinstance(integ, ExactIntegrator):
+        raise TypeError(f"`integrator` must be an ExactIntegrator, got {integrator!r}")
+    if integ.model is not model and integ.model != model:
+        raise ValueError("`integrator` was built for a different model than `model`")
+    return _Settler(model, omega, x.copy(), opts, integ).run()
+
+
+__all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS"]
