@@ -15,12 +15,15 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .analysis import frequency_response
+from .analysis import Comparison, compare, frequency_response, periodic_orbit, time_sweep
 from .continuation import ContinuationOptions
 from .errors import ConfigError, ConvergenceError, RattleError, Status
 from .hb import HBOptions, NewtonOptions
 from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
-from .results import FrequencyResponse, LinearResponse, SpecialPoint, linear_frequency_response
+from .results import (
+    FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult, linear_frequency_response,
+)
+from .timeint import SteadyStateOptions, shoot_periodic_orbit, steady_state
 
 try:
     __version__ = version("rattle")
@@ -30,7 +33,9 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
 __all__ = [
     "__version__",
     "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "reference_case", "backlash_case",
-    "frequency_response", "FrequencyResponse", "SpecialPoint", "LinearResponse", "linear_frequency_response",
+    "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
+    "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions", "shoot_periodic_orbit",
+    "periodic_orbit", "PeriodicOrbit", "compare", "Comparison",
     "HBOptions", "NewtonOptions", "ContinuationOptions",
     "Status", "RattleError", "ConfigError", "ConvergenceError",
 ]

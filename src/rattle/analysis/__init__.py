@@ -1,12 +1,12 @@
 """Front ends: one call from a model to a result."""
 
+from ._compare import Comparison, compare
 from ._frequency_response import assemble, frequency_response, start_solution
+from ._orbit import periodic_orbit
+from ._regimes import confirm_with_sweep, label_regions
+from ._time_sweep import time_sweep
 
-__all__ = ["frequency_response", "start_solution", "assemble"]
-
-from ._time_sweep import time_sweep  # noqa: E402  (time-domain sweep)
-__all__ += ["time_sweep"]
-
-from ._orbit import periodic_orbit  # noqa: E402  (periodic orbits at one frequency)
-from ._compare import Comparison, compare  # noqa: E402  (FRF vs time-domain sweep)
-__all__ += ["periodic_orbit", "compare", "Comparison"]
+__all__ = [
+    "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare", "Comparison",
+    "label_regions", "confirm_with_sweep",
+]

@@ -234,6 +234,12 @@ def frequency_response(
         timings["subharmonics"] = time.perf_counter() - t_sub
         settings = dict(result.settings, subharmonics=True, max_period=max_period)
         result = FrequencyResponse.concatenate([result, *extra], settings=settings, timings=timings)
+    if len(result):
+        from dataclasses import replace
+
+        from ._regimes import label_regions
+
+        result = replace(result, regions=label_regions(result))
     if throw and not status.success:
         raise ConvergenceError(f"frequency response incomplete: {stepper.message}", partial=result)
     return result

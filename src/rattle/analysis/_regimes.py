@@ -13,31 +13,13 @@ the intervals where no computed periodic solution is stable.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from scipy.signal import find_peaks
 
-from ..results import FrequencyResponse
-
-
-@dataclass(frozen=True, slots=True)
-class Region:
-    """An interval [omega_min, omega_max] of forcing frequency with a ``kind`` and a ``label``.
-
-    ``kind``: ``superharmonic``, ``subharmonic`` or ``no_stable_periodic``. ``detail`` holds
-    kind-specific data (order, period, branch, the periods a time sweep saw there…).
-    """
-
-    kind: str
-    omega_min: float
-    omega_max: float
-    label: str
-    detail: dict[str, Any] = field(default_factory=dict)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"kind": self.kind, "omega_min": self.omega_min, "omega_max": self.omega_max, "label": self.label, **self.detail}
+from ..results import FrequencyResponse, Region
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -46,10 +28,18 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def stable_intervals(frf: FrequencyResponse, branch: int) -> list[tuple[float, float]]:
-    """Ω intervals covered by stable stretches of one branch."""
+    """Ω intervals covered by stable stretches of one branch; a stretch extends to the special
+    points that bound it (a located bifurcation row has a multiplier on the circle and is
+    flagged unstable, but it is where the stability ends, not a gap)."""
     sel = np.nonzero(frf.branch == branch)[0]
     om, st = frf.omega[sel], frf.stable[sel]
-    return [(float(om[a:b].min()), float(om[a:b].max())) for a, b in _runs(st)]
+    special = frf.bifurcation[sel] != ""
+    out = []
+    for a, b in _runs(st):
+        a = a - 1 if a > 0 and special[a - 1] else a
+        b = b + 1 if b < sel.size and special[b] else b
+        out.append((float(om[a:b].min()), float(om[a:b].max())))
+    return out
 
 
 def _union(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -94,7 +84,7 @@ def label_regions(frf: FrequencyResponse) -> tuple[Region, ...]:
         if period == 1:
             regions += superharmonic_resonances(frf, int(b))
         else:
-            for lo, hi in stable_intervals(frf, int(b)):
+            for lo, hi in _union(stable_intervals(frf, int(b))):
                 regions.append(Region("subharmonic", lo, hi, f"period {period} (1/{period} sub-harmonic)", {"period": period, "branch": int(b)}))
     covered = _union([iv for b in np.unique(frf.branch) for iv in stable_intervals(frf, int(b))])
     lo_all, hi_all = float(frf.omega.min()), float(frf.omega.max())

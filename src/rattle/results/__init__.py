@@ -1,13 +1,12 @@
-"""Result objects."""
+"""Result objects: columnar, with .plot() and .to_csv() delegating to plotting and io."""
 
 from ._frequency_response import (
-    FRF_COLUMNS, FrequencyResponse, LinearResponse, SpecialPoint, linear_frequency_response,
+    FRF_COLUMNS, FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response,
 )
+from ._orbit import OrbitSolution, PeriodicOrbit
+from ._sweep import SweepResult
 
-__all__ = ["FrequencyResponse", "SpecialPoint", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS"]
-
-from ._sweep import SweepResult  # noqa: E402  (time-domain sweep)
-__all__ += ["SweepResult"]
-
-from ._orbit import OrbitSolution, PeriodicOrbit  # noqa: E402  (periodic orbits at one frequency)
-__all__ += ["PeriodicOrbit", "OrbitSolution"]
+__all__ = [
+    "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS",
+    "SweepResult", "PeriodicOrbit", "OrbitSolution",
+]

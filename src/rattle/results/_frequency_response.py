@@ -33,6 +33,24 @@ class SpecialPoint:
 
 
 @dataclass(frozen=True, slots=True)
+class Region:
+    """An interval [omega_min, omega_max] of forcing frequency with a ``kind`` and a ``label``.
+
+    ``kind``: ``superharmonic``, ``subharmonic`` or ``no_stable_periodic``. ``detail`` holds
+    kind-specific data (order, period, branch, the periods a time sweep saw there…).
+    """
+
+    kind: str
+    omega_min: float
+    omega_max: float
+    label: str
+    detail: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "omega_min": self.omega_min, "omega_max": self.omega_max, "label": self.label, **self.detail}
+
+
+@dataclass(frozen=True, slots=True)
 class LinearResponse:
     """Closed-form response of the linear system (f = δ, same excitation) on a grid ``omega``."""
 
@@ -84,6 +102,7 @@ class FrequencyResponse:
     coefficients: FloatArray
     multipliers: ComplexArray
     special_points: tuple[SpecialPoint, ...] = ()
+    regions: tuple[Region, ...] = ()
     status: Status = Status.SUCCESS
     message: str = ""
     settings: dict[str, Any] = field(default_factory=dict)
@@ -117,8 +136,16 @@ class FrequencyResponse:
             f"(H = {self.harmonics}), {int(np.sum(~self.stable))} unstable",
             f"status: {self.status.name.lower()} — {self.message or self.status.message}",
         ]
+        if len(np.unique(self.branch)) > 1:
+            lines.append("branches: " + ", ".join(
+                f"{b} (period {int(self.period[self.branch == b][0])}, Ω = {self.omega[self.branch == b].min():.4g}…{self.omega[self.branch == b].max():.4g})"
+                for b in np.unique(self.branch)))
         if self.special_points:
             lines.append("stability changes: " + ", ".join(f"{s.kind} at Ω = {s.omega:.5g}" for s in self.special_points))
+        if self.regions:
+            lines.append("regions: " + "; ".join(
+                f"{g.label} at Ω = {g.omega_min:.4g}" if g.omega_min == g.omega_max else f"{g.label} Ω = {g.omega_min:.4g}…{g.omega_max:.4g}"
+                for g in self.regions))
         i = int(np.argmax(self.rms))
         lines.append(f"largest rms {self.rms[i]:.5g} rad at Ω = {self.omega[i]:.5g} ({self.regime[i]})")
         if self.timings:
@@ -133,6 +160,7 @@ class FrequencyResponse:
             "status": self.status.name.lower(),
             "message": self.message or self.status.message,
             "points": len(self),
+            "regions": [g.to_dict() for g in self.regions],
             "special_points": [
                 {"kind": s.kind, "omega": s.omega, "branch": s.branch, "index": s.index, "located": s.located, "omega_error": s.omega_error,
                  "multipliers": [[float(m.real), float(m.imag)] for m in s.multipliers]}
@@ -232,4 +260,4 @@ class FrequencyResponse:
 
 
 
-__all__ = ["FrequencyResponse", "SpecialPoint", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS"]
+__all__ = ["FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS"]
