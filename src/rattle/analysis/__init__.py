@@ -2,11 +2,12 @@
 
 from ._compare import Comparison, compare
 from ._frequency_response import assemble, frequency_response, start_solution
+from ._harmonics import adaptive_frequency_response, truncation_error
 from ._orbit import periodic_orbit
 from ._regimes import confirm_with_sweep, label_regions
 from ._time_sweep import time_sweep
 
 __all__ = [
     "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare", "Comparison",
-    "label_regions", "confirm_with_sweep",
+    "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
 ]
