@@ -84,3 +84,27 @@ def test_no_neimark_sacker_on_any_branch(reference_frf_all):
     assert "neimark_sacker" not in set(reference_frf_all.bifurcation)
     T = 2 * np.pi * reference_frf_all.period / reference_frf_all.omega
     np.testing.assert_allclose(np.prod(reference_frf_all.multipliers, axis=1).real, np.exp(-0.05 * T), rtol=1e-9)
+
+
+def test_labels_agree_with_the_simulation_where_period_one_is_unstable(reference_frf_all, reference_model):
+    """Near Ω ≈ 0.44 (the paper's "A", which it calls quasi-periodic) and above 1.2 ("B") the
+    period-1 solution is unstable; the labels say period-2 motion replaces it, and a time sweep
+    (exact integration, state carried) confirms: it settles on period 2 there, not on period 0."""
+    from rattle import time_sweep
+    from rattle.analysis import confirm_with_sweep
+
+    frf = reference_frf_all
+    sub = [g for g in frf.regions if g.kind == "subharmonic"]
+    assert not [g for g in frf.regions if g.kind == "no_stable_periodic"]
+    for w in (0.44, 1.41):
+        assert any(g.omega_min <= w <= g.omega_max and g.detail["period"] == 2 for g in sub)
+        primary = frf.select(0)
+        near = np.argmin(np.abs(primary.omega - w))
+        assert not primary.stable[near]
+    for lo, hi in ((0.415, 0.455), (1.26, 1.94)):
+        sweep = time_sweep(reference_model, omega=(lo, hi), points=9, direction="up")
+        assert set(sweep.period.tolist()) == {2}, sweep.period
+        confirmed = confirm_with_sweep(frf.regions, sweep)
+        inside = [g for g in confirmed if g.kind == "subharmonic" and g.omega_min <= lo and hi <= g.omega_max + 1e-9
+                  or g.kind == "subharmonic" and g.omega_min < hi and g.omega_max > lo]
+        assert inside and all(set(g.detail["sweep_periods"]) <= {2} for g in inside)
