@@ -108,3 +108,38 @@ def test_labels_agree_with_the_simulation_where_period_one_is_unstable(reference
         inside = [g for g in confirmed if g.kind == "subharmonic" and g.omega_min <= lo and hi <= g.omega_max + 1e-9
                   or g.kind == "subharmonic" and g.omega_min < hi and g.omega_max > lo]
         assert inside and all(set(g.detail["sweep_periods"]) <= {2} for g in inside)
+
+
+def test_isolated_subharmonic_branch_seeded_from_the_sweep():
+    """Backlash b = 1 rad: a time sweep finds period-2 motion near Ω = 0.657 that no period
+    doubling of the primary branch explains; seeded from it, the period-2 branch is followed
+    and matches the simulated orbit's rms there (to the HB truncation error)."""
+    import rattle
+
+    model = rattle.Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=rattle.Backlash(b=1.0),
+                         excitation=rattle.Excitation(mean=0.05, amplitudes=(0.03,)))
+    sweep = rattle.time_sweep(model, omega=(0.55, 0.75), points=21, direction="up")
+    assert 2 in set(sweep.period.tolist())
+    frf = rattle.frequency_response(model, omega=(0.55, 0.75), harmonics=32, subharmonics=True, sweep=sweep)
+    p2 = frf.period == 2
+    assert p2.any()
+    for j in np.nonzero(sweep.period == 2)[0]:
+        w = sweep.omega[j]
+        rows = np.nonzero(p2)[0]
+        i = rows[np.argmin(np.abs(frf.omega[rows] - w) + 10 * np.abs(frf.rms[rows] - sweep.rms[j]))]
+        assert abs(frf.omega[i] - w) < 5e-3 and abs(frf.rms[i] / sweep.rms[j] - 1) < 5e-3
+
+
+def test_user_seed_starts_a_branch(reference_model):
+    """A seed (Ω, period, state at t = 0) from the user: the period-2 orbit near "B"."""
+    import rattle
+
+    ss = rattle.steady_state(reference_model, 1.41, np.array([0.18, 0.0]))
+    assert ss.period == 2
+    frf = rattle.frequency_response(reference_model, omega=(1.3, 1.5), harmonics=32, subharmonics=True,
+                                    seeds=[(1.41, 2, ss.state0)])
+    rows = np.nonzero(frf.period == 2)[0]
+    i = rows[np.argmin(np.abs(frf.omega[rows] - 1.41))]
+    assert abs(frf.omega[i] - 1.41) < 0.01 and abs(frf.rms[i] - ss.rms) < 1e-3
+    with pytest.raises(ValueError, match=r"`seeds\[0\]`"):
+        rattle.frequency_response(reference_model, omega=(1.3, 1.5), subharmonics=True, seeds=[(1.41, 2)])

@@ -172,3 +172,151 @@ def period_doubling_branches(
 
 
 __all__ += ["period_doubling_branches"]
+
+
+def branch_from_seed(
+    model: Model,
+    omega: float,
+    q_seed: FloatArray,
+    period: int,
+    omega_range: tuple[float, float],
+    harmonics: int,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    branch_id: int = 0,
+) -> FrequencyResponse | None:
+    """The branch of period ``period`` through a seed (coefficients with ``harmonics`` harmonics
+    of Ω/period, e.g. from a simulated orbit) at ``omega``: Newton at that Ω, then continuation
+    both ways in Ω, joined into one branch. An isola is closed once (the run stops when it comes
+    back to the seed). None if the seed does not converge."""
+    from ._frequency_response import assemble
+
+    newton = newton or NewtonOptions()
+    hb = HarmonicBalance(model, HBOptions(harmonics=harmonics), period=period)
+    res = solve_harmonic_balance(hb, q_seed, omega, newton)
+    if not res.converged:
+        return None
+    from ..continuation import ArclengthCorrector
+
+    corrector = ArclengthCorrector(hb, newton)
+    _, Rq, Rw = hb.residual_jacobian(res.q, omega)
+    y_seed = corrector.to_scaled(res.q, omega)
+    halves: list[list[BranchPoint]] = []
+    statuses = []
+    for sign in (1.0, -1.0):
+        reference = np.zeros(hb.size + 1)
+        reference[-1] = sign
+        tangent = corrector.tangent(Rq, Rw, reference)
+        if tangent is None:
+            return None
+        count = {"n": 0}
+
+        def back_at_seed(pt: BranchPoint) -> str | None:
+            count["n"] += 1
+            y = corrector.to_scaled(pt.q, pt.omega)
+            if count["n"] > 5 and np.linalg.norm(y - y_seed) < 0.5 * max(pt.step, 1e-9):
+                return "the branch closed on itself (an isola)"
+            return None
+
+        stepper = ContinuationStepper(hb, res.q, omega, omega_range, continuation or ContinuationOptions(), newton,
+                                      tangent=tangent, stop=back_at_seed)
+        stepper.run()
+        halves.append(stepper.points)
+        statuses.append(stepper)
+        if stepper.status is Status.STOPPED:
+            break  # an isola: one way round covers it
+    points = halves[0] if len(halves) == 1 else halves[1][::-1] + halves[0][1:]
+    status = statuses[0].status if statuses[0].status is not Status.STOPPED else Status.STOPPED
+    return assemble(model, hb, points, branch_id=branch_id, newton=newton, status=status,
+                    message="; ".join(s.message for s in statuses))
+
+
+def _explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rtol: float) -> bool:
+    """Whether a stable stretch of a period-``period`` branch crosses Ω with that rms."""
+    for b in np.unique(frf.branch[frf.period == period]):
+        rows = np.nonzero(frf.branch == b)[0]
+        om, r, st = frf.omega[rows], frf.rms[rows], frf.stable[rows] | (frf.bifurcation[rows] != "")
+        lo, hi = om[:-1], om[1:]
+        cross = ((lo - omega) * (hi - omega) <= 0) & st[:-1] & st[1:] & (lo != hi)
+        for i in np.nonzero(cross)[0]:
+            s = (omega - lo[i]) / (hi[i] - lo[i])
+            if abs(((1 - s) * r[i] + s * r[i + 1]) / rms - 1) < rtol:
+                return True
+    return False
+
+
+def sweep_seeds(frf: FrequencyResponse, sweep: object, *, harmonics_per_period: int | None = None,
+                rtol: float = 1e-3) -> list[tuple[float, int, FloatArray]]:
+    """Seeds (Ω, period n, coefficients) for the periodic motions of period n ≥ 2 that a time
+    ``sweep`` (SweepResult) settled on and that no stable computed branch of period n explains
+    (no stable stretch of that period crossing the sweep's Ω with an rms, interpolated there,
+    within ``rtol``). The orbit is closed by exact shooting from the sweep's section state and
+    analysed into n·H harmonics of Ω/n."""
+    from ..timeint import ExactIntegrator, shoot_periodic_orbit
+
+    model = frf.model
+    H = harmonics_per_period or int(frf.settings.get("harmonics", frf.harmonics))
+    integ = ExactIntegrator(model)
+    seeds: list[tuple[float, int, FloatArray]] = []
+    omegas = np.asarray(sweep.omega)  # type: ignore[attr-defined]
+    states = np.asarray(sweep.state0)  # type: ignore[attr-defined]
+    step = float(np.min(np.diff(np.unique(omegas)))) if np.unique(omegas).size > 1 else 0.0
+    for j, (w, n) in enumerate(zip(omegas, np.asarray(sweep.period))):  # type: ignore[attr-defined]
+        n = int(n)
+        if n < 2:
+            continue
+        rms = float(np.asarray(sweep.rms)[j])  # type: ignore[attr-defined]
+        if _explained(frf, n, float(w), rms, rtol):
+            continue
+        if any(abs(s[0] - w) <= step + 1e-12 and s[1] == n for s in seeds):
+            continue  # one seed per stretch of unexplained motion
+        q = seed_from_state(model, float(w), states[j], n, n * H, integrator=integ)
+        if q is not None:
+            seeds.append((float(w), n, q))
+    return seeds
+
+
+def seed_from_state(model: Model, omega: float, x0: FloatArray, period: int, harmonics: int, *,
+                    integrator: object | None = None) -> FloatArray | None:
+    """HB coefficients (``harmonics`` of Ω/period) of the period-``period`` orbit through the
+    state x0 = (δ, δ') at t = 0 (a forcing-phase-aligned section point): the orbit is closed by
+    exact shooting and its samples analysed. None if shooting does not converge."""
+    from ..timeint import ExactIntegrator, shoot_periodic_orbit
+
+    integ = ExactIntegrator(model) if integrator is None else integrator
+    orbit = shoot_periodic_orbit(model, omega, np.asarray(x0, dtype=float), period=period, integrator=integ)
+    if not orbit.converged:
+        return None
+    hb = HarmonicBalance(model, HBOptions(harmonics=harmonics), period=period)
+    T = period * 2 * np.pi / omega
+    return hb.basis.analyze(np.asarray(orbit.trajectory.sample(hb.basis.times(T)).delta))
+
+
+def seeded_branches(
+    frf: FrequencyResponse,
+    seeds: list[tuple[float, int, FloatArray]],
+    omega_range: tuple[float, float],
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    first_branch: int,
+) -> list[FrequencyResponse]:
+    """Branches through ``seeds`` (Ω, period, coefficients), skipping a seed that a branch
+    already found (including one from an earlier seed) explains."""
+    out: list[FrequencyResponse] = []
+    next_id = first_branch
+    for w, n, q in seeds:
+        known = FrequencyResponse.concatenate([frf, *out]) if out else frf
+        rms = float(np.sqrt(q[0] ** 2 + 0.5 * np.sum(q[1:] ** 2)))
+        if _explained(known, n, w, rms, 1e-3):
+            continue
+        H = (q.size - 1) // 2
+        branch = branch_from_seed(frf.model, w, q, n, omega_range, H, continuation=continuation, newton=newton, branch_id=next_id)
+        if branch is not None and len(branch):
+            out.append(branch)
+            next_id += 1
+    return out
+
+
+__all__ += ["branch_from_seed", "sweep_seeds", "seed_from_state", "seeded_branches"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict
 from typing import Literal
 
@@ -165,6 +165,8 @@ def frequency_response(
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
     max_period: int = 4,
+    sweep: object | None = None,
+    seeds: Sequence[tuple[float, int, FloatArray]] = (),
     throw: bool = True,
     callback: Callable[[BranchPoint], None] | None = None,
 ) -> FrequencyResponse:
@@ -173,6 +175,10 @@ def frequency_response(
     With ``subharmonics=True`` every period-doubling point found is followed onto the branch
     of doubled period (branch switching), recursively up to solutions of period
     ``max_period``; all branches are returned together (columns ``branch`` and ``period``).
+    Branches that no period doubling reaches (isolated sub-harmonics) are started from seeds:
+    ``seeds`` = [(Ω, n, (δ, δ') at t = 0), …] given by the user, and the period-n motions
+    (n ≥ 2) of a time-domain ``sweep`` (a SweepResult) that no computed branch explains; each
+    orbit is closed by exact shooting and followed both ways in Ω.
 
     Harmonic balance with ``harmonics`` harmonics of the solution's base frequency Ω/``period``
     (AFT with ``samples`` time samples per period, default :func:`~rattle.hb.default_samples`),
@@ -229,7 +235,27 @@ def frequency_response(
         from ._branches import period_doubling_branches
 
         t_sub = time.perf_counter()
+        from ._branches import seed_from_state, seeded_branches, sweep_seeds
+
         extra = period_doubling_branches(result, (lo, hi), max_period=max_period, continuation=cont_opts, newton=newton_opts)
+        seed_list = []
+        for k, seed in enumerate(seeds):
+            try:
+                w_s, n_s, x_s = float(seed[0]), int(seed[1]), np.asarray(seed[2], dtype=float).reshape(2)
+            except (TypeError, ValueError, IndexError):
+                raise ValueError(f"`seeds[{k}]` must be (omega, period, (delta, velocity)), got {seed!r}") from None
+            if not (lo <= w_s <= hi) or not 1 <= n_s <= 8:
+                raise ValueError(f"`seeds[{k}]`: omega must lie in {(lo, hi)} and period in 1…8, got {seed!r}")
+            q_s = seed_from_state(model, w_s, x_s, n_s, n_s * harmonics)
+            if q_s is not None:
+                seed_list.append((w_s, n_s, q_s))
+        if sweep is not None:
+            partial = FrequencyResponse.concatenate([result, *extra])
+            seed_list += sweep_seeds(partial, sweep, harmonics_per_period=harmonics)
+        if seed_list:
+            partial = FrequencyResponse.concatenate([result, *extra])
+            extra += seeded_branches(partial, seed_list, (lo, hi), continuation=cont_opts, newton=newton_opts,
+                                     first_branch=1 + len(extra))
         timings = dict(result.timings)
         timings["subharmonics"] = time.perf_counter() - t_sub
         settings = dict(result.settings, subharmonics=True, max_period=max_period)

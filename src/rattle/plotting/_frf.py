@@ -1,15 +1,36 @@
-"""Plot of a frequency response: rms vs Ω, stable solid, unstable dashed."""
+"""Plot of a frequency response: a measure vs Ω along every branch, stable solid, unstable
+dashed, special points marked by type, the named regions shaded and labelled."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..results import FrequencyResponse
+    from ..results import FrequencyResponse, Region
 
-_MARKERS = {"fold": ("o", "tab:red"), "period_doubling": ("s", "tab:purple"), "neimark_sacker": ("D", "tab:green")}
+#: Marker, colour and legend text of each kind of special point.
+SPECIAL_POINT_STYLES: dict[str, tuple[str, str, str]] = {
+    "fold": ("o", "tab:red", "fold ○"),
+    "period_doubling": ("s", "tab:purple", "period doubling □"),
+    "neimark_sacker": ("D", "tab:green", "Neimark–Sacker ◇"),
+}
+_MARKERS = {kind: (m, c) for kind, (m, c, _) in SPECIAL_POINT_STYLES.items()}  # kept for older callers
+#: The response measures that can be drawn, with their axis labels.
+QUANTITY_LABELS: dict[str, str] = {
+    "mean": "δ mean δ_m (rad)", "rms": "δ rms (rad)", "rms_ac": "δ rms about the mean (rad)",
+    "p2p": "δ peak-to-peak (rad)", "acc_p2p": "δ'' peak-to-peak (rad/s²)",
+    "delta_min": "δ min (rad)", "delta_max": "δ max (rad)",
+}
+_LEGEND_PLACES = ("outside", "inside", "none")
+#: Face colour of a ``no_stable_periodic`` band (hatched).
+NO_STABLE_COLOR = "0.45"
+#: (band colour, label colour) of the stable sub-harmonic bands, by period.
+SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {
+    2: ("#f5c342", "#8a6100"), 3: ("#9ad39a", "#2e6b2e"), 4: ("#c9a3e0", "#5b2d7a"),
+}
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -18,58 +39,218 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]))
 
 
+def branch_colors(frf: "FrequencyResponse") -> dict[int, str]:
+    """Colour of each branch (matplotlib's default cycle, in branch order)."""
+    import matplotlib.pyplot as plt
+
+    cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    return {int(b): cycle[n % len(cycle)] for n, b in enumerate(np.unique(frf.branch))}
+
+
+def branch_label(frf: "FrequencyResponse", branch: int) -> str:
+    """``branch b`` with ``(period p)`` for a sub-harmonic branch."""
+    period = int(frf.period[frf.branch == branch][0])
+    return f"branch {branch}" + (f" (period {period})" if period > 1 else "")
+
+
+def _harmonics_text(frf: "FrequencyResponse") -> str:
+    h = frf.settings.get("harmonics", frf.harmonics) if isinstance(frf.settings, dict) else frf.harmonics
+    return f"H = {h}"
+
+
+def draw_branches(
+    frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True, lw: float = 1.5
+) -> dict[int, str]:
+    """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours."""
+    y_all = np.asarray(getattr(frf, quantity), dtype=float)
+    colors = branch_colors(frf)
+    for b, color in colors.items():
+        sel = np.nonzero(frf.branch == b)[0]
+        om, y, st = frf.omega[sel], y_all[sel], np.asarray(frf.stable[sel], dtype=bool)
+        base = branch_label(frf, b)
+        for flag, style in ((True, "-"), (False, "--")):
+            first = True
+            for i0, i1 in _runs(st == flag):
+                # Extend each run by one point so that solid and dashed pieces join.
+                j1 = min(i1 + 1, sel.size)
+                lab = None
+                if labels and first:
+                    lab = f"{base}, {'stable' if flag else 'unstable'}"
+                    first = False
+                ax.plot(om[i0:j1], y[i0:j1], style, color=color,
+                        lw=lw if flag else 0.8 * lw, label=lab, zorder=3 if flag else 2)
+    return colors
+
+
+def draw_special_points(frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True) -> None:
+    """Special points (stability changes) marked by type: fold ○, period doubling □, Neimark–Sacker ◇.
+
+    The first row of a period-doubled branch (where it is born) is a period-doubling row too, so
+    each period-doubling point shows on both the parent and the new branch (at the same place).
+    """
+    y_all = np.asarray(getattr(frf, quantity), dtype=float)
+    rows: dict[str, list[int]] = {}
+    for sp in frf.special_points:
+        rows.setdefault(sp.kind, []).append(int(sp.index))
+    for kind, idx in rows.items():
+        marker, color, text = SPECIAL_POINT_STYLES.get(kind, ("X", "black", kind.replace("_", " ")))
+        ax.plot(frf.omega[idx], y_all[idx], marker, color=color, ms=6.5, mfc="none", mew=1.5, ls="none",
+                label=text if labels else None, zorder=5)
+
+
+def _resonance_rows(frf: "FrequencyResponse", omega: float) -> int | None:
+    """Row of a period-1 branch at ``omega`` (a super-harmonic peak is a row's Ω); None if none."""
+    p1 = np.nonzero(frf.period == 1)[0]
+    if p1.size == 0:
+        return None
+    d = np.abs(frf.omega[p1] - omega)
+    return int(p1[int(np.argmin(d))])
+
+
+def draw_regions(
+    frf: "FrequencyResponse",
+    ax: Any,
+    quantity: str,
+    regions: Sequence["Region"],
+    colors: dict[int, str],
+    *,
+    labels: bool = True,
+) -> None:
+    """Shade and label the named regions.
+
+    ``subharmonic``: a light band (a colour per period), labelled "period p" at the top of the
+    axes; ``no_stable_periodic``: a hatched grey band; ``superharmonic``: a small "1/k" label
+    just above the resonance peak.
+    """
+    from matplotlib.transforms import blended_transform_factory
+
+    top = blended_transform_factory(ax.transData, ax.transAxes)
+    y_all = np.asarray(getattr(frf, quantity), dtype=float)
+    seen: set[str] = set()
+    peaks: list[tuple[int, str]] = []
+    for r in regions:
+        if r.kind == "subharmonic":
+            period = int(r.detail.get("period", 2))
+            band, text_color = SUBHARMONIC_COLORS.get(period, ("#bbbbbb", "0.25"))
+            key = f"sub{period}"
+            ax.axvspan(r.omega_min, r.omega_max, color=band, alpha=0.22, lw=0, zorder=0,
+                       label=f"period {period} stable (1/{period} sub-harmonic)" if labels and key not in seen else None)
+            seen.add(key)
+            ax.text(0.5 * (r.omega_min + r.omega_max), 0.985, f"period {period}", transform=top,
+                    ha="center", va="top", fontsize=8, color=text_color, fontweight="bold",
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8}, zorder=6)
+        elif r.kind == "no_stable_periodic":
+            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=NO_STABLE_COLOR, hatch="///", lw=0,
+                       zorder=0, label="no stable periodic solution" if labels and "none" not in seen else None)
+            seen.add("none")
+            ax.text(0.5 * (r.omega_min + r.omega_max), 0.93, "no stable\nperiodic", transform=top,
+                    ha="center", va="top", fontsize=7, color="0.25",
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}, zorder=6)
+        elif r.kind == "superharmonic":
+            i = _resonance_rows(frf, r.omega_min)
+            if i is not None:
+                order = r.detail.get("order")
+                peaks.append((i, f"1/{order}" if order else r.label))
+    # "1/k" labels above the peaks; neighbours closer than 3 % of the Ω axis are staggered upwards
+    # so that the labels do not overlap.
+    lo, hi = ax.get_xlim()
+    level, last = 0, -np.inf
+    for i, text in sorted(peaks, key=lambda p: frf.omega[p[0]]):
+        w = float(frf.omega[i])
+        level = level + 1 if w - last < 0.03 * (hi - lo) else 0
+        last = w
+        ax.annotate(text, (w, y_all[i]), xytext=(0, 9 + 11 * (level % 3)), textcoords="offset points",
+                    ha="center", va="bottom", fontsize=8, color="0.15", zorder=6,
+                    arrowprops={"arrowstyle": "-", "color": "0.4", "lw": 0.6, "shrinkA": 0, "shrinkB": 1})
+
+
+def place_legend(ax: Any, legend: str, fontsize: float = 8) -> Any:
+    """``outside``: to the right of the axes; ``inside``: best place; ``none``: no legend."""
+    if legend == "none":
+        return None
+    if legend == "outside":
+        return ax.legend(fontsize=fontsize, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                         framealpha=0.9)
+    return ax.legend(fontsize=fontsize, loc="best", framealpha=0.9)
+
+
 def frequency_response_plot(
     frf: "FrequencyResponse",
     ax: Any = None,
     *,
     quantity: str = "rms",
     linear: bool = True,
+    special_points: bool = True,
+    regions: "bool | Sequence[Region]" = True,
+    legend: str = "outside",
     title: str | None = None,
 ) -> tuple[Any, Any]:
-    """Draw ``quantity`` (a SPEC column, default rms) vs Ω; returns (figure, axes).
+    """Draw ``quantity`` (a SPEC column, default rms) vs Ω along every branch.
 
-    Stable stretches solid, unstable dashed (each branch its colour), stability changes marked
-    by type, and the linear system's response (f = δ) overlaid in grey.
+    Each branch has its colour (its period in the legend), stable stretches solid and unstable
+    ones dashed. Special points are marked by type (fold ○, period doubling □, Neimark–Sacker
+    ◇). The regions are shaded: a stable sub-harmonic as a light band labelled "period p", an
+    interval without a stable periodic solution as a hatched band, and each super-harmonic
+    resonance gets a small "1/k" label at its peak. The linear system's response (f = δ) is
+    overlaid in grey.
+
+    Parameters
+    ----------
+    frf : FrequencyResponse
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into (default: a new 9.5 × 5 in figure).
+    quantity : str, default "rms"
+        One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``, ``delta_min``, ``delta_max``.
+    linear : bool, default True
+        Overlay the linear system (drawn only for ``mean``, ``rms`` and ``rms_ac``).
+    special_points : bool, default True
+        Mark the special points.
+    regions : bool or sequence of Region, default True
+        Shade ``frf.regions`` (True), none (False), or the given regions (e.g. those returned by
+        :func:`rattle.analysis.confirm_with_sweep`).
+    legend : {"outside", "inside", "none"}, default "outside"
+        Where the legend goes.
+    title : str, optional
+        Axes title (default names H).
+
+    Returns
+    -------
+    (figure, axes)
     """
     import matplotlib.pyplot as plt
 
-    if quantity not in ("mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max"):
-        raise ValueError(f"`quantity` must be a numeric SPEC column, got {quantity!r}")
+    if quantity not in QUANTITY_LABELS:
+        raise ValueError(f"`quantity` must be a numeric SPEC column ({', '.join(QUANTITY_LABELS)}), got {quantity!r}")
+    if legend not in _LEGEND_PLACES:
+        raise ValueError(f"`legend` must be one of {', '.join(_LEGEND_PLACES)}, got {legend!r}")
+    if isinstance(regions, bool):
+        shown: Sequence[Any] = frf.regions if regions else ()
+    else:
+        shown = tuple(regions)
     if ax is None:
-        fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
+        fig, ax = plt.subplots(figsize=(9.5, 5), layout="constrained")
     else:
         fig = ax.figure
-    y_all = getattr(frf, quantity)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for n, b in enumerate(np.unique(frf.branch)):
-        sel = np.nonzero(frf.branch == b)[0]
-        om, y, st = frf.omega[sel], y_all[sel], frf.stable[sel]
-        color = colors[n % len(colors)]
-        period = int(frf.period[sel[0]])
-        label_base = f"branch {b}" + (f" (period {period})" if period > 1 else "")
-        first = {True: True, False: True}
-        for flag, style in ((True, "-"), (False, "--")):
-            for i0, i1 in _runs(st == flag):
-                # Extend each run by one point so that solid and dashed pieces join.
-                j1 = min(i1 + 1, sel.size)
-                lab = None
-                if first[flag]:
-                    lab = f"{label_base}, {'stable' if flag else 'unstable'}"
-                    first[flag] = False
-                ax.plot(om[i0:j1], y[i0:j1], style, color=color, lw=1.4 if flag else 1.1, label=lab)
-    for kind, (marker, color) in _MARKERS.items():
-        idx = np.nonzero(frf.bifurcation == kind)[0]
-        if idx.size:
-            ax.plot(frf.omega[idx], y_all[idx], marker, color=color, ms=6, mfc="none", mew=1.5, ls="none", label=kind.replace("_", " "))
+    colors = draw_branches(frf, ax, quantity)
+    if special_points:
+        draw_special_points(frf, ax, quantity)
     if linear and quantity in ("mean", "rms", "rms_ac"):
         lin = frf.linear_response()
-        ax.plot(lin.omega, getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)")
+        ax.plot(lin.omega, getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
+    if shown:
+        draw_regions(frf, ax, quantity, shown, colors)
     ax.set_xlabel("forcing frequency Ω (rad/s)")
-    ax.set_ylabel({"rms": "δ rms (rad)"}.get(quantity, f"{quantity}"))
-    ax.set_title(title if title is not None else f"Non-linear frequency response (H = {frf.harmonics})")
+    ax.set_ylabel(QUANTITY_LABELS[quantity])
+    ax.set_title(title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
+    if shown:  # room for the "period p" labels at the top
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + 0.08 * (hi - lo))
+    place_legend(ax, legend)
     return fig, ax
 
 
-__all__ = ["frequency_response_plot"]
+__all__ = [
+    "frequency_response_plot", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
+    "branch_colors", "branch_label", "SPECIAL_POINT_STYLES", "QUANTITY_LABELS",
+]
