@@ -129,6 +129,19 @@ def _refine(hb: HarmonicBalance, hb2: HarmonicBalance, newton: NewtonOptions, ki
     return _locate_with(hb2, newton, kind, qa2, wa2, qb2, wb2)
 
 
+def _is_period_halved(q: FloatArray, hb: HarmonicBalance, rtol: float = 0.1) -> bool:
+    """Whether a solution of even period p is (nearly) of period p/2: its odd harmonics carry
+    less than ``rtol`` of the dynamic content. Near the pitchfork where a doubled-period branch
+    meets its parent the odd part vanishes like sqrt(|Ω − Ω_pd|); the located +1 crossing there
+    has ~1–2 % odd content on the reference case, a genuine fold of a period-2 branch ~95 %."""
+    if hb.period % 2:
+        return False
+    H = hb.basis.harmonics
+    k = np.arange(1, H + 1, 2)
+    odd = np.concatenate((k, H + k))
+    return float(np.linalg.norm(q[odd])) <= rtol * max(float(np.linalg.norm(q[1:])), 1e-300)
+
+
 def _locate_changes(
     hb: HarmonicBalance, newton: NewtonOptions, Q: FloatArray, Om: FloatArray, mu: np.ndarray, stable: np.ndarray,
     refine: bool,
@@ -142,6 +155,10 @@ def _locate_changes(
             continue
         kind = classify_loss(mu[i - 1], mu[i])
         loc = _locate_with(hb, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
+        if kind == "fold" and loc is not None and _is_period_halved(loc.q, hb):
+            # +1 at a point that is really of half the period: the pitchfork where this branch
+            # meets the branch it doubled from — that branch's period doubling, not a fold.
+            kind = "period_doubling"
         omega2 = None
         if loc is not None and refine:
             if hb2 is None:
