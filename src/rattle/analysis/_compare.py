@@ -34,7 +34,8 @@ from ..model import Model
 from ..results import FrequencyResponse, PeriodicOrbit, SweepResult
 from ..timeint import ExactIntegrator, SteadyState, SteadyStateOptions, steady_state
 from ._frequency_response import frequency_response
-from ._orbit import MAX_PERIOD, _check_range, periodic_orbit
+from ._frequency_response import check_range
+from ._orbit import MAX_PERIOD, periodic_orbit
 from ._time_sweep import time_sweep
 
 #: Automatic picks: the up/down sweeps must differ by this fraction of the largest rms for the
@@ -247,7 +248,7 @@ def compare(
     """
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    lo, hi = _check_range("omega", omega)
+    lo, hi = check_range(omega)
     chosen = None if at is None else _check_at(at, lo, hi)
     t0 = time.perf_counter()
     frf = frequency_response(model, omega=(lo, hi), harmonics=harmonics, throw=False)

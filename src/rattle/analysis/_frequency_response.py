@@ -27,15 +27,16 @@ logger = logging.getLogger("rattle")
 StabilityMethod = Literal["monodromy", "hill"]
 
 
-def _check_range(omega: object) -> tuple[float, float]:
+def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
+    """Validate a frequency-range argument (min, max) in rad/s; messages name ``name``."""
     try:
         lo, hi = (float(v) for v in omega)  # type: ignore[union-attr]
     except (TypeError, ValueError):
-        raise ValueError(f"`omega` must be a pair (min, max) of frequencies in rad/s, got {omega!r}") from None
+        raise ValueError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {omega!r}") from None
     if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise ValueError(f"`omega` must be finite, got {omega!r}")
+        raise ValueError(f"`{name}` must be finite, got {omega!r}")
     if not 0 < lo < hi:
-        raise ValueError(f"`omega` must satisfy 0 < min < max, got ({lo}, {hi})")
+        raise ValueError(f"`{name}` must satisfy 0 < min < max, got ({lo}, {hi}); give the range as (min, max) rad/s")
     return lo, hi
 
 
@@ -207,7 +208,7 @@ def frequency_response(
     If the run ends before the far end of the range, ``throw=True`` raises ConvergenceError
     with the points computed so far in ``.partial``; ``throw=False`` returns them with the status.
     """
-    lo, hi = _check_range(omega)
+    lo, hi = check_range(omega)
     if start not in ("low", "high"):
         raise ValueError(f"`start` must be 'low' or 'high', got {start!r}")
     if stability not in ("monodromy", "hill"):

@@ -47,7 +47,7 @@ from ..results._orbit import OrbitSolution, PeriodicOrbit
 from ..stability import UNIT_CIRCLE_TOL, monodromy_batch, multipliers_from_monodromy
 from ..timeint import ExactIntegrator, shoot_periodic_orbit
 from ..timeint._steady import SteadyState, SteadyStateOptions, steady_state
-from ._frequency_response import frequency_response
+from ._frequency_response import check_range, frequency_response
 
 logger = logging.getLogger("rattle")
 
@@ -87,16 +87,6 @@ def _check_period(period: object) -> int:
             "use 1 for the primary response, n for a 1/n sub-harmonic"
         )
     return int(period)
-
-
-def _check_range(name: str, value: object) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in value)  # type: ignore[union-attr]
-    except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi):
-        raise ValueError(f"`{name}` must satisfy 0 < min < max (finite, rad/s), got {value!r}")
-    return lo, hi
 
 
 def default_search_range(model: Model, omega: float) -> tuple[float, float]:
@@ -409,7 +399,7 @@ def periodic_orbit(
         raise TypeError(f"`continuation` must be a ContinuationOptions, got {continuation!r}")
     if steady_options is not None and not isinstance(steady_options, SteadyStateOptions):
         raise TypeError(f"`steady_options` must be a SteadyStateOptions, got {steady_options!r}")
-    lo, hi = default_search_range(model, W) if search_range is None else _check_range("search_range", search_range)
+    lo, hi = default_search_range(model, W) if search_range is None else check_range(search_range, "search_range")
     lo, hi = min(lo, W), max(hi, W)
     if x0 is None:
         start_state = np.zeros(2)

@@ -28,24 +28,14 @@ from ..model import Model
 from ..results._sweep import SweepResult
 from ..timeint import ExactIntegrator, SteadyStateOptions, steady_state
 
+from ._frequency_response import check_range
+
 logger = logging.getLogger("rattle")
 
 #: ``direction`` argument → the sweeps run, in order (the one registry of the names).
 DIRECTIONS: dict[str, tuple[str, ...]] = {"up": ("up",), "down": ("down",), "both": ("up", "down")}
 
 ProgressCallback = Callable[[int, int], None]
-
-
-def _check_range(omega: object) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in omega)  # type: ignore[union-attr]
-    except (TypeError, ValueError):
-        raise ValueError(f"`omega` must be a pair (min, max) of frequencies in rad/s, got {omega!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise ValueError(f"`omega` must be finite, got {omega!r}")
-    if not 0 < lo < hi:
-        raise ValueError(f"`omega` must satisfy 0 < min < max, got ({lo}, {hi}); give the range as (min, max) rad/s")
-    return lo, hi
 
 
 def _check_int(name: str, value: object, low: int) -> int:
@@ -226,7 +216,7 @@ def time_sweep(
     """
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    lo, hi = _check_range(omega)
+    lo, hi = check_range(omega)
     points = _check_int("points", points, 2)
     if not isinstance(direction, str) or direction not in DIRECTIONS:
         raise ValueError(
