@@ -84,6 +84,8 @@ class LevelDifference:
     ----------
     band : (float, float)
         Ω interval (rad/s).
+    rows : numpy.ndarray of int, shape (M,)
+        The rows' indices in the frequency response (a gap marks where a branch left the band).
     omega, branch, period, stable : numpy.ndarray, shape (M,)
         The rows' Ω (rad/s), branch, period and stability.
     nonlinear, linear : numpy.ndarray, shape (M,)
@@ -95,6 +97,7 @@ class LevelDifference:
     """
 
     band: tuple[float, float]
+    rows: np.ndarray
     omega: FloatArray
     branch: np.ndarray
     period: np.ndarray
@@ -181,7 +184,7 @@ def level_difference(frf: Any, band: tuple[float, float] = PAPER_BAND) -> LevelD
     lin = linear_acceleration_p2p(frf.model, w)
     lin_ac = frf.linear_response(w).rms_ac
     return LevelDifference(
-        band=(lo, hi), omega=w, branch=np.asarray(frf.branch[m]), period=np.asarray(frf.period[m]),
+        band=(lo, hi), rows=np.flatnonzero(m), omega=w, branch=np.asarray(frf.branch[m]), period=np.asarray(frf.period[m]),
         stable=np.asarray(frf.stable[m], dtype=bool), nonlinear=nl, linear=lin,
         db=20.0 * np.log10(nl / lin), db_displacement=20.0 * np.log10(np.asarray(frf.rms_ac[m]) / lin_ac),
     )
@@ -198,17 +201,23 @@ def _union(intervals: Sequence[tuple[float, float]]) -> list[tuple[float, float]
 
 
 def stage_intervals(frf: Any, threshold: float, *, below: bool = True) -> list[tuple[float, float]]:
-    """Ω intervals where a stable solution has its mean δ_m below (or above) ``threshold``.
+    """Ω intervals where a stable solution has its mean δ_m below (or at/above) ``threshold``.
 
     Used for the mean operating point: with ``threshold`` = b, the intervals where the mean
-    sits on the first stage (|δ_m| < b) rather than the second.
+    sits on the first stage (δ_m < b) rather than the second. A stable stretch extends to the
+    special point that ends it (the located row has a multiplier on the unit circle and is
+    flagged unstable, but the stability ends there, it is not a gap).
     """
     out = []
     for b in np.unique(frf.branch):
         sel = np.flatnonzero(frf.branch == b)
-        ok = np.asarray(frf.stable[sel], dtype=bool) & ((frf.mean[sel] < threshold) if below else (frf.mean[sel] >= threshold))
+        mean = frf.mean[sel]
+        ok = np.asarray(frf.stable[sel], dtype=bool) & ((mean < threshold) if below else (mean >= threshold))
+        special = np.asarray(frf.bifurcation[sel]) != ""
         edges = np.diff(np.concatenate(([0], ok.astype(int), [0])))
         for i0, i1 in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            i0 = i0 - 1 if i0 > 0 and special[i0 - 1] else i0
+            i1 = i1 + 1 if i1 < sel.size and special[i1] else i1
             om = frf.omega[sel[i0:i1]]
             out.append((float(om.min()), float(om.max())))
     return _union(out)
@@ -237,6 +246,23 @@ def _special_by(frf: Any, kind: str, period: int | None = None) -> list[Any]:
         seen.append(sp.omega)
         out.append(sp)
     return sorted(out, key=lambda s: s.omega)
+
+
+def _fold_texts(frf: Any, regions: Sequence[Any]) -> list[str]:
+    """Each fold's Ω with what it belongs to: a super-harmonic resonance (a ``1/k`` region within
+    5 % in Ω), the primary resonance (the other period-1 folds), or a period-p branch."""
+    supers = [g for g in regions if g.kind == "superharmonic"]
+    out = []
+    for sp in _special_by(frf, "fold"):
+        p = int(frf.period[sp.index])
+        if p > 1:
+            what = f"period-{p} branch {sp.branch}"
+        else:
+            near = [g for g in supers if abs(g.omega_min - sp.omega) <= 0.05 * sp.omega]
+            order = near[0].detail.get("order") if near else None
+            what = f"1/{order} super-harmonic" if order else ("super-harmonic" if near else "primary resonance")
+        out.append(f"{sp.omega:.4f} ({what})")
+    return out
 
 
 def _nearest_fold(frf: Any, omega: float) -> Any:
@@ -319,10 +345,7 @@ def demo_report(
     L: list[str] = []
     add = L.append
 
-    folds1 = _special_by(frf, "fold", 1)
-    folds_sub = [sp for sp in _special_by(frf, "fold") if int(frf.period[sp.index]) > 1]
     pds = _special_by(frf, "period_doubling")
-    primary = [sp for sp in folds1 if sp.omega > 0.5]
     i_max = int(np.argmax(frf.rms))
     lin = frf.linear_response()
     j_lin = int(np.argmax(lin.rms))
@@ -358,8 +381,9 @@ def demo_report(
         add(f"![frequency response]({figures['frf']})")
         add("")
         add(f"Largest rms {frf.rms[i_max]:.4f} rad at Ω = {frf.omega[i_max]:.4f} ({frf.regime[i_max].replace('_', '-')} "
-            f"impacts); primary-resonance folds at Ω = {_fmt_list([s.omega for s in primary])}; period doubling at "
-            f"Ω = {_fmt_list([s.omega for s in pds])}, each the birth of a period-2 branch.")
+            f"impacts). Folds at Ω = {', '.join(_fold_texts(frf, regions)) or 'none'}; period doubling at "
+            f"Ω = {_fmt_list([s.omega for s in pds])}, each the birth of a period-2 branch "
+            f"({len(np.unique(frf.branch))} branches in all).")
         add("")
     if "fig4" in figures:
         s_lo, s_hi, d_lo, d_hi = level.single_valued_range()
@@ -428,6 +452,7 @@ def demo_report(
         add("")
     if "mean" in figures:
         below = stage_intervals(frf, b, below=True)
+        above = stage_intervals(frf, b, below=False)
         i_min = int(np.argmin(np.where(frf.stable, frf.mean, np.inf)))
         static = model.static_equilibrium()
         add(f"### Mean operating point — [{figures['mean']}]({figures['mean']})")
@@ -437,8 +462,8 @@ def demo_report(
         add(f"At rest the mean torque puts δ on the second stage (static δ = {static:.4f} rad > b = {b:.4f} rad); "
             f"under the pulsating torque the mean δ_m of the stable solutions drops into the first stage (δ_m < b) over "
             f"Ω = " + (", ".join(f"{a:.3f} … {c:.3f}" for a, c in below) or "nowhere")
-            + f", down to {frf.mean[i_min]:.4f} rad at Ω = {frf.omega[i_min]:.3f}, and returns to the second stage "
-            f"at high Ω.")
+            + f", down to {frf.mean[i_min]:.4f} rad at Ω = {frf.omega[i_min]:.3f}; stable solutions with δ_m on the "
+            f"second stage (δ_m ≥ b): Ω = " + (", ".join(f"{a:.3f} … {c:.3f}" for a, c in above) or "none") + ".")
         add("")
 
     add("## Special points")

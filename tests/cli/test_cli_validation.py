@@ -310,20 +310,6 @@ def test_frf_success_writes_three_files(tmp_path: Path, fake_solver: dict[str, A
     assert result.stderr == ""
 
 
-def test_demo_uses_the_reference_case(tmp_path: Path, fake_solver: dict[str, Any]) -> None:
-    pytest.importorskip("matplotlib")
-    from rattle.model import reference_case
-
-    result = invoke(["demo"], tmp_path)
-    assert result.exit_code == 0, result.stderr
-    (call,) = fake_solver["calls"]
-    assert call["model"] == reference_case()
-    assert call["omega"] == (0.1, 3.0) and call["harmonics"] == 32
-    out = tmp_path / "rattle-out"
-    assert sorted(p.name for p in out.iterdir()) == ["frf.csv", "frf.json", "frf.png"]
-    assert json.loads((out / "frf.json").read_text())["command"] == "demo"
-
-
 def test_convergence_failure_without_partial_exits_1(tmp_path: Path, fake_solver: dict[str, Any]) -> None:
     write_config(tmp_path)
     fake_solver["raise"] = ConvergenceError("no periodic solution at the start of the range")

@@ -15,7 +15,7 @@ import math
 import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +25,7 @@ from ..errors import ConfigError, ConvergenceError, RattleError
 from ..io import (
     AnalysisSettings,
     atomic_path,
+    atomic_write_text,
     load_config,
     model_to_toml_dict,
     rattle_version,
@@ -195,8 +196,9 @@ def check_output_dir(output: Path) -> None:
 # --------------------------------------------------------------------------------------------
 # Running and writing
 # --------------------------------------------------------------------------------------------
-def _save_plot(result: Any, path: Path) -> bool:
-    """Draw ``result`` with its ``.plot()`` and save it atomically as PNG; False without matplotlib."""
+def _save_figure(draw: Callable[[], tuple[Any, Any]], path: Path) -> bool:
+    """Call ``draw()`` (returns (figure, axes)) and save the figure atomically as PNG; False
+    without matplotlib."""
     try:
         import matplotlib
     except ImportError:
@@ -205,13 +207,18 @@ def _save_plot(result: Any, path: Path) -> bool:
     matplotlib.use("Agg")  # never open a window from the command line
     import matplotlib.pyplot as plt
 
-    fig, _ax = result.plot()
+    fig, _ax = draw()
     try:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=150)
     finally:
         plt.close(fig)
     return True
+
+
+def _save_plot(result: Any, path: Path) -> bool:
+    """Draw ``result`` with its ``.plot()`` and save it atomically as PNG; False without matplotlib."""
+    return _save_figure(result.plot, path)
 
 
 def _write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: float) -> list[str]:
@@ -237,30 +244,17 @@ def _write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: flo
     return written
 
 
-def run_frf(model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any]) -> None:
-    """Compute the frequency response, write the three files and print the summary.
-
-    Parameters
-    ----------
-    model : Model
-    analysis : AnalysisSettings
-        Frequency range and harmonics.
-    output : pathlib.Path
-        Output directory (checked with :func:`check_output_dir` beforehand).
-    sections : dict
-        Extra metadata sections for ``frf.json`` (``config``, ``command``, …).
-
-    Raises
-    ------
-    ConvergenceError
-        When the continuation failed; the points computed before the failure are written first
-        when the error carries them in ``.partial``.
-    """
-    t_start = time.perf_counter()
+def _compute_frf(
+    model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], t_start: float,
+    *, subharmonics: bool = False,
+) -> Any:
+    """The frequency response; on a convergence failure the points computed before it are
+    written (frf.csv, frf.json, frf.png) and the error re-raised naming the files."""
     from ..analysis import frequency_response  # only now: all input has been validated
 
+    extra = {"subharmonics": True} if subharmonics else {}
     try:
-        result = frequency_response(model, omega=analysis.omega, harmonics=analysis.harmonics, throw=True)
+        return frequency_response(model, omega=analysis.omega, harmonics=analysis.harmonics, throw=True, **extra)
     except ConvergenceError as exc:
         partial = getattr(exc, "partial", None)
         if partial is None:
@@ -279,6 +273,33 @@ def run_frf(model: Model, analysis: AnalysisSettings, output: Path, sections: di
             f"{', '.join(str(output / name) for name in written)}",
             partial=partial,
         ) from exc
+
+
+def run_frf(
+    model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False
+) -> None:
+    """Compute the frequency response, write the three files and print the summary.
+
+    Parameters
+    ----------
+    model : Model
+    analysis : AnalysisSettings
+        Frequency range and harmonics.
+    output : pathlib.Path
+        Output directory (checked with :func:`check_output_dir` beforehand).
+    sections : dict
+        Extra metadata sections for ``frf.json`` (``config``, ``command``, …).
+    subharmonics : bool, default False
+        Also follow the period-doubled branches (every branch goes into the files).
+
+    Raises
+    ------
+    ConvergenceError
+        When the continuation failed; the points computed before the failure are written first
+        when the error carries them in ``.partial``.
+    """
+    t_start = time.perf_counter()
+    result = _compute_frf(model, analysis, output, sections, t_start, subharmonics=subharmonics)
     written = _write_frf(result, output, sections, t_start)
     click.echo(result.summary())
     click.echo(f"wrote {', '.join(written)} to {output}")
@@ -296,16 +317,25 @@ def run_frf(model: Model, analysis: AnalysisSettings, output: Path, sections: di
               help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega[0].")
 @click.option("--omega-max", type=float, default=None, metavar="Y",
               help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].")
+@click.option("--subharmonics", is_flag=True, default=False,
+              help="Also follow the sub-harmonic (period-doubled) branches born at every period-doubling "
+                   "point; all branches go into frf.csv (columns branch, period) and frf.png.")
 def frf_command(
-    config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None
+    config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
+    subharmonics: bool,
 ) -> None:
-    """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT."""
+    """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
+
+    With --subharmonics every period-doubling point found on the primary branch starts a
+    period-2 branch (and so on, up to period 4); each branch has its colour in frf.png.
+    """
     run_config = load_config(config)
     analysis = override_analysis(
         run_config.analysis, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
     check_output_dir(output)
-    options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max}
+    options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
+               "subharmonics": True if subharmonics else None}
     run_frf(
         run_config.model, analysis, output,
         {
@@ -315,26 +345,7 @@ def frf_command(
             "options": {k: v for k, v in options.items() if v is not None},
             "analysis": analysis.to_dict(),
         },
-    )
-
-
-@cli.command("demo", short_help="The paper's reference case end to end.")
-@_output_option
-def demo_command(output: Path) -> None:
-    """The paper's reference case end to end (clutch, Ω = 0.1 … 3.0 rad/s, 32 harmonics)."""
-    from ..model import reference_case
-
-    check_output_dir(output)
-    model = reference_case()
-    analysis = AnalysisSettings(omega_min=0.1, omega_max=3.0, harmonics=32)
-    click.echo(
-        "rattle demo: the paper's reference case — clutch alpha = 0.25, b = 10 deg, zeta = 0.025, "
-        f"F_m = 0.05, F_p1 = 0.03; Omega = {analysis.omega_min} … {analysis.omega_max} rad/s, "
-        f"H = {analysis.harmonics}"
-    )
-    run_frf(
-        model, analysis, output,
-        {"command": "demo", "config": model_to_toml_dict(model, analysis), "analysis": analysis.to_dict()},
+        subharmonics=subharmonics,
     )
 
 
@@ -638,6 +649,167 @@ def compare_command(
     ])
     click.echo(result.summary())
     click.echo(f"wrote {', '.join(written)} to {output}")
+
+
+# --------------------------------------------------------------------------------------------
+# rattle demo: the paper's reference case end to end
+# --------------------------------------------------------------------------------------------
+#: The demo's frequency range (rad/s), harmonics and sweep frequencies per direction.
+DEMO_OMEGA = (0.1, 3.0)
+DEMO_HARMONICS = 32
+DEMO_POINTS = 200
+#: Processes for the demo's sweep: the up and down sweeps run at once.
+DEMO_WORKERS = 2
+#: The paper's points A (Figure 6) and B (Figure 7), rad/s.
+DEMO_POINT_A = 0.44
+DEMO_POINT_B = 1.41
+#: Files of the demo's figures, by report key.
+DEMO_FIGURES = {
+    "frf": "frf.png",
+    "fig4": "fig4_linear_vs_nonlinear.png",
+    "fig5": "fig5_hbm_vs_simulation.png",
+    "fig6": "fig6_point_A.png",
+    "fig7": "fig7_point_B.png",
+    "mean": "fig_mean_operating_point.png",
+}
+DEMO_REPORT = "report.md"
+
+
+def _draw_demo_figure(key: str, frf: Any, sweep: Any, orbits: dict[str, Any], level: Any) -> Callable[[], Any]:
+    """The drawing function of one demo figure (imports the plotting layer lazily)."""
+
+    def draw() -> Any:
+        from ..plotting import (
+            frequency_response_plot, hbm_vs_simulation_plot, linear_vs_nonlinear_plot, mean_operating_point_plot,
+            point_plot,
+        )
+
+        if key == "frf":
+            return frequency_response_plot(frf)
+        if key == "fig4":
+            return linear_vs_nonlinear_plot(frf, level)
+        if key == "fig5":
+            return hbm_vs_simulation_plot(frf, sweep)
+        if key == "fig6":
+            orbit = orbits["A"]
+            p = orbit.simulated_period
+            note = ("(the paper reported quasi-periodic motion at A; the exact simulation and the harmonic balance "
+                    f"agree on period {p})") if p and p > 1 else "(the paper reported quasi-periodic motion at A)"
+            return point_plot(orbit, name="A", note=note)
+        if key == "fig7":
+            return point_plot(orbits["B"], name="B",
+                              note="(the paper: a sub-harmonic peak near Ω = 1.4, HB and simulation match exactly)")
+        return mean_operating_point_plot(frf)
+
+    return draw
+
+
+@cli.command("demo", short_help="The paper's reference case end to end, with its figures and a report.")
+@_output_option
+@click.option("-q", "--quiet", is_flag=True,
+              help="No progress bar (there is none anyway when stderr is not a terminal).")
+def demo_command(output: Path, quiet: bool) -> None:
+    """The paper's reference case end to end: clutch α = 0.25, b = 10°, ζ = 0.025, F_m = 0.05,
+    F_p1 = 0.03 over Ω = 0.1 … 3.0 rad/s with 32 harmonics.
+
+    Computes the frequency response with its sub-harmonic branches, a time-domain sweep up and
+    down (200 frequencies each way) and the orbits at the paper's points A (Ω = 0.44) and B
+    (Ω = 1.41), and writes into OUTPUT: frf.csv, frf.json, frf.png, sweep.csv, the paper's
+    figures (fig4_linear_vs_nonlinear.png, fig5_hbm_vs_simulation.png, fig6_point_A.png,
+    fig7_point_B.png, fig_mean_operating_point.png) and report.md, which collects them with
+    the computed numbers.
+    """
+    from ..model import reference_case
+
+    check_output_dir(output)
+    t_start = time.perf_counter()
+    model = reference_case()
+    analysis = AnalysisSettings(omega_min=DEMO_OMEGA[0], omega_max=DEMO_OMEGA[1], harmonics=DEMO_HARMONICS)
+    click.echo(
+        "rattle demo: the paper's reference case — clutch alpha = 0.25, b = 10 deg, zeta = 0.025, "
+        f"F_m = 0.05, F_p1 = 0.03; Omega = {analysis.omega_min} … {analysis.omega_max} rad/s, "
+        f"H = {analysis.harmonics}, sub-harmonic branches on; sweep up and down, {DEMO_POINTS} points each"
+    )
+    sections: dict[str, Any] = {
+        "command": "demo", "config": model_to_toml_dict(model, analysis), "analysis": analysis.to_dict(),
+        "options": {"subharmonics": True, "points": DEMO_POINTS, "workers": DEMO_WORKERS},
+    }
+    timings: dict[str, float] = {}
+
+    # --- computation ---------------------------------------------------------------------------
+    t0 = time.perf_counter()
+    frf = _compute_frf(model, analysis, output, sections, t_start, subharmonics=True)
+    timings["frf"] = time.perf_counter() - t0
+
+    from ..analysis import confirm_with_sweep, periodic_orbit, time_sweep
+    from ..report import level_difference
+
+    t0 = time.perf_counter()
+    bar = _ProgressBar("sweep up+down", enabled=not quiet)
+    try:
+        sweep = time_sweep(model, omega=analysis.omega, points=DEMO_POINTS, direction="both",
+                           workers=DEMO_WORKERS, callback=bar)
+    finally:
+        bar.close()
+    timings["sweep"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    orbits = {
+        name: periodic_orbit(model, w, period=2, harmonics=analysis.harmonics, frf=frf)
+        for name, w in (("A", DEMO_POINT_A), ("B", DEMO_POINT_B))
+    }
+    timings["orbits"] = time.perf_counter() - t0
+    regions = confirm_with_sweep(frf.regions, sweep)
+    level = level_difference(frf)
+
+    # --- output: data first, then the figures, then the report --------------------------------
+    meta = dict(frf.metadata())
+    frf_timings = dict(meta.pop("timings", None) or {})
+    demo_section = {
+        "regions_confirmed_by_sweep": [g.to_dict() for g in regions],
+        "sweep": sweep.metadata(),
+        "orbits": {name: {"omega": o.omega, **o.metadata()} for name, o in orbits.items()},
+        "level_difference": {
+            "quantity": "20 log10(acc_p2p non-linear / acc_p2p linear), stable solutions",
+            "band": list(level.band), "db_min": level.db_min, "omega_at_min": level.omega_at_min,
+            "db_max": level.db_max, "omega_at_max": level.omega_at_max,
+            "single_valued": list(level.single_valued_range()),
+        },
+    }
+
+    def write_json(path: Path) -> None:
+        wall = {**frf_timings, **{f"demo_{k}": v for k, v in timings.items()},
+                "cli_wall_time": time.perf_counter() - t_start}
+        write_metadata(path, **{**meta, **sections, "demo": demo_section, "timings": wall})
+
+    written = _write_outputs(output, [("frf.csv", frf.to_csv), ("sweep.csv", sweep.to_csv), ("frf.json", write_json)])
+    t0 = time.perf_counter()
+    figures: dict[str, str] = {}
+    for key, name in DEMO_FIGURES.items():
+        done = _write_outputs(output, [(name, lambda path, k=key: _save_figure(
+            _draw_demo_figure(k, frf, sweep, orbits, level), path))])
+        if done:
+            figures[key] = name
+            written += done
+    timings["figures"] = time.perf_counter() - t0
+    timings["total"] = time.perf_counter() - t_start
+
+    from ..report import demo_report
+
+    text = demo_report(frf, sweep, orbits=orbits, level=level, figures=figures, regions=regions, timings=timings,
+                       data_files=["frf.csv", "frf.json", "sweep.csv"], version=rattle_version())
+    written += _write_outputs(output, [(DEMO_REPORT, lambda path: atomic_write_text(path, text))])
+
+    click.echo(frf.summary())
+    click.echo(sweep.summary())
+    for name, orbit in orbits.items():
+        sim = orbit.simulated_period
+        click.echo(f"point {name} (Omega = {orbit.omega:g}): simulation "
+                   + (f"period {sim}" if sim else "no period <= 8")
+                   + "; HB: " + ", ".join(f"P{s.period} {'stable' if s.stable else 'unstable'} rms {s.rms:.4g}"
+                                         for s in orbit.solutions))
+    click.echo("linear vs non-linear: " + level.summary())
+    click.echo("time: " + ", ".join(f"{k} {v:.2f} s" for k, v in timings.items()))
+    click.echo(f"wrote {len(written)} files to {output}: {', '.join(written)}")
 
 
 def main(argv: Sequence[str] | None = None) -> None:

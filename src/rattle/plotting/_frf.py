@@ -26,7 +26,7 @@ QUANTITY_LABELS: dict[str, str] = {
 }
 _LEGEND_PLACES = ("outside", "inside", "none")
 #: Face colour of a ``no_stable_periodic`` band (hatched).
-NO_STABLE_COLOR = "0.45"
+NO_STABLE_COLOR = "0.6"
 #: (band colour, label colour) of the stable sub-harmonic bands, by period.
 SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {
     2: ("#f5c342", "#8a6100"), 3: ("#9ad39a", "#2e6b2e"), 4: ("#c9a3e0", "#5b2d7a"),
@@ -140,7 +140,7 @@ def draw_regions(
                     ha="center", va="top", fontsize=8, color=text_color, fontweight="bold",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8}, zorder=6)
         elif r.kind == "no_stable_periodic":
-            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=NO_STABLE_COLOR, hatch="///", lw=0,
+            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=NO_STABLE_COLOR, hatch="//", lw=0,
                        zorder=0, label="no stable periodic solution" if labels and "none" not in seen else None)
             seen.add("none")
             ax.text(0.5 * (r.omega_min + r.omega_max), 0.93, "no stable\nperiodic", transform=top,

@@ -17,11 +17,11 @@ from ._frf import (
     draw_regions,
     draw_special_points,
     frequency_response_plot,
+    branch_label,
     place_legend,
     _runs,
 )
 from ._orbit import _amplitudes_from_samples
-from ._sweep import sweep_plot
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..report import LevelDifference
@@ -69,42 +69,44 @@ def linear_vs_nonlinear_plot(
     lo, hi = level.band
     frequency_response_plot(frf, ax=ax_r, special_points=False, regions=False, legend="none",
                             title="δ rms vs Ω: non-linear (harmonic balance, all branches) and linear")
-    ax_r.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0, zorder=0, label=f"band {lo:g} < Ω < {hi:g}")
-    place_legend(ax_r, "outside")
+    ax_r.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0, zorder=0, label=f"band {lo:g} < Ω < {hi:g} (below)")
+    ax_r.legend(fontsize=8, loc="upper right", framealpha=0.9)
 
     colors = branch_colors(frf)
-    for b in np.unique(level.branch):
-        sel = np.flatnonzero(level.branch == b)
-        w, d, st = level.omega[sel], level.db[sel], level.stable[sel]
-        color = colors.get(int(b), "tab:blue")
-        for flag, style in ((True, "-"), (False, "--")):
-            first = True
-            for i0, i1 in _runs(st == flag):
-                j1 = min(i1 + 1, sel.size)
-                lab = None
-                if first:
-                    lab = f"acceleration p2p, branch {int(b)} {'stable' if flag else 'unstable'}"
-                    first = False
-                ax_l.plot(w[i0:j1], d[i0:j1], style, color=color, lw=1.6 if flag else 1.0, label=lab)
+    labelled: set[tuple[int, bool]] = set()
+    # Pieces of consecutive rows with one stability; a gap in the row numbers is where a branch
+    # left the band (e.g. the upper branch beyond Ω = 0.8 before it folds back).
+    rows, st = level.rows, level.stable
+    cut = np.flatnonzero((np.diff(rows) != 1) | (st[1:] != st[:-1]) | (level.branch[1:] != level.branch[:-1])) + 1
+    for i0, i1 in zip(np.concatenate(([0], cut)), np.concatenate((cut, [rows.size]))):
+        flag, b = bool(st[i0]), int(level.branch[i0])
+        j1 = i1 + 1 if i1 < rows.size and rows[i1] == rows[i1 - 1] + 1 else i1  # join to the next piece
+        key = (b, flag)
+        lab = None if key in labelled else f"acceleration p2p, branch {b} {'stable' if flag else 'unstable'}"
+        labelled.add(key)
+        ax_l.plot(level.omega[i0:j1], level.db[i0:j1], "-" if flag else "--", color=colors.get(b, "tab:blue"),
+                  lw=1.6 if flag else 1.0, label=lab)
     ax_l.plot(level.omega[level.stable], level.db_displacement[level.stable], ".", color="0.55", ms=2.5,
               label="for comparison: displacement rms about the mean (stable)")
     ax_l.axhline(20.0, color="tab:red", ls=":", lw=1.2, label="paper: \"at least 20 dB\"")
-    for value, where, text, dy in (
-        (level.db_max, level.omega_at_max, "max", 10), (level.db_min, level.omega_at_min, "min", -14),
+    for value, where, text, xy, ha in (
+        (level.db_max, level.omega_at_max, "max", (6, 9), "left"), (level.db_min, level.omega_at_min, "min", (-10, 0), "right"),
     ):
         ax_l.plot([where], [value], "o", color="black", ms=6, mfc="white", mew=1.4, zorder=6)
-        ax_l.annotate(f"{text} {value:.1f} dB at Ω = {where:.3f}", (where, value), xytext=(-8, dy),
-                      textcoords="offset points", ha="right", va="center", fontsize=9)
+        ax_l.annotate(f"{text} {value:.1f} dB at Ω = {where:.3f}", (where, value), xytext=xy,
+                      textcoords="offset points", ha=ha, va="bottom" if text == "max" else "center", fontsize=9,
+                      bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85})
     ax_l.set_xlim(lo, hi)
     ymin = min(float(np.min(level.db)), float(np.min(level.db_displacement))) - 2.0
     ax_l.set_ylim(ymin, max(22.0, float(np.max(level.db)) + 2.0))
     ax_l.set_xlabel("forcing frequency Ω (rad/s)")
     ax_l.set_ylabel("ΔL = 20 log10(non-linear / linear) (dB)")
     ax_l.set_title(
-        f"Level difference over {lo:g} < Ω < {hi:g}: p2p acceleration δ'' (∝ sound pressure), non-linear HB "
-        f"solution vs linear 2Ω²|X₁|; stable solutions {level.db_min:.1f} … {level.db_max:.1f} dB", fontsize=10)
+        f"Level difference over {lo:g} < Ω < {hi:g}: peak-to-peak acceleration δ'' (∝ sound pressure) of the "
+        f"non-linear solution vs the linear system\nstable solutions {level.db_min:.1f} … {level.db_max:.1f} dB "
+        "(the lower values on the lower branch, where the response is multi-valued)", fontsize=10)
     ax_l.grid(True, alpha=0.3)
-    place_legend(ax_l, "outside")
+    place_legend(ax_l, "inside")
     fig.suptitle(title if title is not None else "Figure 4 — linear vs non-linear frequency response")
     return fig, {"response": ax_r, "level": ax_l}
 
@@ -112,6 +114,44 @@ def linear_vs_nonlinear_plot(
 # --------------------------------------------------------------------------------------------
 # Figure 5: harmonic balance vs the time-domain sweep
 # --------------------------------------------------------------------------------------------
+#: Marker styles of the sweep points over a frequency response (colours apart from the branches').
+SWEEP_STYLES: dict[str, dict[str, Any]] = {
+    "up": {"marker": "^", "mfc": "none", "mec": "black", "ms": 4.6, "mew": 0.9, "label": "sweep up (Ω increasing)"},
+    "down": {"marker": "v", "mfc": "darkcyan", "mec": "darkcyan", "ms": 3.6, "mew": 0.6,
+             "label": "sweep down (Ω decreasing)"},
+}
+
+
+def _draw_sweep_points(sweep: "SweepResult", ax: Any) -> None:
+    """Sweep points as markers, and the period of every point that is not period 1 as a strip of
+    ticks along the bottom of the axes (up sweep lower, down sweep above it), coloured by period."""
+    from matplotlib.transforms import blended_transform_factory
+
+    from ._sweep import PERIOD_COLORS, period_label
+
+    direction = np.asarray(sweep.direction).astype(str)
+    period = np.asarray(sweep.period, dtype=int)
+    for name, style in SWEEP_STYLES.items():
+        m = direction == name
+        if np.any(m):
+            ax.plot(sweep.omega[m], sweep.rms[m], ls="none", zorder=2.5, **style)
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo - 0.12 * (hi - lo), hi)
+    strip = blended_transform_factory(ax.transData, ax.transAxes)
+    labelled: set[int] = set()
+    for k, name in enumerate(SWEEP_STYLES):
+        for p in sorted(set(period[direction == name].tolist()) - {1}):
+            m = (direction == name) & (period == p)
+            ax.plot(sweep.omega[m], np.full(int(np.sum(m)), 0.025 + 0.035 * k), "|", ms=7, mew=1.4,
+                    color=PERIOD_COLORS.get(p, "tab:gray"), transform=strip, ls="none", zorder=4,
+                    label=f"sweep {period_label(p)} (ticks at the bottom: up, then down)" if p not in labelled else None)
+            labelled.add(p)
+    for k, name in enumerate(SWEEP_STYLES):
+        if np.any((direction == name) & (period != 1)):
+            ax.text(0.003, 0.025 + 0.035 * k, name, transform=ax.transAxes, fontsize=7, va="center", ha="left",
+                    color="0.3")
+
+
 def hbm_vs_simulation_plot(
     frf: "FrequencyResponse", sweep: "SweepResult", ax: Any = None, *, title: str | None = None
 ) -> tuple[Any, Any]:
@@ -130,11 +170,11 @@ def hbm_vs_simulation_plot(
     else:
         fig = ax.figure
     frequency_response_plot(frf, ax=ax, linear=False, legend="none", title="")
-    sweep_plot(sweep, ax=ax, lines=False, annotate=False, title="")
+    _draw_sweep_points(sweep, ax)
     folds = [sp for sp in frf.special_points if sp.kind == "fold" and int(frf.period[sp.index]) == 1]
     for j in sweep.jumps():
         near = min(folds, key=lambda s: abs(s.omega - j.omega)) if folds else None
-        color = "tab:blue" if j.direction == "up" else "tab:orange"
+        color = SWEEP_STYLES.get(j.direction, SWEEP_STYLES["up"])["mec"]
         ax.annotate("", (j.omega_after, j.rms_after), xytext=(j.omega_before, j.rms_before),
                     arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.6, "mutation_scale": 14}, zorder=7)
         text = f"{j.direction} sweep: jump {j.kind}\nΩ = {j.omega_before:.3f} → {j.omega_after:.3f}"
@@ -271,7 +311,7 @@ def point_plot(
         h = orbit.time_history(i, samples=samples, periods=periods)
         ax_d.plot(h["t"], h["delta"], style, color=color, lw=lw, label=label, zorder=3)
         one = orbit.time_history(i, samples=samples)
-        ax_p.plot(one["delta"], one["velocity"], style, color=color, lw=lw, label=label, zorder=3)
+        ax_p.plot(one["delta"], one["velocity"], style, color=color, lw=lw, zorder=3)
         if ax_s is not None:
             f = np.arange(sol.harmonics + 1) / sol.period
             amp = sol.amplitudes()
@@ -288,7 +328,7 @@ def point_plot(
         step = max(1, samples // 32)
         lab = f"exact simulation: {_sim_text(p)}" + (f" (shifted {win['shift']}·2π/Ω)" if win["shift"] else "")
         ax_d.plot(win["t"][::step], win["delta"][::step], label=lab, **_SIM_STYLE)
-        ax_p.plot(win["delta"][::step], win["velocity"][::step], label="exact simulation", **{**_SIM_STYLE, "ms": 2.2})
+        ax_p.plot(win["delta"][::step], win["velocity"][::step], **{**_SIM_STYLE, "ms": 2.2})
         strobe = np.arange(0, win["t"].size, samples)
         ax_p.plot(win["delta"][strobe], win["velocity"][strobe], "*", color="crimson", ms=13, mec="black", mew=0.6,
                   ls="none", zorder=7, label=f"simulation at t = k·2π/Ω ({len(set(np.round(win['delta'][strobe], 6)))} distinct points)")
@@ -312,8 +352,9 @@ def point_plot(
     ax_d.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax_p.set_xlabel("δ (rad)")
     ax_p.set_ylabel("δ' (rad/s)")
-    ax_p.set_title("phase portrait (one full period of each orbit)", fontsize=10)
-    ax_p.legend(fontsize=7.5, loc="best", framealpha=0.85)
+    ax_p.set_title("phase portrait (one period of each orbit)", fontsize=10)
+    if ax_p.get_legend_handles_labels()[0]:
+        ax_p.legend(fontsize=7.5, loc="upper left", framealpha=0.85)
     if ax_s is not None:
         ymax = max([float(np.max(s.amplitudes())) for s in orbit.solutions] + [1e-6])
         ax_s.set_yscale("log")
@@ -325,7 +366,7 @@ def point_plot(
         if any(s.period == 2 for s in orbit.solutions) or p == 2:
             for k in range(SPECTRUM_ORDERS):
                 ax_s.axvspan(k + 0.5 - 0.08, k + 0.5 + 0.08, color="tab:orange", alpha=0.10, lw=0, zorder=0)
-            ax_s.set_title("amplitude spectrum of δ; shaded: half-order harmonics (k + ½)Ω", fontsize=10)
+            ax_s.set_title("spectrum of δ; shaded: half orders (k + ½)Ω", fontsize=10)
         else:
             ax_s.set_title("amplitude spectrum of δ", fontsize=10)
         ax_s.legend(fontsize=7.5, loc="upper right", framealpha=0.85)
@@ -345,53 +386,94 @@ def point_plot(
 # --------------------------------------------------------------------------------------------
 # The mean operating point
 # --------------------------------------------------------------------------------------------
-def mean_operating_point_plot(frf: "FrequencyResponse", ax: Any = None, *, title: str | None = None) -> tuple[Any, Any]:
-    """The mean δ_m along every branch vs Ω (stable solid, unstable dashed), with the stage
-    boundaries (the breakpoints, ±b for a clutch), the stages shaded and named, and the static
-    equilibrium.
+def _stage_decoration(ax: Any, model: Any, *, labels: bool) -> None:
+    """Stage boundaries (dotted), the soft stage shaded, and each stage named at the right edge."""
+    from matplotlib.transforms import blended_transform_factory
+
+    st = model.elastic.stages
+    bps = np.asarray(st.breakpoints, dtype=float)
+    for k, bp in enumerate(bps):
+        ax.axhline(bp, color="black", ls=":", lw=1.3, zorder=2,
+                   label=("stage boundaries " + ", ".join(f"{v:+.4f}" for v in bps) + " rad")
+                   if labels and k == 0 else None)
+    y0, y1 = ax.get_ylim()
+    edges = np.concatenate(([-np.inf], bps, [np.inf]))
+    right = blended_transform_factory(ax.transAxes, ax.transData)
+    slopes = np.asarray(st.slopes, dtype=float)
+    # A clutch (soft middle stage between two unit-slope ones): the paper's first and second stage.
+    clutch = slopes.size == 3 and slopes[1] < min(slopes[0], slopes[2])
+    for j, slope in enumerate(slopes):
+        a, b = max(edges[j], y0), min(edges[j + 1], y1)
+        if b - a < 0.06 * (y1 - y0):
+            continue
+        if slope < 1.0:
+            ax.axhspan(a, b, color="tab:cyan", alpha=0.06, lw=0, zorder=0)
+        name = (("first stage" if j == 1 else "second stage") + f" (slope {slope:g})") if clutch else f"slope {slope:g}"
+        ax.text(0.995, 0.5 * (a + b), name, transform=right, ha="right", va="center", fontsize=8.5, color="0.25",
+                bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "0.8", "alpha": 0.9}, zorder=6)
+    ax.set_ylim(y0, y1)
+
+
+def mean_operating_point_plot(
+    frf: "FrequencyResponse", fig: Any = None, *, title: str | None = None
+) -> tuple[Any, dict[str, Any]]:
+    """The mean operating point δ_m along every branch vs Ω (top; stable solid, unstable dashed,
+    special points, the static equilibrium and the stage boundary it crosses), and below it the
+    range of δ (min … max) of the stable solutions against all stage boundaries (±b for a
+    clutch): where the motion crosses them while its mean moves between the stages.
 
     Returns
     -------
     (figure, axes)
+        ``axes`` is a dict with keys ``mean`` and ``range``.
     """
     import matplotlib.pyplot as plt
-    from matplotlib.transforms import blended_transform_factory
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(11, 5.5), layout="constrained")
-    else:
-        fig = ax.figure
+    if fig is None:
+        fig = plt.figure(figsize=(11.5, 8), layout="constrained")
+    ax, ax_r = fig.subplots(2, 1, sharex=True, height_ratios=(1.5, 1.0))
     model = frf.model
     colors = draw_branches(frf, ax, "mean")
     draw_special_points(frf, ax, "mean")
-    draw_regions(frf, ax, "mean", [r for r in frf.regions if r.kind != "superharmonic"], colors, labels=False)
+    draw_regions(frf, ax, "mean", [r for r in frf.regions if r.kind == "subharmonic"], colors, labels=False)
     static = model.static_equilibrium()
     ax.axhline(static, color="0.3", ls="-.", lw=1.0, label=f"static equilibrium δ = {static:.4f} rad")
-    st = model.elastic.stages
-    bps = np.asarray(st.breakpoints, dtype=float)
-    for k, bp in enumerate(bps):
-        ax.axhline(bp, color="black", ls=":", lw=1.3,
-                   label="stage boundaries " + ", ".join(f"{v:+.4f}" for v in bps) + " rad" if k == 0 else None)
-    lo_y = min(float(np.min(frf.mean)), float(np.min(bps)) if bps.size else 0.0)
-    hi_y = max(float(np.max(frf.mean)), float(np.max(bps)) if bps.size else 0.0)
-    pad = 0.12 * (hi_y - lo_y)
-    ax.set_ylim(lo_y - pad, hi_y + 2 * pad)
-    y0, y1 = ax.get_ylim()
-    edges = np.concatenate(([y0], bps, [y1]))
-    right = blended_transform_factory(ax.transAxes, ax.transData)
-    for j, slope in enumerate(st.slopes):
-        a, b = max(edges[j], y0), min(edges[j + 1], y1)
-        if b <= a:
-            continue
-        if slope < 1.0:
-            ax.axhspan(a, b, color="tab:cyan", alpha=0.07, lw=0, zorder=0)
-        ax.text(0.995, 0.5 * (a + b), f"stage slope {slope:g}", transform=right, ha="right", va="center",
-                fontsize=8.5, color="0.25", bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "0.8", "alpha": 0.9})
-    ax.set_xlabel("forcing frequency Ω (rad/s)")
+    bps = np.asarray(model.elastic.stages.breakpoints, dtype=float)
+    lo_y = float(np.min(frf.mean))
+    hi_y = max(float(np.max(frf.mean)), static)
+    near = bps[(bps > lo_y - 0.5 * (hi_y - lo_y)) & (bps < hi_y + 0.5 * (hi_y - lo_y))]
+    if near.size:
+        lo_y, hi_y = min(lo_y, float(near.min())), max(hi_y, float(near.max()))
+    pad = 0.08 * (hi_y - lo_y)
+    ax.set_ylim(lo_y - pad, hi_y + 2.5 * pad)
+    _stage_decoration(ax, model, labels=True)
     ax.set_ylabel("mean δ_m (rad)")
     ax.grid(True, alpha=0.3)
-    ax.set_title(title if title is not None else
-                 "Mean operating point δ_m along every branch: from the second stage (at rest) into the first "
-                 "stage under the pulsating torque", fontsize=10.5)
+    ax.set_title("mean δ_m along every branch (zoomed; stage boundaries outside the range are in the panel below)",
+                 fontsize=10)
     place_legend(ax, "outside")
-    return fig, ax
+
+    for b, color in colors.items():
+        sel = np.flatnonzero(frf.branch == b)
+        for i0, i1 in _runs(np.asarray(frf.stable[sel], dtype=bool)):
+            rows = sel[i0:i1]  # a stable stretch runs monotonically in Ω (folds end it)
+            if rows.size >= 2:
+                ax_r.fill_between(frf.omega[rows], frf.delta_min[rows], frf.delta_max[rows], color=color,
+                                  alpha=0.18, lw=0, zorder=1)
+        st = np.asarray(frf.stable[sel], dtype=bool)
+        ax_r.plot(frf.omega[sel], np.where(st, frf.mean[sel], np.nan), "-", color=color, lw=1.2, zorder=3,
+                  label=f"{'δ_m and ' if b == min(colors) else ''}range of δ, {branch_label(frf, b)} (stable)")
+    lo_r = min(float(np.min(frf.delta_min[frf.stable])), float(bps.min()) if bps.size else 0.0)
+    hi_r = max(float(np.max(frf.delta_max[frf.stable])), float(bps.max()) if bps.size else 0.0)
+    pad = 0.05 * (hi_r - lo_r)
+    ax_r.set_ylim(lo_r - pad, hi_r + pad)
+    _stage_decoration(ax_r, model, labels=False)
+    ax_r.set_xlabel("forcing frequency Ω (rad/s)")
+    ax_r.set_ylabel("δ min … max (rad)")
+    ax_r.grid(True, alpha=0.3)
+    ax_r.set_title("range of δ of the stable solutions (shaded) against the stage boundaries", fontsize=10)
+    place_legend(ax_r, "outside")
+    fig.suptitle(title if title is not None else
+                 "Mean operating point: at rest on the second stage; under the pulsating torque δ_m moves into the "
+                 "first stage")
+    return fig, {"mean": ax, "range": ax_r}

@@ -133,7 +133,7 @@ class FrequencyResponse:
         """A few lines for the terminal."""
         lines = [
             f"{len(self)} solution points over Ω = {self.omega.min():.4g} … {self.omega.max():.4g} "
-            f"(H = {self.harmonics}), {int(np.sum(~self.stable))} unstable",
+            f"(H = {self.settings.get('harmonics', self.harmonics)} harmonics per forcing period), {int(np.sum(~self.stable))} unstable",
             f"status: {self.status.name.lower()} — {self.message or self.status.message}",
         ]
         if len(np.unique(self.branch)) > 1:
