@@ -21,6 +21,7 @@ from ..errors import Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
 from ..model import Model
 from ..results import FrequencyResponse
+from ..timeint import ExactIntegrator
 
 
 def embed_period(q: FloatArray, harmonics: int, factor: int, harmonics_new: int) -> FloatArray:
@@ -163,7 +164,7 @@ def period_doubling_branches(
                         end_is_pd = True
             branch = assemble(
                 model, hb2, points, branch_id=next_id, refine=stability_refine, newton=newton,
-                branch_points=(True, end_is_pd), status=stepper.status, message=stepper.message,
+                branch_points=(True, end_is_pd), status=stepper.status or Status.STOPPED, message=stepper.message,
             )
             next_id += 1
             out.append(branch)
@@ -227,7 +228,7 @@ def branch_from_seed(
         if stepper.status is Status.STOPPED:
             break  # an isola: one way round covers it
     points = halves[0] if len(halves) == 1 else halves[1][::-1] + halves[0][1:]
-    status = statuses[0].status if statuses[0].status is not Status.STOPPED else Status.STOPPED
+    status = statuses[0].status or Status.STOPPED
     return assemble(model, hb, points, branch_id=branch_id, newton=newton, status=status,
                     message="; ".join(s.message for s in statuses))
 
@@ -278,7 +279,7 @@ def sweep_seeds(frf: FrequencyResponse, sweep: object, *, harmonics_per_period: 
 
 
 def seed_from_state(model: Model, omega: float, x0: FloatArray, period: int, harmonics: int, *,
-                    integrator: object | None = None) -> FloatArray | None:
+                    integrator: "ExactIntegrator | None" = None) -> FloatArray | None:
     """HB coefficients (``harmonics`` of Ω/period) of the period-``period`` orbit through the
     state x0 = (δ, δ') at t = 0 (a forcing-phase-aligned section point): the orbit is closed by
     exact shooting and its samples analysed. None if shooting does not converge."""

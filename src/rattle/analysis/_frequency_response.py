@@ -30,7 +30,7 @@ StabilityMethod = Literal["monodromy", "hill"]
 def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
     """Validate a frequency-range argument (min, max) in rad/s; messages name ``name``."""
     try:
-        lo, hi = (float(v) for v in omega)  # type: ignore[union-attr]
+        lo, hi = (float(v) for v in omega)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
         raise ValueError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {omega!r}") from None
     if not (math.isfinite(lo) and math.isfinite(hi)):

@@ -33,11 +33,11 @@ def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, 
     problem does not converge at fixed Ω (fold tips, where ∂R/∂q is singular)."""
     if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
         raise ValueError(f"`factor` must be an integer >= 2, got {factor!r}")
-    rows = np.arange(len(frf)) if rows is None else np.asarray(rows, dtype=int)
-    out = np.full(rows.size, np.nan)
+    idx = np.arange(len(frf)) if rows is None else np.asarray(rows, dtype=int)
+    out = np.full(idx.size, np.nan)
     problems: dict[tuple[int, int], HarmonicBalance] = {}
     H_all = frf.harmonics
-    for n, i in enumerate(rows):
+    for n, i in enumerate(idx):
         p = int(frf.period[i])
         # The row's own harmonic count: the highest non-zero harmonic (branches may be padded).
         q = frf.coefficients[i]
@@ -76,7 +76,7 @@ def adaptive_frequency_response(
     if not (isinstance(tolerance, (int, float)) and 0 < tolerance < 1):
         raise ValueError(f"`tolerance` must be in (0, 1), got {tolerance!r}")
     H = harmonics
-    history = []
+    history: list[dict[str, object]] = []
     while True:
         try:
             frf = frequency_response(model, omega=omega, harmonics=H, subharmonics=subharmonics, newton=newton)

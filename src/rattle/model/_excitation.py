@@ -50,8 +50,8 @@ class Excitation:
         """Σ |F_pn|, the largest possible dynamic force."""
         return float(np.sum(np.abs(self.amplitudes)))
 
-    def __call__(self, t: FloatArray | float, omega: float) -> FloatArray:
-        """F(t) at times ``t`` (any shape) for forcing frequency ``omega``."""
+    def __call__(self, t: FloatArray | float, omega: FloatArray | float) -> FloatArray:
+        """F(t) at times ``t`` for forcing frequency ``omega`` (arrays broadcast together)."""
         t = np.asarray(t, dtype=float)
         out = np.full(t.shape, self.mean)
         for n, amp, phi in zip(self.orders, self.amplitudes, self.phases):  # type: ignore[arg-type]
