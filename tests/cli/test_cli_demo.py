@@ -4,57 +4,20 @@
 from __future__ import annotations
 
 import json
-import os
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner, Result
+from click.testing import Result
 
-from rattle.cli.main import DEMO_FIGURES, cli
+from rattle.cli.main import DEMO_FIGURES
 from rattle.io import FRF_COLUMNS, SWEEP_COLUMNS, read_csv
+from _cli_helpers import PNG, VALID, invoke
 
-VALID = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.1, 3.0]
-harmonics = 32
-"""
-
-PNG = b"\x89PNG\r\n\x1a\n"
 DEMO_FILES = sorted(["frf.csv", "frf.json", "frf.png", "sweep.csv", "fig4_linear_vs_nonlinear.png",
                      "fig5_hbm_vs_simulation.png", "fig6_point_A.png", "fig7_point_B.png",
                      "fig_mean_operating_point.png", "report.md"])
-
-
-def _runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told not to
-        return CliRunner(mix_stderr=False)  # type: ignore[call-arg]
-    except TypeError:
-        return CliRunner()
-
-
-def invoke(args: list[str], cwd: Path) -> Result:
-    old = Path.cwd()
-    os.chdir(cwd)
-    try:
-        return _runner().invoke(cli, args, catch_exceptions=False)
-    finally:
-        os.chdir(old)
 
 
 # --------------------------------------------------------------------------------------------

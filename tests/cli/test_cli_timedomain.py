@@ -8,54 +8,16 @@ from __future__ import annotations
 
 import io
 import json
-import os
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner, Result
 
-from rattle.cli.main import _ProgressBar, cli
+from rattle.cli.main import _ProgressBar
 from rattle.io import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, read_csv
+from _cli_helpers import PNG, VALID, assert_bad_input, invoke
 
-VALID = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.1, 3.0]
-harmonics = 32
-"""
-
-PNG = b"\x89PNG\r\n\x1a\n"
-
-
-def _runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told not to
-        return CliRunner(mix_stderr=False)  # type: ignore[call-arg]
-    except TypeError:
-        return CliRunner()
-
-
-def invoke(args: list[str], cwd: Path) -> Result:
-    old = Path.cwd()
-    os.chdir(cwd)
-    try:
-        return _runner().invoke(cli, args, catch_exceptions=False)
-    finally:
-        os.chdir(old)
 
 
 @pytest.fixture
@@ -68,16 +30,6 @@ def case(tmp_path: Path) -> Path:
 def no_solver(monkeypatch: pytest.MonkeyPatch) -> None:
     """Make importing the solver fail: bad input must be refused before it is imported."""
     monkeypatch.setitem(sys.modules, "rattle.analysis", None)
-
-
-def assert_bad_input(result: Result, *fragments: str) -> None:
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr  # one clear line
-    assert lines[0].startswith("rattle: error: ")
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    assert result.stdout == ""
 
 
 # --------------------------------------------------------------------------------------------

@@ -13,72 +13,19 @@ from typing import Any
 
 import numpy as np
 import pytest
-from click.testing import CliRunner, Result
 
-from rattle.cli.main import cli, main
+from rattle.cli.main import main
 from rattle.errors import ConvergenceError
 from rattle.io import FRF_COLUMNS, read_csv, write_csv
+from _cli_helpers import VALID, assert_bad_input, invoke, write_config
 
 SRC = Path(__file__).resolve().parents[2] / "src"
-
-VALID = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.1, 3.0]
-harmonics = 32
-"""
-
-
-def _runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told not to
-        return CliRunner(mix_stderr=False)  # type: ignore[call-arg]
-    except TypeError:
-        return CliRunner()
-
-
-def invoke(args: list[str], cwd: Path) -> Result:
-    runner = _runner()
-    old = Path.cwd()
-    os.chdir(cwd)
-    try:
-        return runner.invoke(cli, args, catch_exceptions=False)
-    finally:
-        os.chdir(old)
-
-
-def write_config(tmp_path: Path, text: str = VALID) -> Path:
-    path = tmp_path / "case.toml"
-    path.write_text(text, encoding="utf-8")
-    return path
 
 
 @pytest.fixture
 def no_solver(monkeypatch: pytest.MonkeyPatch) -> None:
     """Make importing the solver fail: bad input must be refused before it is imported."""
     monkeypatch.setitem(sys.modules, "rattle.analysis", None)
-
-
-def assert_bad_input(result: Result, *fragments: str) -> None:
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr  # one clear line
-    assert lines[0].startswith("rattle: error: ")
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    assert result.stdout == ""
 
 
 # --------------------------------------------------------------------------------------------
