@@ -299,3 +299,20 @@ def test_frf_end_to_end_with_the_real_solver(tmp_path: Path) -> None:
     assert frf["stable"].dtype == bool
     meta = json.loads((out / "frf.json").read_text())
     assert meta["analysis"] == {"omega": [0.5, 1.5], "harmonics": 8}
+
+
+def test_harmonics_fewer_than_the_excitation_harmonics_are_refused(tmp_path: Path, no_solver: None) -> None:
+    two = VALID.replace("amplitudes = [0.03]", "amplitudes = [0.03, 0.01]")
+    write_config(tmp_path, two.replace("harmonics = 32", "harmonics = 1"))
+    assert_bad_input(invoke(["frf", "case.toml", "-o", "out"], tmp_path), "`analysis.harmonics` must be >= 2")
+    write_config(tmp_path, two)
+    assert_bad_input(invoke(["frf", "case.toml", "-o", "out", "--harmonics", "1"], tmp_path), "`--harmonics` must be >= 2")
+    assert not (tmp_path / "out").exists()
+
+
+def test_library_argument_errors_are_bad_input(tmp_path: Path) -> None:
+    """A combination only the library can judge (harmonics too few for --period) still exits 2
+    with the library's message, not a traceback."""
+    write_config(tmp_path)
+    result = invoke(["orbit", "case.toml", "--omega", "0.8", "--period", "8", "--harmonics", "3", "-o", "out"], tmp_path)
+    assert_bad_input(result, "`--harmonics` must be >= 8")

@@ -9,6 +9,7 @@ from ._config import (
     DEFAULT_OMEGA,
     AnalysisSettings,
     RunConfig,
+    check_harmonics,
     config_from_dict,
     dumps_toml,
     load_config,
@@ -22,6 +23,7 @@ __all__ = [
     # configuration
     "load_config", "config_from_dict", "RunConfig", "AnalysisSettings",
     "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "model_to_toml_dict", "dumps_toml", "rename_keys",
+    "check_harmonics",
     # csv
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS", "write_csv", "read_csv", "format_csv",
     # metadata

@@ -52,7 +52,7 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 
 __all__ = [
     "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "AnalysisSettings", "RunConfig",
-    "load_config", "config_from_dict", "model_to_toml_dict", "dumps_toml", "rename_keys",
+    "load_config", "config_from_dict", "model_to_toml_dict", "dumps_toml", "rename_keys", "check_harmonics",
 ]
 
 #: Default forcing-frequency range ``analysis.omega`` (rad/s): the SPEC §2 example.
@@ -473,7 +473,18 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         elastic=elastic, excitation=excitation,
     )
     analysis = _analysis(check, analysis_t)
+    check_harmonics(model, analysis.harmonics)
     return RunConfig(model=model, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name)
+
+
+def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonics") -> None:
+    """The harmonic balance must hold every excitation harmonic: ``harmonics`` >= their count."""
+    needed = len(model.excitation.amplitudes)
+    if harmonics < needed:
+        raise ConfigError(
+            f"`{name}` must be >= {needed}, the number of excitation harmonics "
+            f"(`excitation.amplitudes` has {needed}), got {harmonics}; raise `{name}`"
+        )
 
 
 def _elastic_structure(
