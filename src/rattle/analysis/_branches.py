@@ -254,8 +254,6 @@ def sweep_seeds(frf: FrequencyResponse, sweep: object, *, harmonics_per_period: 
     (no stable stretch of that period crossing the sweep's Ω with an rms, interpolated there,
     within ``rtol``). The orbit is closed by exact shooting from the sweep's section state and
     analysed into n·H harmonics of Ω/n."""
-    from ..timeint import ExactIntegrator, shoot_periodic_orbit
-
     model = frf.model
     H = harmonics_per_period or int(frf.settings.get("harmonics", frf.harmonics))
     integ = ExactIntegrator(model)

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .._validate import check_omega, check_state
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
@@ -61,18 +62,6 @@ _SAME_ORBIT_TOL = 1e-6
 # A series has a shorter period d | p when the harmonics that do not fit period d carry less
 # than this fraction of its amplitude.
 _REDUCE_TOL = 1e-7
-
-
-def _check_omega(omega: object) -> float:
-    if isinstance(omega, bool):
-        raise TypeError(f"`omega` must be a forcing frequency in rad/s (a number), got {omega!r}")
-    try:
-        w = float(omega)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise TypeError(f"`omega` must be a forcing frequency in rad/s (a number), got {omega!r}") from None
-    if not (math.isfinite(w) and w > 0.0):
-        raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}; use e.g. 0.8")
-    return w
 
 
 def _check_period(period: object) -> int:
@@ -380,7 +369,7 @@ def periodic_orbit(
     """
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    W = _check_omega(omega)
+    W = check_omega(omega)
     period = _check_period(period)
     HBOptions(harmonics=harmonics, samples=samples)  # validates `harmonics` and `samples`
     forced = len(model.excitation.amplitudes)
@@ -404,9 +393,7 @@ def periodic_orbit(
     if x0 is None:
         start_state = np.zeros(2)
     else:
-        start_state = np.asarray(x0, dtype=float)
-        if start_state.shape != (2,) or not np.all(np.isfinite(start_state)):
-            raise ValueError(f"`x0` must be a finite state (delta, velocity) of shape (2,), got {x0!r}")
+        start_state = check_state(x0)
     newton_opts = newton or NewtonOptions()
     cont_opts = continuation or ContinuationOptions()
     timings: dict[str, float] = {}

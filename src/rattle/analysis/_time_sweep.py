@@ -14,7 +14,6 @@ resonance drops near its upper fold, the down sweep jumps up near the lower fold
 from __future__ import annotations
 
 import logging
-import math
 import queue as queue_module
 import time
 from collections.abc import Callable, Sequence
@@ -24,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .._validate import check_int
 from ..model import Model
 from ..results._sweep import SweepResult
 from ..timeint import ExactIntegrator, SteadyStateOptions, steady_state
@@ -36,14 +36,6 @@ logger = logging.getLogger("rattle")
 DIRECTIONS: dict[str, tuple[str, ...]] = {"up": ("up",), "down": ("down",), "both": ("up", "down")}
 
 ProgressCallback = Callable[[int, int], None]
-
-
-def _check_int(name: str, value: object, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"`{name}` must be an integer, got {value!r} ({type(value).__name__})")
-    if value < low:
-        raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-    return int(value)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -217,12 +209,12 @@ def time_sweep(
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
     lo, hi = check_range(omega)
-    points = _check_int("points", points, 2)
+    points = check_int("points", points, 2)
     if not isinstance(direction, str) or direction not in DIRECTIONS:
         raise ValueError(
             f"`direction` must be one of {', '.join(repr(d) for d in DIRECTIONS)}, got {direction!r}"
         )
-    workers = _check_int("workers", workers, 1)
+    workers = check_int("workers", workers, 1)
     if options is None:
         options = SteadyStateOptions()
     elif not isinstance(options, SteadyStateOptions):

@@ -40,6 +40,7 @@ from typing import Callable
 import numpy as np
 
 from .._typing import FloatArray, IntArray
+from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import Model
 
@@ -67,9 +68,7 @@ class StageSolutions:
     """
 
     def __init__(self, model: Model, omega: float, samples_per_scale: int = 40) -> None:
-        omega = float(omega)
-        if not (math.isfinite(omega) and omega > 0.0):
-            raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}")
+        omega = check_omega(omega)
         st = model.elastic.stages
         exc = model.excitation
         c, k = model.c, model.k
@@ -657,9 +656,7 @@ class ExactIntegrator:
 
         Returns the :class:`Trajectory`: its segments, final state and sensitivity ∂x(t1)/∂x0.
         """
-        x0 = np.asarray(x0, dtype=float)
-        if x0.shape != (2,) or not np.all(np.isfinite(x0)):
-            raise ValueError(f"`x0` must be a finite state (delta, velocity) of shape (2,), got {x0!r}")
+        x0 = check_state(x0)
         t0, t1 = float(t0), float(t1)
         if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
             raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")

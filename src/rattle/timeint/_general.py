@@ -30,6 +30,7 @@ from scipy.integrate import solve_ivp
 from scipy.integrate._ivp.ivp import METHODS as _IVP_METHODS
 
 from .._typing import FloatArray, IntArray
+from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import Model
 from ._exact import StateSamples
@@ -181,12 +182,8 @@ def integrate_general(
     """
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    omega = float(omega)
-    if not (math.isfinite(omega) and omega > 0.0):
-        raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}")
-    x = np.asarray(x0, dtype=float)
-    if x.shape != (2,) or not np.all(np.isfinite(x)):
-        raise ValueError(f"`x0` must be a finite state (delta, velocity) of shape (2,), got {x0!r}")
+    omega = check_omega(omega)
+    x = check_state(x0)
     t0, t1 = float(t0), float(t1)
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
         raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")

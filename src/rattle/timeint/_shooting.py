@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
+from .._validate import check_omega
 from ..model import Model
 from ._exact import ExactIntegrator, Trajectory
 
@@ -120,9 +121,7 @@ def shoot_periodic_orbit(
     """
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    omega = float(omega)
-    if not (math.isfinite(omega) and omega > 0.0):
-        raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}")
+    omega = check_omega(omega)
     if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
         raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
     if not (isinstance(tol, (int, float)) and tol > 0.0):

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
+from .._validate import check_int, check_omega, check_state
 from ..model import Model
 from ._exact import ExactIntegrator, ExactMeasures, Trajectory
 from ._shooting import _newton_shooting, _Shot, _state_scale
@@ -65,14 +66,6 @@ METHODS: dict[str, str] = {
     "simulation": "the Poincaré sequence of the plain simulation settled to the tolerance",
     "unsettled": "nothing settled within `max_periods` forcing periods (period 0)",
 }
-
-
-def _check_int(name: str, value: object, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"`{name}` must be an integer, got {value!r} ({type(value).__name__})")
-    if value < low:
-        raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-    return int(value)
 
 
 def _check_positive(name: str, value: object) -> float:
@@ -136,7 +129,7 @@ class SteadyStateOptions:
             object.__setattr__(self, name, _check_positive(name, getattr(self, name)))
         for name, low in (("max_periods", 1), ("max_period_multiple", 1), ("record_periods", 1),
                           ("shooting_iterations", 0), ("section_points", 1)):
-            object.__setattr__(self, name, _check_int(name, getattr(self, name), low))
+            object.__setattr__(self, name, check_int(name, getattr(self, name), low))
         if not isinstance(self.accelerate, (bool, np.bool_)):
             raise TypeError(f"`accelerate` must be True or False, got {self.accelerate!r}")
         object.__setattr__(self, "accelerate", bool(self.accelerate))
@@ -501,14 +494,8 @@ def steady_state(
     """
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    if isinstance(omega, bool) or not isinstance(omega, (int, float, np.integer, np.floating)):
-        raise TypeError(f"`omega` must be a real number, got {omega!r}")
-    omega = float(omega)
-    if not (math.isfinite(omega) and omega > 0.0):
-        raise ValueError(f"`omega` must be a finite forcing frequency > 0 rad/s, got {omega!r}")
-    x = np.asarray(x0, dtype=float)
-    if x.shape != (2,) or not np.all(np.isfinite(x)):
-        raise ValueError(f"`x0` must be a finite state (delta, velocity) of shape (2,), got {x0!r}")
+    omega = check_omega(omega)
+    x = check_state(x0)
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
         raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
