@@ -39,3 +39,16 @@ def test_complex_conversion_round_trip(rng):
     basis = FourierBasis(5, 16)
     q = rng.standard_normal(basis.size)
     np.testing.assert_array_equal(basis.from_complex(basis.to_complex(q)), q)
+
+
+def test_resize_harmonics_pads_truncates_and_embeds(rng):
+    from rattle.hb import resize_harmonics
+
+    q = rng.standard_normal(2 * 5 + 1)
+    np.testing.assert_array_equal(resize_harmonics(resize_harmonics(q, 9), 5), q)  # pad, truncate
+    # Written with base ω/2 (harmonic k → 2k), the series has the same samples over two periods.
+    x1 = FourierBasis(5, 64).synthesize(q)
+    x2 = FourierBasis(10, 128).synthesize(resize_harmonics(q, 10, factor=2))
+    np.testing.assert_allclose(x2, np.concatenate([x1, x1]), rtol=0, atol=1e-13)
+    Q = rng.standard_normal((3, 11))
+    np.testing.assert_array_equal(resize_harmonics(Q, 8)[1], resize_harmonics(Q[1], 8))  # row-wise

@@ -18,22 +18,10 @@ import numpy as np
 from .._typing import FloatArray
 from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import Status
-from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
+from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..model import Model
 from ..results import FrequencyResponse
 from ..timeint import ExactIntegrator
-
-
-def embed_period(q: FloatArray, harmonics: int, factor: int, harmonics_new: int) -> FloatArray:
-    """Coefficients of a solution with H harmonics of ω written with base ω/``factor``:
-    harmonic k of ω becomes harmonic factor·k (zeros elsewhere), in a basis of ``harmonics_new``."""
-    out = np.zeros(2 * harmonics_new + 1)
-    out[0] = q[0]
-    k = np.arange(1, harmonics + 1)
-    keep = factor * k <= harmonics_new
-    out[factor * k[keep]] = q[1 : harmonics + 1][keep]
-    out[harmonics_new + factor * k[keep]] = q[harmonics + 1 :][keep]
-    return out
 
 
 def odd_indices(harmonics: int) -> np.ndarray:
@@ -78,7 +66,7 @@ def switch_period_doubling(
     H2 = 2 * harmonics if harmonics_new is None else harmonics_new
     newton = newton or NewtonOptions()
     hb2 = HarmonicBalance(model, HBOptions(harmonics=H2), period=2 * period)
-    q2 = embed_period(q_pd, harmonics, 2, H2)
+    q2 = resize_harmonics(q_pd, H2, factor=2)
     # Polish the embedding on the doubled-period problem (the even block is regular there).
     res = solve_harmonic_balance(hb2, q2, omega_pd, newton)
     if res.converged and np.max(np.abs(res.q[odd_indices(H2)])) < 1e-9 * max(1.0, np.max(np.abs(res.q))):
@@ -106,7 +94,7 @@ def switch_period_doubling(
     return hb2, stepper
 
 
-__all__ = ["embed_period", "odd_indices", "critical_mode", "switch_period_doubling"]
+__all__ = ["odd_indices", "critical_mode", "switch_period_doubling"]
 
 
 def period_doubling_branches(
@@ -158,7 +146,7 @@ def period_doubling_branches(
                     o = min(others, key=lambda o: abs(float(parent.omega[o.index]) - w_end))
                     if abs(float(parent.omega[o.index]) - w_end) < 1e-2 * (omega_range[1] - omega_range[0]):
                         done.add(o.index)
-                        q_end = embed_period(parent.coefficients[o.index], H, 2, hb2.basis.harmonics)
+                        q_end = resize_harmonics(parent.coefficients[o.index], hb2.basis.harmonics, factor=2)
                         last = points[-1]
                         points[-1] = BranchPoint(q_end, float(parent.omega[o.index]), 0, last.residual, last.tangent, last.step)
                         end_is_pd = True

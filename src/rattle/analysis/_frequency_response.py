@@ -15,7 +15,7 @@ from .._typing import FloatArray
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..continuation._detect import LocatedPoint, locate_on_segment
 from ..errors import ConvergenceError, Status
-from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
+from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..measures import measures_batch, synthesize_batch
 from ..model import Model
 from ..results import FrequencyResponse, SpecialPoint
@@ -101,26 +101,18 @@ def _test_function(kind: str, hb: HarmonicBalance, corrector: ArclengthCorrector
     return unit_modulus
 
 
-def _pad(q: FloatArray, H: int, H2: int) -> FloatArray:
-    """Coefficients of H harmonics written in a basis of H2 ≥ H harmonics (zeros above H)."""
-    out = np.zeros(2 * H2 + 1)
-    out[: H + 1] = q[: H + 1]
-    out[H2 + 1 : H2 + 1 + H] = q[H + 1 :]
-    return out
-
-
 def _locate_with(hb: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
     corrector = ArclengthCorrector(hb, newton)
     return locate_on_segment(corrector, qa, wa, qb, wb, _test_function(kind, hb, corrector))
 
 
-def _refine(hb: HarmonicBalance, hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
+def _refine(hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
     """Locate the same special point with the doubled harmonic count hb2: the end points are
     first corrected onto the 2H branch (in the plane normal to the secant)."""
-    H, H2 = hb.basis.harmonics, hb2.basis.harmonics
+    H2 = hb2.basis.harmonics
     corr2 = ArclengthCorrector(hb2, newton)
-    ya = corr2.to_scaled(_pad(qa, H, H2), wa)
-    yb = corr2.to_scaled(_pad(qb, H, H2), wb)
+    ya = corr2.to_scaled(resize_harmonics(qa, H2), wa)
+    yb = corr2.to_scaled(resize_harmonics(qb, H2), wb)
     d = (yb - ya) / np.linalg.norm(yb - ya)
     ca, cb = corr2.correct(ya, d), corr2.correct(yb, d)
     if ca is None or cb is None:
@@ -164,7 +156,7 @@ def _locate_changes(
         if loc is not None and refine:
             if hb2 is None:
                 hb2 = HarmonicBalance(hb.model, HBOptions(harmonics=2 * hb.basis.harmonics), period=hb.period)
-            loc2 = _refine(hb, hb2, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
+            loc2 = _refine(hb2, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
             omega2 = None if loc2 is None else loc2.omega
         found.append((i, kind, loc, omega2))
     return found

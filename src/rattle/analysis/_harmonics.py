@@ -15,16 +15,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._typing import FloatArray
-from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
+from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..model import Model
 from ..results import FrequencyResponse
-
-
-def _pad(q: FloatArray, H: int, H2: int) -> FloatArray:
-    out = np.zeros(2 * H2 + 1)
-    out[: H + 1] = q[: H + 1]
-    out[H2 + 1 : H2 + 1 + H] = q[H + 1 : 2 * H + 1]
-    return out
 
 
 def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, *, factor: int = 2,
@@ -48,7 +41,7 @@ def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, 
         if key not in problems:
             problems[key] = HarmonicBalance(frf.model, HBOptions(harmonics=factor * H), period=p)
         hb2 = problems[key]
-        r = solve_harmonic_balance(hb2, _pad(q[np.r_[0 : H + 1, H_all + 1 : H_all + 1 + H]], H, factor * H), float(frf.omega[i]), newton)
+        r = solve_harmonic_balance(hb2, resize_harmonics(q, factor * H), float(frf.omega[i]), newton)
         if r.converged:
             rms2 = np.sqrt(r.q[0] ** 2 + 0.5 * np.sum(r.q[1:] ** 2))
             out[n] = abs(rms2 / frf.rms[i] - 1.0)

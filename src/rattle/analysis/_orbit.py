@@ -40,7 +40,7 @@ from .._typing import FloatArray
 from .._validate import check_omega, check_state
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError
-from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
+from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..measures import measures_batch, synthesize_batch
 from ..model import Model
 from ..results import FrequencyResponse
@@ -88,15 +88,6 @@ def default_search_range(model: Model, omega: float) -> tuple[float, float]:
 # --------------------------------------------------------------------------------------------
 # Series helpers
 # --------------------------------------------------------------------------------------------
-def _resize(q: FloatArray, harmonics: int) -> FloatArray:
-    """``q`` truncated or zero-padded to ``harmonics`` harmonics."""
-    H0 = (q.size - 1) // 2
-    out = np.zeros(2 * harmonics + 1)
-    h = min(H0, harmonics)
-    out[0] = q[0]
-    out[1 : h + 1] = q[1 : h + 1]
-    out[harmonics + 1 : harmonics + 1 + h] = q[H0 + 1 : H0 + 1 + h]
-    return out
 
 
 def _shift(q: FloatArray, fraction: float) -> FloatArray:
@@ -409,7 +400,7 @@ def periodic_orbit(
         p_branch = int(primary.period[sel[0]])
         Q = primary.coefficients[sel]
         for i, s in _brackets(primary.omega[sel], W):
-            q_start = _resize((1 - s) * Q[i] + s * Q[i + 1], harmonics)
+            q_start = resize_harmonics((1 - s) * Q[i] + s * Q[i + 1], harmonics)
             solver.add(solver.polish(q_start, p_branch, "continuation"))
     t1 = time.perf_counter()
     timings["primary"] = t1 - t0

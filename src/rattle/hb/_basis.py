@@ -120,4 +120,20 @@ class FourierBasis:
         return kk - jj, kk + jj
 
 
-__all__ = ["FourierBasis"]
+def resize_harmonics(q: FloatArray, harmonics: int, factor: int = 1) -> FloatArray:
+    """Coefficients ``q`` (last axis 2H + 1) rewritten with ``harmonics`` harmonics of the base
+    frequency ω/``factor``: harmonic k of ω becomes harmonic factor·k; harmonics that do not fit
+    are dropped, the others are zero. ``factor = 1`` pads or truncates; ``factor = n`` writes a
+    solution in the basis of period n."""
+    q = np.asarray(q, dtype=float)
+    H0 = (q.shape[-1] - 1) // 2
+    out = np.zeros(q.shape[:-1] + (2 * harmonics + 1,))
+    out[..., 0] = q[..., 0]
+    k = np.arange(1, H0 + 1)
+    keep = factor * k <= harmonics
+    out[..., factor * k[keep]] = q[..., 1 : H0 + 1][..., keep]
+    out[..., harmonics + factor * k[keep]] = q[..., H0 + 1 :][..., keep]
+    return out
+
+
+__all__ = ["FourierBasis", "resize_harmonics"]

@@ -10,6 +10,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
+from ..hb import resize_harmonics
 from ..io._csv import FRF_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model
@@ -178,13 +179,6 @@ class FrequencyResponse:
         model = parts[0].model
         H = max(p.harmonics for p in parts)
 
-        def pad(p: "FrequencyResponse") -> FloatArray:
-            h = p.harmonics
-            out = np.zeros((len(p), 2 * H + 1))
-            out[:, : h + 1] = p.coefficients[:, : h + 1]
-            out[:, H + 1 : H + 1 + h] = p.coefficients[:, h + 1 :]
-            return out
-
         offsets = np.cumsum([0] + [len(p) for p in parts[:-1]])
         special = tuple(
             SpecialPoint(sp.kind, sp.index + int(off), sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error)
@@ -194,7 +188,7 @@ class FrequencyResponse:
             "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max",
             "regime", "stable", "bifurcation", "iterations", "residual", "multipliers")}
         return cls(
-            model=model, harmonics=H, coefficients=np.concatenate([pad(p) for p in parts]), special_points=special,
+            model=model, harmonics=H, coefficients=np.concatenate([resize_harmonics(p.coefficients, H) for p in parts]), special_points=special,
             status=status or parts[0].status, message=message or parts[0].message,
             settings=dict(settings or parts[0].settings), timings=dict(timings or parts[0].timings), **cat,
         )
