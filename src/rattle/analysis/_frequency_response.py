@@ -259,12 +259,11 @@ def frequency_response(
             q_s = seed_from_state(model, w_s, x_s, n_s, n_s * harmonics)
             if q_s is not None:
                 seed_list.append((w_s, n_s, q_s))
+        known = FrequencyResponse.concatenate([result, *extra])  # the branches found so far
         if sweep is not None:
-            partial = FrequencyResponse.concatenate([result, *extra])
-            seed_list += sweep_seeds(partial, sweep, harmonics_per_period=harmonics)
+            seed_list += sweep_seeds(known, sweep, harmonics_per_period=harmonics)
         if seed_list:
-            partial = FrequencyResponse.concatenate([result, *extra])
-            extra += seeded_branches(partial, seed_list, (lo, hi), continuation=cont_opts, newton=newton_opts,
+            extra += seeded_branches(known, seed_list, (lo, hi), continuation=cont_opts, newton=newton_opts,
                                      first_branch=1 + len(extra))
         timings = dict(result.timings)
         timings["subharmonics"] = time.perf_counter() - t_sub
