@@ -1,42 +1,113 @@
-"""Argument checks shared by the front ends (the messages name the argument in backticks)."""
+"""Argument checks shared by the front ends (the messages name the argument in backticks).
+
+The type rules are the same for the library's arguments and the configuration file's values:
+numbers may be Python or numpy scalars (``np.int64(8)``, ``np.float32(0.5)``); booleans,
+strings and None are refused where a number is expected; every real number must be finite.
+The size bounds are in :mod:`rattle._limits`. numpy is imported only when a state is checked,
+so the command line can check its options before the numerics are loaded.
+"""
 
 from __future__ import annotations
 
 import math
+from numbers import Integral, Real
+from typing import Any
 
-import numpy as np
 
-from ._typing import FloatArray
+def _is_bool(value: object) -> bool:
+    return isinstance(value, bool) or type(value).__name__ == "bool_"
+
+
+def check_real(value: object, name: str) -> float:
+    """A real number (int, float or numpy scalar; not a bool or a string), finite."""
+    if _is_bool(value) or not isinstance(value, Real):
+        raise TypeError(f"`{name}` must be a real number, got {value!r} ({type(value).__name__})")
+    try:
+        x = float(value)
+    except OverflowError:  # an int beyond the float range
+        raise ValueError(f"`{name}` must be a finite number, got {value!r} (beyond the floating-point range)") from None
+    if not math.isfinite(x):
+        raise ValueError(f"`{name}` must be finite, got {value!r}")
+    return x
 
 
 def check_omega(value: object, name: str = "omega") -> float:
     """A forcing frequency: a real number, finite and > 0 (rad/s)."""
-    if isinstance(value, bool):
+    if _is_bool(value) or not isinstance(value, Real):
         raise TypeError(f"`{name}` must be a forcing frequency in rad/s (a number), got {value!r}")
     try:
-        w = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise TypeError(f"`{name}` must be a forcing frequency in rad/s (a number), got {value!r}") from None
+        w = float(value)
+    except OverflowError:
+        w = math.inf
     if not (math.isfinite(w) and w > 0.0):
         raise ValueError(f"`{name}` must be a finite forcing frequency > 0 rad/s, got {value!r}; use e.g. 0.8")
     return w
 
 
-def check_state(value: object, name: str = "x0") -> FloatArray:
+def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
+    """A frequency range (min, max) in rad/s: two finite numbers, 0 < min < max."""
+    if isinstance(omega, (str, bytes)) or not hasattr(omega, "__iter__") or hasattr(omega, "items"):
+        raise TypeError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {omega!r}")
+    values = list(omega)  # type: ignore[call-overload]
+    if len(values) != 2:
+        raise ValueError(
+            f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {omega!r} ({len(values)} values)"
+        )
+    for v in values:
+        if _is_bool(v) or not isinstance(v, Real):
+            raise TypeError(f"`{name}` must be a pair (min, max) of numbers (rad/s), got {omega!r}")
+    lo, hi = (check_real(v, name) for v in values)
+    if not 0 < lo < hi:
+        raise ValueError(f"`{name}` must satisfy 0 < min < max, got ({lo}, {hi}); give the range as (min, max) rad/s")
+    return lo, hi
+
+
+def check_state(value: object, name: str = "x0") -> Any:
     """A state (δ, δ') of shape (2,), finite."""
-    x = np.asarray(value, dtype=float)
+    import numpy as np
+
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"`{name}` must be a state (delta, velocity) of two numbers, got {value!r}")
+    try:
+        x = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"`{name}` must be a state (delta, velocity) of two numbers, got {value!r}") from None
     if x.shape != (2,) or not np.all(np.isfinite(x)):
         raise ValueError(f"`{name}` must be a finite state (delta, velocity) of shape (2,), got {value!r}")
     return x
 
 
 def check_int(name: str, value: object, low: int) -> int:
-    """An integer (not a bool) >= ``low``."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+    """An integer (Python or numpy; not a bool) >= ``low``."""
+    if _is_bool(value) or not isinstance(value, Integral):
         raise TypeError(f"`{name}` must be an integer, got {value!r} ({type(value).__name__})")
     if value < low:
         raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
     return int(value)
 
 
-__all__ = ["check_omega", "check_state", "check_int"]
+def check_bool(value: object, name: str) -> bool:
+    """True or False (numpy booleans accepted)."""
+    if not _is_bool(value):
+        raise TypeError(f"`{name}` must be True or False, got {value!r} ({type(value).__name__})")
+    return bool(value)
+
+
+def check_choice(value: object, name: str, choices: tuple[str, ...]) -> str:
+    """One of the strings ``choices``."""
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"`{name}` must be one of {', '.join(repr(c) for c in choices)}, got {value!r}")
+    return value
+
+
+def check_instance(value: object, name: str, cls: type, what: str, optional: bool = True) -> Any:
+    """``value`` is an instance of ``cls`` (or None when ``optional``)."""
+    if value is None and optional:
+        return None
+    if not isinstance(value, cls):
+        raise TypeError(f"`{name}` must be {what}{' or None' if optional else ''}, got {value!r} ({type(value).__name__})")
+    return value
+
+
+__all__ = ["check_real", "check_omega", "check_range", "check_state", "check_int", "check_bool", "check_choice",
+           "check_instance"]

@@ -1,0 +1,316 @@
+"""Upper bounds on the sizes of a run, derived from memory and time, and their checks.
+
+One source of rules for the configuration file (``rattle.io``), the command line
+(``rattle.cli``) and every library front end: each check takes the value and the name the user
+wrote (``harmonics``, ``analysis.harmonics`` or ``--harmonics``) and raises ``TypeError`` (wrong
+kind of value) or ``ValueError`` (out of range) with a message that names it in backticks, shows
+the value, states the rule with its reason and says the fix. The file and command-line layers
+re-raise these as :class:`~rattle.errors.ConfigError` (exit status 2).
+
+This module imports nothing heavy (no numpy, no numerics) so that the command line can check
+its options before the numerics are imported.
+
+Why these bounds (measured on the 2-core test machine, reference clutch, ``benchmarks/bench_limits.py``)
+------------------------------------------------------------------------------------------------
+``harmonics`` H ≤ 256 per base frequency, H·period ≤ 512 on a branch of period p
+    The unknowns are 2H + 1 Fourier coefficients, the AFT uses N = max(512, 32H) samples, and the
+    Jacobian is assembled from an N × (2H + 1) matrix: memory grows as H², time per Newton
+    iteration as H³ (dense solve) and H² N. Each special point is located again with 2H
+    harmonics, so H = 256 means a 512-harmonic (N = 16384) problem there. Measured (frequency
+    response over Ω = 0.6 … 0.7, ~15 points, 2 special points located at H and 2H):
+    see ``HARMONICS_FIGURES``. H = 512 needs the 1024-harmonic re-location (~8× the time of
+    H = 256 per point, hours for a full range); H = 10000 would need ~20 GB.
+``samples`` N ≤ 16384 (= 32 · 512, the default for the 2H re-location at H = 256)
+    The N × (2H + 1) AFT matrices: at N = 16384, H = 256 they take 16384 · 513 · 8 B = 67 MB each.
+``period`` / ``max_period`` ≤ 8
+    The sweep detects periods 1 … 8 (SPEC §1); a period-p branch carries p·H harmonics of Ω/p.
+``points`` (time-domain sweep) ≤ 100 000 per direction
+    Each frequency is a steady-state simulation (tens of ms to seconds); 100 000 of them take
+    hours already. 10⁹ used to end in a MemoryError after allocating the frequency grid.
+``max_points`` (continuation budget) ≤ 1 000 000
+    Each accepted point keeps its 2H + 1 coefficients and N samples for the measures.
+Forcing frequency relative to the stiffest stage's natural frequency ω_s = sqrt(K s_max / I):
+``1e-3 ω_s ≤ Ω ≤ 1e3 ω_s`` (``MIN_OMEGA_RATIO``, ``MAX_OMEGA_RATIO``)
+    A simulation integrates every forcing period 2π/Ω exactly, scanning ~40 grid cells per
+    stage time scale 1/ω_s for breakpoint crossings: a forcing period costs ~ 40 · 2π · ω_s/Ω cells,
+    and settling needs several periods (and ~1/(ζ ω_n) s of time). ``orbit --omega 1e-6`` thus
+    scanned ~10⁹ cells (314 s). At Ω = 1e-3 ω_s a steady state takes about a second. Above
+    1e3 ω_s the response is a pure mass line (amplitude ~ (ω_s/Ω)² of the static one, below
+    1e-6) and the continuation, measured in Ω/ω_n with steps ≤ 0.08, would need > 12 000 points.
+Magnitudes ≤ 1e50 (``MAX_MAGNITUDE``)
+    Every physical number, and the scales derived from them (k = K/I, c = C/I, the force scale
+    |F_m| + Σ|F_pn| and the length scale L), must stay within 1e50 (and the divisors above
+    1e-50) so that products of up to six of them (an acceleration squared, k²L² …) stay below
+    the double-precision limit 1.8e308. ``mean = 1e300`` used to end in an OverflowError.
+
+Hazards of the model that are refused or warned about are in :func:`check_analysable_model`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+from ._validate import check_int, check_real
+
+#: Harmonics of the solution's base frequency, at most (see the module docstring).
+MAX_HARMONICS = 256
+#: Harmonics times period (the count of a period-p branch in harmonics of Ω), at most.
+MAX_EFFECTIVE_HARMONICS = 512
+#: AFT time samples per solution period, at most.
+MAX_SAMPLES = 16384
+#: Longest period searched or followed, as a multiple of the forcing period (SPEC §1).
+MAX_PERIOD = 8
+#: Frequencies per direction of a time-domain sweep, at most.
+MAX_SWEEP_POINTS = 100_000
+#: Budget of accepted continuation points, at most.
+MAX_CONTINUATION_POINTS = 1_000_000
+#: Worker processes, at most.
+MAX_WORKERS = 64
+#: Forcing frequency relative to the stiffest stage's natural frequency, at least / at most.
+MIN_OMEGA_RATIO = 1e-3
+MAX_OMEGA_RATIO = 1e3
+#: Magnitude of any physical number and of the derived scales, at most (and of divisors, at least 1/MAX).
+MAX_MAGNITUDE = 1e50
+#: A clearance ``b`` above this (rad) is most likely given in degrees: warned about.
+CLEARANCE_WARNING = math.pi / 2
+
+#: Measured time and peak memory of a frequency response over Ω = 0.6 … 0.7 (reference clutch):
+#: H -> (points, seconds, peak resident MB). Filled from ``benchmarks/bench_limits.py``.
+HARMONICS_FIGURES: dict[int, tuple[int, float, float]] = {}
+
+_H_REASON = (
+    "the harmonic balance Jacobian grows as H² in memory and H³ in time, and each special point is "
+    f"located again with 2H harmonics; H = {MAX_HARMONICS} already takes seconds per point"
+)
+
+
+def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1) -> int:
+    """``harmonics`` H: an integer 1 … ``MAX_HARMONICS``; with ``period`` p > 1 also
+    H·p ≤ ``MAX_EFFECTIVE_HARMONICS`` (a period-p branch needs p·H harmonics of Ω)."""
+    h = check_int(name, value, 1)
+    if h > MAX_HARMONICS:
+        raise ValueError(
+            f"`{name}` must be <= {MAX_HARMONICS}, got {h}: {_H_REASON}; "
+            "use 32 (the default) to 128 — raise it only where the truncation error asks for it"
+        )
+    if period > 1 and h * period > MAX_EFFECTIVE_HARMONICS:
+        raise ValueError(
+            f"`{name}` must be <= {MAX_EFFECTIVE_HARMONICS // period} for branches of period {period}, got {h}: "
+            f"a period-{period} branch carries {period}·H harmonics of the forcing frequency and "
+            f"{period}·H = {h * period} exceeds {MAX_EFFECTIVE_HARMONICS} ({_H_REASON}); "
+            f"lower `{name}` or the period"
+        )
+    return h
+
+
+def check_samples(value: object, harmonics: int, name: str = "samples") -> int | None:
+    """``samples`` N: None (the default count) or an integer 4H + 2 … ``MAX_SAMPLES``."""
+    if value is None:
+        return None
+    n = check_int(name, value, 1)
+    low = 4 * harmonics + 2
+    if n < low:
+        raise ValueError(
+            f"`{name}` must be >= 4*harmonics + 2 = {low} (so that the Jacobian's harmonics up to 2H "
+            f"are not aliased), got {n}; leave it out for the default"
+        )
+    if n > MAX_SAMPLES:
+        raise ValueError(
+            f"`{name}` must be <= {MAX_SAMPLES}, got {n}: the AFT matrices hold samples × (2H + 1) "
+            f"numbers each ({MAX_SAMPLES} × 513 × 8 B = 67 MB at H = 256); leave it out for the default"
+        )
+    return n
+
+
+def check_period(value: object, name: str = "period") -> int:
+    """A period as a multiple 1 … ``MAX_PERIOD`` of the forcing period."""
+    p = check_int(name, value, 1)
+    if p > MAX_PERIOD:
+        raise ValueError(
+            f"`{name}` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), got {p}: "
+            f"periods above {MAX_PERIOD} are not detected (SPEC) and a period-p branch needs p·H "
+            "harmonics; use 1 for the primary response, n for a 1/n sub-harmonic"
+        )
+    return p
+
+
+def check_points(value: object, name: str = "points") -> int:
+    """Frequencies per direction of a time-domain sweep: an integer 2 … ``MAX_SWEEP_POINTS``."""
+    n = check_int(name, value, 2)
+    if n > MAX_SWEEP_POINTS:
+        raise ValueError(
+            f"`{name}` must be <= {MAX_SWEEP_POINTS} (frequencies per sweep direction), got {n}: each "
+            f"frequency is a steady-state simulation of 10 ms to seconds, so {MAX_SWEEP_POINTS} already "
+            "take hours; use e.g. 200, or sweep a narrower range"
+        )
+    return n
+
+
+def check_max_points(value: object, name: str = "max_points") -> int:
+    """Continuation budget: an integer 1 … ``MAX_CONTINUATION_POINTS``."""
+    n = check_int(name, value, 1)
+    if n > MAX_CONTINUATION_POINTS:
+        raise ValueError(
+            f"`{name}` must be <= {MAX_CONTINUATION_POINTS}, got {n}: every accepted point keeps its "
+            "coefficients and samples in memory; the reference case needs ~100 points"
+        )
+    return n
+
+
+def check_workers(value: object, name: str = "workers") -> int:
+    """Worker processes: an integer 1 … ``MAX_WORKERS``."""
+    n = check_int(name, value, 1)
+    if n > MAX_WORKERS:
+        raise ValueError(f"`{name}` must be <= {MAX_WORKERS} processes, got {n}; use e.g. 2")
+    return n
+
+
+def check_magnitude(value: object, name: str) -> float:
+    """A finite real number of magnitude ≤ ``MAX_MAGNITUDE``."""
+    x = check_real(value, name)
+    if abs(x) > MAX_MAGNITUDE:
+        raise ValueError(
+            f"`{name}` must have magnitude <= {MAX_MAGNITUDE:g}, got {x!r}: products of the problem's "
+            "scales (an acceleration squared) would overflow double precision (1.8e308); "
+            "choose units in which the values are moderate (e.g. scale by 1e-3)"
+        )
+    return x
+
+
+# --------------------------------------------------------------------------------------------
+# Frequencies relative to the model
+# --------------------------------------------------------------------------------------------
+def stiffest_frequency(model: Any) -> float:
+    """ω_s = sqrt(K s_max / I), the natural frequency of the model's stiffest stage (rad/s)."""
+    slopes = [float(s) for s in model.elastic.stages.slopes]
+    return math.sqrt(model.k * max(slopes))
+
+
+def _frequency_rule(model: Any, omega: float, name: str) -> None:
+    ws = stiffest_frequency(model)
+    lo, hi = MIN_OMEGA_RATIO * ws, MAX_OMEGA_RATIO * ws
+    if omega < lo:
+        raise ValueError(
+            f"`{name}` must be >= {lo:.4g} rad/s ({MIN_OMEGA_RATIO:g} × the stiffest stage's natural "
+            f"frequency {ws:.4g} rad/s), got {omega!r}: each forcing period 2π/Ω spans "
+            f"~{ws / omega:.3g} free oscillations of the stage, all integrated exactly (a simulation "
+            "would take hours); the response there is quasi-static — start the range higher, e.g. "
+            f"{0.1 * ws:.3g}"
+        )
+    if omega > hi:
+        raise ValueError(
+            f"`{name}` must be <= {hi:.4g} rad/s ({MAX_OMEGA_RATIO:g} × the stiffest stage's natural "
+            f"frequency {ws:.4g} rad/s), got {omega!r}: the response there is a pure mass line "
+            f"(amplitude < 1e-6 of the static one) and the continuation would need over 10⁴ points; "
+            f"end the range lower, e.g. {3.0 * ws:.3g}"
+        )
+
+
+def check_frequency(model: Any, omega: object, name: str = "omega") -> float:
+    """A single forcing frequency within ``MIN_OMEGA_RATIO`` … ``MAX_OMEGA_RATIO`` × ω_s."""
+    from ._validate import check_omega
+
+    w = check_omega(omega, name)
+    _frequency_rule(model, w, name)
+    return w
+
+
+def check_frequency_range(
+    model: Any, omega_min: float, omega_max: float, names: tuple[str, str] = ("omega", "omega")
+) -> tuple[float, float]:
+    """Both ends of an (already type-checked, ordered) range within the bounds relative to ω_s.
+
+    ``names``: how the two ends are called in messages (``("omega", "omega")`` for the library's
+    pair, ``("analysis.omega[0]", "analysis.omega[1]")`` in a file, ``("--omega-min",
+    "--omega-max")`` on the command line).
+    """
+    _frequency_rule(model, float(omega_min), names[0])
+    _frequency_rule(model, float(omega_max), names[1])
+    return float(omega_min), float(omega_max)
+
+
+# --------------------------------------------------------------------------------------------
+# The model: magnitudes, zero damping, a clearance in degrees
+# --------------------------------------------------------------------------------------------
+def check_scales(model: Any, prefix: str = "") -> None:
+    """The derived scales k = K/I, c = C/I, the force scale and the length scale within
+    [1/``MAX_MAGNITUDE``, ``MAX_MAGNITUDE``] (zero allowed where a zero is meaningful)."""
+    p = prefix
+
+    def bound(value: float, what: str, keys: str, allow_zero: bool = False) -> None:
+        if allow_zero and value == 0.0:
+            return
+        if not (1.0 / MAX_MAGNITUDE <= abs(value) <= MAX_MAGNITUDE):
+            raise ValueError(
+                f"{keys} give {what} = {value:.3g}, outside {1 / MAX_MAGNITUDE:g} … {MAX_MAGNITUDE:g}: "
+                "products of the problem's scales would overflow (or underflow) double precision; "
+                "choose units in which the values are moderate"
+            )
+
+    bound(model.k, "K/I", f"`{p}stiffness` / `{p}inertia`")
+    bound(model.c, "C/I", f"`{p}damping` / `{p}inertia`", allow_zero=True)
+    ex = model.excitation
+    force = abs(ex.mean) + sum(abs(a) for a in ex.amplitudes)
+    bound(force, "the force scale |mean| + Σ|amplitudes|", "`excitation.mean` and `excitation.amplitudes`",
+          allow_zero=True)
+    slopes = [float(s) for s in model.elastic.stages.slopes if s > 0]
+    length = force / (model.k * min(slopes))
+    bound(length, "the deflection scale (force scale)/(K/I)",
+          f"`excitation.mean`, `excitation.amplitudes` and `{p}stiffness` / `{p}inertia`", allow_zero=True)
+
+
+def check_analysable_model(model: object, name: str = "model") -> Any:
+    """A :class:`~rattle.model.Model` that the analyses can treat: refuse zero damping.
+
+    Zero damping is refused (not handled). An undamped forced piecewise-linear oscillator has
+    an unbounded response at its linear resonances and no asymptotically stable periodic orbit:
+    its Floquet multipliers lie on the unit circle (det M = exp(−c T) = 1), so the stability
+    verdicts, the located special points and the settled periods would all be meaningless, and
+    the linear start solution divides 0 by 0 at resonance. Give a small positive damping
+    instead (ζ = 0.001 … 0.05 is typical of drivetrains). The :class:`~rattle.model.Model`
+    itself accepts damping 0, so that undamped motions can still be integrated exactly
+    (:class:`~rattle.timeint.ExactIntegrator`).
+    """
+    from .model import Model
+
+    if not isinstance(model, Model):
+        raise TypeError(
+            f"`{name}` must be a rattle Model (e.g. rattle.reference_case() or Model.from_toml(path)), "
+            f"got {model!r} ({type(model).__name__})"
+        )
+    if model.damping == 0.0:
+        raise ValueError(
+            f"`{name}.damping` must be > 0 for an analysis, got 0.0: an undamped forced system has "
+            "unbounded resonant response and no asymptotically stable periodic orbit (Floquet "
+            "multipliers on the unit circle), so stability and settling verdicts would be meaningless; "
+            "give a small positive damping, e.g. a damping ratio of 0.01 "
+            f"(damping = {0.02 * math.sqrt(model.stiffness * model.inertia):.3g})"
+        )
+    return model
+
+
+def warn_clearance(b: float, name: str = "b", stacklevel: int = 3) -> None:
+    """Warn when a clearance ``b`` exceeds ``CLEARANCE_WARNING`` = π/2 rad (90°).
+
+    Clearances are in radians. A drivetrain clearance (gear backlash, clutch first stage) is a
+    few degrees at most; π/2 rad = 90° is far beyond anything physical, while b = 10 (the
+    reference 10° typed in degrees) is 573°. Not refused: the equation is valid for any b.
+    """
+    if b > CLEARANCE_WARNING:
+        warnings.warn(
+            f"`{name}` = {b:g} rad is {math.degrees(b):.0f}°: clearances are in radians — "
+            f"if you meant {b:g}°, write {math.radians(b):.6g}",
+            UserWarning,
+            stacklevel=stacklevel,
+        )
+
+
+__all__ = [
+    "MAX_HARMONICS", "MAX_EFFECTIVE_HARMONICS", "MAX_SAMPLES", "MAX_PERIOD", "MAX_SWEEP_POINTS",
+    "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
+    "CLEARANCE_WARNING", "check_harmonics", "check_samples", "check_period", "check_points",
+    "check_max_points", "check_workers", "check_magnitude", "check_frequency", "check_frequency_range",
+    "check_scales", "check_analysable_model", "warn_clearance", "stiffest_frequency",
+]
