@@ -9,26 +9,44 @@ bifurcation labels for torsional sub-systems with clearance non-linearities:
 >>> import rattle
 >>> model = rattle.reference_case()
 >>> frf = rattle.frequency_response(model, omega=(0.1, 3.0), harmonics=32)
+
+The names below are re-exported lazily (PEP 562): ``import rattle`` is cheap, and a name's
+sub-package (numpy, scipy) is imported the first time the name is used — so ``rattle --help``
+and a refused input answer without loading the numerics. ``from rattle import X``,
+``rattle.X`` and ``dir(rattle)`` work as with eager imports.
 """
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
+import importlib
+from typing import TYPE_CHECKING, Any
 
-from .analysis import Comparison, compare, frequency_response, periodic_orbit, time_sweep
-from .continuation import ContinuationOptions
-from .errors import ConfigError, ConvergenceError, RattleError, Status
-from .hb import HBOptions, NewtonOptions
-from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
-from .results import (
-    FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult, linear_frequency_response,
-)
-from .timeint import SteadyStateOptions, shoot_periodic_orbit, steady_state
 
-try:
-    __version__ = version("rattle")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.1.0"
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version  # ~50 ms: only when asked
+
+    try:
+        return version("rattle")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0.1.0"
+
+#: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(["Comparison", "compare", "frequency_response", "periodic_orbit", "time_sweep"], ".analysis"),
+    "ContinuationOptions": ".continuation",
+    **dict.fromkeys(["ConfigError", "ConvergenceError", "RattleError", "Status"], ".errors"),
+    **dict.fromkeys(["HBOptions", "NewtonOptions"], ".hb"),
+    **dict.fromkeys(
+        ["Backlash", "Clutch", "Excitation", "Linear", "Model", "Piecewise", "backlash_case", "reference_case"],
+        ".model",
+    ),
+    **dict.fromkeys(
+        ["FrequencyResponse", "LinearResponse", "PeriodicOrbit", "Region", "SpecialPoint", "SweepResult",
+         "linear_frequency_response"],
+        ".results",
+    ),
+    **dict.fromkeys(["SteadyStateOptions", "shoot_periodic_orbit", "steady_state"], ".timeint"),
+}
 
 __all__ = [
     "__version__",
@@ -39,3 +57,33 @@ __all__ = [
     "HBOptions", "NewtonOptions", "ContinuationOptions",
     "Status", "RattleError", "ConfigError", "ConvergenceError",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import the sub-module that defines ``name`` on first use and cache the name here."""
+    if name == "__version__":
+        value: Any = _version()
+    elif name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    else:
+        raise AttributeError(f"module 'rattle' has no attribute {name!r}")
+    globals()[name] = value  # later look-ups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
+    __version__: str
+    from .analysis import Comparison, compare, frequency_response, periodic_orbit, time_sweep
+    from .continuation import ContinuationOptions
+    from .errors import ConfigError, ConvergenceError, RattleError, Status
+    from .hb import HBOptions, NewtonOptions
+    from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
+    from .results import (
+        FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult,
+        linear_frequency_response,
+    )
+    from .timeint import SteadyStateOptions, shoot_periodic_orbit, steady_state

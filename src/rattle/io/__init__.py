@@ -3,7 +3,7 @@
 The numerical core never touches files; everything that reads or writes lives here.
 """
 
-from ._atomic import atomic_path, atomic_write_bytes, atomic_write_text
+from ._atomic import STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging
 from ._config import (
     DEFAULT_HARMONICS,
     DEFAULT_OMEGA,
@@ -17,6 +17,7 @@ from ._config import (
     rename_keys,
 )
 from ._csv import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, format_csv, read_csv, write_csv
+from ._read import MAX_CONFIG_BYTES, read_bounded
 from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
 
 __all__ = [
@@ -28,6 +29,7 @@ __all__ = [
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS", "write_csv", "read_csv", "format_csv",
     # metadata
     "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
-    # atomic writes
-    "atomic_write_text", "atomic_write_bytes", "atomic_path",
+    # atomic writes, output sets, bounded reads
+    "atomic_write_text", "atomic_write_bytes", "atomic_path", "OutputSet", "recover_staging", "STAGING_PREFIX",
+    "read_bounded", "MAX_CONFIG_BYTES",
 ]

@@ -2,19 +2,28 @@
 
 A reader (or a crashed run) therefore sees either the old file or the complete new one, never a
 half-written file. The temporary file lives in the target's directory because a rename is only
-atomic within one file system; it is removed when the write fails.
+atomic within one file system; it is removed when the write fails (also on KeyboardInterrupt).
+
+:class:`OutputSet` extends this to the several files of one run: staged in a hidden folder and
+moved into place together, so that an interrupted run never leaves new and old files mixed.
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
+import json
 import os
+import shutil
+import signal
 import tempfile
-from collections.abc import Iterator
+import threading
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text"]
+__all__ = [
+    "atomic_path", "atomic_write_bytes", "atomic_write_text", "OutputSet", "recover_staging", "STAGING_PREFIX",
+]
 
 
 @functools.cache
@@ -107,3 +116,213 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, encoding: str 
     if not isinstance(text, str):
         raise TypeError(f"`text` must be a str, got {type(text).__name__}; use atomic_write_bytes for bytes")
     atomic_write_bytes(path, text.encode(encoding))
+
+
+# --------------------------------------------------------------------------------------------
+# A set of output files moved into place together
+# --------------------------------------------------------------------------------------------
+#: Name prefix of the hidden staging folders inside an output directory.
+STAGING_PREFIX = ".rattle-staging-"
+#: The commit journal inside a staging folder (written when every file of the set is complete).
+_JOURNAL = ".commit.json"
+#: Signals held back while a staged set is being moved into place.
+_HELD_SIGNALS = tuple(
+    sig for sig in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT")) if sig is not None
+)
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Block SIGINT/SIGTERM/SIGHUP/SIGQUIT in this thread for the body (a few system calls);
+    a signal that arrives meanwhile is delivered when the body ends."""
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None or threading.current_thread() is not threading.main_thread():  # pragma: no cover
+        yield
+        return
+    old = block(signal.SIG_BLOCK, _HELD_SIGNALS)
+    try:
+        yield
+    finally:
+        block(signal.SIG_SETMASK, old)
+
+
+def _fsync_dir(path: Path) -> None:
+    with contextlib.suppress(OSError):  # not every file system lets a directory be opened/synced
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's live process
+        return True
+    return True
+
+
+def _move_in(directory: Path, staging: Path, moves: Sequence[str], removals: Sequence[str]) -> None:
+    """The commit itself: stale files of the set removed, staged files renamed over their targets."""
+    for name in removals:
+        with contextlib.suppress(FileNotFoundError):
+            (directory / name).unlink()
+    for name in moves:
+        src = staging / name
+        if src.exists():  # absent only when a roll-forward repeats a partly done commit
+            os.replace(src, directory / name)
+    _fsync_dir(directory)
+
+
+def recover_staging(directory: str | os.PathLike[str]) -> list[str]:
+    """Finish or discard the staging folders that runs killed outright (SIGKILL, power loss) left
+    in ``directory``; return the names of the folders handled.
+
+    A folder whose journal exists had its set complete: its renames are finished (roll forward).
+    A folder without a journal never got that far: it is removed (roll back; the earlier files are
+    untouched). Folders of live processes (the pid is part of the name) are left alone.
+    """
+    directory = Path(directory)
+    handled: list[str] = []
+    try:
+        entries = list(directory.iterdir())
+    except OSError:
+        return handled
+    for entry in entries:
+        if not entry.name.startswith(STAGING_PREFIX) or not entry.is_dir() or entry.is_symlink():
+            continue
+        try:
+            pid = int(entry.name[len(STAGING_PREFIX):].split("-", 1)[0])
+        except ValueError:
+            continue
+        if pid == os.getpid() or _pid_alive(pid):
+            continue
+        journal = entry / _JOURNAL
+        with contextlib.suppress(OSError, ValueError, TypeError, KeyError):
+            if journal.is_file():
+                plan = json.loads(journal.read_text(encoding="utf-8"))
+                with _signals_held():
+                    _move_in(directory, entry, [str(n) for n in plan["moves"]], [str(n) for n in plan["removals"]])
+        shutil.rmtree(entry, ignore_errors=True)
+        handled.append(entry.name)
+    return handled
+
+
+class OutputSet:
+    """The output files of one run, written into a staging folder and moved into place together.
+
+    How "together" works
+    --------------------
+    The output directory may hold other files (the user's configuration, another command's
+    outputs), so it cannot be swapped for a new directory as a whole: ``rename(2)`` onto a
+    non-empty directory fails, and exchanging directories would take the user's files away.
+    Instead:
+
+    1. every file is written into a hidden staging folder *inside* the output directory
+       (``.rattle-staging-<pid>-<random>/``: the same file system, so the moves are renames);
+    2. when all are complete (each flushed to disk), a journal listing the moves and removals is
+       written into the staging folder — the commit point;
+    3. with SIGINT, SIGTERM, SIGHUP and SIGQUIT held back, each staged file is renamed over its
+       target (``os.replace``, atomic per file) and the files of the set that this run did not
+       produce (e.g. ``frf.png`` without matplotlib) are removed, so that an old one cannot sit
+       beside new data; then the staging folder is removed.
+
+    Step 3 is a handful of system calls with the catchable signals blocked, so an interrupted run
+    (Ctrl-C, ``kill``) leaves either the earlier set untouched (interrupted before step 3; the
+    staging folder is removed on the way out) or the complete new set. Only an uncatchable end in
+    the middle of step 3 (SIGKILL, power loss) can leave a mix, and then the journal says how to
+    finish: the next run in that directory completes the renames (:func:`recover_staging`).
+    Files that are not part of the set are never touched.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The output directory (created, with its parents, when the set is opened; the folders
+        created are removed again if the run ends without committing).
+    names : sequence of str
+        Every file name this command can write: the set. Names only, no sub-folders.
+
+    Examples
+    --------
+    >>> with OutputSet(out, ["frf.csv", "frf.json"]) as staged:  # doctest: +SKIP
+    ...     result.to_csv(staged.path("frf.csv"))
+    ...     write_metadata(staged.path("frf.json"), ...)
+    ...     staged.commit()
+    """
+
+    def __init__(self, directory: str | os.PathLike[str], names: Sequence[str]) -> None:
+        self.directory = Path(directory)
+        self.names = tuple(names)
+        for name in self.names:
+            if not name or Path(name).name != name or name.startswith("."):
+                raise ValueError(f"`names` must be plain file names, got {name!r}")
+        self.staging: Path | None = None
+        self.committed: list[str] = []
+        self._created: list[Path] = []
+
+    # -- context manager ------------------------------------------------------------------------
+    def __enter__(self) -> OutputSet:
+        missing = []
+        d = self.directory
+        while not d.exists() and d != d.parent:
+            missing.append(d)
+            d = d.parent
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self._created = missing  # deepest first
+        try:
+            recover_staging(self.directory)
+            self.staging = Path(tempfile.mkdtemp(dir=self.directory, prefix=f"{STAGING_PREFIX}{os.getpid()}-"))
+        except BaseException:
+            self.discard()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.discard()
+
+    def path(self, name: str) -> Path:
+        """Where to write the file ``name`` of the set (inside the staging folder)."""
+        if name not in self.names:
+            raise ValueError(f"`name` {name!r} is not part of this output set {self.names}")
+        if self.staging is None:
+            raise RuntimeError("the output set is not open (use it in a `with` block)")
+        return self.staging / name
+
+    def commit(self) -> list[str]:
+        """Move the staged files into place together (see the class docstring); return their names
+        in the order of ``names``."""
+        if self.staging is None:
+            raise RuntimeError("the output set is not open (use it in a `with` block)")
+        staging = self.staging
+        moves = [n for n in self.names if (staging / n).is_file()]
+        removals = [n for n in self.names if n not in moves]
+        for name in moves:
+            _fsync(staging / name)
+        journal = staging / _JOURNAL
+        with open(journal, "w", encoding="utf-8") as fh:
+            json.dump({"directory": os.fspath(self.directory), "moves": moves, "removals": removals}, fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        _fsync_dir(staging)
+        with _signals_held():
+            _move_in(self.directory, staging, moves, removals)
+            shutil.rmtree(staging, ignore_errors=True)
+            self.staging = None
+        self._created = []
+        self.committed = moves
+        return moves
+
+    def discard(self) -> None:
+        """Remove the staging folder (and the folders this set created) unless committed; idempotent."""
+        staging, self.staging = self.staging, None
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
+        for d in self._created:  # deepest first; only if still empty
+            with contextlib.suppress(OSError):
+                d.rmdir()
+        self._created = []

@@ -44,6 +44,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..model import ELASTIC_LAWS, AbstractElastic, Excitation, Model
 from ..model._elastic import _check_real
+from ._read import read_bounded
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -390,8 +391,8 @@ def load_config(path: str | os.PathLike[str]) -> RunConfig:
     """
     name = os.fspath(path)
     try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+        # a regular file of at most MAX_CONFIG_BYTES, checked before reading (not /dev/zero, not a FIFO)
+        data = tomllib.loads(read_bounded(path).decode("utf-8"))
     except FileNotFoundError:
         raise ConfigError(
             f"configuration file {name!r} does not exist; check the path "
