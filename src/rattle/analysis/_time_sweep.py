@@ -14,16 +14,20 @@ resonance drops near its upper fold, the down sweep jumps up near the lower fold
 from __future__ import annotations
 
 import logging
+import os
+import pickle
 import queue as queue_module
+import signal
+import sys
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any
 
 import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_int
+from ..errors import RattleError
 from ..model import Model
 from ..results._sweep import SweepResult
 from ..timeint import ExactIntegrator, SteadyStateOptions, steady_state
@@ -42,19 +46,6 @@ ProgressCallback = Callable[[int, int], None]
 # One direction: a pure function of picklable inputs (runs in a worker process when asked)
 # ---------------------------------------------------------------------------------------------
 _ROW_SCALARS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max")
-
-_WORKER_QUEUE: Any = None  # progress queue of a worker process (set by its initializer)
-
-
-def _init_worker(progress_queue: Any) -> None:
-    global _WORKER_QUEUE
-    _WORKER_QUEUE = progress_queue
-
-
-def _report_to_queue(direction: str) -> None:
-    if _WORKER_QUEUE is not None:
-        _WORKER_QUEUE.put(direction)
-
 
 def sweep_direction(
     model: Model, omegas: FloatArray, direction: str, options: SteadyStateOptions,
@@ -106,9 +97,82 @@ def _run_timed(model: Model, omegas: FloatArray, direction: str, options: Steady
     return rows, time.perf_counter() - t0
 
 
-def _run_in_worker(model: Model, omegas: FloatArray, direction: str,
-                   options: SteadyStateOptions) -> tuple[dict[str, np.ndarray], float]:
-    return _run_timed(model, omegas, direction, options, _report_to_queue)
+# ---------------------------------------------------------------------------------------------
+# Worker processes: one per direction, stopped with their parent on any signal
+# ---------------------------------------------------------------------------------------------
+#: How often (s) a worker checks that its parent is still alive, and the parent polls its workers.
+_WATCH_INTERVAL = 0.2
+#: Time (s) a worker gets to end after SIGTERM before it is killed.
+_TERMINATE_GRACE = 1.0
+
+
+def _die_with_parent(parent: int) -> None:
+    """Make this worker end when the process ``parent`` ends, however it ends (SIGKILL included).
+
+    Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)`` asks the kernel to kill us with our parent. Every
+    platform: a daemon thread that sees ``os.getppid()`` change (we were re-parented, so the
+    parent is gone) and ends the process at once.
+    """
+    import threading
+
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: the thread below is enough
+            pass
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent:
+                os._exit(1)
+            time.sleep(_WATCH_INTERVAL)
+
+    if os.getppid() != parent:  # the parent died before we got here
+        os._exit(1)
+    threading.Thread(target=watch, name="rattle-parent-watch", daemon=True).start()
+
+
+def _worker_main(parent: int, messages: Any, model: Model, omegas: FloatArray, direction: str,
+                 options: SteadyStateOptions) -> None:
+    """A worker process: one direction, progress and the result sent back on ``messages``.
+
+    SIGINT is ignored (a Ctrl-C reaches the whole process group; the parent decides and stops the
+    workers), SIGTERM ends the process at once (the default action; a handler inherited from the
+    parent is reset) — that is how the parent stops a worker.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "SIGHUP"):
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    _die_with_parent(parent)
+    try:
+        result = _run_timed(model, omegas, direction, options, lambda d: messages.put(("progress", d, None)))
+    except BaseException as exc:  # sent back whole when it pickles, else as text
+        try:
+            pickle.dumps(exc)
+            payload: Any = exc
+        except Exception:
+            payload = RattleError(f"{type(exc).__name__}: {exc}")
+        messages.put(("error", direction, payload))
+        return
+    messages.put(("done", direction, result))
+
+
+def _stop_workers(processes: Sequence[Any]) -> None:
+    """SIGTERM every live worker, wait up to ``_TERMINATE_GRACE`` s, SIGKILL what is left, reap all."""
+    for p in processes:
+        if p.is_alive():
+            p.terminate()
+    deadline = time.monotonic() + _TERMINATE_GRACE
+    for p in processes:
+        p.join(max(0.0, deadline - time.monotonic()))
+    for p in processes:
+        if p.is_alive():
+            p.kill()
+            p.join(1.0)
 
 
 def _run_parallel(
@@ -116,37 +180,60 @@ def _run_parallel(
     progress: Callable[[], None],
 ) -> dict[str, tuple[dict[str, np.ndarray], float]]:
     """The directions in ``workers`` processes; progress messages come back over a queue and
-    are reported in this process as they arrive."""
+    are reported in this process as they arrive.
+
+    The workers never outlive this call: whatever ends it — the results, a worker's error,
+    KeyboardInterrupt (SIGINT), a SIGTERM turned into an exception by the command line, any other
+    exception — they are terminated and reaped in ``finally``. The parent waits on the queue in
+    short slices, so a signal is acted on within ``_WATCH_INTERVAL`` s. A parent killed outright
+    (SIGKILL) is noticed by the workers themselves (:func:`_die_with_parent`).
+    """
     import multiprocessing
 
     ctx = multiprocessing.get_context()
-    progress_queue = ctx.Queue()
+    messages = ctx.Queue()
+    parent = os.getpid()
+    directions = list(grids)
+    processes: list[Any] = []  # every worker started, for the clean-up
     out: dict[str, tuple[dict[str, np.ndarray], float]] = {}
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                             initargs=(progress_queue,)) as pool:
-        futures: dict[Future, str] = {
-            pool.submit(_run_in_worker, model, grid, d, options): d for d, grid in grids.items()
-        }
-        pending = set(futures)
-        while pending:
+    try:
+        # one process per direction (the frequencies of a direction depend on each other);
+        # `workers` bounds how many run at once
+        waiting = list(directions)
+        running: dict[str, Any] = {}
+        silent_polls = 0  # polls without a message while a worker has ended without a result
+        while waiting or running:
+            while waiting and len(running) < workers:
+                d = waiting.pop(0)
+                p = ctx.Process(target=_worker_main, name=f"rattle-sweep-{d}",
+                                args=(parent, messages, model, grids[d], d, options), daemon=True)
+                p.start()
+                processes.append(p)
+                running[d] = p
             try:
-                while True:  # drain what has arrived
-                    progress_queue.get(timeout=0.05)
-                    progress()
+                kind, d, payload = messages.get(timeout=_WATCH_INTERVAL)
             except queue_module.Empty:
-                pass
-            done, pending = wait(pending, timeout=0.0, return_when=FIRST_COMPLETED)
-            for fut in done:
-                out[futures[fut]] = fut.result()  # re-raises a worker's exception here
-        # the workers are done: every message is in the queue (or about to be flushed)
-        expected = sum(len(g) for g in grids.values())
-        while progress.count < expected:  # type: ignore[attr-defined]
-            try:
-                progress_queue.get(timeout=1.0)
-            except queue_module.Empty:
-                break
-            progress()
-    progress_queue.close()
+                ended = [d for d, p in running.items() if not p.is_alive()]
+                silent_polls = silent_polls + 1 if ended else 0
+                if silent_polls > 5:  # its last message would have arrived by now
+                    d = ended[0]
+                    raise RattleError(
+                        f"the {d} sweep's worker process ended without a result "
+                        f"(exit status {running[d].exitcode}); run with --workers 1 to see why"
+                    ) from None
+                continue
+            silent_polls = 0
+            if kind == "progress":
+                progress()
+            elif kind == "error":
+                raise payload
+            else:
+                out[d] = payload
+                running.pop(d).join(_TERMINATE_GRACE)
+    finally:
+        _stop_workers(processes)
+        messages.close()
+        messages.cancel_join_thread()
     return out
 
 
