@@ -22,6 +22,15 @@ from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, so
 from ..model import Model
 from ..results import FrequencyResponse
 from ..timeint import ExactIntegrator
+from ._settings import RunSettings
+
+
+def _run(run: RunSettings | None, harmonics: int, continuation: ContinuationOptions | None,
+         newton: NewtonOptions | None) -> RunSettings:
+    """``run``, or (old keyword style) one made of ``continuation``/``newton`` and default HB."""
+    if run is not None:
+        return run
+    return RunSettings.make(HBOptions(harmonics=harmonics), newton, continuation)
 
 
 def odd_indices(harmonics: int) -> np.ndarray:
@@ -56,16 +65,19 @@ def switch_period_doubling(
     harmonics_new: int | None = None,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
+    run: RunSettings | None = None,
 ) -> tuple[HarmonicBalance, ContinuationStepper]:
     """Follow the period-2p branch born at a period-doubling point of a period-p branch.
 
     ``q_pd`` (H = ``harmonics`` harmonics of Ω/p) is the located point at ``omega_pd``. The new
     branch uses ``harmonics_new`` harmonics of Ω/(2p) (default 2H: the same resolution in
-    frequency). Returns the HB problem of period 2p and the finished stepper.
+    frequency), with the run's HBOptions scaled to that count (``run.for_harmonics``), its
+    Newton and continuation options. Returns the HB problem of period 2p and the finished stepper.
     """
     H2 = 2 * harmonics if harmonics_new is None else harmonics_new
-    newton = newton or NewtonOptions()
-    hb2 = HarmonicBalance(model, HBOptions(harmonics=H2), period=2 * period)
+    run = _run(run, harmonics, continuation, newton)
+    newton = run.newton
+    hb2 = HarmonicBalance(model, run.for_harmonics(H2), period=2 * period)
     q2 = resize_harmonics(q_pd, H2, factor=2)
     # Polish the embedding on the doubled-period problem (the even block is regular there).
     res = solve_harmonic_balance(hb2, q2, omega_pd, newton)
@@ -88,7 +100,7 @@ def switch_period_doubling(
         return None
 
     stepper = ContinuationStepper(
-        hb2, q2, omega_pd, omega_range, continuation or ContinuationOptions(), newton, tangent=tangent, stop=rejoined,
+        hb2, q2, omega_pd, omega_range, run.continuation, newton, tangent=tangent, stop=rejoined,
     )
     stepper.run()
     return hb2, stepper
@@ -106,12 +118,16 @@ def period_doubling_branches(
     newton: NewtonOptions | None = None,
     first_branch: int = 1,
     stability_refine: bool = True,
+    run: RunSettings | None = None,
 ) -> list[FrequencyResponse]:
     """All branches born by period doubling from ``primary`` (one branch), recursively up to
     solutions of period ``max_period``. A branch that rejoins its parent at another
-    period-doubling point ends exactly there, and that point is not switched at again."""
+    period-doubling point ends exactly there, and that point is not switched at again.
+    ``run`` (the parent run's settings) goes unchanged to every branch; each branch's
+    ``settings`` records what it used."""
     from ._frequency_response import assemble
 
+    run = _run(run, primary.harmonics, continuation, newton)
     model = primary.model
     out: list[FrequencyResponse] = []
     queue = [primary]
@@ -133,9 +149,7 @@ def period_doubling_branches(
             done.add(sp.index)
             q_pd = parent.coefficients[sp.index]
             w_pd = float(parent.omega[sp.index])
-            hb2, stepper = switch_period_doubling(
-                model, q_pd, w_pd, H, period, omega_range, continuation=continuation, newton=newton,
-            )
+            hb2, stepper = switch_period_doubling(model, q_pd, w_pd, H, period, omega_range, run=run)
             points = list(stepper.points)
             end_is_pd = False
             if stepper.status is Status.STOPPED and len(points) > 2:
@@ -151,8 +165,11 @@ def period_doubling_branches(
                         points[-1] = BranchPoint(q_end, float(parent.omega[o.index]), 0, last.residual, last.tangent, last.step)
                         end_is_pd = True
             branch = assemble(
-                model, hb2, points, branch_id=next_id, refine=stability_refine, newton=newton,
-                branch_points=(True, end_is_pd), status=stepper.status or Status.STOPPED, message=stepper.message,
+                model, hb2, points, branch_id=next_id, refine=stability_refine, newton=run.newton,
+                stability=run.stability, branch_points=(True, end_is_pd), status=stepper.status or Status.STOPPED,
+                message=stepper.message,
+                settings=run.record(hb2.options, period=2 * period,
+                                    origin=f"period doubling of branch {int(parent.branch[0])} at Ω = {w_pd:.6g}"),
             )
             next_id += 1
             out.append(branch)
@@ -174,15 +191,19 @@ def branch_from_seed(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     branch_id: int = 0,
+    run: RunSettings | None = None,
 ) -> FrequencyResponse | None:
     """The branch of period ``period`` through a seed (coefficients with ``harmonics`` harmonics
     of Ω/period, e.g. from a simulated orbit) at ``omega``: Newton at that Ω, then continuation
     both ways in Ω, joined into one branch. An isola is closed once (the run stops when it comes
-    back to the seed). None if the seed does not converge."""
+    back to the seed). None if the seed does not converge. ``run``: the run's settings (HB
+    options scaled to ``harmonics``, Newton, continuation, stability method)."""
     from ._frequency_response import assemble
 
-    newton = newton or NewtonOptions()
-    hb = HarmonicBalance(model, HBOptions(harmonics=harmonics), period=period)
+    run = _run(run, harmonics, continuation, newton)
+    newton = run.newton
+    hb_opts = run.for_harmonics(harmonics)
+    hb = HarmonicBalance(model, hb_opts, period=period)
     res = solve_harmonic_balance(hb, q_seed, omega, newton)
     if not res.converged:
         return None
@@ -208,7 +229,7 @@ def branch_from_seed(
                 return "the branch closed on itself (an isola)"
             return None
 
-        stepper = ContinuationStepper(hb, res.q, omega, omega_range, continuation or ContinuationOptions(), newton,
+        stepper = ContinuationStepper(hb, res.q, omega, omega_range, run.continuation, newton,
                                       tangent=tangent, stop=back_at_seed)
         stepper.run()
         halves.append(stepper.points)
@@ -217,8 +238,9 @@ def branch_from_seed(
             break  # an isola: one way round covers it
     points = halves[0] if len(halves) == 1 else halves[1][::-1] + halves[0][1:]
     status = statuses[0].status or Status.STOPPED
-    return assemble(model, hb, points, branch_id=branch_id, newton=newton, status=status,
-                    message="; ".join(s.message for s in statuses))
+    return assemble(model, hb, points, branch_id=branch_id, newton=newton, stability=run.stability, status=status,
+                    message="; ".join(s.message for s in statuses),
+                    settings=run.record(hb_opts, period=period, origin=f"seed at Ω = {omega:.6g}"))
 
 
 def _explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rtol: float) -> bool:
@@ -236,7 +258,7 @@ def _explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rt
 
 
 def sweep_seeds(frf: FrequencyResponse, sweep: object, *, harmonics_per_period: int | None = None,
-                rtol: float = 1e-3) -> list[tuple[float, int, FloatArray]]:
+                rtol: float = 1e-3, run: RunSettings | None = None) -> list[tuple[float, int, FloatArray]]:
     """Seeds (Ω, period n, coefficients) for the periodic motions of period n ≥ 2 that a time
     ``sweep`` (SweepResult) settled on and that no stable computed branch of period n explains
     (no stable stretch of that period crossing the sweep's Ω with an rms, interpolated there,
@@ -258,26 +280,30 @@ def sweep_seeds(frf: FrequencyResponse, sweep: object, *, harmonics_per_period: 
             continue
         if any(abs(s[0] - w) <= step + 1e-12 and s[1] == n for s in seeds):
             continue  # one seed per stretch of unexplained motion
-        q = seed_from_state(model, float(w), states[j], n, n * H, integrator=integ)
+        q = seed_from_state(model, float(w), states[j], n, n * H, integrator=integ,
+                            hb=None if run is None else run.for_harmonics(n * H))
         if q is not None:
             seeds.append((float(w), n, q))
     return seeds
 
 
 def seed_from_state(model: Model, omega: float, x0: FloatArray, period: int, harmonics: int, *,
-                    integrator: "ExactIntegrator | None" = None) -> FloatArray | None:
+                    integrator: "ExactIntegrator | None" = None, hb: HBOptions | None = None) -> FloatArray | None:
     """HB coefficients (``harmonics`` of Ω/period) of the period-``period`` orbit through the
     state x0 = (δ, δ') at t = 0 (a forcing-phase-aligned section point): the orbit is closed by
-    exact shooting and its samples analysed. None if shooting does not converge."""
+    exact shooting and its samples analysed (on the sample grid of ``hb``, whose harmonic count
+    must be ``harmonics``; default HBOptions). None if shooting does not converge."""
     from ..timeint import ExactIntegrator, shoot_periodic_orbit
 
     integ = ExactIntegrator(model) if integrator is None else integrator
     orbit = shoot_periodic_orbit(model, omega, np.asarray(x0, dtype=float), period=period, integrator=integ)
     if not orbit.converged:
         return None
-    hb = HarmonicBalance(model, HBOptions(harmonics=harmonics), period=period)
+    if hb is not None and hb.harmonics != harmonics:
+        raise ValueError(f"`hb.harmonics` ({hb.harmonics}) must equal `harmonics` ({harmonics})")
+    problem = HarmonicBalance(model, hb or HBOptions(harmonics=harmonics), period=period)
     T = period * 2 * np.pi / omega
-    return hb.basis.analyze(np.asarray(orbit.trajectory.sample(hb.basis.times(T)).delta))
+    return problem.basis.analyze(np.asarray(orbit.trajectory.sample(problem.basis.times(T)).delta))
 
 
 def seeded_branches(
@@ -288,6 +314,7 @@ def seeded_branches(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     first_branch: int,
+    run: RunSettings | None = None,
 ) -> list[FrequencyResponse]:
     """Branches through ``seeds`` (Ω, period, coefficients), skipping a seed that a branch
     already found (including one from an earlier seed) explains."""
@@ -299,7 +326,8 @@ def seeded_branches(
         if _explained(known, n, w, rms, 1e-3):
             continue
         H = (q.size - 1) // 2
-        branch = branch_from_seed(frf.model, w, q, n, omega_range, H, continuation=continuation, newton=newton, branch_id=next_id)
+        branch = branch_from_seed(frf.model, w, q, n, omega_range, H, continuation=continuation, newton=newton,
+                                  branch_id=next_id, run=run)
         if branch is not None and len(branch):
             out.append(branch)
             next_id += 1

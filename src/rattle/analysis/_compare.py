@@ -24,18 +24,22 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..continuation import ContinuationOptions
+from ..hb import HBOptions, NewtonOptions
 from ..model import Model
 from ..results import FrequencyResponse, PeriodicOrbit, SweepResult
 from ..timeint import ExactIntegrator, SteadyState, SteadyStateOptions, steady_state
 from ._frequency_response import frequency_response
 from ._frequency_response import check_range
 from ._orbit import MAX_PERIOD, periodic_orbit
+from ._regimes import confirm_with_sweep
+from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
 from ._time_sweep import time_sweep
 
 #: Automatic picks: the up/down sweeps must differ by this fraction of the largest rms for the
@@ -213,10 +217,15 @@ def _check_at(at: object, lo: float, hi: float) -> list[float]:
 def compare(
     model: Model,
     omega: tuple[float, float] = (0.1, 3.0),
-    harmonics: int = 32,
+    harmonics: int = DEFAULT_HARMONICS,
     points: int = 200,
     at: Sequence[float] | None = None,
     *,
+    samples: int | None = None,
+    hb: HBOptions | None = None,
+    newton: NewtonOptions | None = None,
+    continuation: ContinuationOptions | None = None,
+    stability: StabilityMethod = "monodromy",
     options: SteadyStateOptions | None = None,
     workers: int = 1,
     callback: Callable[[int, int], None] | None = None,
@@ -235,6 +244,10 @@ def compare(
     at : sequence of float, optional
         Frequencies (rad/s, within ``omega``) to examine in detail; default: picked by the rules
         in the module docstring.
+    samples, hb, newton, continuation, stability
+        Harmonic-balance, corrector and continuation settings and the stability method, as in
+        :func:`frequency_response`; used unchanged by the frequency response and by every
+        orbit examined.
     options : SteadyStateOptions, optional
         Settling settings of the simulations.
     workers : int, default 1
@@ -250,12 +263,17 @@ def compare(
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
     lo, hi = check_range(omega)
     chosen = None if at is None else _check_at(at, lo, hi)
+    run = RunSettings.make(resolve_hb(harmonics, samples, hb), newton, continuation, stability)
     t0 = time.perf_counter()
-    frf = frequency_response(model, omega=(lo, hi), harmonics=harmonics, throw=False)
+    frf = frequency_response(model, omega=(lo, hi), hb=run.hb, newton=run.newton, continuation=run.continuation,
+                             stability=run.stability, throw=False)
     t1 = time.perf_counter()
     sweep = time_sweep(model, omega=(lo, hi), points=points, direction="both", options=options,
                        workers=workers, callback=callback)
     t2 = time.perf_counter()
+    # What the sweep saw in each region (a stretch without a stable computed orbit is labelled
+    # by the periods the simulation found there).
+    frf = replace(frf, regions=confirm_with_sweep(frf.regions, sweep))
     picks = pick_frequencies(frf, sweep) if chosen is None else [(w, "requested") for w in chosen]
     integ = ExactIntegrator(model)
     grid = np.unique(sweep.omega)
@@ -277,8 +295,8 @@ def compare(
                 x0 = s.state0
                 break
         orbits.append(periodic_orbit(
-            model, w, period=period, harmonics=harmonics, frf=frf, search_range=(lo, hi),
-            x0=x0, steady_options=options,
+            model, w, period=period, hb=run.hb, newton=run.newton, continuation=run.continuation,
+            stability=run.stability, frf=frf, search_range=(lo, hi), x0=x0, steady_options=options,
         ))
         sims.append(states)
     t3 = time.perf_counter()
@@ -286,7 +304,7 @@ def compare(
         model=model, frf=frf, sweep=sweep,
         at=tuple(w for w, _ in picks), reasons=tuple(r for _, r in picks),
         orbits=tuple(orbits), simulations=tuple(sims),
-        settings={"omega": [lo, hi], "harmonics": harmonics, "points": points,
+        settings={"omega": [lo, hi], **run.record(), "points": points,
                   "at": None if at is None else list(chosen or []), "workers": workers},
         timings={"frequency_response": t1 - t0, "sweep": t2 - t1, "orbits": t3 - t2, "total": t3 - t0},
     )

@@ -6,7 +6,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -21,10 +21,9 @@ from ..model import Model
 from ..results import FrequencyResponse, SpecialPoint
 from ..stability import classify_loss, hill_multipliers, monodromy, monodromy_batch, multipliers_from_monodromy
 from ..stability._classify import UNIT_CIRCLE_TOL
+from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb, scaled_hb
 
 logger = logging.getLogger("rattle")
-
-StabilityMethod = Literal["monodromy", "hill"]
 
 
 def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
@@ -107,8 +106,9 @@ def _locate_with(hb: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, 
 
 
 def _refine(hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
-    """Locate the same special point with the doubled harmonic count hb2: the end points are
-    first corrected onto the 2H branch (in the plane normal to the secant)."""
+    """Locate the same special point with the doubled harmonic count hb2 (built with the run's
+    HBOptions scaled to 2H: see ``_settings``): the end points are first corrected onto the 2H
+    branch (in the plane normal to the secant)."""
     H2 = hb2.basis.harmonics
     corr2 = ArclengthCorrector(hb2, newton)
     ya = corr2.to_scaled(resize_harmonics(qa, H2), wa)
@@ -140,7 +140,8 @@ def _locate_changes(
     refine: bool,
 ) -> list[tuple[int, str, LocatedPoint | None, float | None]]:
     """For each change of stability between rows i−1 and i: (i, kind, located point or None,
-    Ω located again with 2H harmonics or None)."""
+    Ω located again with 2H harmonics or None). The 2H problem keeps ``hb.options``' sample
+    ratio (``RunSettings.for_harmonics``)."""
     found = []
     hb2 = None
     for i in range(1, stable.size):
@@ -155,7 +156,8 @@ def _locate_changes(
         omega2 = None
         if loc is not None and refine:
             if hb2 is None:
-                hb2 = HarmonicBalance(hb.model, HBOptions(harmonics=2 * hb.basis.harmonics), period=hb.period)
+                hb_opts = hb.options if isinstance(hb.options, HBOptions) else HBOptions(harmonics=hb.basis.harmonics)
+                hb2 = HarmonicBalance(hb.model, scaled_hb(hb_opts, 2 * hb.basis.harmonics), period=hb.period)
             loc2 = _refine(hb2, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
             omega2 = None if loc2 is None else loc2.omega
         found.append((i, kind, loc, omega2))
@@ -165,9 +167,10 @@ def _locate_changes(
 def frequency_response(
     model: Model,
     omega: tuple[float, float] = (0.1, 3.0),
-    harmonics: int = 32,
+    harmonics: int = DEFAULT_HARMONICS,
     *,
     samples: int | None = None,
+    hb: HBOptions | None = None,
     period: int = 1,
     start: Literal["low", "high"] = "low",
     stability: StabilityMethod = "monodromy",
@@ -191,7 +194,9 @@ def frequency_response(
     orbit is closed by exact shooting and followed both ways in Ω.
 
     Harmonic balance with ``harmonics`` harmonics of the solution's base frequency Ω/``period``
-    (AFT with ``samples`` time samples per period, default :func:`~rattle.hb.default_samples`),
+    (AFT with ``samples`` time samples per period, default :func:`~rattle.hb.default_samples`;
+    or both at once as ``hb=HBOptions(harmonics=…, samples=…)``, not together with a
+    ``harmonics``/``samples`` that disagrees with it),
     followed from the linear solution at the ``start`` end of the range by pseudo-arclength
     continuation through every fold. Floquet multipliers for every point (``stability``:
     ``"monodromy"`` the exact monodromy of the piecewise-linear linearisation about the HB
@@ -199,6 +204,11 @@ def frequency_response(
 
     If the run ends before the far end of the range, ``throw=True`` raises ConvergenceError
     with the points computed so far in ``.partial``; ``throw=False`` returns them with the status.
+
+    Every sub-problem (the 2H re-location of special points, period-doubling branches, seeded
+    branches) gets the same HBOptions (its sample count scaled with its harmonic count, see
+    ``rattle.analysis._settings``), NewtonOptions, ContinuationOptions and stability method;
+    ``result.settings["branches"]`` records what each branch actually used.
     """
     lo, hi = check_range(omega)
     if start not in ("low", "high"):
@@ -209,9 +219,31 @@ def frequency_response(
         raise TypeError(f"`continuation` must be a ContinuationOptions, got {continuation!r}")
     if newton is not None and not isinstance(newton, NewtonOptions):
         raise TypeError(f"`newton` must be a NewtonOptions, got {newton!r}")
-    cont_opts = continuation or ContinuationOptions()
-    newton_opts = newton or NewtonOptions()
-    hb_opts = HBOptions(harmonics=harmonics, samples=samples)
+    run = RunSettings.make(resolve_hb(harmonics, samples, hb), newton, continuation, stability)
+    return _frequency_response(
+        model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,
+        sweep=sweep, seeds=seeds, throw=throw, callback=callback,
+    )
+
+
+def _frequency_response(
+    model: Model,
+    omega_range: tuple[float, float],
+    run: RunSettings,
+    *,
+    period: int = 1,
+    start: Literal["low", "high"] = "low",
+    subharmonics: bool = False,
+    max_period: int = 4,
+    sweep: object | None = None,
+    seeds: Sequence[tuple[float, int, FloatArray]] = (),
+    throw: bool = True,
+    callback: Callable[[BranchPoint], None] | None = None,
+) -> FrequencyResponse:
+    """frequency_response() after its arguments are checked: every option comes in ``run``."""
+    lo, hi = omega_range
+    cont_opts, newton_opts, hb_opts, stability = run.continuation, run.newton, run.hb, run.stability
+    harmonics = hb_opts.harmonics
     t_start = time.perf_counter()
     hb = HarmonicBalance(model, hb_opts, period=period)
     omega0 = lo if start == "low" else hi
@@ -232,10 +264,9 @@ def frequency_response(
     result = assemble(
         model, hb, points, stability=stability, newton=newton_opts, status=status, message=stepper.message,
         settings={
-            "omega": [lo, hi], "harmonics": harmonics, "samples": hb.basis.samples, "period": period,
-            "start": start, "start_solution": how, "stability": stability,
-            "continuation": asdict(cont_opts), "newton": asdict(newton_opts),
-            "rejected_steps": stepper.rejected,
+            "omega": [lo, hi], **run.record(), "period": period,
+            "start": start, "start_solution": how, "rejected_steps": stepper.rejected,
+            "origin": f"continuation from the {start} end of the range",
         },
         timings={"continuation": t_cont - t_start},
     )
@@ -247,7 +278,7 @@ def frequency_response(
         t_sub = time.perf_counter()
         from ._branches import seed_from_state, seeded_branches, sweep_seeds
 
-        extra = period_doubling_branches(result, (lo, hi), max_period=max_period, continuation=cont_opts, newton=newton_opts)
+        extra = period_doubling_branches(result, (lo, hi), max_period=max_period, run=run)
         seed_list = []
         for k, seed in enumerate(seeds):
             try:
@@ -256,28 +287,36 @@ def frequency_response(
                 raise ValueError(f"`seeds[{k}]` must be (omega, period, (delta, velocity)), got {seed!r}") from None
             if not (lo <= w_s <= hi) or not 1 <= n_s <= 8:
                 raise ValueError(f"`seeds[{k}]`: omega must lie in {(lo, hi)} and period in 1…8, got {seed!r}")
-            q_s = seed_from_state(model, w_s, x_s, n_s, n_s * harmonics)
+            q_s = seed_from_state(model, w_s, x_s, n_s, n_s * harmonics, hb=run.for_harmonics(n_s * harmonics))
             if q_s is not None:
                 seed_list.append((w_s, n_s, q_s))
         known = FrequencyResponse.concatenate([result, *extra])  # the branches found so far
         if sweep is not None:
-            seed_list += sweep_seeds(known, sweep, harmonics_per_period=harmonics)
+            seed_list += sweep_seeds(known, sweep, harmonics_per_period=harmonics, run=run)
         if seed_list:
-            extra += seeded_branches(known, seed_list, (lo, hi), continuation=cont_opts, newton=newton_opts,
-                                     first_branch=1 + len(extra))
+            extra += seeded_branches(known, seed_list, (lo, hi), run=run, first_branch=1 + len(extra))
         timings = dict(result.timings)
         timings["subharmonics"] = time.perf_counter() - t_sub
-        settings = dict(result.settings, subharmonics=True, max_period=max_period)
+        settings = dict(result.settings, subharmonics=True, max_period=max_period,
+                        branches=[_branch_record(result), *(_branch_record(b) for b in extra)])
         result = FrequencyResponse.concatenate([result, *extra], settings=settings, timings=timings)
+    else:
+        result = replace(result, settings=dict(result.settings, subharmonics=False, branches=[_branch_record(result)]))
     if len(result):
-        from dataclasses import replace
-
         from ._regimes import label_regions
 
         result = replace(result, regions=label_regions(result))
     if throw and not status.success:
         raise ConvergenceError(f"frequency response incomplete: {stepper.message}", partial=result)
     return result
+
+
+def _branch_record(branch: FrequencyResponse) -> dict:
+    """The settings one branch was computed with (``assemble``'s ``settings``), tagged with its id."""
+    b = int(branch.branch[0]) if len(branch) else 0
+    keep = ("harmonics", "samples", "samples_given", "stability", "newton", "continuation", "origin")
+    return {"branch": b, "period": int(branch.period[0]) if len(branch) else None,
+            **{k: branch.settings[k] for k in keep if k in branch.settings}}
 
 
 def _multipliers(model: Model, hb: HarmonicBalance, Q: FloatArray, Om: FloatArray, X: FloatArray, stability: StabilityMethod) -> np.ndarray:

@@ -15,21 +15,29 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._typing import FloatArray
+from ..continuation import ContinuationOptions
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..model import Model
 from ..results import FrequencyResponse
+from ._settings import DEFAULT_ADAPTIVE_HARMONICS, StabilityMethod, scaled_hb
 
 
 def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, *, factor: int = 2,
-                     newton: NewtonOptions | None = None) -> FloatArray:
+                     newton: NewtonOptions | None = None, hb: HBOptions | None = None) -> FloatArray:
     """|rms(factor·H) / rms(H) − 1| for the given rows (default all); NaN where the finer
-    problem does not converge at fixed Ω (fold tips, where ∂R/∂q is singular)."""
+    problem does not converge at fixed Ω (fold tips, where ∂R/∂q is singular). The finer
+    problem uses ``newton`` and the HB options ``hb`` of the run (an explicit sample count scaled
+    with the harmonic count; default: the samples recorded in ``frf.settings``, else default)."""
     if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
         raise ValueError(f"`factor` must be an integer >= 2, got {factor!r}")
     idx = np.arange(len(frf)) if rows is None else np.asarray(rows, dtype=int)
     out = np.full(idx.size, np.nan)
     problems: dict[tuple[int, int], HarmonicBalance] = {}
     H_all = frf.harmonics
+    if hb is None:
+        given = frf.settings.get("samples_given")
+        h0 = int(frf.settings.get("harmonics", H_all))
+        hb = HBOptions(harmonics=h0, samples=int(given) if given is not None else None)
     for n, i in enumerate(idx):
         p = int(frf.period[i])
         # The row's own harmonic count: the highest non-zero harmonic (branches may be padded).
@@ -39,7 +47,7 @@ def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, 
         H = max(H, p)
         key = (factor * H, p)
         if key not in problems:
-            problems[key] = HarmonicBalance(frf.model, HBOptions(harmonics=factor * H), period=p)
+            problems[key] = HarmonicBalance(frf.model, scaled_hb(hb, factor * H), period=p)
         hb2 = problems[key]
         r = solve_harmonic_balance(hb2, resize_harmonics(q, factor * H), float(frf.omega[i]), newton)
         if r.converged:
@@ -53,26 +61,38 @@ def adaptive_frequency_response(
     omega: tuple[float, float] = (0.1, 3.0),
     *,
     tolerance: float = 1e-3,
-    harmonics: int = 8,
+    harmonics: int = DEFAULT_ADAPTIVE_HARMONICS,
     max_harmonics: int = 128,
     every: int = 4,
     subharmonics: bool = False,
     newton: NewtonOptions | None = None,
+    samples: int | None = None,
+    hb: HBOptions | None = None,
+    continuation: ContinuationOptions | None = None,
+    stability: StabilityMethod = "monodromy",
 ) -> FrequencyResponse:
     """Frequency response whose harmonic count is raised (doubled) until the estimated rms
     truncation error, checked at every ``every``-th point, is below ``tolerance`` everywhere
     (or ``max_harmonics`` is reached). A count too small for a periodic solution to be found at
-    all is doubled too. The estimates and the count used go in ``settings``."""
+    all is doubled too. The estimates and the count used go in ``settings``.
+
+    ``hb`` (or ``harmonics``/``samples``) is the starting discretisation; each doubling keeps
+    its sample ratio (an explicit ``samples`` doubles with H). ``newton``, ``continuation`` and
+    ``stability`` go unchanged to every run and every truncation estimate."""
     from ..errors import ConvergenceError
     from ._frequency_response import frequency_response
+    from ._settings import resolve_hb
 
     if not (isinstance(tolerance, (int, float)) and 0 < tolerance < 1):
         raise ValueError(f"`tolerance` must be in (0, 1), got {tolerance!r}")
-    H = harmonics
+    hb0 = resolve_hb(harmonics, samples, hb)
+    H = hb0.harmonics
     history: list[dict[str, object]] = []
     while True:
+        hb_H = scaled_hb(hb0, H)
         try:
-            frf = frequency_response(model, omega=omega, harmonics=H, subharmonics=subharmonics, newton=newton)
+            frf = frequency_response(model, omega=omega, hb=hb_H, subharmonics=subharmonics, newton=newton,
+                                     continuation=continuation, stability=stability)
         except ConvergenceError as exc:
             history.append({"harmonics": H, "max_truncation_error": None, "failed": str(exc)})
             if 2 * H > max_harmonics:
@@ -81,7 +101,7 @@ def adaptive_frequency_response(
             continue
         rows = np.arange(0, len(frf), max(1, every))
         rows = rows[frf.bifurcation[rows] == ""]
-        err = truncation_error(frf, rows)
+        err = truncation_error(frf, rows, newton=newton, hb=hb_H)
         worst = float(np.nanmax(err)) if np.isfinite(err).any() else np.inf
         history.append({"harmonics": H, "max_truncation_error": worst, "checked": int(np.isfinite(err).sum())})
         if worst <= tolerance or 2 * H > max_harmonics:

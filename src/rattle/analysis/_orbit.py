@@ -31,7 +31,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -45,15 +45,18 @@ from ..measures import measures_batch, synthesize_batch
 from ..model import Model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
-from ..stability import UNIT_CIRCLE_TOL, monodromy_batch, multipliers_from_monodromy
+from ..stability import UNIT_CIRCLE_TOL, hill_multipliers, monodromy_batch, multipliers_from_monodromy
 from ..timeint import ExactIntegrator, shoot_periodic_orbit
 from ..timeint._steady import SteadyState, SteadyStateOptions, steady_state
 from ._frequency_response import check_range, frequency_response
+from ._settings import DEFAULT_HARMONICS, StabilityMethod, check_stability, resolve_hb
 
 logger = logging.getLogger("rattle")
 
 #: Largest period (multiple of the forcing period) that is searched for, as in the sweep.
 MAX_PERIOD = 8
+# Simulations started next to unstable orbits, at most (besides the one from ``x0``).
+_MAX_EXTRA_SIMULATIONS = 6
 
 # Two solutions are the same orbit when their δ(t) differ by less than this fraction of the
 # model's length scale everywhere (Newton converges to ~1e-10 of it; distinct coexisting orbits
@@ -138,16 +141,18 @@ class _Candidate:
     source: str
     iterations: int
     residual: float
+    simulated: bool = False  # a simulation settled on this orbit
 
 
 class _Solver:
     """HB problems per period at one Ω, Newton polish, reduction and de-duplication."""
 
-    def __init__(self, model: Model, omega: float, harmonics: int, samples: int | None, newton: NewtonOptions) -> None:
+    def __init__(self, model: Model, omega: float, hb: HBOptions, newton: NewtonOptions) -> None:
         self.model = model
         self.omega = omega
-        self.harmonics = harmonics
-        self.samples = samples
+        self.options = hb
+        self.harmonics = hb.harmonics
+        self.samples = hb.samples
         self.newton = newton
         self._hb: dict[int, HarmonicBalance] = {}
         self.found: list[_Candidate] = []
@@ -155,9 +160,8 @@ class _Solver:
 
     def hb(self, period: int) -> HarmonicBalance:
         if period not in self._hb:
-            self._hb[period] = HarmonicBalance(
-                self.model, HBOptions(harmonics=self.harmonics, samples=self.samples), period=period
-            )
+            # H harmonics of Ω/period for every period: the same HBOptions throughout.
+            self._hb[period] = HarmonicBalance(self.model, self.options, period=period)
         return self._hb[period]
 
     def polish(self, q0: FloatArray, period: int, source: str) -> _Candidate | None:
@@ -193,11 +197,14 @@ class _Solver:
         )
 
     def add(self, cand: _Candidate | None) -> bool:
-        """Keep ``cand`` unless it duplicates one found before; True if it was new."""
+        """Keep ``cand`` unless it duplicates one found before; True if it was new. A duplicate
+        of a simulated candidate marks the one kept as simulated too."""
         if cand is None:
             return False
-        if any(self.same(cand, c) for c in self.found):
-            return False
+        for c in self.found:
+            if self.same(cand, c):
+                c.simulated = c.simulated or cand.simulated
+                return False
         self.found.append(cand)
         return True
 
@@ -242,7 +249,25 @@ def _simulation_seed(solver: _Solver, steady: Any, integrator: ExactIntegrator |
     hb = solver.hb(n)
     t = hb.basis.times(n * Tf)
     q0 = hb.basis.analyze(np.asarray(path.sample(t).delta))
-    return solver.polish(q0, n, "simulation")
+    cand = solver.polish(q0, n, "simulation")
+    if cand is None and orbit.converged:
+        # The simulated motion is a solution whatever Newton on the truncated series does: keep
+        # the exact (shooting) orbit's series, with its HB residual for what it is worth.
+        R, _, _ = hb.residual_jacobian(q0, W)
+        residual = float(np.max(np.abs(R))) / hb.force_scale
+        logger.info("periodic_orbit: the simulated period-%d orbit kept unpolished (HB residual %.3g)", n, residual)
+        cand = _Candidate(n, q0, "simulation", 0, residual)
+    if cand is not None:
+        cand.simulated = True
+    return cand
+
+
+def _unstable_not_saddle(mu: np.ndarray) -> bool:
+    """A multiplier outside the unit circle that is not a real μ > 1 (a period doubling, μ < −1,
+    or a complex pair, Neimark–Sacker): motion nearby may settle on another periodic orbit (of
+    doubled period, say) rather than on a coexisting orbit already known."""
+    big = mu[np.abs(mu) > 1.0 + UNIT_CIRCLE_TOL]
+    return bool(np.any((big.real < 0) | (np.abs(big.imag) > 1e-12)))
 
 
 def _follow_subharmonic(
@@ -300,8 +325,10 @@ def periodic_orbit(
     model: Model,
     omega: float,
     period: int = 1,
-    harmonics: int = 32,
+    harmonics: int = DEFAULT_HARMONICS,
     *,
+    hb: HBOptions | None = None,
+    stability: StabilityMethod = "monodromy",
     simulate: bool = True,
     search_range: tuple[float, float] | None = None,
     frf: FrequencyResponse | None = None,
@@ -340,8 +367,15 @@ def periodic_orbit(
         Initial state (δ, δ') of the simulation (rad, rad/s); default rest (0, 0).
     samples : int, optional
         AFT samples per solution period (default :func:`rattle.hb.default_samples`).
+    hb : HBOptions, optional
+        ``harmonics`` and ``samples`` in one object (not together with a ``harmonics`` or
+        ``samples`` that disagrees with it).
+    stability : {"monodromy", "hill"}, default "monodromy"
+        How the Floquet multipliers are computed (as in :func:`frequency_response`).
     newton, continuation : NewtonOptions, ContinuationOptions, optional
-        Corrector and continuation settings.
+        Corrector and continuation settings. These, the HB options and ``stability`` are used
+        unchanged by every sub-problem: the primary branch, the Newton polish at Ω and the
+        sub-harmonic branches.
     steady_options : SteadyStateOptions, optional
         Settling tolerance and budget of the simulation.
 
@@ -362,7 +396,9 @@ def periodic_orbit(
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
     W = check_omega(omega)
     period = _check_period(period)
-    HBOptions(harmonics=harmonics, samples=samples)  # validates `harmonics` and `samples`
+    hb_opts = resolve_hb(harmonics, samples, hb)  # validates `harmonics` and `samples`
+    harmonics = hb_opts.harmonics
+    stability = check_stability(stability)
     forced = len(model.excitation.amplitudes)
     if harmonics < forced * period:
         raise ValueError(
@@ -389,12 +425,13 @@ def periodic_orbit(
     cont_opts = continuation or ContinuationOptions()
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    solver = _Solver(model, W, harmonics, samples, newton_opts)
+    solver = _Solver(model, W, hb_opts, newton_opts)
 
     # 1. Primary branch through W.
     primary = frf
     if primary is None:
-        primary = frequency_response(model, omega=(lo, hi), harmonics=harmonics, samples=samples, throw=False)
+        primary = frequency_response(model, omega=(lo, hi), hb=hb_opts, newton=newton_opts, continuation=cont_opts,
+                                     stability=stability, throw=False)
     for b in np.unique(primary.branch):
         sel = np.nonzero(primary.branch == b)[0]
         p_branch = int(primary.period[sel[0]])
@@ -409,39 +446,55 @@ def periodic_orbit(
     steady = None
     if simulate:
         integ = ExactIntegrator(model)
+        runs_done = 0
 
         def simulate_from(x: FloatArray) -> SteadyState:
+            nonlocal runs_done
+            runs_done += 1
             return steady_state(model, W, x, options=steady_options, integrator=integ)
 
-        steady = simulate_from(start_state)
-        runs = [steady]
-        if period > 1 and int(getattr(steady, "period", 0) or 0) != period:
-            # From rest the motion settled elsewhere: start next to each unstable primary orbit.
-            primaries = _assembled(model, solver, solver.found)
-            for cand, sol in zip(solver.found, primaries):
-                if sol.stable or cand.period != 1:
-                    continue
-                x_start = _state_at_zero(solver, cand)
-                x_start[0] += 1e-3 * solver.scale
-                runs.append(simulate_from(x_start))
-                if int(getattr(runs[-1], "period", 0) or 0) == period:
-                    break
-        timings["simulation"] = time.perf_counter() - t1
-        for run in runs:
+        def take(run: SteadyState) -> None:
             seed = _simulation_seed(solver, run, integ)
             if seed is None:
-                continue
+                return
             new = solver.add(seed)
             if new and seed.period > 1:
                 _follow_subharmonic(solver, seed, (lo, hi), cont_opts)
-        timings["subharmonics"] = time.perf_counter() - t1 - timings["simulation"]
+
+        t_sim = 0.0
+        ts = time.perf_counter()
+        steady = simulate_from(start_state)
+        t_sim += time.perf_counter() - ts
+        take(steady)
+        # From next to each orbit that is unstable by a period doubling or a complex pair: the
+        # motion there may settle on an orbit no branch reached (a sub-harmonic, most often).
+        # When a period was asked for and not yet found, next to every unstable orbit.
+        tried: list[_Candidate] = []
+        while runs_done <= _MAX_EXTRA_SIMULATIONS:
+            sols = _assembled(model, solver, solver.found, stability)
+            want_period = period > 1 and not any(c.period == period for c in solver.found)
+            todo = [c for c, sol in zip(solver.found, sols)
+                    if not sol.stable and all(c is not t for t in tried)
+                    and (want_period and c.period == 1 or _unstable_not_saddle(sol.multipliers))]
+            if not todo:
+                break
+            cand = todo[0]
+            tried.append(cand)
+            x_start = _state_at_zero(solver, cand)
+            x_start[0] += 1e-3 * solver.scale
+            ts = time.perf_counter()
+            run = simulate_from(x_start)
+            t_sim += time.perf_counter() - ts
+            take(run)
+        timings["simulation"] = t_sim
+        timings["subharmonics"] = time.perf_counter() - t1 - t_sim
 
     if not solver.found:
         raise ConvergenceError(
             f"no periodic solution found at Ω = {W:g}: the primary branch over {lo:g} … {hi:g} rad/s "
             "does not reach it and the simulation gave no start"
         )
-    solutions = _assembled(model, solver, solver.found)
+    solutions = _assembled(model, solver, solver.found, stability)
     order = sorted(range(len(solutions)), key=lambda i: (solutions[i].period != period, solutions[i].period, -solutions[i].rms))
     timings["total"] = time.perf_counter() - t0
     return PeriodicOrbit(
@@ -455,7 +508,11 @@ def periodic_orbit(
             "omega": W, "period": period, "harmonics": harmonics, "simulate": simulate,
             "search_range": [lo, hi], "x0": start_state.tolist(),
             "samples": {p: hb.basis.samples for p, hb in solver._hb.items()},
+            "samples_given": hb_opts.samples, "stability": stability,
+            "newton": asdict(newton_opts), "continuation": asdict(cont_opts),
             "primary_branch_status": primary.status.name.lower(),
+            "primary_branch_settings": {k: primary.settings.get(k) for k in (
+                "harmonics", "samples", "stability", "newton", "continuation") if k in primary.settings},
         },
         timings=timings,
     )
@@ -467,9 +524,10 @@ def _state_at_zero(solver: _Solver, cand: _Candidate) -> FloatArray:
     return np.array([float(basis.evaluate(cand.q, w, 0.0)), float(basis.evaluate(cand.q, w, 0.0, derivative=1))])
 
 
-def _assembled(model: Model, solver: _Solver, cands: list[_Candidate]) -> list[OrbitSolution]:
-    """Floquet multipliers (exact monodromy of the linearisation about each orbit) and SPEC
-    measures of each candidate, batched per period."""
+def _assembled(model: Model, solver: _Solver, cands: list[_Candidate],
+               stability: StabilityMethod = "monodromy") -> list[OrbitSolution]:
+    """Floquet multipliers (exact monodromy of the linearisation about each orbit, or Hill's
+    method) and SPEC measures of each candidate, batched per period."""
     out: list[OrbitSolution | None] = [None] * len(cands)
     st = model.elastic.stages
     for p in sorted({c.period for c in cands}):
@@ -479,7 +537,10 @@ def _assembled(model: Model, solver: _Solver, cands: list[_Candidate]) -> list[O
         w = np.full(len(idx), solver.omega / p)
         Om = np.full(len(idx), solver.omega)
         X = synthesize_batch(Q, hb.basis.samples)
-        mu = multipliers_from_monodromy(monodromy_batch(Q, w, X, st.breakpoints, model.k * st.slopes, model.c))
+        if stability == "hill":
+            mu = np.array([hill_multipliers(hb, q, solver.omega) for q in Q]).reshape(len(idx), 2)
+        else:
+            mu = multipliers_from_monodromy(monodromy_batch(Q, w, X, st.breakpoints, model.k * st.slopes, model.c))
         stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL
         meas = measures_batch(model, Q, w, Om, X)
         for j, i in enumerate(idx):
@@ -491,6 +552,7 @@ def _assembled(model: Model, solver: _Solver, cands: list[_Candidate]) -> list[O
                 delta_min=float(meas.delta_min[j]), delta_max=float(meas.delta_max[j]),
                 regime=str(meas.regime[j]), source=cands[i].source,
                 iterations=int(cands[i].iterations), residual=float(cands[i].residual),
+                simulated=bool(cands[i].simulated),
             )
     return [s for s in out if s is not None]
 

@@ -53,6 +53,9 @@ class OrbitSolution:
         Newton iterations of the final polish at exactly Ω.
     residual : float
         Scaled harmonic-balance residual.
+    simulated : bool
+        A simulation (from the given initial state, or from next to an unstable orbit) settled
+        on this orbit, whatever ``source`` first found it.
     """
 
     omega: float
@@ -71,6 +74,7 @@ class OrbitSolution:
     source: str
     iterations: int = 0
     residual: float = 0.0
+    simulated: bool = False
 
     @property
     def harmonics(self) -> int:
@@ -96,7 +100,7 @@ class OrbitSolution:
         return (
             f"OrbitSolution(Ω = {self.omega:.6g}, period {self.period}, rms = {self.rms:.6g} rad, "
             f"{'stable' if self.stable else 'unstable'}, |μ|max = {float(np.max(np.abs(self.multipliers))):.4g}, "
-            f"{self.regime}, from {self.source})"
+            f"{self.regime}, from {self.source}{', simulation lands here' if self.simulated else ''})"
         )
 
 
@@ -294,7 +298,7 @@ class PeriodicOrbit:
             lines.append(
                 f" {mark} [{i}] period {s.period}, rms {s.rms:.6g} rad, p2p {s.p2p:.5g} rad, "
                 f"{'stable' if s.stable else 'unstable'} (|μ|max {float(np.max(np.abs(s.multipliers))):.4g}), "
-                f"{s.regime}, from {s.source}"
+                f"{s.regime}, from {s.source}{'; the simulation settles here' if s.simulated and s.source != 'simulation' else ''}"
             )
         if self.simulation is not None:
             p = self.simulated_period
@@ -328,7 +332,7 @@ class PeriodicOrbit:
             "selected": self.selected,
             "solutions": [
                 {
-                    "period": s.period, "stable": s.stable, "source": s.source,
+                    "period": s.period, "stable": s.stable, "source": s.source, "simulated": s.simulated,
                     "mean": s.mean, "rms": s.rms, "rms_ac": s.rms_ac, "p2p": s.p2p, "acc_p2p": s.acc_p2p,
                     "delta_min": s.delta_min, "delta_max": s.delta_max, "regime": s.regime,
                     "multipliers": [[float(z.real), float(z.imag)] for z in s.multipliers],
