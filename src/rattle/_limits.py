@@ -60,6 +60,12 @@ MAX_HARMONICS = 256
 MAX_EFFECTIVE_HARMONICS = 512
 #: AFT time samples per solution period, at most.
 MAX_SAMPLES = 16384
+#: Hard bounds of a single harmonic balance problem (HBOptions): the 2H re-location of a
+#: branch of the largest effective size, and its default sample count 32 per harmonic.
+PROBLEM_MAX_HARMONICS = 2 * MAX_EFFECTIVE_HARMONICS
+PROBLEM_MAX_SAMPLES = 32 * PROBLEM_MAX_HARMONICS
+#: Newton iterations per corrector call, at most.
+MAX_NEWTON_ITERATIONS = 1000
 #: Longest period searched or followed, as a multiple of the forcing period (SPEC §1).
 MAX_PERIOD = 8
 #: Frequencies per direction of a time-domain sweep, at most.
@@ -105,8 +111,10 @@ def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1) 
     return h
 
 
-def check_samples(value: object, harmonics: int, name: str = "samples") -> int | None:
-    """``samples`` N: None (the default count) or an integer 4H + 2 … ``MAX_SAMPLES``."""
+def check_samples(value: object, harmonics: int, name: str = "samples", *, period: int = 1) -> int | None:
+    """``samples`` N: None (the default count) or an integer 4H + 2 … ``MAX_SAMPLES``; with
+    ``period`` p > 1 also N·p ≤ ``MAX_SAMPLES`` (a period-p branch keeps the ratio N/H, so it
+    carries p·N samples)."""
     if value is None:
         return None
     n = check_int(name, value, 1)
@@ -116,10 +124,13 @@ def check_samples(value: object, harmonics: int, name: str = "samples") -> int |
             f"`{name}` must be >= 4*harmonics + 2 = {low} (so that the Jacobian's harmonics up to 2H "
             f"are not aliased), got {n}; leave it out for the default"
         )
-    if n > MAX_SAMPLES:
+    limit = MAX_SAMPLES // max(1, period)
+    if n > limit:
+        extra = f" for branches of period {period} (they carry {period}·N samples)" if period > 1 else ""
         raise ValueError(
-            f"`{name}` must be <= {MAX_SAMPLES}, got {n}: the AFT matrices hold samples × (2H + 1) "
-            f"numbers each ({MAX_SAMPLES} × 513 × 8 B = 67 MB at H = 256); leave it out for the default"
+            f"`{name}` must be <= {limit}{extra}, got {n}: the AFT matrices hold samples × (2H + 1) "
+            f"numbers each ({MAX_SAMPLES} × 513 × 8 B = 67 MB at H = 256, twice that in the 2H "
+            "re-location of special points); leave it out for the default (32 per harmonic)"
         )
     return n
 

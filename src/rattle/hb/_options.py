@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .._limits import MAX_NEWTON_ITERATIONS, PROBLEM_MAX_HARMONICS, PROBLEM_MAX_SAMPLES
+from .._validate import check_int, check_real
+
 
 def default_samples(harmonics: int) -> int:
     """Default AFT time samples per solution period: the power of two ≥ 32 H, at least 512.
@@ -31,20 +34,30 @@ class HBOptions:
     samples: int | None = None
 
     def __post_init__(self) -> None:
-        h = self.harmonics
-        if isinstance(h, bool) or not isinstance(h, int):
-            raise TypeError(f"`harmonics` must be an integer, got {h!r}")
-        if h < 1:
-            raise ValueError(f"`harmonics` must be >= 1, got {h}")
+        # The object's own (hard) bounds are those of any single problem a run may build: the
+        # 2H re-location of a branch of period p carries 2·p·H harmonics. The front ends apply the
+        # tighter user-facing bounds of rattle._limits (H <= 256, H·period <= 512) before.
+        h = check_int("harmonics", self.harmonics, 1)
+        if h > PROBLEM_MAX_HARMONICS:
+            raise ValueError(
+                f"`harmonics` must be <= {PROBLEM_MAX_HARMONICS} in a single harmonic balance problem, got {h}: "
+                "the Jacobian grows as H² in memory and H³ in time (H = 512 takes ~1 s per point); "
+                "use 32 to 128"
+            )
+        object.__setattr__(self, "harmonics", h)
         if self.samples is not None:
-            n = self.samples
-            if isinstance(n, bool) or not isinstance(n, int):
-                raise TypeError(f"`samples` must be an integer or None, got {n!r}")
+            n = check_int("samples", self.samples, 1)
             if n < 4 * h + 2:
                 raise ValueError(
                     f"`samples` must be >= 4*harmonics + 2 = {4 * h + 2} (so that the Jacobian "
                     f"is not aliased), got {n}"
                 )
+            if n > PROBLEM_MAX_SAMPLES:
+                raise ValueError(
+                    f"`samples` must be <= {PROBLEM_MAX_SAMPLES} in a single harmonic balance problem, got {n}: "
+                    "the AFT matrices hold samples × (2·harmonics + 1) numbers; leave it out for the default"
+                )
+            object.__setattr__(self, "samples", n)
 
     @property
     def n_samples(self) -> int:
@@ -66,12 +79,17 @@ class NewtonOptions:
 
     def __post_init__(self) -> None:
         for name in ("residual_tol", "step_tol"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, float)) or not (v > 0 and v < 1):
+            v = check_real(getattr(self, name), name)
+            if not 0 < v < 1:
                 raise ValueError(f"`{name}` must be a number in (0, 1), got {v!r}")
-        m = self.max_iterations
-        if isinstance(m, bool) or not isinstance(m, int) or m < 1:
-            raise ValueError(f"`max_iterations` must be an integer >= 1, got {m!r}")
+            object.__setattr__(self, name, v)
+        m = check_int("max_iterations", self.max_iterations, 1)
+        if m > MAX_NEWTON_ITERATIONS:
+            raise ValueError(
+                f"`max_iterations` must be <= {MAX_NEWTON_ITERATIONS}, got {m}: Newton converges in 2–5 "
+                "iterations where it converges at all, and every iteration is a dense solve; use e.g. 12"
+            )
+        object.__setattr__(self, "max_iterations", m)
 
 
 __all__ = ["HBOptions", "NewtonOptions", "default_samples"]
