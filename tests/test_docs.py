@@ -1,0 +1,305 @@
+"""The user documentation stands alone and matches the code.
+
+Every list checked here is derived from the code (the configuration loader's allowed keys, the
+click commands and their options, the column lists, the status values), so that a key, option
+or column added to the package without its documentation fails here.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import shlex
+import sys
+import unicodedata
+from pathlib import Path
+
+import click
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+README = ROOT / "README.md"
+PAGES = ("index.md", "configuration.md", "cli.md", "outputs.md", "definitions.md", "python.md")
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+
+def _text(name: str) -> str:
+    return (DOCS / name).read_text(encoding="utf-8")
+
+
+def _user_files() -> list[Path]:
+    return [README, *sorted(DOCS.glob("**/*.md"))]
+
+
+def _blocks(text: str, lang: str) -> list[str]:
+    """The fenced code blocks of one info string (```lang ... ```)."""
+    return re.findall(rf"^```{re.escape(lang)}[ \t]*\n(.*?)^```", text, flags=re.S | re.M)
+
+
+def _mentions(text: str, word: str) -> bool:
+    """``word`` occurs with no letter, digit, ``_`` or ``-`` on either side (``-o`` is not in ``--omega``)."""
+    return re.search(rf"(?<![\w-]){re.escape(word)}(?![\w-])", text) is not None
+
+
+# --------------------------------------------------------------------------------------------
+# Standing alone
+# --------------------------------------------------------------------------------------------
+def test_every_page_exists_and_the_readme_lists_them():
+    readme = README.read_text(encoding="utf-8")
+    for name in PAGES:
+        assert (DOCS / name).is_file(), f"docs/{name} is missing"
+        assert f"docs/{name}" in readme, f"README.md does not list docs/{name}"
+    index = _text("index.md")
+    for name in PAGES[1:]:
+        assert f"({name}" in index, f"docs/index.md does not link {name}"
+
+
+# Each pattern points to material a user of the package does not have.
+_FORBIDDEN = {
+    "shared/": re.compile(r"shared/"),
+    "../shared": re.compile(r"\.\./shared"),
+    "shared folder": re.compile(r"shared\s+folder", re.I),
+    "SPEC.md": re.compile(r"SPEC\.md"),
+    "SPEC (the internal contract)": re.compile(r"\bSPEC\b"),
+    "STYLE.md": re.compile(r"STYLE\.md"),
+    "paper.txt": re.compile(r"paper\.txt"),
+}
+
+
+@pytest.mark.parametrize("path", _user_files(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_reference_to_a_folder_users_do_not_have(path):
+    text = path.read_text(encoding="utf-8")
+    for what, pattern in _FORBIDDEN.items():
+        m = pattern.search(text)
+        if m:
+            line = text.count("\n", 0, m.start()) + 1
+            pytest.fail(f"{path.relative_to(ROOT)}:{line} refers to {what!r}, which users do not have")
+
+
+def _slug(heading: str) -> str:
+    """The anchor GitHub gives a heading: lower case, punctuation dropped, spaces to hyphens."""
+    text = heading.strip().lower()
+    text = "".join(c for c in text if c in " -_" or unicodedata.category(c)[0] in "LN")
+    return text.replace(" ", "-")
+
+
+@pytest.mark.parametrize("path", _user_files(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_relative_links_and_anchors_resolve(path):
+    text = path.read_text(encoding="utf-8")
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"[a-z]+:", target):  # http:, https:, mailto:
+            continue
+        file_part, _, anchor = target.partition("#")
+        dest = (path.parent / file_part) if file_part else path
+        assert dest.exists(), f"{path.name}: link {target!r} points to a missing file"
+        if anchor:
+            headings = re.findall(r"^#+\s+(.*)$", dest.read_text(encoding="utf-8"), flags=re.M)
+            assert anchor in {_slug(h) for h in headings}, f"{path.name}: anchor {target!r} has no heading"
+
+
+def test_license_file_and_pyproject():
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert text.startswith("MIT License")
+    assert "Copyright (c) 2026 rattle developers" in text
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert pyproject["project"]["license"] == "MIT"
+    assert pyproject["project"]["license-files"] == ["LICENSE"]
+    assert "LICENSE" in README.read_text(encoding="utf-8")
+
+
+def test_readme_keeps_the_two_set_up_commands():
+    readme = README.read_text(encoding="utf-8")
+    assert "python3 -m pip install -e . && rattle demo" in readme
+    assert 'python3 -m pip install -e ".[test]" && python3 -m pytest' in readme
+
+
+# --------------------------------------------------------------------------------------------
+# Configuration keys
+# --------------------------------------------------------------------------------------------
+def _config_keys() -> list[str]:
+    """Every key the loader accepts, dotted, from its allowed-key sets and the elastic laws."""
+    from rattle.io import _config
+    from rattle.model import ELASTIC_LAWS
+
+    keys: list[str] = []
+    for name, value in vars(_config).items():
+        m = re.fullmatch(r"_([A-Z_]+)_KEYS", name)
+        if not m or not isinstance(value, (tuple, list, set, frozenset, dict)):
+            continue
+        prefix = "" if m.group(1) == "TOP" else m.group(1).lower().replace("_", ".") + "."
+        keys += [prefix + str(k) for k in value]
+    assert "model" in keys and "excitation" in keys, f"no allowed-key sets found in rattle.io._config: {keys}"
+    keys.append("model.elastic.type")
+    for law in ELASTIC_LAWS.values():
+        keys += [f"model.elastic.{p}" for p in _config._law_params(law)]
+    return sorted(set(keys))
+
+
+@pytest.mark.parametrize("key", _config_keys())
+def test_every_configuration_key_is_documented(key):
+    assert f"`{key}`" in _text("configuration.md"), f"configuration key `{key}` is not in docs/configuration.md"
+
+
+def test_elastic_types_and_defaults_are_documented():
+    from rattle.io import DEFAULT_HARMONICS, DEFAULT_OMEGA
+    from rattle.model import ELASTIC_LAWS
+
+    text = _text("configuration.md")
+    for name in ELASTIC_LAWS:
+        assert f'`"{name}"`' in text, f"elastic type {name!r} is not in docs/configuration.md"
+        assert f"`{name}`" in _text("definitions.md"), f"elastic type {name!r} is not in docs/definitions.md"
+    assert f"`{DEFAULT_HARMONICS}`" in text
+    assert f"`[{DEFAULT_OMEGA[0]}, {DEFAULT_OMEGA[1]}]`" in text
+
+
+def test_configuration_examples_are_valid():
+    """Every TOML block of the docs is accepted by the loader (fragments inside the full example)."""
+    from rattle.io import config_from_dict
+
+    blocks = [(name, b) for name in PAGES for b in _blocks(_text(name), "toml")]
+    full = [tomllib.loads(b) for _, b in blocks if "excitation" in tomllib.loads(b)]
+    assert full, "docs/configuration.md has no complete example"
+    for name, block in blocks:
+        data = tomllib.loads(block)
+        if "excitation" not in data:  # a fragment: put it into the complete example
+            data = {**full[0], "model": {**full[0]["model"], **data.get("model", {})}}
+        config_from_dict(data, source_name=f"docs/{name}")
+
+
+# --------------------------------------------------------------------------------------------
+# Command line
+# --------------------------------------------------------------------------------------------
+def _options(command: click.Command) -> set[str]:
+    ctx = click.Context(command, info_name=command.name)
+    out: set[str] = set()
+    for param in command.get_params(ctx):
+        if isinstance(param, click.Option):
+            out |= set(param.opts) | set(param.secondary_opts)
+    return out
+
+
+def _sections(text: str) -> dict[str, str]:
+    """``## `rattle NAME``` section bodies by command name."""
+    parts = re.split(r"^## ", text, flags=re.M)
+    out = {}
+    for part in parts:
+        m = re.match(r"`rattle (\w+)`", part)
+        if m:
+            out[m.group(1)] = part
+    return out
+
+
+def test_every_command_and_option_is_documented():
+    from rattle.cli.main import cli
+
+    text = _text("cli.md")
+    sections = _sections(text)
+    commands = dict(cli.commands)
+    assert commands, "the rattle group has no commands"
+    # Options every command has are documented once, under the general options.
+    common = set.intersection(*(_options(c) for c in commands.values()))
+    for opt in _options(cli) | common:
+        assert _mentions(text, opt), f"option {opt} is not in docs/cli.md"
+    for name, command in commands.items():
+        assert name in sections, f"docs/cli.md has no section '## `rattle {name}`'"
+        body = sections[name]
+        for opt in _options(command) - common:
+            assert _mentions(body, opt), f"option {opt} of `rattle {name}` is not in its section of docs/cli.md"
+        for param in command.params:
+            if isinstance(param.type, click.Choice):
+                for choice in param.type.choices:
+                    assert _mentions(body, str(choice)), f"`rattle {name}`: choice {choice!r} is not documented"
+            if isinstance(param, click.Argument):
+                assert param.human_readable_name in body
+
+
+def _command_lines() -> list[tuple[str, list[str]]]:
+    lines = []
+    for page in [*(DOCS / p for p in PAGES), README]:
+        for block in _blocks(page.read_text(encoding="utf-8"), "bash"):
+            for line in block.splitlines():
+                line = line.split("#", 1)[0].strip()
+                for part in line.split("&&"):
+                    argv = shlex.split(part)
+                    if argv and argv[0] == "rattle":
+                        lines.append((page.name, argv))
+    return lines
+
+
+def test_command_examples_parse():
+    """Every ``rattle …`` line in a bash block names a real command with real options and files."""
+    from rattle.cli.main import cli
+
+    examples = _command_lines()
+    assert len(examples) >= 10
+    for page, argv in examples:
+        args = argv[1:]
+        while args and args[0].startswith("-"):  # group options: -v, --version
+            assert args[0] in _options(cli), f"{page}: {' '.join(argv)}: unknown option {args[0]}"
+            args = args[1:]
+        if not args:
+            continue
+        name, rest = args[0], args[1:]
+        assert name in cli.commands, f"{page}: {' '.join(argv)}: no command {name!r}"
+        command = cli.commands[name]
+        try:
+            command.make_context(name, list(rest))
+        except click.ClickException as exc:
+            pytest.fail(f"{page}: {' '.join(argv)}: {exc.format_message()}")
+        for token in rest:
+            if token.startswith("examples/"):
+                assert (ROOT / token).is_file(), f"{page}: {' '.join(argv)}: {token} does not exist"
+
+
+# --------------------------------------------------------------------------------------------
+# Outputs
+# --------------------------------------------------------------------------------------------
+def test_every_output_column_is_documented():
+    from rattle.io import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
+
+    text = _text("outputs.md")
+    for columns in (FRF_COLUMNS, SWEEP_COLUMNS, ORBIT_COLUMNS):
+        assert f"`{','.join(columns)}`" in text, f"the header {','.join(columns)} is not in docs/outputs.md"
+        for column in columns:
+            assert f"`{column}`" in text, f"column `{column}` is not in docs/outputs.md"
+
+
+def test_labels_and_status_values_are_documented():
+    from rattle.errors import Status
+    from rattle.measures import REGIMES
+    from rattle.stability import _classify
+
+    outputs, definitions = _text("outputs.md"), _text("definitions.md")
+    kinds = set(re.findall(r"``(\w+)``", _classify.classify_loss.__doc__ or ""))
+    assert {"fold", "period_doubling"} <= kinds
+    for word in (*REGIMES, *kinds):
+        assert f"`{word}`" in outputs and f"`{word}`" in definitions, f"`{word}` is not documented"
+    for status in Status:
+        assert f"`{status.name.lower()}`" in outputs, f"status {status.name.lower()} is not in docs/outputs.md"
+
+
+# --------------------------------------------------------------------------------------------
+# The Python page runs
+# --------------------------------------------------------------------------------------------
+def test_python_examples_run(tmp_path, monkeypatch):
+    """Every ```python block of docs/python.md runs, in order, in one namespace."""
+    from rattle.io import FRF_COLUMNS, read_csv
+
+    blocks = _blocks(_text("python.md"), "python")
+    assert len(blocks) >= 3
+    monkeypatch.chdir(tmp_path)
+    namespace: dict[str, object] = {"__name__": "__docs__"}
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        for i, block in enumerate(blocks):
+            exec(compile(block, f"docs/python.md block {i + 1}", "exec"), namespace)  # noqa: S102
+    assert tuple(read_csv(tmp_path / "frf.csv")) == FRF_COLUMNS
+    for name in ("frf.png", "sweep.csv", "orbit.csv", "compare.png"):
+        assert (tmp_path / name).is_file(), f"the example did not write {name}"
+    assert "fold" in out.getvalue()
