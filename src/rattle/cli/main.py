@@ -1,21 +1,34 @@
 """The ``rattle`` command line (SPEC §3): a thin layer over the library.
 
 Exit status: 0 success, 2 bad input (configuration, options, output path), 1 a numerical
-failure that could not be recovered. Errors are one line on stderr, ``rattle: error: …``.
+failure that could not be recovered, 128 + the signal number when interrupted (130 SIGINT,
+143 SIGTERM, 129 SIGHUP). Errors are one line on stderr, ``rattle: error: …``; warnings of the
+numerics (numpy's RuntimeWarning …) one line each, ``rattle: warning: …``, never raw.
 
-Every input is validated before the solver is imported, and nothing is created in the output
-directory until there is something to write; every file is written atomically.
+A front door that answers at once: this module imports click, numpy and the configuration
+reader only; the solver (scipy) is imported when a command runs, matplotlib when a figure is
+drawn. Every input is validated before that, and nothing is created in the output directory
+until there is something to write.
+
+Interrupted runs leave nothing wrong: every command writes its files into a staging folder inside
+the output directory and moves them into place together at the end
+(:class:`rattle.io.OutputSet`); SIGTERM and SIGHUP are turned into the same clean exit path as
+Ctrl-C (an exception, so that every ``finally`` removes its temporary files and stops its worker
+processes).
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
 import math
 import os
+import signal
 import sys
 import time
-from collections.abc import Callable, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +36,9 @@ import click
 
 from ..errors import ConfigError, ConvergenceError, RattleError
 from ..io import (
+    STAGING_PREFIX,
     AnalysisSettings,
+    OutputSet,
     atomic_path,
     check_harmonics,
     atomic_write_text,
@@ -45,6 +60,18 @@ DEFAULT_OUTPUT = "rattle-out"
 
 _NoArgsIsHelpError: Any = getattr(click.exceptions, "NoArgsIsHelpError", ())
 
+logger = logging.getLogger("rattle")
+
+#: The files each command writes (its output set: staged and moved into place together; a file
+#: of the set that a run does not produce is removed, so no old one stays beside new data).
+FRF_FILES = ("frf.csv", "frf.json", "frf.png")
+SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")
+ORBIT_FILES = ("orbit.csv", "orbit.json", "orbit.png")
+COMPARE_FILES = ("frf.csv", "sweep.csv", "compare.json", "compare.png")
+#: Longest file name a command writes plus its staging folder and temporary suffix (bytes): the
+#: room ``--output`` must leave below the file system's path limit.
+_PATH_ROOM = 128
+
 
 def _error(message: str) -> None:
     click.echo(f"rattle: error: {message}", err=True)
@@ -52,6 +79,118 @@ def _error(message: str) -> None:
 
 def _warning(message: str) -> None:
     click.echo(f"rattle: warning: {message}", err=True)
+
+
+# --------------------------------------------------------------------------------------------
+# Signals and warnings
+# --------------------------------------------------------------------------------------------
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM or SIGHUP received: raised in the main thread like Ctrl-C's KeyboardInterrupt, so
+    that the same ``finally`` blocks remove temporary files and stop worker processes."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_interrupted(signum: int, _frame: object) -> None:
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def _signals_as_exceptions() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise :class:`Interrupted` for the body (main thread only; the previous
+    handlers come back afterwards, which matters when the CLI runs inside another program)."""
+    installed: dict[int, Any] = {}
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is None:
+            continue
+        try:
+            installed[sig] = signal.signal(sig, _raise_interrupted)
+        except ValueError:  # not the main thread: leave the signals alone
+            break
+    try:
+        yield
+    finally:
+        for sig, old in installed.items():
+            with contextlib.suppress(ValueError, TypeError):
+                signal.signal(sig, old)
+
+
+def _signal_name(signum: int) -> str:
+    try:
+        return signal.Signals(signum).name
+    except ValueError:  # pragma: no cover
+        return f"signal {signum}"
+
+
+#: Warning lines shown per run; the rest are counted and summarised in one line.
+MAX_WARNINGS = 8
+
+
+@contextlib.contextmanager
+def _warnings_as_lines() -> Iterator[None]:
+    """Every warning raised during the body reaches the user as one ``rattle: warning: …`` line:
+    rattle's own warnings (their message names the key in backticks) as they are; others (numpy's
+    "overflow encountered in …") with where they arose (the rattle module and line), what kind
+    they are, and what they mean for the run. Each distinct warning once; at most
+    ``MAX_WARNINGS`` lines."""
+    seen: set[tuple[Any, ...]] = set()
+    hidden = 0
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: Any = None, line: str | None = None) -> None:
+        nonlocal hidden
+        key = (category, str(message), filename, lineno)
+        if key in seen:
+            return
+        seen.add(key)
+        if len(seen) > MAX_WARNINGS:
+            hidden += 1
+            return
+        text = " ".join(str(message).split())
+        if "`" in text:  # one of ours: already says what and why
+            _warning(text)
+            return
+        where = _where(filename, lineno)
+        _warning(f"{text} ({category.__name__} at {where}); the run went on, but check the results "
+                 "at the frequencies where this happened")
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        try:
+            yield
+        finally:
+            if hidden:
+                _warning(f"{hidden} further warning(s) not shown")
+
+
+def _where(filename: str, lineno: int) -> str:
+    """``rattle/measures.py:141`` for a file of the package; the file name otherwise."""
+    parts = Path(filename).parts
+    if "rattle" in parts:
+        i = len(parts) - 1 - parts[::-1].index("rattle")
+        return "/".join(parts[i:]) + f":{lineno}"
+    return f"{Path(filename).name}:{lineno}"
+
+
+def _set_verbose(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    """``-v``: the library's progress (logger ``rattle``, INFO) on stderr as ``rattle: …`` lines."""
+    if not value or ctx.resilient_parsing:
+        return
+    if not any(h.get_name() == "rattle-cli" for h in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.set_name("rattle-cli")
+        handler.setFormatter(logging.Formatter("rattle: %(message)s"))
+        logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+
+
+def _reset_verbose() -> None:
+    for handler in [h for h in logger.handlers if h.get_name() == "rattle-cli"]:
+        logger.removeHandler(handler)
+    logger.setLevel(logging.NOTSET)
 
 
 class RattleGroup(click.Group):
@@ -76,6 +215,19 @@ class RattleGroup(click.Group):
 
     def _run(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None, **extra: Any) -> int:
         try:
+            with _signals_as_exceptions(), _warnings_as_lines():
+                return self._invoke(args, prog_name, complete_var, **extra)
+        except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM/SIGHUP raised as Interrupted
+            signum = exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT)
+            _error(f"interrupted by {_signal_name(signum)}; temporary files were removed and no output "
+                   "set was left half-written")
+            return 128 + signum
+        finally:
+            _reset_verbose()
+
+    def _invoke(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None,
+                **extra: Any) -> int:
+        try:
             rv = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except _NoArgsIsHelpError as exc:  # bare `rattle`: show the help, as click does
             exc.show()
@@ -99,7 +251,17 @@ class RattleGroup(click.Group):
         except RattleError as exc:
             _error(str(exc))
             return EXIT_NUMERICAL
+        except ArithmeticError as exc:  # OverflowError, FloatingPointError, ZeroDivisionError
+            _error(f"numerical failure: {_one_line(exc)} ({type(exc).__name__}); the model's numbers are "
+                   "probably too large or too small for double precision — check their scale")
+            return EXIT_NUMERICAL
+        except MemoryError:
+            _error("numerical failure: out of memory; lower --harmonics, --points or the frequency range")
+            return EXIT_NUMERICAL
         except (ValueError, TypeError) as exc:
+            if type(exc).__name__ == "LinAlgError":  # numpy.linalg's, without importing numpy here
+                _error(f"numerical failure: {_one_line(exc)} (a singular or non-finite linear system)")
+                return EXIT_NUMERICAL
             # The library validates its arguments with ValueError/TypeError naming the argument
             # (a combination the CLI's own checks did not anticipate): bad input, not a crash.
             if "`" not in str(exc):
@@ -109,33 +271,44 @@ class RattleGroup(click.Group):
         return rv if isinstance(rv, int) else EXIT_OK
 
 
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
 def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
     if value and not ctx.resilient_parsing:
         click.echo(f"rattle {rattle_version()}")
         ctx.exit(EXIT_OK)
 
 
+def _common_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--version`` and ``-v/--verbose``, on the group and on every command."""
+    f = click.option("-v", "--verbose", is_flag=True, expose_value=False, callback=_set_verbose,
+                     help="Report progress on stderr.")(f)
+    return click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+                        help="Show the version and exit.")(f)
+
+
 @click.group(name="rattle", cls=RattleGroup, context_settings={"help_option_names": ["-h", "--help"]})
-@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
-              help="Show the version and exit.")
-@click.option("-v", "--verbose", is_flag=True, help="Report progress on stderr.")
-def cli(verbose: bool) -> None:
+@_common_options
+def cli() -> None:
     """Non-linear frequency response of drivetrain rattle (harmonic balance + continuation).
 
-    Exit status: 0 success, 2 bad input, 1 numerical failure.
+    Exit status: 0 success, 2 bad input, 1 numerical failure, 130/143 interrupted.
     """
-    if verbose:
-        logger = logging.getLogger("rattle")
-        if not any(h.get_name() == "rattle-cli" for h in logger.handlers):
-            handler = logging.StreamHandler(sys.stderr)
-            handler.set_name("rattle-cli")
-            handler.setFormatter(logging.Formatter("rattle: %(message)s"))
-            logger.addHandler(handler)
-        logger.setLevel(logging.INFO)
+
+
+def _output_path(_ctx: click.Context, _param: click.Parameter, value: str) -> Path:
+    """``-o``: a non-blank path (``-o ""`` is refused: it would silently mean the current folder)."""
+    if not value.strip():
+        raise ConfigError(
+            f"`--output` must name a folder, got {value!r}; give e.g. -o rattle-out (or -o . for the current folder)"
+        )
+    return Path(value)
 
 
 _output_option = click.option(
-    "-o", "--output", "output", type=click.Path(path_type=Path), default=DEFAULT_OUTPUT,
+    "-o", "--output", "output", type=str, default=DEFAULT_OUTPUT, callback=_output_path, metavar="DIR",
     show_default=True, help="Directory for the output files (created if needed).",
 )
 
@@ -177,31 +350,128 @@ def override_analysis(base: AnalysisSettings, model: Model | None = None, **opti
     return analysis
 
 
+#: File-system types that hold no files a user can keep (kernel interfaces, device nodes):
+#: ``-o`` there is refused before computing (as root the permission check would pass).
+VIRTUAL_FILESYSTEMS = frozenset({
+    "proc", "sysfs", "devtmpfs", "devpts", "cgroup", "cgroup2", "debugfs", "tracefs", "securityfs", "pstore",
+    "bpf", "configfs", "fusectl", "mqueue", "binfmt_misc", "autofs", "efivarfs", "selinuxfs", "hugetlbfs",
+    "rpc_pipefs", "nsfs", "nfsd",
+})
+#: Path prefixes that are virtual on every Linux system (also when /proc/self/mountinfo is unreadable).
+_VIRTUAL_ROOTS = ("/proc", "/sys", "/dev")
+_REAL_UNDER_VIRTUAL = ("/dev/shm",)  # an ordinary tmpfs below /dev
+
+
+def _mount_type(path: str) -> str | None:
+    """The file-system type of the mount holding ``path`` (an absolute, resolved path), from
+    /proc/self/mountinfo; None where that is unavailable."""
+    try:
+        with open("/proc/self/mountinfo", encoding="utf-8", errors="replace") as fh:
+            lines = fh.read().splitlines()
+    except OSError:
+        return None
+    best, fstype = "", None
+    for line in lines:
+        left, _, right = line.partition(" - ")
+        fields = left.split()
+        if len(fields) < 5 or not right:
+            continue
+        mount = fields[4].replace("\\040", " ").replace("\\011", "\t").replace("\\134", "\\")
+        inside = path == mount or path.startswith(mount.rstrip("/") + "/")
+        if inside and len(mount) >= len(best):
+            best, fstype = mount, right.split()[0]
+    return fstype
+
+
+def _limit(path: Path, name: str, default: int) -> int:
+    try:
+        value = os.pathconf(path, name)
+    except (OSError, ValueError, AttributeError):
+        return default
+    return value if value and value > 0 else default
+
+
 def check_output_dir(output: Path) -> None:
     """Refuse an output path that cannot become a writable directory, without creating anything.
+
+    The rules, in order: not blank (checked when the option is read); no name component longer
+    than the file system allows (``PC_NAME_MAX``, usually 255 bytes) and the whole path short
+    enough to hold the staging folder and file names below ``PC_PATH_MAX``; no broken symbolic
+    link on the way; an existing ``output`` is a directory; the nearest existing ancestor is a
+    directory we may write in; not on a virtual file system (/proc, /sys, /dev, cgroup …).
 
     Raises
     ------
     ConfigError
-        If ``output`` is an existing file, lies below a file, or its nearest existing ancestor
-        is not writable.
+        Naming ``--output``, the value and the rule broken.
     """
-    if output.exists() and not output.is_dir():
+    shown = str(output)
+    if len(shown) > 80:
+        shown = shown[:60] + "…" + shown[-15:]
+    absolute = Path(os.path.abspath(output))
+
+    def as_given(p: Path) -> str:  # a path on the way, spelled as the user wrote --output
+        if not output.is_absolute():
+            with contextlib.suppress(ValueError):
+                return str(p.relative_to(Path(os.path.abspath("."))))
+        return str(p)
+
+    # Walk down from the root: every name must fit the file system, the existing part must be
+    # directories (no file, no broken link on the way), the rest is created by the run. os.path's
+    # predicates are used because they answer False instead of raising on a too-long name.
+    ancestor = Path(absolute.anchor or "/")
+    existing = True
+    name_max = _limit(ancestor, "PC_NAME_MAX", 255)
+    for part in absolute.parts[1:]:
+        size = len(os.fsencode(part))
+        if size > name_max:
+            part_shown = part if len(part) <= 40 else part[:30] + "…"
+            raise ConfigError(
+                f"`--output` has a folder name of {size} bytes ({part_shown!r}), more than the {name_max} "
+                "this file system allows; use a shorter name"
+            )
+        if not existing:
+            continue
+        candidate = ancestor / part
+        if os.path.isdir(candidate):
+            ancestor = candidate
+            name_max = _limit(ancestor, "PC_NAME_MAX", name_max)
+        elif os.path.lexists(candidate):
+            if os.path.islink(candidate) and not os.path.exists(candidate):
+                raise ConfigError(
+                    f"`--output` {shown!r}: {as_given(candidate)!r} is a broken symbolic link; remove it or choose "
+                    "another path"
+                )
+            if candidate == absolute:
+                raise ConfigError(
+                    f"`--output` must be a directory, got {shown!r}, which is an existing file; choose another path"
+                )
+            raise ConfigError(
+                f"`--output` {shown!r} cannot be created because {as_given(candidate)!r} is a file, "
+                "not a directory; choose another path"
+            )
+        else:
+            existing = False
+    path_max = _limit(ancestor, "PC_PATH_MAX", 4096)
+    size = len(os.fsencode(str(absolute)))
+    if size + _PATH_ROOM > path_max:
         raise ConfigError(
-            f"`--output` must be a directory, got {str(output)!r}, which is an existing file; "
-            "choose another path"
+            f"`--output` is a path of {size} bytes; with the file names below it, it must stay under the "
+            f"{path_max} bytes this file system allows (at most {path_max - _PATH_ROOM}); use a shorter path"
         )
-    ancestor = output
-    while not ancestor.exists() and ancestor != ancestor.parent:
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
+    resolved = os.path.realpath(ancestor)
+    virtual_root = any(resolved == r or resolved.startswith(r + "/") for r in _VIRTUAL_ROOTS) and not any(
+        resolved == r or resolved.startswith(r + "/") for r in _REAL_UNDER_VIRTUAL)
+    fstype = _mount_type(resolved) if sys.platform.startswith("linux") else None
+    if virtual_root or fstype in VIRTUAL_FILESYSTEMS:
+        kind = f"a {fstype} file system" if fstype in VIRTUAL_FILESYSTEMS else "a virtual file system"
         raise ConfigError(
-            f"`--output` {str(output)!r} cannot be created because {str(ancestor)!r} is a file, "
-            "not a directory; choose another path"
+            f"`--output` {shown!r} lies on {kind} ({resolved}), which cannot hold output files; "
+            "choose a folder on a disk"
         )
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise ConfigError(
-            f"`--output` {str(output)!r}: no permission to write in {str(ancestor)!r}; "
+            f"`--output` {shown!r}: no permission to write in {str(ancestor)!r}; "
             "choose a writable directory"
         )
 
@@ -234,55 +504,84 @@ def _save_plot(result: Any, path: Path) -> bool:
     return _save_figure(result.plot, path)
 
 
-def _write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: float) -> list[str]:
-    """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output``; return the names written.
+Writer = Callable[[Path], Any]
 
-    The data files come first so that they exist even if drawing the figure fails.
+
+def write_set(output: Path, names: Sequence[str], steps: Sequence[tuple[str, Writer]]) -> list[str]:
+    """Write one output set: each ``(name, writer)`` writes ``name`` into a staging folder inside
+    ``output``, then all are moved into place together (:class:`rattle.io.OutputSet`); return
+    the names written.
+
+    ``names`` is the command's whole set: a file of it that this run does not write (a writer
+    returning False, e.g. no matplotlib) is removed from ``output`` at the move, so that an old
+    file never sits beside new ones. Any exception (KeyboardInterrupt, a numerical error while
+    drawing) leaves ``output`` as it was: the staging folder is removed, and so are the folders
+    the run created.
     """
-    written: list[str] = []
     try:
-        output.mkdir(parents=True, exist_ok=True)
-        result.to_csv(output / "frf.csv")
-        written.append("frf.csv")
-        meta = dict(result.metadata())
-        timings = dict(meta.pop("timings", None) or {})
-        timings["cli_wall_time"] = time.perf_counter() - t_start
-        write_metadata(output / "frf.json", **{**meta, **sections, "timings": timings})
-        written.append("frf.json")
-        if _save_plot(result, output / "frf.png"):
-            written.append("frf.png")
+        with OutputSet(output, names) as staged:
+            logger.info("staging %s in %s", ", ".join(n for n, _ in steps), staged.staging)
+            for name, writer in steps:
+                logger.info("writing %s", name)
+                writer(staged.path(name))
+            written = staged.commit()
     except OSError as exc:
         where = f"{exc.filename}" if exc.filename else str(output)
         raise click.ClickException(f"cannot write {where}: {exc.strerror or exc}") from exc
+    logger.info("moved %s into %s", ", ".join(written), output)
     return written
+
+
+def _frf_steps(result: Any, sections: dict[str, Any], t_start: float) -> list[tuple[str, Writer]]:
+    """Writers of ``frf.csv``, ``frf.json`` and ``frf.png`` (the data first, the figure last)."""
+    meta = dict(result.metadata())
+    timings = dict(meta.pop("timings", None) or {})
+
+    def write_json(path: Path) -> None:
+        write_metadata(path, **{**meta, **sections,
+                                "timings": {**timings, "cli_wall_time": time.perf_counter() - t_start}})
+
+    return [("frf.csv", result.to_csv), ("frf.json", write_json), ("frf.png", lambda path: _save_plot(result, path))]
+
+
+def _write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: float,
+               names: Sequence[str] = FRF_FILES) -> list[str]:
+    """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output`` as one set (``names``: the
+    command's whole set, see :func:`write_set`); return the names written."""
+    return write_set(output, names, _frf_steps(result, sections, t_start))
 
 
 def _compute_frf(
     model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], t_start: float,
-    *, subharmonics: bool = False,
+    *, subharmonics: bool = False, names: Sequence[str] = FRF_FILES,
 ) -> Any:
-    """The frequency response; on a convergence failure the points computed before it are
-    written (frf.csv, frf.json, frf.png) and the error re-raised naming the files."""
+    """The frequency response; on a numerical failure the points computed before it are
+    written (frf.csv, frf.json, frf.png, as the command's whole set ``names``: files of an
+    earlier run that the partial set does not replace are removed) and the error re-raised
+    naming the files."""
     from ..analysis import frequency_response  # only now: all input has been validated
 
     extra = {"subharmonics": True} if subharmonics else {}
+    logger.info("computing the frequency response over %g … %g rad/s with %d harmonics",
+                analysis.omega_min, analysis.omega_max, analysis.harmonics)
     try:
         return frequency_response(model, omega=analysis.omega, harmonics=analysis.harmonics, throw=True, **extra)
-    except ConvergenceError as exc:
+    except (ConvergenceError, ArithmeticError) as exc:
         partial = getattr(exc, "partial", None)
-        if partial is None:
+        if partial is None or not len(partial):
             raise
+        reason = str(exc) if isinstance(exc, ConvergenceError) else f"{_one_line(exc)} ({type(exc).__name__})"
         try:
-            written = _write_frf(partial, output, sections, t_start)
+            written = _write_frf(partial, output, sections, t_start, names)
         except click.ClickException as write_error:
             raise ConvergenceError(
-                f"{exc}; the points computed before the failure could not be saved: "
+                f"{reason}; the points computed before the failure could not be saved: "
                 f"{write_error.format_message()}",
                 partial=partial,
             ) from exc
         click.echo(partial.summary())
         raise ConvergenceError(
-            f"{exc}; the points computed before the failure were written to "
+            f"{reason}; the points computed before the failure were written to "
             f"{', '.join(str(output / name) for name in written)}",
             partial=partial,
         ) from exc
@@ -322,6 +621,7 @@ def run_frf(
 # Commands
 # --------------------------------------------------------------------------------------------
 @cli.command("frf", short_help="Frequency response of the model in a configuration file.")
+@_common_options
 @click.argument("config", type=click.Path(path_type=Path))
 @_output_option
 @click.option("--harmonics", type=int, default=None, metavar="H",
@@ -475,24 +775,6 @@ class _ProgressBar:
             self._bar = None
 
 
-def _write_outputs(output: Path, steps: list[tuple[str, Any]]) -> list[str]:
-    """Run each (file name, writer(path) -> bool | None) into ``output``; return the names written.
-
-    Data files should come first so that they exist even if drawing a figure fails; a writer
-    returning False wrote nothing (e.g. no matplotlib).
-    """
-    written: list[str] = []
-    try:
-        output.mkdir(parents=True, exist_ok=True)
-        for name, writer in steps:
-            if writer(output / name) is not False:
-                written.append(name)
-    except OSError as exc:
-        where = f"{exc.filename}" if exc.filename else str(output)
-        raise click.ClickException(f"cannot write {where}: {exc.strerror or exc}") from exc
-    return written
-
-
 def _metadata_writer(meta: dict[str, Any], sections: dict[str, Any], t_start: float) -> Any:
     def write(path: Path) -> None:
         doc = dict(meta)
@@ -514,6 +796,7 @@ def _sections(command: str, config: Path, run_config: Any, analysis: AnalysisSet
 
 
 @cli.command("sweep", short_help="Time-domain frequency sweep (steady state at each frequency).")
+@_common_options
 @click.argument("config", type=click.Path(path_type=Path))
 @_output_option
 @click.option("--direction", type=click.Choice(_DIRECTIONS), default=None,
@@ -556,7 +839,7 @@ def sweep_command(
         "direction": direction, "points": points, "workers": workers,
         "omega_min": omega_min, "omega_max": omega_max,
     })
-    written = _write_outputs(output, [
+    written = write_set(output, SWEEP_FILES, [
         ("sweep.csv", result.to_csv),
         ("sweep.json", _metadata_writer(result.metadata(), sections, t_start)),
         ("sweep.png", lambda path: _save_plot(result, path)),
@@ -566,6 +849,7 @@ def sweep_command(
 
 
 @cli.command("orbit", short_help="Every periodic orbit at one forcing frequency, against the simulation.")
+@_common_options
 @click.argument("config", type=click.Path(path_type=Path))
 @_output_option
 @click.option("--omega", "omega", type=float, required=True, metavar="W",
@@ -604,7 +888,7 @@ def orbit_command(
         "omega": omega, "period": period, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max,
     })
-    written = _write_outputs(output, [
+    written = write_set(output, ORBIT_FILES, [
         ("orbit.csv", result.to_csv),
         ("orbit.json", _metadata_writer(result.metadata(), sections, t_start)),
         ("orbit.png", lambda path: _save_plot(result, path)),
@@ -614,6 +898,7 @@ def orbit_command(
 
 
 @cli.command("compare", short_help="Frequency response and time-domain sweep together.")
+@_common_options
 @click.argument("config", type=click.Path(path_type=Path))
 @_output_option
 @click.option("--points", type=int, default=200, show_default=True, metavar="N",
@@ -654,7 +939,7 @@ def compare_command(
         "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max,
     })
-    written = _write_outputs(output, [
+    written = write_set(output, COMPARE_FILES, [
         ("frf.csv", result.frf.to_csv),
         ("sweep.csv", result.sweep.to_csv),
         ("compare.json", _metadata_writer(result.metadata(), sections, t_start)),
@@ -686,6 +971,8 @@ DEMO_FIGURES = {
     "mean": "fig_mean_operating_point.png",
 }
 DEMO_REPORT = "report.md"
+#: Every file of the demo: its output set.
+DEMO_FILES = ("frf.csv", "sweep.csv", "frf.json", *DEMO_FIGURES.values(), DEMO_REPORT)
 
 
 def _draw_demo_figure(key: str, frf: Any, sweep: Any, orbits: dict[str, Any], level: Any) -> Callable[[], Any]:
@@ -718,6 +1005,7 @@ def _draw_demo_figure(key: str, frf: Any, sweep: Any, orbits: dict[str, Any], le
 
 
 @cli.command("demo", short_help="The paper's reference case end to end, with its figures and a report.")
+@_common_options
 @_output_option
 @click.option("-q", "--quiet", is_flag=True,
               help="No progress bar (there is none anyway when stderr is not a terminal).")
@@ -751,7 +1039,7 @@ def demo_command(output: Path, quiet: bool) -> None:
 
     # --- computation ---------------------------------------------------------------------------
     t0 = time.perf_counter()
-    frf = _compute_frf(model, analysis, output, sections, t_start, subharmonics=True)
+    frf = _compute_frf(model, analysis, output, sections, t_start, subharmonics=True, names=DEMO_FILES)
     timings["frf"] = time.perf_counter() - t0
 
     from ..analysis import confirm_with_sweep, periodic_orbit, time_sweep
@@ -794,23 +1082,30 @@ def demo_command(output: Path, quiet: bool) -> None:
                 "cli_wall_time": time.perf_counter() - t_start}
         write_metadata(path, **{**meta, **sections, "demo": demo_section, "timings": wall})
 
-    written = _write_outputs(output, [("frf.csv", frf.to_csv), ("sweep.csv", sweep.to_csv), ("frf.json", write_json)])
-    t0 = time.perf_counter()
-    figures: dict[str, str] = {}
-    for key, name in DEMO_FIGURES.items():
-        done = _write_outputs(output, [(name, lambda path, k=key: _save_figure(
-            _draw_demo_figure(k, frf, sweep, orbits, level), path))])
-        if done:
-            figures[key] = name
-            written += done
-    timings["figures"] = time.perf_counter() - t0
-    timings["total"] = time.perf_counter() - t_start
-
     from ..report import demo_report
 
-    text = demo_report(frf, sweep, orbits=orbits, level=level, figures=figures, regions=regions, timings=timings,
-                       data_files=["frf.csv", "frf.json", "sweep.csv"], version=rattle_version())
-    written += _write_outputs(output, [(DEMO_REPORT, lambda path: atomic_write_text(path, text))])
+    figures: dict[str, str] = {}
+
+    def write_figure(key: str, path: Path) -> bool:
+        done = _save_figure(_draw_demo_figure(key, frf, sweep, orbits, level), path)
+        if done:
+            figures[key] = path.name
+        return done
+
+    def write_report(path: Path) -> None:
+        timings["figures"] = time.perf_counter() - t_figures
+        timings["total"] = time.perf_counter() - t_start
+        text = demo_report(frf, sweep, orbits=orbits, level=level, figures=figures, regions=regions,
+                           timings=timings, data_files=["frf.csv", "frf.json", "sweep.csv"],
+                           version=rattle_version())
+        atomic_write_text(path, text)
+
+    t_figures = time.perf_counter()
+    written = write_set(output, DEMO_FILES, [
+        ("frf.csv", frf.to_csv), ("sweep.csv", sweep.to_csv), ("frf.json", write_json),
+        *[(name, lambda path, k=key: write_figure(k, path)) for key, name in DEMO_FIGURES.items()],
+        (DEMO_REPORT, write_report),
+    ])
 
     click.echo(frf.summary())
     click.echo(sweep.summary())
