@@ -210,6 +210,7 @@ def _run_parallel(
                 p.start()
                 processes.append(p)
                 running[d] = p
+                logger.info("%s sweep: worker process %d started", d, p.pid)
             try:
                 kind, d, payload = messages.get(timeout=_WATCH_INTERVAL)
             except queue_module.Empty:

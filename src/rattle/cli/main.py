@@ -93,6 +93,15 @@ class Interrupted(KeyboardInterrupt):
         self.signum = signum
 
 
+class _Stopped(Exception):
+    """An interruption carried through click's main loop (which would turn KeyboardInterrupt into
+    a generic "Aborted!")."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
 def _raise_interrupted(signum: int, _frame: object) -> None:
     raise Interrupted(signum)
 
@@ -225,10 +234,19 @@ class RattleGroup(click.Group):
         finally:
             _reset_verbose()
 
+    def invoke(self, ctx: click.Context) -> Any:
+        # click turns KeyboardInterrupt into Abort (and prints a blank line); keep the signal
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            raise _Stopped(exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT)) from None
+
     def _invoke(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None,
                 **extra: Any) -> int:
         try:
             rv = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except _Stopped as exc:
+            raise Interrupted(exc.signum) from None
         except _NoArgsIsHelpError as exc:  # bare `rattle`: show the help, as click does
             exc.show()
             return int(exc.exit_code)
