@@ -52,7 +52,7 @@ import math
 import warnings
 from typing import Any
 
-from ._validate import check_int, check_real
+from ._validate import check_int, check_real, show
 
 #: Harmonics of the solution's base frequency, at most (see the module docstring).
 MAX_HARMONICS = 256
@@ -72,6 +72,9 @@ MAX_PERIOD = 8
 MAX_SWEEP_POINTS = 100_000
 #: Budget of accepted continuation points, at most.
 MAX_CONTINUATION_POINTS = 1_000_000
+#: Entries of an elastic law's breakpoints/slopes or of the excitation's amplitudes, at most:
+#: the harmonic balance must carry every forcing harmonic (H >= their count, H <= 256).
+MAX_LIST_LENGTH = MAX_HARMONICS
 #: Worker processes, at most.
 MAX_WORKERS = 64
 #: Forcing frequency relative to the stiffest stage's natural frequency, at least / at most.
@@ -98,12 +101,12 @@ def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1) 
     h = check_int(name, value, 1)
     if h > MAX_HARMONICS:
         raise ValueError(
-            f"`{name}` must be <= {MAX_HARMONICS}, got {h}: {_H_REASON}; "
+            f"`{name}` must be <= {MAX_HARMONICS}, got {show(h)}: {_H_REASON}; "
             "use 32 (the default) to 128 — raise it only where the truncation error asks for it"
         )
     if period > 1 and h * period > MAX_EFFECTIVE_HARMONICS:
         raise ValueError(
-            f"`{name}` must be <= {MAX_EFFECTIVE_HARMONICS // period} for branches of period {period}, got {h}: "
+            f"`{name}` must be <= {MAX_EFFECTIVE_HARMONICS // period} for branches of period {period}, got {show(h)}: "
             f"a period-{period} branch carries {period}·H harmonics of the forcing frequency and "
             f"{period}·H = {h * period} exceeds {MAX_EFFECTIVE_HARMONICS} ({_H_REASON}); "
             f"lower `{name}` or the period"
@@ -122,13 +125,13 @@ def check_samples(value: object, harmonics: int, name: str = "samples", *, perio
     if n < low:
         raise ValueError(
             f"`{name}` must be >= 4*harmonics + 2 = {low} (so that the Jacobian's harmonics up to 2H "
-            f"are not aliased), got {n}; leave it out for the default"
+            f"are not aliased), got {show(n)}; leave it out for the default"
         )
     limit = MAX_SAMPLES // max(1, period)
     if n > limit:
         extra = f" for branches of period {period} (they carry {period}·N samples)" if period > 1 else ""
         raise ValueError(
-            f"`{name}` must be <= {limit}{extra}, got {n}: the AFT matrices hold samples × (2H + 1) "
+            f"`{name}` must be <= {limit}{extra}, got {show(n)}: the AFT matrices hold samples × (2H + 1) "
             f"numbers each ({MAX_SAMPLES} × 513 × 8 B = 67 MB at H = 256, twice that in the 2H "
             "re-location of special points); leave it out for the default (32 per harmonic)"
         )
@@ -140,7 +143,7 @@ def check_period(value: object, name: str = "period") -> int:
     p = check_int(name, value, 1)
     if p > MAX_PERIOD:
         raise ValueError(
-            f"`{name}` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), got {p}: "
+            f"`{name}` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), got {show(p)}: "
             f"periods above {MAX_PERIOD} are not detected (SPEC) and a period-p branch needs p·H "
             "harmonics; use 1 for the primary response, n for a 1/n sub-harmonic"
         )
@@ -152,7 +155,7 @@ def check_points(value: object, name: str = "points") -> int:
     n = check_int(name, value, 2)
     if n > MAX_SWEEP_POINTS:
         raise ValueError(
-            f"`{name}` must be <= {MAX_SWEEP_POINTS} (frequencies per sweep direction), got {n}: each "
+            f"`{name}` must be <= {MAX_SWEEP_POINTS} (frequencies per sweep direction), got {show(n)}: each "
             f"frequency is a steady-state simulation of 10 ms to seconds, so {MAX_SWEEP_POINTS} already "
             "take hours; use e.g. 200, or sweep a narrower range"
         )
@@ -164,7 +167,7 @@ def check_max_points(value: object, name: str = "max_points") -> int:
     n = check_int(name, value, 1)
     if n > MAX_CONTINUATION_POINTS:
         raise ValueError(
-            f"`{name}` must be <= {MAX_CONTINUATION_POINTS}, got {n}: every accepted point keeps its "
+            f"`{name}` must be <= {MAX_CONTINUATION_POINTS}, got {show(n)}: every accepted point keeps its "
             "coefficients and samples in memory; the reference case needs ~100 points"
         )
     return n
@@ -174,7 +177,7 @@ def check_workers(value: object, name: str = "workers") -> int:
     """Worker processes: an integer 1 … ``MAX_WORKERS``."""
     n = check_int(name, value, 1)
     if n > MAX_WORKERS:
-        raise ValueError(f"`{name}` must be <= {MAX_WORKERS} processes, got {n}; use e.g. 2")
+        raise ValueError(f"`{name}` must be <= {MAX_WORKERS} processes, got {show(n)}; use e.g. 2")
     return n
 
 

@@ -18,6 +18,15 @@ def _is_bool(value: object) -> bool:
     return isinstance(value, bool) or type(value).__name__ == "bool_"
 
 
+def show(value: object) -> str:
+    """``repr(value)``, with integers of more than 20 digits shortened (1e400 has 401)."""
+    text = repr(value)
+    if isinstance(value, Integral) and len(text) > 20:
+        digits = len(str(abs(int(value))))
+        text = f"{str(value)[:5]}… (an integer of {digits} digits)"
+    return text
+
+
 def check_real(value: object, name: str) -> float:
     """A real number (int, float or numpy scalar; not a bool or a string), finite."""
     if _is_bool(value) or not isinstance(value, Real):
@@ -25,7 +34,7 @@ def check_real(value: object, name: str) -> float:
     try:
         x = float(value)
     except OverflowError:  # an int beyond the float range
-        raise ValueError(f"`{name}` must be a finite number, got {value!r} (beyond the floating-point range)") from None
+        raise ValueError(f"`{name}` must be a finite number, got {show(value)} (beyond the floating-point range)") from None
     if not math.isfinite(x):
         raise ValueError(f"`{name}` must be finite, got {value!r}")
     return x
@@ -40,7 +49,7 @@ def check_omega(value: object, name: str = "omega") -> float:
     except OverflowError:
         w = math.inf
     if not (math.isfinite(w) and w > 0.0):
-        raise ValueError(f"`{name}` must be a finite forcing frequency > 0 rad/s, got {value!r}; use e.g. 0.8")
+        raise ValueError(f"`{name}` must be a finite forcing frequency > 0 rad/s, got {show(value)}; use e.g. 0.8")
     return w
 
 
@@ -82,7 +91,7 @@ def check_int(name: str, value: object, low: int) -> int:
     if _is_bool(value) or not isinstance(value, Integral):
         raise TypeError(f"`{name}` must be an integer, got {value!r} ({type(value).__name__})")
     if value < low:
-        raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
+        raise ValueError(f"`{name}` must be >= {low}, got {show(value)}")
     return int(value)
 
 
@@ -109,5 +118,5 @@ def check_instance(value: object, name: str, cls: type, what: str, optional: boo
     return value
 
 
-__all__ = ["check_real", "check_omega", "check_range", "check_state", "check_int", "check_bool", "check_choice",
+__all__ = ["show", "check_real", "check_omega", "check_range", "check_state", "check_int", "check_bool", "check_choice",
            "check_instance"]

@@ -16,7 +16,7 @@ from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise,
 @st.composite
 def piecewise_laws(draw):
     k = draw(st.integers(min_value=1, max_value=5))
-    d = sorted(draw(st.lists(st.floats(-2, 2, allow_nan=False), min_size=k, max_size=k, unique=True)))
+    d = sorted(draw(st.lists(st.floats(-1.5, 1.5, allow_nan=False), min_size=k, max_size=k, unique=True)))
     if any(b - a < 1e-6 for a, b in zip(d, d[1:])):
         d = list(np.linspace(-1.0, 1.0, k))
     slopes = draw(st.lists(st.floats(0.0, 3.0, allow_nan=False), min_size=k + 1, max_size=k + 1))

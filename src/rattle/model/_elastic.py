@@ -11,28 +11,33 @@ with offsets e_j fixed by continuity at the breakpoints and by f(0) = 0.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 
+from .._limits import MAX_LIST_LENGTH, check_magnitude, warn_clearance
 from .._typing import FloatArray, IntArray
 
 
 def _check_real(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise TypeError(f"`{name}` must be a real number, got {value!r} ({type(value).__name__})")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"`{name}` must be finite, got {value!r}")
-    return value
+    """A finite real number (Python or numpy scalar, not a bool) of magnitude <= MAX_MAGNITUDE.
+
+    The same rule as the library's arguments and the configuration file's values
+    (:func:`rattle._limits.check_magnitude`)."""
+    return check_magnitude(value, name)
 
 
 def _check_real_sequence(name: str, values: object) -> tuple[float, ...]:
-    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__") or hasattr(values, "items"):
         raise TypeError(f"`{name}` must be a list of real numbers, got {values!r}")
-    return tuple(_check_real(f"{name}[{i}]", v) for i, v in enumerate(values))  # type: ignore[union-attr]
+    values = list(values)  # type: ignore[call-overload]
+    if len(values) > MAX_LIST_LENGTH:
+        raise ValueError(
+            f"`{name}` must hold at most {MAX_LIST_LENGTH} numbers, got {len(values)}: every entry is a stage "
+            "or a forcing harmonic the harmonic balance must carry; use fewer"
+        )
+    return tuple(_check_real(f"{name}[{i}]", v) for i, v in enumerate(values))
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,6 +149,7 @@ class Backlash(AbstractElastic):
         b = _check_real("b", self.b)
         if b <= 0:
             raise ValueError(f"`b` (backlash) must be > 0 rad, got {b!r}")
+        warn_clearance(b, "b", stacklevel=4)
         object.__setattr__(self, "b", b)
         object.__setattr__(self, "_data", _stages((-b, b), (1.0, 0.0, 1.0)))
 
@@ -182,6 +188,7 @@ class Clutch(AbstractElastic):
             )
         if b <= 0:
             raise ValueError(f"`b` (clutch first-stage half-width) must be > 0 rad, got {b!r}")
+        warn_clearance(b, "b", stacklevel=4)
         object.__setattr__(self, "alpha", alpha)
         object.__setattr__(self, "b", b)
         object.__setattr__(self, "_data", _stages((-b, b), (1.0, alpha, 1.0)))
@@ -236,6 +243,10 @@ class Piecewise(AbstractElastic):
                 f"the outer `slopes` (first and last) must be > 0 so that the law confines the "
                 f"motion, got {list(s)!r}"
             )
+        if d:
+            widest = max(abs(d[0]), abs(d[-1]))
+            warn_clearance(widest, "breakpoints[0]" if abs(d[0]) >= abs(d[-1]) else f"breakpoints[{len(d) - 1}]",
+                           stacklevel=4)
         object.__setattr__(self, "breakpoints", d)
         object.__setattr__(self, "slopes", s)
         object.__setattr__(self, "_data", _stages(d, s))

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._limits import check_scales
 from ._elastic import AbstractElastic, _check_real
 from ._excitation import Excitation
 
@@ -21,7 +22,15 @@ from ._excitation import Excitation
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Model:
     """Frozen, validated model: ``inertia`` I > 0, ``damping`` C ≥ 0, ``stiffness`` K > 0,
-    ``elastic`` law and ``excitation``."""
+    ``elastic`` law and ``excitation``.
+
+    Every number is finite with magnitude ≤ 1e50, and so are the derived scales K/I, C/I, the
+    force scale |F_m| + Σ|F_pn| and the deflection scale (products of a few of them must stay
+    finite in double precision; see :mod:`rattle._limits`). ``damping`` = 0 is a valid model
+    (its motion can be integrated exactly) but the analyses refuse it: an undamped forced system
+    has no asymptotically stable periodic orbit (see
+    :func:`rattle._limits.check_analysable_model`).
+    """
 
     inertia: float
     damping: float
@@ -46,6 +55,9 @@ class Model:
         object.__setattr__(self, "inertia", inertia)
         object.__setattr__(self, "damping", damping)
         object.__setattr__(self, "stiffness", stiffness)
+        # k = K/I, c = C/I, the force and deflection scales within 1e-50 … 1e50 (rattle._limits):
+        # products of a few of them (an acceleration squared) must stay finite in double precision.
+        check_scales(self)
 
     # --- coefficients of the equation -------------------------------------------------------
     @property
