@@ -388,7 +388,7 @@ def test_analysis_settings_validate_themselves() -> None:
     assert AnalysisSettings() == AnalysisSettings(omega_min=0.1, omega_max=3.0, harmonics=32)
     with pytest.raises(ValueError, match=r"`harmonics` must be an integer >= 1, got 0"):
         AnalysisSettings(harmonics=0)
-    with pytest.raises(TypeError, match=r"`harmonics` must be an integer >= 1, got 2.5"):
+    with pytest.raises(TypeError, match=r"`harmonics` must be an integer, got 2.5"):
         AnalysisSettings(harmonics=2.5)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match=r"`omega_min` must be < `omega_max`"):
         AnalysisSettings(omega_min=2.0, omega_max=1.0)
@@ -411,7 +411,7 @@ def test_rename_keys() -> None:
 
 MODELS = [
     reference_case(),
-    Model(inertia=2.5, damping=0.0, stiffness=3.0, elastic=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,))),
+    Model(inertia=2.5, damping=1e-3, stiffness=3.0, elastic=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,))),
     Model(inertia=1.0, damping=0.1, stiffness=1.0, elastic=Backlash(b=1e-3),
           excitation=Excitation(mean=-0.05, amplitudes=(0.03, 0.01, 1 / 3), phases=(0.0, math.pi, -1e-7))),
     Model(inertia=0.5, damping=0.02, stiffness=4.0,

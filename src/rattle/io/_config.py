@@ -10,7 +10,14 @@ Schema (every other key is refused)::
                          amplitudes                       array of numbers, required, not empty
                          phases                           array of numbers, optional (default 0)
     [analysis]           omega                            [min, max] in rad/s, optional (default [0.1, 3.0])
-                         harmonics                        integer >= 1, optional (default 32)
+                         harmonics                        integer 1 … 256, optional (default 32)
+
+Bounds shared with the library (:mod:`rattle._limits`, the reasons are in the messages): every
+number finite with magnitude <= 1e50 (and K/I, C/I, the force and deflection scales too);
+``model.damping`` > 0 (an undamped system has no stable periodic orbit to analyse);
+``analysis.omega`` within 1e-3 … 1e3 times the stiffest stage's natural frequency; at most 256
+entries per array. A clearance ``b`` (or breakpoint) above pi/2 rad is warned about (degrees by
+mistake?), not refused.
 
 The ``[analysis]`` table holds numerical settings, not physics, so it may be left out: the
 defaults are the SPEC §2 example values and end up in the run metadata. Every physical
@@ -35,12 +42,14 @@ import math
 import os
 import re
 import sys
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 import numpy as np
 
+from .. import _limits
 from ..errors import ConfigError
 from ..model import ELASTIC_LAWS, AbstractElastic, Excitation, Model
 from ..model._elastic import _check_real
@@ -54,6 +63,7 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 __all__ = [
     "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "AnalysisSettings", "RunConfig",
     "load_config", "config_from_dict", "model_to_toml_dict", "dumps_toml", "rename_keys", "check_harmonics",
+    "check_analysis",
 ]
 
 #: Default forcing-frequency range ``analysis.omega`` (rad/s): the SPEC §2 example.
@@ -97,14 +107,8 @@ class AnalysisSettings:
                 f"`omega_max` = {omega_max!r}: the frequency range is empty; "
                 "give the lower frequency first and make the upper one larger"
             )
-        harmonics = self.harmonics
-        if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)):
-            raise TypeError(
-                f"`harmonics` must be an integer >= 1, got {harmonics!r} ({type(harmonics).__name__}); "
-                "write a whole number such as 32"
-            )
-        if harmonics < 1:
-            raise ValueError(f"`harmonics` must be an integer >= 1, got {int(harmonics)!r}; use e.g. 32")
+        # The same rule (and upper bound, from memory and time) as the library's `harmonics`.
+        harmonics = _limits.check_harmonics(self.harmonics, "harmonics")
         object.__setattr__(self, "omega_min", omega_min)
         object.__setattr__(self, "omega_max", omega_max)
         object.__setattr__(self, "harmonics", int(harmonics))
@@ -358,7 +362,14 @@ class _Checker:
     def build(self, factory: Callable[..., _T], names: Mapping[str, str], /, **kwargs: Any) -> _T:
         """Call ``factory(**kwargs)``; re-raise its ValueError/TypeError with the full key names."""
         try:
-            return factory(**kwargs)
+            # Warnings of the dataclasses (a clearance that looks like degrees) name their field:
+            # re-issue them with the full key, as the errors below.
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                result = factory(**kwargs)
+            for w in caught:
+                warnings.warn(f"{self.source_name}: {rename_keys(str(w.message), names)}", w.category, stacklevel=3)
+            return result
         except (ValueError, TypeError) as exc:
             message = str(exc)
             renamed = rename_keys(message, names)
@@ -475,6 +486,10 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
     )
     analysis = _analysis(check, analysis_t)
     check_harmonics(model, analysis.harmonics)
+    try:
+        check_analysis(model, analysis)
+    except ConfigError as exc:
+        raise check.error(str(exc)) from None
     return RunConfig(model=model, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name)
 
 
@@ -486,6 +501,26 @@ def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonic
             f"`{name}` must be >= {needed}, the number of excitation harmonics "
             f"(`excitation.amplitudes` has {needed}), got {harmonics}; raise `{name}`"
         )
+
+
+def check_analysis(
+    model: Model, analysis: AnalysisSettings, names: Mapping[str, str] | None = None
+) -> None:
+    """The rules that need the model and the analysis settings together (after
+    :func:`check_harmonics`): the analyses refuse zero damping, and the frequency range must lie
+    within the bounds relative to the model's stiffest stage (:mod:`rattle._limits`).
+
+    ``names`` maps ``omega_min`` / ``omega_max`` to the key or option the value came from
+    (default ``analysis.omega[0]`` / ``analysis.omega[1]``; the command line passes
+    ``--omega-min`` / ``--omega-max`` for the values it overrides). Raises ConfigError.
+    """
+    names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", **(names or {})}
+    try:
+        _limits.check_analysable_model(model)
+        _limits.check_frequency_range(model, analysis.omega_min, analysis.omega_max,
+                                      (names["omega_min"], names["omega_max"]))
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(str(exc)) from None
 
 
 def _elastic_structure(
