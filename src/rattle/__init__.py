@@ -46,12 +46,13 @@ _LAZY: dict[str, str] = {
         ".results",
     ),
     **dict.fromkeys(["SteadyStateOptions", "shoot_periodic_orbit", "steady_state"], ".timeint"),
+    "load_case": ".io",
 }
 
 __all__ = [
     "__version__",
     "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "reference_case", "backlash_case",
-    "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
+    "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
     "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions", "shoot_periodic_orbit",
     "periodic_orbit", "PeriodicOrbit", "compare", "Comparison",
     "HBOptions", "NewtonOptions", "ContinuationOptions",
@@ -81,6 +82,7 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .continuation import ContinuationOptions
     from .errors import ConfigError, ConvergenceError, RattleError, Status
     from .hb import HBOptions, NewtonOptions
+    from .io import load_case
     from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
     from .results import (
         FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult,

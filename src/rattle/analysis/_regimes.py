@@ -6,9 +6,11 @@ the intervals where no computed periodic solution is stable.
   amplitude, taken at the primary branch's lower fold (the jump-up frequency) when it has one,
   else at the rms_ac maximum;
 * sub-harmonic (period p > 1): an Ω interval where a period-p branch is stable;
-* no stable periodic solution: an Ω interval where none of the computed branches is stable —
-  the motion there is quasi-periodic, chaotic or periodic of a period not computed; a time
-  sweep decides (:func:`confirm_with_sweep`).
+* an Ω interval where none of the computed branches is stable, labelled by what is known
+  (:data:`UNSTABLE_KINDS`): bounded by a period doubling with sub-harmonics not computed (a
+  stable sub-harmonic is likely), sub-harmonics not computed otherwise, sub-harmonics computed
+  and none stable; only when a time sweep then finds no period ≤ 8 there too is it "no stable
+  periodic solution" (:func:`confirm_with_sweep`).
 """
 
 from __future__ import annotations
@@ -76,12 +78,67 @@ def superharmonic_resonances(frf: FrequencyResponse, branch: int = 0, prominence
     return out
 
 
+#: Region kinds for an interval where no computed periodic solution is stable, from the least
+#: to the most that is known (see :func:`label_regions` and :func:`confirm_with_sweep`).
+UNSTABLE_KINDS: tuple[str, ...] = (
+    "unstable_period_doubling",  # sub-harmonics not computed; a period doubling bounds the interval
+    "unstable_not_computed",     # sub-harmonics not computed; no period doubling there
+    "no_stable_computed",        # sub-harmonics computed (up to max_period), none stable there
+    "no_stable_periodic",        # … and a time sweep found no period ≤ 8 there either
+)
+
+_PERIOD_DOUBLING_TEXT = "period-{p} unstable (period doubling): stable period-{q} motion likely — run with --subharmonics (subharmonics=True)"
+
+
+def _gap_region(frf: FrequencyResponse, a: float, b: float, tol: float) -> Region:
+    """The region of an interval [a, b] where none of the computed branches is stable, labelled
+    by what is known: whether sub-harmonic branches were computed, and what bounds it."""
+    inside = [sp for sp in frf.special_points if a - tol <= float(frf.omega[sp.index]) <= b + tol]
+    kinds = sorted({sp.kind for sp in inside})
+    # Genuine period doublings (a multiplier at −1 on the branch; not the birth row of a
+    # switched branch, whose multiplier there is +1).
+    pds = [sp for sp in inside if sp.kind == "period_doubling" and sp.multipliers[0].real < 0]
+    periods_there = sorted({int(frf.period[sp.index]) for sp in pds})
+    computed = bool(frf.settings.get("subharmonics", False)) if isinstance(frf.settings, dict) else False
+    detail: dict[str, Any] = {"subharmonics_computed": computed, "bounded_by": kinds}
+    if computed:
+        max_period = int(frf.settings.get("max_period", int(np.max(frf.period))))
+        detail["max_period"] = max_period
+        found = sorted({int(p) for p in np.unique(frf.period)})
+        return Region(
+            "no_stable_computed", a, b,
+            f"no stable orbit of period ≤ {max_period} computed (branches of period {', '.join(map(str, found))} "
+            "unstable or absent here) — a time sweep tells what the motion is",
+            detail,
+        )
+    if pds:
+        p = periods_there[0]
+        detail["period"] = p
+        return Region("unstable_period_doubling", a, b, _PERIOD_DOUBLING_TEXT.format(p=p, q=2 * p), detail)
+    if "neimark_sacker" in kinds:
+        what = "period-1 unstable (Neimark–Sacker): quasi-periodic motion likely"
+    else:
+        what = "no stable period-1 solution"
+    return Region(
+        "unstable_not_computed", a, b,
+        f"{what}; sub-harmonics not computed — run with --subharmonics (subharmonics=True) or a time sweep",
+        detail,
+    )
+
+
 def label_regions(frf: FrequencyResponse, min_gap: float = 1e-4) -> tuple[Region, ...]:
     """All regions of a (possibly multi-branch) frequency response, sorted by Ω.
 
-    A gap between stable stretches narrower than ``min_gap`` × (Ω range) is not reported as a
-    region without a stable solution: branches meet at located points (accurate to ~1e-6 in Ω),
-    and such slivers are where two stretches join, not a physical interval."""
+    An interval where none of the computed branches is stable is never called "no stable
+    periodic solution" here (that takes sub-harmonics computed *and* a simulation, see
+    :func:`confirm_with_sweep`); its kind says what is known (:data:`UNSTABLE_KINDS`):
+    ``unstable_period_doubling`` when sub-harmonics were not computed and a period doubling
+    bounds it (a stable period-2p motion is likely), ``unstable_not_computed`` when they were not
+    computed otherwise, ``no_stable_computed`` when they were and none is stable there.
+
+    A gap between stable stretches narrower than ``min_gap`` × (Ω range) is not reported:
+    branches meet at located points (accurate to ~1e-6 in Ω), and such slivers are where two
+    stretches join, not a physical interval."""
     regions: list[Region] = []
     for b in np.unique(frf.branch):
         period = int(frf.period[frf.branch == b][0])
@@ -92,31 +149,45 @@ def label_regions(frf: FrequencyResponse, min_gap: float = 1e-4) -> tuple[Region
                 regions.append(Region("subharmonic", lo, hi, f"period {period} (1/{period} sub-harmonic)", {"period": period, "branch": int(b)}))
     covered = _union([iv for b in np.unique(frf.branch) for iv in stable_intervals(frf, int(b))])
     lo_all, hi_all = float(frf.omega.min()), float(frf.omega.max())
+    tol = 1e-6 * (hi_all - lo_all)
     edge = lo_all
     for a, b in covered + [(hi_all, hi_all)]:
         if a - edge > min_gap * (hi_all - lo_all):
-            regions.append(Region("no_stable_periodic", edge, a, "no stable periodic solution (quasi-periodic or chaotic?)", {}))
+            regions.append(_gap_region(frf, edge, a, tol))
         edge = max(edge, b)
     return tuple(sorted(regions, key=lambda r: (r.omega_min, r.kind)))
 
 
+def _periods_text(periods: list[int]) -> str:
+    return ", ".join(f"period {p}" if p else "no period ≤ 8" for p in periods)
+
+
 def confirm_with_sweep(regions: tuple[Region, ...], sweep: Any) -> tuple[Region, ...]:
-    """Add to each region the periods a time-domain ``sweep`` (SweepResult) saw inside it; a
-    ``no_stable_periodic`` region is relabelled quasi-periodic/chaotic when the simulation found
-    no period ≤ 8 (period 0) there, or by the period it did find."""
+    """Add to each region the periods a time-domain ``sweep`` (SweepResult) saw inside it, and
+    say them in the label of every interval without a stable computed orbit.
+
+    Only an interval whose sub-harmonics were computed (``no_stable_computed``) and where the
+    simulation found no period ≤ 8 (period 0) becomes ``no_stable_periodic``, "no stable
+    periodic solution (quasi-periodic or chaotic)"; without sub-harmonics computed the label
+    keeps saying so."""
     out = []
     for r in regions:
         inside = (sweep.omega >= r.omega_min) & (sweep.omega <= r.omega_max)
         periods = sorted(set(int(p) for p in sweep.period[inside]))
         detail = dict(r.detail, sweep_periods=periods)
-        label = r.label
-        if r.kind == "no_stable_periodic" and periods:
-            if periods == [0]:
-                label = "quasi-periodic or chaotic (no period ≤ 8 in the simulation)"
+        label, kind = r.label, r.kind
+        if kind in UNSTABLE_KINDS and periods:
+            if periods == [0] and kind in ("no_stable_computed", "no_stable_periodic"):
+                kind = "no_stable_periodic"
+                label = (f"no stable periodic solution: none of period ≤ {detail.get('max_period', '?')} computed "
+                         "and the simulation finds no period ≤ 8 (quasi-periodic or chaotic)")
+            elif kind == "unstable_period_doubling" and any(p > 1 for p in periods):
+                label = (f"period-{detail.get('period', 1)} unstable (period doubling); simulation: "
+                         f"{_periods_text(periods)} — run with --subharmonics (subharmonics=True) for the branches")
             else:
-                label = "no stable computed orbit; simulation: period " + ", ".join(str(p) if p else "none ≤ 8" for p in periods)
-        out.append(replace(r, label=label, detail=detail))
+                label = f"{r.label.split(' — ')[0].split('; sub-harmonics')[0]}; simulation: {_periods_text(periods)}"
+        out.append(replace(r, kind=kind, label=label, detail=detail))
     return tuple(out)
 
 
-__all__ = ["Region", "label_regions", "superharmonic_resonances", "stable_intervals", "confirm_with_sweep"]
+__all__ = ["Region", "label_regions", "superharmonic_resonances", "stable_intervals", "confirm_with_sweep", "UNSTABLE_KINDS"]

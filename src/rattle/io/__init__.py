@@ -12,6 +12,7 @@ from ._config import (
     check_harmonics,
     config_from_dict,
     dumps_toml,
+    load_case,
     load_config,
     model_to_toml_dict,
     rename_keys,
@@ -22,7 +23,7 @@ from ._metadata import environment, metadata_document, rattle_version, to_jsonab
 
 __all__ = [
     # configuration
-    "load_config", "config_from_dict", "RunConfig", "AnalysisSettings",
+    "load_config", "load_case", "config_from_dict", "RunConfig", "AnalysisSettings",
     "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "model_to_toml_dict", "dumps_toml", "rename_keys",
     "check_harmonics",
     # csv

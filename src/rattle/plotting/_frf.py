@@ -27,6 +27,16 @@ QUANTITY_LABELS: dict[str, str] = {
 _LEGEND_PLACES = ("outside", "inside", "none")
 #: Face colour of a ``no_stable_periodic`` band (hatched).
 NO_STABLE_COLOR = "0.6"
+#: How each kind of interval without a stable computed orbit is drawn: (hatch, edge colour,
+#: legend text, short text on the band). Only ``no_stable_periodic`` (sub-harmonics computed
+#: and a simulation found no period ≤ 8) says "no stable periodic solution".
+UNSTABLE_REGION_STYLES: dict[str, tuple[str, str, str, str]] = {
+    "unstable_period_doubling": ("\\\\", "tab:purple",
+                                 "period 1 unstable (period doubling):\nperiod 2 likely, not computed", "period 2\nlikely"),
+    "unstable_not_computed": ("..", "0.5", "no stable period-1 orbit;\nsub-harmonics not computed", "P1\nunstable"),
+    "no_stable_computed": ("xx", "0.5", "no stable orbit computed\n(sub-harmonics included)", "none\nstable"),
+    "no_stable_periodic": ("//", NO_STABLE_COLOR, "no stable periodic solution\n(simulation: none ≤ 8)", "no stable\nperiodic"),
+}
 #: (band colour, label colour) of the stable sub-harmonic bands, by period.
 SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {
     2: ("#f5c342", "#8a6100"), 3: ("#9ad39a", "#2e6b2e"), 4: ("#c9a3e0", "#5b2d7a"),
@@ -119,8 +129,9 @@ def draw_regions(
     """Shade and label the named regions.
 
     ``subharmonic``: a light band (a colour per period), labelled "period p" at the top of the
-    axes; ``no_stable_periodic``: a hatched grey band; ``superharmonic``: a small "1/k" label
-    just above the resonance peak.
+    axes; an interval without a stable computed orbit: a hatched band whose hatch and legend
+    say what is known (:data:`UNSTABLE_REGION_STYLES`; "no stable periodic solution" only for
+    ``no_stable_periodic``); ``superharmonic``: a small "1/k" label just above the resonance peak.
     """
     from matplotlib.transforms import blended_transform_factory
 
@@ -139,11 +150,17 @@ def draw_regions(
             ax.text(0.5 * (r.omega_min + r.omega_max), 0.985, f"period {period}", transform=top,
                     ha="center", va="top", fontsize=8, color=text_color, fontweight="bold",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8}, zorder=6)
-        elif r.kind == "no_stable_periodic":
-            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=NO_STABLE_COLOR, hatch="//", lw=0,
-                       zorder=0, label="no stable periodic solution" if labels and "none" not in seen else None)
-            seen.add("none")
-            ax.text(0.5 * (r.omega_min + r.omega_max), 0.93, "no stable\nperiodic", transform=top,
+        elif r.kind in UNSTABLE_REGION_STYLES:
+            hatch, edge, legend_text, short = UNSTABLE_REGION_STYLES[r.kind]
+            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=edge, hatch=hatch, lw=0,
+                       zorder=0, label=legend_text if labels and r.kind not in seen else None)
+            seen.add(r.kind)
+            sim = [int(p) for p in r.detail.get("sweep_periods", []) or []]
+            if r.kind == "unstable_period_doubling":
+                short = f"period {2 * int(r.detail.get('period', 1))}\nlikely"
+            if sim and r.kind != "no_stable_periodic":
+                short = "sim: " + ",".join(f"P{p}" if p else "none" for p in sim)
+            ax.text(0.5 * (r.omega_min + r.omega_max), 0.93, short, transform=top,
                     ha="center", va="top", fontsize=7, color="0.25",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}, zorder=6)
         elif r.kind == "superharmonic":
@@ -190,7 +207,9 @@ def frequency_response_plot(
     Each branch has its colour (its period in the legend), stable stretches solid and unstable
     ones dashed. Special points are marked by type (fold ○, period doubling □, Neimark–Sacker
     ◇). The regions are shaded: a stable sub-harmonic as a light band labelled "period p", an
-    interval without a stable periodic solution as a hatched band, and each super-harmonic
+    interval without a stable computed orbit as a hatched band (hatch and legend say what is
+    known: a period doubling with sub-harmonics not computed, none stable with sub-harmonics
+    computed, no periodic motion in the simulation either), and each super-harmonic
     resonance gets a small "1/k" label at its peak. The linear system's response (f = δ) is
     overlaid in grey.
 
