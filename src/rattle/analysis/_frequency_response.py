@@ -11,6 +11,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import _limits, _validate
 from .._typing import FloatArray
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..continuation._detect import LocatedPoint, locate_on_segment
@@ -27,16 +28,9 @@ logger = logging.getLogger("rattle")
 
 
 def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
-    """Validate a frequency-range argument (min, max) in rad/s; messages name ``name``."""
-    try:
-        lo, hi = (float(v) for v in omega)  # type: ignore[attr-defined]
-    except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {omega!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise ValueError(f"`{name}` must be finite, got {omega!r}")
-    if not 0 < lo < hi:
-        raise ValueError(f"`{name}` must satisfy 0 < min < max, got ({lo}, {hi}); give the range as (min, max) rad/s")
-    return lo, hi
+    """Validate a frequency-range argument (min, max) in rad/s; messages name ``name``
+    (:func:`rattle._validate.check_range`: two finite numbers, 0 < min < max)."""
+    return _validate.check_range(omega, name)
 
 
 def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> tuple[FloatArray, str]:
@@ -210,15 +204,22 @@ def frequency_response(
     ``rattle.analysis._settings``), NewtonOptions, ContinuationOptions and stability method;
     ``result.settings["branches"]`` records what each branch actually used.
     """
-    lo, hi = check_range(omega)
-    if start not in ("low", "high"):
-        raise ValueError(f"`start` must be 'low' or 'high', got {start!r}")
-    if stability not in ("monodromy", "hill"):
-        raise ValueError(f"`stability` must be 'monodromy' or 'hill', got {stability!r}")
-    if continuation is not None and not isinstance(continuation, ContinuationOptions):
-        raise TypeError(f"`continuation` must be a ContinuationOptions, got {continuation!r}")
-    if newton is not None and not isinstance(newton, NewtonOptions):
-        raise TypeError(f"`newton` must be a NewtonOptions, got {newton!r}")
+    # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
+    _limits.check_analysable_model(model)
+    lo, hi = _limits.check_frequency_range(model, *check_range(omega))
+    _validate.check_choice(start, "start", ("low", "high"))
+    _validate.check_choice(stability, "stability", ("monodromy", "hill"))
+    period = _limits.check_period(period)
+    subharmonics = _validate.check_bool(subharmonics, "subharmonics")
+    max_period = _limits.check_period(max_period, "max_period")
+    throw = _validate.check_bool(throw, "throw")
+    # The largest sub-problem: a period-P branch (P = max_period, or up to 8 for the sweep's and
+    # the seeds' motions) carries P·H harmonics, and its special points are re-located with 2P·H.
+    largest = 1 if not subharmonics else (_limits.MAX_PERIOD if (sweep is not None or len(seeds)) else max_period)
+    _limits.check_hb_settings(harmonics, samples, hb, period=largest)
+    _validate.check_instance(continuation, "continuation", ContinuationOptions, "a ContinuationOptions")
+    _validate.check_instance(newton, "newton", NewtonOptions, "a NewtonOptions")
+    _limits.check_callback(callback)
     run = RunSettings.make(resolve_hb(harmonics, samples, hb), newton, continuation, stability)
     return _frequency_response(
         model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,
