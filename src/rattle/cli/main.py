@@ -365,6 +365,12 @@ def override_analysis(base: AnalysisSettings, model: Model | None = None, **opti
         raise ConfigError(rename_keys(str(exc), names)) from exc
     if model is not None:
         check_harmonics(model, analysis.harmonics, names["harmonics"])
+        if "omega_min" in given or "omega_max" in given:  # the file's own range was checked on loading
+            from .. import _limits
+
+            with _as_bad_input():
+                _limits.check_frequency_range(model, analysis.omega_min, analysis.omega_max,
+                                              (names["omega_min"], names["omega_max"]))
     return analysis
 
 
@@ -705,26 +711,49 @@ _quiet_option = click.option(
 )
 
 
+@contextlib.contextmanager
+def _as_bad_input() -> Iterator[None]:
+    """The library's argument checks (ValueError/TypeError naming the argument) as ConfigError."""
+    try:
+        yield
+    except (ValueError, TypeError) as exc:
+        if isinstance(exc, ConfigError):
+            raise
+        raise ConfigError(str(exc)) from exc
+
+
 def check_points(points: int) -> int:
-    """``--points`` N: an integer >= 2 (a sweep needs two frequencies)."""
+    """``--points`` N: an integer 2 … ``rattle._limits.MAX_SWEEP_POINTS`` (the library's rule)."""
     if points < 2:
         raise ConfigError(
             f"`--points` must be an integer >= 2 (frequencies per sweep direction), got {points}; use e.g. 200"
         )
-    return points
+    from .. import _limits
+
+    with _as_bad_input():
+        return _limits.check_points(points, "--points")
 
 
 def check_workers(workers: int) -> int:
-    """``--workers``: an integer >= 1 (2 runs the up and down sweeps at once)."""
+    """``--workers``: an integer 1 … ``rattle._limits.MAX_WORKERS`` (2 runs the up and down sweeps at once)."""
     if workers < 1:
         raise ConfigError(f"`--workers` must be an integer >= 1, got {workers}; use 1 (serial) or 2")
-    return workers
+    from .. import _limits
+
+    with _as_bad_input():
+        return _limits.check_workers(workers, "--workers")
 
 
-def check_omega(omega: float, option: str = "--omega") -> float:
-    """A forcing frequency given on the command line: finite and > 0 rad/s."""
+def check_omega(omega: float, option: str = "--omega", model: Model | None = None) -> float:
+    """A forcing frequency given on the command line: finite and > 0 rad/s, and with ``model``
+    within the library's bounds relative to its stiffest stage (``rattle._limits``)."""
     if not (math.isfinite(omega) and omega > 0.0):
         raise ConfigError(f"`{option}` must be a finite forcing frequency > 0 rad/s, got {omega!r}; use e.g. 0.8")
+    if model is not None:
+        from .. import _limits
+
+        with _as_bad_input():
+            _limits.check_frequency(model, omega, option)
     return omega
 
 
@@ -894,7 +923,7 @@ def orbit_command(
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
-    check_omega(omega)
+    check_omega(omega, model=run_config.model)
     check_period(period, analysis.harmonics, len(run_config.model.excitation.amplitudes))
     check_output_dir(output)
     t_start = time.perf_counter()
