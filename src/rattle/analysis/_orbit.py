@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .. import _limits, _validate
 from .._validate import check_omega, check_state
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError
@@ -68,17 +69,7 @@ _REDUCE_TOL = 1e-7
 
 
 def _check_period(period: object) -> int:
-    if isinstance(period, bool) or not isinstance(period, (int, np.integer)):
-        raise TypeError(
-            f"`period` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), "
-            f"got {period!r} ({type(period).__name__})"
-        )
-    if not 1 <= int(period) <= MAX_PERIOD:
-        raise ValueError(
-            f"`period` must be an integer 1 … {MAX_PERIOD} (multiple of the forcing period), got {int(period)}; "
-            "use 1 for the primary response, n for a 1/n sub-harmonic"
-        )
-    return int(period)
+    return _limits.check_period(period)
 
 
 def default_search_range(model: Model, omega: float) -> tuple[float, float]:
@@ -392,10 +383,11 @@ def periodic_orbit(
     ConvergenceError
         If no periodic solution could be found at all.
     """
-    if not isinstance(model, Model):
-        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    W = check_omega(omega)
+    # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
+    _limits.check_analysable_model(model)
+    W = _limits.check_frequency(model, omega)
     period = _check_period(period)
+    _limits.check_hb_settings(harmonics, samples, hb)
     hb_opts = resolve_hb(harmonics, samples, hb)  # validates `harmonics` and `samples`
     harmonics = hb_opts.harmonics
     stability = check_stability(stability)
@@ -405,8 +397,7 @@ def periodic_orbit(
             f"`harmonics` must be >= {forced * period} to hold the excitation's harmonic {forced} at "
             f"`period` {period} (harmonics count multiples of Ω/period), got {harmonics}"
         )
-    if not isinstance(simulate, bool):
-        raise TypeError(f"`simulate` must be True or False, got {simulate!r}")
+    simulate = _validate.check_bool(simulate, "simulate")
     if frf is not None and not isinstance(frf, FrequencyResponse):
         raise TypeError(f"`frf` must be a FrequencyResponse or None, got {type(frf).__name__}")
     if newton is not None and not isinstance(newton, NewtonOptions):
@@ -415,7 +406,14 @@ def periodic_orbit(
         raise TypeError(f"`continuation` must be a ContinuationOptions, got {continuation!r}")
     if steady_options is not None and not isinstance(steady_options, SteadyStateOptions):
         raise TypeError(f"`steady_options` must be a SteadyStateOptions, got {steady_options!r}")
-    lo, hi = default_search_range(model, W) if search_range is None else check_range(search_range, "search_range")
+    if search_range is None:
+        lo, hi = default_search_range(model, W)
+        # Within the frequency bounds relative to the model (W itself is within them).
+        ws = _limits.stiffest_frequency(model)
+        lo, hi = max(lo, _limits.MIN_OMEGA_RATIO * ws), min(hi, _limits.MAX_OMEGA_RATIO * ws)
+    else:
+        lo, hi = _limits.check_frequency_range(model, *check_range(search_range, "search_range"),
+                                               ("search_range", "search_range"))
     lo, hi = min(lo, W), max(hi, W)
     if x0 is None:
         start_state = np.zeros(2)
