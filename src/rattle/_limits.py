@@ -75,6 +75,8 @@ MAX_CONTINUATION_POINTS = 1_000_000
 #: Entries of an elastic law's breakpoints/slopes or of the excitation's amplitudes, at most:
 #: the harmonic balance must carry every forcing harmonic (H >= their count, H <= 256).
 MAX_LIST_LENGTH = MAX_HARMONICS
+#: Frequencies examined in detail by ``compare(at=…)`` (a periodic-orbit search each), at most.
+MAX_DETAIL_FREQUENCIES = 100
 #: Worker processes, at most.
 MAX_WORKERS = 64
 #: Forcing frequency relative to the stiffest stage's natural frequency, at least / at most.

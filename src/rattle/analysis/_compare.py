@@ -24,12 +24,14 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from numbers import Real
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .. import _limits, _validate
 from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
 from ..model import Model
@@ -197,10 +199,12 @@ def _check_at(at: object, lo: float, hi: float) -> list[float]:
         raise TypeError(f"`at` must be a sequence of frequencies in rad/s, got {at!r}")
     out = []
     for w in at:  # type: ignore[union-attr]
+        if _validate._is_bool(w) or not isinstance(w, Real):
+            raise TypeError(f"`at` must hold numbers (rad/s), got {w!r} ({type(w).__name__})")
         try:
             x = float(w)
-        except (TypeError, ValueError):
-            raise TypeError(f"`at` must hold numbers (rad/s), got {w!r}") from None
+        except OverflowError:
+            x = math.inf
         if not (math.isfinite(x) and lo <= x <= hi):
             raise ValueError(
                 f"`at` frequencies must be finite and within the range {lo:g} … {hi:g} rad/s, got {w!r}"
@@ -208,6 +212,11 @@ def _check_at(at: object, lo: float, hi: float) -> list[float]:
         out.append(x)
     if not out:
         raise ValueError("`at` must hold at least one frequency (or be None to pick them automatically)")
+    if len(out) > _limits.MAX_DETAIL_FREQUENCIES:
+        raise ValueError(
+            f"`at` must hold at most {_limits.MAX_DETAIL_FREQUENCIES} frequencies, got {len(out)}: each one is "
+            "a periodic-orbit search with simulations (seconds each); use `time_sweep` for many frequencies"
+        )
     return sorted(out)
 
 
@@ -259,9 +268,15 @@ def compare(
     -------
     Comparison
     """
-    if not isinstance(model, Model):
-        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    lo, hi = check_range(omega)
+    # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file
+    # (all of them before the frequency response, so that a bad `points` is not found after it).
+    _limits.check_analysable_model(model)
+    lo, hi = _limits.check_frequency_range(model, *check_range(omega))
+    _limits.check_hb_settings(harmonics, samples, hb)
+    _limits.check_points(points)
+    _limits.check_workers(workers)
+    _validate.check_instance(options, "options", SteadyStateOptions, "a SteadyStateOptions")
+    _limits.check_callback(callback)
     chosen = None if at is None else _check_at(at, lo, hi)
     run = RunSettings.make(resolve_hb(harmonics, samples, hb), newton, continuation, stability)
     t0 = time.perf_counter()

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .. import _limits, _validate
 from .._typing import FloatArray
 from ..continuation import ContinuationOptions
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
@@ -28,8 +29,15 @@ def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, 
     problem does not converge at fixed Ω (fold tips, where ∂R/∂q is singular). The finer
     problem uses ``newton`` and the HB options ``hb`` of the run (an explicit sample count scaled
     with the harmonic count; default: the samples recorded in ``frf.settings``, else default)."""
-    if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
-        raise ValueError(f"`factor` must be an integer >= 2, got {factor!r}")
+    _validate.check_instance(frf, "frf", FrequencyResponse, "a FrequencyResponse", optional=False)
+    factor = _validate.check_int("factor", factor, 2)
+    if factor * frf.harmonics > _limits.PROBLEM_MAX_HARMONICS:
+        raise ValueError(
+            f"`factor` must be <= {max(2, _limits.PROBLEM_MAX_HARMONICS // frf.harmonics)} for a response with "
+            f"{frf.harmonics} harmonics, got {factor}: the finer problem would carry {factor * frf.harmonics} "
+            f"harmonics (at most {_limits.PROBLEM_MAX_HARMONICS}; memory grows as H², time as H³); use 2"
+        )
+    _validate.check_instance(newton, "newton", NewtonOptions, "a NewtonOptions")
     idx = np.arange(len(frf)) if rows is None else np.asarray(rows, dtype=int)
     out = np.full(idx.size, np.nan)
     problems: dict[tuple[int, int], HarmonicBalance] = {}
@@ -83,8 +91,17 @@ def adaptive_frequency_response(
     from ._frequency_response import frequency_response
     from ._settings import resolve_hb
 
-    if not (isinstance(tolerance, (int, float)) and 0 < tolerance < 1):
+    # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
+    _limits.check_analysable_model(model)
+    _limits.check_frequency_range(model, *_validate.check_range(omega))
+    tolerance = _validate.check_real(tolerance, "tolerance")
+    if not 0 < tolerance < 1:
         raise ValueError(f"`tolerance` must be in (0, 1), got {tolerance!r}")
+    subharmonics = _validate.check_bool(subharmonics, "subharmonics")
+    largest = 4 if subharmonics else 1  # frequency_response's default max_period
+    _limits.check_hb_settings(harmonics, samples, hb, period=largest)
+    max_harmonics = _limits.check_harmonics(max_harmonics, "max_harmonics", period=largest)
+    every = _validate.check_int("every", every, 1)
     hb0 = resolve_hb(harmonics, samples, hb)
     H = hb0.harmonics
     history: list[dict[str, object]] = []

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .. import _limits
 from .._validate import check_int
 from ..errors import RattleError
 from ..model import Model
@@ -294,15 +295,15 @@ def time_sweep(
         One row per frequency in sweep order (up rows first for ``both``), with the SPEC
         ``sweep.csv`` columns, effort, states and provenance.
     """
-    if not isinstance(model, Model):
-        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    lo, hi = check_range(omega)
-    points = check_int("points", points, 2)
+    # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
+    _limits.check_analysable_model(model)
+    lo, hi = _limits.check_frequency_range(model, *check_range(omega))
+    points = _limits.check_points(points)
     if not isinstance(direction, str) or direction not in DIRECTIONS:
         raise ValueError(
             f"`direction` must be one of {', '.join(repr(d) for d in DIRECTIONS)}, got {direction!r}"
         )
-    workers = check_int("workers", workers, 1)
+    workers = _limits.check_workers(workers)
     if options is None:
         options = SteadyStateOptions()
     elif not isinstance(options, SteadyStateOptions):
