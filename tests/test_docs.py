@@ -284,6 +284,16 @@ def test_labels_and_status_values_are_documented():
         assert f"`{status.name.lower()}`" in outputs, f"status {status.name.lower()} is not in docs/outputs.md"
 
 
+def test_region_kinds_are_documented():
+    from rattle.analysis import _regimes
+
+    kinds = {"superharmonic", "subharmonic", *getattr(_regimes, "UNSTABLE_KINDS", ())}
+    kinds |= set(re.findall(r'Region\(\s*"(\w+)"', Path(_regimes.__file__).read_text(encoding="utf-8")))
+    outputs = _text("outputs.md")
+    for kind in sorted(kinds):
+        assert f"| `{kind}` |" in outputs, f"region kind `{kind}` has no row in docs/outputs.md"
+
+
 # --------------------------------------------------------------------------------------------
 # The Python page runs
 # --------------------------------------------------------------------------------------------
