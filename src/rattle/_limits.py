@@ -75,6 +75,10 @@ MAX_CONTINUATION_POINTS = 1_000_000
 #: Entries of an elastic law's breakpoints/slopes or of the excitation's amplitudes, at most:
 #: the harmonic balance must carry every forcing harmonic (H >= their count, H <= 256).
 MAX_LIST_LENGTH = MAX_HARMONICS
+#: Forcing periods a steady-state simulation may run while settling (~0.5 ms each), at most.
+MAX_SETTLING_PERIODS = 100_000
+#: Forcing periods recorded / Poincaré points kept by a steady-state simulation, at most.
+MAX_RECORD_PERIODS = 10_000
 #: Frequencies examined in detail by ``compare(at=…)`` (a periodic-orbit search each), at most.
 MAX_DETAIL_FREQUENCIES = 100
 #: Worker processes, at most.

@@ -147,7 +147,7 @@ def test_directions_start_from_rest():
         ({"omega": (1.0, 0.5)}, ValueError, r"`omega` must satisfy 0 < min < max"),
         ({"omega": (0.0, 1.0)}, ValueError, r"`omega` must satisfy 0 < min < max"),
         ({"omega": (0.1, math.nan)}, ValueError, r"`omega` must be finite"),
-        ({"omega": 3.0}, ValueError, r"`omega` must be a pair"),
+        ({"omega": 3.0}, TypeError, r"`omega` must be a pair"),  # a wrong type: TypeError (shared rule)
         ({"workers": 0}, ValueError, r"`workers` must be >= 1"),
         ({"callback": 3}, TypeError, r"`callback` must be callable"),
         ({"options": {"tolerance": 1e-6}}, TypeError, r"`options` must be a SteadyStateOptions"),

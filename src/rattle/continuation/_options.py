@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import math
+from numbers import Integral
 from dataclasses import dataclass
+
+from .._limits import check_max_points
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -46,8 +49,10 @@ class ContinuationOptions:
             raise ValueError(f"`max_turn` must be < pi/2 rad, got {self.max_turn}")
         for name in ("target_iterations", "max_points"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            if isinstance(v, bool) or not isinstance(v, Integral) or v < 1:
                 raise ValueError(f"`{name}` must be an integer >= 1, got {v!r}")
+            object.__setattr__(self, name, int(v))  # numpy integers accepted, stored as int
+        check_max_points(self.max_points)  # upper bound from memory (rattle._limits)
         if self.max_time is not None and (isinstance(self.max_time, bool) or not isinstance(self.max_time, (int, float)) or not self.max_time > 0):
             raise ValueError(f"`max_time` must be None or a number of seconds > 0, got {self.max_time!r}")
 

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
+from .. import _limits
 from .._validate import check_int, check_omega, check_state
 from ..model import Model
 from ._exact import ExactIntegrator, ExactMeasures, Trajectory
@@ -130,6 +131,18 @@ class SteadyStateOptions:
         for name, low in (("max_periods", 1), ("max_period_multiple", 1), ("record_periods", 1),
                           ("shooting_iterations", 0), ("section_points", 1)):
             object.__setattr__(self, name, check_int(name, getattr(self, name), low))
+        # Upper bounds (rattle._limits): an exactly integrated forcing period costs ~0.5 ms on the
+        # reference case, so max_periods = 100 000 is ~1 min per frequency already.
+        _limits.check_period(self.max_period_multiple, "max_period_multiple")
+        for name, high, why in (
+            ("max_periods", _limits.MAX_SETTLING_PERIODS,
+             "each forcing period is integrated exactly (~0.5 ms), so this is ~1 min per frequency; use e.g. 1500"),
+            ("record_periods", _limits.MAX_RECORD_PERIODS, "the measures of an unsettled motion need tens; use e.g. 50"),
+            ("section_points", _limits.MAX_RECORD_PERIODS, "the Poincaré points kept; use e.g. 32"),
+            ("shooting_iterations", _limits.MAX_NEWTON_ITERATIONS, "Newton converges in 2–5 iterations; use e.g. 10"),
+        ):
+            if getattr(self, name) > high:
+                raise ValueError(f"`{name}` must be <= {high}, got {getattr(self, name)}: {why}")
         if not isinstance(self.accelerate, (bool, np.bool_)):
             raise TypeError(f"`accelerate` must be True or False, got {self.accelerate!r}")
         object.__setattr__(self, "accelerate", bool(self.accelerate))
@@ -492,9 +505,8 @@ def steady_state(
         Period (0 when nothing settled within ``max_periods``), orbit, measures, multipliers and
         the final state to carry to the next frequency.
     """
-    if not isinstance(model, Model):
-        raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-    omega = check_omega(omega)
+    _limits.check_analysable_model(model)
+    omega = _limits.check_frequency(model, omega)
     x = check_state(x0)
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
