@@ -20,6 +20,8 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
+import numpy as np
+
 from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
 
@@ -53,6 +55,11 @@ def resolve_hb(harmonics: int, samples: int | None, hb: HBOptions | None) -> HBO
     ValueError
         ``hb`` is given together with a ``harmonics`` or ``samples`` that disagrees with it.
     """
+    # numpy integers (from arrays, or a parsed file) count as integers, as in the file's checks
+    if isinstance(harmonics, np.integer):
+        harmonics = int(harmonics)
+    if isinstance(samples, np.integer):
+        samples = int(samples)
     if hb is None:
         return HBOptions(harmonics=harmonics, samples=samples)
     if not isinstance(hb, HBOptions):

@@ -35,7 +35,7 @@ UNSTABLE_REGION_STYLES: dict[str, tuple[str, str, str, str]] = {
                                  "period 1 unstable (period doubling):\nperiod 2 likely, not computed", "period 2\nlikely"),
     "unstable_not_computed": ("..", "0.5", "no stable period-1 orbit;\nsub-harmonics not computed", "P1\nunstable"),
     "no_stable_computed": ("xx", "0.5", "no stable orbit computed\n(sub-harmonics included)", "none\nstable"),
-    "no_stable_periodic": ("//", NO_STABLE_COLOR, "no stable periodic solution\n(simulation: none ≤ 8)", "no stable\nperiodic"),
+    "no_stable_periodic": ("//", NO_STABLE_COLOR, "no stable periodic solution", "no stable\nperiodic"),
 }
 #: (band colour, label colour) of the stable sub-harmonic bands, by period.
 SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {

@@ -37,8 +37,12 @@ class SpecialPoint:
 class Region:
     """An interval [omega_min, omega_max] of forcing frequency with a ``kind`` and a ``label``.
 
-    ``kind``: ``superharmonic``, ``subharmonic`` or ``no_stable_periodic``. ``detail`` holds
-    kind-specific data (order, period, branch, the periods a time sweep saw there…).
+    ``kind``: ``superharmonic``, ``subharmonic``, or for an interval where no computed orbit is
+    stable, by what is known: ``unstable_period_doubling`` (sub-harmonics not computed, a period
+    doubling bounds it: a stable period-2p motion is likely), ``unstable_not_computed``
+    (sub-harmonics not computed), ``no_stable_computed`` (sub-harmonics computed, none stable)
+    and ``no_stable_periodic`` (… and a time sweep found no period ≤ 8 there either). ``detail``
+    holds kind-specific data (order, period, branch, the periods a time sweep saw there…).
     """
 
     kind: str
