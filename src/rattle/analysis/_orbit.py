@@ -442,6 +442,7 @@ def periodic_orbit(
 
     # 2. Simulation (and 3. the sub-harmonic branches of its sub-harmonics).
     steady = None
+    extra_runs: list[dict[str, Any]] = []  # simulations started next to unstable orbits
     if simulate:
         integ = ExactIntegrator(model)
         runs_done = 0
@@ -483,6 +484,8 @@ def periodic_orbit(
             ts = time.perf_counter()
             run = simulate_from(x_start)
             t_sim += time.perf_counter() - ts
+            extra_runs.append({"from_period": cand.period, "from_rms": float(np.sqrt(cand.q[0] ** 2 + 0.5 * np.sum(cand.q[1:] ** 2))),
+                               "period": int(getattr(run, "period", 0) or 0)})
             take(run)
         timings["simulation"] = t_sim
         timings["subharmonics"] = time.perf_counter() - t1 - t_sim
@@ -509,6 +512,7 @@ def periodic_orbit(
             "samples_given": hb_opts.samples, "stability": stability,
             "newton": asdict(newton_opts), "continuation": asdict(cont_opts),
             "primary_branch_status": primary.status.name.lower(),
+            "extra_simulations": extra_runs,
             "primary_branch_settings": {k: primary.settings.get(k) for k in (
                 "harmonics", "samples", "stability", "newton", "continuation") if k in primary.settings},
         },

@@ -307,6 +307,13 @@ class PeriodicOrbit:
             rms_text = f", rms {rms:.6g} rad" if rms is not None else ""
             settled = getattr(self.simulation, "settled", True)
             lines.append(f"simulation: {what}{rms_text}{'' if settled else ' (not settled)'}")
+            for run in (self.settings.get("extra_simulations") or []) if isinstance(self.settings, dict) else []:
+                p_run = int(run.get("period", 0))
+                lines.append(
+                    f"simulation from next to the unstable period-{run.get('from_period')} orbit (rms "
+                    f"{float(run.get('from_rms', float('nan'))):.6g} rad): "
+                    + (f"period {p_run}" if p_run else "no period <= 8")
+                )
         if not self.of_period(self.period):
             lines.append(f"no harmonic-balance solution of period {self.period} was found at this frequency")
         if sel is not None:
