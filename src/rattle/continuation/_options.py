@@ -22,6 +22,14 @@ class ContinuationOptions:
     rejected and retried with a shorter step (guards against jumping between branches).
     ``target_turn``: turn the controller aims for (the step shrinks when turns are larger).
     ``max_points``: budget of accepted points; ``max_time``: wall-time budget in s (None: none).
+
+    Test-function monitoring (used when the stepper is given a monitor, as every front end of
+    rattle does; see ``continuation._monitor``): ``monitor_tolerance`` θ ∈ (0, 1], the fraction
+    of a test function's distance from zero that the error of its cubic model between two
+    points may use before the step is shortened; ``max_change`` the largest change of a test
+    function per step relative to 1 + its size (bounds how far the multipliers move);
+    ``resolution`` the arc-length step below which the monitor no longer rejects a step (two
+    bifurcations closer than this are not separated).
     """
 
     initial_step: float = 0.01
@@ -32,9 +40,12 @@ class ContinuationOptions:
     target_turn: float = 0.1
     max_points: int = 20000
     max_time: float | None = None
+    monitor_tolerance: float = 0.5
+    max_change: float = 1.0
+    resolution: float = 1e-4
 
     def __post_init__(self) -> None:
-        for name in ("initial_step", "min_step", "max_step", "max_turn", "target_turn"):
+        for name in ("initial_step", "min_step", "max_step", "max_turn", "target_turn", "max_change", "resolution", "monitor_tolerance"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
                 raise ValueError(f"`{name}` must be a finite number > 0, got {v!r}")
@@ -43,6 +54,8 @@ class ContinuationOptions:
                 f"steps must satisfy min_step <= initial_step <= max_step, got "
                 f"{self.min_step}, {self.initial_step}, {self.max_step}"
             )
+        if self.monitor_tolerance > 1.0:
+            raise ValueError(f"`monitor_tolerance` must be in (0, 1], got {self.monitor_tolerance}")
         if self.target_turn > self.max_turn:
             raise ValueError(f"`target_turn` ({self.target_turn}) must be <= `max_turn` ({self.max_turn})")
         if self.max_turn >= math.pi / 2:

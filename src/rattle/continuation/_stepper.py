@@ -7,7 +7,12 @@ Keller's method in scaled variables y = (q / L, Ω / ω_s) (see ``_corrector``):
 * step control: Δs is scaled by the ratio of the target to the actual number of Newton
   iterations and by the ratio of the target to the actual turn of the tangent (angle between
   successive tangents); a step whose corrector fails, or whose tangent turns by more than the
-  allowed angle, is rejected and retried with half the step, down to the minimum step.
+  allowed angle, is rejected and retried with half the step, down to the minimum step;
+* with a ``monitor`` (test functions whose zeros are the special points, see ``_monitor``) a
+  step that leaves a test function unresolved — a hidden pair of zeros, a model that could
+  reach zero, a kink near zero, too large a move — is rejected and retried with half the step
+  (down to ``resolution``), and the next step is bounded by how fast the test functions move,
+  so that every zero is bracketed by two consecutive points: no bifurcation is stepped over.
 
 The stepper yields one accepted point per :meth:`ContinuationStepper.step`; the run ends when the
 branch leaves the frequency range (the last point is placed exactly on the bound), when an
@@ -27,6 +32,7 @@ from .._typing import FloatArray
 from ..errors import Status
 from ..hb import HarmonicBalance, NewtonOptions, solve_harmonic_balance
 from ._corrector import ArclengthCorrector
+from ._monitor import Monitor, MonitorReading, check_segment
 from ._options import ContinuationOptions
 
 
@@ -41,6 +47,7 @@ class BranchPoint:
     residual: float
     tangent: FloatArray
     step: float
+    reading: MonitorReading | None = None
 
 
 @dataclass(slots=True)
@@ -52,7 +59,8 @@ class ContinuationStepper:
     the range; with ``tangent`` (a direction in scaled variables, e.g. the critical eigenvector
     at a branch point) the start may be anywhere in the range and the branch is followed along
     that direction. ``stop(point) -> str | None`` may end the run (status ``STOPPED``) with the
-    returned reason.
+    returned reason. ``monitor(q, Ω, dq/ds, dΩ/ds)`` returns the test functions whose zeros
+    are the special points (see ``_monitor``); with it no zero is stepped over.
     """
 
     hb: HarmonicBalance
@@ -63,16 +71,19 @@ class ContinuationStepper:
     newton: NewtonOptions = field(default_factory=NewtonOptions)
     tangent: FloatArray | None = None
     stop: Callable[[BranchPoint], str | None] | None = None
+    monitor: Monitor | None = None
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
     rejected: int = 0
+    monitor_rejected: int = 0
     corrector: ArclengthCorrector = field(init=False, repr=False)
     _y: FloatArray = field(init=False, repr=False)
     _t: FloatArray = field(init=False, repr=False)
     _ds: float = field(init=False, repr=False)
     _start_time: float = field(init=False, repr=False)
     _direction: float = field(init=False, repr=False)
+    _reading: MonitorReading | None = field(init=False, repr=False, default=None)
 
     def __post_init__(self) -> None:
         lo, hi = self.omega_range
@@ -96,6 +107,14 @@ class ContinuationStepper:
         self.status = status
         self.message = message or status.message
 
+    def _read(self, y: FloatArray, t: FloatArray) -> MonitorReading | None:
+        """The monitor's reading at scaled point y with unit scaled tangent t (None: no monitor)."""
+        if self.monitor is None:
+            return None
+        q, w = self.corrector.unscale(y)
+        d = t * self.corrector.scale
+        return self.monitor(q, w, d[:-1], float(d[-1]))
+
     # --- public ----------------------------------------------------------------------------
     def start(self) -> BranchPoint | None:
         """Converge the first point at ``omega0`` and compute its tangent.
@@ -108,7 +127,8 @@ class ContinuationStepper:
             if r0 <= self.newton.residual_tol:
                 self._t = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
                 self._y = self.corrector.to_scaled(np.asarray(self.q0, dtype=float), self.omega0)
-                pt = BranchPoint(np.array(self.q0, dtype=float), self.omega0, 0, r0, self._t.copy(), 0.0)
+                self._reading = self._read(self._y, self._t)
+                pt = BranchPoint(np.array(self.q0, dtype=float), self.omega0, 0, r0, self._t.copy(), 0.0, self._reading)
                 self.points.append(pt)
                 return pt
         res = solve_harmonic_balance(self.hb, self.q0, self.omega0, self.newton)
@@ -131,7 +151,8 @@ class ContinuationStepper:
             return None
         self._t = t0
         self._y = self.corrector.to_scaled(res.q, self.omega0)
-        pt = BranchPoint(res.q, self.omega0, res.iterations, res.residual, self._t.copy(), 0.0)
+        self._reading = self._read(self._y, self._t)
+        pt = BranchPoint(res.q, self.omega0, res.iterations, res.residual, self._t.copy(), 0.0, self._reading)
         self.points.append(pt)
         return pt
 
@@ -155,12 +176,24 @@ class ContinuationStepper:
             y_pred = self._y + ds * self._t
             corr = corr_.correct(y_pred, self._t)
             t_new = None if corr is None else corr_.tangent(corr.Rq, corr.Rw, self._t)
+            at_floor = ds <= opts.min_step * 1.0000001
             if corr is not None and t_new is not None:
                 turn = math.acos(min(1.0, float(t_new @ self._t)))
-                if turn <= opts.max_turn or ds <= opts.min_step * 1.0000001:
-                    break
+                if turn <= opts.max_turn or at_floor:
+                    reading = self._read(corr.y, t_new)
+                    if reading is None or self._reading is None:
+                        verdict = None
+                        break
+                    length = float(np.linalg.norm(corr.y - self._y))
+                    verdict = check_segment(
+                        self._reading, reading, length, tolerance=opts.monitor_tolerance,
+                        max_change=opts.max_change, resolved=ds <= opts.resolution or at_floor,
+                    )
+                    if verdict.accept:
+                        break
+                    self.monitor_rejected += 1
             self.rejected += 1
-            if ds <= opts.min_step * 1.0000001:
+            if at_floor:
                 _, w = corr_.unscale(self._y)
                 self._finish(
                     Status.STEP_TOO_SMALL,
@@ -182,19 +215,23 @@ class ContinuationStepper:
             if end.converged:
                 R, Rq, Rw = self.hb.residual_jacobian(end.q, bound)
                 t_end = corr_.tangent(Rq, Rw, self._t)
-                pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_new if t_end is None else t_end, ds * frac)
+                t_end = t_new if t_end is None else t_end
+                pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_end, ds * frac,
+                                 self._read(corr_.to_scaled(end.q, bound), t_end))
             else:  # keep the point just outside rather than nothing
-                pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds)
+                pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds, reading)
             self.points.append(pt)
             self._finish(status)
             return pt
-        pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds)
+        pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds, reading)
         self.points.append(pt)
-        self._y, self._t = corr.y, t_new
+        self._y, self._t, self._reading = corr.y, t_new, reading
         # Step control from the iteration count and the tangent's turn.
         f_it = opts.target_iterations / max(corr.iterations, 1)
         f_turn = opts.target_turn / max(turn, 1e-12)
         factor = min(max(min(f_it, f_turn), 0.5), 2.0)
+        if verdict is not None:
+            factor = min(factor, max(verdict.factor, 0.25))
         self._ds = min(opts.max_step, max(opts.min_step, ds * factor))
         if self.stop is not None:
             reason = self.stop(pt)

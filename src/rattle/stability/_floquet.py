@@ -27,7 +27,8 @@ def stage_transition(stiffness: FloatArray, damping: float, tau: FloatArray) -> 
 
     With σ = −c/2 and D = c²/4 − κ:  exp(Aτ) = e^{στ} [C(τ) I + S(τ) (A − σ I)], where
     C = cosh(√D τ), S = sinh(√D τ)/√D (D > 0); C = cos(√−D τ), S = sin(√−D τ)/√−D (D < 0);
-    C = 1, S = τ (D = 0). Returns shape (..., 2, 2).
+    C = 1, S = τ (D = 0). Overdamped stages are evaluated without overflow (exponentials of
+    non-positive arguments only, for stiffness ≥ 0). Returns shape (..., 2, 2).
     """
     kappa = np.asarray(stiffness, dtype=float)
     tau = np.asarray(tau, dtype=float)
@@ -36,17 +37,29 @@ def stage_transition(stiffness: FloatArray, damping: float, tau: FloatArray) -> 
     D = 0.25 * damping**2 - kappa
     root = np.sqrt(np.abs(D))
     x = root * tau
-    with np.errstate(invalid="ignore", divide="ignore"):
-        C = np.where(D > 0, np.cosh(x), np.cos(x))
-        S = np.where(D > 0, np.sinh(x), np.sin(x)) / np.where(root > 0, root, 1.0)
-    S = np.where(root > 0, S, tau)
-    C = np.where(root > 0, C, 1.0)
-    e = np.exp(sigma * tau)
+    over = D > 0
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        # D > 0 (overdamped stage): e^{στ} cosh(√D τ) and e^{στ} sinh(√D τ)/√D written with
+        # e^{(σ+√D)τ} and expm1(−2√D τ), which neither overflow (cosh of a large argument times
+        # a vanishing e^{στ} would give inf·0) nor cancel for small √D τ.
+        grow = np.exp((sigma + root) * tau)
+        decay = np.expm1(-2.0 * x)
+        eC_over = grow * (1.0 + 0.5 * decay)
+        eS_over = grow * (-0.5 * decay) / np.where(root > 0, root, 1.0)
+        e = np.exp(sigma * tau)
+        eC_osc = e * np.cos(x)
+        eS_osc = e * np.sin(x) / np.where(root > 0, root, 1.0)
+    eC = np.where(over, eC_over, eC_osc)
+    eS = np.where(over, eS_over, eS_osc)
+    flat = root == 0  # critically damped stage: C = 1, S = τ
+    e0 = np.exp(sigma * tau)
+    eC = np.where(flat, e0, eC)
+    eS = np.where(flat, e0 * tau, eS)
     out = np.empty(kappa.shape + (2, 2))
-    out[..., 0, 0] = e * (C - sigma * S)
-    out[..., 0, 1] = e * S
-    out[..., 1, 0] = -e * kappa * S
-    out[..., 1, 1] = e * (C + sigma * S)
+    out[..., 0, 0] = eC - sigma * eS
+    out[..., 0, 1] = eS
+    out[..., 1, 0] = -kappa * eS
+    out[..., 1, 1] = eC + sigma * eS
     return out
 
 
@@ -100,22 +113,38 @@ def crossing_times_batch(
     Qp = Q[p]
     kw = np.arange(1, H + 1)[None, :] * omega[p][:, None]
     tol = 64 * np.finfo(float).eps * T
+    fa_val, fb_val = fa.copy(), fb.copy()  # f at the bracket ends
+    side = np.zeros(p.size, dtype=int)  # which end moved last (Illinois rule): -1 a, +1 b
     active = np.arange(p.size)
     for _ in range(60):
         f, fp = _series(Qp[active], kw[active], t[active])
         f = f - lvl[active]
         left = (f > 0) == (fa[active] > 0)
         ta = t[active]
+        # Illinois: an end kept twice in a row has its value halved, so that regula falsi
+        # does not creep towards the root from one side (linear convergence).
+        keep_b = left & (side[active] == -1)
+        keep_a = ~left & (side[active] == 1)
+        fb_val[active] = np.where(keep_b, 0.5 * fb_val[active], fb_val[active])
+        fa_val[active] = np.where(keep_a, 0.5 * fa_val[active], fa_val[active])
         a[active] = np.where(left, ta, a[active])
+        fa_val[active] = np.where(left, f, fa_val[active])
         b[active] = np.where(left, b[active], ta)
+        fb_val[active] = np.where(left, fb_val[active], f)
+        side[active] = np.where(left, -1, 1)
         with np.errstate(divide="ignore", invalid="ignore"):
             t_new = ta - f / fp
-        bad = ~np.isfinite(t_new) | (t_new <= a[active]) | (t_new >= b[active])
-        t_new = np.where(bad, 0.5 * (a[active] + b[active]), t_new)
+            # Where Newton leaves the bracket (the series may ripple inside one sample interval
+            # near a kink), regula falsi on the bracket; bisection if even that fails.
+            t_rf = a[active] - fa_val[active] * (b[active] - a[active]) / (fb_val[active] - fa_val[active])
+        # (A step onto a bracket end is allowed: at round-off the root may be that end.)
+        bad = ~np.isfinite(t_new) | (t_new < a[active]) | (t_new > b[active])
+        bad_rf = ~np.isfinite(t_rf) | (t_rf < a[active]) | (t_rf > b[active])
+        t_new = np.where(bad, np.where(bad_rf, 0.5 * (a[active] + b[active]), t_rf), t_new)
         exact = f == 0.0  # landed on the root: keep it (the bracket test would move it)
         t_new = np.where(exact, ta, t_new)
         t[active] = t_new
-        moving = (np.abs(t_new - ta) > tol[active]) & ~exact
+        moving = (np.abs(t_new - ta) > tol[active]) & ~exact & (b[active] - a[active] > tol[active])
         active = active[moving]
         if active.size == 0:
             break
@@ -138,10 +167,27 @@ def monodromy_batch(
     ``stage_breakpoints`` (k,) and ``stage_stiffness`` (k+1,) are the breakpoints and the stage
     stiffnesses k s_j; ``damping`` is c = C/I.
     """
+    return monodromy_and_crossings_batch(Q, omega, samples, stage_breakpoints, stage_stiffness, damping)[0]
+
+
+def monodromy_and_crossings_batch(
+    Q: FloatArray,
+    omega: FloatArray,
+    samples: FloatArray,
+    stage_breakpoints: FloatArray,
+    stage_stiffness: FloatArray,
+    damping: float,
+) -> tuple[FloatArray, np.ndarray]:
+    """:func:`monodromy_batch` and the number of crossings of each breakpoint per period,
+    shape (P, k): the orbit's crossing structure, which changes where it grazes a breakpoint."""
     P = Q.shape[0]
     H = (Q.shape[1] - 1) // 2
     T = 2 * np.pi / omega
-    p, t, _ = crossing_times_batch(Q, omega, samples, stage_breakpoints)
+    levels = np.atleast_1d(np.asarray(stage_breakpoints, dtype=float))
+    p, t, lvl = crossing_times_batch(Q, omega, samples, levels)
+    per_level = np.zeros((P, levels.size), dtype=int)
+    if p.size:
+        np.add.at(per_level, (p, np.searchsorted(levels, lvl)), 1)
     counts = np.bincount(p, minlength=P)
     n_seg = counts + 1
     S = int(n_seg.max())
@@ -164,7 +210,7 @@ def monodromy_batch(
     M = phis[:, 0]
     for s in range(1, S):
         M = phis[:, s] @ M
-    return M
+    return M, per_level
 
 
 def crossing_times(
@@ -215,5 +261,5 @@ def multipliers_from_monodromy(M: FloatArray) -> ComplexArray:
 
 __all__ = [
     "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
-    "multipliers_from_monodromy",
+    "monodromy_and_crossings_batch", "multipliers_from_monodromy",
 ]
