@@ -21,6 +21,7 @@ from ..errors import Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..model import Model
 from ..results import FrequencyResponse
+from ..stability import FloquetMonitor
 from ..timeint import ExactIntegrator
 from ._settings import RunSettings
 
@@ -101,6 +102,7 @@ def switch_period_doubling(
 
     stepper = ContinuationStepper(
         hb2, q2, omega_pd, omega_range, run.continuation, newton, tangent=tangent, stop=rejoined,
+        monitor=FloquetMonitor(hb2),
     )
     stepper.run()
     return hb2, stepper
@@ -230,7 +232,7 @@ def branch_from_seed(
             return None
 
         stepper = ContinuationStepper(hb, res.q, omega, omega_range, run.continuation, newton,
-                                      tangent=tangent, stop=back_at_seed)
+                                      tangent=tangent, stop=back_at_seed, monitor=FloquetMonitor(hb))
         stepper.run()
         halves.append(stepper.points)
         statuses.append(stepper)

@@ -20,7 +20,7 @@ from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, so
 from ..measures import measures_batch, synthesize_batch
 from ..model import Model
 from ..results import FrequencyResponse, SpecialPoint
-from ..stability import classify_loss, hill_multipliers, monodromy, monodromy_batch, multipliers_from_monodromy
+from ..stability import FloquetMonitor, classify_loss, hill_multipliers, monodromy, monodromy_batch, multipliers_from_monodromy
 from ..stability._classify import UNIT_CIRCLE_TOL
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb, scaled_hb
 
@@ -254,7 +254,7 @@ def _frequency_response(
         if throw:
             raise
         q0, how = hb.linear_solution(omega0), "failed"
-    stepper = ContinuationStepper(hb, q0, omega0, (lo, hi), cont_opts, newton_opts)
+    stepper = ContinuationStepper(hb, q0, omega0, (lo, hi), cont_opts, newton_opts, monitor=FloquetMonitor(hb))
     while (pt := stepper.step()) is not None:
         if callback is not None:
             callback(pt)

@@ -46,7 +46,7 @@ from ..measures import measures_batch, synthesize_batch
 from ..model import Model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
-from ..stability import UNIT_CIRCLE_TOL, hill_multipliers, monodromy_batch, multipliers_from_monodromy
+from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, hill_multipliers, monodromy_batch, multipliers_from_monodromy
 from ..timeint import ExactIntegrator, shoot_periodic_orbit
 from ..timeint._steady import SteadyState, SteadyStateOptions, steady_state
 from ._frequency_response import check_range, frequency_response
@@ -298,7 +298,8 @@ def _follow_subharmonic(
             return None
 
         stepper = ContinuationStepper(
-            hb, seed.q, W, search_range, continuation, solver.newton, tangent=tangent, stop=stop
+            hb, seed.q, W, search_range, continuation, solver.newton, tangent=tangent, stop=stop,
+            monitor=FloquetMonitor(hb),
         )
         stepper.run()
         logger.info(
