@@ -1,0 +1,601 @@
+"""Exact reference of the special points of the period-1 branch (independent of harmonic balance).
+
+What it does
+------------
+The period-1 orbits of δ'' + c δ' + k f(δ) = F_m + Σ F_pn cos(nΩt + φ_n) (f continuous, piecewise
+linear) are the zeros of the shooting function
+
+    G(x0, Ω) = φ(x0; 0 → 2π/Ω, Ω) − x0,        x0 = (δ(0), δ'(0)) ∈ R²,
+
+φ the flow of :class:`rattle.timeint.ExactIntegrator`: closed-form stage solutions, crossings
+located to round-off, ∂φ/∂x0 = M the exact monodromy (product of the stage transition matrices; the
+saltation matrices are the identity because f is continuous). Nothing of harmonic balance is used.
+
+1. Variables are scaled: y = (δ0 / L, δ'0 / (L ω_n), Ω / ω_n), L = ``model.length_scale()``,
+   ω_n = ``model.natural_frequency``; G is scaled like x0.
+2. Start: at Ω_min the orbit is found by Newton shooting from the linear response about the static
+   equilibrium (checked against a simulation from rest by :func:`low_frequency_orbits`, see below).
+3. Pseudo-arclength continuation in (x0, Ω): secant predictor, Newton corrector on
+   [G; d·(y − y_pred)] = 0 in the plane normal to the predictor direction d. The steps are SMALL and
+   fixed: arclength ≤ ``max_step`` (2e-3 scaled) and |ΔΩ| ≤ ``max_domega`` (1e-3 ω_n); they are only
+   ever halved (corrector failure, a tangent turn above 0.1 rad), never enlarged beyond the caps.
+   ∂G/∂Ω enters only the corrector's Jacobian column, by central differences of the exact flow with
+   a step of 1e-6 in Ω/ω_n (truncation ~h²·|G'''|/6 ≈ 1e-9 and round-off ~ε/h ≈ 1e-10 relative, see
+   :func:`check_g_omega`): its error slows Newton by a factor ~1e-8 per iteration at worst and has
+   no effect on the converged orbits, which solve |G| ≤ 1e-11 (scaled) with the exact flow. The
+   column is refreshed whenever Newton needs more than three iterations.
+4. Test functions from the exact monodromy at every point: ψ_fold = det(M − I) = 1 − tr M + det M
+   (a multiplier at +1), ψ_pd = det(M + I) = 1 + tr M + det M (a multiplier at −1). Neimark–Sacker
+   cannot occur: one coordinate, so det M = exp(−c T) < 1 for c > 0 and a complex pair lies inside
+   the unit circle.
+5. Guard against hidden pairs (two sign changes inside one step): a segment between consecutive
+   points is bisected in arclength (each midpoint re-corrected onto the branch in the plane normal
+   to the segment's secant), recursively, down to ``min_split`` (1e-7 scaled), wherever
+   * the number of breakpoint crossings per period (per breakpoint) differs between its ends: the
+     orbit grazes a breakpoint in between, where M is not smooth (a square-root change), and a
+     border collision can flip the sign of ψ; or
+   * a test function does not change sign but one of its end values is small relative to its
+     variation, |ψ| ≤ 4·V, V the largest |Δψ| over the segment and its neighbours (a smooth ψ that
+     dips through zero and back inside the segment must be near zero at an end in that sense).
+   Sub-segments are judged the same way (V halves with the length, the expected variation of a
+   smooth ψ).
+6. Every sign change of ψ between consecutive (refined) points is located by Brent's method on the
+   arclength s along the segment's secant, each trial point corrected onto the branch in the plane
+   normal to the secant, to |Δs| ≤ 1e-11 (scaled; |ΔΩ| ≤ |Δs| ω_n). Roots outside [Ω_min, Ω_max]
+   are dropped.
+
+Why it can be trusted
+---------------------
+The flow is exact (no truncation), so the located points carry only round-off and the 1e-11
+location error; the steps are ~50× shorter than harmonic balance's and fixed in advance, so a pair
+of sign changes can hide only within 2e-3 of arclength, and even there the guard of point 5 splits
+the segment wherever a hidden pair is possible (a smooth ψ near zero, or a crossing-structure
+change). It reproduces the H-independent exact special points of the reference clutch and the gear
+example to < 1e-6 (tests/test_random_bifurcations.py checks them).
+
+Conventions of the comparison
+-----------------------------
+On the period-1 branch there are only folds (a multiplier crossing +1; with a generic, non-
+symmetric law or F_m ≠ 0 the +1 crossing is a fold, not a pitchfork) and period doublings (a
+multiplier crossing −1). rattle labels a +1 crossing at the vertex of a period-doubling pitchfork
+``period_doubling`` only on sub-harmonic branches, which this reference does not follow.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.optimize
+
+from rattle.model import Model
+from rattle.timeint import ExactIntegrator, shoot_periodic_orbit, steady_state
+
+KINDS = ("fold", "period_doubling")
+
+
+class ReferenceError(RuntimeError):
+    """The reference continuation could not be carried out (the case is rejected)."""
+
+
+@dataclass(frozen=True, slots=True)
+class BranchPoint:
+    """A point of the exact branch: scaled ``y``, monodromy ``M``, test functions ``psi`` (fold,
+    period doubling), ``signature`` (crossings per period of each breakpoint)."""
+
+    y: np.ndarray
+    M: np.ndarray
+    psi: tuple[float, float]
+    signature: tuple[int, ...]
+
+
+@dataclass
+class ExactBranch:
+    """The result: ``special`` [(kind, Ω), …] sorted by arclength, ``points`` of the branch
+    (Ω, δ0, δ'0, ψ_fold, ψ_pd as rows of an array), effort counters and the wall time."""
+
+    special: list[tuple[str, float]]
+    points: np.ndarray
+    steps: int = 0
+    evaluations: int = 0
+    splits: int = 0
+    seconds: float = 0.0
+    stats: dict = field(default_factory=dict)
+
+
+def _psi(M: np.ndarray) -> tuple[float, float]:
+    tr = M[0, 0] + M[1, 1]
+    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+    return 1.0 - tr + det, 1.0 + tr + det
+
+
+class _ShootingProblem:
+    """G(y) in scaled variables, with the exact monodromy."""
+
+    def __init__(self, model: Model, fd_step: float = 1e-6) -> None:
+        self.model = model
+        self.integ = ExactIntegrator(model)
+        self.L = model.length_scale()
+        self.wn = model.natural_frequency
+        self.sx = np.array([self.L, self.L * self.wn])
+        self.fd_step = fd_step
+        self.evaluations = 0
+        nb = len(model.elastic.stages.breakpoints)
+        self._bp = np.asarray(model.elastic.stages.breakpoints, dtype=float)
+        self._nb = nb
+
+    def unscale(self, y: np.ndarray) -> tuple[np.ndarray, float]:
+        return y[:2] * self.sx, float(y[2] * self.wn)
+
+    def scale(self, x0: np.ndarray, omega: float) -> np.ndarray:
+        return np.array([x0[0] / self.sx[0], x0[1] / self.sx[1], omega / self.wn])
+
+    def evaluate(self, y: np.ndarray):
+        """(scaled G, M (unscaled), scaled M, signature)."""
+        x0, w = self.unscale(y)
+        traj = self.integ.propagate(x0, 0.0, 2.0 * math.pi / w, w)
+        self.evaluations += 1
+        G = (traj.state1 - x0) / self.sx
+        M = traj.sensitivity
+        Ms = M * self.sx[None, :] / self.sx[:, None]
+        crossed = traj.crossed_breakpoints
+        sig = tuple(int(np.count_nonzero(crossed == b)) for b in self._bp)
+        return G, M, Ms, sig
+
+    def g_omega(self, y: np.ndarray) -> np.ndarray:
+        """∂G/∂(Ω/ω_n) (scaled) by central differences of the exact flow, step ``fd_step``."""
+        h = self.fd_step * max(1.0, abs(y[2]))
+        yp, ym = y.copy(), y.copy()
+        yp[2] += h
+        ym[2] -= h
+        return (self.evaluate(yp)[0] - self.evaluate(ym)[0]) / (2.0 * h)
+
+
+@dataclass
+class _Corrector:
+    prob: _ShootingProblem
+    tol: float = 1e-11
+    max_iter: int = 12
+    g_col: np.ndarray | None = None
+
+    def correct(self, y_pred: np.ndarray, d: np.ndarray, y_fix: np.ndarray | None = None,
+                tol: float | None = None) -> BranchPoint | None:
+        """Newton on [G(y); d·(y − y_fix)] = 0 from y_pred (y_fix defaults to y_pred), until the
+        scaled |G| ≤ ``tol`` (default ``self.tol``) and the next Newton step is below 10·tol."""
+        tol = self.tol if tol is None else tol
+        y = y_pred.copy()
+        anchor = y_pred if y_fix is None else y_fix
+        if self.g_col is None:
+            self.g_col = self.prob.g_omega(y)
+        refreshed = False
+        for it in range(self.max_iter):
+            G, M, Ms, sig = self.prob.evaluate(y)
+            r = np.concatenate((G, [float(d @ (y - anchor))]))
+            J = np.zeros((3, 3))
+            J[:2, :2] = Ms - np.eye(2)
+            J[:2, 2] = self.g_col
+            J[2] = d
+            try:
+                dy = np.linalg.solve(J, -r)
+            except np.linalg.LinAlgError:
+                return None
+            if not np.all(np.isfinite(dy)):
+                return None
+            if float(np.max(np.abs(G))) <= tol and float(np.max(np.abs(dy))) <= 10.0 * tol:
+                return BranchPoint(y, M, _psi(M), sig)
+            if it >= 3 and not refreshed:  # slow: the stale ∂G/∂Ω column is the likely cause
+                self.g_col = self.prob.g_omega(y)
+                refreshed = True
+            y = y + dy
+            if y[2] <= 0.0:
+                return None
+        return None
+
+    def correct_fixed_omega(self, y_pred: np.ndarray, tol: float | None = None) -> BranchPoint | None:
+        """Newton on G(x0, Ω) = 0 in x0 only, at the predicted Ω (natural parameter): the
+        Jacobian Ms − I is exact and the stage solutions are reused (one Ω per step)."""
+        tol = self.tol if tol is None else tol
+        y = y_pred.copy()
+        for _ in range(self.max_iter):
+            G, M, Ms, sig = self.prob.evaluate(y)
+            try:
+                dx = np.linalg.solve(Ms - np.eye(2), -G)
+            except np.linalg.LinAlgError:
+                return None
+            if not np.all(np.isfinite(dx)):
+                return None
+            if float(np.max(np.abs(G))) <= tol and float(np.max(np.abs(dx))) <= 10.0 * tol:
+                return BranchPoint(y, M, _psi(M), sig)
+            y = y.copy()
+            y[:2] += dx
+        return None
+
+
+def _linear_guess(model: Model, omega: float) -> np.ndarray:
+    """(δ(0), δ'(0)) of the linear response on the stage of the static equilibrium."""
+    ds = model.static_equilibrium()
+    s = float(model.elastic.stiffness(ds))
+    ks = model.k * (s if s > 0 else 1.0)
+    exc = model.excitation
+    d0, v0 = ds, 0.0
+    for n, a, ph in zip(exc.orders, exc.amplitudes, exc.phases):
+        X = a * np.exp(1j * ph) / (ks - (n * omega) ** 2 + 1j * model.c * n * omega)
+        d0 += X.real
+        v0 += -n * omega * X.imag
+    return np.array([d0, v0])
+
+
+def low_frequency_orbits(model: Model, omega: float, tol: float = 1e-6) -> list[np.ndarray]:
+    """Distinct period-1 states at ``omega`` reached from the linear guess (shooting) and by
+    simulations from rest, from the linear guess and from a large-amplitude start: more than one
+    entry means the start of the branch is ambiguous (coexisting orbits)."""
+    integ = ExactIntegrator(model)
+    L = model.length_scale()
+    sx = np.array([L, L * model.natural_frequency])
+    found: list[np.ndarray] = []
+
+    def add(x):
+        if not any(np.max(np.abs((x - f) / sx)) < tol for f in found):
+            found.append(np.asarray(x, dtype=float))
+
+    orbit = shoot_periodic_orbit(model, omega, _linear_guess(model, omega), integrator=integ)
+    if orbit.converged:
+        add(orbit.state0)
+    big = np.array([model.static_equilibrium() + 3.0 * L, 0.0])
+    for x0 in (np.array([model.static_equilibrium(), 0.0]), _linear_guess(model, omega), big):
+        ss = steady_state(model, omega, x0, integrator=integ)
+        if ss.period == 1:
+            add(np.asarray(ss.state0))
+        else:
+            found.append(np.full(2, np.nan))  # a non-period-1 attractor also makes the start ambiguous
+    return found
+
+
+def exact_special_points(
+    model: Model,
+    omega: tuple[float, float],
+    *,
+    max_step: float = 2e-3,
+    max_domega: float = 1e-3,
+    min_step: float = 1e-8,
+    min_split: float = 1e-7,
+    split_factor: float = 4.0,
+    xtol: float = 1e-11,
+    max_steps: int = 200_000,
+    natural_slope: float = 0.3,
+    cont_tol: float = 1e-9,
+) -> ExactBranch:
+    """Folds and period doublings of the period-1 branch of ``model`` over ``omega`` = (Ω_min,
+    Ω_max) from the exact flow (module docstring). Raises :class:`ReferenceError` if the start
+    orbit or a step cannot be computed."""
+    import time
+
+    t0 = time.perf_counter()
+    lo, hi = map(float, omega)
+    prob = _ShootingProblem(model)
+    corr = _Corrector(prob)
+    orbit = shoot_periodic_orbit(model, lo, _linear_guess(model, lo), integrator=prob.integ)
+    if not orbit.converged:
+        raise ReferenceError(f"no start orbit at Ω_min = {lo}")
+    y0 = prob.scale(orbit.state0, lo)
+    # Initial direction: the null vector of [Ms − I, g_Ω], oriented towards increasing Ω.
+    G, M, Ms, sig = prob.evaluate(y0)
+    corr.g_col = prob.g_omega(y0)
+    J = np.hstack((Ms - np.eye(2), corr.g_col[:, None]))
+    t = np.linalg.svd(J)[2][-1]
+    d = t / np.linalg.norm(t) * (1.0 if t[2] > 0 else -1.0)
+    pts = [BranchPoint(y0, M, _psi(M), sig)]
+    h = max_step
+    steps = 0
+    w_hi = hi / prob.wn
+    while pts[-1].y[2] < w_hi:
+        if steps >= max_steps:
+            raise ReferenceError(f"more than {max_steps} steps (reached Ω = {pts[-1].y[2] * prob.wn:.6g})")
+        if len(pts) >= 2:
+            sec = pts[-1].y - pts[-2].y
+            d_new = sec / np.linalg.norm(sec)
+        else:
+            d_new = d
+        hh = min(h, max_step, max_domega / max(abs(d_new[2]), 1e-300))
+        if len(pts) >= 3:
+            # Quadratic extrapolation through the last three points (chord-length parameter):
+            # an O(h³) predictor, so the corrector needs one or two Newton steps.
+            y1, y2, y3 = pts[-3].y, pts[-2].y, pts[-1].y
+            s1 = -float(np.linalg.norm(y3 - y2)) - float(np.linalg.norm(y2 - y1))
+            s2 = -float(np.linalg.norm(y3 - y2))
+            s = hh
+            y_pred = (y1 * (s - s2) * s / ((s1 - s2) * s1) + y2 * (s - s1) * s / ((s2 - s1) * s2)
+                      + y3 * (s - s1) * (s - s2) / (s1 * s2))
+            step = y_pred - y3
+            d_pred = step / np.linalg.norm(step)
+        else:
+            y_pred = pts[-1].y + hh * d_new
+            d_pred = d_new
+        # Away from folds (the branch steep in Ω) the corrector works at the predicted Ω; near a
+        # fold, in the plane normal to the predictor direction (pseudo-arclength).
+        if abs(d_pred[2]) > natural_slope:
+            p = corr.correct_fixed_omega(y_pred, tol=cont_tol)
+        else:
+            p = corr.correct(y_pred, d_pred, tol=cont_tol)
+        ok = p is not None
+        if ok:
+            sec = p.y - pts[-1].y
+            ns = float(np.linalg.norm(sec))
+            turn = math.acos(min(1.0, max(-1.0, float(sec @ d_new) / ns))) if ns > 0 else math.pi
+            ok = ns > 0 and turn < 0.1 and ns < 2.0 * hh
+        if not ok:
+            h = 0.5 * hh
+            corr.g_col = prob.g_omega(pts[-1].y)
+            if h < min_step:
+                raise ReferenceError(f"step below {min_step} at Ω = {pts[-1].y[2] * prob.wn:.8g}")
+            continue
+        pts.append(p)
+        steps += 1
+        h = min(2.0 * hh, max_step)
+
+    # --- refine (guard against hidden pairs), then locate ----------------------------------
+    splits = 0
+
+    def correct_mid(a: BranchPoint, b: BranchPoint) -> BranchPoint | None:
+        sec = b.y - a.y
+        dd = sec / np.linalg.norm(sec)
+        mid = 0.5 * (a.y + b.y)
+        return corr.correct(mid, dd, tol=cont_tol)
+
+    def variation(a: BranchPoint, b: BranchPoint) -> np.ndarray:
+        return np.abs(np.subtract(b.psi, a.psi))
+
+    def flagged(a: BranchPoint, b: BranchPoint, V: np.ndarray) -> bool:
+        if a.signature != b.signature:
+            return True
+        for k in range(2):
+            if np.sign(a.psi[k]) == np.sign(b.psi[k]) and min(abs(a.psi[k]), abs(b.psi[k])) <= split_factor * V[k]:
+                return True
+        return False
+
+    def refine(a: BranchPoint, b: BranchPoint, V: np.ndarray) -> list[BranchPoint]:
+        """Points strictly between a and b added by the guard."""
+        nonlocal splits
+        length = float(np.linalg.norm(b.y - a.y))
+        if length <= min_split or not flagged(a, b, V):
+            return []
+        m = correct_mid(a, b)
+        if m is None:
+            return []
+        splits += 1
+        Vh = np.maximum(0.5 * V, np.maximum(variation(a, m), variation(m, b)))
+        return refine(a, m, Vh) + [m] + refine(m, b, Vh)
+
+    refined = [pts[0]]
+    n = len(pts)
+    for i in range(n - 1):
+        a, b = pts[i], pts[i + 1]
+        V = variation(a, b)
+        if i > 0:
+            V = np.maximum(V, variation(pts[i - 1], a))
+        if i + 2 < n:
+            V = np.maximum(V, variation(b, pts[i + 2]))
+        refined.extend(refine(a, b, V))
+        refined.append(b)
+
+    special: list[tuple[str, float]] = []
+    for a, b in zip(refined[:-1], refined[1:]):
+        for k, kind in enumerate(KINDS):
+            if np.sign(a.psi[k]) * np.sign(b.psi[k]) >= 0:
+                if a.psi[k] == 0.0 and lo <= a.y[2] * prob.wn <= hi:
+                    special.append((kind, float(a.y[2] * prob.wn)))
+                continue
+            w = _locate(corr, a, b, k, xtol) * prob.wn
+            if lo <= w <= hi:
+                special.append((kind, float(w)))
+    points = np.array([[p.y[2] * prob.wn, *(p.y[:2] * prob.sx), *p.psi] for p in refined])
+    return ExactBranch(special=special, points=points, steps=steps, evaluations=prob.evaluations,
+                       splits=splits, seconds=time.perf_counter() - t0)
+
+
+def _locate(corr: _Corrector, a: BranchPoint, b: BranchPoint, k: int, xtol: float) -> float:
+    """Scaled Ω of the root of ψ_k on the branch between a and b (Brent on the arclength along
+    the secant, trial points corrected in the plane normal to it)."""
+    sec = b.y - a.y
+    length = float(np.linalg.norm(sec))
+    d = sec / length
+    corr.g_col = corr.prob.g_omega(a.y)
+    last: dict[float, BranchPoint] = {}
+
+    def f(s: float) -> float:
+        if s <= 0.0:
+            return a.psi[k]
+        if s >= length:
+            return b.psi[k]
+        p = corr.correct(a.y + s * d, d)
+        if p is None:
+            raise ReferenceError(f"corrector failed while locating at Ω ≈ {a.y[2]}")
+        last[s] = p
+        return p.psi[k]
+
+    s = scipy.optimize.brentq(f, 0.0, length, xtol=xtol, rtol=4 * np.finfo(float).eps)
+    p = last.get(s)
+    if p is None:
+        p = corr.correct(a.y + s * d, d) if 0.0 < s < length else (a if s <= 0.0 else b)
+    return float(p.y[2])
+
+
+def check_g_omega(model: Model, omega: float) -> float:
+    """Relative difference of the central-difference ∂G/∂Ω at steps 1e-6 and 1e-5 (Ω/ω_n) on the
+    orbit at ``omega``: the two agree to O(h²) when the step is in the right range."""
+    prob = _ShootingProblem(model)
+    orbit = shoot_periodic_orbit(model, omega, _linear_guess(model, omega), integrator=prob.integ)
+    y = prob.scale(orbit.state0, omega)
+    g1 = prob.g_omega(y)
+    prob.fd_step = 1e-5
+    g2 = prob.g_omega(y)
+    return float(np.max(np.abs(g1 - g2)) / np.max(np.abs(g1)))
+
+
+# ---------------------------------------------------------------------------------------------
+# Random cases and the comparison with harmonic balance
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class RandomCase:
+    """A random model with its frequency range and a one-line description."""
+
+    model: Model
+    omega: tuple[float, float]
+    label: str
+
+
+def random_case(rng: np.random.Generator, omega: tuple[float, float] = (0.2, 2.5)) -> RandomCase:
+    """A random continuous piecewise-linear case (ω_n = 1): a backlash, a clutch or an asymmetric
+    law with 2–5 breakpoints (slopes in [0, 1.5], the outer ones ≥ 0.3), clearances 0.05–1 rad,
+    c = C/I in 0.02–0.12, mean load 0.2–1 × (the first breakpoint's restoring force scale) and up to
+    three harmonics with random phases, sized so that the resonance amplitude (~F_p1/c) spans the
+    clearance a few times while the off-resonance response stays at the breakpoints' scale."""
+    from rattle.model import Backlash, Clutch, Excitation, Piecewise
+
+    kind = ("backlash", "clutch", "piecewise")[int(rng.integers(3))]
+    inertia = float(10.0 ** rng.uniform(-1.0, 1.0))  # scale-invariant: K = I keeps ω_n = 1
+    c = float(rng.uniform(0.02, 0.12))
+    if kind == "backlash":
+        b = float(rng.uniform(0.05, 1.0))
+        law = Backlash(b=b)
+        scale = b
+        desc = f"backlash b={b:.4f}"
+    elif kind == "clutch":
+        b = float(rng.uniform(0.05, 1.0))
+        alpha = float(rng.uniform(0.05, 0.6))
+        law = Clutch(alpha=alpha, b=b)
+        scale = b * alpha + 0.3 * b
+        desc = f"clutch alpha={alpha:.4f} b={b:.4f}"
+    else:
+        nb = int(rng.integers(2, 6))
+        lo_b, hi_b = -float(rng.uniform(0.05, 1.0)), float(rng.uniform(0.05, 1.0))
+        while True:
+            bp = np.sort(rng.uniform(lo_b, hi_b, nb))
+            if np.min(np.diff(bp)) > 0.02:
+                break
+        slopes = rng.uniform(0.0, 1.5, nb + 1)
+        slopes[0], slopes[-1] = rng.uniform(0.3, 1.5), rng.uniform(0.3, 1.5)
+        slopes[rng.random(nb + 1) < 0.15] = 0.0  # some dead stages
+        slopes[0], slopes[-1] = max(slopes[0], 0.3), max(slopes[-1], 0.3)
+        law = Piecewise(breakpoints=tuple(float(v) for v in bp), slopes=tuple(float(v) for v in slopes))
+        scale = float(np.max(np.abs(bp))) * float(np.mean(slopes))
+        desc = "piecewise bp=[" + ",".join(f"{v:.4f}" for v in bp) + "] s=[" + ",".join(f"{v:.3f}" for v in slopes) + "]"
+    mean = float(rng.uniform(0.2, 1.0)) * scale
+    n_h = int(rng.integers(1, 4))
+    a1 = float(rng.uniform(0.1, 0.3)) * scale * (c / 0.05) ** 0.5
+    amps = [a1] + [a1 * float(rng.uniform(0.1, 0.7)) for _ in range(n_h - 1)]
+    phases = [0.0] + [float(rng.uniform(0.0, 2.0 * math.pi)) for _ in range(n_h - 1)]
+    model = Model(inertia=inertia, damping=c * inertia, stiffness=inertia, elastic=law,
+                  excitation=Excitation(mean=mean, amplitudes=tuple(amps), phases=tuple(phases)))
+    label = (f"{desc} c={c:.4f} I=K={inertia:.4g} Fm={mean:.4g} Fp=[" + ",".join(f"{a:.4g}" for a in amps)
+             + "] phi=[" + ",".join(f"{p:.3f}" for p in phases) + f"] omega={omega}")
+    return RandomCase(model=model, omega=omega, label=label)
+
+
+@dataclass
+class Accepted:
+    """An accepted random case with its exact reference."""
+
+    case: RandomCase
+    reference: ExactBranch
+    index: int  # position in the random stream (accepted or not)
+
+
+def accepted_cases(seed: int, n: int, *, max_special: int = 20, max_tries: int | None = None,
+                   **reference_options) -> tuple[list[Accepted], list[tuple[int, str, str]]]:
+    """The first ``n`` random cases of ``seed`` whose reference is unambiguous and computable with
+    at most ``max_special`` special points; also the rejected ones as (index, label, reason)."""
+    rng = np.random.default_rng(seed)
+    out: list[Accepted] = []
+    rejected: list[tuple[int, str, str]] = []
+    i = 0
+    max_tries = 4 * n + 10 if max_tries is None else max_tries
+    while len(out) < n and i < max_tries:
+        case = random_case(rng)
+        i += 1
+        starts = low_frequency_orbits(case.model, case.omega[0])
+        if len(starts) != 1:
+            rejected.append((i - 1, case.label, f"{len(starts)} coexisting motions at Ω_min"))
+            continue
+        try:
+            ref = exact_special_points(case.model, case.omega, **reference_options)
+        except ReferenceError as exc:
+            rejected.append((i - 1, case.label, f"reference failed: {exc}"))
+            continue
+        if len(ref.special) > max_special:
+            rejected.append((i - 1, case.label, f"{len(ref.special)} special points (> {max_special})"))
+            continue
+        out.append(Accepted(case, ref, i - 1))
+    return out, rejected
+
+
+def hb_special_points(frf) -> list[tuple[str, float]]:
+    """(kind, Ω) of the special points on branch 0 of a FrequencyResponse."""
+    return [(p.kind, float(p.omega)) for p in frf.special_points if p.branch == 0]
+
+
+@dataclass
+class Matching:
+    """Exact points matched to HB points of the same kind within ``tol``: ``pairs`` (exact, HB),
+    ``missed`` exact points, ``spurious`` HB points."""
+
+    pairs: list[tuple[tuple[str, float], tuple[str, float]]]
+    missed: list[tuple[str, float]]
+    spurious: list[tuple[str, float]]
+
+    @property
+    def errors(self) -> list[float]:
+        return [abs(e[1] - h[1]) for e, h in self.pairs]
+
+
+def match(exact: list[tuple[str, float]], hb: list[tuple[str, float]], tol: float = 1e-4) -> Matching:
+    """One-to-one matching, nearest first, same kind, |ΔΩ| ≤ ``tol``."""
+    cand = sorted(
+        (abs(e[1] - h[1]), i, j) for i, e in enumerate(exact) for j, h in enumerate(hb)
+        if e[0] == h[0] and abs(e[1] - h[1]) <= tol
+    )
+    used_e: set[int] = set()
+    used_h: set[int] = set()
+    pairs = []
+    for _, i, j in cand:
+        if i in used_e or j in used_h:
+            continue
+        used_e.add(i)
+        used_h.add(j)
+        pairs.append((exact[i], hb[j]))
+    missed = [e for i, e in enumerate(exact) if i not in used_e]
+    spurious = [h for j, h in enumerate(hb) if j not in used_h]
+    return Matching(pairs, missed, spurious)
+
+
+def diagnose(frf, point: tuple[str, float], exact: list[tuple[str, float]]) -> str:
+    """Where the HB branch (branch 0) stepped over an exact special point: the continuation rows
+    bracketing its Ω, their step ΔΩ, multipliers and test functions, and the exact points inside
+    the same step."""
+    kind, w = point
+    rows = np.flatnonzero(np.asarray(frf.branch) == 0)
+    om = np.asarray(frf.omega)[rows]
+    lines = [f"  {kind} at Ω = {w:.8f}:"]
+    hb_near = [p for p in frf.special_points if p.branch == 0 and abs(p.omega - w) < 5e-3]
+    if hb_near:
+        lines.append("    HB special points within 5e-3: " + ", ".join(f"{p.kind} {p.omega:.8f}" for p in hb_near))
+    for i in range(len(rows) - 1):
+        a, b = om[i], om[i + 1]
+        if min(a, b) <= w <= max(a, b):
+            ia, ib = rows[i], rows[i + 1]
+            inside = [f"{k} {x:.6f}" for k, x in exact if min(a, b) <= x <= max(a, b)]
+            lines.append(f"    HB step rows {ia}->{ib}: Ω {a:.6f} -> {b:.6f} (ΔΩ = {b - a:+.3e}); exact points in "
+                         f"this step: {inside}")
+            for r in range(max(rows[0], ia - 2), min(rows[-1], ib + 2) + 1):
+                mu = np.asarray(frf.multipliers[r])
+                M_tr, M_det = float(np.sum(mu).real), float(np.prod(mu).real)
+                lines.append(f"      row {r}: Ω = {frf.omega[r]:.7f}  μ = {np.round(mu, 5)}  "
+                             f"ψ_fold = {1 - M_tr + M_det:+.3e}  ψ_pd = {1 + M_tr + M_det:+.3e}  "
+                             f"stable = {bool(frf.stable[r])}")
+    return "\n".join(lines)
+
+
+__all__ = ["ExactBranch", "BranchPoint", "ReferenceError", "exact_special_points", "low_frequency_orbits",
+           "check_g_omega", "KINDS", "RandomCase", "random_case", "Accepted", "accepted_cases",
+           "hb_special_points", "Matching", "match", "diagnose"]
