@@ -27,6 +27,8 @@ end slope (a lower-order model's error, which vanishes at both ends). For each t
   laws: the orbit grazed a breakpoint, where M has a square-root singularity and a border
   collision may flip ψ) the slopes do not describe the interior, and the step is rejected
   whenever the variation |ψ_b − ψ_a| + L(|ψ'_a| + |ψ'_b|)/2 could reach zero;
+* near the unit circle (a multiplier within ``NEAR_CRITICAL`` of +1 or −1) the step may
+  shrink but never grow;
 * movement: ψ may change by at most ``max_change`` × (1 + min(|ψ_a|, |ψ_b|)) per step (twice
   that rejects the step): this bounds how far the multipliers move in one step.
 
@@ -43,6 +45,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import FloatArray
+
+#: A multiplier within this distance of its critical value (+1, −1) is "near the unit circle":
+#: the step may shrink but not grow there.
+NEAR_CRITICAL = 0.1
 
 
 @dataclass(frozen=True, slots=True)
@@ -167,6 +173,8 @@ def check_segment(
             # err grows like L^3: aim for err <= theta x (the model's distance from zero), pointwise.
             ratio = np.min(tolerance * (sign * p[inner])[e > 0] / e[e > 0])
             factor = min(factor, float(max(ratio, 0.0)) ** (1.0 / 3.0))
+    if b.distance < NEAR_CRITICAL:
+        factor = min(factor, 1.0)
     return SegmentVerdict(True, factor)
 
 
