@@ -30,25 +30,23 @@ import time
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from ..errors import ConfigError, ConvergenceError, RattleError
-from ..io import (
-    STAGING_PREFIX,
-    AnalysisSettings,
-    OutputSet,
-    atomic_path,
-    check_harmonics,
-    atomic_write_text,
-    load_config,
-    model_to_toml_dict,
-    rattle_version,
-    rename_keys,
-    write_metadata,
-)
-from ..model import Model
+
+if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
+    from ..io import AnalysisSettings
+    from ..model import Model
+
+
+def _io() -> Any:
+    """``rattle.io`` (numpy, the model and the configuration reader), imported on first use so
+    that ``--help``, ``--version`` and options click refuses need none of it."""
+    from .. import io
+
+    return io
 
 __all__ = ["cli", "main", "EXIT_OK", "EXIT_NUMERICAL", "EXIT_BAD_INPUT", "DEFAULT_OUTPUT"]
 
@@ -295,7 +293,9 @@ def _one_line(exc: BaseException) -> str:
 
 def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
     if value and not ctx.resilient_parsing:
-        click.echo(f"rattle {rattle_version()}")
+        from .. import __version__  # the package metadata only, not the numerics
+
+        click.echo(f"rattle {__version__}")
         ctx.exit(EXIT_OK)
 
 
@@ -362,9 +362,9 @@ def override_analysis(base: AnalysisSettings, model: Model | None = None, **opti
     try:
         analysis = dataclasses.replace(base, **given)
     except (ValueError, TypeError) as exc:
-        raise ConfigError(rename_keys(str(exc), names)) from exc
+        raise ConfigError(_io().rename_keys(str(exc), names)) from exc
     if model is not None:
-        check_harmonics(model, analysis.harmonics, names["harmonics"])
+        _io().check_harmonics(model, analysis.harmonics, names["harmonics"])
         if "omega_min" in given or "omega_max" in given:  # the file's own range was checked on loading
             from .. import _limits
 
@@ -516,7 +516,7 @@ def _save_figure(draw: Callable[[], tuple[Any, Any]], path: Path) -> bool:
 
     fig, _ax = draw()
     try:
-        with atomic_path(path) as tmp:
+        with _io().atomic_path(path) as tmp:
             fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=150)
     finally:
         plt.close(fig)
@@ -543,7 +543,7 @@ def write_set(output: Path, names: Sequence[str], steps: Sequence[tuple[str, Wri
     the run created.
     """
     try:
-        with OutputSet(output, names) as staged:
+        with _io().OutputSet(output, names) as staged:
             logger.info("staging %s in %s", ", ".join(n for n, _ in steps), staged.staging)
             for name, writer in steps:
                 logger.info("writing %s", name)
@@ -562,7 +562,7 @@ def _frf_steps(result: Any, sections: dict[str, Any], t_start: float) -> list[tu
     timings = dict(meta.pop("timings", None) or {})
 
     def write_json(path: Path) -> None:
-        write_metadata(path, **{**meta, **sections,
+        _io().write_metadata(path, **{**meta, **sections,
                                 "timings": {**timings, "cli_wall_time": time.perf_counter() - t_start}})
 
     return [("frf.csv", result.to_csv), ("frf.json", write_json), ("frf.png", lambda path: _save_plot(result, path))]
@@ -666,7 +666,7 @@ def frf_command(
     With --subharmonics every period-doubling point found on the primary branch starts a
     period-2 branch (and so on, up to period 4); each branch has its colour in frf.png.
     """
-    run_config = load_config(config)
+    run_config = _io().load_config(config)
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
@@ -827,7 +827,7 @@ def _metadata_writer(meta: dict[str, Any], sections: dict[str, Any], t_start: fl
         doc = dict(meta)
         timings = dict(doc.pop("timings", None) or {})
         timings["cli_wall_time"] = time.perf_counter() - t_start
-        write_metadata(path, **{**doc, **sections, "timings": timings})
+        _io().write_metadata(path, **{**doc, **sections, "timings": timings})
 
     return write
 
@@ -868,7 +868,7 @@ def sweep_command(
     """
     if direction is None:  # checked here: click's own message for a missing choice spans lines
         raise ConfigError("`--direction` is required: give --direction up, down or both")
-    run_config = load_config(config)
+    run_config = _io().load_config(config)
     analysis = override_analysis(run_config.analysis, run_config.model, omega_min=omega_min, omega_max=omega_max)
     check_points(points)
     check_workers(workers)
@@ -919,7 +919,7 @@ def orbit_command(
     selected solution: the stable one closest in rms to the simulated steady state (preferring
     the requested period); orbit.json lists them all.
     """
-    run_config = load_config(config)
+    run_config = _io().load_config(config)
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
@@ -965,7 +965,7 @@ def compare_command(
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
     compare.png, frf.csv, sweep.csv, compare.json in OUTPUT."""
-    run_config = load_config(config)
+    run_config = _io().load_config(config)
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
@@ -1072,14 +1072,14 @@ def demo_command(output: Path, quiet: bool) -> None:
     check_output_dir(output)
     t_start = time.perf_counter()
     model = reference_case()
-    analysis = AnalysisSettings(omega_min=DEMO_OMEGA[0], omega_max=DEMO_OMEGA[1], harmonics=DEMO_HARMONICS)
+    analysis = _io().AnalysisSettings(omega_min=DEMO_OMEGA[0], omega_max=DEMO_OMEGA[1], harmonics=DEMO_HARMONICS)
     click.echo(
         "rattle demo: the paper's reference case — clutch alpha = 0.25, b = 10 deg, zeta = 0.025, "
         f"F_m = 0.05, F_p1 = 0.03; Omega = {analysis.omega_min} … {analysis.omega_max} rad/s, "
         f"H = {analysis.harmonics}, sub-harmonic branches on; sweep up and down, {DEMO_POINTS} points each"
     )
     sections: dict[str, Any] = {
-        "command": "demo", "config": model_to_toml_dict(model, analysis), "analysis": analysis.to_dict(),
+        "command": "demo", "config": _io().model_to_toml_dict(model, analysis), "analysis": analysis.to_dict(),
         "options": {"subharmonics": True, "points": DEMO_POINTS, "workers": DEMO_WORKERS},
     }
     timings: dict[str, float] = {}
@@ -1127,7 +1127,7 @@ def demo_command(output: Path, quiet: bool) -> None:
     def write_json(path: Path) -> None:
         wall = {**frf_timings, **{f"demo_{k}": v for k, v in timings.items()},
                 "cli_wall_time": time.perf_counter() - t_start}
-        write_metadata(path, **{**meta, **sections, "demo": demo_section, "timings": wall})
+        _io().write_metadata(path, **{**meta, **sections, "demo": demo_section, "timings": wall})
 
     from ..report import demo_report
 
@@ -1144,8 +1144,8 @@ def demo_command(output: Path, quiet: bool) -> None:
         timings["total"] = time.perf_counter() - t_start
         text = demo_report(frf, sweep, orbits=orbits, level=level, figures=figures, regions=regions,
                            timings=timings, data_files=["frf.csv", "frf.json", "sweep.csv"],
-                           version=rattle_version())
-        atomic_write_text(path, text)
+                           version=_io().rattle_version())
+        _io().atomic_write_text(path, text)
 
     t_figures = time.perf_counter()
     written = write_set(output, DEMO_FILES, [
