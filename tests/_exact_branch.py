@@ -160,9 +160,12 @@ class _Corrector:
     g_col: np.ndarray | None = None
 
     def correct(self, y_pred: np.ndarray, d: np.ndarray, y_fix: np.ndarray | None = None,
-                tol: float | None = None) -> BranchPoint | None:
+                tol: float | None = None, last_step: float | None = None) -> BranchPoint | None:
         """Newton on [G(y); d·(y − y_fix)] = 0 from y_pred (y_fix defaults to y_pred), until the
-        scaled |G| ≤ ``tol`` (default ``self.tol``) and the next Newton step is below 10·tol."""
+        scaled |G| ≤ ``tol`` (default ``self.tol``) and the next Newton step is below 10·tol, or,
+        with ``last_step``, until a Newton step is below it: that step is then taken without a
+        further evaluation (Newton's quadratic convergence puts the point within ~|step|² of the
+        branch) and the monodromy of the point it started from is kept (|step| away)."""
         tol = self.tol if tol is None else tol
         y = y_pred.copy()
         anchor = y_pred if y_fix is None else y_fix
@@ -184,6 +187,8 @@ class _Corrector:
                 return None
             if float(np.max(np.abs(G))) <= tol and float(np.max(np.abs(dy))) <= 10.0 * tol:
                 return BranchPoint(y, M, _psi(M), sig)
+            if last_step is not None and float(np.max(np.abs(dy))) <= last_step:
+                return BranchPoint(y + dy, M, _psi(M), sig)
             if it >= 3 and not refreshed:  # slow: the stale ∂G/∂Ω column is the likely cause
                 self.g_col = self.prob.g_omega(y)
                 refreshed = True
@@ -192,9 +197,11 @@ class _Corrector:
                 return None
         return None
 
-    def correct_fixed_omega(self, y_pred: np.ndarray, tol: float | None = None) -> BranchPoint | None:
+    def correct_fixed_omega(self, y_pred: np.ndarray, tol: float | None = None,
+                            last_step: float | None = None) -> BranchPoint | None:
         """Newton on G(x0, Ω) = 0 in x0 only, at the predicted Ω (natural parameter): the
-        Jacobian Ms − I is exact and the stage solutions are reused (one Ω per step)."""
+        Jacobian Ms − I is exact and the stage solutions are reused (one Ω per step).
+        ``tol``, ``last_step``: as for :meth:`correct`."""
         tol = self.tol if tol is None else tol
         y = y_pred.copy()
         for _ in range(self.max_iter):
@@ -206,6 +213,10 @@ class _Corrector:
             if not np.all(np.isfinite(dx)):
                 return None
             if float(np.max(np.abs(G))) <= tol and float(np.max(np.abs(dx))) <= 10.0 * tol:
+                return BranchPoint(y, M, _psi(M), sig)
+            if last_step is not None and float(np.max(np.abs(dx))) <= last_step:
+                y = y.copy()
+                y[:2] += dx
                 return BranchPoint(y, M, _psi(M), sig)
             y = y.copy()
             y[:2] += dx
@@ -263,8 +274,9 @@ def exact_special_points(
     split_factor: float = 4.0,
     xtol: float = 1e-11,
     max_steps: int = 200_000,
-    natural_slope: float = 0.3,
+    natural_slope: float = 0.05,
     cont_tol: float = 1e-9,
+    last_step: float = 1e-7,
 ) -> ExactBranch:
     """Folds and period doublings of the period-1 branch of ``model`` over ``omega`` = (Ω_min,
     Ω_max) from the exact flow (module docstring). Raises :class:`ReferenceError` if the start
@@ -288,6 +300,7 @@ def exact_special_points(
     pts = [BranchPoint(y0, M, _psi(M), sig)]
     h = max_step
     steps = 0
+    retry = False
     w_hi = hi / prob.wn
     while pts[-1].y[2] < w_hi:
         if steps >= max_steps:
@@ -298,7 +311,7 @@ def exact_special_points(
         else:
             d_new = d
         hh = min(h, max_step, max_domega / max(abs(d_new[2]), 1e-300))
-        if len(pts) >= 3:
+        if len(pts) >= 3 and not retry:
             # Quadratic extrapolation through the last three points (chord-length parameter):
             # an O(h³) predictor, so the corrector needs one or two Newton steps.
             y1, y2, y3 = pts[-3].y, pts[-2].y, pts[-1].y
@@ -314,22 +327,29 @@ def exact_special_points(
             d_pred = d_new
         # Away from folds (the branch steep in Ω) the corrector works at the predicted Ω; near a
         # fold, in the plane normal to the predictor direction (pseudo-arclength).
-        if abs(d_pred[2]) > natural_slope:
-            p = corr.correct_fixed_omega(y_pred, tol=cont_tol)
+        if abs(d_pred[2]) > natural_slope and not retry:
+            p = corr.correct_fixed_omega(y_pred, tol=cont_tol, last_step=last_step)
         else:
-            p = corr.correct(y_pred, d_pred, tol=cont_tol)
+            p = corr.correct(y_pred, d_pred, tol=cont_tol, last_step=last_step)
         ok = p is not None
         if ok:
             sec = p.y - pts[-1].y
             ns = float(np.linalg.norm(sec))
             turn = math.acos(min(1.0, max(-1.0, float(sec @ d_new) / ns))) if ns > 0 else math.pi
-            ok = ns > 0 and turn < 0.1 and ns < 2.0 * hh
+            # A turn above 0.1 rad means a jump to another branch — or a corner: where the orbit
+            # grazes a breakpoint M changes like the square root of the distance, with a huge
+            # constant when the orbit is slow there, so within ~1e-8 the branch turns by a
+            # finite angle. Once the step is 1000× below its cap, a turn up to 1.2 rad is taken.
+            max_turn = 0.1 if hh > 1e-3 * max_step else 1.2
+            ok = ns > 0 and turn < max_turn and ns < 2.0 * hh
         if not ok:
+            retry = True  # retry from the secant, in the plane normal to it
             h = 0.5 * hh
             corr.g_col = prob.g_omega(pts[-1].y)
             if h < min_step:
                 raise ReferenceError(f"step below {min_step} at Ω = {pts[-1].y[2] * prob.wn:.8g}")
             continue
+        retry = False
         pts.append(p)
         steps += 1
         h = min(2.0 * hh, max_step)
@@ -341,7 +361,7 @@ def exact_special_points(
         sec = b.y - a.y
         dd = sec / np.linalg.norm(sec)
         mid = 0.5 * (a.y + b.y)
-        return corr.correct(mid, dd, tol=cont_tol)
+        return corr.correct(mid, dd, tol=cont_tol, last_step=last_step)
 
     def variation(a: BranchPoint, b: BranchPoint) -> np.ndarray:
         return np.abs(np.subtract(b.psi, a.psi))
