@@ -294,6 +294,19 @@ def test_region_kinds_are_documented():
         assert f"| `{kind}` |" in outputs, f"region kind `{kind}` has no row in docs/outputs.md"
 
 
+def test_option_fields_are_documented():
+    import dataclasses
+
+    import rattle
+
+    text = _text("python.md")
+    for cls in (rattle.HBOptions, rattle.NewtonOptions, rattle.ContinuationOptions, rattle.SteadyStateOptions):
+        assert f"`{cls.__name__}`" in text
+        for f in dataclasses.fields(cls):
+            if f.init:
+                assert f"`{f.name}`" in text, f"{cls.__name__}.{f.name} is not in docs/python.md"
+
+
 # --------------------------------------------------------------------------------------------
 # The Python page runs
 # --------------------------------------------------------------------------------------------
