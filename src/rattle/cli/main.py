@@ -500,6 +500,27 @@ def check_output_dir(output: Path) -> None:
         )
 
 
+def precheck(config: Path | None, output: Path, *, harmonics: int | None = None, points: int | None = None,
+             workers: int | None = None) -> None:
+    """The checks that need neither numpy nor the model, first, so that a refusal answers at once:
+    the configuration file is an existing regular file within the size limit (from ``stat``), the
+    options' bounds (``rattle._limits``), the output folder."""
+    if config is not None:
+        from ..io._read import check_input_file  # no numpy
+
+        check_input_file(config)
+    if harmonics is not None:
+        from .. import _limits
+
+        with _as_bad_input():
+            _limits.check_harmonics(harmonics, "--harmonics")
+    if points is not None:
+        check_points(points)
+    if workers is not None:
+        check_workers(workers)
+    check_output_dir(output)
+
+
 # --------------------------------------------------------------------------------------------
 # Running and writing
 # --------------------------------------------------------------------------------------------
@@ -666,11 +687,11 @@ def frf_command(
     With --subharmonics every period-doubling point found on the primary branch starts a
     period-2 branch (and so on, up to period 4); each branch has its colour in frf.png.
     """
+    precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
-    check_output_dir(output)
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "subharmonics": True if subharmonics else None}
     run_frf(
@@ -868,11 +889,9 @@ def sweep_command(
     """
     if direction is None:  # checked here: click's own message for a missing choice spans lines
         raise ConfigError("`--direction` is required: give --direction up, down or both")
+    precheck(config, output, points=points, workers=workers)
     run_config = _io().load_config(config)
     analysis = override_analysis(run_config.analysis, run_config.model, omega_min=omega_min, omega_max=omega_max)
-    check_points(points)
-    check_workers(workers)
-    check_output_dir(output)
     t_start = time.perf_counter()
     from ..analysis import time_sweep  # only now: all input has been validated
 
@@ -919,13 +938,14 @@ def orbit_command(
     selected solution: the stable one closest in rms to the simulated steady state (preferring
     the requested period); orbit.json lists them all.
     """
+    check_omega(omega)
+    precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
     check_omega(omega, model=run_config.model)
     check_period(period, analysis.harmonics, len(run_config.model.excitation.amplitudes))
-    check_output_dir(output)
     t_start = time.perf_counter()
     from ..analysis import periodic_orbit  # only now: all input has been validated
 
@@ -965,14 +985,12 @@ def compare_command(
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
     compare.png, frf.csv, sweep.csv, compare.json in OUTPUT."""
+    precheck(config, output, harmonics=harmonics, points=points, workers=workers)
     run_config = _io().load_config(config)
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
-    check_points(points)
-    check_workers(workers)
     at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
-    check_output_dir(output)
     t_start = time.perf_counter()
     from ..analysis import compare  # only now: all input has been validated
 
@@ -1067,9 +1085,9 @@ def demo_command(output: Path, quiet: bool) -> None:
     fig7_point_B.png, fig_mean_operating_point.png) and report.md, which collects them with
     the computed numbers.
     """
+    precheck(None, output)
     from ..model import reference_case
 
-    check_output_dir(output)
     t_start = time.perf_counter()
     model = reference_case()
     analysis = _io().AnalysisSettings(omega_min=DEMO_OMEGA[0], omega_max=DEMO_OMEGA[1], harmonics=DEMO_HARMONICS)

@@ -3,23 +3,52 @@
 The numerical core never touches files; everything that reads or writes lives here.
 """
 
-from ._atomic import STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging
-from ._config import (
-    DEFAULT_HARMONICS,
-    DEFAULT_OMEGA,
-    AnalysisSettings,
-    RunConfig,
-    check_harmonics,
-    config_from_dict,
-    dumps_toml,
-    load_case,
-    load_config,
-    model_to_toml_dict,
-    rename_keys,
-)
-from ._csv import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, format_csv, read_csv, write_csv
-from ._read import MAX_CONFIG_BYTES, read_bounded
-from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: Public name → the module that defines it. Imported on first use (PEP 562): the command line
+#: reaches ``rattle.io._read`` and ``._atomic`` without numpy, which ``._config`` (the model)
+#: and ``._csv``/``._metadata`` need.
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
+                     "recover_staging"], "._atomic"),
+    **dict.fromkeys(["DEFAULT_HARMONICS", "DEFAULT_OMEGA", "AnalysisSettings", "RunConfig", "check_harmonics",
+                     "config_from_dict", "dumps_toml", "load_case", "load_config", "model_to_toml_dict",
+                     "rename_keys"], "._config"),
+    **dict.fromkeys(["FRF_COLUMNS", "ORBIT_COLUMNS", "SWEEP_COLUMNS", "format_csv", "read_csv", "write_csv"],
+                    "._csv"),
+    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
+    **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
+                    "._metadata"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'rattle.io' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+if TYPE_CHECKING:
+    from ._atomic import (
+        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging,
+    )
+    from ._config import (
+        DEFAULT_HARMONICS, DEFAULT_OMEGA, AnalysisSettings, RunConfig, check_harmonics, config_from_dict, dumps_toml,
+        load_case, load_config, model_to_toml_dict, rename_keys,
+    )
+    from ._csv import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, format_csv, read_csv, write_csv
+    from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
+    from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
 
 __all__ = [
     # configuration
@@ -32,5 +61,5 @@ __all__ = [
     "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
     # atomic writes, output sets, bounded reads
     "atomic_write_text", "atomic_write_bytes", "atomic_path", "OutputSet", "recover_staging", "STAGING_PREFIX",
-    "read_bounded", "MAX_CONFIG_BYTES",
+    "read_bounded", "check_input_file", "MAX_CONFIG_BYTES",
 ]

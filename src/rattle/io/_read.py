@@ -12,7 +12,7 @@ import stat
 
 from ..errors import ConfigError
 
-__all__ = ["MAX_CONFIG_BYTES", "read_bounded"]
+__all__ = ["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"]
 
 #: Largest configuration file read (bytes). A case file is a few hundred bytes; 1 MiB leaves
 #: room for long comments and generated files while keeping a mistaken path harmless.
@@ -22,6 +22,45 @@ _KINDS = {
     stat.S_IFCHR: "a character device", stat.S_IFBLK: "a block device", stat.S_IFIFO: "a named pipe (FIFO)",
     stat.S_IFSOCK: "a socket",
 }
+
+
+def check_input_file(path: str | os.PathLike[str], limit: int = MAX_CONFIG_BYTES,
+                     what: str = "configuration file") -> os.stat_result:
+    """Refuse ``path`` unless it is an existing regular file of at most ``limit`` bytes, from
+    ``stat`` alone (no read, no numpy): the command line calls it before anything heavy.
+
+    Raises
+    ------
+    ConfigError
+        Missing, a directory, not a regular file, too large, or not accessible; the message says
+        which and the fix.
+    """
+    name = os.fspath(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise ConfigError(
+            f"{what} {name!r} does not exist; check the path (relative paths start at {os.getcwd()!r})"
+        ) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read {what} {name!r}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # an embedded NUL byte
+        raise ConfigError(f"{what} {name!r} is not a valid path ({exc}); give the path of a .toml file") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ConfigError(f"{what} {name!r} is a directory; give the path of a .toml file")
+    _check_kind_and_size(name, st, limit, what)
+    return st
+
+
+def _check_kind_and_size(name: str, st: os.stat_result, limit: int, what: str) -> None:
+    if not stat.S_ISREG(st.st_mode):
+        kind = _KINDS.get(stat.S_IFMT(st.st_mode), "not a regular file")
+        raise ConfigError(f"{what} {name!r} is {kind}, not a regular file; give the path of a .toml file")
+    if st.st_size > limit:
+        raise ConfigError(
+            f"{what} {name!r} has {st.st_size} bytes, more than the limit of {limit} bytes ({limit >> 10} KiB); "
+            "give the path of a .toml case file"
+        )
 
 
 def read_bounded(path: str | os.PathLike[str], limit: int = MAX_CONFIG_BYTES, what: str = "configuration file") -> bytes:
@@ -38,15 +77,11 @@ def read_bounded(path: str | os.PathLike[str], limit: int = MAX_CONFIG_BYTES, wh
     st = os.stat(path)
     if stat.S_ISDIR(st.st_mode):
         raise IsADirectoryError(21, "Is a directory", name)
-    if not stat.S_ISREG(st.st_mode):
-        kind = _KINDS.get(stat.S_IFMT(st.st_mode), "not a regular file")
-        raise ConfigError(f"{what} {name!r} is {kind}, not a regular file; give the path of a .toml file")
-    if st.st_size > limit:
-        raise ConfigError(
-            f"{what} {name!r} has {st.st_size} bytes, more than the limit of {limit} bytes ({limit >> 10} KiB); "
-            "give the path of a .toml case file"
-        )
-    with open(path, "rb") as fh:
+    _check_kind_and_size(name, st, limit, what)
+    # O_NONBLOCK: should the path have become a FIFO since the stat, opening it does not wait
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    with os.fdopen(fd, "rb") as fh:
+        _check_kind_and_size(name, os.fstat(fd), limit, what)  # what was opened is what was checked
         data = fh.read(limit + 1)
     if len(data) > limit:
         raise ConfigError(
