@@ -283,3 +283,32 @@ def test_verbose_does_not_leak_into_the_next_run(tmp_path: Path, fake_solver: di
     invoke(["frf", "-v", "case.toml", "-o", "out"], tmp_path)
     result = invoke(["frf", "case.toml", "-o", "out"], tmp_path)
     assert "rattle: writing" not in result.stderr
+
+
+def test_a_signal_during_the_move_waits_until_the_set_is_in_place(tmp_path: Path,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """SIGINT arriving between two renames is held back: the whole new set is in place before
+    the KeyboardInterrupt is raised."""
+    import signal
+
+    from rattle.io import _atomic
+
+    out = tmp_path / "out"
+    _old_set(out)
+    real_replace = os.replace
+    seen: list[str] = []
+
+    def replace_then_signal(src: Any, dst: Any) -> None:
+        real_replace(src, dst)
+        seen.append(Path(dst).name)
+        if len(seen) == 1:
+            os.kill(os.getpid(), signal.SIGINT)  # arrives in the middle of the move
+
+    monkeypatch.setattr(_atomic.os, "replace", replace_then_signal)
+    with pytest.raises(KeyboardInterrupt):
+        with OutputSet(out, FRF_FILES) as staged:
+            for name in FRF_FILES:
+                staged.path(name).write_text("new " + name)
+            staged.commit()
+    assert seen == list(FRF_FILES)
+    assert {p.name: p.read_text() for p in out.iterdir()} == {n: "new " + n for n in FRF_FILES}

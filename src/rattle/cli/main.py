@@ -255,7 +255,10 @@ class RattleGroup(click.Group):
         except click.ClickException as exc:
             _error(exc.format_message())
             return int(exc.exit_code)
-        except click.Abort:
+        except click.Abort as exc:
+            cause = exc.__cause__ or exc.__context__
+            if isinstance(cause, KeyboardInterrupt):  # Ctrl-C while click itself was parsing
+                raise Interrupted(cause.signum if isinstance(cause, Interrupted) else int(signal.SIGINT)) from None
             _error("aborted")
             return EXIT_NUMERICAL
         except ConfigError as exc:

@@ -20,6 +20,7 @@ import tempfile
 import threading
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
 __all__ = [
     "atomic_path", "atomic_write_bytes", "atomic_write_text", "OutputSet", "recover_staging", "STAGING_PREFIX",
@@ -133,17 +134,39 @@ _HELD_SIGNALS = tuple(
 
 @contextlib.contextmanager
 def _signals_held() -> Iterator[None]:
-    """Block SIGINT/SIGTERM/SIGHUP/SIGQUIT in this thread for the body (a few system calls);
-    a signal that arrives meanwhile is delivered when the body ends."""
-    block = getattr(signal, "pthread_sigmask", None)
-    if block is None or threading.current_thread() is not threading.main_thread():  # pragma: no cover
+    """Hold SIGINT/SIGTERM/SIGHUP/SIGQUIT back for the body (a few system calls): a signal that
+    arrives meanwhile is recorded and raised again, to the handler that was in place, when the
+    body ends.
+
+    The Python-level handlers are swapped rather than the signals blocked with
+    ``pthread_sigmask``: a process-directed signal blocked in the main thread is delivered to
+    another thread (a queue feeder, a progress monitor), and Python then runs its handler in the
+    main thread all the same. Handlers can only be set in the main thread; elsewhere the body
+    runs unprotected.
+    """
+    if threading.current_thread() is not threading.main_thread():  # pragma: no cover
         yield
         return
-    old = block(signal.SIG_BLOCK, _HELD_SIGNALS)
+    pending: list[int] = []
+
+    def hold(signum: int, _frame: object) -> None:
+        pending.append(signum)
+
+    previous: dict[int, Any] = {}
+    for sig in _HELD_SIGNALS:
+        handler = signal.getsignal(sig)
+        if handler is None:  # set outside Python: leave it alone
+            continue
+        with contextlib.suppress(ValueError, OSError):
+            signal.signal(sig, hold)
+            previous[sig] = handler
     try:
         yield
     finally:
-        block(signal.SIG_SETMASK, old)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if pending:
+            signal.raise_signal(pending[0])  # now: KeyboardInterrupt, the CLI's Interrupted, or the default
 
 
 def _fsync_dir(path: Path) -> None:
@@ -227,12 +250,13 @@ class OutputSet:
        (``.rattle-staging-<pid>-<random>/``: the same file system, so the moves are renames);
     2. when all are complete (each flushed to disk), a journal listing the moves and removals is
        written into the staging folder — the commit point;
-    3. with SIGINT, SIGTERM, SIGHUP and SIGQUIT held back, each staged file is renamed over its
+    3. with SIGINT, SIGTERM, SIGHUP and SIGQUIT held back (recorded, and raised again when the
+       move is done), each staged file is renamed over its
        target (``os.replace``, atomic per file) and the files of the set that this run did not
        produce (e.g. ``frf.png`` without matplotlib) are removed, so that an old one cannot sit
        beside new data; then the staging folder is removed.
 
-    Step 3 is a handful of system calls with the catchable signals blocked, so an interrupted run
+    Step 3 is a handful of system calls with the catchable signals held back, so an interrupted run
     (Ctrl-C, ``kill``) leaves either the earlier set untouched (interrupted before step 3; the
     staging folder is removed on the way out) or the complete new set. Only an uncatchable end in
     the middle of step 3 (SIGKILL, power loss) can leave a mix, and then the journal says how to
