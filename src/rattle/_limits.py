@@ -234,46 +234,66 @@ def stiffest_frequency(model: Any) -> float:
     return math.sqrt(model.k * max(slopes))
 
 
-def _frequency_rule(model: Any, omega: float, name: str) -> None:
+def simulation_rate(model: Any) -> float:
+    """ν = max(ω_s, 2π·C/I) (rad/s): the exact integrator scans every forcing period in steps of
+    1/40 of the model's fastest time scale min(2π/ω_s, 1/c), i.e. ~40·ν/Ω steps per period."""
+    return max(stiffest_frequency(model), 2.0 * math.pi * model.c)
+
+
+def _frequency_rule(model: Any, omega: float, name: str, simulate: bool) -> None:
     ws = stiffest_frequency(model)
     lo, hi = MIN_OMEGA_RATIO * ws, MAX_OMEGA_RATIO * ws
     if omega < lo:
         raise ValueError(
             f"`{name}` must be >= {lo:.4g} rad/s ({MIN_OMEGA_RATIO:g} × the stiffest stage's natural "
-            f"frequency {ws:.4g} rad/s), got {omega!r}: each forcing period 2π/Ω spans "
+            f"frequency {ws:.4g} rad/s), got {show(omega)}: each forcing period 2π/Ω spans "
             f"~{ws / omega:.3g} free oscillations of the stage, all integrated exactly (a simulation "
-            "at 1e-6 × that frequency took 314 s, at 1e-3 × it under a second); the response there is quasi-static — start the range higher, e.g. "
-            f"{0.1 * ws:.3g}"
+            "at 1e-6 × that frequency took 314 s, at 1e-3 × it under a second); the response there is quasi-static — "
+            f"start the range higher, e.g. {0.1 * ws:.3g}"
         )
     if omega > hi:
         raise ValueError(
             f"`{name}` must be <= {hi:.4g} rad/s ({MAX_OMEGA_RATIO:g} × the stiffest stage's natural "
-            f"frequency {ws:.4g} rad/s), got {omega!r}: the response there is a pure mass line "
+            f"frequency {ws:.4g} rad/s), got {show(omega)}: the response there is a pure mass line "
             f"(amplitude < 1e-6 of the static one) and the continuation would need over 10⁴ points; "
             f"end the range lower, e.g. {3.0 * ws:.3g}"
         )
+    nu = simulation_rate(model)
+    if simulate and nu > ws and omega < MIN_OMEGA_RATIO * nu:
+        # Heavily overdamped (c > ω_s / 2π): the damping rate, not the stiffness, sets the step.
+        raise ValueError(
+            f"`{name}` must be >= {MIN_OMEGA_RATIO * nu:.4g} rad/s for a simulation of this model, got "
+            f"{show(omega)}: its damping rate C/I = {model.c:.3g} 1/s sets the exact integrator's time step "
+            f"(1/40 of 1/(C/I)), so one forcing period would take ~{40 * 2 * math.pi * model.c / omega:.2g} "
+            "steps (hours of simulation); the harmonic balance alone (frequency_response, or "
+            "periodic_orbit with simulate=False) has no such limit"
+        )
 
 
-def check_frequency(model: Any, omega: object, name: str = "omega") -> float:
-    """A single forcing frequency within ``MIN_OMEGA_RATIO`` … ``MAX_OMEGA_RATIO`` × ω_s."""
+def check_frequency(model: Any, omega: object, name: str = "omega", *, simulate: bool = True) -> float:
+    """A single forcing frequency within ``MIN_OMEGA_RATIO`` … ``MAX_OMEGA_RATIO`` × ω_s; with
+    ``simulate`` also Ω ≥ ``MIN_OMEGA_RATIO`` × ν (:func:`simulation_rate`), which differs from
+    the first rule only for a heavily overdamped model."""
     from ._validate import check_omega
 
     w = check_omega(omega, name)
-    _frequency_rule(model, w, name)
+    _frequency_rule(model, w, name, simulate)
     return w
 
 
 def check_frequency_range(
-    model: Any, omega_min: float, omega_max: float, names: tuple[str, str] = ("omega", "omega")
+    model: Any, omega_min: float, omega_max: float, names: tuple[str, str] = ("omega", "omega"),
+    *, simulate: bool = False,
 ) -> tuple[float, float]:
-    """Both ends of an (already type-checked, ordered) range within the bounds relative to ω_s.
+    """Both ends of an (already type-checked, ordered) range within the bounds relative to ω_s
+    (and, with ``simulate``, to ν: see :func:`check_frequency`).
 
     ``names``: how the two ends are called in messages (``("omega", "omega")`` for the library's
     pair, ``("analysis.omega[0]", "analysis.omega[1]")`` in a file, ``("--omega-min",
     "--omega-max")`` on the command line).
     """
-    _frequency_rule(model, float(omega_min), names[0])
-    _frequency_rule(model, float(omega_max), names[1])
+    _frequency_rule(model, float(omega_min), names[0], simulate)
+    _frequency_rule(model, float(omega_max), names[1], simulate)
     return float(omega_min), float(omega_max)
 
 
@@ -358,5 +378,5 @@ __all__ = [
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
     "CLEARANCE_WARNING", "check_harmonics", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
-    "check_scales", "check_analysable_model", "warn_clearance", "stiffest_frequency",
+    "check_scales", "check_analysable_model", "warn_clearance", "stiffest_frequency", "simulation_rate",
 ]

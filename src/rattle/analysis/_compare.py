@@ -271,7 +271,7 @@ def compare(
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file
     # (all of them before the frequency response, so that a bad `points` is not found after it).
     _limits.check_analysable_model(model)
-    lo, hi = _limits.check_frequency_range(model, *check_range(omega))
+    lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
     _limits.check_hb_settings(harmonics, samples, hb)
     _limits.check_points(points)
     _limits.check_workers(workers)

@@ -386,7 +386,7 @@ def periodic_orbit(
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     _limits.check_analysable_model(model)
-    W = _limits.check_frequency(model, omega)
+    W = _limits.check_frequency(model, omega, simulate=False)
     period = _check_period(period)
     _limits.check_hb_settings(harmonics, samples, hb)
     hb_opts = resolve_hb(harmonics, samples, hb)  # validates `harmonics` and `samples`
@@ -399,6 +399,8 @@ def periodic_orbit(
             f"`period` {period} (harmonics count multiples of Ω/period), got {harmonics}"
         )
     simulate = _validate.check_bool(simulate, "simulate")
+    if simulate:
+        _limits.check_frequency(model, W, simulate=True)
     if frf is not None and not isinstance(frf, FrequencyResponse):
         raise TypeError(f"`frf` must be a FrequencyResponse or None, got {type(frf).__name__}")
     if newton is not None and not isinstance(newton, NewtonOptions):

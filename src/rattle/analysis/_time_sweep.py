@@ -297,7 +297,7 @@ def time_sweep(
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     _limits.check_analysable_model(model)
-    lo, hi = _limits.check_frequency_range(model, *check_range(omega))
+    lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
     points = _limits.check_points(points)
     if not isinstance(direction, str) or direction not in DIRECTIONS:
         raise ValueError(
