@@ -9,9 +9,13 @@ so the command line can check its options before the numerics are loaded.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from numbers import Integral, Real
-from typing import Any
+from typing import Any, TypeVar
+
+_F = TypeVar("_F", bound=Callable[..., Any])
 
 
 def _is_bool(value: object) -> bool:
@@ -118,5 +122,27 @@ def check_instance(value: object, name: str, cls: type, what: str, optional: boo
     return value
 
 
-__all__ = ["show", "check_real", "check_omega", "check_range", "check_state", "check_int", "check_bool", "check_choice",
+def numerical_failures(func: _F) -> _F:
+    """Decorator of the analysis front ends: an OverflowError or FloatingPointError raised in
+    the numerics (values beyond double precision, despite the magnitude bounds of
+    :mod:`rattle._limits`) becomes a :class:`~rattle.errors.ConvergenceError` (a clear numerical
+    failure, command-line exit status 1) naming the front end, instead of a raw traceback."""
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return func(*args, **kwargs)
+        except (OverflowError, FloatingPointError) as exc:
+            from .errors import ConvergenceError
+
+            raise ConvergenceError(
+                f"numerical failure in {func.__name__}: {exc} ({type(exc).__name__}): values beyond the "
+                "range of double precision appeared; choose units in which the model's numbers are moderate "
+                "(damping, stiffness and forcing within a few orders of magnitude of each other)"
+            ) from exc
+
+    return wrapper  # type: ignore[return-value]
+
+
+__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_range", "check_state", "check_int", "check_bool", "check_choice",
            "check_instance"]

@@ -223,6 +223,7 @@ def _check_at(at: object, lo: float, hi: float) -> list[float]:
 # --------------------------------------------------------------------------------------------
 # Front end
 # --------------------------------------------------------------------------------------------
+@_validate.numerical_failures
 def compare(
     model: Model,
     omega: tuple[float, float] = (0.1, 3.0),

@@ -158,6 +158,7 @@ def _locate_changes(
     return found
 
 
+@_validate.numerical_failures
 def frequency_response(
     model: Model,
     omega: tuple[float, float] = (0.1, 3.0),

@@ -64,6 +64,7 @@ def truncation_error(frf: FrequencyResponse, rows: Sequence[int] | None = None, 
     return out
 
 
+@_validate.numerical_failures
 def adaptive_frequency_response(
     model: Model,
     omega: tuple[float, float] = (0.1, 3.0),

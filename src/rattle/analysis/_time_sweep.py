@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
-from .. import _limits
+from .. import _limits, _validate
 from .._validate import check_int
 from ..errors import RattleError
 from ..model import Model
@@ -249,6 +249,7 @@ class _Progress:
             self.callback(self.count, self.total)
 
 
+@_validate.numerical_failures
 def time_sweep(
     model: Model,
     omega: Sequence[float] = (0.1, 3.0),
