@@ -15,6 +15,7 @@ Run:  python benchmarks/bench_bifurcations.py [--cases 40] [--seed 2026] [--verb
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -24,29 +25,74 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 import rattle  # noqa: E402
-from _exact_branch import accepted_cases, diagnose, hb_special_points, match  # noqa: E402
+from _exact_branch import Accepted, diagnose, hb_special_points, iter_cases, match  # noqa: E402
 
 TOL = 1e-4
+
+
+def _saved_cases(path: str, seed: int):
+    """Accepted cases rebuilt from the generator, with the exact points read from ``path``."""
+    from _exact_branch import ExactBranch, random_case
+
+    saved = {}
+    with open(path) as fh:
+        for line in fh:
+            rec = json.loads(line)
+            if rec["seed"] == seed:
+                saved[rec["index"]] = rec
+    rng = np.random.default_rng(seed)
+    for i in range(max(saved, default=-1) + 1):
+        case = random_case(rng)
+        if i in saved:
+            rec = saved[i]
+            assert rec["label"] == case.label, (rec["label"], case.label)
+            ref = ExactBranch(special=[tuple(p) for p in rec["special"]], points=np.empty((0, 5)),
+                              seconds=rec["seconds"])
+            yield Accepted(case, ref, i)
+        else:
+            yield (i, case.label, "rejected when the references were saved")
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=40, help="accepted random cases (default 40)")
     ap.add_argument("--seed", type=int, default=2026, help="seed of the case generator (default 2026)")
+    ap.add_argument("--max-steps", type=int, default=200_000,
+                    help="step budget of one exact reference; a longer branch rejects the case (default 200000)")
+    ap.add_argument("--save-references", metavar="FILE",
+                    help="write every accepted case's exact special points to FILE (JSON lines)")
+    ap.add_argument("--references", metavar="FILE",
+                    help="take the exact special points from FILE (written by --save-references with the same "
+                         "seed) instead of recomputing them: compares another version's HB with the same reference")
     ap.add_argument("--verbose", action="store_true", help="print the HB rows around every miss")
     args = ap.parse_args(argv)
 
     t0 = time.perf_counter()
-    cases, rejected = accepted_cases(args.seed, args.cases)
-    t_gen = time.perf_counter() - t0
     found = total = spurious = 0
     errors: list[float] = []
     hb_counts: list[int] = []
     t_hb = t_ref = 0.0
     failed_cases = 0
+    cases: list[Accepted] = []
+    rejected: list[tuple[int, str, str]] = []
     print(f"{'case':>4} {'law':<10} {'exact':>5} {'HB':>4} {'found':>5} {'spur':>4} {'worst dΩ':>9} "
-          f"{'HB s':>6} {'ref s':>6}  missed / spurious")
-    for acc in cases:
+          f"{'HB s':>6} {'ref s':>6}  missed / spurious", flush=True)
+    if args.references:
+        stream = _saved_cases(args.references, args.seed)
+    else:
+        stream = iter_cases(args.seed, max_steps=args.max_steps)
+    save = open(args.save_references, "w") if args.save_references else None
+    while len(cases) < args.cases and len(cases) + len(rejected) < 4 * args.cases + 10:
+        acc = next(stream)
+        if not isinstance(acc, Accepted):
+            rejected.append(acc)
+            print(f"{acc[0]:>4} rejected: {acc[2]}", flush=True)
+            continue
+        cases.append(acc)
+        if save is not None:
+            save.write(json.dumps({"seed": args.seed, "index": acc.index, "label": acc.case.label,
+                                   "special": acc.reference.special, "seconds": acc.reference.seconds}) + "\n")
+            save.flush()
         t = time.perf_counter()
         frf = rattle.frequency_response(acc.case.model, omega=acc.case.omega, throw=False)
         dt = time.perf_counter() - t
@@ -62,9 +108,12 @@ def main(argv: list[str] | None = None) -> int:
         if m.missed or m.spurious:
             failed_cases += 1
         worst = max(m.errors) if m.errors else float("nan")
-        note = "; ".join([f"MISSED {k} {w:.6f}" for k, w in m.missed] + [f"SPURIOUS {k} {w:.6f}" for k, w in m.spurious])
+        status = getattr(frf, "status", None)
+        bad_status = status is not None and not getattr(status, "success", True)
+        note = "; ".join(([f"HB status {status.name}"] if bad_status else []) + [f"MISSED {k} {w:.6f}" for k, w in m.missed] + [f"SPURIOUS {k} {w:.6f}" for k, w in m.spurious])
         print(f"{acc.index:>4} {acc.case.label.split()[0]:<10} {len(acc.reference.special):>5} {len(hb):>4} "
-              f"{len(m.pairs):>5} {len(m.spurious):>4} {worst:>9.2e} {dt:>6.2f} {acc.reference.seconds:>6.2f}  {note}")
+              f"{len(m.pairs):>5} {len(m.spurious):>4} {worst:>9.2e} {dt:>6.2f} {acc.reference.seconds:>6.2f}  {note}",
+              flush=True)
         if args.verbose and (m.missed or m.spurious):
             print("      " + acc.case.label)
             for p in m.missed + m.spurious:
@@ -72,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
     err = np.asarray(errors)
     print()
     print(f"seed {args.seed}: {len(cases)} cases accepted, {len(rejected)} rejected "
-          f"({time.perf_counter() - t0:.0f} s in all; case generation with references {t_gen:.0f} s)")
+          f"({time.perf_counter() - t0:.0f} s in all)")
     for i, label, why in rejected:
         print(f"  rejected #{i}: {why}  [{label}]")
     print(f"special points found / total exact : {found} / {total}")

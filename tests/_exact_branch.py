@@ -15,15 +15,25 @@ saltation matrices are the identity because f is continuous). Nothing of harmoni
    ω_n = ``model.natural_frequency``; G is scaled like x0.
 2. Start: at Ω_min the orbit is found by Newton shooting from the linear response about the static
    equilibrium (checked against a simulation from rest by :func:`low_frequency_orbits`, see below).
-3. Pseudo-arclength continuation in (x0, Ω): secant predictor, Newton corrector on
-   [G; d·(y − y_pred)] = 0 in the plane normal to the predictor direction d. The steps are SMALL and
-   fixed: arclength ≤ ``max_step`` (2e-3 scaled) and |ΔΩ| ≤ ``max_domega`` (1e-3 ω_n); they are only
-   ever halved (corrector failure, a tangent turn above 0.1 rad), never enlarged beyond the caps.
-   ∂G/∂Ω enters only the corrector's Jacobian column, by central differences of the exact flow with
-   a step of 1e-6 in Ω/ω_n (truncation ~h²·|G'''|/6 ≈ 1e-9 and round-off ~ε/h ≈ 1e-10 relative, see
-   :func:`check_g_omega`): its error slows Newton by a factor ~1e-8 per iteration at worst and has
-   no effect on the converged orbits, which solve |G| ≤ 1e-11 (scaled) with the exact flow. The
-   column is refreshed whenever Newton needs more than three iterations.
+3. Continuation in (x0, Ω) with SMALL steps: arclength ≤ ``max_step`` (2e-3 scaled) and
+   |ΔΩ| ≤ ``max_domega`` (1e-3 ω_n); a step is only ever halved (corrector failure, a turn of the
+   secant above 0.1 rad, a corrected point farther than twice the step), never enlarged beyond the
+   caps. Predictor: quadratic extrapolation through the last three points (error O(h³) ≈ 1e-8).
+   Corrector: where the branch is steep in Ω (|dΩ/ds| > 0.05) Newton on G = 0 at the predicted Ω
+   with the exact Jacobian M − I; elsewhere (near folds) pseudo-arclength, Newton on
+   [G; d·(y − y_pred)] = 0 in the plane normal to the predictor direction d. ∂G/∂Ω enters only
+   that corrector's Jacobian column, by central differences of the exact flow with a step of 1e-6
+   in Ω/ω_n (truncation ~h²·|∂³G/∂Ω³|/6 and round-off ~ε/h, both below 1e-8 relative; checked by
+   :func:`check_g_omega`): its error slows Newton slightly and has no effect on the solution, which
+   is that of the exact G. A Newton iterate is accepted when |G| ≤ 1e-9 (scaled) with a next step
+   ≤ 1e-8, or when the Newton step itself is ≤ 1e-7: that last step is then applied without a
+   further evaluation (quadratic convergence: the point is within ~1e-14 of the branch) and the
+   point keeps the monodromy of the iterate it came from, 1e-7 away — immaterial for the signs of
+   ψ except where |ψ| is tiny, which the guard of 5. refines with fresh points anyway. Where the
+   orbit grazes a breakpoint while moving slowly, M changes like the square root of the distance
+   with a huge constant and the branch turns by a finite angle within ~1e-8 (a corner): after a
+   rejected step the retry uses the secant predictor and the pseudo-arclength corrector, and once
+   the step is 1000× below its cap a turn up to 1.2 rad is accepted.
 4. Test functions from the exact monodromy at every point: ψ_fold = det(M − I) = 1 − tr M + det M
    (a multiplier at +1), ψ_pd = det(M + I) = 1 + tr M + det M (a multiplier at −1). Neimark–Sacker
    cannot occur: one coordinate, so det M = exp(−c T) < 1 for c > 0 and a complex pair lies inside
@@ -47,7 +57,7 @@ saltation matrices are the identity because f is continuous). Nothing of harmoni
 Why it can be trusted
 ---------------------
 The flow is exact (no truncation), so the located points carry only round-off and the 1e-11
-location error; the steps are ~50× shorter than harmonic balance's and fixed in advance, so a pair
+location error; the steps are ~10–50× shorter than harmonic balance's and capped in advance, so a pair
 of sign changes can hide only within 2e-3 of arclength, and even there the guard of point 5 splits
 the segment wherever a hidden pair is possible (a smooth ψ near zero, or a crossing-structure
 change). It reproduces the H-independent exact special points of the reference clutch and the gear
@@ -522,31 +532,47 @@ class Accepted:
     index: int  # position in the random stream (accepted or not)
 
 
-def accepted_cases(seed: int, n: int, *, max_special: int = 20, max_tries: int | None = None,
-                   **reference_options) -> tuple[list[Accepted], list[tuple[int, str, str]]]:
-    """The first ``n`` random cases of ``seed`` whose reference is unambiguous and computable with
-    at most ``max_special`` special points; also the rejected ones as (index, label, reason)."""
+def iter_cases(seed: int, *, max_special: int = 20, **reference_options):
+    """Random cases of ``seed`` in order, each yielded as an :class:`Accepted` (unambiguous start,
+    reference computed, at most ``max_special`` special points) or as a rejection
+    (index, label, reason). ``reference_options`` go to :func:`exact_special_points` (e.g. a
+    ``max_steps`` budget)."""
     rng = np.random.default_rng(seed)
-    out: list[Accepted] = []
-    rejected: list[tuple[int, str, str]] = []
     i = 0
-    max_tries = 4 * n + 10 if max_tries is None else max_tries
-    while len(out) < n and i < max_tries:
+    while True:
         case = random_case(rng)
         i += 1
         starts = low_frequency_orbits(case.model, case.omega[0])
         if len(starts) != 1:
-            rejected.append((i - 1, case.label, f"{len(starts)} coexisting motions at Ω_min"))
+            other = sum(bool(np.isnan(x).any()) for x in starts)
+            yield (i - 1, case.label, f"ambiguous start at Ω_min: {len(starts) - other} period-1 orbit(s) "
+                   f"and {other} simulation(s) not settling on period 1")
             continue
         try:
             ref = exact_special_points(case.model, case.omega, **reference_options)
         except ReferenceError as exc:
-            rejected.append((i - 1, case.label, f"reference failed: {exc}"))
+            yield (i - 1, case.label, f"reference failed: {exc}")
             continue
         if len(ref.special) > max_special:
-            rejected.append((i - 1, case.label, f"{len(ref.special)} special points (> {max_special})"))
+            yield (i - 1, case.label, f"{len(ref.special)} special points (> {max_special})")
             continue
-        out.append(Accepted(case, ref, i - 1))
+        yield Accepted(case, ref, i - 1)
+
+
+def accepted_cases(seed: int, n: int, *, max_tries: int | None = None, **options
+                   ) -> tuple[list[Accepted], list[tuple[int, str, str]]]:
+    """The first ``n`` accepted cases of :func:`iter_cases` and the rejected ones before them
+    (at most ``max_tries`` cases drawn, default 4n + 10)."""
+    out: list[Accepted] = []
+    rejected: list[tuple[int, str, str]] = []
+    max_tries = 4 * n + 10 if max_tries is None else max_tries
+    for item in iter_cases(seed, **options):
+        if isinstance(item, Accepted):
+            out.append(item)
+        else:
+            rejected.append(item)
+        if len(out) >= n or len(out) + len(rejected) >= max_tries:
+            break
     return out, rejected
 
 
@@ -617,5 +643,5 @@ def diagnose(frf, point: tuple[str, float], exact: list[tuple[str, float]]) -> s
 
 
 __all__ = ["ExactBranch", "BranchPoint", "ReferenceError", "exact_special_points", "low_frequency_orbits",
-           "check_g_omega", "KINDS", "RandomCase", "random_case", "Accepted", "accepted_cases",
+           "check_g_omega", "KINDS", "RandomCase", "random_case", "Accepted", "accepted_cases", "iter_cases",
            "hb_special_points", "Matching", "match", "diagnose"]
