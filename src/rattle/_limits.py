@@ -10,40 +10,61 @@ re-raise these as :class:`~rattle.errors.ConfigError` (exit status 2).
 This module imports nothing heavy (no numpy, no numerics) so that the command line can check
 its options before the numerics are imported.
 
-Why these bounds (measured on the 2-core test machine, reference clutch, ``benchmarks/bench_limits.py``)
+Why these bounds (measured on the 2-core test machine shared with other jobs, reference clutch;
+``python benchmarks/bench_limits.py``; each case in a fresh process, peak memory = VmHWM)
 ------------------------------------------------------------------------------------------------
 ``harmonics`` H ≤ 256 per base frequency, H·period ≤ 512 on a branch of period p
     The unknowns are 2H + 1 Fourier coefficients, the AFT uses N = max(512, 32H) samples, and the
     Jacobian is assembled from an N × (2H + 1) matrix: memory grows as H², time per Newton
     iteration as H³ (dense solve) and H² N. Each special point is located again with 2H
-    harmonics, so H = 256 means a 512-harmonic (N = 16384) problem there. Measured (frequency
-    response over Ω = 0.6 … 0.7, ~15 points, 2 special points located at H and 2H):
-    see ``HARMONICS_FIGURES``. H = 512 needs the 1024-harmonic re-location (~8× the time of
-    H = 256 per point, hours for a full range); H = 10000 would need ~20 GB.
-``samples`` N ≤ 16384 (= 32 · 512, the default for the 2H re-location at H = 256)
+    harmonics, so H = 256 means a 512-harmonic (N = 16384) problem there. Frequency response
+    over Ω = 0.35 … 0.5 (two period doublings, re-located with 2H):
+
+    ======  ======  ========  =========  =======
+    H       points  time (s)  ms/point   peak MB
+    ======  ======  ========  =========  =======
+    32      71      1.4–2.9   20–41      112
+    64      79      1.8–3.5   23–45      127
+    128     69      2.4–7.4   35–107     172
+    256     79      6–18      76–231     330
+    512     79      51        651        998
+    ======  ======  ========  =========  =======
+
+    (ranges: repeated runs under varying load). The whole reference range 0.1 … 3 with its 10
+    special points: H = 32 4.2 s and 160 MB, H = 256 211 s and 1.3 GB. H = 512 would take ~8×
+    that (its re-location is a 1024-harmonic problem); ``--harmonics 10000`` was measured at 20 GB.
+``samples`` N ≤ 16384 (= 32 · 512, the default for the 2H re-location at H = 256), N·p ≤ 16384
     The N × (2H + 1) AFT matrices: at N = 16384, H = 256 they take 16384 · 513 · 8 B = 67 MB each.
+    A single problem (:class:`~rattle.hb.HBOptions`) is capped at twice the user bounds
+    (H ≤ 1024, N ≤ 32768), the size of the 2H re-location of the largest allowed branch.
 ``period`` / ``max_period`` ≤ 8
-    The sweep detects periods 1 … 8 (SPEC §1); a period-p branch carries p·H harmonics of Ω/p.
+    The sweep detects periods 1 … 8 (SPEC §1); a period-p branch carries p·H harmonics.
 ``points`` (time-domain sweep) ≤ 100 000 per direction
-    Each frequency is a steady-state simulation (tens of ms to seconds); 100 000 of them take
+    Each frequency is a steady-state simulation (0.01 s to seconds); 100 000 of them take
     hours already. 10⁹ used to end in a MemoryError after allocating the frequency grid.
-``max_points`` (continuation budget) ≤ 1 000 000
-    Each accepted point keeps its 2H + 1 coefficients and N samples for the measures.
+``max_points`` (continuation budget) ≤ 1 000 000; ``max_periods`` (settling) ≤ 100 000
+    Each accepted point keeps its 2H + 1 coefficients; an exactly integrated forcing period
+    costs ~0.5 ms (reference case), so 100 000 periods are ~1 min for one frequency.
 Forcing frequency relative to the stiffest stage's natural frequency ω_s = sqrt(K s_max / I):
 ``1e-3 ω_s ≤ Ω ≤ 1e3 ω_s`` (``MIN_OMEGA_RATIO``, ``MAX_OMEGA_RATIO``)
-    A simulation integrates every forcing period 2π/Ω exactly, scanning ~40 grid cells per
-    stage time scale 1/ω_s for breakpoint crossings: a forcing period costs ~ 40 · 2π · ω_s/Ω cells,
-    and settling needs several periods (and ~1/(ζ ω_n) s of time). ``orbit --omega 1e-6`` thus
-    scanned ~10⁹ cells (314 s). At Ω = 1e-3 ω_s a steady state takes about a second. Above
-    1e3 ω_s the response is a pure mass line (amplitude ~ (ω_s/Ω)² of the static one, below
-    1e-6) and the continuation, measured in Ω/ω_n with steps ≤ 0.08, would need > 12 000 points.
+    A simulation integrates every forcing period 2π/Ω exactly, scanning 40 grid cells per
+    fastest time scale min(2π/ω_s, 1/c) for breakpoint crossings: a forcing period costs
+    ~40 · ν/Ω cells, ν = max(ω_s, 2π c). One steady state from rest took 0.2 s at Ω = 1e-3 ω_s,
+    0.9 s at 1e-4, 9 s at 1e-5 and 328 s at 1e-6 (``orbit --omega 1e-6``: 314 s). Below 1e-3 ω_s
+    the response is quasi-static anyway. For a heavily overdamped model (2π c > ω_s) the
+    simulations also need Ω ≥ 1e-3 · 2π c (:func:`simulation_rate`); the harmonic balance does
+    not. Above 1e3 ω_s the response is a pure mass line (amplitude ~ (ω_s/Ω)² of the static
+    one, below 1e-6) and the continuation, measured in Ω/ω_n with steps ≤ 0.08, would need
+    > 12 000 points.
 Magnitudes ≤ 1e50 (``MAX_MAGNITUDE``)
     Every physical number, and the scales derived from them (k = K/I, c = C/I, the force scale
     |F_m| + Σ|F_pn| and the length scale L), must stay within 1e50 (and the divisors above
     1e-50) so that products of up to six of them (an acceleration squared, k²L² …) stay below
     the double-precision limit 1.8e308. ``mean = 1e300`` used to end in an OverflowError.
+    Models with K = I = 1e±40 or C/I = 1e6 are computed (tested).
 
-Hazards of the model that are refused or warned about are in :func:`check_analysable_model`.
+Hazards of the model that are refused or warned about: :func:`check_analysable_model` (zero
+damping refused by every analysis) and :func:`warn_clearance` (b > π/2 rad warned about).
 """
 
 from __future__ import annotations
@@ -91,14 +112,16 @@ MAX_MAGNITUDE = 1e50
 #: A clearance ``b`` above this (rad) is most likely given in degrees: warned about.
 CLEARANCE_WARNING = math.pi / 2
 
-#: Measured time and peak memory of a frequency response over Ω = 0.6 … 0.7 (reference clutch):
-#: H -> (points, seconds, peak resident MB). Filled from ``benchmarks/bench_limits.py``.
-HARMONICS_FIGURES: dict[int, tuple[int, float, float]] = {}
+#: Measured frequency response over Ω = 0.35 … 0.5 (reference clutch, two special points
+#: re-located with 2H; the faster of the runs under load): H -> (points, seconds, peak MB).
+HARMONICS_FIGURES: dict[int, tuple[int, float, float]] = {
+    32: (71, 1.4, 112), 64: (79, 1.8, 127), 128: (69, 2.4, 172), 256: (79, 6.0, 330), 512: (79, 51.0, 998),
+}
 
 _H_REASON = (
     "the harmonic balance Jacobian grows as H² in memory and H³ in time, and each special point is "
-    f"located again with 2H harmonics; H = {MAX_HARMONICS} takes ~80 ms per point and 330 MB, "
-    "H = 512 ~650 ms per point and 1 GB"
+    f"located again with 2H harmonics; measured, H = {MAX_HARMONICS} takes 80–230 ms per point and 330 MB "
+    "(the whole reference range 211 s, 1.3 GB), H = 512 650 ms per point and 1 GB"
 )
 
 
@@ -247,8 +270,9 @@ def _frequency_rule(model: Any, omega: float, name: str, simulate: bool) -> None
         raise ValueError(
             f"`{name}` must be >= {lo:.4g} rad/s ({MIN_OMEGA_RATIO:g} × the stiffest stage's natural "
             f"frequency {ws:.4g} rad/s), got {show(omega)}: each forcing period 2π/Ω spans "
-            f"~{ws / omega:.3g} free oscillations of the stage, all integrated exactly (a simulation "
-            "at 1e-6 × that frequency took 314 s, at 1e-3 × it under a second); the response there is quasi-static — "
+            f"~{ws / omega:.3g} free oscillations of the stage, all integrated exactly (one steady state "
+            "from rest took 0.2 s at 1e-3 × that frequency, 9 s at 1e-5 ×, 330 s at 1e-6 ×); the response there is "
+            "quasi-static — "
             f"start the range higher, e.g. {0.1 * ws:.3g}"
         )
     if omega > hi:
