@@ -47,6 +47,7 @@ def _saved_cases(path: str, seed: int):
             rec = saved[i]
             assert rec["label"] == case.label, (rec["label"], case.label)
             ref = ExactBranch(special=[tuple(p) for p in rec["special"]], points=np.empty((0, 5)),
+                              states=[np.asarray(x) for x in rec.get("states", [])] or None,
                               seconds=rec["seconds"])
             yield Accepted(case, ref, i)
         else:
@@ -91,7 +92,8 @@ def main(argv: list[str] | None = None) -> int:
         cases.append(acc)
         if save is not None:
             save.write(json.dumps({"seed": args.seed, "index": acc.index, "label": acc.case.label,
-                                   "special": acc.reference.special, "seconds": acc.reference.seconds}) + "\n")
+                                   "special": acc.reference.special, "seconds": acc.reference.seconds,
+                                   "states": [list(map(float, x)) for x in acc.reference.states]}) + "\n")
             save.flush()
         t = time.perf_counter()
         frf = rattle.frequency_response(acc.case.model, omega=acc.case.omega, throw=False)
@@ -117,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.verbose and (m.missed or m.spurious):
             print("      " + acc.case.label)
             for p in m.missed + m.spurious:
-                print(diagnose(frf, p, acc.reference.special))
+                print(diagnose(frf, p, acc.reference.special, acc.reference.states))
     err = np.asarray(errors)
     print()
     print(f"seed {args.seed}: {len(cases)} cases accepted, {len(rejected)} rejected "

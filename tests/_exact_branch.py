@@ -102,11 +102,13 @@ class BranchPoint:
 
 @dataclass
 class ExactBranch:
-    """The result: ``special`` [(kind, Ω), …] sorted by arclength, ``points`` of the branch
-    (Ω, δ0, δ'0, ψ_fold, ψ_pd as rows of an array), effort counters and the wall time."""
+    """The result: ``special`` [(kind, Ω), …] in the order of the branch (arclength), ``states``
+    the orbits' (δ(0), δ'(0)) there, ``points`` of the branch (Ω, δ0, δ'0, ψ_fold, ψ_pd as rows of
+    an array), effort counters and the wall time."""
 
     special: list[tuple[str, float]]
     points: np.ndarray
+    states: list[np.ndarray] = field(default_factory=list)  # (δ(0), δ'(0)) at each special point
     steps: int = 0
     evaluations: int = 0
     splits: int = 0
@@ -410,22 +412,26 @@ def exact_special_points(
         refined.append(b)
 
     special: list[tuple[str, float]] = []
+    states: list[np.ndarray] = []
     for a, b in zip(refined[:-1], refined[1:]):
         for k, kind in enumerate(KINDS):
             if np.sign(a.psi[k]) * np.sign(b.psi[k]) >= 0:
                 if a.psi[k] == 0.0 and lo <= a.y[2] * prob.wn <= hi:
                     special.append((kind, float(a.y[2] * prob.wn)))
+                    states.append(a.y[:2] * prob.sx)
                 continue
-            w = _locate(corr, a, b, k, xtol) * prob.wn
+            p = _locate(corr, a, b, k, xtol)
+            w = float(p.y[2] * prob.wn)
             if lo <= w <= hi:
-                special.append((kind, float(w)))
+                special.append((kind, w))
+                states.append(p.y[:2] * prob.sx)
     points = np.array([[p.y[2] * prob.wn, *(p.y[:2] * prob.sx), *p.psi] for p in refined])
-    return ExactBranch(special=special, points=points, steps=steps, evaluations=prob.evaluations,
+    return ExactBranch(special=special, points=points, states=states, steps=steps, evaluations=prob.evaluations,
                        splits=splits, seconds=time.perf_counter() - t0)
 
 
-def _locate(corr: _Corrector, a: BranchPoint, b: BranchPoint, k: int, xtol: float) -> float:
-    """Scaled Ω of the root of ψ_k on the branch between a and b (Brent on the arclength along
+def _locate(corr: _Corrector, a: BranchPoint, b: BranchPoint, k: int, xtol: float) -> BranchPoint:
+    """The branch point at the root of ψ_k on the branch between a and b (Brent on the arclength along
     the secant, trial points corrected in the plane normal to it)."""
     sec = b.y - a.y
     length = float(np.linalg.norm(sec))
@@ -448,7 +454,7 @@ def _locate(corr: _Corrector, a: BranchPoint, b: BranchPoint, k: int, xtol: floa
     p = last.get(s)
     if p is None:
         p = corr.correct(a.y + s * d, d) if 0.0 < s < length else (a if s <= 0.0 else b)
-    return float(p.y[2])
+    return p
 
 
 def check_g_omega(model: Model, omega: float) -> float:
@@ -615,30 +621,70 @@ def match(exact: list[tuple[str, float]], hb: list[tuple[str, float]], tol: floa
     return Matching(pairs, missed, spurious)
 
 
-def diagnose(frf, point: tuple[str, float], exact: list[tuple[str, float]]) -> str:
-    """Where the HB branch (branch 0) stepped over an exact special point: the continuation rows
-    bracketing its Ω, their step ΔΩ, multipliers and test functions, and the exact points inside
-    the same step."""
+def _hb_delta0(frf, rows: np.ndarray) -> np.ndarray:
+    """δ(0) of HB rows from their Fourier coefficients [a_0, a_1 … a_H, b_1 … b_H]."""
+    q = np.asarray(frf.coefficients)[rows]
+    H = (q.shape[1] - 1) // 2
+    return q[:, 0] + q[:, 1 : H + 1].sum(axis=1)
+
+
+def _rows_table(frf, lo_row: int, hi_row: int, d0: dict[int, float]) -> list[str]:
+    out = []
+    for r in range(lo_row, hi_row + 1):
+        mu = np.asarray(frf.multipliers[r])
+        tr, det = float(np.sum(mu).real), float(np.prod(mu).real)
+        out.append(f"      row {r}: Ω = {frf.omega[r]:.7f}  δ(0) = {d0.get(r, float('nan')):+.5f}  μ = {np.round(mu, 4)}  "
+                   f"ψ_fold = {1 - tr + det:+.3e}  ψ_pd = {1 + tr + det:+.3e}  stable = {bool(frf.stable[r])}")
+    return out
+
+
+def diagnose(frf, point: tuple[str, float], exact: list[tuple[str, float]],
+             states: list[np.ndarray] | None = None) -> str:
+    """What the HB branch (branch 0) did at a special point it missed or made up.
+
+    For an exact point: the HB continuation step whose Ω interval holds it — the pass of the
+    branch nearest the exact orbit (its δ(0) from ``states``, parallel to ``exact``) when the
+    branch passes that Ω several times — with the step ΔΩ, the rows around it (Ω, δ(0),
+    multipliers, test functions, stability) and every exact point inside the same step. For an HB
+    point with no exact counterpart: the rows around it."""
     kind, w = point
     rows = np.flatnonzero(np.asarray(frf.branch) == 0)
+    first, last = int(rows[0]), int(rows[-1])
     om = np.asarray(frf.omega)[rows]
+    d0 = dict(zip(rows.tolist(), _hb_delta0(frf, rows).tolist()))
     lines = [f"  {kind} at Ω = {w:.8f}:"]
-    hb_near = [p for p in frf.special_points if p.branch == 0 and abs(p.omega - w) < 5e-3]
-    if hb_near:
-        lines.append("    HB special points within 5e-3: " + ", ".join(f"{p.kind} {p.omega:.8f}" for p in hb_near))
+    hb_pts = [p for p in frf.special_points if p.branch == 0]
+    near = [p for p in hb_pts if abs(p.omega - w) < 5e-3]
+    if near:
+        lines.append("    HB special points within 5e-3: " + ", ".join(f"{p.kind} {p.omega:.8f} (row {p.index})" for p in near))
+    if point not in exact:  # a spurious HB point: show its rows
+        for p in hb_pts:
+            if p.kind == kind and float(p.omega) == w:
+                lines += _rows_table(frf, max(first, p.index - 3), min(last, p.index + 3), d0)
+        return "\n".join(lines)
+    state = None if states is None else states[exact.index(point)]
+    passes = []
     for i in range(len(rows) - 1):
         a, b = om[i], om[i + 1]
-        if min(a, b) <= w <= max(a, b):
-            ia, ib = rows[i], rows[i + 1]
-            inside = [f"{k} {x:.6f}" for k, x in exact if min(a, b) <= x <= max(a, b)]
-            lines.append(f"    HB step rows {ia}->{ib}: Ω {a:.6f} -> {b:.6f} (ΔΩ = {b - a:+.3e}); exact points in "
-                         f"this step: {inside}")
-            for r in range(max(rows[0], ia - 2), min(rows[-1], ib + 2) + 1):
-                mu = np.asarray(frf.multipliers[r])
-                M_tr, M_det = float(np.sum(mu).real), float(np.prod(mu).real)
-                lines.append(f"      row {r}: Ω = {frf.omega[r]:.7f}  μ = {np.round(mu, 5)}  "
-                             f"ψ_fold = {1 - M_tr + M_det:+.3e}  ψ_pd = {1 + M_tr + M_det:+.3e}  "
-                             f"stable = {bool(frf.stable[r])}")
+        if min(a, b) <= w <= max(a, b) and a != b:
+            ia, ib = int(rows[i]), int(rows[i + 1])
+            t = (w - a) / (b - a)
+            passes.append((ia, ib, (1 - t) * d0[ia] + t * d0[ib]))
+    if not passes:
+        lines.append("    the HB branch never reaches this Ω")
+        return "\n".join(lines)
+    if state is not None:
+        passes.sort(key=lambda p: abs(p[2] - state[0]))
+        lines.append(f"    exact orbit δ(0) = {state[0]:+.5f}; the HB branch passes this Ω {len(passes)} time(s), "
+                     "the pass nearest the exact orbit:")
+        passes = passes[:1]
+    for ia, ib, dd in passes:
+        a, b = frf.omega[ia], frf.omega[ib]
+        inside = [f"{k} {x:.6f}" for k, x in exact if min(a, b) <= x <= max(a, b)]
+        lines.append(f"    HB step rows {ia}->{ib}: Ω {a:.6f} -> {b:.6f} (ΔΩ = {b - a:+.3e}, Δδ(0) = "
+                     f"{d0[ib] - d0[ia]:+.3e}; δ(0) interpolated at Ω: {dd:+.5f}); exact points with Ω in this step "
+                     f"(any pass): {inside}")
+        lines += _rows_table(frf, max(first, ia - 2), min(last, ib + 2), d0)
     return "\n".join(lines)
 
 

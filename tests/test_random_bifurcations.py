@@ -26,6 +26,7 @@ import pytest
 
 import rattle
 from _exact_branch import (
+    ExactBranch,
     RandomCase,
     accepted_cases,
     check_g_omega,
@@ -60,7 +61,7 @@ def random_cases():
     return cases
 
 
-def _report(label: str, exact, hb, m, frf) -> str:
+def _report(label: str, exact, states, hb, m, frf) -> str:
     lines = [f"case: {label}", "exact (kind, Ω):"]
     lines += [f"  {k:<16} {w:.8f}" for k, w in sorted(exact, key=lambda p: p[1])]
     lines.append("HB branch 0 (kind, Ω):")
@@ -69,15 +70,15 @@ def _report(label: str, exact, hb, m, frf) -> str:
     lines.append("missed: " + ", ".join(f"{k} {w:.6f}" for k, w in m.missed))
     lines.append("spurious: " + ", ".join(f"{k} {w:.6f}" for k, w in m.spurious))
     for p in m.missed + m.spurious:
-        lines.append(diagnose(frf, p, exact))
+        lines.append(diagnose(frf, p, exact, states))
     return "\n".join(lines)
 
 
-def _check(case: RandomCase, exact) -> None:
+def _check(case: RandomCase, ref: ExactBranch) -> None:
     frf = rattle.frequency_response(case.model, omega=case.omega)
     hb = hb_special_points(frf)
-    m = match(exact, hb, TOL)
-    assert not m.missed and not m.spurious, _report(case.label, exact, hb, m, frf)
+    m = match(ref.special, hb, TOL)
+    assert not m.missed and not m.spurious, _report(case.label, ref.special, ref.states, hb, m, frf)
 
 
 def test_g_omega_finite_difference_step():
@@ -92,7 +93,7 @@ def test_reference_clutch():
     want = sorted(REFERENCE_EXACT)
     assert [k for k, _ in got] == [k for k, _ in want], got
     assert np.allclose([w for _, w in got], [w for _, w in want], atol=1e-5), got
-    _check(RandomCase(model, (0.1, 3.0), "reference clutch (rattle.reference_case())"), ref.special)
+    _check(RandomCase(model, (0.1, 3.0), "reference clutch (rattle.reference_case())"), ref)
 
 
 def test_gear_example():
@@ -100,11 +101,11 @@ def test_gear_example():
     ref = exact_special_points(model, (0.1, 3.0))
     pds = sorted(w for k, w in ref.special if k == "period_doubling")
     assert any(abs(w - 0.64016) < 1e-5 for w in pds) and any(abs(w - 0.65668) < 1e-5 for w in pds), ref.special
-    _check(RandomCase(model, (0.1, 3.0), "examples/gear_backlash.toml"), ref.special)
+    _check(RandomCase(model, (0.1, 3.0), "examples/gear_backlash.toml"), ref)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("i", range(N_RANDOM))
 def test_random_case(random_cases, i):
     acc = random_cases[i]
-    _check(acc.case, acc.reference.special)
+    _check(acc.case, acc.reference)

@@ -66,8 +66,22 @@ class LinearResponse:
 
 
 def linear_frequency_response(model: Model, omega: FloatArray) -> LinearResponse:
-    """δ = F_m/k + Σ_n Re[X_n e^{inΩt}], X_n = F_pn e^{iφ_n} / (k − (nΩ)² + i c nΩ)."""
-    omega = np.asarray(omega, dtype=float)
+    """δ = F_m/k + Σ_n Re[X_n e^{inΩt}], X_n = F_pn e^{iφ_n} / (k − (nΩ)² + i c nΩ).
+
+    ``omega``: frequencies (rad/s), finite and > 0, at most 10⁷ of them; ``model.damping`` > 0
+    (the undamped linear response is infinite at resonance)."""
+    from .. import _limits
+
+    _limits.check_analysable_model(model)
+    if isinstance(omega, (str, bytes)):
+        raise TypeError(f"`omega` must be frequencies in rad/s (numbers), got {omega!r}")
+    try:
+        omega = np.asarray(omega, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"`omega` must be frequencies in rad/s (numbers), got {omega!r}") from None
+    if omega.size > 10**7 or not np.all(np.isfinite(omega) & (omega > 0)):
+        raise ValueError(f"`omega` must hold at most 10⁷ finite frequencies > 0 rad/s, got {omega.size} values "
+                         f"(min {np.min(omega) if omega.size else 'none'})")
     exc = model.excitation
     mean = np.full(omega.shape, exc.mean / model.k)
     ac2 = np.zeros(omega.shape)
