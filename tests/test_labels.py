@@ -53,8 +53,15 @@ def test_the_figure_legend_says_what_is_known(reference_frf):
 
 
 def test_with_subharmonics_the_gap_is_covered_or_says_none_computed_is_stable(reference_model):
-    frf = rattle.frequency_response(reference_model, omega=(0.40, 0.47), harmonics=16, subharmonics=True)
+    # A sweep given to frequency_response labels the regions with what it saw (here a stand-in
+    # that saw period 2 everywhere: it seeds nothing new, the branches explain it).
+    grid = np.linspace(0.40, 0.47, 15)
+    sweep = SimpleNamespace(omega=grid, period=np.full(grid.size, 2), rms=np.full(grid.size, 0.15),
+                            state0=np.zeros((grid.size, 2)))
+    frf = rattle.frequency_response(reference_model, omega=(0.40, 0.47), harmonics=16, subharmonics=True,
+                                    sweep=sweep)
     assert any(r.kind == "subharmonic" and r.omega_min < 0.44 < r.omega_max for r in frf.regions)
+    assert all("sweep_periods" in r.detail for r in frf.regions)
     for r in _gaps(frf):  # slivers between a period doubling and a fold of the period-2 branch
         assert r.kind == "no_stable_computed" and r.detail["subharmonics_computed"]
         assert FALSE_CLAIM not in r.label

@@ -305,9 +305,12 @@ def _frequency_response(
     else:
         result = replace(result, settings=dict(result.settings, subharmonics=False, branches=[_branch_record(result)]))
     if len(result):
-        from ._regimes import label_regions
+        from ._regimes import confirm_with_sweep, label_regions
 
-        result = replace(result, regions=label_regions(result))
+        regions = label_regions(result)
+        if sweep is not None:  # what the simulation saw there goes into the labels
+            regions = confirm_with_sweep(regions, sweep)
+        result = replace(result, regions=regions)
     if throw and not status.success:
         raise ConvergenceError(f"frequency response incomplete: {stepper.message}", partial=result)
     return result
