@@ -73,7 +73,17 @@ def test_period_doubled_branches_found_and_joined(reference_frf_all):
 def test_period_two_branches_against_period_two_shooting(reference_frf_all):
     frf = reference_frf_all
     rows = np.nonzero(frf.period == 2)[0]
-    idx = rows[::4]
+    # Rows at the vertex of a period-doubling pitchfork (odd harmonics < 10 % of the dynamic
+    # content, i.e. within ~1e-4 of Ω_pd) are left out: there the doubled orbit's state moves
+    # like sqrt(Ω − Ω_pd) and the truncation shift of Ω_pd (~1e-6 … 1e-5, the located point's
+    # omega_error) makes "the same orbit at the same Ω" ill-posed, as at a fold tip; the vertex
+    # itself is checked through the located period-doubling point.
+    H = frf.harmonics
+    odd = np.concatenate((np.arange(1, H + 1, 2), H + np.arange(1, H + 1, 2)))
+    Q = frf.coefficients[rows]
+    halved = np.linalg.norm(Q[:, odd], axis=1) < 0.1 * np.linalg.norm(Q[:, 1:], axis=1)
+    idx = rows[~halved][::4]
+    assert idx.size > 40
     err, mu = compare_with_shooting(frf, idx)
     assert err.max() < 1e-3, err.max()
     assert check_stability(frf, idx, mu, margin=1e-2) > 0.8 * len(idx)

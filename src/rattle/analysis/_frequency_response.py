@@ -116,6 +116,22 @@ def _refine(hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, 
     return _locate_with(hb2, newton, kind, qa2, wa2, qb2, wb2)
 
 
+def _vertex_stretch(Q: FloatArray, hb: HarmonicBalance, rows: range) -> int:
+    """How many rows after the first of ``rows`` (a branch-point end, walking inwards) are
+    still (nearly) of half the period: the vertex of the period-doubling pitchfork.
+
+    There the doubled-period orbit's critical multiplier is the square of its parent's, ≈ +1,
+    and sits on either side of the unit circle within the truncation error; the stability
+    changes it shows there are the branch point itself (labelled at the end row), not folds.
+    """
+    count = 0
+    for j in list(rows)[1:-1]:
+        if not _is_period_halved(Q[j], hb):
+            break
+        count += 1
+    return count
+
+
 def _is_period_halved(q: FloatArray, hb: HarmonicBalance, rtol: float = 0.1) -> bool:
     """Whether a solution of even period p is (nearly) of period p/2: its odd harmonics carry
     less than ``rtol`` of the dynamic content. Near the pitchfork where a doubled-period branch
@@ -379,10 +395,12 @@ def assemble(
     stable_for_changes = stable.copy()
     if P > 1 and branch_points[0]:
         labels[0] = "period_doubling"
-        stable_for_changes[0] = stable[1]
+        k = _vertex_stretch(Q, hb, range(P))
+        stable_for_changes[: k + 1] = stable[min(k + 1, P - 1)]
     if P > 1 and branch_points[1]:
         labels[P - 1] = "period_doubling"
-        stable_for_changes[P - 1] = stable[P - 2]
+        k = _vertex_stretch(Q, hb, range(P - 1, -1, -1))
+        stable_for_changes[P - 1 - k :] = stable[max(P - 2 - k, 0)]
     changes = _locate_changes(hb, newton, Q, Om, mu, stable_for_changes, refine) if locate and stability == "monodromy" else [
         (i, classify_loss(mu[i - 1], mu[i]), None, None) for i in range(1, P) if stable_for_changes[i] != stable_for_changes[i - 1]
     ]

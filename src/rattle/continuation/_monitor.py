@@ -28,7 +28,8 @@ end slope (a lower-order model's error, which vanishes at both ends). For each t
   collision may flip ψ) the slopes do not describe the interior, and the step is rejected
   whenever the variation |ψ_b − ψ_a| + L(|ψ'_a| + |ψ'_b|)/2 could reach zero;
 * near the unit circle (a multiplier within ``NEAR_CRITICAL`` of +1 or −1) the step may
-  shrink but never grow;
+  shrink, and grows only while |ψ| / |ψ'| exceeds the present step (at the present rate no
+  test function could reach zero within it);
 * movement: ψ may change by at most ``max_change`` × (1 + min(|ψ_a|, |ψ_b|)) per step (twice
   that rejects the step): this bounds how far the multipliers move in one step.
 
@@ -49,6 +50,9 @@ from .._typing import FloatArray
 #: A multiplier within this distance of its critical value (+1, −1) is "near the unit circle":
 #: the step may shrink but not grow there.
 NEAR_CRITICAL = 0.1
+#: A test function this small (relative to 1 + |ψ| at the other end) is a zero: the end is a
+#: located special point (e.g. the period-doubling point a sub-harmonic branch starts from).
+AT_ZERO = 1e-7
 
 
 @dataclass(frozen=True, slots=True)
@@ -146,6 +150,10 @@ def check_segment(
         change = (pb > 0) != (pa > 0)
         move = abs(pb - pa)
         scale = 1.0 + min(abs(pa), abs(pb))
+        if min(abs(pa), abs(pb)) <= AT_ZERO * (1.0 + max(abs(pa), abs(pb))):
+            # An end sits on a zero (a branch started at a located special point): its sign is
+            # round-off, and a second zero within the same step cannot be told from it.
+            continue
         if move > max_change * scale:
             factor = min(factor, max_change * scale / move)
             if move > 2.0 * max_change * scale and not resolved:
@@ -173,8 +181,13 @@ def check_segment(
             # err grows like L^3: aim for err <= theta x (the model's distance from zero), pointwise.
             ratio = np.min(tolerance * (sign * p[inner])[e > 0] / e[e > 0])
             factor = min(factor, float(max(ratio, 0.0)) ** (1.0 / 3.0))
-    if b.distance < NEAR_CRITICAL:
-        factor = min(factor, 1.0)
+    if b.distance < NEAR_CRITICAL and factor > 1.0:
+        # Near the unit circle the step grows only while, at the present rate, no test function
+        # would reach zero within the present step (a step shrunk for another reason, e.g. a
+        # corrector failure at a branch point, is not frozen).
+        reach = [abs(v) / (abs(g) * length) for v, g in zip(b.values, b.slopes)
+                 if math.isfinite(v) and math.isfinite(g) and g != 0.0 and length > 0.0]
+        factor = min(factor, max(1.0, min(reach, default=1.0)))
     return SegmentVerdict(True, factor)
 
 
