@@ -152,10 +152,13 @@ def draw_regions(
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8}, zorder=6)
         elif r.kind in UNSTABLE_REGION_STYLES:
             hatch, edge, legend_text, short = UNSTABLE_REGION_STYLES[r.kind]
-            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=edge, hatch=hatch, lw=0,
-                       zorder=0, label=legend_text if labels and r.kind not in seen else None)
-            seen.add(r.kind)
             sim = [int(p) for p in r.detail.get("sweep_periods", []) or []]
+            if sim and r.kind != "no_stable_periodic":  # what the simulation saw replaces the guess
+                seen_text = ", ".join(f"period {p}" if p else "no period ≤ 8" for p in sim)
+                legend_text = legend_text.split(":")[0].split(";")[0] + f":\nsimulation: {seen_text}"
+            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=edge, hatch=hatch, lw=0,
+                       zorder=0, label=legend_text if labels and legend_text not in seen else None)
+            seen.add(legend_text)
             if r.kind == "unstable_period_doubling":
                 short = f"period {2 * int(r.detail.get('period', 1))}\nlikely"
             if sim and r.kind != "no_stable_periodic":
