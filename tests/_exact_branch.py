@@ -104,10 +104,12 @@ class BranchPoint:
 class ExactBranch:
     """The result: ``special`` [(kind, Ω), …] in the order of the branch (arclength), ``states``
     the orbits' (δ(0), δ'(0)) there, ``points`` of the branch (Ω, δ0, δ'0, ψ_fold, ψ_pd as rows of
-    an array), effort counters and the wall time."""
+    an array), effort counters, the wall time and ``stats["guard_failures"]``: Ω of segments the
+    hidden-pair guard wanted to split but whose midpoint could not be corrected (a case with any
+    is not trusted: :func:`iter_cases` rejects it)."""
 
     special: list[tuple[str, float]]
-    points: np.ndarray
+    points: np.ndarray | None
     states: list[np.ndarray] = field(default_factory=list)  # (δ(0), δ'(0)) at each special point
     steps: int = 0
     evaluations: int = 0
@@ -366,8 +368,26 @@ def exact_special_points(
         steps += 1
         h = min(2.0 * hh, max_step)
 
+    special, states, refined, splits, guard_failures = guard_and_locate(
+        corr, pts, (lo, hi), split_factor=split_factor, min_split=min_split, xtol=xtol, cont_tol=cont_tol,
+        last_step=last_step)
+    points = np.array([[p.y[2] * prob.wn, *(p.y[:2] * prob.sx), *p.psi] for p in refined])
+    return ExactBranch(special=special, points=points, states=states, steps=steps, evaluations=prob.evaluations,
+                       splits=splits, seconds=time.perf_counter() - t0,
+                       stats={"guard_failures": guard_failures})
+
+
+def guard_and_locate(corr: "_Corrector", pts: list[BranchPoint], omega: tuple[float, float], *,
+                     split_factor: float = 4.0, min_split: float = 1e-7, xtol: float = 1e-11,
+                     cont_tol: float = 1e-9, last_step: float = 1e-7):
+    """Steps 5 and 6 of the module docstring on the consecutive branch points ``pts``: the
+    hidden-pair guard, then Brent's method on every sign change. Returns (special, states, refined
+    points, number of splits, Ω of failed splits)."""
+    prob = corr.prob
+    lo, hi = omega
     # --- refine (guard against hidden pairs), then locate ----------------------------------
     splits = 0
+    guard_failures: list[float] = []  # Ω of midpoints that could not be corrected
 
     def correct_mid(a: BranchPoint, b: BranchPoint) -> BranchPoint | None:
         sec = b.y - a.y
@@ -394,6 +414,7 @@ def exact_special_points(
             return []
         m = correct_mid(a, b)
         if m is None:
+            guard_failures.append(float(0.5 * (a.y[2] + b.y[2]) * prob.wn))
             return []
         splits += 1
         Vh = np.maximum(0.5 * V, np.maximum(variation(a, m), variation(m, b)))
@@ -425,9 +446,26 @@ def exact_special_points(
             if lo <= w <= hi:
                 special.append((kind, w))
                 states.append(p.y[:2] * prob.sx)
-    points = np.array([[p.y[2] * prob.wn, *(p.y[:2] * prob.sx), *p.psi] for p in refined])
-    return ExactBranch(special=special, points=points, states=states, steps=steps, evaluations=prob.evaluations,
-                       splits=splits, seconds=time.perf_counter() - t0)
+    return special, states, refined, splits, guard_failures
+
+
+def branch_points_at(model: Model, omegas, x0=None) -> tuple["_Corrector", list[BranchPoint]]:
+    """Branch points at the given Ω (in order, each shot from the previous orbit, the first from
+    ``x0`` or the linear guess) and a corrector: the input of :func:`guard_and_locate` for a
+    hand-made coarse branch."""
+    prob = _ShootingProblem(model)
+    corr = _Corrector(prob)
+    x = _linear_guess(model, omegas[0]) if x0 is None else np.asarray(x0, dtype=float)
+    pts = []
+    for w in omegas:
+        orbit = shoot_periodic_orbit(model, float(w), x, integrator=prob.integ)
+        if not orbit.converged:
+            raise ReferenceError(f"no orbit at Ω = {w}")
+        x = orbit.state0
+        y = prob.scale(x, float(w))
+        _, M, _, sig = prob.evaluate(y)
+        pts.append(BranchPoint(y, M, _psi(M), sig))
+    return corr, pts
 
 
 def _locate(corr: _Corrector, a: BranchPoint, b: BranchPoint, k: int, xtol: float) -> BranchPoint:
@@ -558,6 +596,10 @@ def iter_cases(seed: int, *, max_special: int = 20, **reference_options):
             ref = exact_special_points(case.model, case.omega, **reference_options)
         except ReferenceError as exc:
             yield (i - 1, case.label, f"reference failed: {exc}")
+            continue
+        if ref.stats.get("guard_failures"):
+            yield (i - 1, case.label, "hidden-pair guard could not subdivide near Ω = "
+                   + ", ".join(f"{w:.6f}" for w in ref.stats["guard_failures"][:3]))
             continue
         if len(ref.special) > max_special:
             yield (i - 1, case.label, f"{len(ref.special)} special points (> {max_special})")
@@ -690,4 +732,4 @@ def diagnose(frf, point: tuple[str, float], exact: list[tuple[str, float]],
 
 __all__ = ["ExactBranch", "BranchPoint", "ReferenceError", "exact_special_points", "low_frequency_orbits",
            "check_g_omega", "KINDS", "RandomCase", "random_case", "Accepted", "accepted_cases", "iter_cases",
-           "hb_special_points", "Matching", "match", "diagnose"]
+           "hb_special_points", "Matching", "match", "diagnose", "guard_and_locate", "branch_points_at"]

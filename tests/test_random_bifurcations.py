@@ -14,7 +14,10 @@ Two fixed cases come first: the reference clutch (whose exact points are also ch
 their published values) and examples/gear_backlash.toml (period-doubling pair 0.64016/0.65668).
 A failure prints the case, both lists and the HB continuation rows around every miss.
 
-The reference costs ~5–15 s a case (steps ≤ 2e-3 in scaled arclength); HB ~1–3 s.
+Then the first ``N_RANDOM`` accepted cases of seed ``SEED`` — the stream of
+benchmarks/bench_bifurcations.py, whose figure covers 40 cases — with a step budget per reference
+(rejections are printed with their reason). A reference costs ~5–15 s of CPU (steps ≤ 2e-3 in
+scaled arclength), HB ~1–3 s: the file takes ~2 min of CPU.
 """
 
 from __future__ import annotations
@@ -29,16 +32,18 @@ from _exact_branch import (
     ExactBranch,
     RandomCase,
     accepted_cases,
+    branch_points_at,
     check_g_omega,
     diagnose,
     exact_special_points,
+    guard_and_locate,
     hb_special_points,
     match,
 )
 
 TOL = 1e-4  # the issue's bound on the located Ω
 SEED = 2026
-N_RANDOM = 8
+N_RANDOM = 6
 #: Step budget of a random case's reference (~10 s): a longer branch (light damping, large
 #: resonance amplitudes) rejects the case here; the benchmark has no such budget.
 MAX_STEPS = 12_000
@@ -86,9 +91,25 @@ def test_g_omega_finite_difference_step():
     assert check_g_omega(rattle.reference_case(), 0.5) < 1e-6
 
 
+def test_guard_recovers_hidden_pair():
+    # The reference's hidden-pair guard on its own, on a hand-made coarse branch of the gear
+    # example: Ω = 0.62, 0.635, 0.665, 0.68. The step 0.635 -> 0.665 holds the period-doubling pair
+    # (ψ_pd > 0 at both ends, the situation of the HB step that missed it); without the guard no
+    # point is found, with it both, at the Ω of the fine continuation.
+    model = rattle.Model.from_toml(EXAMPLES / "gear_backlash.toml")
+    corr, pts = branch_points_at(model, [0.62, 0.635, 0.665, 0.68])
+    assert pts[1].psi[1] > 0.0 and pts[2].psi[1] > 0.0
+    assert guard_and_locate(corr, pts, (0.62, 0.68), min_split=1.0)[0] == []  # guard off
+    special, _, _, splits, failures = guard_and_locate(corr, pts, (0.62, 0.68))
+    pds = sorted(w for k, w in special if k == "period_doubling")
+    assert len(pds) == 2 and splits > 0 and not failures, special
+    assert abs(pds[0] - 0.6401643474) < 1e-8 and abs(pds[1] - 0.6566801262) < 1e-8, pds
+
+
 def test_reference_clutch():
     model = rattle.reference_case()
     ref = exact_special_points(model, (0.1, 3.0))
+    assert not ref.stats["guard_failures"], ref.stats
     got = sorted(ref.special, key=lambda p: (p[0], p[1]))
     want = sorted(REFERENCE_EXACT)
     assert [k for k, _ in got] == [k for k, _ in want], got
@@ -99,6 +120,7 @@ def test_reference_clutch():
 def test_gear_example():
     model = rattle.Model.from_toml(EXAMPLES / "gear_backlash.toml")
     ref = exact_special_points(model, (0.1, 3.0))
+    assert not ref.stats["guard_failures"], ref.stats
     pds = sorted(w for k, w in ref.special if k == "period_doubling")
     assert any(abs(w - 0.64016) < 1e-5 for w in pds) and any(abs(w - 0.65668) < 1e-5 for w in pds), ref.special
     _check(RandomCase(model, (0.1, 3.0), "examples/gear_backlash.toml"), ref)
