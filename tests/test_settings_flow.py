@@ -190,3 +190,18 @@ def test_case_file_analysis_library_equals_cli(tmp_path):
     assert case.frequency_response(omega=(1.0, 1.02), hb=HBOptions(harmonics=4, samples=40)).settings["samples"] == 40
     with pytest.raises(TypeError):
         case.frequency_response(harmonic=4)
+
+
+def test_sweep_seeded_branch_gets_every_option(record):
+    """Backlash b = 1: the period-2 motion a time sweep finds at Ω = 0.65 seeds a branch (period
+    doublings not followed: ``max_period=1``), which gets the user's options like every other."""
+    model = rattle.Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=rattle.Backlash(b=1.0),
+                         excitation=rattle.Excitation(mean=0.05, amplitudes=(0.03,)))
+    sweep = rattle.time_sweep(model, omega=(0.55, 0.75), points=21, direction="up")
+    assert 2 in set(sweep.period.tolist())
+    record["hb"].clear()
+    frf = rattle.frequency_response(model, omega=(0.62, 0.70), hb=HBOptions(harmonics=16, samples=16 * RATIO),
+                                    newton=NEWTON, continuation=CONT, subharmonics=True, max_period=1, sweep=sweep)
+    _assert_carried(record)
+    seeded = [b for b in frf.settings["branches"] if b["origin"].startswith("seed")]
+    assert seeded and all(b["samples"] == RATIO * b["harmonics"] == RATIO * 32 for b in seeded)
