@@ -127,3 +127,12 @@ def test_gear_orbit_at_0_6538_lists_the_stable_period_two_orbit(gear_orbit):
     assert any(not s.stable and s.multipliers[0].real < -1 for s in gear_orbit.of_period(1))  # its parent
     assert "period 2" in gear_orbit.summary()
     assert {s["simulated"] for s in gear_orbit.metadata()["solutions"]} == {True, False}
+
+
+def test_compare_labels_the_interval_with_what_the_sweep_saw(reference_model):
+    cmp = rattle.compare(reference_model, omega=(0.40, 0.47), harmonics=16, points=5, at=[0.44])
+    (gap,) = _gaps(cmp.frf)
+    assert gap.kind == "unstable_period_doubling" and 2 in gap.detail["sweep_periods"]
+    assert "simulation: period 2" in gap.label and FALSE_CLAIM not in gap.label
+    assert FALSE_CLAIM not in cmp.summary()
+    assert 2 in {s.period for s in cmp.orbits[0].solutions}
