@@ -109,7 +109,9 @@ def check_bool(value: object, name: str) -> bool:
 def check_choice(value: object, name: str, choices: tuple[str, ...]) -> str:
     """One of the strings ``choices``."""
     if not isinstance(value, str) or value not in choices:
-        raise ValueError(f"`{name}` must be one of {', '.join(repr(c) for c in choices)}, got {value!r}")
+        allowed = " or ".join(repr(c) for c in choices) if len(choices) == 2 else \
+            "one of " + ", ".join(repr(c) for c in choices)
+        raise ValueError(f"`{name}` must be {allowed}, got {value!r}")
     return value
 
 
