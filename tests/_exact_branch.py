@@ -57,11 +57,21 @@ saltation matrices are the identity because f is continuous). Nothing of harmoni
 Why it can be trusted
 ---------------------
 The flow is exact (no truncation), so the located points carry only round-off and the 1e-11
-location error; the steps are ~10–50× shorter than harmonic balance's and capped in advance, so a pair
-of sign changes can hide only within 2e-3 of arclength, and even there the guard of point 5 splits
-the segment wherever a hidden pair is possible (a smooth ψ near zero, or a crossing-structure
-change). It reproduces the H-independent exact special points of the reference clutch and the gear
-example to < 1e-6 (tests/test_random_bifurcations.py checks them).
+location error. The steps are capped in advance at 2e-3 (HB's continuation allows up to 0.08 in
+its own scaled variables) and shortened wherever the branch turns, so a pair of sign changes could
+hide only within one such short step, and there the guard of point 5 splits the segment wherever
+a hidden pair is possible: a smooth ψ dipping through zero and back within a step has an end value
+small compared with the variation over the neighbouring steps (exact for a quadratic ψ), and a
+non-smooth one needs a change of the crossing structure, which is bisected to 1e-7. The guard on
+its own recovers the gear example's period-doubling pair from a branch sampled only at Ω = 0.62,
+0.635, 0.665, 0.68 (a test). The reference reproduces the H-independent exact special points of the
+reference clutch and the gear example to < 1e-6, and harmonic balance at H = 32 agrees with it to
+~1e-7 typically, 1e-5 at worst (tests/test_random_bifurcations.py, benchmarks/bench_bifurcations.py).
+What it does not guard against: three sign changes inside one step (one visible, two hidden); a
+smooth ψ that is far from quadratic over three steps of 2e-3; a border collision that flips ψ
+without changing the number of crossings of any breakpoint (two grazings at once, codimension
+two). A case whose guard could not split a segment (corrector failure) is reported in
+``stats["guard_failures"]`` and rejected.
 
 Conventions of the comparison
 -----------------------------
