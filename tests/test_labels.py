@@ -136,3 +136,20 @@ def test_compare_labels_the_interval_with_what_the_sweep_saw(reference_model):
     assert "simulation: period 2" in gap.label and FALSE_CLAIM not in gap.label
     assert FALSE_CLAIM not in cmp.summary()
     assert 2 in {s.period for s in cmp.orbits[0].solutions}
+
+
+def test_cli_orbit_on_the_gear_example_lists_the_period_two_orbit(tmp_path):
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent / "cli"))
+    try:
+        from _cli_helpers import invoke
+    finally:
+        sys.path.pop(0)
+    out = tmp_path / "out"
+    result = invoke(["orbit", str(GEAR), "--omega", "0.6538", "--omega-min", "0.6", "--omega-max", "0.7",
+                     "-o", str(out)], tmp_path)
+    assert result.exit_code == 0, result.stderr
+    assert "period 2, rms 0.2274" in result.stdout and "from simulation" in result.stdout
+    sols = json.loads((out / "orbit.json").read_text())["solutions"]
+    assert any(s["period"] == 2 and s["stable"] and s["simulated"] for s in sols)
