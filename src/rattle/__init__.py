@@ -49,6 +49,12 @@ _LAZY: dict[str, str] = {
     "load_case": ".io",
 }
 
+#: Sub-packages reachable as attributes of ``rattle`` (imported on first use, as eagerly before).
+_SUBPACKAGES = frozenset({
+    "analysis", "continuation", "errors", "hb", "io", "measures", "model", "plotting", "report", "results",
+    "stability", "timeint",
+})
+
 __all__ = [
     "__version__",
     "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "reference_case", "backlash_case",
@@ -66,6 +72,8 @@ def __getattr__(name: str) -> Any:
         value: Any = _version()
     elif name in _LAZY:
         value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    elif name in _SUBPACKAGES:  # ``rattle.analysis.x`` without importing rattle.analysis first
+        value = importlib.import_module(f".{name}", __name__)
     else:
         raise AttributeError(f"module 'rattle' has no attribute {name!r}")
     globals()[name] = value  # later look-ups skip __getattr__
