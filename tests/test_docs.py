@@ -270,6 +270,22 @@ def test_every_output_column_is_documented():
             assert f"`{column}`" in text, f"column `{column}` is not in docs/outputs.md"
 
 
+def test_every_output_file_is_documented():
+    import importlib
+
+    main = importlib.import_module("rattle.cli.main")
+    sets = {name: value for name, value in vars(main).items()
+            if re.fullmatch(r"[A-Z]+_FILES", name) and isinstance(value, tuple)}
+    assert {"FRF_FILES", "SWEEP_FILES", "ORBIT_FILES"} <= set(sets), f"output sets not found: {sorted(sets)}"
+    outputs, cli_text = _text("outputs.md"), _text("cli.md")
+    for name, files in sets.items():
+        command = name.split("_")[0].lower()
+        body = _sections(cli_text).get(command, "")
+        for file in files:
+            assert f"`{file}`" in outputs or file.startswith("fig"), f"{file} ({name}) is not in docs/outputs.md"
+            assert f"`{file}`" in body, f"{file} is not in the `rattle {command}` section of docs/cli.md"
+
+
 def test_labels_and_status_values_are_documented():
     from rattle.errors import Status
     from rattle.measures import REGIMES
