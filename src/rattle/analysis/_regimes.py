@@ -44,10 +44,11 @@ def stable_intervals(frf: FrequencyResponse, branch: int) -> list[tuple[float, f
     return out
 
 
-def _union(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
+def _union(intervals: list[tuple[float, float]], tol: float = 0.0) -> list[tuple[float, float]]:
+    """Union of intervals; two closer than ``tol`` are joined."""
     out: list[list[float]] = []
     for lo, hi in sorted(intervals):
-        if out and lo <= out[-1][1]:
+        if out and lo <= out[-1][1] + tol:
             out[-1][1] = max(out[-1][1], hi)
         else:
             out.append([lo, hi])
@@ -136,16 +137,18 @@ def label_regions(frf: FrequencyResponse, min_gap: float = 1e-4) -> tuple[Region
     bounds it (a stable period-2p motion is likely), ``unstable_not_computed`` when they were not
     computed otherwise, ``no_stable_computed`` when they were and none is stable there.
 
-    A gap between stable stretches narrower than ``min_gap`` × (Ω range) is not reported:
-    branches meet at located points (accurate to ~1e-6 in Ω), and such slivers are where two
-    stretches join, not a physical interval."""
+    A gap between stable stretches narrower than ``min_gap`` × (Ω range) is not reported, and
+    two stable stretches of one sub-harmonic branch that close are one region: branches meet at
+    located points (accurate to ~1e-6 in Ω), and such slivers are where two stretches join, not
+    a physical interval."""
     regions: list[Region] = []
+    sliver = min_gap * float(np.ptp(frf.omega))
     for b in np.unique(frf.branch):
         period = int(frf.period[frf.branch == b][0])
         if period == 1:
             regions += superharmonic_resonances(frf, int(b))
         else:
-            for lo, hi in _union(stable_intervals(frf, int(b))):
+            for lo, hi in _union(stable_intervals(frf, int(b)), sliver):
                 regions.append(Region("subharmonic", lo, hi, f"period {period} (1/{period} sub-harmonic)", {"period": period, "branch": int(b)}))
     covered = _union([iv for b in np.unique(frf.branch) for iv in stable_intervals(frf, int(b))])
     lo_all, hi_all = float(frf.omega.min()), float(frf.omega.max())
