@@ -61,6 +61,8 @@ def resolve_hb(harmonics: int, samples: int | None, hb: HBOptions | None) -> HBO
     if isinstance(samples, np.integer):
         samples = int(samples)
     if hb is None:
+        if isinstance(harmonics, _DefaultHarmonics):
+            harmonics = int(harmonics)  # the marker does not leak into results and settings
         return HBOptions(harmonics=harmonics, samples=samples)
     if not isinstance(hb, HBOptions):
         raise TypeError(f"`hb` must be an HBOptions (rattle.HBOptions(harmonics=…, samples=…)) or None, got {hb!r}")
