@@ -54,8 +54,8 @@ Forcing frequency relative to the stiffest stage's natural frequency ω_s = sqrt
     the response is quasi-static anyway. For a heavily overdamped model (2π c > ω_s) the
     simulations also need Ω ≥ 1e-3 · 2π c (:func:`simulation_rate`); the harmonic balance does
     not. Above 1e3 ω_s the response is a pure mass line (amplitude ~ (ω_s/Ω)² of the static
-    one, below 1e-6) and the continuation, measured in Ω/ω_n with steps ≤ 0.08, would need
-    > 12 000 points.
+    one, below 1e-6) and the continuation, measured in Ω/ω_n with steps ≤ 0.08, needs ~13 points
+    per unit of Ω/ω_n: Ω = 0.5 … 300 took 4000 points and 17 s (H = 16), up to 1e3 ω_s > 12 000.
 Magnitudes ≤ 1e50 (``MAX_MAGNITUDE``)
     Every physical number, and the scales derived from them (k = K/I, c = C/I, the force scale
     |F_m| + Σ|F_pn| and the length scale L), must stay within 1e50 (and the divisors above
