@@ -27,7 +27,6 @@ import numpy as np
 
 from .._typing import FloatArray
 from .. import _limits, _validate
-from .._validate import check_int
 from ..errors import RattleError
 from ..model import Model
 from ..results._sweep import SweepResult

@@ -48,7 +48,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from .. import _limits
-from .._validate import check_int, check_omega, check_state, numerical_failures
+from .._validate import check_int, check_state, numerical_failures
 from ..model import Model
 from ._exact import ExactIntegrator, ExactMeasures, Trajectory
 from ._shooting import _newton_shooting, _Shot, _state_scale
