@@ -296,3 +296,38 @@ def test_worker_watchdog_without_prctl_ends_an_orphan(tmp_path: Path) -> None:
         proc.kill()
         if worker and _alive(worker):
             os.kill(worker, signal.SIGKILL)
+
+
+# --------------------------------------------------------------------------------------------
+# In-process: a worker's failure ends the sweep and leaves no process behind
+# --------------------------------------------------------------------------------------------
+@pytest.fixture
+def forked(monkeypatch: pytest.MonkeyPatch) -> None:
+    import multiprocessing
+
+    if multiprocessing.get_start_method(allow_none=False) != "fork":
+        pytest.skip("the patched worker reaches the child only with the fork start method")
+
+
+@pytest.mark.usefixtures("forked")
+@pytest.mark.parametrize("how", ["raises", "dies"])
+def test_a_failing_worker_ends_the_sweep_without_leftovers(monkeypatch: pytest.MonkeyPatch, how: str) -> None:
+    import multiprocessing
+
+    from rattle import RattleError, reference_case, time_sweep
+    from rattle.analysis import _time_sweep as ts
+
+    real = ts._run_timed
+
+    def broken(model, omegas, direction, options, report):  # type: ignore[no-untyped-def]
+        if direction == "down":
+            if how == "dies":
+                os._exit(3)
+            raise RattleError("the down sweep broke")
+        return real(model, omegas, direction, options, report)
+
+    monkeypatch.setattr(ts, "_run_timed", broken)
+    message = "the down sweep broke" if how == "raises" else "down sweep's worker process ended without a result"
+    with pytest.raises(RattleError, match=message):
+        time_sweep(reference_case(), omega=(0.5, 0.6), points=3, direction="both", workers=2)
+    assert multiprocessing.active_children() == []
