@@ -26,6 +26,7 @@ from rattle import _limits
 from rattle.analysis._harmonics import adaptive_frequency_response, truncation_error
 from rattle.io import config_from_dict, load_config
 from rattle.timeint import steady_state
+from _cases import clutch_toml  # tests/_cases.py (tests/ is on sys.path through its conftest)
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -234,25 +235,7 @@ def test_refusals_come_before_any_work(monkeypatch) -> None:
 # --------------------------------------------------------------------------------------------
 # Configuration values: the same rules, with the file's key names
 # --------------------------------------------------------------------------------------------
-VALID = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.1, 3.0]
-harmonics = 32
-"""
+VALID = clutch_toml((0.1, 3.0), 32)
 
 FILE_CASES = [
     ("harmonics huge int", "harmonics = 32", "harmonics = 99999999999999999999",

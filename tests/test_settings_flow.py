@@ -17,6 +17,7 @@ from rattle.analysis import _orbit as orbit_module
 from rattle.analysis import adaptive_frequency_response
 from rattle.continuation import ContinuationStepper
 from rattle.hb import HarmonicBalance
+from _cases import clutch_toml  # tests/_cases.py (tests/ is on sys.path through its conftest)
 
 NEWTON = NewtonOptions(residual_tol=2e-10, step_tol=3e-8, max_iterations=11)
 CONT = ContinuationOptions(initial_step=0.009, max_step=0.07, max_points=5000)
@@ -148,25 +149,7 @@ def test_hb_options_and_plain_arguments_do_not_conflict(reference_model):
         rattle.periodic_orbit(reference_model, 0.95, harmonics=8, hb=HBOptions(harmonics=4))
 
 
-CASE = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [1.0, 1.1]
-harmonics = 5
-"""
+CASE = clutch_toml((1.0, 1.1), 5)
 
 
 def test_case_file_analysis_library_equals_cli(tmp_path):

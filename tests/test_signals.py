@@ -21,30 +21,13 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from _cases import clutch_toml  # tests/_cases.py (tests/ is on sys.path through its conftest)
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals and /proc as on Linux")
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
-FAST = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.5, 0.8]
-harmonics = 8
-"""
+FAST = clutch_toml((0.5, 0.8), 8)
 
 OLD = {"frf.csv": "old csv\n", "frf.json": "{\"old\": true}\n", "frf.png": "old png"}
 #: Longest wait for a progress line (the machine may be busy).

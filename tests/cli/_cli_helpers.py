@@ -9,26 +9,9 @@ from pathlib import Path
 from click.testing import CliRunner, Result
 
 from rattle.cli.main import cli
+from _cases import clutch_toml  # tests/_cases.py (tests/ is on sys.path through its conftest)
 
-VALID = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.1, 3.0]
-harmonics = 32
-"""
+VALID = clutch_toml((0.1, 3.0), 32)
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
