@@ -191,10 +191,18 @@ class _Corrector:
         further evaluation (Newton's quadratic convergence puts the point within ~|step|² of the
         branch) and the monodromy of the point it started from is kept (|step| away)."""
         tol = self.tol if tol is None else tol
+        if self.g_col is None:
+            self.g_col = self.prob.g_omega(y_pred)
+        p = self._newton(y_pred, d, y_fix, tol, last_step)
+        if p is None:  # the ∂G/∂Ω column may come from far away: once more with a fresh one
+            self.g_col = self.prob.g_omega(y_pred)
+            p = self._newton(y_pred, d, y_fix, tol, last_step)
+        return p
+
+    def _newton(self, y_pred: np.ndarray, d: np.ndarray, y_fix: np.ndarray | None, tol: float,
+                last_step: float | None) -> BranchPoint | None:
         y = y_pred.copy()
         anchor = y_pred if y_fix is None else y_fix
-        if self.g_col is None:
-            self.g_col = self.prob.g_omega(y)
         refreshed = False
         for it in range(self.max_iter):
             G, M, Ms, sig = self.prob.evaluate(y)
@@ -217,7 +225,7 @@ class _Corrector:
                 self.g_col = self.prob.g_omega(y)
                 refreshed = True
             y = y + dy
-            if y[2] <= 0.0:
+            if y[2] <= 0.0 or float(np.max(np.abs(y - y_pred))) > 0.1:  # diverging
                 return None
         return None
 

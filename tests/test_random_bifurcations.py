@@ -14,7 +14,8 @@ Two fixed cases come first: the reference clutch (whose exact points are also ch
 their published values) and examples/gear_backlash.toml (period-doubling pair 0.64016/0.65668).
 A failure prints the case, both lists and the HB continuation rows around every miss.
 
-Then the first ``N_RANDOM`` accepted cases of seed ``SEED`` — the stream of
+Then three backlash cases on which the continuation before issue 7 stepped over a
+period-doubling pair (screened from 80 gear-like cases), and the first ``N_RANDOM`` accepted cases of seed ``SEED`` — the stream of
 benchmarks/bench_bifurcations.py, whose figure covers 40 cases — with a step budget per reference
 (rejections are printed with their reason). A reference costs ~5–15 s of CPU (steps ≤ 2e-3 in
 scaled arclength), HB ~1–3 s: the file takes ~2 min of CPU.
@@ -43,7 +44,7 @@ from _exact_branch import (
 
 TOL = 1e-4  # the issue's bound on the located Ω
 SEED = 2026
-N_RANDOM = 6
+N_RANDOM = 4
 #: Step budget of a random case's reference (~10 s): a longer branch (light damping, large
 #: resonance amplitudes) rejects the case here; the benchmark has no such budget.
 MAX_STEPS = 12_000
@@ -55,6 +56,20 @@ REFERENCE_EXACT = [
     ("fold", 0.87437), ("period_doubling", 0.40823), ("period_doubling", 0.46323),
     ("period_doubling", 1.24258), ("period_doubling", 1.95908),
 ]
+
+
+#: Backlash cases (K = I = 1, one harmonic, Ω 0.2…2.5) on which the continuation before issue 7
+#: (fda89e3) stepped over a period-doubling pair (ψ_pd > 0 at both ends of one step) — found by
+#: screening 80 gear-like cases, old against new continuation — with the pair's exact Ω:
+#: (b, c, F_m, F_p1, (Ω_pd1, Ω_pd2)).
+HARD_CASES = {
+    "hard-13": (0.443334661767277, 0.05648858953353816, 0.18232961690673818, 0.10717270785305268,
+                (0.650354416927, 0.656142109891)),
+    "hard-26": (0.4451845367382262, 0.04646584599627554, 0.13689389578873534, 0.07921044833621778,
+                (0.655027173479, 0.658671870484)),
+    "hard-54": (0.42936128007871377, 0.061084632362127286, 0.10567071030219373, 0.09185075538172113,
+                (0.384150539213, 0.390279216368)),
+}
 
 
 @pytest.fixture(scope="module")
@@ -124,6 +139,20 @@ def test_gear_example():
     pds = sorted(w for k, w in ref.special if k == "period_doubling")
     assert any(abs(w - 0.64016) < 1e-5 for w in pds) and any(abs(w - 0.65668) < 1e-5 for w in pds), ref.special
     _check(RandomCase(model, (0.1, 3.0), "examples/gear_backlash.toml"), ref)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(HARD_CASES))
+def test_hard_case(name):
+    b, c, mean, amp, pair = HARD_CASES[name]
+    model = rattle.Model(inertia=1.0, damping=c, stiffness=1.0, elastic=rattle.Backlash(b=b),
+                         excitation=rattle.Excitation(mean=mean, amplitudes=(amp,)))
+    ref = exact_special_points(model, (0.2, 2.5))
+    assert not ref.stats["guard_failures"], ref.stats
+    pds = [w for k, w in ref.special if k == "period_doubling"]
+    assert all(min(abs(w - x) for x in pds) < 1e-9 for w in pair), (pair, ref.special)
+    label = f"{name}: backlash b={b} c={c} Fm={mean} Fp=({amp},) omega=(0.2, 2.5)"
+    _check(RandomCase(model, (0.2, 2.5), label), ref)
 
 
 @pytest.mark.slow
