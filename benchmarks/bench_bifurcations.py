@@ -112,7 +112,9 @@ def main(argv: list[str] | None = None) -> int:
         worst = max(m.errors) if m.errors else float("nan")
         status = getattr(frf, "status", None)
         bad_status = status is not None and not getattr(status, "success", True)
-        note = "; ".join(([f"HB status {status.name}"] if bad_status else []) + [f"MISSED {k} {w:.6f}" for k, w in m.missed] + [f"SPURIOUS {k} {w:.6f}" for k, w in m.spurious])
+        note = "; ".join(([f"HB status {status.name}"] if bad_status else [])
+                         + [f"MISSED {k} {w:.6f}" for k, w in m.missed]
+                         + [f"SPURIOUS {k} {w:.6f}" for k, w in m.spurious])
         print(f"{acc.index:>4} {acc.case.label.split()[0]:<10} {len(acc.reference.special):>5} {len(hb):>4} "
               f"{len(m.pairs):>5} {len(m.spurious):>4} {worst:>9.2e} {dt:>6.2f} {acc.reference.seconds:>6.2f}  {note}",
               flush=True)

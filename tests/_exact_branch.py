@@ -14,7 +14,9 @@ saltation matrices are the identity because f is continuous). Nothing of harmoni
 1. Variables are scaled: y = (δ0 / L, δ'0 / (L ω_n), Ω / ω_n), L = ``model.length_scale()``,
    ω_n = ``model.natural_frequency``; G is scaled like x0.
 2. Start: at Ω_min the orbit is found by Newton shooting from the linear response about the static
-   equilibrium (checked against a simulation from rest by :func:`low_frequency_orbits`, see below).
+   equilibrium. The random cases (:func:`iter_cases`) must have a unique motion there
+   (:func:`low_frequency_orbits`: shooting and three simulations agree), so that HB and the
+   reference follow the same branch; a case with coexisting motions at Ω_min is rejected.
 3. Continuation in (x0, Ω) with SMALL steps: arclength ≤ ``max_step`` (2e-3 scaled) and
    |ΔΩ| ≤ ``max_domega`` (1e-3 ω_n); a step is only ever halved (corrector failure, a turn of the
    secant above 0.1 rad, a corrected point farther than twice the step), never enlarged beyond the
@@ -145,9 +147,7 @@ class _ShootingProblem:
         self.sx = np.array([self.L, self.L * self.wn])
         self.fd_step = fd_step
         self.evaluations = 0
-        nb = len(model.elastic.stages.breakpoints)
         self._bp = np.asarray(model.elastic.stages.breakpoints, dtype=float)
-        self._nb = nb
 
     def unscale(self, y: np.ndarray) -> tuple[np.ndarray, float]:
         return y[:2] * self.sx, float(y[2] * self.wn)
@@ -572,7 +572,8 @@ def random_case(rng: np.random.Generator, omega: tuple[float, float] = (0.2, 2.5
         slopes[0], slopes[-1] = max(slopes[0], 0.3), max(slopes[-1], 0.3)
         law = Piecewise(breakpoints=tuple(float(v) for v in bp), slopes=tuple(float(v) for v in slopes))
         scale = float(np.max(np.abs(bp))) * float(np.mean(slopes))
-        desc = "piecewise bp=[" + ",".join(f"{v:.4f}" for v in bp) + "] s=[" + ",".join(f"{v:.3f}" for v in slopes) + "]"
+        desc = ("piecewise bp=[" + ",".join(f"{v:.4f}" for v in bp) + "] s=["
+                + ",".join(f"{v:.3f}" for v in slopes) + "]")
     mean = float(rng.uniform(0.2, 1.0)) * scale
     n_h = int(rng.integers(1, 4))
     a1 = float(rng.uniform(0.1, 0.3)) * scale * (c / 0.05) ** 0.5
@@ -693,7 +694,8 @@ def _rows_table(frf, lo_row: int, hi_row: int, d0: dict[int, float]) -> list[str
     for r in range(lo_row, hi_row + 1):
         mu = np.asarray(frf.multipliers[r])
         tr, det = float(np.sum(mu).real), float(np.prod(mu).real)
-        out.append(f"      row {r}: Ω = {frf.omega[r]:.7f}  δ(0) = {d0.get(r, float('nan')):+.5f}  μ = {np.round(mu, 4)}  "
+        out.append(f"      row {r}: Ω = {frf.omega[r]:.7f}  δ(0) = {d0.get(r, float('nan')):+.5f}  "
+                   f"μ = {np.round(mu, 4)}  "
                    f"ψ_fold = {1 - tr + det:+.3e}  ψ_pd = {1 + tr + det:+.3e}  stable = {bool(frf.stable[r])}")
     return out
 
@@ -716,7 +718,8 @@ def diagnose(frf, point: tuple[str, float], exact: list[tuple[str, float]],
     hb_pts = [p for p in frf.special_points if p.branch == 0]
     near = [p for p in hb_pts if abs(p.omega - w) < 5e-3]
     if near:
-        lines.append("    HB special points within 5e-3: " + ", ".join(f"{p.kind} {p.omega:.8f} (row {p.index})" for p in near))
+        lines.append("    HB special points within 5e-3: "
+                     + ", ".join(f"{p.kind} {p.omega:.8f} (row {p.index})" for p in near))
     if point not in exact:  # a spurious HB point: show its rows
         for p in hb_pts:
             if p.kind == kind and float(p.omega) == w:

@@ -14,11 +14,12 @@ Two fixed cases come first: the reference clutch (whose exact points are also ch
 their published values) and examples/gear_backlash.toml (period-doubling pair 0.64016/0.65668).
 A failure prints the case, both lists and the HB continuation rows around every miss.
 
-Then three backlash cases on which the continuation before issue 7 stepped over a
-period-doubling pair (screened from 80 gear-like cases), and the first ``N_RANDOM`` accepted cases of seed ``SEED`` — the stream of
-benchmarks/bench_bifurcations.py, whose figure covers 40 cases — with a step budget per reference
-(rejections are printed with their reason). A reference costs ~5–15 s of CPU (steps ≤ 2e-3 in
-scaled arclength), HB ~1–3 s: the file takes ~2 min of CPU.
+Then three backlash cases on which the continuation before issue 7 (fda89e3) stepped over a
+period-doubling pair (screened from 80 gear-like cases), and the first ``N_RANDOM`` accepted
+random cases of seed ``SEED`` — the stream of benchmarks/bench_bifurcations.py, whose figure covers
+40 cases — with a step budget per reference (rejections are printed with their reason). A
+reference costs ~5–15 s of CPU (steps ≤ 2e-3 in scaled arclength), HB ~1–3 s: the file takes
+~2 min.
 """
 
 from __future__ import annotations
