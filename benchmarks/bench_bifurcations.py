@@ -33,19 +33,19 @@ from _exact_branch import Accepted, diagnose, hb_special_points, iter_cases, mat
 TOL = 1e-4
 
 
-def _saved_cases(path: str, seed: int):
+def _saved_cases(path: str, seed: int, family: str):
     """Accepted cases rebuilt from the generator, with the exact points read from ``path``."""
-    from _exact_branch import ExactBranch, random_case
+    from _exact_branch import FAMILIES, ExactBranch
 
     saved = {}
     with open(path) as fh:
         for line in fh:
             rec = json.loads(line)
-            if rec["seed"] == seed:
+            if rec["seed"] == seed and rec.get("family", "mixed") == family:
                 saved[rec["index"]] = rec
     rng = np.random.default_rng(seed)
     for i in range(max(saved, default=-1) + 1):
-        case = random_case(rng)
+        case = FAMILIES[family](rng)
         if i in saved:
             rec = saved[i]
             assert rec["label"] == case.label, (rec["label"], case.label)
@@ -61,6 +61,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=40, help="accepted random cases (default 40)")
     ap.add_argument("--seed", type=int, default=2026, help="seed of the case generator (default 2026)")
+    ap.add_argument("--family", choices=("mixed", "gear"), default="mixed",
+                    help="case family: mixed (backlash, clutch, asymmetric multi-stage, 1-3 harmonics; default) or "
+                         "gear (near examples/gear_backlash.toml, narrow period-doubling bubbles)")
     ap.add_argument("--max-steps", type=int, default=200_000,
                     help="step budget of one exact reference; a longer branch rejects the case (default 200000)")
     ap.add_argument("--save-references", metavar="FILE",
@@ -82,9 +85,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'case':>4} {'law':<10} {'exact':>5} {'HB':>4} {'found':>5} {'spur':>4} {'worst dΩ':>9} "
           f"{'HB cpu':>6} {'ref cpu':>7}  missed / spurious", flush=True)
     if args.references:
-        stream = _saved_cases(args.references, args.seed)
+        stream = _saved_cases(args.references, args.seed, args.family)
     else:
-        stream = iter_cases(args.seed, max_steps=args.max_steps)
+        stream = iter_cases(args.seed, family=args.family, max_steps=args.max_steps)
     save = open(args.save_references, "w") if args.save_references else None
     while len(cases) < args.cases and len(cases) + len(rejected) < 4 * args.cases + 10:
         acc = next(stream)
@@ -94,7 +97,8 @@ def main(argv: list[str] | None = None) -> int:
             continue
         cases.append(acc)
         if save is not None:
-            save.write(json.dumps({"seed": args.seed, "index": acc.index, "label": acc.case.label,
+            save.write(json.dumps({"seed": args.seed, "family": args.family, "index": acc.index,
+                                   "label": acc.case.label,
                                    "special": acc.reference.special, "seconds": acc.reference.seconds,
                                    "cpu": acc.reference.cpu,
                                    "states": [list(map(float, x)) for x in acc.reference.states]}) + "\n")
@@ -128,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(diagnose(frf, p, acc.reference.special, acc.reference.states))
     err = np.asarray(errors)
     print()
-    print(f"seed {args.seed}: {len(cases)} cases accepted, {len(rejected)} rejected "
+    print(f"family {args.family}, seed {args.seed}: {len(cases)} cases accepted, {len(rejected)} rejected "
           f"({time.perf_counter() - t0:.0f} s in all)")
     for i, label, why in rejected:
         print(f"  rejected #{i}: {why}  [{label}]")
