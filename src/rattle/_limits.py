@@ -63,7 +63,7 @@ Magnitudes ≤ 1e50 (``MAX_MAGNITUDE``)
     the double-precision limit 1.8e308. ``mean = 1e300`` used to end in an OverflowError.
     Models with K = I = 1e±40 or C/I = 1e6 are computed (tested).
 
-Hazards of the model that are refused or warned about: :func:`check_analysable_model` (zero
+Hazards of the model that are refused or warned about: :func:`rattle.model.check_analysable_model` (zero
 damping refused by every analysis) and :func:`warn_clearance` (b > π/2 rad warned about).
 """
 
@@ -351,36 +351,6 @@ def check_scales(model: Any, prefix: str = "") -> None:
           f"`excitation.mean`, `excitation.amplitudes` and `{p}stiffness` / `{p}inertia`", allow_zero=True)
 
 
-def check_analysable_model(model: object, name: str = "model") -> Any:
-    """A :class:`~rattle.model.Model` that the analyses can treat: refuse zero damping.
-
-    Zero damping is refused (not handled). An undamped forced piecewise-linear oscillator has
-    an unbounded response at its linear resonances and no asymptotically stable periodic orbit:
-    its Floquet multipliers lie on the unit circle (det M = exp(−c T) = 1), so the stability
-    verdicts, the located special points and the settled periods would all be meaningless, and
-    the linear start solution divides 0 by 0 at resonance. Give a small positive damping
-    instead (ζ = 0.001 … 0.05 is typical of drivetrains). The :class:`~rattle.model.Model`
-    itself accepts damping 0, so that undamped motions can still be integrated exactly
-    (:class:`~rattle.timeint.ExactIntegrator`).
-    """
-    from .model import Model
-
-    if not isinstance(model, Model):
-        raise TypeError(
-            f"`{name}` must be a rattle Model (e.g. rattle.reference_case() or Model.from_toml(path)), "
-            f"got {model!r} ({type(model).__name__})"
-        )
-    if model.damping == 0.0:
-        raise ValueError(
-            f"`{name}.damping` must be > 0 for an analysis, got 0.0: an undamped forced system has "
-            "unbounded resonant response and no asymptotically stable periodic orbit (Floquet "
-            "multipliers on the unit circle), so stability and settling verdicts would be meaningless; "
-            "give a small positive damping, e.g. a damping ratio of 0.01 "
-            f"(damping = {0.02 * math.sqrt(model.stiffness * model.inertia):.3g})"
-        )
-    return model
-
-
 def warn_clearance(b: float, name: str = "b", stacklevel: int = 3) -> None:
     """Warn when a clearance ``b`` exceeds ``CLEARANCE_WARNING`` = π/2 rad (90°).
 
@@ -402,5 +372,5 @@ __all__ = [
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
     "CLEARANCE_WARNING", "check_harmonics", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
-    "check_scales", "check_analysable_model", "warn_clearance", "stiffest_frequency", "simulation_rate",
+    "check_scales", "warn_clearance", "stiffest_frequency", "simulation_rate",
 ]

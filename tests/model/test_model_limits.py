@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rattle import _limits
-from rattle.model import Backlash, Clutch, Excitation, Linear, Model
+from rattle.model import Backlash, Clutch, Excitation, Linear, Model, check_analysable_model
 
 
 def _model(**kw) -> Model:
@@ -23,8 +23,8 @@ def test_zero_damping_is_a_valid_model_but_not_analysable() -> None:
     model = _model(damping=0.0)
     assert model.damping == 0.0 and model.zeta == 0.0
     with pytest.raises(ValueError, match=r"`model.damping` must be > 0 for an analysis"):
-        _limits.check_analysable_model(model)
-    assert _limits.check_analysable_model(_model(damping=1e-6)).damping == 1e-6
+        check_analysable_model(model)
+    assert check_analysable_model(_model(damping=1e-6)).damping == 1e-6
 
 
 @pytest.mark.parametrize(

@@ -34,7 +34,7 @@ import numpy as np
 from .. import _limits, _validate
 from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
-from ..model import Model
+from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, PeriodicOrbit, SweepResult
 from ..timeint import ExactIntegrator, SteadyState, SteadyStateOptions, steady_state
 from ._frequency_response import frequency_response
@@ -271,7 +271,7 @@ def compare(
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file
     # (all of them before the frequency response, so that a bad `points` is not found after it).
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
     _limits.check_hb_settings(harmonics, samples, hb)
     _limits.check_points(points)

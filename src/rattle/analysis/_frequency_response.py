@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import logging
-import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -18,7 +17,7 @@ from ..continuation._detect import LocatedPoint, locate_on_segment
 from ..errors import ConvergenceError, Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..measures import measures_batch, synthesize_batch
-from ..model import Model
+from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, SpecialPoint
 from ..stability import FloquetMonitor, classify_loss, hill_multipliers, monodromy, monodromy_batch, multipliers_from_monodromy
 from ..stability._classify import UNIT_CIRCLE_TOL
@@ -222,7 +221,7 @@ def frequency_response(
     ``result.settings["branches"]`` records what each branch actually used.
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     lo, hi = _limits.check_frequency_range(model, *check_range(omega))
     _validate.check_choice(start, "start", ("low", "high"))
     _validate.check_choice(stability, "stability", ("monodromy", "hill"))

@@ -18,7 +18,7 @@ from .. import _limits, _validate
 from .._typing import FloatArray
 from ..continuation import ContinuationOptions
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
-from ..model import Model
+from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ._settings import DEFAULT_ADAPTIVE_HARMONICS, StabilityMethod, scaled_hb
 
@@ -93,7 +93,7 @@ def adaptive_frequency_response(
     from ._settings import resolve_hb
 
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     _limits.check_frequency_range(model, *_validate.check_range(omega))
     tolerance = _validate.check_real(tolerance, "tolerance")
     if not 0 < tolerance < 1:

@@ -38,12 +38,12 @@ import numpy as np
 
 from .._typing import FloatArray
 from .. import _limits, _validate
-from .._validate import check_omega, check_state
+from .._validate import check_state
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..measures import measures_batch, synthesize_batch
-from ..model import Model
+from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
 from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, hill_multipliers, monodromy_batch, multipliers_from_monodromy
@@ -386,7 +386,7 @@ def periodic_orbit(
         If no periodic solution could be found at all.
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     W = _limits.check_frequency(model, omega, simulate=False)
     period = _check_period(period)
     _limits.check_hb_settings(harmonics, samples, hb)

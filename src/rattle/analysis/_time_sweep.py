@@ -28,7 +28,7 @@ import numpy as np
 from .._typing import FloatArray
 from .. import _limits, _validate
 from ..errors import RattleError
-from ..model import Model
+from ..model import Model, check_analysable_model
 from ..results._sweep import SweepResult
 from ..timeint import ExactIntegrator, SteadyStateOptions, steady_state
 
@@ -296,7 +296,7 @@ def time_sweep(
         ``sweep.csv`` columns, effort, states and provenance.
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
     points = _limits.check_points(points)
     if not isinstance(direction, str) or direction not in DIRECTIONS:

@@ -51,7 +51,7 @@ import numpy as np
 
 from .. import _limits
 from ..errors import ConfigError
-from ..model import ELASTIC_LAWS, AbstractElastic, Excitation, Model
+from ..model import AbstractElastic, ELASTIC_LAWS, Excitation, Model, check_analysable_model
 from ..model._elastic import _check_real
 from ._read import read_bounded
 
@@ -569,7 +569,7 @@ def check_analysis(
     """
     names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", **(names or {})}
     try:
-        _limits.check_analysable_model(model)
+        check_analysable_model(model)
         _limits.check_frequency_range(model, analysis.omega_min, analysis.omega_max,
                                       (names["omega_min"], names["omega_max"]))
     except (ValueError, TypeError) as exc:

@@ -29,7 +29,7 @@ class Model:
     finite in double precision; see :mod:`rattle._limits`). ``damping`` = 0 is a valid model
     (its motion can be integrated exactly) but the analyses refuse it: an undamped forced system
     has no asymptotically stable periodic orbit (see
-    :func:`rattle._limits.check_analysable_model`).
+    :func:`check_analysable_model`).
     """
 
     inertia: float
@@ -118,7 +118,7 @@ class Model:
 
     # --- I/O delegates --------------------------------------------------------------------
     @classmethod
-    def from_toml(cls, path: str | Path) -> "Model":
+    def from_toml(cls, path: str | Path) -> Model:
         """Read the ``[model]`` and ``[excitation]`` tables of a SPEC §2 TOML file."""
         from ..io import load_config
 
@@ -134,4 +134,33 @@ class Model:
         }
 
 
-__all__ = ["Model"]
+def check_analysable_model(model: object, name: str = "model") -> Model:
+    """A :class:`~rattle.model.Model` that the analyses can treat: refuse zero damping.
+
+    Zero damping is refused (not handled). An undamped forced piecewise-linear oscillator has
+    an unbounded response at its linear resonances and no asymptotically stable periodic orbit:
+    its Floquet multipliers lie on the unit circle (det M = exp(−c T) = 1), so the stability
+    verdicts, the located special points and the settled periods would all be meaningless, and
+    the linear start solution divides 0 by 0 at resonance. Give a small positive damping
+    instead (ζ = 0.001 … 0.05 is typical of drivetrains). The :class:`~rattle.model.Model`
+    itself accepts damping 0, so that undamped motions can still be integrated exactly
+    (:class:`~rattle.timeint.ExactIntegrator`).
+    """
+    if not isinstance(model, Model):
+        raise TypeError(
+            f"`{name}` must be a rattle Model (e.g. rattle.reference_case() or Model.from_toml(path)), "
+            f"got {model!r} ({type(model).__name__})"
+        )
+    if model.damping == 0.0:
+        raise ValueError(
+            f"`{name}.damping` must be > 0 for an analysis, got 0.0: an undamped forced system has "
+            "unbounded resonant response and no asymptotically stable periodic orbit (Floquet "
+            "multipliers on the unit circle), so stability and settling verdicts would be meaningless; "
+            "give a small positive damping, e.g. a damping ratio of 0.01 "
+            f"(damping = {0.02 * math.sqrt(model.stiffness * model.inertia):.3g})"
+        )
+    return model
+
+
+
+__all__ = ["Model", "check_analysable_model"]

@@ -13,7 +13,7 @@ from ..errors import Status
 from ..hb import resize_harmonics
 from ..io._csv import FRF_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
-from ..model import Model
+from ..model import Model, check_analysable_model
 
 @dataclass(frozen=True, slots=True)
 class SpecialPoint:
@@ -70,9 +70,8 @@ def linear_frequency_response(model: Model, omega: FloatArray) -> LinearResponse
 
     ``omega``: frequencies (rad/s), finite and > 0, at most 10⁷ of them; ``model.damping`` > 0
     (the undamped linear response is infinite at resonance)."""
-    from .. import _limits
 
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     if isinstance(omega, (str, bytes)):
         raise TypeError(f"`omega` must be frequencies in rad/s (numbers), got {omega!r}")
     try:

@@ -49,7 +49,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from .. import _limits
 from .._validate import check_int, check_state, numerical_failures
-from ..model import Model
+from ..model import Model, check_analysable_model
 from ._exact import ExactIntegrator, ExactMeasures, Trajectory
 from ._shooting import _newton_shooting, _Shot, _state_scale
 
@@ -506,7 +506,7 @@ def steady_state(
         Period (0 when nothing settled within ``max_periods``), orbit, measures, multipliers and
         the final state to carry to the next frequency.
     """
-    _limits.check_analysable_model(model)
+    check_analysable_model(model)
     omega = _limits.check_frequency(model, omega)
     x = check_state(x0)
     opts = SteadyStateOptions() if options is None else options
