@@ -60,8 +60,9 @@ REFERENCE_EXACT = [
 
 
 #: Backlash cases (K = I = 1, one harmonic, Ω 0.2…2.5) on which the continuation before issue 7
-#: (fda89e3) stepped over a period-doubling pair (ψ_pd > 0 at both ends of one step) — found by
-#: screening 80 gear-like cases, old against new continuation — with the pair's exact Ω:
+#: (fda89e3) stepped over a period-doubling pair (ψ_pd > 0 at both ends of one step) — cases 13,
+#: 26 and 54 of ``gear_like_case`` with seed 7 (``bench_bifurcations.py --family gear --seed 7``),
+#: found by screening 80 of them, old against new continuation — with the pair's exact Ω:
 #: (b, c, F_m, F_p1, (Ω_pd1, Ω_pd2)).
 HARD_CASES = {
     "hard-13": (0.443334661767277, 0.05648858953353816, 0.18232961690673818, 0.10717270785305268,
