@@ -33,6 +33,16 @@ from ._floquet import monodromy_and_crossings_batch
 EPSILON = 1e-7
 
 
+def _pair(tr: float, det: float) -> tuple[complex, complex]:
+    """The two eigenvalues of a 2×2 matrix with trace ``tr`` and determinant ``det``."""
+    disc = 0.25 * tr * tr - det
+    if disc >= 0.0:
+        r = math.sqrt(disc)
+        return complex(0.5 * tr + r), complex(0.5 * tr - r)
+    r = math.sqrt(-disc)
+    return complex(0.5 * tr, r), complex(0.5 * tr, -r)
+
+
 class FloquetMonitor:
     """Test functions ψ_fold, ψ_pd (with slopes and crossing structure) of ``hb``'s orbits.
 
@@ -73,8 +83,16 @@ class FloquetMonitor:
                 slopes = (psi[0] - psi_b[0]) / eps
             else:  # grazing within ±ε: no derivative; the stepper treats the point as a kink
                 slopes = np.full(2, np.nan)
-        mu = np.linalg.eigvals(M[0]) if np.all(np.isfinite(M[0])) else np.array([np.inf])
-        distance = float(np.min(np.minimum(np.abs(mu - 1.0), np.abs(mu + 1.0))))
+        M0 = M[0]
+        if not np.all(np.isfinite(M0)):
+            distance = math.inf
+        elif M0.shape == (2, 2):  # closed form: μ = tr/2 ± sqrt(tr²/4 − det)
+            tr, det = float(M0[0, 0] + M0[1, 1]), float(M0[0, 0] * M0[1, 1] - M0[0, 1] * M0[1, 0])
+            mu = _pair(tr, det)
+            distance = min(min(abs(m - 1.0), abs(m + 1.0)) for m in mu)
+        else:
+            mu = np.linalg.eigvals(M0)
+            distance = float(np.min(np.minimum(np.abs(mu - 1.0), np.abs(mu + 1.0))))
         return MonitorReading(psi[0], slopes, here, distance if math.isfinite(distance) else math.inf)
 
 
