@@ -65,7 +65,9 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
     raise ConvergenceError(
         f"no periodic solution found at Ω = {omega:g}: Newton from the linear solution failed "
         f"({res.message}, scaled residual {res.residual:.3g}) and the amplitude homotopy stalled at "
-        f"{lam:.3g} of the forcing"
+        f"{lam:.3g} of the forcing; with {hb.basis.harmonics} harmonics the truncated problem may have "
+        "no solution there (a slow orbit through the stages needs many harmonics): give more "
+        "harmonics or start the range higher"
     )
 
 
