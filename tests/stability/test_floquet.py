@@ -121,3 +121,19 @@ def test_crossing_times_are_roots_to_round_off(rng):
     values = np.array([basis.evaluate(Q[i], w[i], np.array([ti]))[0] for i, ti in zip(p, t)])
     # Refinement stops when the Newton update is below 64 eps T (≤ 4e-13 s here) and |δ'| ≲ 1.
     np.testing.assert_allclose(values, lvl, rtol=0, atol=1e-12)
+
+
+def test_hill_multipliers_keep_the_single_dof_structure():
+    """Hill's exponent has truncation errors in both parts; without projecting the pair onto the
+    admissible structures (a conjugate pair on |μ| = e^{−cT/2}, or two reals with product
+    e^{−cT}) a period doubling came out as 'neimark_sacker' (measured at H = 16: Ω 0.407, 0.460)."""
+    from rattle import frequency_response, reference_case
+
+    model = reference_case()
+    frf = frequency_response(model, omega=(0.3, 0.6), harmonics=16, stability="hill")
+    kinds = {s.kind for s in frf.special_points}
+    assert "neimark_sacker" not in kinds and "period_doubling" in kinds
+    T = 2 * np.pi / frf.omega
+    np.testing.assert_allclose(np.prod(frf.multipliers, axis=1).real, np.exp(-model.c * T), rtol=1e-9)
+    complex_pair = np.abs(frf.multipliers[:, 0].imag) > 0
+    np.testing.assert_allclose(np.abs(frf.multipliers[complex_pair]), np.exp(-0.5 * model.c * T[complex_pair])[:, None], rtol=1e-9)

@@ -52,10 +52,33 @@ def hill_exponents(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexA
 
 
 def hill_multipliers(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexArray:
-    """Floquet multipliers exp(λ T_p), T_p = p 2π/Ω, from :func:`hill_exponents`, largest first."""
+    """Floquet multipliers exp(λ T_p), T_p = p 2π/Ω, from :func:`hill_exponents`, largest first.
+
+    The monodromy of the single-DOF equation is a real 2×2 matrix with det M = e^{−cT}, so its
+    multipliers are either a complex-conjugate pair on the circle |μ| = e^{−cT/2} or two real
+    numbers with product e^{−cT}. Hill's exponent carries a truncation error in both parts, which
+    would otherwise make a real multiplier come out slightly complex (and a period doubling be
+    named a Neimark–Sacker bifurcation). The pair is therefore projected onto the nearer of the
+    two admissible structures: with λ_1 = a + i b, the distance to the circle is |a + c/2| T and
+    the distance to the real axis is that of bT from the nearest multiple of π; the nearer one wins
+    (real: μ_1 = ±e^{aT}, μ_2 = e^{−cT}/μ_1; circle: μ = e^{−cT/2} e^{±ibT}).
+    """
     lam = hill_exponents(hb, q, omega)
     period = 2 * np.pi / hb.base_frequency(omega)
-    mu = np.exp(lam * period)
+    c = hb.model.c
+    a, b = float(lam[0].real), float(lam[0].imag)
+    to_circle = abs(a + 0.5 * c) * period
+    phase = b * period
+    k = round(phase / np.pi)
+    to_axis = abs(phase - k * np.pi)
+    with np.errstate(over="ignore", under="ignore"):
+        if to_axis <= to_circle:
+            mu1 = np.exp(a * period) * (-1.0 if k % 2 else 1.0)
+            mu2 = np.exp(-c * period) / mu1 if mu1 != 0.0 else 0.0
+            mu = np.array([mu1, mu2], dtype=complex)
+        else:
+            r = np.exp(-0.5 * c * period)
+            mu = np.array([r * np.exp(1j * phase), r * np.exp(-1j * phase)])
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
