@@ -32,7 +32,8 @@ def _version() -> str:
 
 #: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
 _LAZY: dict[str, str] = {
-    **dict.fromkeys(["Comparison", "compare", "frequency_response", "periodic_orbit", "time_sweep"], ".analysis"),
+    **dict.fromkeys(["Comparison", "compare", "frequency_response", "load_case", "periodic_orbit", "time_sweep"],
+                   ".analysis"),
     "ContinuationOptions": ".continuation",
     **dict.fromkeys(["ConfigError", "ConvergenceError", "RattleError", "Status"], ".errors"),
     **dict.fromkeys(["HBOptions", "NewtonOptions"], ".hb"),
@@ -46,7 +47,6 @@ _LAZY: dict[str, str] = {
         ".results",
     ),
     **dict.fromkeys(["SteadyStateOptions", "shoot_periodic_orbit", "steady_state"], ".timeint"),
-    "load_case": ".io",
 }
 
 #: Sub-packages reachable as attributes of ``rattle`` (imported on first use, as eagerly before).
@@ -86,11 +86,10 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     __version__: str
-    from .analysis import Comparison, compare, frequency_response, periodic_orbit, time_sweep
+    from .analysis import Comparison, compare, frequency_response, load_case, periodic_orbit, time_sweep
     from .continuation import ContinuationOptions
     from .errors import ConfigError, ConvergenceError, RattleError, Status
     from .hb import HBOptions, NewtonOptions
-    from .io import load_case
     from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
     from .results import (
         FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult,

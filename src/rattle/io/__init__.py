@@ -15,7 +15,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
                      "recover_staging"], "._atomic"),
     **dict.fromkeys(["DEFAULT_HARMONICS", "DEFAULT_OMEGA", "AnalysisSettings", "RunConfig", "check_harmonics",
-                     "config_from_dict", "dumps_toml", "load_case", "load_config", "model_to_toml_dict",
+                     "config_from_dict", "dumps_toml", "load_config", "model_to_toml_dict",
                      "rename_keys"], "._config"),
     **dict.fromkeys(["FRF_COLUMNS", "ORBIT_COLUMNS", "SWEEP_COLUMNS", "format_csv", "read_csv", "write_csv"],
                     "._csv"),
@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     )
     from ._config import (
         DEFAULT_HARMONICS, DEFAULT_OMEGA, AnalysisSettings, RunConfig, check_harmonics, config_from_dict, dumps_toml,
-        load_case, load_config, model_to_toml_dict, rename_keys,
+        load_config, model_to_toml_dict, rename_keys,
     )
     from ._csv import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, format_csv, read_csv, write_csv
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
@@ -52,7 +52,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     # configuration
-    "load_config", "load_case", "config_from_dict", "RunConfig", "AnalysisSettings",
+    "load_config", "config_from_dict", "RunConfig", "AnalysisSettings",
     "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "model_to_toml_dict", "dumps_toml", "rename_keys",
     "check_harmonics",
     # csv

@@ -148,59 +148,6 @@ class RunConfig:
         """The resolved configuration (defaults filled in) as a TOML-shaped dict."""
         return model_to_toml_dict(self.model, self.analysis)
 
-    # --- the library front ends with the file's [analysis] (what the command line does) -------
-    def frequency_response(self, **options: Any) -> Any:
-        """:func:`rattle.frequency_response` of this case over the file's ``analysis.omega`` with
-        its ``analysis.harmonics`` — what ``rattle frf CONFIG`` computes. Keyword ``options``
-        (``subharmonics=True``, ``omega=…``, ``hb=HBOptions(…)``, ``newton=…``, …) are passed on
-        and override the file; an unknown keyword raises TypeError."""
-        from ..analysis import frequency_response
-
-        return frequency_response(self.model, **self._with_analysis(options, "omega"))
-
-    def periodic_orbit(self, omega: float, **options: Any) -> Any:
-        """:func:`rattle.periodic_orbit` at ``omega`` with the file's harmonics, the primary branch
-        followed over ``analysis.omega`` (as ``rattle orbit CONFIG --omega W``)."""
-        from ..analysis import periodic_orbit
-
-        return periodic_orbit(self.model, omega, **self._with_analysis(options, "search_range"))
-
-    def compare(self, **options: Any) -> Any:
-        """:func:`rattle.compare` over the file's range with its harmonics (as ``rattle compare``)."""
-        from ..analysis import compare
-
-        return compare(self.model, **self._with_analysis(options, "omega"))
-
-    def time_sweep(self, **options: Any) -> Any:
-        """:func:`rattle.time_sweep` over the file's range (as ``rattle sweep``)."""
-        from ..analysis import time_sweep
-
-        kw = {"omega": self.analysis.omega, **options}
-        return time_sweep(self.model, **kw)
-
-    def _with_analysis(self, options: dict[str, Any], range_name: str) -> dict[str, Any]:
-        kw: dict[str, Any] = {range_name: self.analysis.omega}
-        if "hb" not in options:  # the harmonic count given inside hb= replaces the file's
-            kw["harmonics"] = self.analysis.harmonics
-        kw.update(options)
-        return kw
-
-
-def load_case(path: str | os.PathLike[str]) -> RunConfig:
-    """Read a configuration file into its model *and* its ``[analysis]`` settings.
-
-    ``rattle.Model.from_toml(path)`` gives the model alone; ``load_case`` keeps the analysis too,
-    so that the library computes what the command line does from the same file::
-
-        case = rattle.load_case("case.toml")
-        frf = case.frequency_response()          # = rattle frf case.toml
-        frf = rattle.frequency_response(case.model, omega=case.analysis.omega,
-                                        harmonics=case.analysis.harmonics)   # the same
-
-    Raises ConfigError on a bad file (see :func:`load_config`).
-    """
-    return load_config(path)
-
 
 # --------------------------------------------------------------------------------------------
 # Schema

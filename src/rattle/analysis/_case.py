@@ -1,0 +1,87 @@
+"""A case file read whole (model and ``[analysis]``), with the front ends run on its settings.
+
+``rattle.load_case(path)`` is what the command line does with a file, from Python: the file's
+frequency range and harmonic count go to the front ends unless given explicitly. It lives here,
+above ``io`` (which reads the file) and beside the front ends it calls, so that ``io`` imports
+no analysis.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any
+
+from ..io import AnalysisSettings, RunConfig, load_config
+from ..model import Model
+from ._compare import compare
+from ._frequency_response import frequency_response
+from ._orbit import periodic_orbit
+from ._time_sweep import time_sweep
+
+
+@dataclass(frozen=True, slots=True)
+class Case:
+    """A validated case file: its ``config`` (:class:`~rattle.io.RunConfig`), with ``model``,
+    ``analysis`` and ``source`` at hand, and the front ends on the file's settings."""
+
+    config: RunConfig
+
+    @property
+    def model(self) -> Model:
+        return self.config.model
+
+    @property
+    def analysis(self) -> AnalysisSettings:
+        return self.config.analysis
+
+    @property
+    def source(self) -> dict[str, Any]:
+        return self.config.source
+
+    def frequency_response(self, **options: Any) -> Any:
+        """:func:`rattle.frequency_response` of this case over the file's ``analysis.omega`` with
+        its ``analysis.harmonics`` — what ``rattle frf CONFIG`` computes. Keyword ``options``
+        (``subharmonics=True``, ``omega=…``, ``hb=HBOptions(…)``, ``newton=…``, …) are passed on
+        and override the file; an unknown keyword raises TypeError."""
+        return frequency_response(self.model, **self._with_analysis(options, "omega"))
+
+    def periodic_orbit(self, omega: float, **options: Any) -> Any:
+        """:func:`rattle.periodic_orbit` at ``omega`` with the file's harmonics, the primary branch
+        followed over ``analysis.omega`` (as ``rattle orbit CONFIG --omega W``)."""
+        return periodic_orbit(self.model, omega, **self._with_analysis(options, "search_range"))
+
+    def compare(self, **options: Any) -> Any:
+        """:func:`rattle.compare` over the file's range with its harmonics (as ``rattle compare``)."""
+        return compare(self.model, **self._with_analysis(options, "omega"))
+
+    def time_sweep(self, **options: Any) -> Any:
+        """:func:`rattle.time_sweep` over the file's range (as ``rattle sweep``)."""
+        kw = {"omega": self.analysis.omega, **options}
+        return time_sweep(self.model, **kw)
+
+    def _with_analysis(self, options: dict[str, Any], range_name: str) -> dict[str, Any]:
+        kw: dict[str, Any] = {range_name: self.analysis.omega}
+        if "hb" not in options:  # the harmonic count given inside hb= replaces the file's
+            kw["harmonics"] = self.analysis.harmonics
+        kw.update(options)
+        return kw
+
+
+def load_case(path: str | os.PathLike[str]) -> Case:
+    """Read a configuration file into its model *and* its ``[analysis]`` settings.
+
+    ``rattle.Model.from_toml(path)`` gives the model alone; ``load_case`` keeps the analysis too,
+    so that the library computes what the command line does from the same file::
+
+        case = rattle.load_case("case.toml")
+        frf = case.frequency_response()          # = rattle frf case.toml
+        frf = rattle.frequency_response(case.model, omega=case.analysis.omega,
+                                        harmonics=case.analysis.harmonics)   # the same
+
+    Raises ConfigError on a bad file (see :func:`rattle.io.load_config`).
+    """
+    return Case(load_config(path))
+
+
+__all__ = ["Case", "load_case"]
