@@ -176,7 +176,15 @@ def test_configuration_examples_are_valid():
 # Command line
 # --------------------------------------------------------------------------------------------
 def _options(command: click.Command) -> set[str]:
-    ctx = click.Context(command, info_name=command.name)
+    # The context the real command line builds: the group's settings (help_option_names
+    # "-h", "--help") reach every sub-command (click caches a command's help option once it has
+    # run, so a bare context would see "-h" or not depending on what ran before).
+    from rattle.cli.main import cli
+
+    parent = click.Context(cli, info_name="rattle", **cli.context_settings)
+    ctx = click.Context(command, info_name=command.name, parent=None if command is cli else parent)
+    if command is cli:
+        ctx = parent
     out: set[str] = set()
     for param in command.get_params(ctx):
         if isinstance(param, click.Option):
