@@ -36,11 +36,12 @@ class FourierBasis:
 
     # --- conversions ---------------------------------------------------------------------
     def to_complex(self, q: FloatArray) -> ComplexArray:
-        """One-sided complex coefficients Q_k, k = 0 … H (δ = Σ_{k=-H}^{H} Q_k e^{ikωt})."""
+        """One-sided complex coefficients Q_k, k = 0 … H (δ = Σ_{k=-H}^{H} Q_k e^{ikωt}); ``q``
+        may hold several series as rows (..., 2H+1)."""
         H = self.harmonics
-        c = np.empty(H + 1, dtype=complex)
-        c[0] = q[0]
-        c[1:] = 0.5 * (q[1 : H + 1] - 1j * q[H + 1 :])
+        c = np.empty(q.shape[:-1] + (H + 1,), dtype=complex)
+        c[..., 0] = q[..., 0]
+        c[..., 1:] = 0.5 * (q[..., 1 : H + 1] - 1j * q[..., H + 1 :])
         return c
 
     def from_complex(self, c: ComplexArray) -> FloatArray:
@@ -53,11 +54,12 @@ class FourierBasis:
         return q
 
     def synthesize(self, q: FloatArray) -> FloatArray:
-        """Samples δ(t_j), j = 0 … N − 1, of the series q (inverse real FFT)."""
+        """Samples δ(t_j), j = 0 … N − 1, of the series q (inverse real FFT); rows (..., 2H+1)
+        give rows of samples (..., N)."""
         N = self.samples
-        spec = np.zeros(N // 2 + 1, dtype=complex)
-        spec[: self.harmonics + 1] = N * self.to_complex(q)
-        return np.fft.irfft(spec, n=N)
+        spec = np.zeros(q.shape[:-1] + (N // 2 + 1,), dtype=complex)
+        spec[..., : self.harmonics + 1] = N * self.to_complex(q)
+        return np.fft.irfft(spec, n=N, axis=-1)
 
     def analyze(self, x: FloatArray) -> FloatArray:
         """Coefficients q of the samples x (length N), truncated to H harmonics (real FFT)."""

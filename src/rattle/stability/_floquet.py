@@ -52,9 +52,8 @@ def stage_transition(stiffness: FloatArray, damping: float, tau: FloatArray) -> 
     eC = np.where(over, eC_over, eC_osc)
     eS = np.where(over, eS_over, eS_osc)
     flat = root == 0  # critically damped stage: C = 1, S = τ
-    e0 = np.exp(sigma * tau)
-    eC = np.where(flat, e0, eC)
-    eS = np.where(flat, e0 * tau, eS)
+    eC = np.where(flat, e, eC)
+    eS = np.where(flat, e * tau, eS)
     out = np.empty(kappa.shape + (2, 2))
     out[..., 0, 0] = eC - sigma * eS
     out[..., 0, 1] = eS

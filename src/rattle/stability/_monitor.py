@@ -27,20 +27,10 @@ import numpy as np
 from .._typing import FloatArray
 from ..continuation import MonitorReading
 from ..hb import HarmonicBalance
-from ._floquet import monodromy_and_crossings_batch
+from ._floquet import monodromy_and_crossings_batch, multipliers_from_monodromy
 
 #: Difference step in scaled arc length for the test functions' derivative.
 EPSILON = 1e-7
-
-
-def _pair(tr: float, det: float) -> tuple[complex, complex]:
-    """The two eigenvalues of a 2×2 matrix with trace ``tr`` and determinant ``det``."""
-    disc = 0.25 * tr * tr - det
-    if disc >= 0.0:
-        r = math.sqrt(disc)
-        return complex(0.5 * tr + r), complex(0.5 * tr - r)
-    r = math.sqrt(-disc)
-    return complex(0.5 * tr, r), complex(0.5 * tr, -r)
 
 
 class FloquetMonitor:
@@ -59,11 +49,7 @@ class FloquetMonitor:
 
     def _evaluate(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
         hb = self.hb
-        H, N = hb.basis.harmonics, hb.basis.samples
-        spec = np.zeros((Q.shape[0], N // 2 + 1), dtype=complex)
-        spec[:, 0] = Q[:, 0]
-        spec[:, 1 : H + 1] = 0.5 * (Q[:, 1 : H + 1] - 1j * Q[:, H + 1 :])
-        X = np.fft.irfft(spec * N, n=N, axis=1)  # samples at t_j = j T / N, as FourierBasis
+        X = hb.basis.synthesize(Q)
         M, counts = monodromy_and_crossings_batch(Q, Om / hb.period, X, self._breakpoints, self._stiffness, self._damping)
         n = M.shape[-1]
         eye = np.eye(n)
@@ -83,17 +69,12 @@ class FloquetMonitor:
                 slopes = (psi[0] - psi_b[0]) / eps
             else:  # grazing within ±ε: no derivative; the stepper treats the point as a kink
                 slopes = np.full(2, np.nan)
-        M0 = M[0]
-        if not np.all(np.isfinite(M0)):
-            distance = math.inf
-        elif M0.shape == (2, 2):  # closed form: μ = tr/2 ± sqrt(tr²/4 − det)
-            tr, det = float(M0[0, 0] + M0[1, 1]), float(M0[0, 0] * M0[1, 1] - M0[0, 1] * M0[1, 0])
-            mu = _pair(tr, det)
-            distance = min(min(abs(m - 1.0), abs(m + 1.0)) for m in mu)
-        else:
-            mu = np.linalg.eigvals(M0)
+        if np.all(np.isfinite(M[0])):
+            mu = multipliers_from_monodromy(M[0])
             distance = float(np.min(np.minimum(np.abs(mu - 1.0), np.abs(mu + 1.0))))
-        return MonitorReading(psi[0], slopes, here, distance if math.isfinite(distance) else math.inf)
+        else:
+            distance = math.inf
+        return MonitorReading(psi[0], slopes, here, distance)
 
 
 __all__ = ["FloquetMonitor", "EPSILON"]
