@@ -285,6 +285,7 @@ def _frequency_response(
         settings={
             "omega": [lo, hi], **run.record(), "period": period,
             "start": start, "start_solution": how, "rejected_steps": stepper.rejected,
+            "rejected_by_monitor": stepper.monitor_rejected,
             "origin": f"continuation from the {start} end of the range",
         },
         timings={"continuation": t_cont - t_start},

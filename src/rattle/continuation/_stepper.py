@@ -75,8 +75,8 @@ class ContinuationStepper:
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
-    rejected: int = 0
-    monitor_rejected: int = 0
+    rejected: int = 0  # trial steps rejected, for any reason
+    monitor_rejected: int = 0  # of which by the test-function monitor
     corrector: ArclengthCorrector = field(init=False, repr=False)
     _y: FloatArray = field(init=False, repr=False)
     _t: FloatArray = field(init=False, repr=False)
