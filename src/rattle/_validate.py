@@ -75,16 +75,24 @@ def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
     return lo, hi
 
 
+def as_float_array(value: object, name: str, what: str) -> Any:
+    """``value`` as a float array; a string, or what numpy cannot read as numbers, is a
+    TypeError "`name` must be <what>, got …"."""
+    import numpy as np
+
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"`{name}` must be {what}, got {value!r}")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"`{name}` must be {what}, got {value!r}") from None
+
+
 def check_state(value: object, name: str = "x0") -> Any:
     """A state (δ, δ') of shape (2,), finite."""
     import numpy as np
 
-    if isinstance(value, (str, bytes)):
-        raise TypeError(f"`{name}` must be a state (delta, velocity) of two numbers, got {value!r}")
-    try:
-        x = np.asarray(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        raise TypeError(f"`{name}` must be a state (delta, velocity) of two numbers, got {value!r}") from None
+    x = as_float_array(value, name, "a state (delta, velocity) of two numbers")
     if x.shape != (2,) or not np.all(np.isfinite(x)):
         raise ValueError(f"`{name}` must be a finite state (delta, velocity) of shape (2,), got {value!r}")
     return x
@@ -146,5 +154,5 @@ def numerical_failures(func: _F) -> _F:
     return wrapper  # type: ignore[return-value]
 
 
-__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_range", "check_state", "check_int", "check_bool", "check_choice",
+__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_range", "check_state", "as_float_array", "check_int", "check_bool", "check_choice",
            "check_instance"]

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
+from .._validate import as_float_array
 from ..errors import Status
 from ..hb import resize_harmonics
 from ..io._csv import FRF_COLUMNS
@@ -72,12 +73,7 @@ def linear_frequency_response(model: Model, omega: FloatArray) -> LinearResponse
     (the undamped linear response is infinite at resonance)."""
 
     check_analysable_model(model)
-    if isinstance(omega, (str, bytes)):
-        raise TypeError(f"`omega` must be frequencies in rad/s (numbers), got {omega!r}")
-    try:
-        omega = np.asarray(omega, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        raise TypeError(f"`omega` must be frequencies in rad/s (numbers), got {omega!r}") from None
+    omega = as_float_array(omega, "omega", "frequencies in rad/s (numbers)")
     if omega.size > 10**7 or not np.all(np.isfinite(omega) & (omega > 0)):
         raise ValueError(f"`omega` must hold at most 10⁷ finite frequencies > 0 rad/s, got {omega.size} values "
                          f"(min {np.min(omega) if omega.size else 'none'})")
