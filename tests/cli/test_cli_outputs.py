@@ -13,47 +13,15 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 
 from rattle.cli.main import FRF_FILES
 from rattle.errors import ConvergenceError
-from rattle.io import FRF_COLUMNS, STAGING_PREFIX, OutputSet, read_csv, recover_staging, write_csv
+from rattle.io import STAGING_PREFIX, OutputSet, read_csv, recover_staging
 from _cli_helpers import invoke, write_config
+from _fake_result import FakeResponse
 
 OLD = {"frf.csv": "old csv\n", "frf.json": "{\"old\": true}\n", "frf.png": "old png"}
-
-
-class FakeResponse:
-    """The part of FrequencyResponse the command line uses; ``on_plot`` runs while drawing."""
-
-    def __init__(self, n: int = 3, on_plot: Any = None) -> None:
-        self.n, self.on_plot = n, on_plot
-
-    def __len__(self) -> int:
-        return self.n
-
-    def to_csv(self, path: Path) -> None:
-        cols: dict[str, Any] = {name: np.linspace(0.1, 1.0, self.n) for name in FRF_COLUMNS}
-        cols.update(branch=np.zeros(self.n, int), period=np.ones(self.n, int), iterations=np.ones(self.n, int),
-                    regime=["no_impact"] * self.n, stable=np.ones(self.n, bool), bifurcation=[""] * self.n)
-        write_csv(path, cols, FRF_COLUMNS)
-
-    def plot(self, ax: Any = None) -> tuple[Any, Any]:
-        if self.on_plot is not None:
-            self.on_plot()
-        from matplotlib.figure import Figure
-
-        fig = Figure()
-        ax = fig.add_subplot()
-        ax.plot([0, 1], [0, 1])
-        return fig, ax
-
-    def summary(self) -> str:
-        return f"{self.n} solution points (fake)"
-
-    def metadata(self) -> dict[str, Any]:
-        return {"settings": {}, "timings": {}, "status": "success"}
 
 
 @pytest.fixture

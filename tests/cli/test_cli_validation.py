@@ -16,8 +16,9 @@ import pytest
 
 from rattle.cli.main import main
 from rattle.errors import ConvergenceError
-from rattle.io import FRF_COLUMNS, read_csv, write_csv
+from rattle.io import FRF_COLUMNS, read_csv
 from _cli_helpers import VALID, assert_bad_input, invoke, write_config
+from _fake_result import FakeResponse as _FakeResponse
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 
@@ -187,34 +188,9 @@ def test_main_exits_with_the_status(tmp_path: Path, monkeypatch: pytest.MonkeyPa
 # --------------------------------------------------------------------------------------------
 # Numerical failure and success, with a stand-in solver (the CLI's contract with the core)
 # --------------------------------------------------------------------------------------------
-class FakeResponse:
-    """The part of FrequencyResponse the command line uses."""
-
-    def __init__(self, n: int = 3) -> None:
-        self.n = n
-
-    def __len__(self) -> int:
-        return self.n
-
-    def to_csv(self, path: Path) -> None:
-        cols: dict[str, Any] = {name: np.linspace(0.1, 1.0, self.n) for name in FRF_COLUMNS}
-        cols.update(branch=np.zeros(self.n, int), period=np.ones(self.n, int), iterations=np.ones(self.n, int),
-                    regime=["no_impact"] * self.n, stable=np.ones(self.n, bool), bifurcation=[""] * self.n)
-        write_csv(path, cols, FRF_COLUMNS)
-
-    def plot(self, ax: Any = None) -> tuple[Any, Any]:
-        from matplotlib.figure import Figure
-
-        fig = Figure()
-        ax = fig.add_subplot()
-        ax.plot([0, 1], [0, 1])
-        return fig, ax
-
-    def summary(self) -> str:
-        return f"{self.n} solution points (fake)"
-
-    def metadata(self) -> dict[str, Any]:
-        return {"settings": {"harmonics": np.int64(32)}, "timings": {"continuation": 0.5}, "status": "success"}
+def FakeResponse(n: int = 3) -> _FakeResponse:  # noqa: N802 - stands for the class
+    """The shared stand-in, with numpy scalars in its settings (the metadata must still be JSON)."""
+    return _FakeResponse(n, settings={"harmonics": np.int64(32)}, timings={"continuation": 0.5})
 
 
 @pytest.fixture
@@ -222,7 +198,7 @@ def fake_solver(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
     """Replace rattle.analysis by a module whose frequency_response does what ``state`` says."""
     state: dict[str, Any] = {"calls": [], "raise": None, "result": FakeResponse()}
 
-    def frequency_response(model: Any, omega: tuple[float, float] = (0.1, 3.0), harmonics: int = 32, *, throw: bool = True) -> FakeResponse:
+    def frequency_response(model: Any, omega: tuple[float, float] = (0.1, 3.0), harmonics: int = 32, *, throw: bool = True) -> _FakeResponse:
         state["calls"].append({"model": model, "omega": omega, "harmonics": harmonics, "throw": throw})
         if state["raise"] is not None:
             raise state["raise"]
