@@ -2,11 +2,18 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import matplotlib
 import numpy as np
 import pytest
 
 matplotlib.use("Agg")
+
+# The command-line tests' shared helpers (tests/cli/_cli_helpers.py) are importable from every
+# test module, as tests/_cases.py is (pytest puts this folder on sys.path for its conftest).
+sys.path.insert(0, str(Path(__file__).resolve().parent / "cli"))
 
 
 @pytest.fixture

@@ -316,11 +316,7 @@ CLI_CASES = [
 
 @pytest.mark.parametrize(("args", "text", "fragments"), [c[1:] for c in CLI_CASES], ids=[c[0] for c in CLI_CASES])
 def test_cli_refuses_with_the_shared_rules(tmp_path: Path, args, text, fragments) -> None:
-    sys.path.insert(0, str(Path(__file__).parent / "cli"))
-    try:
-        from _cli_helpers import assert_bad_input, invoke
-    finally:
-        sys.path.pop(0)
+    from _cli_helpers import assert_bad_input, invoke
     (tmp_path / "case.toml").write_text(text, encoding="utf-8")
     result = invoke(args, tmp_path)
     assert_bad_input(result, *fragments)

@@ -17,8 +17,7 @@ from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "cli"))  # the CLI tests' shared helpers
-from _cli_helpers import VALID, assert_bad_input, invoke  # type: ignore[import-not-found]  # noqa: E402
+from _cli_helpers import VALID, assert_bad_input, invoke  # type: ignore[import-not-found]  # tests/cli, via conftest
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 

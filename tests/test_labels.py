@@ -87,13 +87,8 @@ def test_no_stable_periodic_only_with_subharmonics_computed_and_the_simulation_a
 
 
 def test_cli_frf_prints_no_false_label(tmp_path):
-    import sys
 
-    sys.path.insert(0, str(Path(__file__).parent / "cli"))
-    try:
-        from _cli_helpers import invoke, write_config
-    finally:
-        sys.path.pop(0)
+    from _cli_helpers import invoke, write_config
     config = write_config(tmp_path)
     out = tmp_path / "out"
     result = invoke(["frf", str(config), "--omega-min", "0.38", "--omega-max", "0.5", "--harmonics", "16",
@@ -139,13 +134,8 @@ def test_compare_labels_the_interval_with_what_the_sweep_saw(reference_model):
 
 
 def test_cli_orbit_on_the_gear_example_lists_the_period_two_orbit(tmp_path):
-    import sys
 
-    sys.path.insert(0, str(Path(__file__).parent / "cli"))
-    try:
-        from _cli_helpers import invoke
-    finally:
-        sys.path.pop(0)
+    from _cli_helpers import invoke
     out = tmp_path / "out"
     result = invoke(["orbit", str(GEAR), "--omega", "0.6538", "--omega-min", "0.6", "--omega-max", "0.7",
                      "-o", str(out)], tmp_path)

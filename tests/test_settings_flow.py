@@ -153,13 +153,8 @@ CASE = clutch_toml((1.0, 1.1), 5)
 
 
 def test_case_file_analysis_library_equals_cli(tmp_path):
-    import sys
 
-    sys.path.insert(0, str(Path(__file__).parent / "cli"))
-    try:
-        from _cli_helpers import invoke
-    finally:
-        sys.path.pop(0)
+    from _cli_helpers import invoke
     path = tmp_path / "case.toml"
     path.write_text(CASE, encoding="utf-8")
     result = invoke(["frf", str(path), "-o", str(tmp_path / "out")], tmp_path)
