@@ -17,6 +17,7 @@ import numpy as np
 from .._limits import check_scales
 from ._elastic import AbstractElastic, _check_real
 from ._excitation import Excitation
+from ._system import System, single_equation_system
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -115,6 +116,12 @@ class Model:
     def force_scale(self) -> float:
         """A characteristic force per inertia for residual scaling: |F_m| + Σ |F_pn|."""
         return max(abs(self.excitation.mean) + self.excitation.amplitude_scale, 1e-300)
+
+    def system(self) -> System:
+        """The equations of motion as the numerics see them: the n = m = 1
+        :class:`~rattle.model.System` with C = [[C/I]], K = [[0]], a = [1], b = [K/I]."""
+        exc = self.excitation
+        return single_equation_system(self.c, self.k, self.elastic, exc.mean, exc.amplitudes, exc.phases or ())
 
     # --- I/O delegates --------------------------------------------------------------------
     @classmethod

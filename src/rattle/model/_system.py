@@ -1,0 +1,286 @@
+"""The equations of motion every analysis works on: n coordinates, m clearance elements.
+
+    x'' + C x' + K x + Σ_e b_e f_e(a_e · x) = F(t),
+    F(t) = F_0 + Σ_{h=1}^{H_f} (F_ch cos hΩt + F_sh sin hΩt),
+
+with x ∈ ℝⁿ the coordinates, C and K (n × n) the linear damping and stiffness per unit inertia,
+and for every clearance element e its deflection δ_e = a_e · x, its continuous piecewise-linear
+law f_e (``rattle.model._elastic``, f_e(0) = 0, slopes relative to the element's stiffness) and
+its force direction b_e (which carries the element stiffness and the inverse inertias).
+
+A :class:`System` is what the numerics see — harmonic balance, Floquet stability and the exact
+time integration all work on it and on nothing else. The models build it:
+
+* the single equation of SPEC §1, δ'' + (C/I) δ' + (K/I) f(δ) = F(t), is n = m = 1 with
+  C = [[C/I]], K = [[0]], a = [1], b = [K/I];
+* a chain of N inertias M θ'' + C_θ θ' + K_θ θ + Σ_e w_eᵀ K_e f_e(w_e · θ) = T(t) (SPEC §5) is
+  n = N when grounded (x = θ: C = M⁻¹C_θ, K = M⁻¹K_θ, a_e = w_e, b_e = M⁻¹w_eᵀK_e) and n = N − 1
+  when free (relative coordinates x = D θ, x_k = θ_k − θ_{k+1}; θ = Z x + θ_N 1 with Z upper
+  triangular ones; C = D M⁻¹C_θ Z, K = D M⁻¹K_θ Z, a_e = w_e Z, b_e = D M⁻¹w_eᵀK_e,
+  F = D M⁻¹T): the rigid-body motion drops out exactly because C_θ 1 = K_θ 1 = 0 and w_e 1 = 0.
+
+Within a stage combination s = (s_1 … s_m) (element e on its stage s_e, f_e = k_e δ + o_e there)
+the equation is linear:
+
+    x'' + C x' + K_s x = F(t) − Σ_e b_e o_e,       K_s = K + Σ_e k_e b_e a_eᵀ,
+
+and its first-order form z = (x, x') has the stage matrix A_s = [[0, I], [−K_s, −C]].
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._typing import FloatArray
+from ._elastic import AbstractElastic
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ReducedElement:
+    """A clearance element in the coordinates x: δ = ``a`` · x, force ``b`` f(δ) on the
+    left-hand side, law ``law`` (its breakpoints and slopes)."""
+
+    name: str
+    a: FloatArray  # (n,)
+    b: FloatArray  # (n,)
+    law: AbstractElastic
+
+    @property
+    def breakpoints(self) -> FloatArray:
+        return self.law.stages.breakpoints
+
+    @property
+    def slopes(self) -> FloatArray:
+        return self.law.stages.slopes
+
+    @property
+    def offsets(self) -> FloatArray:
+        return self.law.stages.offsets
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class System:
+    """Equations of motion x'' + C x' + K x + Σ_e b_e f_e(a_e·x) = F(t) (module docstring).
+
+    ``damping`` C and ``stiffness`` K (n, n); ``elements`` the clearance elements; forcing
+    ``mean`` F_0 (n,), ``cos`` and ``sin`` (H_f, n): row h−1 holds F_ch and F_sh of harmonic h.
+    ``coordinates`` names the coordinates; ``angles`` Z (N, n) maps x to the inertias' angles
+    (relative to the last inertia for a free chain, ``free`` True).
+    """
+
+    damping: FloatArray
+    stiffness: FloatArray
+    elements: tuple[ReducedElement, ...]
+    mean: FloatArray
+    cos: FloatArray
+    sin: FloatArray
+    coordinates: tuple[str, ...]
+    angles: FloatArray
+    free: bool = False
+    _stiffness_cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    # --- sizes --------------------------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        """Number of coordinates."""
+        return self.damping.shape[0]
+
+    @property
+    def m(self) -> int:
+        """Number of clearance elements."""
+        return len(self.elements)
+
+    @property
+    def forced_harmonics(self) -> int:
+        """H_f, the highest forcing harmonic of Ω."""
+        return self.cos.shape[0]
+
+    @property
+    def element_rows(self) -> FloatArray:
+        """A (m, n): δ = A x, one row a_e per element."""
+        return np.array([e.a for e in self.elements], dtype=float).reshape(self.m, self.n)
+
+    @property
+    def element_columns(self) -> FloatArray:
+        """B (n, m): the non-linear force B f(δ), one column b_e per element."""
+        return np.array([e.b for e in self.elements], dtype=float).reshape(self.m, self.n).T
+
+    # --- the forcing --------------------------------------------------------------------------
+    def forcing(self, t: FloatArray | float, omega: float) -> FloatArray:
+        """F(t) at times ``t``: shape t.shape + (n,)."""
+        t = np.asarray(t, dtype=float)
+        out = np.broadcast_to(self.mean, t.shape + (self.n,)).copy()
+        for h in range(1, self.forced_harmonics + 1):
+            ph = h * omega * t
+            out += np.cos(ph)[..., None] * self.cos[h - 1] + np.sin(ph)[..., None] * self.sin[h - 1]
+        return out
+
+    # --- stages -------------------------------------------------------------------------------
+    def stage_counts(self) -> tuple[int, ...]:
+        """Number of stages of every element's law."""
+        return tuple(len(e.slopes) for e in self.elements)
+
+    def stage_stiffness(self, stages: tuple[int, ...]) -> FloatArray:
+        """K_s = K + Σ_e k_e b_e a_eᵀ for the stage combination ``stages`` (cached)."""
+        key = tuple(int(s) for s in stages)
+        K = self._stiffness_cache.get(key)
+        if K is None:
+            K = np.array(self.stiffness, dtype=float)
+            for e, s in zip(self.elements, key):
+                K = K + e.slopes[s] * np.outer(e.b, e.a)
+            self._stiffness_cache[key] = K
+        return K
+
+    def stage_offset(self, stages: tuple[int, ...]) -> FloatArray:
+        """Σ_e b_e o_e, the constant part of the element forces on the stage combination."""
+        out = np.zeros(self.n)
+        for e, s in zip(self.elements, stages):
+            out = out + e.offsets[int(s)] * e.b
+        return out
+
+    def stage_matrix(self, stages: tuple[int, ...]) -> FloatArray:
+        """A_s = [[0, I], [−K_s, −C]] (2n, 2n), the first-order stage matrix."""
+        n = self.n
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -self.stage_stiffness(stages)
+        A[n:, n:] = -self.damping
+        return A
+
+    def stages_of(self, x: FloatArray) -> tuple[int, ...]:
+        """The stage of every element at coordinates ``x`` (n,)."""
+        return tuple(int(np.searchsorted(e.breakpoints, float(e.a @ x), side="right")) for e in self.elements)
+
+    def restoring(self, x: FloatArray) -> FloatArray:
+        """K x + Σ_e b_e f_e(a_e·x) for x of shape (..., n)."""
+        x = np.asarray(x, dtype=float)
+        out = x @ self.stiffness.T
+        for e in self.elements:
+            out = out + e.law.force(x @ e.a)[..., None] * e.b
+        return out
+
+    # --- equilibrium and scales ---------------------------------------------------------------
+    def static_equilibrium(self) -> FloatArray:
+        """x_s solving K x + Σ_e b_e f_e(a_e·x) = F_0.
+
+        Every stage combination is linear: K_s x = F_0 − Σ b_e o_e. Starting from the
+        combination at x = 0 the solution is iterated (non-smooth Newton: solve on the current
+        combination, move to the combination of the solution) and, should that cycle, every
+        combination is tried. Where a combination is singular (a backlash gap in a chain with no
+        other stiffness) and F_0 balances it, the least-squares solution in the middle of the
+        gap is taken.
+        """
+        x = np.zeros(self.n)
+        seen: set[tuple[int, ...]] = set()
+        stages = self.stages_of(x)
+        for _ in range(4 * (self.m + 1) + 8):
+            sol = self._solve_on(stages)
+            if sol is not None and self.stages_of(sol) == stages:
+                return sol
+            seen.add(stages)
+            if sol is None:
+                break
+            stages = self.stages_of(sol)
+            if stages in seen:
+                break
+        for combo in itertools.product(*(range(c) for c in self.stage_counts())):
+            sol = self._solve_on(combo)
+            if sol is not None and self._on_stages(sol, combo):
+                return sol
+        raise ValueError(
+            "the static equilibrium K x + Σ b f(a·x) = F_0 has no solution: the mean torques are not "
+            "balanced by any stage of the elastic elements (check the links to ground and the mean torques)"
+        )
+
+    def _solve_on(self, stages: tuple[int, ...]) -> FloatArray | None:
+        Ks = self.stage_stiffness(stages)
+        rhs = self.mean - self.stage_offset(stages)
+        try:
+            cond = np.linalg.cond(Ks)
+        except np.linalg.LinAlgError:
+            cond = np.inf
+        if np.isfinite(cond) and cond < 1e12:
+            return np.linalg.solve(Ks, rhs)
+        # Singular: a balanced gap. Least squares plus the move into the middle of the gap.
+        x, *_ = np.linalg.lstsq(Ks, rhs, rcond=1e-12)
+        if np.linalg.norm(Ks @ x - rhs) > 1e-9 * max(1.0, np.linalg.norm(rhs)):
+            return None
+        null = np.linalg.svd(Ks)[2][np.linalg.svd(Ks, compute_uv=False) <= 1e-12 * max(1.0, np.abs(Ks).max())]
+        for v in null:  # centre every free direction in the gaps it opens
+            lo, hi = -np.inf, np.inf
+            for e, s in zip(self.elements, stages):
+                av = float(e.a @ v)
+                if abs(av) < 1e-14:
+                    continue
+                d = np.concatenate(([-np.inf], e.breakpoints, [np.inf]))
+                base = float(e.a @ x)
+                t1, t2 = (d[s] - base) / av, (d[s + 1] - base) / av
+                lo, hi = max(lo, min(t1, t2)), min(hi, max(t1, t2))
+            if np.isfinite(lo) and np.isfinite(hi):
+                x = x + 0.5 * (lo + hi) * v
+        return x
+
+    def _on_stages(self, x: FloatArray, stages: tuple[int, ...]) -> bool:
+        for e, s in zip(self.elements, stages):
+            d = float(e.a @ x)
+            lo = e.breakpoints[s - 1] if s > 0 else -np.inf
+            hi = e.breakpoints[s] if s < len(e.breakpoints) else np.inf
+            tol = 1e-12 * max(1.0, abs(d))
+            if not (lo - tol <= d <= hi + tol):
+                return False
+        return True
+
+    def natural_frequencies(self) -> FloatArray:
+        """Undamped natural frequencies (rad/s) of the stiffest stage combination (every element
+        on its stiffest stage), ascending; zero for rigid-body-like directions."""
+        stiffest = tuple(int(np.argmax(e.slopes)) for e in self.elements)
+        lam = np.linalg.eigvals(self.stage_stiffness(stiffest))
+        return np.sort(np.sqrt(np.maximum(lam.real, 0.0)))
+
+    def stiffest_frequency(self) -> float:
+        """The highest natural frequency over the stage combinations (every element on its
+        stiffest stage), rad/s."""
+        return float(self.natural_frequencies()[-1])
+
+    def force_scale(self) -> float:
+        """A characteristic force per inertia: max over coordinates of |F_0| + Σ_h |F_h|."""
+        amp = np.abs(self.mean) + np.sum(np.hypot(self.cos, self.sin), axis=0)
+        return max(float(np.max(amp)), 1e-300)
+
+    def length_scale(self) -> float:
+        """A characteristic deflection (rad): the static deflection, the breakpoints and the
+        quasi-static dynamic amplitude on the softest positive stages, whichever is largest."""
+        xs = self.static_equilibrium()
+        bp = max((float(np.max(np.abs(e.breakpoints))) for e in self.elements if e.breakpoints.size), default=0.0)
+        softest = tuple(int(np.argmin(np.where(e.slopes > 0, e.slopes, np.inf))) for e in self.elements)
+        Ks = self.stage_stiffness(softest)
+        amp = np.sum(np.hypot(self.cos, self.sin), axis=0)
+        try:
+            dyn = float(np.max(np.abs(np.linalg.solve(Ks, amp)))) if np.any(amp) else 0.0
+        except np.linalg.LinAlgError:
+            dyn = 0.0
+        return max(float(np.max(np.abs(xs))) if xs.size else 0.0, bp, dyn, 1e-300)
+
+
+def single_equation_system(c: float, k: float, law: AbstractElastic, mean: float,
+                           amplitudes: tuple[float, ...], phases: tuple[float, ...], name: str = "delta") -> System:
+    """The n = m = 1 system of δ'' + c δ' + k f(δ) = F_m + Σ_n F_pn cos(nΩt + φ_n)."""
+    amps = np.asarray(amplitudes, dtype=float)
+    ph = np.asarray(phases, dtype=float)
+    return System(
+        damping=np.array([[c]]),
+        stiffness=np.zeros((1, 1)),
+        elements=(ReducedElement(name, np.array([1.0]), np.array([k]), law),),
+        mean=np.array([mean]),
+        cos=(amps * np.cos(ph))[:, None],
+        sin=(-amps * np.sin(ph))[:, None],
+        coordinates=(name,),
+        angles=np.array([[1.0], [0.0]]),
+        free=True,
+    )
+
+
+__all__ = ["System", "ReducedElement", "single_equation_system"]
