@@ -73,6 +73,8 @@ import math
 import warnings
 from typing import Any
 
+import numpy as np
+
 from ._validate import check_int, check_real, show
 
 #: Harmonics of the solution's base frequency, at most (see the module docstring).
@@ -252,15 +254,22 @@ def check_magnitude(value: object, name: str) -> float:
 # Frequencies relative to the model
 # --------------------------------------------------------------------------------------------
 def stiffest_frequency(model: Any) -> float:
-    """ω_s = sqrt(K s_max / I), the natural frequency of the model's stiffest stage (rad/s)."""
-    slopes = [float(s) for s in model.elastic.stages.slopes]
-    return math.sqrt(model.k * max(slopes))
+    """ω_s (rad/s), the highest natural frequency of the model's stiffest stage combination:
+    sqrt(K s_max / I) for the single equation (every element on its stiffest stage for a chain)."""
+    return model.system().stiffest_frequency()
+
+
+def damping_rate(model: Any) -> float:
+    """c (1/s), the largest damping rate per inertia: C/I for the single equation, the spectral
+    radius of M⁻¹C for a chain."""
+    C = model.system().damping
+    return float(np.max(np.abs(np.linalg.eigvals(C)))) if C.size else 0.0
 
 
 def simulation_rate(model: Any) -> float:
-    """ν = max(ω_s, 2π·C/I) (rad/s): the exact integrator scans every forcing period in steps of
+    """ν = max(ω_s, 2π·c) (rad/s): the exact integrator scans every forcing period in steps of
     1/40 of the model's fastest time scale min(2π/ω_s, 1/c), i.e. ~40·ν/Ω steps per period."""
-    return max(stiffest_frequency(model), 2.0 * math.pi * model.c)
+    return max(stiffest_frequency(model), 2.0 * math.pi * damping_rate(model))
 
 
 def _frequency_rule(model: Any, omega: float, name: str, simulate: bool) -> None:
@@ -287,8 +296,8 @@ def _frequency_rule(model: Any, omega: float, name: str, simulate: bool) -> None
         # Heavily overdamped (c > ω_s / 2π): the damping rate, not the stiffness, sets the step.
         raise ValueError(
             f"`{name}` must be >= {MIN_OMEGA_RATIO * nu:.4g} rad/s for a simulation of this model, got "
-            f"{show(omega)}: its damping rate C/I = {model.c:.3g} 1/s sets the exact integrator's time step "
-            f"(1/40 of 1/(C/I)), so one forcing period would take ~{40 * 2 * math.pi * model.c / omega:.2g} "
+            f"{show(omega)}: its damping rate C/I = {damping_rate(model):.3g} 1/s sets the exact integrator's time step "
+            f"(1/40 of 1/(C/I)), so one forcing period would take ~{40 * 2 * math.pi * damping_rate(model) / omega:.2g} "
             "steps (hours of simulation); the harmonic balance alone (frequency_response, or "
             "periodic_orbit with simulate=False) has no such limit"
         )
@@ -372,5 +381,5 @@ __all__ = [
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
     "CLEARANCE_WARNING", "check_harmonics", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
-    "check_scales", "warn_clearance", "stiffest_frequency", "simulation_rate",
+    "check_scales", "warn_clearance", "stiffest_frequency", "simulation_rate", "damping_rate",
 ]

@@ -449,6 +449,8 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
     # Structure of every table first, so that a misspelt key is reported before its values.
     check.keys(data, "", _TOP_KEYS, required=("model", "excitation"))
     model_t = check.table(data, "model", "model")
+    if "inertias" in model_t:  # SPEC §5: a chain of inertias
+        return _chain_config(check, data, model_t)
     check.keys(model_t, "model", _MODEL_KEYS, required=_MODEL_KEYS)
     elastic_t = check.table(model_t, "elastic", "model.elastic")
     law, law_params = _elastic_structure(check, elastic_t)
@@ -495,11 +497,14 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
 
 def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonics") -> None:
     """The harmonic balance must hold every excitation harmonic: ``harmonics`` >= their count."""
-    needed = len(model.excitation.amplitudes)
+    if hasattr(model, "excitation"):
+        needed, where = len(model.excitation.amplitudes), f"`excitation.amplitudes` has {len(model.excitation.amplitudes)}"
+    else:
+        needed, where = model.forced_harmonics, f"the longest `excitation.torques` amplitudes list has {model.forced_harmonics}"
     if harmonics < needed:
         raise ConfigError(
             f"`{name}` must be >= {needed}, the number of excitation harmonics "
-            f"(`excitation.amplitudes` has {needed}), got {harmonics}; raise `{name}`"
+            f"({where}), got {harmonics}; raise `{name}`"
         )
 
 
@@ -586,6 +591,135 @@ def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
 
 
 # --------------------------------------------------------------------------------------------
+# Chains (SPEC §5)
+# --------------------------------------------------------------------------------------------
+_CHAIN_MODEL_KEYS = ("inertias", "links", "elements")
+_LINK_KEYS = ("between", "stiffness", "damping")
+_ELEMENT_KEYS = ("name", "between", "stiffness")
+_TORQUE_KEYS = ("inertia", "mean", "amplitudes", "phases")
+_EXAMPLES.update({
+    "model.inertias": "inertias = [2.0, 2.0]",
+    "model.elements": '[[model.elements]] with name = "clutch", between = [1, 2], stiffness = 1.0, type = "clutch", alpha = 0.25, b = 0.174533',
+    "excitation.torques": "[[excitation.torques]] with inertia = 1, mean = 0.05, amplitudes = [0.06]",
+})
+
+
+def _tables(check: _Checker, parent: Mapping[str, Any], key: str, full: str) -> list[Mapping[str, Any]]:
+    """An array of tables ``[[full]]``."""
+    value = parent[key]
+    if not isinstance(value, (list, tuple)) or not all(isinstance(v, Mapping) for v in value):
+        raise check.error(
+            f"`{full}` must be an array of tables (one [[{full}]] section each), got {_show(value)} "
+            f"({_kind(value)}); write e.g. {_example(full)}"
+        )
+    return list(value)
+
+
+def _between(check: _Checker, value: Any, key: str, n: int) -> None:
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        raise check.error(
+            f"`{key}` must be a pair of inertia numbers [i, j] (j = 0: ground), got {_show(value)}; "
+            "write e.g. between = [1, 2]"
+        )
+    for i, v in enumerate(value):
+        check.integer(v, f"{key}[{i}]")
+        lo = 1 if i == 0 else 0
+        if not lo <= v <= n:
+            raise check.error(
+                f"`{key}[{i}]` must be an inertia number 1 … {n}{' or 0 (ground)' if i else ''} "
+                f"(`model.inertias` has {n}), got {v}"
+            )
+    if value[0] == value[1]:
+        raise check.error(f"`{key}` must join two different inertias, got {_show(value)}")
+
+
+def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str, Any]) -> RunConfig:
+    """The SPEC §5 chain: ``[model] inertias``, ``[[model.links]]``, ``[[model.elements]]``,
+    ``[[excitation.torques]]``."""
+    from ..model import Chain, Element, Link, Torque
+
+    for key in _MODEL_KEYS:
+        if key in model_t:
+            raise check.error(
+                f"`model.{key}` belongs to the single-equation form, but [model] has `inertias` (a chain, "
+                f"SPEC §5): give the chain's links and elements instead ([[model.links]], "
+                f"[[model.elements]]) and remove `model.{key}`"
+            )
+    check.keys(model_t, "model", _CHAIN_MODEL_KEYS, required=("inertias", "elements"))
+    excitation_t = check.table(data, "excitation", "excitation")
+    check.keys(excitation_t, "excitation", ("torques",), required=("torques",))
+    analysis_t: Mapping[str, Any] = {}
+    if "analysis" in data:
+        analysis_t = check.table(data, "analysis", "analysis")
+        check.keys(analysis_t, "analysis", _ANALYSIS_KEYS, required=())
+    check.array(model_t["inertias"], "model.inertias")
+    n = len(model_t["inertias"])
+
+    links = []
+    for k, t in enumerate(_tables(check, model_t, "links", "model.links") if "links" in model_t else []):
+        where = f"model.links[{k}]"
+        check.keys(t, where, _LINK_KEYS, required=("between",))
+        _between(check, t["between"], f"{where}.between", n)
+        for key in ("stiffness", "damping"):
+            if key in t:
+                check.number(t[key], f"{where}.{key}")
+        links.append(check.build(Link, {f: f"{where}.{f}" for f in _LINK_KEYS}, **dict(t)))
+
+    elements = []
+    for k, t in enumerate(_tables(check, model_t, "elements", "model.elements")):
+        where = f"model.elements[{k}]"
+        law_t = {key: v for key, v in t.items() if key not in _ELEMENT_KEYS}
+        for key in ("between", "stiffness"):
+            if key not in t:
+                raise check.error(f"`{where}.{key}` is missing: every [[model.elements]] needs between, stiffness "
+                                  f"and type (+ the parameters of that type); add e.g. {_example('model.elements')}")
+        try:
+            law, law_params = _elastic_structure(check, law_t)
+        except ConfigError as exc:
+            raise check.error(str(exc).split(": ", 1)[1].replace("model.elastic", where)) from None
+        name = t.get("name", f"element{k + 1}")
+        if not isinstance(name, str):
+            raise check.error(f"`{where}.name` must be a string, got {_show(name)} ({_kind(name)}); write e.g. name = \"clutch\"")
+        _between(check, t["between"], f"{where}.between", n)
+        check.number(t["stiffness"], f"{where}.stiffness")
+        for key, (kind, _) in law_params.items():
+            if key in law_t:
+                (check.array if kind == "array" else check.number)(law_t[key], f"{where}.{key}")
+        elastic = check.build(law, {f: f"{where}.{f}" for f in law_params} or {"type": f"{where}.type"},
+                              **{f: law_t[f] for f in law_params if f in law_t})
+        elements.append(check.build(Element, {"name": f"{where}.name", "between": f"{where}.between",
+                                              "stiffness": f"{where}.stiffness"},
+                                    name=name, between=t["between"], stiffness=t["stiffness"], law=elastic))
+
+    torques = []
+    for k, t in enumerate(_tables(check, excitation_t, "torques", "excitation.torques")):
+        where = f"excitation.torques[{k}]"
+        check.keys(t, where, _TORQUE_KEYS, required=("inertia",))
+        check.integer(t["inertia"], f"{where}.inertia")
+        if not 1 <= t["inertia"] <= n:
+            raise check.error(f"`{where}.inertia` must be an inertia number 1 … {n} (`model.inertias` has {n}), "
+                              f"got {t['inertia']}")
+        if "mean" in t:
+            check.number(t["mean"], f"{where}.mean")
+        for key in ("amplitudes", "phases"):
+            if key in t:
+                check.array(t[key], f"{where}.{key}")
+        torques.append(check.build(Torque, {f: f"{where}.{f}" for f in _TORQUE_KEYS}, **dict(t)))
+
+    names = {"inertias": "model.inertias", "links": "model.links", "elements": "model.elements",
+             "torques": "excitation.torques"}
+    chain = check.build(Chain, names, inertias=model_t["inertias"], links=tuple(links), elements=tuple(elements),
+                        torques=tuple(torques))
+    analysis = _analysis(check, analysis_t)
+    check_harmonics(chain, analysis.harmonics)
+    try:
+        check_analysis(chain, analysis)
+    except ConfigError as exc:
+        raise check.error(str(exc)) from None
+    return RunConfig(model=chain, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=check.source_name)
+
+
+# --------------------------------------------------------------------------------------------
 # Writers (round trip)
 # --------------------------------------------------------------------------------------------
 def model_to_toml_dict(model: Model, analysis: AnalysisSettings | None = None) -> dict[str, Any]:
@@ -604,6 +738,16 @@ def model_to_toml_dict(model: Model, analysis: AnalysisSettings | None = None) -
     dict
         ``{"model": {..., "elastic": {...}}, "excitation": {...}[, "analysis": {...}]}``.
     """
+    if not hasattr(model, "elastic"):  # a chain
+        d = model.to_dict()
+        elements = [{k: v for k, v in e.items()} for e in d["elements"]]
+        out_c: dict[str, Any] = {"model": {"inertias": d["inertias"], "links": d["links"], "elements": elements},
+                                 "excitation": {"torques": d["torques"]}}
+        if not d["links"]:
+            del out_c["model"]["links"]
+        if analysis is not None:
+            out_c["analysis"] = analysis.to_dict()
+        return out_c
     out: dict[str, Any] = {
         "model": {
             "inertia": model.inertia,
@@ -658,14 +802,25 @@ def dumps_toml(data: Mapping[str, Any]) -> str:
     lines: list[str] = []
 
     def emit(table: Mapping[str, Any], path: list[str]) -> None:
-        scalars = [(k, v) for k, v in table.items() if not isinstance(v, Mapping)]
+        def is_array_of_tables(v: Any) -> bool:
+            return isinstance(v, (list, tuple)) and bool(v) and all(isinstance(x, Mapping) for x in v)
+
+        scalars = [(k, v) for k, v in table.items() if not isinstance(v, Mapping) and not is_array_of_tables(v)]
         tables = [(k, v) for k, v in table.items() if isinstance(v, Mapping)]
-        if path and (scalars or not tables):
+        arrays = [(k, v) for k, v in table.items() if is_array_of_tables(v)]
+        if path and (scalars or not (tables or arrays)):
             if lines:
                 lines.append("")
             lines.append("[" + ".".join(_toml_key(p) for p in path) + "]")
         for k, v in scalars:
             lines.append(f"{_toml_key(str(k))} = {_toml_value(v, '.'.join([*path, str(k)]))}")
+        for k, v in arrays:
+            for item in v:
+                if lines:
+                    lines.append("")
+                lines.append("[[" + ".".join(_toml_key(p) for p in [*path, str(k)]) + "]]")
+                for kk, vv in item.items():
+                    lines.append(f"{_toml_key(str(kk))} = {_toml_value(vv, '.'.join([*path, str(k), str(kk)]))}")
         for k, v in tables:
             emit(v, [*path, str(k)])
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -141,21 +142,33 @@ class Model:
         }
 
 
-def check_analysable_model(model: object, name: str = "model") -> Model:
-    """A :class:`~rattle.model.Model` that the analyses can treat: refuse zero damping.
+def check_analysable_model(model: object, name: str = "model") -> Any:
+    """A model the analyses can treat (:class:`~rattle.model.Model` or
+    :class:`~rattle.model.Chain`): refuse zero damping.
 
     Zero damping is refused (not handled). An undamped forced piecewise-linear oscillator has
     an unbounded response at its linear resonances and no asymptotically stable periodic orbit:
     its Floquet multipliers lie on the unit circle (det M = exp(−c T) = 1), so the stability
     verdicts, the located special points and the settled periods would all be meaningless, and
     the linear start solution divides 0 by 0 at resonance. Give a small positive damping
-    instead (ζ = 0.001 … 0.05 is typical of drivetrains). The :class:`~rattle.model.Model`
-    itself accepts damping 0, so that undamped motions can still be integrated exactly
-    (:class:`~rattle.timeint.ExactIntegrator`).
+    instead (ζ = 0.001 … 0.05 is typical of drivetrains). The models themselves accept damping
+    0, so that undamped motions can still be integrated exactly
+    (:class:`~rattle.timeint.ExactIntegrator`). For a chain, a chain with no damping in any
+    link is refused.
     """
+    from ._chain import Chain
+
+    if isinstance(model, Chain):
+        if not model.has_damping:
+            raise ValueError(
+                f"`{name}.links` must give some damping for an analysis, got none: an undamped forced "
+                "chain has unbounded resonant response and no asymptotically stable periodic orbit "
+                "(Floquet multipliers on the unit circle); give the links a small positive damping"
+            )
+        return model
     if not isinstance(model, Model):
         raise TypeError(
-            f"`{name}` must be a rattle Model (e.g. rattle.reference_case() or Model.from_toml(path)), "
+            f"`{name}` must be a rattle Model or Chain (e.g. rattle.reference_case() or Model.from_toml(path)), "
             f"got {model!r} ({type(model).__name__})"
         )
     if model.damping == 0.0:
