@@ -1,12 +1,17 @@
 """Response measures of periodic solutions (SPEC §1), batched over many solutions.
 
-For a solution δ(t) = a_0 + Σ (a_k cos kωt + b_k sin kωt) of period T_p = 2π/ω:
+For an element's deflection δ(t) = a_0 + Σ (a_k cos kωt + b_k sin kωt) of period T_p = 2π/ω:
 
     mean = a_0,  rms² = a_0² + ½ Σ (a_k² + b_k²),  rms_ac² = ½ Σ (a_k² + b_k²)   (Parseval),
     p2p = max δ − min δ,  acc_p2p = max δ'' − min δ'',
 
-with δ'' = F(t) − c δ' − k f(δ) taken from the equation of motion (exact for the orbit, and
-continuous, unlike the truncated series of δ''). Extremes are located on the N samples and
+with δ'' taken from the equation of motion (exact for the orbit, and continuous, unlike the
+truncated series of δ''): for the system x'' + C x' + K x + Σ_j b_j f_j(a_j·x) = F(t) and an
+element δ = a·x,
+
+    δ'' = a · (F(t) − C x' − K x − Σ_j b_j f_j(a_j·x))
+
+(δ'' = F − c δ' − k f(δ) for the single equation). Extremes are located on the N samples and
 polished: those of δ by Newton on δ' = 0 (δ is smooth there), those of δ'' on two nested local
 grids (resolution T_p / (64 N); δ'' has kinks at breakpoint crossings).
 """
@@ -18,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._typing import FloatArray
-from .model import Model
+from .model import Model, System
 
 REGIMES = ("no_impact", "single_sided", "double_sided")
 
@@ -80,10 +85,9 @@ def _position_velocity(Q: FloatArray, omega: FloatArray, t: FloatArray) -> tuple
 
 
 def acceleration_batch(model: Model, Q: FloatArray, omega: FloatArray, forcing_omega: FloatArray, t: FloatArray) -> FloatArray:
-    """δ''(t) = F(t) − c δ' − k f(δ) along the orbits (base frequencies ω, forcing Ω), times t (P, m)."""
-    delta, vel = _position_velocity(Q, omega, t)
-    F = model.excitation(t, forcing_omega[:, None])
-    return F - model.c * vel - model.k * model.elastic.force(delta)
+    """δ''(t) = F(t) − c δ' − k f(δ) along single-coordinate orbits Q (P, 2H+1) (base
+    frequencies ω, forcing Ω), times t (P, m): :func:`element_accelerations` of the first element."""
+    return element_accelerations(_system_of(model), Q[:, None, :], omega, forcing_omega, t)[:, 0]
 
 
 def _refine_grid(func, t_best: FloatArray, half_width: FloatArray, sign: float, levels: int = 2, points: int = 17) -> FloatArray:
@@ -118,8 +122,12 @@ def _refine_smooth_extreme(Q: FloatArray, omega: FloatArray, t: FloatArray, dt: 
 
 def regime_of(model: Model, delta_min: FloatArray, delta_max: FloatArray) -> np.ndarray:
     """``no_impact`` (one stage), ``single_sided`` (breakpoints crossed on one side of δ = 0
-    only) or ``double_sided``, for each (delta_min, delta_max)."""
-    d = model.elastic.stages.breakpoints
+    only) or ``double_sided``, for each (delta_min, delta_max) of the model's (first) element."""
+    return regime_of_breakpoints(_system_of(model).elements[0].breakpoints, delta_min, delta_max)
+
+
+def regime_of_breakpoints(d: FloatArray, delta_min: FloatArray, delta_max: FloatArray) -> np.ndarray:
+    """:func:`regime_of` for an element with breakpoints ``d``."""
     out = np.full(delta_min.shape, "no_impact", dtype=object)
     if d.size == 0:
         return out
@@ -132,47 +140,87 @@ def regime_of(model: Model, delta_min: FloatArray, delta_max: FloatArray) -> np.
 
 
 def measures_batch(model: Model, Q: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: FloatArray) -> Measures:
-    """Measures of P solutions: rows Q (P, 2H+1), base frequencies ω (P,), forcing frequencies
-    Ω (P,) and their N samples (P, N)."""
-    H = (Q.shape[1] - 1) // 2
-    P, N = samples.shape
-    mean = Q[:, 0].copy()
-    ac2 = 0.5 * np.sum(Q[:, 1:] ** 2, axis=1)
-    rms = np.sqrt(mean**2 + ac2)
-    rms_ac = np.sqrt(ac2)
+    """Measures of P single-coordinate solutions: rows Q (P, 2H+1), base frequencies ω (P,),
+    forcing frequencies Ω (P,), on N = samples.shape[1] points per period (the first element of
+    :func:`system_measures_batch`)."""
+    return system_measures_batch(model, Q[:, None, :], omega, forcing_omega, samples.shape[1])[0]
+
+
+# ---------------------------------------------------------------------------------------------
+# Systems: every coordinate and element
+# ---------------------------------------------------------------------------------------------
+def _system_of(model: object) -> System:
+    return model if isinstance(model, System) else model.system()  # type: ignore[attr-defined]
+
+
+def coordinate_accelerations(system: System, X: FloatArray, V: FloatArray, t: FloatArray, forcing_omega: FloatArray) -> FloatArray:
+    """x'' = F(t) − C x' − K x − Σ_j b_j f_j(a_j·x) from positions X and velocities V
+    (P, n, m) at times t (P, m), forcing frequencies Ω (P,). Returns (P, n, m)."""
+    F = system.forcing(t, forcing_omega[:, None])  # (P, m, n)
+    acc = np.moveaxis(F, -1, 1) - np.einsum("ij,pjm->pim", system.damping, V) - np.einsum("ij,pjm->pim", system.stiffness, X)
+    for e in system.elements:
+        d = np.einsum("j,pjm->pm", e.a, X)
+        acc -= e.b[None, :, None] * e.law.force(d)[:, None, :]
+    return acc
+
+
+def _series_position_velocity(Qx: FloatArray, omega: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """x(t), x'(t) of coefficient blocks Qx (P, n, 2H+1) at times t (P, m): (P, n, m) each."""
+    P, n, L = Qx.shape
+    Qr = Qx.reshape(P * n, L)
+    w = np.repeat(omega, n)
+    tr = np.repeat(t, n, axis=0)
+    x, v = _position_velocity(Qr, w, tr)
+    return x.reshape(P, n, -1), v.reshape(P, n, -1)
+
+
+def element_accelerations(system: System, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, t: FloatArray) -> FloatArray:
+    """δ_e''(t) of every element (P, m_el, m) along orbits with coefficient blocks Qx (P, n, 2H+1)."""
+    X, V = _series_position_velocity(Qx, omega, t)
+    acc = coordinate_accelerations(system, X, V, t, forcing_omega)
+    return np.einsum("ej,pjm->pem", system.element_rows, acc)
+
+
+def system_measures_batch(model: object, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: int) -> tuple[Measures, ...]:
+    """SPEC §1 measures of every element's deflection, one :class:`Measures` per element, for P
+    orbits with coefficient blocks Qx (P, n, 2H+1) (coordinate-major), base frequencies ω (P,),
+    forcing frequencies Ω (P,), evaluated on ``samples`` points per period."""
+    system = _system_of(model)
+    P, n, L = Qx.shape
+    H = (L - 1) // 2
+    N = samples
+    A = system.element_rows
+    Qe = np.einsum("ej,pjl->pel", A, Qx)  # element deflection series (P, m, 2H+1)
+    X = synthesize_batch(Qx.reshape(P * n, L), N).reshape(P, n, N)
+    k = np.arange(1, H + 1)[None, :] * np.repeat(omega, n)[:, None]
+    dQ = np.zeros((P * n, L))
+    Qr = Qx.reshape(P * n, L)
+    dQ[:, 1 : H + 1] = k * Qr[:, H + 1 :]
+    dQ[:, H + 1 :] = -k * Qr[:, 1 : H + 1]
+    V = synthesize_batch(dQ, N).reshape(P, n, N)
     T = 2 * np.pi / omega
     dt = T / N
     rows = np.arange(P)
     times = np.arange(N)[None, :] * dt[:, None]
+    acc_all = np.einsum("ej,pjm->pem", A, coordinate_accelerations(system, X, V, times, forcing_omega))
+    out = []
+    for e_idx, e in enumerate(system.elements):
+        Q = Qe[:, e_idx]
+        d = np.einsum("j,pjm->pm", e.a, X)
+        mean = Q[:, 0].copy()
+        ac2 = 0.5 * np.sum(Q[:, 1:] ** 2, axis=1)
+        dmax = np.maximum(d.max(axis=1), _refine_smooth_extreme(Q, omega, times[rows, np.argmax(d, axis=1)], dt))
+        dmin = np.minimum(d.min(axis=1), _refine_smooth_extreme(Q, omega, times[rows, np.argmin(d, axis=1)], dt))
+        acc = acc_all[:, e_idx]
 
-    # δ extremes: the sampled ones, polished by Newton on δ' = 0.
-    dmax = np.maximum(samples.max(axis=1), _refine_smooth_extreme(Q, omega, times[rows, np.argmax(samples, axis=1)], dt))
-    dmin = np.minimum(samples.min(axis=1), _refine_smooth_extreme(Q, omega, times[rows, np.argmin(samples, axis=1)], dt))
+        def acc_f(t: FloatArray, e_idx: int = e_idx) -> FloatArray:
+            return element_accelerations(system, Qx, omega, forcing_omega, t)[:, e_idx]
 
-    # δ'' = F − c δ' − k f(δ) on the samples (δ' from the derivative series), extremes refined
-    # on nested grids (kink-safe).
-    dQ = np.zeros_like(Q)
-    k = np.arange(1, H + 1)[None, :] * omega[:, None]
-    dQ[:, 1 : H + 1] = k * Q[:, H + 1 :]
-    dQ[:, H + 1 :] = -k * Q[:, 1 : H + 1]
-    vel = synthesize_batch(dQ, N)
-    acc = model.excitation(times, forcing_omega[:, None]) - model.c * vel - model.k * model.elastic.force(samples)
+        amax = np.maximum(acc.max(axis=1), _refine_grid(acc_f, times[rows, np.argmax(acc, axis=1)], dt, +1.0))
+        amin = np.minimum(acc.min(axis=1), _refine_grid(acc_f, times[rows, np.argmin(acc, axis=1)], dt, -1.0))
+        out.append(Measures(mean=mean, rms=np.sqrt(mean**2 + ac2), rms_ac=np.sqrt(ac2), p2p=dmax - dmin,
+                            acc_p2p=amax - amin, delta_min=dmin, delta_max=dmax,
+                            regime=regime_of_breakpoints(e.breakpoints, dmin, dmax)))
+    return tuple(out)
 
-    def acc_f(t: FloatArray) -> FloatArray:
-        return acceleration_batch(model, Q, omega, forcing_omega, t)
-
-    amax = np.maximum(acc.max(axis=1), _refine_grid(acc_f, times[rows, np.argmax(acc, axis=1)], dt, +1.0))
-    amin = np.minimum(acc.min(axis=1), _refine_grid(acc_f, times[rows, np.argmin(acc, axis=1)], dt, -1.0))
-    return Measures(
-        mean=mean,
-        rms=rms,
-        rms_ac=rms_ac,
-        p2p=dmax - dmin,
-        acc_p2p=amax - amin,
-        delta_min=dmin,
-        delta_max=dmax,
-        regime=regime_of(model, dmin, dmax),
-    )
-
-
-__all__ = ["Measures", "measures_batch", "synthesize_batch", "evaluate_batch", "acceleration_batch", "regime_of", "REGIMES"]
+__all__ = ["system_measures_batch", "element_accelerations", "coordinate_accelerations", "regime_of_breakpoints", "Measures", "measures_batch", "synthesize_batch", "evaluate_batch", "acceleration_batch", "regime_of", "REGIMES"]
