@@ -16,6 +16,19 @@ from ..io._csv import FRF_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model, check_analysable_model
 
+#: Per-element columns of a chain's ``frf.csv`` (SPEC §5): ``NAME_`` + each of these.
+ELEMENT_COLUMNS: tuple[str, ...] = ("mean", "rms", "rms_ac", "p2p", "acc_p2p", "min", "max", "regime")
+
+
+def element_columns_from(names: tuple[str, ...], measures: tuple[Any, ...]) -> dict[str, np.ndarray]:
+    """``{NAME_mean: …, …, NAME_regime: …}`` from one :class:`rattle.measures.Measures` per element."""
+    out: dict[str, np.ndarray] = {}
+    for name, m in zip(names, measures):
+        for c, attr in zip(ELEMENT_COLUMNS, ("mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max", "regime")):
+            out[f"{name}_{c}"] = getattr(m, attr)
+    return out
+
+
 @dataclass(frozen=True, slots=True)
 class SpecialPoint:
     """A point where stability changes: ``kind`` (fold, period_doubling, neimark_sacker), its
@@ -121,6 +134,7 @@ class FrequencyResponse:
     message: str = ""
     settings: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
+    element_columns: dict[str, np.ndarray] = field(default_factory=dict)
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -140,8 +154,26 @@ class FrequencyResponse:
         )
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The SPEC columns in order, as a dict of arrays."""
-        return {name: getattr(self, name) for name in FRF_COLUMNS}
+        """The SPEC columns in order, as a dict of arrays; for a chain also, per element NAME,
+        ``NAME_mean … NAME_regime`` (SPEC §5, :data:`ELEMENT_COLUMNS`)."""
+        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **self.element_columns}
+
+    @property
+    def column_names(self) -> list[str]:
+        """Names of :meth:`columns` in file order."""
+        return [*FRF_COLUMNS, *self.element_columns]
+
+    @property
+    def element_names(self) -> tuple[str, ...]:
+        """Names of the clearance elements whose columns this result carries (a chain's)."""
+        suffix = "_" + ELEMENT_COLUMNS[0]
+        return tuple(k[: -len(suffix)] for k in self.element_columns if k.endswith(suffix))
+
+    def element(self, name: str) -> dict[str, np.ndarray]:
+        """The SPEC §5 measures of element ``name`` as a dict (``mean``, ``rms``, … ``regime``)."""
+        if name not in self.element_names:
+            raise KeyError(f"`name` must be one of the elements {list(self.element_names)}, got {name!r}")
+        return {c: self.element_columns[f"{name}_{c}"] for c in ELEMENT_COLUMNS}
 
     def summary(self) -> str:
         """A few lines for the terminal."""
@@ -200,8 +232,16 @@ class FrequencyResponse:
         cat = {name: np.concatenate([getattr(p, name) for p in parts]) for name in (
             "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max",
             "regime", "stable", "bifurcation", "iterations", "residual", "multipliers")}
+        cat["element_columns"] = {k: np.concatenate([p.element_columns[k] for p in parts]) for k in parts[0].element_columns}
+        n_coord = parts[0].coefficients.shape[1] // (2 * parts[0].harmonics + 1) if len(parts[0]) else 1
+
+        def padded(p: "FrequencyResponse") -> FloatArray:
+            L = 2 * p.harmonics + 1
+            blocks = p.coefficients.reshape(len(p), n_coord, L)
+            return resize_harmonics(blocks, H).reshape(len(p), n_coord * (2 * H + 1))
+
         return cls(
-            model=model, harmonics=H, coefficients=np.concatenate([resize_harmonics(p.coefficients, H) for p in parts]), special_points=special,
+            model=model, harmonics=H, coefficients=np.concatenate([padded(p) for p in parts]), special_points=special,
             status=status or parts[0].status, message=message or parts[0].message,
             settings=dict(settings or parts[0].settings), timings=dict(timings or parts[0].timings), **cat,
         )
@@ -219,6 +259,7 @@ class FrequencyResponse:
             SpecialPoint(sp.kind, sp.index - first, sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error)
             for sp in self.special_points if sp.branch == branch
         )
+        fields["element_columns"] = {k: v[rows] for k, v in self.element_columns.items()}
         return type(self)(model=self.model, harmonics=self.harmonics, special_points=special, status=self.status,
                           message=self.message, settings=self.settings, timings=self.timings, **fields)
 
@@ -254,7 +295,7 @@ class FrequencyResponse:
         """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
         from ..io import write_csv
 
-        write_csv(path, self.columns(), list(FRF_COLUMNS))
+        write_csv(path, self.columns(), self.column_names)
         return Path(path)
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
@@ -267,4 +308,4 @@ class FrequencyResponse:
 
 
 
-__all__ = ["FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS"]
+__all__ = ["ELEMENT_COLUMNS", "element_columns_from", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS"]
