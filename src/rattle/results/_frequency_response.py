@@ -79,23 +79,38 @@ class LinearResponse:
     rms_ac: FloatArray
 
 
-def linear_frequency_response(model: Model, omega: FloatArray) -> LinearResponse:
-    """δ = F_m/k + Σ_n Re[X_n e^{inΩt}], X_n = F_pn e^{iφ_n} / (k − (nΩ)² + i c nΩ).
+def linear_frequency_response(model: Model, omega: FloatArray, element: int = 0) -> LinearResponse:
+    """The linear system's response (every element's law replaced by f = δ, same excitation),
+    measured on element ``element`` (the first by default).
 
-    ``omega``: frequencies (rad/s), finite and > 0, at most 10⁷ of them; ``model.damping`` > 0
-    (the undamped linear response is infinite at resonance)."""
+    For x'' + C x' + K_l x = F(t), K_l = K + Σ_e b_e a_eᵀ: the mean K_l⁻¹F_0 and per forcing
+    harmonic h the amplitude X_h = (K_l − (hΩ)² I + i hΩ C)⁻¹ (F_ch − i F_sh); the element's
+    δ = a·x. For the single equation this is δ = F_m/k + Σ_n Re[X_n e^{inΩt}],
+    X_n = F_pn e^{iφ_n} / (k − (nΩ)² + i c nΩ).
+
+    ``omega``: frequencies (rad/s), finite and > 0, at most 10⁷ of them; the model must be
+    damped (the undamped linear response is infinite at resonance)."""
 
     check_analysable_model(model)
     omega = as_float_array(omega, "omega", "frequencies in rad/s (numbers)")
     if omega.size > 10**7 or not np.all(np.isfinite(omega) & (omega > 0)):
         raise ValueError(f"`omega` must hold at most 10⁷ finite frequencies > 0 rad/s, got {omega.size} values "
                          f"(min {np.min(omega) if omega.size else 'none'})")
-    exc = model.excitation
-    mean = np.full(omega.shape, exc.mean / model.k)
+    system = model.system()
+    a = system.elements[element].a
+    K_l = system.stiffness + sum(np.outer(e.b, e.a) for e in system.elements)
+    n = system.n
+    mean = np.full(omega.shape, float(a @ np.linalg.solve(K_l, system.mean)))
     ac2 = np.zeros(omega.shape)
-    for n, amp in zip(exc.orders, exc.amplitudes):
-        w = n * omega
-        ac2 += 0.5 * amp**2 / ((model.k - w**2) ** 2 + (model.c * w) ** 2)
+    flat = omega.ravel()
+    for h in range(1, system.forced_harmonics + 1):
+        F = system.cos[h - 1] - 1j * system.sin[h - 1]
+        if not np.any(F):
+            continue
+        w = h * flat
+        Z = K_l[None, :, :] - (w**2)[:, None, None] * np.eye(n) + 1j * w[:, None, None] * system.damping[None, :, :]
+        X = np.linalg.solve(Z, np.broadcast_to(F, (w.size, n))[..., None])[..., 0]
+        ac2 += (0.5 * np.abs(X @ a) ** 2).reshape(omega.shape)
     return LinearResponse(omega, mean, np.sqrt(mean**2 + ac2), np.sqrt(ac2))
 
 
