@@ -1,0 +1,212 @@
+"""Crossings of the clearance elements' breakpoints on an exact segment, located to round-off.
+
+On a segment every element e sits on one stage [lo_e, hi_e) of its law. The segment ends at the
+first local time where any deflection δ_e = a_e·x leaves its stage. Crossings are bracketed on a
+grid of ``samples_per_scale`` points per fastest time scale of the stage combination (highest
+forcing harmonic, highest natural frequency, fastest decay) scanned in growing chunks, all
+elements at once. Inside a grid cell, an extremum of δ_e (a sign change of δ_e') is refined
+too, so that a trajectory touching a breakpoint tangentially inside a cell is not missed. Roots
+are refined by Newton's method safeguarded by bisection. An excursion beyond a breakpoint below
+round-off (an exact graze) does not switch the stage; the segment start is inside its stages by
+construction (a crossing enters the new stage), whatever round-off says of δ there.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from .._typing import FloatArray, IntArray
+from ._stage_flow import Segment
+
+_EPS = float(np.finfo(float).eps)
+_FIRST_CHUNK = 48  # grid cells scanned at once for the first crossing; doubled up to _MAX_CHUNK
+_MAX_CHUNK = 4096
+
+
+def bracketed_newton(
+    fun: Callable[[float], tuple[float, float]], a: float, b: float, fa: float, fb: float, tol: float,
+    ftol: float = 0.0,
+) -> float:
+    """Root of ``fun`` in [a, b] (fa·fb ≤ 0) by Newton's method safeguarded by bisection
+    (rtsafe); ``fun(x)`` returns (f, f'). Stops when the step is below ``tol`` or |f| ≤ ``ftol``."""
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    if fa > 0.0:
+        lo, hi = b, a
+    else:
+        lo, hi = a, b
+    x = a - fa * (b - a) / (fb - fa)
+    dx_old = dx = abs(b - a)
+    for _ in range(200):
+        f, df = fun(x)
+        if abs(f) <= ftol:
+            return x
+        if f < 0.0:
+            lo = x
+        else:
+            hi = x
+        if ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0 or abs(2.0 * f) > abs(dx_old * df):
+            dx_old, dx = dx, 0.5 * (hi - lo)
+            x = lo + dx
+        else:
+            dx_old, dx = dx, f / df
+            x -= dx
+        if abs(dx) <= tol:
+            return x
+    return x
+
+
+def vector_bracketed_newton(
+    fun: Callable[[FloatArray, IntArray], tuple[FloatArray, FloatArray]],
+    a: FloatArray, b: FloatArray, fa: FloatArray, fb: FloatArray, tol: FloatArray,
+) -> FloatArray:
+    """Roots of ``fun`` in the brackets [a_i, b_i] (fa·fb ≤ 0), all at once: Newton steps, with a
+    bisection wherever the step leaves the bracket. ``fun(x, idx)`` evaluates the roots ``idx``."""
+    lo = np.where(fa > 0.0, b, a)
+    hi = np.where(fa > 0.0, a, b)
+    x = np.where(fa == fb, a, a - fa * (b - a) / np.where(fa == fb, 1.0, fb - fa))
+    active = np.ones(a.shape, dtype=bool)
+    for _ in range(200):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        f, df = fun(x[idx], idx)
+        neg = f < 0.0
+        lo[idx] = np.where(neg, x[idx], lo[idx])
+        hi[idx] = np.where(neg, hi[idx], x[idx])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            newton = x[idx] - f / df
+        inside = np.isfinite(newton) & ((newton - lo[idx]) * (newton - hi[idx]) <= 0.0)
+        x_new = np.where(inside, newton, 0.5 * (lo[idx] + hi[idx]))
+        done = (f == 0.0) | (np.abs(x_new - x[idx]) <= tol[idx]) | (np.abs(hi[idx] - lo[idx]) <= tol[idx])
+        x[idx] = np.where(f == 0.0, x[idx], x_new)
+        active[idx[done]] = False
+    return x
+
+
+def first_exit(
+    seg: Segment, lo: FloatArray, hi: FloatArray, tau_end: float, step: float, samples_per_scale: int,
+) -> tuple[float, int, int]:
+    """First local time in (0, ``tau_end``] where an element leaves its stage on ``seg``:
+    (τ, element, direction +1 up / −1 down); element −1 and τ = ``tau_end`` when none does.
+
+    ``lo``, ``hi`` (m,) are the elements' stage bounds (±inf where open), ``step`` the grid step.
+    """
+    watched = [e for e in range(lo.size) if lo[e] > -math.inf or hi[e] < math.inf]
+    if not watched or tau_end <= 0.0:
+        return tau_end, -1, 0
+    if not (math.isfinite(step) and step > 0.0):
+        step = max(tau_end, 1e-300) / samples_per_scale
+    tau_a = 0.0
+    chunk = _FIRST_CHUNK
+    while tau_a < tau_end:
+        n = max(1, min(chunk, math.ceil((tau_end - tau_a) / step)))
+        taus = tau_a + step * np.arange(n + 1)
+        if n < chunk or taus[-1] >= tau_end:
+            taus[-1] = tau_end
+        d, v = seg.scan(taus)
+        cands: list[tuple[int, int]] = []
+        for e in watched:
+            de = d[:, e]
+            lo_e, hi_e = lo[e], hi[e]
+            outside = (de[1:] >= hi_e) | (de[1:] < lo_e)
+            i_out = int(outside.argmax())
+            if not outside[i_out]:
+                i_out = n
+            pos = v[:, e] > 0.0
+            turns = (pos[:-1] != pos[1:]).nonzero()[0]
+            for i in turns.tolist():
+                if i >= i_out:
+                    break
+                d_a, d_b, v_a, v_b = de[i], de[i + 1], v[i, e], v[i + 1, e]
+                excursion = 2.0 * float(taus[i + 1] - taus[i]) * max(abs(v_a), abs(v_b))
+                if (max(d_a, d_b) + excursion < hi_e) if v_a > 0.0 else (min(d_a, d_b) - excursion > lo_e):
+                    continue
+                cands.append((i, e))
+            if i_out < n:
+                cands.append((i_out, e))
+        if cands:
+            cands.sort()
+            best: tuple[float, int, int] | None = None
+            cell = -1
+            for i, e in cands:
+                if best is not None and i != cell:
+                    break
+                cell = i
+                hit = _resolve_cell(seg, e, float(lo[e]), float(hi[e]), float(taus[i]), float(taus[i + 1]),
+                                    float(d[i, e]), float(d[i + 1, e]), float(v[i, e]), float(v[i + 1, e]),
+                                    at_start=(i == 0 and tau_a == 0.0))
+                if hit is not None and hit[0] < tau_end and (best is None or hit[0] < best[0]):
+                    best = (hit[0], e, hit[1])
+            if best is not None:
+                return best
+        tau_a = float(taus[-1])
+        chunk = min(2 * chunk, _MAX_CHUNK)
+    return tau_end, -1, 0
+
+
+def _resolve_cell(
+    seg: Segment, e: int, lo: float, hi: float, tau_a: float, tau_b: float,
+    d_a: float, d_b: float, v_a: float, v_b: float, at_start: bool,
+) -> tuple[float, int] | None:
+    """The exit of element ``e`` from its stage inside the grid cell [tau_a, tau_b], if any:
+    (τ, direction); None when δ_e stays inside or only grazes a breakpoint (an excursion beyond
+    it below round-off)."""
+
+    def state(tau: float) -> tuple[float, float, float]:
+        return seg.element_point(tau, e)
+
+    def velocity_and_acceleration(tau: float) -> tuple[float, float]:
+        _, v, a = state(tau)
+        return v, a
+
+    d_floor = float(seg.d_floor[e]) + 8.0 * _EPS * max(abs(lo) if math.isfinite(lo) else 0.0,
+                                                       abs(hi) if math.isfinite(hi) else 0.0)
+    v_floor = float(seg.v_floor[e])
+    tol = 4.0 * _EPS * tau_b + 1e-300
+    end_up, end_down = d_b >= hi, d_b < lo
+    if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):
+        tau_e = tau_b if v_b == 0.0 else bracketed_newton(
+            velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol, v_floor)
+        d_e = state(tau_e)[0]
+        if v_a > 0.0:  # a maximum
+            if d_e - hi > d_floor or end_up:
+                up, a_, b_, d_a_, d_b_ = True, tau_a, tau_e, d_a, d_e
+            elif end_down:
+                up, a_, b_, d_a_, d_b_ = False, tau_e, tau_b, d_e, d_b
+            else:
+                return None
+        else:  # a minimum
+            if lo - d_e > d_floor or end_down:
+                up, a_, b_, d_a_, d_b_ = False, tau_a, tau_e, d_a, d_e
+            elif end_up:
+                up, a_, b_, d_a_, d_b_ = True, tau_e, tau_b, d_e, d_b
+            else:
+                return None
+    elif end_up or end_down:
+        up, a_, b_, d_a_, d_b_ = end_up, tau_a, tau_b, d_a, d_b
+    else:
+        return None
+    bound = hi if up else lo
+    fa, fb = d_a_ - bound, d_b_ - bound
+    tau_c = a_
+    if (fa >= 0.0) if up else (fa < 0.0):
+        if at_start and a_ == 0.0:
+            fa = -1e-300 if up else 1e-300  # the segment start is inside by construction
+        else:
+            return tau_c, (1 if up else -1)  # round-off at a graze: the crossing is at the bracket's start
+
+    def gap(tau: float) -> tuple[float, float]:
+        d, v, _ = state(tau)
+        return d - bound, v
+
+    tau_c = bracketed_newton(gap, a_, b_, fa, fb, tol, d_floor)
+    return tau_c, (1 if up else -1)
+
+
+__all__ = ["first_exit", "bracketed_newton", "vector_bracketed_newton"]

@@ -1,0 +1,445 @@
+"""The exact solution of a :class:`~rattle.model.System` on one stage combination.
+
+On a stage combination s (every element e on one stage s_e of its law) the equations of motion
+are linear; in first-order form z = (x, x'),
+
+    z' = A_s z + g_s + Σ_h (c_h cos hΩt + s_h sin hΩt),
+
+with A_s = [[0, I], [−K_s, −C]], g_s = (0, F_0 − Σ_e b_e o_e), c_h = (0, F_ch), s_h = (0, F_sh).
+
+* The harmonics have the particular solution z_h(t) = Re Σ_h Z_h e^{ihΩt},
+  Z_h = (ihΩ I − A_s)⁻¹ (c_h − i s_h); it exists unless ihΩ is an eigenvalue of A_s (an undamped
+  stage in exact resonance), which is refused with a clear error.
+* The rest, u = z − z_h, solves the autonomous u' = A_s u + g_s, i.e. w = (u, 1) solves
+  w' = Ā w with the augmented matrix Ā = [[A_s, g_s], [0, 0]] (Van Loan): w(τ) = exp(Ā τ) w(0).
+  This covers, without special cases, a singular A_s (a free sub-chain inside a backlash gap:
+  ramp- and parabola-type solutions) and the constant part of the force.
+
+exp(Ā τ) is evaluated exactly (to round-off) in a split form: a complex Schur decomposition of Ā
+puts the eigenvalues of a "zero cluster" (|λ| ≤ 1e-5 ρ, ρ the spectral radius — it holds the
+augmented eigenvalue 0 and any rigid-body-like modes of the stage, possibly defective) first, a
+Sylvester equation decouples that block from the rest, and the rest is diagonalised:
+
+    Ā = P diag(T_0, Λ) P⁻¹,   exp(Ā τ) = P diag(exp(T_0 τ), e^{Λ τ}) P⁻¹.
+
+exp(T_0 τ) is the Taylor series of a nearly nilpotent block (a polynomial in τ for an exactly
+nilpotent one: ramps and parabolas), summed until its terms are below round-off over the
+segment's length; e^{Λτ} are the stage's damped modes. Where P is ill-conditioned (a stage close
+to critical damping: two nearly equal non-zero eigenvalues) the stage falls back to
+``scipy.linalg.expm`` of Ā τ, slower but as exact.
+
+A :class:`Segment` is the solution from a state z_s at t_s on one stage combination, written as
+z(t_s + τ) = Re[Σ_j B_j e^{μ_j τ}] + Re[Σ_k Q_k τ^k] (modes μ: the diagonalised eigenvalues and
+the harmonics ihΩ, whose phases at t_s are folded into B so that τ, not t, carries the round-off),
+evaluated vectorised for the crossing search and at single points for the root refinement.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sla
+
+from .._typing import FloatArray
+from ..model import System
+
+_EPS = float(np.finfo(float).eps)
+_TWO_PI = 2.0 * math.pi
+_ZERO_CLUSTER = 1e-5  # |λ| ≤ this × spectral radius: in the Taylor-summed block
+_MAX_CONDITION = 1e6  # condition number of P beyond which the stage falls back to expm
+_SEGMENT_SCALES = 64.0  # longest segment, in stage time scales (a new segment starts beyond it)
+_MAX_TAYLOR = 200
+
+
+def _taylor_terms(T: np.ndarray, c: np.ndarray, tau_max: float) -> np.ndarray:
+    """u_k = T^k c / k! for k = 0 … K−1, stopped when ‖u_k‖ τ_max^k is below round-off of the
+    sum (shape (K, len(c)))."""
+    terms = [c]
+    if T.size == 0:
+        return np.asarray(terms)
+    total = float(np.max(np.abs(c))) if c.size else 0.0
+    u = c
+    scale = 1.0
+    for k in range(1, _MAX_TAYLOR):
+        u = (T @ u) / k
+        scale *= tau_max
+        size = float(np.max(np.abs(u))) * scale
+        if size == 0.0 or not math.isfinite(size):
+            break
+        terms.append(u)
+        total += size
+        if size <= 1e-18 * total and k >= 2:
+            break
+    return np.asarray(terms)
+
+
+def _taylor_expm(T: np.ndarray, tau: float) -> np.ndarray:
+    """exp(T τ) by its Taylor series (T nearly nilpotent, small)."""
+    k_dim = T.shape[0]
+    out = np.eye(k_dim, dtype=complex)
+    if k_dim == 0:
+        return out
+    term = np.eye(k_dim, dtype=complex)
+    Tt = T * tau
+    for k in range(1, _MAX_TAYLOR):
+        term = (term @ Tt) / k
+        size = float(np.max(np.abs(term)))
+        if size == 0.0:
+            break
+        out = out + term
+        if size <= 1e-18 * float(np.max(np.abs(out))) and k >= 2:
+            break
+    return out
+
+
+class SystemStages:
+    """Forcing data of ``system`` at forcing frequency ``omega`` and the cache of its stage
+    solutions (:meth:`solution`).
+
+    ``samples_per_scale`` grid points per stage time scale bracket the crossings.
+    """
+
+    def __init__(self, system: System, omega: float, samples_per_scale: int = 40) -> None:
+        self.system = system
+        self.omega = float(omega)
+        self.samples_per_scale = int(samples_per_scale)
+        n, m = system.n, system.m
+        self.n, self.m = n, m
+        self.C = np.asarray(system.damping, dtype=float)
+        self.mean = np.asarray(system.mean, dtype=float).reshape(n)
+        cos = np.asarray(system.cos, dtype=float).reshape(-1, n)
+        sin = np.asarray(system.sin, dtype=float).reshape(-1, n)
+        keep = np.any(cos != 0.0, axis=1) | np.any(sin != 0.0, axis=1)
+        self.hw = (np.arange(1, cos.shape[0] + 1, dtype=float) * self.omega)[keep]
+        self.fc = cos[keep]
+        self.fs = sin[keep]
+        rows = system.element_rows.reshape(m, n)
+        self.rows = rows
+        G = np.zeros((2 * m, 2 * n))
+        G[:m, :n] = rows
+        G[m:, n:] = rows
+        self.G = G
+        self.lower = [np.concatenate(([-np.inf], np.asarray(e.breakpoints, dtype=float))) for e in system.elements]
+        self.upper = [np.concatenate((np.asarray(e.breakpoints, dtype=float), [np.inf])) for e in system.elements]
+        self._cache: dict[tuple[int, ...], StageSolution] = {}
+
+    def solution(self, stages: tuple[int, ...]) -> StageSolution:
+        """The :class:`StageSolution` of the stage combination ``stages`` (cached)."""
+        sol = self._cache.get(stages)
+        if sol is None:
+            sol = StageSolution(self, stages)
+            self._cache[stages] = sol
+        return sol
+
+    def forcing(self, t: FloatArray | float, derivative: int = 0) -> FloatArray:
+        """F(t) or its ``derivative``-th time derivative, shape t.shape + (n,)."""
+        t = np.asarray(t, dtype=float)
+        th = np.multiply.outer(t, self.hw)
+        co, si = np.cos(th), np.sin(th)
+        w = self.hw[:, None] ** derivative
+        fc, fs = w * self.fc, w * self.fs
+        r = derivative % 4
+        if r == 0:
+            out = co @ fc + si @ fs
+        elif r == 1:
+            out = -si @ fc + co @ fs
+        elif r == 2:
+            out = -(co @ fc + si @ fs)
+        else:
+            out = si @ fc - co @ fs
+        return out + self.mean if derivative == 0 else out
+
+    def stages_at(self, t: float, z: FloatArray) -> tuple[int, ...]:
+        """The stage of every element at state ``z`` = (x, x') at time ``t``; exactly on a
+        breakpoint the direction of motion decides (sign of δ', then of δ'', the upper stage if
+        both vanish)."""
+        n = self.n
+        x, v = z[:n], z[n:]
+        stages = []
+        for e, elem in enumerate(self.system.elements):
+            bp = np.asarray(elem.breakpoints, dtype=float)
+            d = float(self.rows[e] @ x)
+            j = int(np.searchsorted(bp, d, side="right"))
+            stages.append(j)
+        stages_t = tuple(stages)
+        acc = None
+        for e, elem in enumerate(self.system.elements):
+            j = stages_t[e]
+            bp = np.asarray(elem.breakpoints, dtype=float)
+            d = float(self.rows[e] @ x)
+            if j > 0 and d == bp[j - 1]:
+                direction = float(self.rows[e] @ v)
+                if direction == 0.0:
+                    if acc is None:
+                        Ks = self.system.stage_stiffness(stages_t)
+                        acc = self.forcing(t) - self.C @ v - Ks @ x - self.system.stage_offset(stages_t)
+                    direction = float(self.rows[e] @ acc)
+                if direction < 0.0:
+                    stages[e] = j - 1
+        return tuple(stages)
+
+
+class StageSolution:
+    """The exact solution data of one stage combination (see the module docstring).
+
+    Attributes: ``stages``; ``A`` (2n, 2n) the stage matrix; ``g`` (2n,) its constant forcing;
+    ``Zh`` (H, 2n) complex harmonic particular amplitudes; ``eigenvalues`` of A; ``time_scale``
+    the fastest time scale (highest forcing harmonic, highest natural frequency, fastest decay);
+    ``grid_step`` the crossing-search step; ``max_segment`` the longest segment; ``method``
+    ``"modal"`` (split Schur form) or ``"expm"`` (ill-conditioned fallback).
+    """
+
+    def __init__(self, flow: SystemStages, stages: tuple[int, ...]) -> None:
+        system = flow.system
+        n = flow.n
+        self.flow = flow
+        self.stages = stages
+        self.Ks = np.asarray(system.stage_stiffness(stages), dtype=float)
+        self.offset = np.asarray(system.stage_offset(stages), dtype=float)
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -self.Ks
+        A[n:, n:] = -flow.C
+        self.A = A
+        g = np.zeros(2 * n)
+        g[n:] = flow.mean - self.offset
+        self.g = g
+        k = 2 * n + 1
+        Abar = np.zeros((k, k))
+        Abar[: 2 * n, : 2 * n] = A
+        Abar[: 2 * n, 2 * n] = g
+        self.Abar = Abar
+        lam = np.linalg.eigvals(A)
+        self.eigenvalues = lam
+        rho = float(np.max(np.abs(lam))) if lam.size else 0.0
+
+        # Harmonic particular solutions.
+        hw = flow.hw
+        if hw.size:
+            dist = np.abs(lam[None, :] - 1j * hw[:, None])
+            bad = dist <= 1e-10 * np.maximum(hw[:, None], rho)
+            if np.any(bad):
+                h_i, l_i = np.argwhere(bad)[0]
+                raise ValueError(
+                    f"the stage combination {stages} has the eigenvalue {lam[l_i]!r}: it is undamped and in "
+                    f"exact resonance with the forcing harmonic at {hw[h_i]!r} rad/s (`omega` = {flow.omega!r}); "
+                    "the response grows without bound: add damping or change `omega`"
+                )
+            rhs = np.zeros((hw.size, 2 * n), dtype=complex)
+            rhs[:, n:] = flow.fc - 1j * flow.fs
+            M = 1j * hw[:, None, None] * np.eye(2 * n)[None] - A[None]
+            self.Zh = np.linalg.solve(M, rhs[..., None])[..., 0]
+        else:
+            self.Zh = np.zeros((0, 2 * n), dtype=complex)
+
+        # Time scales.
+        scale = math.inf
+        if hw.size:
+            scale = min(scale, _TWO_PI / float(np.max(hw)))
+        im = float(np.max(np.abs(lam.imag))) if lam.size else 0.0
+        re = float(np.max(np.abs(lam.real))) if lam.size else 0.0
+        if im > 0.0:
+            scale = min(scale, _TWO_PI / im)
+        if re > 0.0:
+            scale = min(scale, 0.5 / re)
+        self.time_scale = scale
+        self.grid_step = scale / flow.samples_per_scale
+        self.max_segment = _SEGMENT_SCALES * scale
+
+        # Split form of exp(Ā τ).
+        self.method = "modal"
+        ztol = _ZERO_CLUSTER * rho
+        try:
+            T, Z, sdim = sla.schur(Abar, output="complex", sort=lambda x: abs(x) <= ztol)
+            T11, T12, T22 = T[:sdim, :sdim], T[:sdim, sdim:], T[sdim:, sdim:]
+            if sdim and sdim < k:
+                Y = sla.solve_sylvester(T11, -T22, -T12)
+            else:
+                Y = np.zeros((sdim, k - sdim), dtype=complex)
+            lam2, V2 = np.linalg.eig(T22) if k - sdim else (np.zeros(0, dtype=complex), np.zeros((0, 0), dtype=complex))
+            V2inv = np.linalg.inv(V2) if k - sdim else V2
+            upper = np.eye(k, dtype=complex)
+            upper[:sdim, sdim:] = Y
+            upper_inv = np.eye(k, dtype=complex)
+            upper_inv[:sdim, sdim:] = -Y
+            P = Z @ upper
+            P[:, sdim:] = P[:, sdim:] @ V2
+            Pinv = upper_inv @ Z.conj().T
+            Pinv[sdim:, :] = V2inv @ Pinv[sdim:, :]
+            cond = float(np.linalg.norm(P, 2) * np.linalg.norm(Pinv, 2))
+            if not (math.isfinite(cond) and cond <= _MAX_CONDITION):
+                self.method = "expm"
+        except (np.linalg.LinAlgError, ValueError):
+            self.method = "expm"
+        if self.method == "modal":
+            self.sdim = sdim
+            self.T0 = T11
+            self.lam = lam2
+            self.P = P
+            self.Pinv = Pinv
+            self.Pz = P[: 2 * n]  # (2n, k)
+            self.Pd = flow.G @ self.Pz  # (2m, k)
+
+    # --- pieces ---------------------------------------------------------------------------------
+    def harmonic_state(self, t: float) -> tuple[FloatArray, np.ndarray]:
+        """z_h(t) (2n,) and the phase-folded amplitudes Z_h e^{ihΩt} (H, 2n)."""
+        if not self.flow.hw.size:
+            return np.zeros(2 * self.flow.n), self.Zh
+        ph = np.exp(1j * self.flow.hw * t)
+        amps = self.Zh * ph[:, None]
+        return amps.sum(axis=0).real, amps
+
+    def transition(self, tau: float) -> FloatArray:
+        """exp(A_s τ) (2n, 2n), exact to round-off."""
+        n2 = 2 * self.flow.n
+        if self.method == "expm":
+            return sla.expm(self.A * tau)
+        E0 = _taylor_expm(self.T0, tau)
+        s = self.sdim
+        left = self.Pz.copy()
+        left[:, :s] = left[:, :s] @ E0
+        left[:, s:] = left[:, s:] * np.exp(self.lam * tau)[None, :]
+        return (left @ self.Pinv[:, :n2]).real
+
+    def segment(self, ts: float, z: FloatArray, tau_max: float) -> Segment:
+        """The solution from state ``z`` at ``ts`` for local times 0 ≤ τ ≤ ``tau_max``."""
+        return Segment(self, ts, z, tau_max)
+
+
+class Segment:
+    """The exact solution on one stage combination from (t_s, z_s) (module docstring).
+
+    ``state(tau)`` gives z = (x, x') and z' = (x', x'') at local times τ = t − t_s (vector or
+    scalar); ``scan(taus)`` the element deflections δ and δ' (N, m) at once; ``element_point``
+    (δ_e, δ_e', δ_e'') of one element at one τ (the root finder's hot call).
+    """
+
+    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "Bz", "Bd", "Qz", "Qd", "w0", "hamps",
+                 "d_floor", "v_floor", "_mu_l", "_bd_l", "_qd_l")
+
+    def __init__(self, sol: StageSolution, ts: float, z: FloatArray, tau_max: float) -> None:
+        flow = sol.flow
+        self.sol, self.ts, self.z0 = sol, float(ts), z
+        self.tau_max = tau_max = float(tau_max) if math.isfinite(tau_max) else 1.0
+        zh0, hamps = sol.harmonic_state(ts)
+        self.hamps = hamps
+        hw = flow.hw
+        G = flow.G
+        if sol.method == "modal":
+            w0 = np.empty(z.size + 1)
+            w0[:-1] = z - zh0
+            w0[-1] = 1.0
+            c = sol.Pinv @ w0
+            s = sol.sdim
+            self.mu = np.concatenate((sol.lam, 1j * hw))
+            self.Bz = np.concatenate(((sol.Pz[:, s:] * c[s:][None, :]).T, hamps), axis=0)  # (K, 2n)
+            U = _taylor_terms(sol.T0, c[:s], tau_max)  # (Kp, s)
+            self.Qz = U @ sol.Pz[:, :s].T  # (Kp, 2n)
+            self.w0 = None
+        else:
+            self.w0 = np.concatenate((z - zh0, [1.0]))
+            self.mu = 1j * hw
+            self.Bz = hamps
+            self.Qz = np.zeros((0, z.size), dtype=complex)
+        self.Bd = self.Bz @ G.T  # (K, 2m)
+        self.Qd = self.Qz @ G.T
+        m = flow.m
+        dmag = np.abs(self.Bd[:, :m]).sum(axis=0) + np.abs(G[:m] @ z)
+        vmag = np.abs(self.Bd[:, m:]).sum(axis=0) + np.abs(G[m:] @ z)
+        if self.Qd.shape[0]:
+            powers = tau_max ** np.arange(self.Qd.shape[0])
+            dmag = dmag + np.abs(self.Qd[:, :m]).T @ powers
+            vmag = vmag + np.abs(self.Qd[:, m:]).T @ powers
+        self.d_floor = 8.0 * _EPS * dmag
+        self.v_floor = 8.0 * _EPS * vmag
+        self._mu_l = self.mu.tolist()
+        self._bd_l = None
+        self._qd_l = None
+
+    # --- evaluation -----------------------------------------------------------------------------
+    def _expm_w(self, taus: FloatArray) -> np.ndarray:
+        """w(τ) = exp(Ā τ) w0 by scipy's expm (fallback stages), shape (N, 2n+1)."""
+        E = sla.expm(self.sol.Abar[None] * taus[:, None, None])
+        return E @ self.w0
+
+    def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """δ and δ' of every element at local times ``taus`` (N,): two (N, m) arrays."""
+        m = self.sol.flow.m
+        y = (np.exp(np.multiply.outer(taus, self.mu)) @ self.Bd).real if self.mu.size else np.zeros((taus.size, 2 * m))
+        Q = self.Qd
+        if Q.shape[0]:
+            acc = np.broadcast_to(Q[-1], (taus.size, 2 * m)).astype(complex)
+            for k in range(Q.shape[0] - 2, -1, -1):
+                acc = acc * taus[:, None] + Q[k]
+            y = y + acc.real
+        if self.w0 is not None:
+            w = self._expm_w(taus)
+            y = y + w[:, :-1] @ self.sol.flow.G.T
+        return y[:, :m], y[:, m:]
+
+    def state(self, taus: FloatArray | float) -> tuple[FloatArray, FloatArray]:
+        """z = (x, x') and z' = (x', x'') at local times ``taus``: shapes taus.shape + (2n,)."""
+        taus = np.asarray(taus, dtype=float)
+        shape = taus.shape
+        t = taus.reshape(-1)
+        n2 = self.Bz.shape[1]
+        if self.mu.size:
+            E = np.exp(np.multiply.outer(t, self.mu))
+            z = (E @ self.Bz).real
+            zd = (E @ (self.mu[:, None] * self.Bz)).real
+        else:
+            z = np.zeros((t.size, n2))
+            zd = np.zeros((t.size, n2))
+        Q = self.Qz
+        if Q.shape[0]:
+            acc = np.broadcast_to(Q[-1], (t.size, n2)).astype(complex)
+            dacc = np.zeros((t.size, n2), dtype=complex)
+            for k in range(Q.shape[0] - 2, -1, -1):
+                dacc = dacc * t[:, None] + acc
+                acc = acc * t[:, None] + Q[k]
+            z = z + acc.real
+            zd = zd + dacc.real
+        if self.w0 is not None:
+            w = self._expm_w(t)
+            z = z + w[:, :-1]
+            zd = zd + w @ self.sol.Abar[:-1].T
+        return z.reshape(shape + (n2,)), zd.reshape(shape + (n2,))
+
+    def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
+        """(δ_e, δ_e', δ_e'') at local time ``tau`` (a scalar)."""
+        if self.w0 is not None:
+            z, zd = self.state(np.array([tau]))
+            a = self.sol.flow.rows[e]
+            n = self.sol.flow.n
+            return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
+        if self._bd_l is None:
+            m = self.sol.flow.m
+            self._bd_l = [(list(self.Bd[:, i]), list(self.Bd[:, m + i])) for i in range(m)]
+            self._qd_l = [(list(self.Qd[:, i]), list(self.Qd[:, m + i])) for i in range(m)]
+        bd, bv = self._bd_l[e]
+        qd, qv = self._qd_l[e]
+        d = v = a = 0.0
+        exp = math.exp
+        for mu, b0, b1 in zip(self._mu_l, bd, bv):
+            r = exp(mu.real * tau)
+            ph = mu.imag * tau
+            ez = complex(r * math.cos(ph), r * math.sin(ph))
+            d += (b0 * ez).real
+            v += (b1 * ez).real
+            a += (mu * b1 * ez).real
+        if qd:
+            pd = qd[-1]
+            pv = qv[-1]
+            dpv = 0.0
+            for k in range(len(qd) - 2, -1, -1):
+                dpv = dpv * tau + pv
+                pd = pd * tau + qd[k]
+                pv = pv * tau + qv[k]
+            d += pd.real
+            v += pv.real
+            a += dpv.real if isinstance(dpv, complex) else dpv
+        return d, v, a
+
+
+__all__ = ["SystemStages", "StageSolution", "Segment"]
