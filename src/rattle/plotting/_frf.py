@@ -43,6 +43,18 @@ SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {
 }
 
 
+#: An element's column suffix for each drawable quantity (SPEC §5: NAME_min, NAME_max).
+_ELEMENT_SUFFIX = {"delta_min": "min", "delta_max": "max"}
+
+
+def column(frf: "FrequencyResponse", quantity: str) -> np.ndarray:
+    """The values of ``quantity``: a SPEC column (``rms``) or an element's (``clutch_rms``)."""
+    cols = getattr(frf, "element_columns", {}) or {}
+    if quantity in cols:
+        return np.asarray(cols[quantity], dtype=float)
+    return np.asarray(getattr(frf, quantity), dtype=float)
+
+
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """(start, stop) index pairs of consecutive True values, stop exclusive."""
     edges = np.diff(np.concatenate(([0], mask.astype(int), [0])))
@@ -72,7 +84,7 @@ def draw_branches(
     frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True, lw: float = 1.5
 ) -> dict[int, str]:
     """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours."""
-    y_all = np.asarray(getattr(frf, quantity), dtype=float)
+    y_all = column(frf, quantity)
     colors = branch_colors(frf)
     for b, color in colors.items():
         sel = np.nonzero(frf.branch == b)[0]
@@ -98,7 +110,7 @@ def draw_special_points(frf: "FrequencyResponse", ax: Any, quantity: str, *, lab
     The first row of a period-doubled branch (where it is born) is a period-doubling row too, so
     each period-doubling point shows on both the parent and the new branch (at the same place).
     """
-    y_all = np.asarray(getattr(frf, quantity), dtype=float)
+    y_all = column(frf, quantity)
     rows: dict[str, list[int]] = {}
     for sp in frf.special_points:
         rows.setdefault(sp.kind, []).append(int(sp.index))
@@ -136,7 +148,7 @@ def draw_regions(
     from matplotlib.transforms import blended_transform_factory
 
     top = blended_transform_factory(ax.transData, ax.transAxes)
-    y_all = np.asarray(getattr(frf, quantity), dtype=float)
+    y_all = column(frf, quantity)
     seen: set[str] = set()
     peaks: list[tuple[int, str]] = []
     for r in regions:
@@ -249,30 +261,49 @@ def frequency_response_plot(
         shown: Sequence[Any] = frf.regions if regions else ()
     else:
         shown = tuple(regions)
+    names = tuple(getattr(frf, "element_names", ()) or ())
+    if names and ax is None:  # a chain: one panel per element, sharing Ω
+        fig, axes = plt.subplots(len(names), 1, figsize=(9.5, 2.2 + 2.6 * len(names)), sharex=True,
+                                 layout="constrained", squeeze=False)
+        for k, (name, ax_k) in enumerate(zip(names, axes[:, 0])):
+            key = f"{name}_{_ELEMENT_SUFFIX.get(quantity, quantity)}"
+            _draw_panel(frf, ax_k, key, quantity, linear, special_points, shown, legend if k == 0 else "none",
+                        element=k, label=f"{name}: ")
+            first = title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})"
+            ax_k.set_title(f"{first} — element {name}" if k == 0 else f"element {name}", fontsize=10)
+            if k < len(names) - 1:
+                ax_k.set_xlabel("")
+        return fig, axes[:, 0]
     if ax is None:
         fig, ax = plt.subplots(figsize=(9.5, 5), layout="constrained")
     else:
         fig = ax.figure
-    colors = draw_branches(frf, ax, quantity)
+    _draw_panel(frf, ax, quantity, quantity, linear, special_points, shown, legend)
+    ax.set_title(title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})")
+    return fig, ax
+
+
+def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, linear: bool, special_points: bool,
+                shown: Sequence[Any], legend: str, *, element: int = 0, label: str = "") -> None:
+    """One frequency-response panel: column ``key`` (``quantity`` of element ``element``)."""
+    colors = draw_branches(frf, ax, key)
     if special_points:
-        draw_special_points(frf, ax, quantity)
+        draw_special_points(frf, ax, key)
     if linear and quantity in ("mean", "rms", "rms_ac"):
-        lin = frf.linear_response()
+        lin = frf.linear_response() if element == 0 else frf.linear_response(element=element)
         ax.plot(lin.omega, getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
     if shown:
-        draw_regions(frf, ax, quantity, shown, colors)
+        draw_regions(frf, ax, key, shown, colors)
     ax.set_xlabel("forcing frequency Ω (rad/s)")
-    ax.set_ylabel(QUANTITY_LABELS[quantity])
-    ax.set_title(title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})")
+    ax.set_ylabel(QUANTITY_LABELS[quantity] if not label else QUANTITY_LABELS[quantity].replace("δ", label.strip(": ").split()[-1] + " δ", 1))
     ax.grid(True, alpha=0.3)
     if shown:  # room for the "period p" labels at the top
         lo, hi = ax.get_ylim()
         ax.set_ylim(lo, hi + 0.08 * (hi - lo))
     place_legend(ax, legend)
-    return fig, ax
 
 
 __all__ = [
-    "frequency_response_plot", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
+    "frequency_response_plot", "column", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
     "branch_colors", "branch_label", "SPECIAL_POINT_STYLES", "QUANTITY_LABELS",
 ]

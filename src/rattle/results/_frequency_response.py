@@ -299,11 +299,12 @@ class FrequencyResponse:
             "acceleration": acceleration_batch(self.model, Q, w, self.omega[index : index + 1] if index >= 0 else self.omega[[index]], t)[0],
         }
 
-    def linear_response(self, omega: FloatArray | None = None, points: int = 600) -> LinearResponse:
-        """The linear system's (f = δ) closed-form response, by default on a uniform grid."""
+    def linear_response(self, omega: FloatArray | None = None, points: int = 600, *, element: int = 0) -> LinearResponse:
+        """The linear system's (f = δ) closed-form response on element ``element``, by default
+        on a uniform grid."""
         if omega is None:
             omega = np.linspace(self.omega.min(), self.omega.max(), points)
-        return linear_frequency_response(self.model, omega)
+        return linear_frequency_response(self.model, omega, element)
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
