@@ -281,10 +281,11 @@ def test_every_output_column_is_documented():
 def test_every_output_file_is_documented():
     import importlib
 
-    main = importlib.import_module("rattle.cli.main")
-    sets = {name: value for name, value in vars(main).items()
+    sets = {name: value for module in ("rattle.cli.output", "rattle.demo")
+            for name, value in vars(importlib.import_module(module)).items()
             if re.fullmatch(r"[A-Z]+_FILES", name) and isinstance(value, tuple)}
-    assert {"FRF_FILES", "SWEEP_FILES", "ORBIT_FILES"} <= set(sets), f"output sets not found: {sorted(sets)}"
+    assert {"FRF_FILES", "SWEEP_FILES", "ORBIT_FILES", "COMPARE_FILES", "DEMO_FILES"} <= set(sets), (
+        f"output sets not found: {sorted(sets)}")
     outputs, cli_text = _text("outputs.md"), _text("cli.md")
     for name, files in sets.items():
         command = name.split("_")[0].lower()

@@ -51,7 +51,7 @@ _LAZY: dict[str, str] = {
 
 #: Sub-packages reachable as attributes of ``rattle`` (imported on first use, as eagerly before).
 _SUBPACKAGES = frozenset({
-    "analysis", "continuation", "errors", "hb", "io", "measures", "model", "plotting", "report", "results",
+    "analysis", "continuation", "demo", "errors", "hb", "io", "measures", "model", "plotting", "results",
     "stability", "timeint",
 })
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from click.testing import Result
 
-from rattle.cli.main import DEMO_FIGURES
+from rattle.demo import DEMO_FIGURES
 from rattle.io import FRF_COLUMNS, SWEEP_COLUMNS, read_csv
 from _cli_helpers import PNG, VALID, invoke
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from rattle.cli.main import FRF_FILES
+from rattle.cli.output import FRF_FILES
 from rattle.errors import ConvergenceError
 from rattle.io import STAGING_PREFIX, OutputSet, read_csv, recover_staging
 from _cli_helpers import invoke, write_config

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rattle.cli.main import _ProgressBar
+from rattle.cli.output import ProgressBar
 from rattle.io import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, read_csv
 from _cli_helpers import PNG, VALID, assert_bad_input, invoke
 
@@ -181,7 +181,7 @@ def test_progress_bar_draws_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> No
     pytest.importorskip("tqdm")
     term = _Terminal()
     monkeypatch.setattr(sys, "stderr", term)
-    bar = _ProgressBar("sweep both", enabled=True)
+    bar = ProgressBar("sweep both", enabled=True)
     for done in range(1, 5):
         bar(done, 4)
     assert bar._bar is not None and bar._bar.n == 4 and bar._bar.total == 4
@@ -192,13 +192,13 @@ def test_progress_bar_draws_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> No
 def test_progress_bar_silent_when_quiet_or_not_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
     term = _Terminal()
     monkeypatch.setattr(sys, "stderr", term)
-    bar = _ProgressBar("sweep", enabled=False)  # --quiet
+    bar = ProgressBar("sweep", enabled=False)  # --quiet
     bar(1, 2)
     bar.close()
     assert term.getvalue() == ""
     plain = io.StringIO()
     monkeypatch.setattr(sys, "stderr", plain)
-    bar = _ProgressBar("sweep", enabled=True)
+    bar = ProgressBar("sweep", enabled=True)
     bar(1, 2)
     bar.close()
     assert plain.getvalue() == ""

@@ -18,11 +18,11 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from rattle import Region, periodic_orbit, time_sweep  # noqa: E402
 from rattle.model import Excitation  # noqa: E402
-from rattle.plotting import (  # noqa: E402
-    frequency_response_plot, hbm_vs_simulation_plot, linear_vs_nonlinear_plot, mean_operating_point_plot, point_plot,
+from rattle.demo import (  # noqa: E402
+    demo_report, hbm_vs_simulation_plot, level_difference, linear_acceleration_p2p, linear_vs_nonlinear_plot,
+    mean_operating_point_plot, point_plot, simulated_window, stage_intervals,
 )
-from rattle.plotting._paper import simulated_window  # noqa: E402
-from rattle.report import demo_report, level_difference, linear_acceleration_p2p, stage_intervals  # noqa: E402
+from rattle.plotting import frequency_response_plot  # noqa: E402
 
 
 @pytest.fixture(autouse=True)

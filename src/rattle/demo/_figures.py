@@ -1,7 +1,9 @@
 """The paper's figures (Figures 4–7 and the mean operating point) for ``rattle demo``.
 
 Each function draws one figure from result objects and returns ``(figure, axes)``; the numbers
-(level differences, stage intervals) come from :mod:`rattle.report`, which holds no plotting.
+(level differences, stage intervals) come from :mod:`rattle.demo._report`, which holds no
+plotting. The building blocks (branch colours, special-point markers, sweep styles) are those
+of :mod:`rattle.plotting`.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._frf import (
+from ..plotting._frf import (
     branch_colors,
     draw_branches,
     draw_regions,
@@ -21,10 +23,10 @@ from ._frf import (
     place_legend,
     _runs,
 )
-from ._orbit import _amplitudes_from_samples
+from ..plotting._orbit import _amplitudes_from_samples
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..report import LevelDifference
+    from ._report import LevelDifference
     from ..results import FrequencyResponse, PeriodicOrbit, SweepResult
 
 __all__ = [
@@ -50,7 +52,7 @@ def linear_vs_nonlinear_plot(
     ----------
     frf : FrequencyResponse
     level : LevelDifference
-        From :func:`rattle.report.level_difference`.
+        From :func:`rattle.demo.level_difference`.
     fig : matplotlib.figure.Figure, optional
         An empty figure (default a new 10 × 8 in one).
     title : str, optional
@@ -127,7 +129,7 @@ def _draw_sweep_points(sweep: "SweepResult", ax: Any) -> None:
     ticks along the bottom of the axes (up sweep lower, down sweep above it), coloured by period."""
     from matplotlib.transforms import blended_transform_factory
 
-    from ._sweep import PERIOD_COLORS, period_label
+    from ..plotting._sweep import PERIOD_COLORS, period_label
 
     direction = np.asarray(sweep.direction).astype(str)
     period = np.asarray(sweep.period, dtype=int)

@@ -1,8 +1,8 @@
 """The numbers the paper quotes, computed from the results, and the markdown report of ``rattle demo``.
 
 Everything here is pure: result objects in, numbers or text out. No matplotlib, no files (the
-command line writes the report atomically; the figures are drawn by :mod:`rattle.plotting` and
-only their file names come in here).
+command line writes the report atomically; the figures are drawn by
+:mod:`rattle.demo._figures` and only their file names come in here).
 
 Sound pressure and acceleration
 -------------------------------
@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from ._typing import FloatArray
-from .model import Model
+from .._typing import FloatArray
+from ..model import Model
 
 __all__ = [
     "LevelDifference", "linear_acceleration_p2p", "level_difference", "stage_intervals", "demo_report",

@@ -1,0 +1,263 @@
+"""The ``rattle`` command group (SPEC §3): the argument parser, the dispatch to the commands
+(:mod:`rattle.cli.commands`), and the one place where failures become exit statuses and
+``rattle: error:`` lines.
+
+Exit status: 0 success, 2 bad input (configuration, options, output path), 1 a numerical
+failure that could not be recovered, 128 + the signal number when interrupted (130 SIGINT,
+143 SIGTERM, 129 SIGHUP). Errors are one line on stderr, ``rattle: error: …``; warnings of the
+numerics (numpy's RuntimeWarning …) one line each, ``rattle: warning: …``, never raw.
+
+A front door that answers at once: the command line imports click, and numpy and the
+configuration reader when a command reads its file; the solver (scipy) is imported when a command runs, matplotlib when a figure is
+drawn. Every input is validated before that, and nothing is created in the output directory
+until there is something to write.
+
+Interrupted runs leave nothing wrong: every command writes its files into a staging folder inside
+the output directory and moves them into place together at the end
+(:class:`rattle.io.OutputSet`); SIGTERM and SIGHUP are turned into the same clean exit path as
+Ctrl-C (an exception, so that every ``finally`` removes its temporary files and stops its worker
+processes).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import sys
+import warnings
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ConfigError, ConvergenceError, RattleError
+from .commands import COMMANDS, common_options
+from .output import error, one_line, reset_verbose, warning
+
+__all__ = ["cli", "main", "EXIT_OK", "EXIT_NUMERICAL", "EXIT_BAD_INPUT", "Interrupted", "RattleGroup"]
+
+EXIT_OK = 0
+EXIT_NUMERICAL = 1
+EXIT_BAD_INPUT = 2
+
+_NoArgsIsHelpError: Any = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
+
+# --------------------------------------------------------------------------------------------
+# Signals and warnings
+# --------------------------------------------------------------------------------------------
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM or SIGHUP received: raised in the main thread like Ctrl-C's KeyboardInterrupt, so
+    that the same ``finally`` blocks remove temporary files and stop worker processes."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _Stopped(Exception):
+    """An interruption carried through click's main loop (which would turn KeyboardInterrupt into
+    a generic "Aborted!")."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_interrupted(signum: int, _frame: object) -> None:
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def _signals_as_exceptions() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise :class:`Interrupted` for the body (main thread only; the previous
+    handlers come back afterwards, which matters when the CLI runs inside another program)."""
+    installed: dict[int, Any] = {}
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is None:
+            continue
+        try:
+            installed[sig] = signal.signal(sig, _raise_interrupted)
+        except ValueError:  # not the main thread: leave the signals alone
+            break
+    try:
+        yield
+    finally:
+        for sig, old in installed.items():
+            with contextlib.suppress(ValueError, TypeError):
+                signal.signal(sig, old)
+
+
+def _signal_name(signum: int) -> str:
+    try:
+        return signal.Signals(signum).name
+    except ValueError:  # pragma: no cover
+        return f"signal {signum}"
+
+
+#: Warning lines shown per run; the rest are counted and summarised in one line.
+MAX_WARNINGS = 8
+
+
+@contextlib.contextmanager
+def _warnings_as_lines() -> Iterator[None]:
+    """Every warning raised during the body reaches the user as one ``rattle: warning: …`` line:
+    rattle's own warnings (their message names the key in backticks) as they are; others (numpy's
+    "overflow encountered in …") with where they arose (the rattle module and line), what kind
+    they are, and what they mean for the run. Each distinct warning once; at most
+    ``MAX_WARNINGS`` lines."""
+    seen: set[tuple[Any, ...]] = set()
+    hidden = 0
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: Any = None, line: str | None = None) -> None:
+        nonlocal hidden
+        key = (category, str(message), filename, lineno)
+        if key in seen:
+            return
+        seen.add(key)
+        if len(seen) > MAX_WARNINGS:
+            hidden += 1
+            return
+        text = " ".join(str(message).split())
+        if "`" in text:  # one of ours: already says what and why
+            warning(text)
+            return
+        where = _where(filename, lineno)
+        warning(f"{text} ({category.__name__} at {where}); the run went on, but check the results "
+                 "at the frequencies where this happened")
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        try:
+            yield
+        finally:
+            if hidden:
+                warning(f"{hidden} further warning(s) not shown")
+
+
+def _where(filename: str, lineno: int) -> str:
+    """``rattle/measures.py:141`` for a file of the package; the file name otherwise."""
+    parts = Path(filename).parts
+    if "rattle" in parts:
+        i = len(parts) - 1 - parts[::-1].index("rattle")
+        return "/".join(parts[i:]) + f":{lineno}"
+    return f"{Path(filename).name}:{lineno}"
+
+
+
+class RattleGroup(click.Group):
+    """A click group that turns every failure into one ``rattle: error: …`` line and an exit status.
+
+    Works the same under ``main()`` (console script, ``python -m rattle``) and under
+    ``click.testing.CliRunner``, both of which call :meth:`main`.
+    """
+
+    def main(  # type: ignore[override]
+        self,
+        args: Sequence[str] | None = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        **extra: Any,
+    ) -> Any:
+        code = self._run(args, prog_name, complete_var, **extra)
+        if standalone_mode:
+            sys.exit(code)
+        return code
+
+    def _run(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None, **extra: Any) -> int:
+        try:
+            with _signals_as_exceptions(), _warnings_as_lines():
+                return self._invoke(args, prog_name, complete_var, **extra)
+        except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM/SIGHUP raised as Interrupted
+            signum = exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT)
+            error(f"interrupted by {_signal_name(signum)}; temporary files were removed and no output "
+                   "set was left half-written")
+            return 128 + signum
+        finally:
+            reset_verbose()
+
+    def invoke(self, ctx: click.Context) -> Any:
+        # click turns KeyboardInterrupt into Abort (and prints a blank line); keep the signal
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            raise _Stopped(exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT)) from None
+
+    def _invoke(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None,
+                **extra: Any) -> int:
+        try:
+            rv = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except _Stopped as exc:
+            raise Interrupted(exc.signum) from None
+        except _NoArgsIsHelpError as exc:  # bare `rattle`: show the help, as click does
+            exc.show()
+            return int(exc.exit_code)
+        except click.UsageError as exc:
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            error(exc.format_message() + hint)
+            return int(exc.exit_code)
+        except click.ClickException as exc:
+            error(exc.format_message())
+            return int(exc.exit_code)
+        except click.Abort as exc:
+            cause = exc.__cause__ or exc.__context__
+            if isinstance(cause, KeyboardInterrupt):  # Ctrl-C while click itself was parsing
+                raise Interrupted(cause.signum if isinstance(cause, Interrupted) else int(signal.SIGINT)) from None
+            error("aborted")
+            return EXIT_NUMERICAL
+        except ConfigError as exc:
+            error(str(exc))
+            return EXIT_BAD_INPUT
+        except ConvergenceError as exc:
+            error(f"numerical failure: {exc}")
+            return EXIT_NUMERICAL
+        except RattleError as exc:
+            error(str(exc))
+            return EXIT_NUMERICAL
+        except ArithmeticError as exc:  # OverflowError, FloatingPointError, ZeroDivisionError
+            error(f"numerical failure: {one_line(exc)} ({type(exc).__name__}); the model's numbers are "
+                   "probably too large or too small for double precision — check their scale")
+            return EXIT_NUMERICAL
+        except MemoryError:
+            error("numerical failure: out of memory; lower --harmonics, --points or the frequency range")
+            return EXIT_NUMERICAL
+        except (ValueError, TypeError) as exc:
+            if type(exc).__name__ == "LinAlgError":  # numpy.linalg's, without importing numpy here
+                error(f"numerical failure: {one_line(exc)} (a singular or non-finite linear system)")
+                return EXIT_NUMERICAL
+            # The library validates its arguments with ValueError/TypeError naming the argument
+            # (a combination the CLI's own checks did not anticipate): bad input, not a crash.
+            if "`" not in str(exc):
+                raise  # not one of our validation messages: a bug, keep the traceback
+            error(str(exc))
+            return EXIT_BAD_INPUT
+        return rv if isinstance(rv, int) else EXIT_OK
+
+
+
+@click.group(name="rattle", cls=RattleGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@common_options
+def cli() -> None:
+    """Non-linear frequency response of drivetrain rattle (harmonic balance + continuation).
+
+    Exit status: 0 success, 2 bad input, 1 numerical failure, 130/143 interrupted.
+    """
+
+
+for _command in COMMANDS:
+    cli.add_command(_command)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Console entry point ``rattle`` (and ``python -m rattle``); exits with status 0, 1 or 2.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments without the program name; default ``sys.argv[1:]``.
+    """
+    cli.main(args=list(argv) if argv is not None else None, prog_name="rattle")

@@ -1,0 +1,421 @@
+"""The commands of ``rattle``, one function each: ``frf``, ``sweep``, ``orbit``, ``compare`` and
+``demo`` (which runs :mod:`rattle.demo`), with the options they share.
+
+Each command checks its input (:mod:`rattle.cli.checks`), reads the configuration, imports the
+numerics only then, calls one front end of the library and hands the result to
+:mod:`rattle.cli.output`. The group that dispatches to them is :mod:`rattle.cli.app`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import click
+
+from ..errors import ConfigError, ConvergenceError
+from .checks import (
+    DIRECTIONS, MAX_PERIOD, check_omega, check_period, output_path, override_analysis, parse_at, precheck,
+)
+from .output import (
+    COMPARE_FILES, FRF_FILES, ORBIT_FILES, SWEEP_FILES, ProgressBar, echo_written, logger, metadata_writer,
+    one_line, save_figure, save_plot, sections, set_verbose, write_frf, write_set,
+)
+
+if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
+    from ..io import AnalysisSettings
+    from ..model import Model
+
+__all__ = [
+    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf",
+    "frf_command", "sweep_command", "orbit_command", "compare_command", "demo_command",
+]
+
+#: Output directory when ``-o`` is not given.
+DEFAULT_OUTPUT = "rattle-out"
+
+
+def _io() -> Any:
+    """``rattle.io`` (numpy, the model and the configuration reader), imported on first use so
+    that ``--help``, ``--version`` and options click refuses need none of it."""
+    from .. import io
+
+    return io
+
+
+# --------------------------------------------------------------------------------------------
+# Options shared by the commands
+# --------------------------------------------------------------------------------------------
+def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    if value and not ctx.resilient_parsing:
+        from .. import __version__  # the package metadata only, not the numerics
+
+        click.echo(f"rattle {__version__}")
+        ctx.exit(0)
+
+
+def common_options(f: Callable[..., Any]) -> Callable[..., Any]:
+    """``--version`` and ``-v/--verbose``, on the group and on every command."""
+    f = click.option("-v", "--verbose", is_flag=True, expose_value=False, callback=set_verbose,
+                     help="Report progress on stderr.")(f)
+    return click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+                        help="Show the version and exit.")(f)
+
+
+_output_option = click.option(
+    "-o", "--output", "output", type=str, default=DEFAULT_OUTPUT, callback=output_path, metavar="DIR",
+    show_default=True, help="Directory for the output files (created if needed).",
+)
+_harmonics_option = click.option(
+    "--harmonics", type=int, default=None, metavar="H",
+    help="Harmonics kept in the harmonic balance (>= 1); overrides analysis.harmonics.",
+)
+_omega_min_option = click.option(
+    "--omega-min", type=float, default=None, metavar="X",
+    help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega[0].",
+)
+_omega_max_option = click.option(
+    "--omega-max", type=float, default=None, metavar="Y",
+    help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].",
+)
+_quiet_option = click.option(
+    "-q", "--quiet", is_flag=True,
+    help="No progress bar (there is none anyway when stderr is not a terminal).",
+)
+
+
+# --------------------------------------------------------------------------------------------
+# rattle frf
+# --------------------------------------------------------------------------------------------
+def compute_frf(
+    model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], t_start: float,
+    *, subharmonics: bool = False, names: Sequence[str] = FRF_FILES,
+) -> Any:
+    """The frequency response; on a numerical failure the points computed before it are
+    written (frf.csv, frf.json, frf.png, as the command's whole set ``names``: files of an
+    earlier run that the partial set does not replace are removed) and the error re-raised
+    naming the files."""
+    from ..analysis import frequency_response  # only now: all input has been validated
+
+    extra = {"subharmonics": True} if subharmonics else {}
+    logger.info("computing the frequency response over %g … %g rad/s with %d harmonics",
+                analysis.omega_min, analysis.omega_max, analysis.harmonics)
+    try:
+        return frequency_response(model, omega=analysis.omega, harmonics=analysis.harmonics, throw=True, **extra)
+    except (ConvergenceError, ArithmeticError) as exc:
+        partial = getattr(exc, "partial", None)
+        if partial is None or not len(partial):
+            raise
+        reason = str(exc) if isinstance(exc, ConvergenceError) else f"{one_line(exc)} ({type(exc).__name__})"
+        try:
+            written = write_frf(partial, output, sections, t_start, names)
+        except click.ClickException as write_error:
+            raise ConvergenceError(
+                f"{reason}; the points computed before the failure could not be saved: "
+                f"{write_error.format_message()}",
+                partial=partial,
+            ) from exc
+        click.echo(partial.summary())
+        raise ConvergenceError(
+            f"{reason}; the points computed before the failure were written to "
+            f"{', '.join(str(output / name) for name in written)}",
+            partial=partial,
+        ) from exc
+
+
+def run_frf(
+    model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False
+) -> None:
+    """Compute the frequency response, write the three files and print the summary.
+
+    Parameters
+    ----------
+    model : Model
+    analysis : AnalysisSettings
+        Frequency range and harmonics.
+    output : pathlib.Path
+        Output directory (checked with :func:`rattle.cli.checks.check_output_dir` beforehand).
+    sections : dict
+        Extra metadata sections for ``frf.json`` (``config``, ``command``, …).
+    subharmonics : bool, default False
+        Also follow the period-doubled branches (every branch goes into the files).
+
+    Raises
+    ------
+    ConvergenceError
+        When the continuation failed; the points computed before the failure are written first
+        when the error carries them in ``.partial``.
+    """
+    t_start = time.perf_counter()
+    result = compute_frf(model, analysis, output, sections, t_start, subharmonics=subharmonics)
+    written = write_frf(result, output, sections, t_start)
+    echo_written(result.summary(), written, output)
+
+
+@click.command("frf", short_help="Frequency response of the model in a configuration file.")
+@common_options
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@_harmonics_option
+@_omega_min_option
+@_omega_max_option
+@click.option("--subharmonics", is_flag=True, default=False,
+              help="Also follow the sub-harmonic (period-doubled) branches born at every period-doubling "
+                   "point; all branches go into frf.csv (columns branch, period) and frf.png.")
+def frf_command(
+    config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
+    subharmonics: bool,
+) -> None:
+    """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
+
+    With --subharmonics every period-doubling point found on the primary branch starts a
+    period-2 branch (and so on, up to period 4); each branch has its colour in frf.png.
+    """
+    precheck(config, output, harmonics=harmonics)
+    run_config = _io().load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
+               "subharmonics": True if subharmonics else None}
+    run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
+            subharmonics=subharmonics)
+
+
+# --------------------------------------------------------------------------------------------
+# Time-domain commands: sweep, orbit, compare
+# --------------------------------------------------------------------------------------------
+@click.command("sweep", short_help="Time-domain frequency sweep (steady state at each frequency).")
+@common_options
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--direction", type=click.Choice(DIRECTIONS), default=None,
+              help="Required: sweep up (run-up), down (run-down) or both, the state carried from each "
+                   "frequency to the next.")
+@click.option("--points", type=int, default=200, show_default=True, metavar="N",
+              help="Equally spaced frequencies per direction (>= 2).")
+@click.option("--workers", type=int, default=1, show_default=True, metavar="W",
+              help="Processes: 2 runs the up and down sweeps of --direction both at once.")
+@_omega_min_option
+@_omega_max_option
+@_quiet_option
+def sweep_command(
+    config: Path, output: Path, direction: str | None, points: int, workers: int,
+    omega_min: float | None, omega_max: float | None, quiet: bool,
+) -> None:
+    """Time-domain frequency sweep of the model in CONFIG: sweep.csv, sweep.png, sweep.json in OUTPUT.
+
+    At N equally spaced frequencies the motion is simulated exactly until it settles (period
+    1 … 8 of the forcing period, or 0 when none is found), the state carried from one frequency
+    to the next as in a run-up or run-down.
+    """
+    if direction is None:  # checked here: click's own message for a missing choice spans lines
+        raise ConfigError("`--direction` is required: give --direction up, down or both")
+    precheck(config, output, points=points, workers=workers)
+    run_config = _io().load_config(config)
+    analysis = override_analysis(run_config.analysis, run_config.model, omega_min=omega_min, omega_max=omega_max)
+    t_start = time.perf_counter()
+    from ..analysis import time_sweep  # only now: all input has been validated
+
+    bar = ProgressBar(f"sweep {direction}", enabled=not quiet)
+    try:
+        result = time_sweep(run_config.model, omega=analysis.omega, points=points, direction=direction,
+                            workers=workers, callback=bar)
+    finally:
+        bar.close()
+    meta = sections("sweep", config, run_config, analysis, {
+        "direction": direction, "points": points, "workers": workers,
+        "omega_min": omega_min, "omega_max": omega_max,
+    })
+    written = write_set(output, SWEEP_FILES, [
+        ("sweep.csv", result.to_csv),
+        ("sweep.json", metadata_writer(result.metadata(), meta, t_start)),
+        ("sweep.png", lambda path: save_plot(result, path)),
+    ])
+    echo_written(result.summary(), written, output)
+
+
+@click.command("orbit", short_help="Every periodic orbit at one forcing frequency, against the simulation.")
+@common_options
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--omega", "omega", type=float, required=True, metavar="W",
+              help="Forcing frequency in rad/s (finite, > 0).")
+@click.option("--period", type=int, default=1, show_default=True, metavar="N",
+              help=f"Period of the orbit as a multiple of the forcing period, 1 … {MAX_PERIOD} (N: a 1/N sub-harmonic).")
+@_harmonics_option
+@_omega_min_option
+@_omega_max_option
+def orbit_command(
+    config: Path, output: Path, omega: float, period: int, harmonics: int | None,
+    omega_min: float | None, omega_max: float | None,
+) -> None:
+    """Periodic orbits at the forcing frequency W for the model in CONFIG: orbit.csv, orbit.png,
+    orbit.json in OUTPUT.
+
+    Every coexisting harmonic-balance solution at W is found (the primary branch is followed over
+    the analysis range, widened to include W; sub-harmonics are seeded from a simulation) and its
+    stability computed. orbit.csv holds t, delta, velocity, acceleration over one period of the
+    selected solution: the stable one closest in rms to the simulated steady state (preferring
+    the requested period); orbit.json lists them all.
+    """
+    check_omega(omega)
+    precheck(config, output, harmonics=harmonics)
+    run_config = _io().load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    check_omega(omega, model=run_config.model)
+    check_period(period, analysis.harmonics, len(run_config.model.excitation.amplitudes))
+    t_start = time.perf_counter()
+    from ..analysis import periodic_orbit  # only now: all input has been validated
+
+    result = periodic_orbit(run_config.model, omega, period=period, harmonics=analysis.harmonics,
+                            search_range=analysis.omega)
+    meta = sections("orbit", config, run_config, analysis, {
+        "omega": omega, "period": period, "harmonics": harmonics,
+        "omega_min": omega_min, "omega_max": omega_max,
+    })
+    written = write_set(output, ORBIT_FILES, [
+        ("orbit.csv", result.to_csv),
+        ("orbit.json", metadata_writer(result.metadata(), meta, t_start)),
+        ("orbit.png", lambda path: save_plot(result, path)),
+    ])
+    echo_written(result.summary(), written, output)
+
+
+@click.command("compare", short_help="Frequency response and time-domain sweep together.")
+@common_options
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--points", type=int, default=200, show_default=True, metavar="N",
+              help="Equally spaced frequencies per sweep direction (>= 2).")
+@click.option("--at", "at", type=str, default=None, metavar="W1,W2,...",
+              help="Frequencies (rad/s) for the time-history panels; default: picked automatically "
+                   "(one in the multi-valued region, one where the sweep is not period 1).")
+@click.option("--workers", type=int, default=1, show_default=True, metavar="W",
+              help="Processes for the sweep: 2 runs the up and down sweeps at once.")
+@_harmonics_option
+@_omega_min_option
+@_omega_max_option
+@_quiet_option
+def compare_command(
+    config: Path, output: Path, points: int, at: str | None, workers: int, harmonics: int | None,
+    omega_min: float | None, omega_max: float | None, quiet: bool,
+) -> None:
+    """Frequency response against the up/down time-domain sweep for the model in CONFIG:
+    compare.png, frf.csv, sweep.csv, compare.json in OUTPUT."""
+    precheck(config, output, harmonics=harmonics, points=points, workers=workers)
+    run_config = _io().load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
+    t_start = time.perf_counter()
+    from ..analysis import compare  # only now: all input has been validated
+
+    bar = ProgressBar("sweep up+down", enabled=not quiet)
+    try:
+        result = compare(run_config.model, omega=analysis.omega, harmonics=analysis.harmonics, points=points,
+                         at=at_values, workers=workers, callback=bar)
+    finally:
+        bar.close()
+    meta = sections("compare", config, run_config, analysis, {
+        "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
+        "omega_min": omega_min, "omega_max": omega_max,
+    })
+    written = write_set(output, COMPARE_FILES, [
+        ("frf.csv", result.frf.to_csv),
+        ("sweep.csv", result.sweep.to_csv),
+        ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
+        ("compare.png", lambda path: save_plot(result, path)),
+    ])
+    echo_written(result.summary(), written, output)
+
+
+# --------------------------------------------------------------------------------------------
+# rattle demo: the paper's reference case end to end (rattle.demo computes, this writes)
+# --------------------------------------------------------------------------------------------
+@click.command("demo", short_help="The paper's reference case end to end, with its figures and a report.")
+@common_options
+@_output_option
+@_quiet_option
+def demo_command(output: Path, quiet: bool) -> None:
+    """The paper's reference case end to end: clutch α = 0.25, b = 10°, ζ = 0.025, F_m = 0.05,
+    F_p1 = 0.03 over Ω = 0.1 … 3.0 rad/s with 32 harmonics.
+
+    Computes the frequency response with its sub-harmonic branches, a time-domain sweep up and
+    down (200 frequencies each way) and the orbits at the paper's points A (Ω = 0.44) and B
+    (Ω = 1.41), and writes into OUTPUT: frf.csv, frf.json, frf.png, sweep.csv, the paper's
+    figures (fig4_linear_vs_nonlinear.png, fig5_hbm_vs_simulation.png, fig6_point_A.png,
+    fig7_point_B.png, fig_mean_operating_point.png) and report.md, which collects them with
+    the computed numbers.
+    """
+    precheck(None, output)
+    from .. import demo  # only now: all input has been validated
+
+    t_start = time.perf_counter()
+    model, analysis = demo.demo_case()
+    click.echo("rattle demo: " + demo.describe(analysis))
+    meta_sections: dict[str, Any] = {
+        "command": "demo", "config": _io().model_to_toml_dict(model, analysis), "analysis": analysis.to_dict(),
+        "options": {"subharmonics": True, "points": demo.DEMO_POINTS, "workers": demo.DEMO_WORKERS},
+    }
+
+    # --- computation ---------------------------------------------------------------------------
+    t0 = time.perf_counter()
+    frf = compute_frf(model, analysis, output, meta_sections, t_start, subharmonics=True, names=demo.DEMO_FILES)
+    timings: dict[str, float] = {"frf": time.perf_counter() - t0}
+    bar = ProgressBar("sweep up+down", enabled=not quiet)
+
+    def progress(done: int, total: int) -> None:  # the bar goes when the sweep is done, before the orbits
+        bar(done, total)
+        if done >= total:
+            bar.close()
+
+    try:
+        run = demo.run_demo(frf, callback=progress)
+    finally:
+        bar.close()
+    timings.update(run.timings)
+
+    # --- output: data first, then the figures, then the report --------------------------------
+    meta = dict(frf.metadata())
+    frf_timings = dict(meta.pop("timings", None) or {})
+    demo_section = run.metadata()
+
+    def write_json(path: Path) -> None:
+        wall = {**frf_timings, **{f"demo_{k}": v for k, v in timings.items()},
+                "cli_wall_time": time.perf_counter() - t_start}
+        _io().write_metadata(path, **{**meta, **meta_sections, "demo": demo_section, "timings": wall})
+
+    figures: dict[str, str] = {}
+
+    def write_figure(key: str, path: Path) -> bool:
+        done = save_figure(lambda: run.figure(key), path)
+        if done:
+            figures[key] = path.name
+        return done
+
+    def write_report(path: Path) -> None:
+        timings["figures"] = time.perf_counter() - t_figures
+        timings["total"] = time.perf_counter() - t_start
+        text = run.report(figures=figures, timings=timings, version=_io().rattle_version())
+        _io().atomic_write_text(path, text)
+
+    t_figures = time.perf_counter()
+    written = write_set(output, demo.DEMO_FILES, [
+        ("frf.csv", frf.to_csv), ("sweep.csv", run.sweep.to_csv), ("frf.json", write_json),
+        *[(name, lambda path, k=key: write_figure(k, path)) for key, name in demo.DEMO_FIGURES.items()],
+        (demo.DEMO_REPORT, write_report),
+    ])
+
+    click.echo(run.summary())
+    click.echo("time: " + ", ".join(f"{k} {v:.2f} s" for k, v in timings.items()))
+    click.echo(f"wrote {len(written)} files to {output}: {', '.join(written)}")
+
+
+#: Every command of ``rattle``, in the order of the documentation.
+COMMANDS = (frf_command, sweep_command, orbit_command, compare_command, demo_command)

@@ -1,0 +1,212 @@
+"""What the command line writes and prints: output sets written atomically through
+:mod:`rattle.io`, figures saved as PNG, the metadata file, the progress bar, the
+``rattle: error:``/``rattle: warning:`` lines and ``-v`` progress on stderr.
+
+Nothing is computed here; the commands (:mod:`rattle.cli.commands`) hand in result objects
+and writer functions.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import click
+
+if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
+    from ..io import AnalysisSettings
+
+__all__ = [
+    "FRF_FILES", "SWEEP_FILES", "ORBIT_FILES", "COMPARE_FILES", "Writer", "ProgressBar", "write_set", "save_figure",
+    "save_plot", "frf_steps", "write_frf", "metadata_writer", "sections", "echo_written", "error", "warning",
+    "one_line", "set_verbose", "reset_verbose", "logger",
+]
+
+logger = logging.getLogger("rattle")
+
+#: The files each command writes (its output set: staged and moved into place together; a file
+#: of the set that a run does not produce is removed, so no old one stays beside new data).
+#: The demo's set is :data:`rattle.demo.DEMO_FILES`.
+FRF_FILES = ("frf.csv", "frf.json", "frf.png")
+SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")
+ORBIT_FILES = ("orbit.csv", "orbit.json", "orbit.png")
+COMPARE_FILES = ("frf.csv", "sweep.csv", "compare.json", "compare.png")
+
+
+def _io() -> Any:
+    """``rattle.io`` (numpy, the model and the configuration reader), imported on first use so
+    that ``--help``, ``--version`` and options click refuses need none of it."""
+    from .. import io
+
+    return io
+
+
+# --------------------------------------------------------------------------------------------
+# Lines on stderr
+# --------------------------------------------------------------------------------------------
+def error(message: str) -> None:
+    """``rattle: error: message`` on stderr."""
+    click.echo(f"rattle: error: {message}", err=True)
+
+
+def warning(message: str) -> None:
+    """``rattle: warning: message`` on stderr."""
+    click.echo(f"rattle: warning: {message}", err=True)
+
+
+def one_line(exc: BaseException) -> str:
+    """The exception's message on one line (its type's name when it has none)."""
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def set_verbose(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    """``-v``: the library's progress (logger ``rattle``, INFO) on stderr as ``rattle: …`` lines."""
+    if not value or ctx.resilient_parsing:
+        return
+    if not any(h.get_name() == "rattle-cli" for h in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.set_name("rattle-cli")
+        handler.setFormatter(logging.Formatter("rattle: %(message)s"))
+        logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+
+
+def reset_verbose() -> None:
+    """Remove what :func:`set_verbose` installed (the CLI may run inside another program)."""
+    for handler in [h for h in logger.handlers if h.get_name() == "rattle-cli"]:
+        logger.removeHandler(handler)
+    logger.setLevel(logging.NOTSET)
+
+
+class ProgressBar:
+    """``callback(done, total)`` drawing a tqdm bar on stderr; a no-op when stderr is not a
+    terminal, with ``--quiet``, or without tqdm. The library never draws one itself."""
+
+    def __init__(self, description: str, enabled: bool) -> None:
+        self.description = description
+        self.enabled = enabled and sys.stderr.isatty()
+        self._bar: Any = None
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled:
+            return
+        if self._bar is None:
+            try:
+                from tqdm import tqdm
+            except ImportError:  # pragma: no cover - tqdm is a dependency
+                self.enabled = False
+                return
+            self._bar = tqdm(total=total, desc=self.description, unit="Ω", file=sys.stderr, leave=False,
+                             dynamic_ncols=True)
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+
+def echo_written(summary: str, written: Sequence[str], output: Path) -> None:
+    """The result's summary and the files written, on stdout."""
+    click.echo(summary)
+    click.echo(f"wrote {', '.join(written)} to {output}")
+
+
+# --------------------------------------------------------------------------------------------
+# Files
+# --------------------------------------------------------------------------------------------
+def save_figure(draw: Callable[[], tuple[Any, Any]], path: Path) -> bool:
+    """Call ``draw()`` (returns (figure, axes)) and save the figure atomically as PNG; False
+    without matplotlib."""
+    try:
+        import matplotlib
+    except ImportError:
+        warning(f"matplotlib is not installed, so {path.name} was not written (pip install matplotlib)")
+        return False
+    matplotlib.use("Agg")  # never open a window from the command line
+    import matplotlib.pyplot as plt
+
+    fig, _ax = draw()
+    try:
+        with _io().atomic_path(path) as tmp:
+            fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=150)
+    finally:
+        plt.close(fig)
+    return True
+
+
+def save_plot(result: Any, path: Path) -> bool:
+    """Draw ``result`` with its ``.plot()`` and save it atomically as PNG; False without matplotlib."""
+    return save_figure(result.plot, path)
+
+
+Writer = Callable[[Path], Any]
+
+
+def write_set(output: Path, names: Sequence[str], steps: Sequence[tuple[str, Writer]]) -> list[str]:
+    """Write one output set: each ``(name, writer)`` writes ``name`` into a staging folder inside
+    ``output``, then all are moved into place together (:class:`rattle.io.OutputSet`); return
+    the names written.
+
+    ``names`` is the command's whole set: a file of it that this run does not write (a writer
+    returning False, e.g. no matplotlib) is removed from ``output`` at the move, so that an old
+    file never sits beside new ones. Any exception (KeyboardInterrupt, a numerical error while
+    drawing) leaves ``output`` as it was: the staging folder is removed, and so are the folders
+    the run created.
+    """
+    try:
+        with _io().OutputSet(output, names) as staged:
+            logger.info("staging %s in %s", ", ".join(n for n, _ in steps), staged.staging)
+            for name, writer in steps:
+                logger.info("writing %s", name)
+                writer(staged.path(name))
+            written = staged.commit()
+    except OSError as exc:
+        where = f"{exc.filename}" if exc.filename else str(output)
+        raise click.ClickException(f"cannot write {where}: {exc.strerror or exc}") from exc
+    logger.info("moved %s into %s", ", ".join(written), output)
+    return written
+
+
+def metadata_writer(meta: dict[str, Any], sections: dict[str, Any], t_start: float) -> Writer:
+    """A writer of the ``.json`` metadata: the result's ``meta`` with the command's ``sections``
+    and the command's wall time added to its timings."""
+
+    def write(path: Path) -> None:
+        doc = dict(meta)
+        timings = dict(doc.pop("timings", None) or {})
+        timings["cli_wall_time"] = time.perf_counter() - t_start
+        _io().write_metadata(path, **{**doc, **sections, "timings": timings})
+
+    return write
+
+
+def sections(command: str, config: Path, run_config: Any, analysis: AnalysisSettings,
+             options: dict[str, Any]) -> dict[str, Any]:
+    """The metadata sections every command adds: the command, the configuration file and its
+    text, the options given (None left out) and the analysis settings used."""
+    return {
+        "command": command,
+        "config_file": os.fspath(config),
+        "config": run_config.source,
+        "options": {k: v for k, v in options.items() if v is not None},
+        "analysis": analysis.to_dict(),
+    }
+
+
+def frf_steps(result: Any, sections: dict[str, Any], t_start: float) -> list[tuple[str, Writer]]:
+    """Writers of ``frf.csv``, ``frf.json`` and ``frf.png`` (the data first, the figure last)."""
+    return [("frf.csv", result.to_csv), ("frf.json", metadata_writer(result.metadata(), sections, t_start)),
+            ("frf.png", lambda path: save_plot(result, path))]
+
+
+def write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: float,
+              names: Sequence[str] = FRF_FILES) -> list[str]:
+    """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output`` as one set (``names``: the
+    command's whole set, see :func:`write_set`); return the names written."""
+    return write_set(output, names, frf_steps(result, sections, t_start))
