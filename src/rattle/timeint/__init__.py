@@ -2,13 +2,16 @@
 periodic orbits by shooting and the steady state of a simulation with period detection."""
 
 from ._exact import ExactIntegrator, ExactMeasures, StageSolutions, StateSamples, Trajectory
+from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory
 from ._general import GeneralSolution, integrate_general
 from ._shooting import ShootingOrbit, shoot_periodic_orbit
 from ._steady import SteadyState, SteadyStateOptions, steady_state
+from ._system_shooting import SystemOrbit, shoot_system_orbit
 
 __all__ = [
     "ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
     "ShootingOrbit", "shoot_periodic_orbit",
     "integrate_general", "GeneralSolution",
     "SteadyStateOptions", "SteadyState", "steady_state",
+    "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
 ]
