@@ -593,10 +593,10 @@ def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
 # --------------------------------------------------------------------------------------------
 # Chains (SPEC §5)
 # --------------------------------------------------------------------------------------------
-_CHAIN_MODEL_KEYS = ("inertias", "links", "elements")
-_LINK_KEYS = ("between", "stiffness", "damping")
-_ELEMENT_KEYS = ("name", "between", "stiffness")
-_TORQUE_KEYS = ("inertia", "mean", "amplitudes", "phases")
+_CHAIN_MODEL = ("inertias", "links", "elements")
+_MODEL_LINKS_KEYS = ("between", "stiffness", "damping")
+_MODEL_ELEMENTS_KEYS = ("name", "between", "stiffness")
+_EXCITATION_TORQUES_KEYS = ("inertia", "mean", "amplitudes", "phases")
 _EXAMPLES.update({
     "model.inertias": "inertias = [2.0, 2.0]",
     "model.elements": '[[model.elements]] with name = "clutch", between = [1, 2], stiffness = 1.0, type = "clutch", alpha = 0.25, b = 0.174533',
@@ -645,7 +645,7 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                 f"SPEC §5): give the chain's links and elements instead ([[model.links]], "
                 f"[[model.elements]]) and remove `model.{key}`"
             )
-    check.keys(model_t, "model", _CHAIN_MODEL_KEYS, required=("inertias", "elements"))
+    check.keys(model_t, "model", _CHAIN_MODEL, required=("inertias", "elements"))
     excitation_t = check.table(data, "excitation", "excitation")
     check.keys(excitation_t, "excitation", ("torques",), required=("torques",))
     analysis_t: Mapping[str, Any] = {}
@@ -658,17 +658,17 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
     links = []
     for k, t in enumerate(_tables(check, model_t, "links", "model.links") if "links" in model_t else []):
         where = f"model.links[{k}]"
-        check.keys(t, where, _LINK_KEYS, required=("between",))
+        check.keys(t, where, _MODEL_LINKS_KEYS, required=("between",))
         _between(check, t["between"], f"{where}.between", n)
         for key in ("stiffness", "damping"):
             if key in t:
                 check.number(t[key], f"{where}.{key}")
-        links.append(check.build(Link, {f: f"{where}.{f}" for f in _LINK_KEYS}, **dict(t)))
+        links.append(check.build(Link, {f: f"{where}.{f}" for f in _MODEL_LINKS_KEYS}, **dict(t)))
 
     elements = []
     for k, t in enumerate(_tables(check, model_t, "elements", "model.elements")):
         where = f"model.elements[{k}]"
-        law_t = {key: v for key, v in t.items() if key not in _ELEMENT_KEYS}
+        law_t = {key: v for key, v in t.items() if key not in _MODEL_ELEMENTS_KEYS}
         for key in ("between", "stiffness"):
             if key not in t:
                 raise check.error(f"`{where}.{key}` is missing: every [[model.elements]] needs between, stiffness "
@@ -694,7 +694,7 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
     torques = []
     for k, t in enumerate(_tables(check, excitation_t, "torques", "excitation.torques")):
         where = f"excitation.torques[{k}]"
-        check.keys(t, where, _TORQUE_KEYS, required=("inertia",))
+        check.keys(t, where, _EXCITATION_TORQUES_KEYS, required=("inertia",))
         check.integer(t["inertia"], f"{where}.inertia")
         if not 1 <= t["inertia"] <= n:
             raise check.error(f"`{where}.inertia` must be an inertia number 1 … {n} (`model.inertias` has {n}), "
@@ -704,7 +704,7 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         for key in ("amplitudes", "phases"):
             if key in t:
                 check.array(t[key], f"{where}.{key}")
-        torques.append(check.build(Torque, {f: f"{where}.{f}" for f in _TORQUE_KEYS}, **dict(t)))
+        torques.append(check.build(Torque, {f: f"{where}.{f}" for f in _EXCITATION_TORQUES_KEYS}, **dict(t)))
 
     names = {"inertias": "model.inertias", "links": "model.links", "elements": "model.elements",
              "torques": "excitation.torques"}
