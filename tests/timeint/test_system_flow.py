@@ -1,0 +1,195 @@
+"""Exact integration of a System (n coordinates, m clearance elements): against the single-equation
+exact integrator, scipy's DOP853, closed forms and finite differences."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _systems import free_chain, free_pair, grounded_chain, rhs
+from scipy.integrate import solve_ivp
+
+import rattle
+from rattle.model import Linear, ReducedElement, System
+from rattle.timeint import ExactIntegrator, SystemIntegrator
+
+
+def _state(system: System) -> np.ndarray:
+    z = np.zeros(2 * system.n)
+    z[: system.n] = system.static_equilibrium()
+    return z
+
+
+@pytest.mark.parametrize("omega", [0.3, 0.8, 1.6])
+@pytest.mark.parametrize("case", ["reference", "backlash"])
+def test_one_coordinate_system_equals_exact_integrator(case, omega):
+    model = rattle.reference_case() if case == "reference" else rattle.backlash_case()
+    T = 2 * math.pi / omega
+    ref = ExactIntegrator(model).propagate([0.01, 0.0], 0.0, 20 * T, omega)
+    traj = SystemIntegrator(model.system()).propagate([0.01, 0.0], 0.0, 20 * T, omega)
+    scale = np.abs(ref.state1).max()
+    np.testing.assert_allclose(traj.state1, ref.state1, rtol=0, atol=1e-11 * scale)
+    np.testing.assert_allclose(traj.sensitivity, ref.sensitivity, rtol=0, atol=1e-11)  # a product of O(1) factors
+    assert traj.crossing_times.size == ref.crossing_times.size > 0
+    np.testing.assert_allclose(traj.crossing_times, ref.crossing_times, rtol=0, atol=1e-10)
+    np.testing.assert_array_equal(traj.crossing_breakpoints, ref.crossed_breakpoints)
+    assert np.all(traj.crossing_elements == 0)
+    t = np.linspace(0.0, 20 * T, 97)
+    np.testing.assert_allclose(traj.sample(t).deflection[:, 0], ref.sample(t).delta, rtol=0, atol=1e-11 * scale)
+    mine, theirs = traj.measures(), ref.measures()
+    for key in ("mean", "rms", "rms_ac", "delta_min", "delta_max", "p2p", "acc_min", "acc_max", "acc_p2p"):
+        assert getattr(mine, key)[0] == pytest.approx(getattr(theirs, key), rel=1e-11, abs=1e-13)
+
+
+def test_grounded_three_inertia_chain_equals_dop853():
+    system = grounded_chain()
+    omega = 0.4
+    T = 2 * math.pi / omega
+    z0 = _state(system)
+    traj = SystemIntegrator(system).propagate(z0, 0.0, 2 * T, omega)
+    assert set(traj.crossing_elements.tolist()) == {0, 1}  # both elements switch
+    t = np.linspace(0.0, 2 * T, 41)
+    ref = solve_ivp(rhs(system, omega), (0.0, 2 * T), z0, method="DOP853", rtol=1e-12, atol=1e-14,
+                    max_step=T / 50, dense_output=True)
+    scale = np.abs(ref.y).max()
+    np.testing.assert_allclose(traj.state1, ref.y[:, -1], rtol=0, atol=1e-8 * scale)
+    s = traj.sample(t)
+    np.testing.assert_allclose(np.concatenate((s.x, s.velocity), axis=1), ref.sol(t).T, rtol=0, atol=1e-8 * scale)
+    # the acceleration from the closed form equals the equation of motion
+    acc = system.forcing(t, omega) - s.velocity @ system.damping.T - system.restoring(s.x)
+    np.testing.assert_allclose(s.acceleration, acc, rtol=0, atol=1e-12 * np.abs(acc).max())
+    # every crossing puts the element exactly on a breakpoint of its law
+    at = traj.deflections(traj.crossing_times, order=0)[0]
+    hit = at[np.arange(traj.crossing_times.size), traj.crossing_elements]
+    np.testing.assert_allclose(hit, traj.crossing_breakpoints, rtol=0, atol=1e-13)
+
+
+def test_free_chain_with_defective_gap_stage_equals_dop853():
+    """Inside the gear gap the free chain has an undamped rigid relative mode (a defective zero
+    eigenvalue of the stage matrix, plus the mean torque: parabolas)."""
+    system = free_chain()
+    omega = 0.5
+    T = 2 * math.pi / omega
+    z0 = _state(system)
+    traj = SystemIntegrator(system).propagate(z0, 0.0, 2 * T, omega)
+    gaps = [i for i in range(traj.n_segments) if traj.stages[i, 1] == 1]
+    assert gaps and set(traj.crossing_elements.tolist()) == {0, 1}
+    assert np.abs(np.linalg.eigvals(traj.segments[gaps[0]].sol.A)).min() == pytest.approx(0.0, abs=1e-12)
+    ref = solve_ivp(rhs(system, omega), (0.0, 2 * T), z0, method="DOP853", rtol=1e-13, atol=1e-15,
+                    max_step=T / 200, dense_output=True)
+    t = np.linspace(0.0, 2 * T, 41)
+    s = traj.sample(t)
+    scale = np.abs(ref.y).max()
+    np.testing.assert_allclose(np.concatenate((s.x, s.velocity), axis=1), ref.sol(t).T, rtol=0, atol=1e-8 * scale)
+
+
+@pytest.mark.parametrize("damping", [0.0, 0.04])
+def test_free_pair_inside_the_gap_is_the_closed_form(damping):
+    """Two free inertias inside a wide backlash gap: x'' + c x' = F0 + F1 cos Ωt exactly (a parabola
+    when c = 0, a ramp with a decaying exponential when c > 0)."""
+    system = free_pair(damping, mean=0.01)
+    omega = 1.3
+    c, F0, F1 = 1.5 * damping, float(system.mean[0]), float(system.cos[0, 0])
+    x0, v0 = -0.2, 0.05
+    t1 = 4.0
+    traj = SystemIntegrator(system).propagate([x0, v0], 0.0, t1, omega)
+    assert traj.crossing_times.size == 0
+    t = np.linspace(0.0, t1, 33)
+    if c == 0.0:
+        x = x0 + v0 * t + 0.5 * F0 * t**2 + F1 * (1 - np.cos(omega * t)) / omega**2
+        v = v0 + F0 * t + F1 * np.sin(omega * t) / omega
+    else:
+        X = F1 / (-(omega**2) + 1j * c * omega)  # harmonic part Re(X e^{iΩt})
+        xp0, vp0 = X.real, (1j * omega * X).real
+        # x = A + B e^{−ct} + (F0/c) t + Re(X e^{iΩt})
+        B = -(v0 - vp0 - F0 / c) / c
+        A = x0 - xp0 - B
+        x = A + B * np.exp(-c * t) + F0 / c * t + (X * np.exp(1j * omega * t)).real
+        v = -c * B * np.exp(-c * t) + F0 / c + (1j * omega * X * np.exp(1j * omega * t)).real
+    s = traj.sample(t)
+    np.testing.assert_allclose(s.x[:, 0], x, rtol=0, atol=1e-14 * 8)
+    np.testing.assert_allclose(s.velocity[:, 0], v, rtol=0, atol=1e-14 * 8)
+    # and it leaves the gap through the upper breakpoint when integrated further
+    longer = SystemIntegrator(system).propagate([x0, v0], 0.0, 20.0, omega)
+    assert longer.crossing_times.size >= 1 and longer.crossing_breakpoints[0] == 0.5
+
+
+@pytest.mark.parametrize("which", ["grounded", "free", "single"])
+def test_sensitivity_equals_central_differences(which):
+    system = {"grounded": grounded_chain(), "free": free_chain(),
+              "single": rattle.reference_case().system()}[which]
+    omega = 0.8
+    T = 2 * math.pi / omega
+    z0 = _state(system) + 0.01
+    integ = SystemIntegrator(system)
+    traj = integ.propagate(z0, 0.0, T, omega)
+    assert traj.crossing_times.size > 0
+    h = 1e-6
+    fd = np.empty_like(traj.sensitivity)
+    for j in range(z0.size):
+        dz = np.zeros_like(z0)
+        dz[j] = h
+        fd[:, j] = (integ.propagate(z0 + dz, 0.0, T, omega).state1 - integ.propagate(z0 - dz, 0.0, T, omega).state1) / (2 * h)
+    np.testing.assert_allclose(traj.sensitivity, fd, rtol=0, atol=1e-6 * np.abs(fd).max())
+    # advance (no record) gives the same state and sensitivity
+    z1, M = integ.advance(z0, 0.0, T, omega)
+    np.testing.assert_array_equal(z1, traj.state1)
+    np.testing.assert_array_equal(M, traj.sensitivity)
+
+
+def test_composition_of_intervals():
+    system = grounded_chain()
+    omega = 1.0
+    integ = SystemIntegrator(system)
+    z0 = _state(system)
+    whole = integ.propagate(z0, 0.0, 9.0, omega)
+    first = integ.propagate(z0, 0.0, 4.0, omega)
+    second = integ.propagate(first.state1, 4.0, 9.0, omega)
+    np.testing.assert_allclose(second.state1, whole.state1, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(second.sensitivity @ first.sensitivity, whole.sensitivity, rtol=0, atol=1e-11)
+
+
+def test_linear_system_without_crossings_over_many_periods():
+    """A linear element (no breakpoint): one stage, long segments cut and continued, exact."""
+    system = System(damping=np.array([[0.1]]), stiffness=np.zeros((1, 1)),
+                    elements=(ReducedElement("lin", np.array([1.0]), np.array([4.0]), Linear()),),
+                    mean=np.array([0.2]), cos=np.array([[0.3]]), sin=np.array([[0.1]]), coordinates=("x",),
+                    angles=np.array([[1.0], [0.0]]), free=True)
+    omega = 1.0
+    t1 = 200 * 2 * math.pi
+    traj = SystemIntegrator(system).propagate([0.0, 0.0], 0.0, t1, omega)
+    X = (0.3 - 0.1j) / (4.0 - omega**2 + 0.1j * omega)  # steady state: the transient is gone
+    assert traj.state1[0] == pytest.approx(0.05 + (X * np.exp(1j * omega * t1)).real, abs=1e-12)
+    assert traj.crossing_times.size == 0
+
+
+def test_resonant_undamped_stage_is_refused():
+    system = System(damping=np.zeros((1, 1)), stiffness=np.zeros((1, 1)),
+                    elements=(ReducedElement("lin", np.array([1.0]), np.array([4.0]), Linear()),),
+                    mean=np.zeros(1), cos=np.array([[0.3]]), sin=np.zeros((1, 1)), coordinates=("x",),
+                    angles=np.array([[1.0], [0.0]]), free=True)
+    with pytest.raises(ValueError, match="resonance"):
+        SystemIntegrator(system).propagate([0.0, 0.0], 0.0, 1.0, 2.0)
+
+
+def test_input_checks_name_the_argument():
+    system = grounded_chain()
+    integ = SystemIntegrator(system)
+    with pytest.raises(ValueError, match="`z0`.*shape \\(6,\\)"):
+        integ.propagate([0.0, 0.0], 0.0, 1.0, 1.0)
+    with pytest.raises(ValueError, match="`z0`"):
+        integ.propagate([0.0] * 5 + [math.nan], 0.0, 1.0, 1.0)
+    with pytest.raises(TypeError, match="`z0`"):
+        integ.propagate("zero", 0.0, 1.0, 1.0)
+    with pytest.raises(ValueError, match="`omega`"):
+        integ.propagate(np.zeros(6), 0.0, 1.0, 0.0)
+    with pytest.raises(ValueError, match="`t0` and `t1`"):
+        integ.propagate(np.zeros(6), 1.0, 0.0, 1.0)
+    with pytest.raises(TypeError, match="`system`"):
+        SystemIntegrator(rattle.reference_case())
+    with pytest.raises(ValueError, match="`samples_per_scale`"):
+        SystemIntegrator(system, samples_per_scale=2)
+    traj = integ.propagate(np.zeros(6), 0.0, 1.0, 1.0)
+    with pytest.raises(ValueError, match="`t`"):
+        traj.sample(2.0)
