@@ -1,15 +1,18 @@
 """Stability of periodic solutions: exact monodromy along the HB orbit, Hill's method, labels."""
 
-from ._classify import UNIT_CIRCLE_TOL, classify_loss, is_stable
+from ._classify import COMPLEX_TOL, UNIT_CIRCLE_TOL, classify_loss, critical_distance, is_stable, torus_ratio
 from ._floquet import (
-    crossing_times, crossing_times_batch, monodromy, monodromy_and_crossings_batch, monodromy_batch,
-    multipliers_from_monodromy,
-    stage_transition,
+    TEST_FUNCTIONS, crossing_times, crossing_times_batch, element_monodromy_batch, floquet_test_functions, monodromy,
+    monodromy_and_crossings_batch, monodromy_batch, multipliers_from_monodromy, second_compound, stage_transition,
+    system_monodromy_batch,
 )
 from ._hill import hill_exponents, hill_multipliers
-from ._monitor import FloquetMonitor
+from ._monitor import FloquetMonitor, hb_system
 
 __all__ = [
-    "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch", "monodromy_and_crossings_batch", "multipliers_from_monodromy",
-    "hill_exponents", "hill_multipliers", "FloquetMonitor", "is_stable", "classify_loss", "UNIT_CIRCLE_TOL",
+    "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
+    "monodromy_and_crossings_batch", "element_monodromy_batch", "system_monodromy_batch",
+    "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "TEST_FUNCTIONS",
+    "hill_exponents", "hill_multipliers", "FloquetMonitor", "hb_system",
+    "is_stable", "classify_loss", "torus_ratio", "critical_distance", "UNIT_CIRCLE_TOL", "COMPLEX_TOL",
 ]

@@ -1,25 +1,45 @@
 """Floquet multipliers of a harmonic-balance orbit from the exact monodromy of its linearisation.
 
-Around a periodic orbit δ(t) the variational equation is
+For a :class:`~rattle.model.System` x'' + C x' + K x + Σ_e b_e f_e(a_e·x) = F(t) the variational
+equation about a periodic orbit x(t) is, in first-order form z = (y, y'),
 
-    y'' + c y' + k f'(δ(t)) y = 0,
+    z' = A(t) z,     A(t) = A_s = [[0, I], [−K_s, −C]],  K_s = K + Σ_e k_{e,s_e} b_e a_eᵀ,
 
-and for a piecewise-linear law f'(δ(t)) = s_j is piecewise constant in time: it switches where
-δ(t) crosses a breakpoint. Because f is continuous the vector field is continuous across the
-switching surface, so the saltation matrix is the identity and the monodromy is exactly
+where s = (s_1 … s_m) is the stage combination at time t: element e is on the stage of its law
+holding its deflection δ_e(t) = a_e·x(t). For piecewise-linear laws A(t) is piecewise constant: it
+switches where some δ_e(t) crosses one of ITS breakpoints. Because every law is continuous the
+vector field is continuous across each switching surface, so the saltation matrices are the
+identity and the monodromy (2n × 2n) is exactly
 
-    M = Φ_m(Δt_m) ⋯ Φ_1(Δt_1),     Φ_j(τ) = exp(A_j τ),  A_j = [[0, 1], [−k s_j, −c]],
+    M = Φ_S(τ_S) ⋯ Φ_1(τ_1),     Φ_j(τ) = exp(A_{s_j} τ),
 
-over the segments between successive crossings. The crossing times of the HB orbit are found
-on its N samples and refined to round-off by safeguarded Newton on the Fourier series.
+over the segments between successive crossings of all elements (merged and sorted per orbit);
+the stage combination of a segment is read from the deflections at its mid-point. The crossing
+times of each element's deflection series are found on its samples and refined to round-off by
+Newton (safeguarded where needed) on the Fourier series.
+
+One core serves every size: for n = 1 (the single equation, A_j = [[0, 1], [−κ_j, −c]])
+exp(A τ) is the closed form :func:`stage_transition`; for n > 1 each stage combination met is
+diagonalised once, exp(A τ) = V diag(e^{λτ}) V⁻¹ for all its segments, and a combination whose
+eigenvector matrix is ill-conditioned (near-defective, e.g. a critically damped mode) goes
+through ``scipy.linalg.expm`` instead. (``rattle.timeint._exact`` keeps a second closed form of
+the 2 × 2 exponential, with the particular solutions it needs; issue 8 wants them merged.)
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
+import scipy.linalg
 
 from .._typing import ComplexArray, FloatArray
 from ..hb import FourierBasis
+from ..model import System
+
+#: A stage combination whose eigenvector matrix has a condition number above this goes through
+#: ``scipy.linalg.expm`` instead of V diag(e^{λτ}) V⁻¹ (whose relative error is ~ cond · eps).
+EIG_CONDITION_LIMIT = 1e4
 
 
 def stage_transition(stiffness: FloatArray, damping: float, tau: FloatArray) -> FloatArray:
@@ -73,36 +93,35 @@ def _series(Q: FloatArray, kw: FloatArray, t: FloatArray) -> tuple[FloatArray, F
     return delta, vel
 
 
-def crossing_times_batch(
+def _crossings(
     Q: FloatArray, omega: FloatArray, samples: FloatArray, levels: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Crossings of many series at once.
-
-    ``Q`` (P, 2H+1) coefficient rows, ``omega`` (P,) base frequencies, ``samples`` (P, N) their
-    samples at t_j = j T_p / N, ``levels`` (k,) breakpoints. Sign changes of δ − d between
-    successive samples bracket each crossing; Newton from the interpolated samples refines it to
-    round-off, and where it does not converge inside the bracket (ripples of the series near a
-    kink) Newton safeguarded by Illinois regula falsi and bisection does (δ is C²).
-
-    Returns (point index, crossing time in [0, T_p), level), sorted by point then time.
-    """
+) -> tuple[np.ndarray, FloatArray, FloatArray, np.ndarray]:
+    """:func:`crossing_times_batch` with per-row levels; also returns each crossing's level column."""
     P, N = samples.shape
     H = (Q.shape[1] - 1) // 2
-    pts, idxs, lvls = [], [], []
-    for d in np.atleast_1d(levels):
-        s = samples > d
+    levels = np.asarray(levels, dtype=float)
+    per_row = levels.ndim == 2
+    if not per_row:
+        levels = np.atleast_1d(levels)
+    k = levels.shape[-1]
+    pts, idxs, lvls, cols = [], [], [], []
+    for i in range(k):
+        d = levels[:, i] if per_row else levels[i]
+        s = samples > (d[:, None] if per_row else d)  # a NaN level (padding) never changes sign
         change = s != np.roll(s, -1, axis=1)
         p, j = np.nonzero(change)
         pts.append(p)
         idxs.append(j)
-        lvls.append(np.full(p.size, d))
+        lvls.append(d[p] if per_row else np.full(p.size, d))
+        cols.append(np.full(p.size, i))
     if not pts:
-        return np.empty(0, dtype=int), np.empty(0), np.empty(0)
+        return np.empty(0, dtype=int), np.empty(0), np.empty(0), np.empty(0, dtype=int)
     p = np.concatenate(pts)
     j = np.concatenate(idxs)
     lvl = np.concatenate(lvls)
+    col = np.concatenate(cols)
     if p.size == 0:
-        return p, np.empty(0), lvl
+        return p, np.empty(0), lvl, col
     T = 2 * np.pi / omega[p]
     dt = T / N
     fa = samples[p, j] - lvl
@@ -163,9 +182,193 @@ def crossing_times_batch(
             break
     t = np.mod(t, T)
     order = np.lexsort((t, p))
-    return p[order], t[order], lvl[order]
+    return p[order], t[order], lvl[order], col[order]
 
 
+def crossing_times_batch(
+    Q: FloatArray, omega: FloatArray, samples: FloatArray, levels: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Crossings of many series at once.
+
+    ``Q`` (P, 2H+1) coefficient rows, ``omega`` (P,) base frequencies, ``samples`` (P, N) their
+    samples at t_j = j T_p / N, ``levels`` (k,) breakpoints shared by all rows, or (P, k) one
+    set per row (NaN pads rows with fewer levels). Sign changes of δ − d between
+    successive samples bracket each crossing; Newton from the interpolated samples refines it to
+    round-off, and where it does not converge inside the bracket (ripples of the series near a
+    kink) Newton safeguarded by Illinois regula falsi and bisection does (δ is C²).
+
+    Returns (row index, crossing time in [0, T_p), level), sorted by row then time.
+    """
+    p, t, lvl, _ = _crossings(Q, omega, samples, levels)
+    return p, t, lvl
+
+
+# --- the one core: segments between the crossings of all elements ---------------------------
+def _padded_levels(breakpoints: Sequence[FloatArray]) -> FloatArray:
+    """Breakpoints of m elements as an (m, k_max) array padded with NaN."""
+    kmax = max((len(b) for b in breakpoints), default=0)
+    out = np.full((len(breakpoints), kmax), np.nan)
+    for e, b in enumerate(breakpoints):
+        out[e, : len(b)] = b
+    return out
+
+
+def _segments(
+    S: FloatArray, omega: FloatArray, samples: FloatArray, breakpoints: Sequence[FloatArray]
+) -> tuple[FloatArray, np.ndarray, np.ndarray]:
+    """Segments of each orbit between the crossings of all its elements.
+
+    ``S`` (P, m, 2H+1) element deflection series, ``omega`` (P,), ``samples`` (P, m, N) their
+    samples, ``breakpoints`` one sorted array per element. Returns ``tau`` (P, G) the segment
+    durations (padded with zero-length segments), ``combo`` (P, G) the flat index of each
+    segment's stage combination (mixed radix over the elements' stage counts, first element
+    most significant) and ``counts`` (P, m, k_max) the crossings per element per breakpoint.
+    """
+    P, m, n_coef = S.shape
+    H = (n_coef - 1) // 2
+    T = 2 * np.pi / omega
+    levels = _padded_levels(breakpoints)
+    kmax = levels.shape[1]
+    counts_pb = np.zeros((P, m, kmax), dtype=int)
+    if m == 1:  # one element: one set of levels for all rows, rows = points (sorted by time)
+        p, t, _, col = _crossings(S[:, 0], omega, samples[:, 0], levels[0])
+        if p.size:
+            np.add.at(counts_pb, (p, 0, col), 1)
+    else:
+        rows, t, _, col = _crossings(S.reshape(P * m, n_coef), np.repeat(omega, m),
+                                     samples.reshape(P * m, -1), np.tile(levels, (P, 1)))
+        p, e = np.divmod(rows, m)
+        if p.size:
+            np.add.at(counts_pb, (p, e, col), 1)
+        order = np.lexsort((t, p))
+        p, t = p[order], t[order]
+    counts = np.bincount(p, minlength=P)
+    G = int(counts.max()) + 1 if P else 1
+    # Segment edges per point, padded with T (zero-length segments give the identity).
+    edges = np.repeat(T[:, None], G + 1, axis=1)
+    edges[:, 0] = 0.0
+    rank = np.arange(p.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    edges[p, rank + 1] = t
+    tau = np.diff(edges, axis=1)  # (P, G)
+    mids = 0.5 * (edges[:, :-1] + edges[:, 1:])
+    kw = np.arange(1, H + 1)[None, None, :] * omega[:, None, None]
+    ph = kw * mids[:, :, None]
+    c, s = np.cos(ph), np.sin(ph)
+    combo = np.zeros((P, G), dtype=np.intp)
+    for e, bp in enumerate(breakpoints):
+        delta_mid = (
+            S[:, None, e, 0]
+            + np.einsum("psh,ph->ps", c, S[:, e, 1 : H + 1])
+            + np.einsum("psh,ph->ps", s, S[:, e, H + 1 :])
+        )
+        stage = np.searchsorted(bp, delta_mid, side="right")
+        combo = combo * (len(bp) + 1) + stage if e else stage
+    return tau, combo, counts_pb
+
+
+def _chain_product(phis: FloatArray) -> FloatArray:
+    """Φ_G ⋯ Φ_1 of (P, G, k, k) transitions."""
+    M = phis[:, 0]
+    for s in range(1, phis.shape[1]):
+        M = phis[:, s] @ M
+    return M
+
+
+def _combination(system: System, flat: int) -> tuple[int, ...]:
+    """The stage combination (one stage per element) of a flat mixed-radix index."""
+    out = []
+    for c in reversed(system.stage_counts()):
+        flat, s = divmod(flat, c)
+        out.append(s)
+    return tuple(reversed(out))
+
+
+def _stage_exponentials(system: System, combo: np.ndarray, tau: FloatArray, cache: dict | None = None) -> FloatArray:
+    """exp(A_s τ) (..., 2n, 2n) for the flat stage combinations ``combo`` and durations ``tau``.
+
+    n = 1: the closed form :func:`stage_transition`. n > 1: per combination met, its eigen-
+    decomposition (cached in ``cache``, keyed by combination) and V diag(e^{λτ}) V⁻¹; where V is
+    ill-conditioned (``EIG_CONDITION_LIMIT``), ``scipy.linalg.expm`` of the stacked A_s τ.
+    """
+    n = system.n
+    cache = {} if cache is None else cache
+    if n == 1:
+        key = ("kappa",)
+        kappa = cache.get(key)
+        if kappa is None:
+            total = int(np.prod(system.stage_counts()))
+            kappa = np.array([system.stage_stiffness(_combination(system, i))[0, 0] for i in range(total)])
+            cache[key] = kappa
+        return stage_transition(kappa[combo], float(system.damping[0, 0]), tau)
+    out = np.empty(combo.shape + (2 * n, 2 * n))
+    for u in np.unique(combo):
+        entry = cache.get(int(u))
+        if entry is None:
+            A = system.stage_matrix(_combination(system, int(u)))
+            lam, V = np.linalg.eig(A)
+            try:
+                cond = np.linalg.cond(V)
+                Vinv = np.linalg.inv(V)
+            except np.linalg.LinAlgError:
+                cond, Vinv = np.inf, None
+            entry = (A, lam, V, Vinv) if cond <= EIG_CONDITION_LIMIT else (A, None, None, None)
+            cache[int(u)] = entry
+        A, lam, V, Vinv = entry
+        sel = combo == u
+        tu = tau[sel]
+        if lam is None:
+            out[sel] = scipy.linalg.expm(A[None, :, :] * tu[:, None, None])
+        else:
+            with np.errstate(over="ignore", invalid="ignore"):
+                E = (V[None, :, :] * np.exp(np.multiply.outer(tu, lam))[:, None, :]) @ Vinv
+            out[sel] = E.real
+    return out
+
+
+def element_monodromy_batch(
+    system: System, S: FloatArray, omega: FloatArray, samples: FloatArray | None = None,
+    n_samples: int | None = None, cache: dict | None = None,
+) -> tuple[FloatArray, np.ndarray]:
+    """Exact monodromies about orbits given by their element deflection series.
+
+    ``S`` (P, m, 2H+1) the deflection series δ_e = a_e·x of every element ([a_0, a_1..a_H,
+    b_1..b_H], FourierBasis convention), ``omega`` (P,) base frequencies (period 2π/ω),
+    ``samples`` (P, m, N) their samples at t_j = j T / N (synthesised with ``n_samples`` points,
+    default 4(2H+1) rounded up to a power of two, when not given), ``cache`` an optional dict
+    keeping the stage combinations' decompositions between calls for the same ``system``.
+
+    Returns ``M`` (P, 2n, 2n) and ``crossings`` (P, m, k_max) the crossings of each element's
+    breakpoint j per period (zero where element e has fewer breakpoints than k_max): the orbit's
+    crossing structure, which changes where it grazes a breakpoint.
+    """
+    S = np.asarray(S, dtype=float)
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    if S.ndim != 3 or S.shape[1] != system.m or S.shape[2] % 2 != 1:
+        raise ValueError(f"`S` must have shape (P, m={system.m}, 2H+1), got {S.shape}")
+    if samples is None:
+        H = (S.shape[2] - 1) // 2
+        N = n_samples or int(2 ** np.ceil(np.log2(4 * (2 * H + 1))))
+        samples = FourierBasis(H, N).synthesize(S)
+    tau, combo, counts = _segments(S, omega, samples, [e.breakpoints for e in system.elements])
+    return _chain_product(_stage_exponentials(system, combo, tau, cache)), counts
+
+
+def system_monodromy_batch(
+    system: System, X: FloatArray, omega: FloatArray, n_samples: int | None = None, cache: dict | None = None,
+) -> tuple[FloatArray, np.ndarray]:
+    """Exact monodromies (P, 2n, 2n) and crossings (P, m, k_max) about orbits given by their
+    coordinate series ``X`` (P, n, 2H+1) (or (P, n·(2H+1)) coordinate-major rows); see
+    :func:`element_monodromy_batch`."""
+    X = np.asarray(X, dtype=float)
+    if X.ndim == 2:
+        X = X.reshape(X.shape[0], system.n, -1)
+    if X.ndim != 3 or X.shape[1] != system.n:
+        raise ValueError(f"`X` must have shape (P, n={system.n}, 2H+1), got {X.shape}")
+    S = np.einsum("en,pnk->pek", system.element_rows, X)
+    return element_monodromy_batch(system, S, omega, n_samples=n_samples, cache=cache)
+
+
+# --- the single-element API (the n = m = 1 case of the core) ---------------------------------
 def monodromy_batch(
     Q: FloatArray,
     omega: FloatArray,
@@ -192,38 +395,14 @@ def monodromy_and_crossings_batch(
     damping: float,
 ) -> tuple[FloatArray, np.ndarray]:
     """:func:`monodromy_batch` and the number of crossings of each breakpoint per period,
-    shape (P, k): the orbit's crossing structure, which changes where it grazes a breakpoint."""
-    P = Q.shape[0]
-    H = (Q.shape[1] - 1) // 2
-    T = 2 * np.pi / omega
-    levels = np.atleast_1d(np.asarray(stage_breakpoints, dtype=float))
-    p, t, lvl = crossing_times_batch(Q, omega, samples, levels)
-    per_level = np.zeros((P, levels.size), dtype=int)
-    if p.size:
-        np.add.at(per_level, (p, np.searchsorted(levels, lvl)), 1)
-    counts = np.bincount(p, minlength=P)
-    n_seg = counts + 1
-    S = int(n_seg.max())
-    # Segment edges per point, padded with T (zero-length segments give the identity).
-    edges = np.repeat(T[:, None], S + 1, axis=1)
-    edges[:, 0] = 0.0
-    rank = np.arange(p.size) - np.repeat(np.cumsum(counts) - counts, counts)
-    edges[p, rank + 1] = t
-    tau = np.diff(edges, axis=1)  # (P, S)
-    mids = 0.5 * (edges[:, :-1] + edges[:, 1:])
-    kw = np.arange(1, H + 1)[None, None, :] * omega[:, None, None]
-    ph = kw * mids[:, :, None]
-    delta_mid = (
-        Q[:, None, 0]
-        + np.einsum("psh,ph->ps", np.cos(ph), Q[:, 1 : H + 1])
-        + np.einsum("psh,ph->ps", np.sin(ph), Q[:, H + 1 :])
-    )
-    stage = np.searchsorted(stage_breakpoints, delta_mid, side="right")
-    phis = stage_transition(stage_stiffness[stage], damping, tau)  # (P, S, 2, 2)
-    M = phis[:, 0]
-    for s in range(1, S):
-        M = phis[:, s] @ M
-    return M, per_level
+    shape (P, k): the orbit's crossing structure, which changes where it grazes a breakpoint.
+    (The single-element case of :func:`element_monodromy_batch`, stage stiffnesses given.)"""
+    bp = np.atleast_1d(np.asarray(stage_breakpoints, dtype=float))
+    tau, combo, counts = _segments(Q[:, None, :], omega, samples[:, None, :], [bp])
+    phis = stage_transition(np.asarray(stage_stiffness, dtype=float)[combo], damping, tau)
+    return _chain_product(phis), counts[:, 0]
+
+
 
 
 def crossing_times(
@@ -250,12 +429,23 @@ def monodromy(
     return monodromy_batch(q[None, :], np.array([omega]), x[None, :], stage_breakpoints, stage_stiffness, damping)[0]
 
 
+# --- multipliers and test functions ----------------------------------------------------------
 def multipliers_from_monodromy(M: FloatArray) -> ComplexArray:
-    """Eigenvalues of monodromy matrices (..., 2, 2), sorted by modulus, largest first (..., 2).
+    """Eigenvalues of monodromy matrices (..., k, k), sorted by modulus, largest first (..., k).
 
-    Closed form for 2×2: μ = tr/2 ± sqrt(tr²/4 − det); real pairs stay exactly real.
+    Closed form for 2×2: μ = tr/2 ± sqrt(tr²/4 − det); real pairs stay exactly real. Larger
+    matrices: LAPACK (real multipliers come out with Im μ = 0 exactly, complex ones in conjugate
+    pairs).
     """
     M = np.asarray(M, dtype=float)
+    if M.shape[-1] != 2:
+        with np.errstate(invalid="ignore"):
+            finite = np.all(np.isfinite(M), axis=(-2, -1))
+            mu = np.full(M.shape[:-1], np.nan, dtype=complex)
+            if np.any(finite):
+                mu[finite] = np.linalg.eigvals(M[finite])
+        order = np.argsort(-np.abs(mu), axis=-1, kind="stable")
+        return np.take_along_axis(mu, order, axis=-1)
     tr = M[..., 0, 0] + M[..., 1, 1]
     det = M[..., 0, 0] * M[..., 1, 1] - M[..., 0, 1] * M[..., 1, 0]
     disc = 0.25 * tr**2 - det
@@ -272,7 +462,45 @@ def multipliers_from_monodromy(M: FloatArray) -> ComplexArray:
     return np.take_along_axis(mu, order, axis=-1)
 
 
+def second_compound(M: FloatArray) -> FloatArray:
+    """The bialternate product M ⊙ M (the second compound matrix) of (..., k, k) matrices:
+    entry ((i, j), (r, s)), i < j, r < s, is the 2 × 2 minor m_ir m_js − m_is m_jr; shape
+    (..., k(k−1)/2, k(k−1)/2). Its eigenvalues are the products μ_i μ_j (i < j) of M's."""
+    M = np.asarray(M, dtype=float)
+    i, j = np.triu_indices(M.shape[-1], 1)
+    a = M[..., i[:, None], i[None, :]] * M[..., j[:, None], j[None, :]]
+    b = M[..., i[:, None], j[None, :]] * M[..., j[:, None], i[None, :]]
+    return a - b
+
+
+#: Names of the test functions of :func:`floquet_test_functions`, in order (the last only for n ≥ 2).
+TEST_FUNCTIONS = ("fold", "period_doubling", "neimark_sacker")
+
+
+def floquet_test_functions(M: FloatArray) -> FloatArray:
+    """Floquet test functions of monodromies (..., 2n, 2n), shape (..., 2) for n = 1, (..., 3) else:
+
+        ψ_fold = det(M − I) = Π (μ_k − 1),    ψ_pd = det(M + I) = Π (μ_k + 1),
+        ψ_ns = det(M ⊙ M − I) = Π_{i<j} (μ_i μ_j − 1)    (n ≥ 2 only),
+
+    zero at a fold (μ = 1), a period doubling (μ = −1) and a Neimark–Sacker point (μ = e^{±iθ}:
+    μ μ̄ = 1) — ψ_ns also vanishes at a neutral saddle (real μ_i μ_j = 1), which
+    :func:`~rattle.stability.classify_loss` tells apart. For n = 1, det M = e^{−cT} < 1 and no
+    pair reaches the circle: only ψ_fold, ψ_pd.
+    """
+    M = np.asarray(M, dtype=float)
+    k = M.shape[-1]
+    eye = np.eye(k)
+    with np.errstate(over="ignore", invalid="ignore"):
+        parts = [np.linalg.det(M - eye), np.linalg.det(M + eye)]
+        if k > 2:
+            B = second_compound(M)
+            parts.append(np.linalg.det(B - np.eye(B.shape[-1])))
+    return np.stack(parts, axis=-1)
+
+
 __all__ = [
     "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
-    "monodromy_and_crossings_batch", "multipliers_from_monodromy",
+    "monodromy_and_crossings_batch", "element_monodromy_batch", "system_monodromy_batch",
+    "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "TEST_FUNCTIONS", "EIG_CONDITION_LIMIT",
 ]

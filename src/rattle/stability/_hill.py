@@ -16,6 +16,19 @@ is still fragile: a real multiplier's exponent and its conjugate are copies of e
 (at period doubling both sit at centroid ±½). For the single-DOF equation we therefore take
 only the best-centred exponent λ_1 and obtain the other from Liouville's formula: every stage
 matrix has trace −c, so λ_1 + λ_2 = −c (mod iω) and μ_2 = e^{−cT} / μ_1 exactly.
+
+For a :class:`~rattle.model.System` of n ≥ 2 coordinates (q coordinate-major, n blocks of
+2H + 1) the same problem reads
+
+    (λ² I + λ (2 I_n ⊗ ∇ + C ⊗ I) + J) Y = 0,
+    J = I_n ⊗ ∇² + C ⊗ ∇ + K ⊗ I + Σ_e (b_e a_eᵀ) ⊗ Γ* diag(f_e'(δ_e(t_j))) Γ,
+
+J the HB Jacobian ∂R/∂q, built here from the System and the element stiffness samples (the
+check does not depend on how the HB problem assembles or condenses its own). 2n exponents are
+physical; they are chosen by eigenvector centroid (|centroid| smallest first), skipping every
+candidate that is a copy λ + i m ω (m ≠ 0) of one already taken. An exponent whose phase Im λ T
+lies within ``REAL_PHASE_TOL`` of 0 or π stands for a real multiplier (±e^{Re λ T}, one slot);
+any other brings its complex conjugate (a pair, two slots).
 """
 
 from __future__ import annotations
@@ -24,16 +37,128 @@ import numpy as np
 import scipy.linalg
 
 from .._typing import ComplexArray, FloatArray
-from ..hb import HarmonicBalance
+from ..hb import FourierBasis, HarmonicBalance
+from ..model import System
+
+#: Phase distance (rad) of Im λ T from 0 or π under which a Hill exponent (n ≥ 2) is taken as a
+#: real multiplier: Hill's truncation error in Im λ T is ~1e-3 at H = 16–32 for a stiffness
+#: that jumps in time.
+REAL_PHASE_TOL = 0.02
+
+
+def _system_of(hb: HarmonicBalance) -> System:
+    system = getattr(hb, "system", None)
+    return system if system is not None else hb.model.system()
+
+
+def _synthesis(basis: FourierBasis) -> tuple[FloatArray, FloatArray]:
+    """Γ (N, 2H+1) synthesis and Γ* (2H+1, N) analysis matrices of the real basis."""
+    H, N = basis.harmonics, basis.samples
+    ph = np.outer(2 * np.pi * np.arange(N) / N, basis.k)
+    G = np.concatenate([np.ones((N, 1)), np.cos(ph), np.sin(ph)], axis=1)
+    Gs = G.T * (2.0 / N)
+    Gs[0] = 1.0 / N
+    return G, Gs
+
+
+def system_hill_matrices(system: System, basis: FourierBasis, X: FloatArray, w: float) -> tuple[FloatArray, FloatArray]:
+    """The HB Jacobian J = ∂R/∂q and the λ-coefficient D = 2 I_n ⊗ ∇ + C ⊗ I, both
+    (n(2H+1), n(2H+1)) coordinate-major, of the orbit with coordinate series ``X`` (n, 2H+1)
+    at base frequency ``w`` (module docstring)."""
+    X = np.asarray(X, dtype=float).reshape(system.n, basis.size)
+    n, N = system.n, basis.size
+    G, Gs = _synthesis(basis)
+    nabla = basis.derivative_matrix(w)
+    eye = np.eye(N)
+    J = np.kron(np.eye(n), nabla @ nabla) + np.kron(system.damping, nabla) + np.kron(system.stiffness, eye)
+    deltas = system.element_rows @ X  # (m, 2H+1)
+    for e, el in enumerate(system.elements):
+        d = G @ deltas[e]
+        g = el.slopes[np.searchsorted(el.breakpoints, d, side="right")]
+        J += np.kron(np.outer(el.b, el.a), Gs @ (g[:, None] * G))
+    D = 2.0 * np.kron(np.eye(n), nabla) + np.kron(system.damping, eye)
+    return J, D
+
+
+def _centroids(vec: ComplexArray, n: int, H: int) -> FloatArray:
+    """Σ k |Y_k|² / Σ |Y_k|² of eigenvectors (columns of ``vec``, first n(2H+1) rows the
+    displacement part, coordinate-major), summed over the coordinates."""
+    Y = vec[: n * (2 * H + 1)].reshape(n, 2 * H + 1, -1)
+    a, b = Y[:, 1 : H + 1], Y[:, H + 1 :]
+    # Complex harmonic amplitudes of e^{ikωt}: k > 0 ↔ (a − i b)/2, k < 0 ↔ (a + i b)/2.
+    w_pos = np.abs(0.5 * (a - 1j * b)) ** 2
+    w_neg = np.abs(0.5 * (a + 1j * b)) ** 2
+    k = np.arange(1, H + 1)[None, :, None]
+    total = np.sum(np.abs(Y[:, 0]) ** 2, axis=0) + np.sum(w_pos + w_neg, axis=(0, 1))
+    return np.sum(k * (w_pos - w_neg), axis=(0, 1)) / total
+
+
+def system_hill_exponents(system: System, basis: FourierBasis, X: FloatArray, w: float) -> ComplexArray:
+    """The 2n physical Floquet exponents λ of the orbit ``X`` (n, 2H+1) of base frequency ``w``
+    (module docstring: eigenvector-centroid selection, copies skipped, conjugates paired),
+    Im λ in (−ω/2, ω/2]."""
+    n, H = system.n, basis.harmonics
+    J, D = system_hill_matrices(system, basis, X, w)
+    size = J.shape[0]
+    A = np.zeros((2 * size, 2 * size))
+    A[:size, size:] = np.eye(size)
+    A[size:, :size] = -J
+    A[size:, size:] = -D
+    lam, vec = scipy.linalg.eig(A, check_finite=False)
+    centroid = _centroids(vec, n, H)
+    T = 2 * np.pi / w
+    # Fold every exponent into the fundamental strip Im λ ∈ (−ω/2, ω/2].
+    shift = np.round(lam.imag / w)
+    folded = lam - 1j * w * shift
+    chosen: list[complex] = []
+
+    def is_copy(z: complex) -> bool:
+        """z is (within Hill's truncation error) λ + i m ω of an exponent already chosen."""
+        for c in chosen:
+            d = (z - c) / (1j * w)
+            if abs(z.real - c.real) <= 1e-3 * max(w, abs(c.real)) and abs(d.real - round(d.real)) < 0.01:
+                return True
+        return False
+
+    for i in np.argsort(np.abs(centroid), kind="stable"):
+        if len(chosen) >= 2 * n:
+            break
+        z = complex(folded[i])
+        if is_copy(z):
+            continue
+        phase = z.imag * T
+        if abs(phase) <= REAL_PHASE_TOL or abs(abs(phase) - np.pi) <= REAL_PHASE_TOL or len(chosen) == 2 * n - 1:
+            # a real multiplier: ±e^{Re λ T} (Im λ on 0 or ω/2)
+            chosen.append(complex(z.real, 0.0 if abs(phase) < 0.5 * np.pi else 0.5 * w))
+        else:
+            chosen.extend([z, z.conjugate()])
+    return np.array(chosen[: 2 * n])
+
+
+def system_hill_multipliers(system: System, basis: FourierBasis, X: FloatArray, w: float) -> ComplexArray:
+    """exp(λ T), T = 2π/w, of :func:`system_hill_exponents`, largest modulus first; real
+    multipliers exactly real."""
+    lam = system_hill_exponents(system, basis, X, w)
+    T = 2 * np.pi / w
+    with np.errstate(over="ignore", under="ignore"):
+        mu = np.exp(lam.real * T) * np.exp(1j * lam.imag * T)
+    real = (lam.imag == 0.0) | (lam.imag == 0.5 * w)
+    mu = np.where(real, np.where(lam.imag == 0.0, 1.0, -1.0) * np.exp(lam.real * T), mu)
+    return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
 def hill_exponents(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexArray:
-    """The two physical Floquet exponents λ of the HB orbit q at forcing frequency Ω."""
+    """The 2n physical Floquet exponents λ of the HB orbit q at forcing frequency Ω (n = 1: the
+    single-DOF selection below; n ≥ 2: :func:`system_hill_exponents`)."""
+    system = _system_of(hb)
+    if system.n > 1:
+        return system_hill_exponents(system, hb.basis, q.reshape(system.n, -1), hb.base_frequency(omega))
     H = hb.basis.harmonics
     n = hb.size
     w = hb.base_frequency(omega)
     _, Rq, _ = hb.residual_jacobian(q, omega)
-    D1 = 2.0 * hb.basis.derivative_matrix(w) + hb.model.c * np.eye(n)
+    c = float(system.damping[0, 0])
+    D1 = 2.0 * hb.basis.derivative_matrix(w) + c * np.eye(n)
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -Rq
@@ -48,11 +173,12 @@ def hill_exponents(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexA
     total = np.abs(Y[0]) ** 2 + np.sum(w_pos + w_neg, axis=0)
     centroid = np.sum(k * (w_pos - w_neg), axis=0) / total
     lam1 = lam[int(np.argmin(np.abs(centroid)))]
-    return np.array([lam1, -hb.model.c - lam1])
+    return np.array([lam1, -c - lam1])
 
 
 def hill_multipliers(hb: HarmonicBalance, q: FloatArray, omega: float) -> ComplexArray:
-    """Floquet multipliers exp(λ T_p), T_p = p 2π/Ω, from :func:`hill_exponents`, largest first.
+    """Floquet multipliers exp(λ T_p), T_p = p 2π/Ω, from :func:`hill_exponents`, largest first
+    (n ≥ 2: :func:`system_hill_multipliers`).
 
     The monodromy of the single-DOF equation is a real 2×2 matrix with det M = e^{−cT}, so its
     multipliers are either a complex-conjugate pair on the circle |μ| = e^{−cT/2} or two real
@@ -63,9 +189,12 @@ def hill_multipliers(hb: HarmonicBalance, q: FloatArray, omega: float) -> Comple
     the distance to the real axis is that of bT from the nearest multiple of π; the nearer one wins
     (real: μ_1 = ±e^{aT}, μ_2 = e^{−cT}/μ_1; circle: μ = e^{−cT/2} e^{±ibT}).
     """
+    system = _system_of(hb)
+    if system.n > 1:
+        return system_hill_multipliers(system, hb.basis, q.reshape(system.n, -1), hb.base_frequency(omega))
     lam = hill_exponents(hb, q, omega)
     period = 2 * np.pi / hb.base_frequency(omega)
-    c = hb.model.c
+    c = float(system.damping[0, 0])
     a, b = float(lam[0].real), float(lam[0].imag)
     to_circle = abs(a + 0.5 * c) * period
     phase = b * period
@@ -82,4 +211,7 @@ def hill_multipliers(hb: HarmonicBalance, q: FloatArray, omega: float) -> Comple
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
-__all__ = ["hill_exponents", "hill_multipliers"]
+__all__ = [
+    "hill_exponents", "hill_multipliers", "system_hill_matrices", "system_hill_exponents", "system_hill_multipliers",
+    "REAL_PHASE_TOL",
+]

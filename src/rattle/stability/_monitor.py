@@ -1,16 +1,19 @@
 """Floquet test functions along a harmonic-balance branch, for the continuation's step control.
 
-At a point (q, Ω) of the branch the exact monodromy M of the piecewise-linear linearisation
-about the HB orbit (``_floquet``) gives the test functions
+At a point (q, Ω) of the branch the exact monodromy M (2n × 2n) of the piecewise-linear
+linearisation about the HB orbit (``_floquet``) gives the test functions
 
     ψ_fold = det(M − I) = Π (μ_k − 1),     ψ_pd = det(M + I) = Π (μ_k + 1),
+    ψ_ns = det(M ⊙ M − I) = Π_{i<j} (μ_i μ_j − 1)    (n ≥ 2),
 
-whose zeros are the folds (a multiplier at +1) and the period doublings (a multiplier at −1).
-(Neimark–Sacker needs two or more coordinates: with one, det M = e^{−cT} < 1 and no complex
-pair can reach the unit circle.) Both are polynomials in the entries of M, so they are smooth
-where M is — unlike the multipliers themselves, which move with infinite speed where a complex
-pair meets the real axis — and M is smooth in (q, Ω) except where the orbit grazes a
-breakpoint, which the crossing counts per breakpoint (the reading's ``structure``) reveal.
+whose zeros are the folds (a multiplier at +1), the period doublings (a multiplier at −1) and
+the Neimark–Sacker points (a complex pair on the unit circle; ψ_ns also vanishes at a neutral
+saddle, a real pair with μ_i μ_j = 1, which the labelling tells apart). With one coordinate,
+det M = e^{−cT} < 1 and no complex pair can reach the unit circle: only the first two are
+monitored. All are polynomials in the entries of M, so they are smooth where M is — unlike the
+multipliers themselves, which move with infinite speed where a complex pair meets the real axis —
+and M is smooth in (q, Ω) except where the orbit grazes a breakpoint, which the crossing counts
+per element and breakpoint (the reading's ``structure``) reveal.
 
 Their derivative along the branch is the forward difference quotient (ψ(x + ε d) − ψ(x))/ε
 along the unit tangent d, ε = 1e-7 in scaled arc length: the truncation error O(ε ψ'') is far
@@ -20,61 +23,108 @@ the shifted point grazes (a different structure) the backward quotient is taken 
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
 
 import numpy as np
 
 from .._typing import FloatArray
 from ..continuation import MonitorReading
 from ..hb import HarmonicBalance
-from ._floquet import monodromy_and_crossings_batch, multipliers_from_monodromy
+from ..model import System
+from ._classify import critical_distance
+from ._floquet import (
+    TEST_FUNCTIONS, element_monodromy_batch, floquet_test_functions, monodromy_and_crossings_batch,
+    multipliers_from_monodromy,
+)
 
 #: Difference step in scaled arc length for the test functions' derivative.
 EPSILON = 1e-7
 
 
+def hb_system(hb: HarmonicBalance) -> System:
+    """The :class:`~rattle.model.System` of a harmonic-balance problem (``hb.system`` when it has
+    one, else its model's)."""
+    system = getattr(hb, "system", None)
+    return system if system is not None else hb.model.system()
+
+
 class FloquetMonitor:
-    """Test functions ψ_fold, ψ_pd (with slopes and crossing structure) of ``hb``'s orbits.
+    """Test functions ψ_fold, ψ_pd (and ψ_ns for n ≥ 2) with slopes and crossing structure of
+    ``hb``'s orbits.
 
     Callable as ``monitor(q, Ω, dq/ds, dΩ/ds)`` (see ``rattle.continuation._monitor``); the
-    tangent is per unit scaled arc length, so ``EPSILON`` is a step in scaled variables.
+    tangent is per unit scaled arc length, so ``EPSILON`` is a step in scaled variables. ``q``
+    holds the n·(2H+1) coefficients coordinate-major.
     """
 
     def __init__(self, hb: HarmonicBalance) -> None:
         self.hb = hb
-        st = hb.model.elastic.stages
-        self._breakpoints = np.asarray(st.breakpoints, dtype=float)
-        self._stiffness = hb.model.k * np.asarray(st.slopes, dtype=float)
-        self._damping = hb.model.c
+        self.system = hb_system(hb)
+        system = self.system
+        self.names = TEST_FUNCTIONS[:2] if system.n == 1 else TEST_FUNCTIONS
+        self._cache: dict = {}
+        # The single element of the single equation: the closed-form path on q itself.
+        self._single = system.n == 1 and system.m == 1 and float(system.element_rows[0, 0]) == 1.0
+        if self._single:
+            e = system.elements[0]
+            self._breakpoints = np.asarray(e.breakpoints, dtype=float)
+            self._stiffness = np.array([system.stage_stiffness((j,))[0, 0] for j in range(len(e.slopes))])
+            self._damping = float(system.damping[0, 0])
+        self._rows = system.element_rows
+
+    def monodromy_and_crossings(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
+        """Monodromies (P, 2n, 2n) and crossings (P, m, k_max) of the orbits ``Q`` (P, n·(2H+1))
+        at forcing frequencies ``Om`` (P,)."""
+        hb = self.hb
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        Om = np.atleast_1d(np.asarray(Om, dtype=float))
+        w = Om / hb.period
+        if self._single:
+            M, counts = monodromy_and_crossings_batch(Q, w, hb.basis.synthesize(Q), self._breakpoints,
+                                                      self._stiffness, self._damping)
+            return M, counts[:, None, :]
+        S = np.einsum("en,pnk->pek", self._rows, Q.reshape(Q.shape[0], self.system.n, -1))
+        return element_monodromy_batch(self.system, S, w, hb.basis.synthesize(S), cache=self._cache)
+
+    def monodromy(self, q: FloatArray, omega: float) -> FloatArray:
+        """The exact monodromy (2n, 2n) of the orbit q at forcing frequency Ω."""
+        return self.monodromy_and_crossings(q[None, :], np.array([omega]))[0][0]
+
+    def test_functions(self, q: FloatArray, omega: float) -> FloatArray:
+        """ψ (fold, period doubling[, Neimark–Sacker]) at one point: ``names`` gives the order."""
+        return floquet_test_functions(self.monodromy(q, omega))
+
+    def test_function(self, kind: str) -> Callable[[FloatArray, float], float]:
+        """ψ_kind(q, Ω) for ``kind`` in ``names`` ("fold", "period_doubling", "neimark_sacker"),
+        e.g. to locate the zero between two branch points."""
+        if kind not in self.names:
+            raise ValueError(f"`kind` must be one of {self.names} for a system of {self.system.n} coordinate(s), got {kind!r}")
+        i = self.names.index(kind)
+        return lambda q, omega: float(self.test_functions(q, omega)[i])
 
     def _evaluate(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
-        hb = self.hb
-        X = hb.basis.synthesize(Q)
-        M, counts = monodromy_and_crossings_batch(Q, Om / hb.period, X, self._breakpoints, self._stiffness, self._damping)
-        n = M.shape[-1]
-        eye = np.eye(n)
-        with np.errstate(over="ignore", invalid="ignore"):
-            psi = np.stack([np.linalg.det(M - eye), np.linalg.det(M + eye)], axis=-1)
-        return psi, counts, M
+        M, counts = self.monodromy_and_crossings(Q, Om)
+        return floquet_test_functions(M), counts, M
+
+    def _structure(self, counts: np.ndarray) -> tuple[int, ...]:
+        if self._single:
+            return tuple(int(c) for c in counts[0])
+        return tuple(int(c) for e, el in enumerate(self.system.elements) for c in counts[e, : len(el.breakpoints)])
 
     def __call__(self, q: FloatArray, omega: float, dq: FloatArray, domega: float) -> MonitorReading:
         eps = EPSILON
         psi, counts, M = self._evaluate(np.stack([q, q + eps * dq]), np.array([omega, omega + eps * domega]))
-        here = tuple(int(c) for c in counts[0])
-        if tuple(int(c) for c in counts[1]) == here:
+        here = self._structure(counts[0])
+        if self._structure(counts[1]) == here:
             slopes = (psi[1] - psi[0]) / eps
         else:  # the forward point grazes: take the backward difference
             psi_b, counts_b, _ = self._evaluate((q - eps * dq)[None, :], np.array([omega - eps * domega]))
-            if tuple(int(c) for c in counts_b[0]) == here:
+            if self._structure(counts_b[0]) == here:
                 slopes = (psi[0] - psi_b[0]) / eps
             else:  # grazing within ±ε: no derivative; the stepper treats the point as a kink
-                slopes = np.full(2, np.nan)
-        if np.all(np.isfinite(M[0])):
-            mu = multipliers_from_monodromy(M[0])
-            distance = float(np.min(np.minimum(np.abs(mu - 1.0), np.abs(mu + 1.0))))
-        else:
-            distance = math.inf
-        return MonitorReading(psi[0], slopes, here, distance)
+                slopes = np.full(psi.shape[1], np.nan)
+        distance = critical_distance(multipliers_from_monodromy(M[0])) if np.all(np.isfinite(M[0])) else np.inf
+        return MonitorReading(psi[0], slopes, here, float(distance))
 
 
-__all__ = ["FloquetMonitor", "EPSILON"]
+__all__ = ["FloquetMonitor", "EPSILON", "hb_system"]
