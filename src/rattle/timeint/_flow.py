@@ -354,8 +354,7 @@ class SystemIntegrator:
             remaining = t1 - t
             tau_lim = min(remaining, sol.max_segment)
             seg = sol.segment(t, z, tau_lim)
-            lo = np.array([flow.lower[e][s] for e, s in enumerate(stages)])
-            hi = np.array([flow.upper[e][s] for e, s in enumerate(stages)])
+            lo, hi = sol.lo, sol.hi
             tau_c, e, direction = first_exit(seg, lo, hi, tau_lim, sol.grid_step, flow.samples_per_scale)
             if rec is not None and (tau_c > 0.0 or (e < 0 and n_seg == 0 and not rec["ts"])):
                 rec["ts"].append(t)
@@ -365,7 +364,7 @@ class SystemIntegrator:
             if tau_c > 0.0:
                 n_seg += 1
                 M = sol.transition(tau_c) @ M
-            zc = seg.state(tau_c)[0] if tau_c > 0.0 else z
+            zc = seg.end_state(tau_c) if tau_c > 0.0 else z
             if e < 0:
                 if tau_lim >= remaining:
                     return zc, M

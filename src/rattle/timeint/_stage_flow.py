@@ -280,6 +280,14 @@ class StageSolution:
             self.Pinv = Pinv
             self.Pz = P[: 2 * n]  # (2n, k)
             self.Pd = flow.G @ self.Pz  # (2m, k)
+            self.Pz_poly, self.Pz_modal = self.Pz[:, :sdim], self.Pz[:, sdim:]
+            self.Pd_poly, self.Pd_modal = self.Pd[:, :sdim], self.Pd[:, sdim:]
+            self.T0_zero = not np.any(T11)
+            self.modes = np.concatenate((lam2, 1j * hw))
+            self.Pinv_z = Pinv[:, : 2 * n]
+        self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
+        self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
+        self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
 
     # --- pieces ---------------------------------------------------------------------------------
     def harmonic_state(self, t: float) -> tuple[FloatArray, np.ndarray]:
@@ -292,15 +300,14 @@ class StageSolution:
 
     def transition(self, tau: float) -> FloatArray:
         """exp(A_s τ) (2n, 2n), exact to round-off."""
-        n2 = 2 * self.flow.n
         if self.method == "expm":
             return sla.expm(self.A * tau)
-        E0 = _taylor_expm(self.T0, tau)
         s = self.sdim
-        left = self.Pz.copy()
-        left[:, :s] = left[:, :s] @ E0
-        left[:, s:] = left[:, s:] * np.exp(self.lam * tau)[None, :]
-        return (left @ self.Pinv[:, :n2]).real
+        right = self.Pinv_z.copy()
+        right[s:] *= np.exp(self.lam * tau)[:, None]
+        if not self.T0_zero:
+            right[:s] = _taylor_expm(self.T0, tau) @ right[:s]
+        return (self.Pz @ right).real
 
     def segment(self, ts: float, z: FloatArray, tau_max: float) -> Segment:
         """The solution from state ``z`` at ``ts`` for local times 0 ≤ τ ≤ ``tau_max``."""
@@ -315,47 +322,83 @@ class Segment:
     (δ_e, δ_e', δ_e'') of one element at one τ (the root finder's hot call).
     """
 
-    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "Bz", "Bd", "Qz", "Qd", "w0", "hamps",
-                 "d_floor", "v_floor", "_mu_l", "_bd_l", "_qd_l")
+    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "c", "U", "ph", "Bd", "Qd", "w0", "_Bz", "_Qz",
+                 "_floors", "_mu_l", "_bd_l", "_qd_l")
 
     def __init__(self, sol: StageSolution, ts: float, z: FloatArray, tau_max: float) -> None:
         flow = sol.flow
         self.sol, self.ts, self.z0 = sol, float(ts), z
         self.tau_max = tau_max = float(tau_max) if math.isfinite(tau_max) else 1.0
-        zh0, hamps = sol.harmonic_state(ts)
-        self.hamps = hamps
         hw = flow.hw
-        G = flow.G
+        if hw.size:
+            ph = np.exp(1j * self.ts * hw)
+            zh0 = (ph @ sol.Zh).real
+        else:
+            ph = np.zeros(0, dtype=complex)
+            zh0 = 0.0
+        self.ph = ph
+        self._Bz = self._Qz = self._floors = None
+        self._bd_l = self._qd_l = None
         if sol.method == "modal":
             w0 = np.empty(z.size + 1)
             w0[:-1] = z - zh0
             w0[-1] = 1.0
             c = sol.Pinv @ w0
             s = sol.sdim
-            self.mu = np.concatenate((sol.lam, 1j * hw))
-            self.Bz = np.concatenate(((sol.Pz[:, s:] * c[s:][None, :]).T, hamps), axis=0)  # (K, 2n)
-            U = _taylor_terms(sol.T0, c[:s], tau_max)  # (Kp, s)
-            self.Qz = U @ sol.Pz[:, :s].T  # (Kp, 2n)
+            self.c = c
+            self.mu = sol.modes
+            self.Bd = np.concatenate((sol.Pd_modal.T * c[s:, None], sol.Zh_d * ph[:, None]), axis=0)  # (K, 2m)
+            self.U = U = c[None, :s] if sol.T0_zero else _taylor_terms(sol.T0, c[:s], tau_max)  # (Kp, s)
+            self.Qd = U @ sol.Pd_poly.T  # (Kp, 2m)
             self.w0 = None
         else:
             self.w0 = np.concatenate((z - zh0, [1.0]))
             self.mu = 1j * hw
-            self.Bz = hamps
-            self.Qz = np.zeros((0, z.size), dtype=complex)
-        self.Bd = self.Bz @ G.T  # (K, 2m)
-        self.Qd = self.Qz @ G.T
-        m = flow.m
-        dmag = np.abs(self.Bd[:, :m]).sum(axis=0) + np.abs(G[:m] @ z)
-        vmag = np.abs(self.Bd[:, m:]).sum(axis=0) + np.abs(G[m:] @ z)
-        if self.Qd.shape[0]:
-            powers = tau_max ** np.arange(self.Qd.shape[0])
-            dmag = dmag + np.abs(self.Qd[:, :m]).T @ powers
-            vmag = vmag + np.abs(self.Qd[:, m:]).T @ powers
-        self.d_floor = 8.0 * _EPS * dmag
-        self.v_floor = 8.0 * _EPS * vmag
+            self.Bd = sol.Zh_d * ph[:, None]
+            self.Qd = np.zeros((0, 2 * flow.m), dtype=complex)
         self._mu_l = self.mu.tolist()
-        self._bd_l = None
-        self._qd_l = None
+
+    # --- lazily built pieces ------------------------------------------------------------------
+    @property
+    def Bz(self) -> np.ndarray:
+        """Mode amplitudes of z (K, 2n)."""
+        if self._Bz is None:
+            sol = self.sol
+            hamps = sol.Zh * self.ph[:, None]
+            if self.w0 is None:
+                self._Bz = np.concatenate((sol.Pz_modal.T * self.c[sol.sdim:, None], hamps), axis=0)
+            else:
+                self._Bz = hamps
+        return self._Bz
+
+    @property
+    def Qz(self) -> np.ndarray:
+        """Polynomial coefficients of z (Kp, 2n)."""
+        if self._Qz is None:
+            self._Qz = self.U @ self.sol.Pz_poly.T if self.w0 is None else np.zeros((0, self.z0.size), dtype=complex)
+        return self._Qz
+
+    def floors(self) -> tuple[FloatArray, FloatArray]:
+        """Round-off floors of δ and δ' of every element over the segment, (m,) each."""
+        if self._floors is None:
+            flow = self.sol.flow
+            m, G = flow.m, flow.G
+            dmag = np.abs(self.Bd[:, :m]).sum(axis=0) + np.abs(G[:m] @ self.z0)
+            vmag = np.abs(self.Bd[:, m:]).sum(axis=0) + np.abs(G[m:] @ self.z0)
+            if self.Qd.shape[0]:
+                powers = self.tau_max ** np.arange(self.Qd.shape[0])
+                dmag = dmag + np.abs(self.Qd[:, :m]).T @ powers
+                vmag = vmag + np.abs(self.Qd[:, m:]).T @ powers
+            self._floors = (8.0 * _EPS * dmag, 8.0 * _EPS * vmag)
+        return self._floors
+
+    @property
+    def d_floor(self) -> FloatArray:
+        return self.floors()[0]
+
+    @property
+    def v_floor(self) -> FloatArray:
+        return self.floors()[1]
 
     # --- evaluation -----------------------------------------------------------------------------
     def _expm_w(self, taus: FloatArray) -> np.ndarray:
@@ -366,13 +409,19 @@ class Segment:
     def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
         """δ and δ' of every element at local times ``taus`` (N,): two (N, m) arrays."""
         m = self.sol.flow.m
-        y = (np.exp(np.multiply.outer(taus, self.mu)) @ self.Bd).real if self.mu.size else np.zeros((taus.size, 2 * m))
+        if self.mu.size:
+            y = (np.exp(np.multiply.outer(taus, self.mu)) @ self.Bd).real
+        else:
+            y = np.zeros((taus.size, 2 * m))
         Q = self.Qd
-        if Q.shape[0]:
-            acc = np.broadcast_to(Q[-1], (taus.size, 2 * m)).astype(complex)
-            for k in range(Q.shape[0] - 2, -1, -1):
-                acc = acc * taus[:, None] + Q[k]
-            y = y + acc.real
+        kp = Q.shape[0]
+        if kp == 1:
+            y += Q[0].real
+        elif kp > 1:
+            acc = Q[-1] * taus[:, None]
+            for k in range(kp - 2, 0, -1):
+                acc = (acc + Q[k]) * taus[:, None]
+            y += (acc + Q[0]).real
         if self.w0 is not None:
             w = self._expm_w(taus)
             y = y + w[:, :-1] @ self.sol.flow.G.T
@@ -383,21 +432,24 @@ class Segment:
         taus = np.asarray(taus, dtype=float)
         shape = taus.shape
         t = taus.reshape(-1)
-        n2 = self.Bz.shape[1]
+        Bz = self.Bz
+        n2 = Bz.shape[1]
         if self.mu.size:
             E = np.exp(np.multiply.outer(t, self.mu))
-            z = (E @ self.Bz).real
-            zd = (E @ (self.mu[:, None] * self.Bz)).real
+            z = (E @ Bz).real
+            zd = ((E * self.mu) @ Bz).real
         else:
             z = np.zeros((t.size, n2))
             zd = np.zeros((t.size, n2))
         Q = self.Qz
-        if Q.shape[0]:
-            acc = np.broadcast_to(Q[-1], (t.size, n2)).astype(complex)
+        kp = Q.shape[0]
+        if kp:
+            tt = t[:, None]
+            acc = np.broadcast_to(Q[-1], (t.size, n2))
             dacc = np.zeros((t.size, n2), dtype=complex)
-            for k in range(Q.shape[0] - 2, -1, -1):
-                dacc = dacc * t[:, None] + acc
-                acc = acc * t[:, None] + Q[k]
+            for k in range(kp - 2, -1, -1):
+                dacc = dacc * tt + acc
+                acc = acc * tt + Q[k]
             z = z + acc.real
             zd = zd + dacc.real
         if self.w0 is not None:
@@ -405,6 +457,27 @@ class Segment:
             z = z + w[:, :-1]
             zd = zd + w @ self.sol.Abar[:-1].T
         return z.reshape(shape + (n2,)), zd.reshape(shape + (n2,))
+
+    def end_state(self, tau: float) -> FloatArray:
+        """z = (x, x') at one local time ``tau`` (2n,)."""
+        if self.w0 is not None:
+            return self.state(np.array([tau]))[0][0]
+        sol = self.sol
+        s = sol.sdim
+        e = np.exp(self.mu * tau)
+        k2 = sol.lam.size
+        z = (sol.Pz_modal @ (e[:k2] * self.c[s:])).real
+        if self.ph.size:
+            z += ((e[k2:] * self.ph) @ sol.Zh).real
+        U = self.U
+        if U.shape[0] == 1:
+            z += (sol.Pz_poly @ U[0]).real
+        else:
+            u = U[-1]
+            for k in range(U.shape[0] - 2, -1, -1):
+                u = u * tau + U[k]
+            z += (sol.Pz_poly @ u).real
+        return z
 
     def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
         """(δ_e, δ_e', δ_e'') at local time ``tau`` (a scalar)."""
@@ -415,30 +488,33 @@ class Segment:
             return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
         if self._bd_l is None:
             m = self.sol.flow.m
-            self._bd_l = [(list(self.Bd[:, i]), list(self.Bd[:, m + i])) for i in range(m)]
-            self._qd_l = [(list(self.Qd[:, i]), list(self.Qd[:, m + i])) for i in range(m)]
-        bd, bv = self._bd_l[e]
-        qd, qv = self._qd_l[e]
+            self._bd_l = [list(zip(self._mu_l, self.Bd[:, i].tolist(), self.Bd[:, m + i].tolist())) for i in range(m)]
+            self._qd_l = [(self.Qd[:, i].tolist(), self.Qd[:, m + i].tolist()) for i in range(m)]
         d = v = a = 0.0
-        exp = math.exp
-        for mu, b0, b1 in zip(self._mu_l, bd, bv):
+        exp, cos, sin = math.exp, math.cos, math.sin
+        for mu, b0, b1 in self._bd_l[e]:
             r = exp(mu.real * tau)
             ph = mu.imag * tau
-            ez = complex(r * math.cos(ph), r * math.sin(ph))
+            ez = complex(r * cos(ph), r * sin(ph))
+            b1e = b1 * ez
             d += (b0 * ez).real
-            v += (b1 * ez).real
-            a += (mu * b1 * ez).real
-        if qd:
+            v += b1e.real
+            a += (mu * b1e).real
+        qd, qv = self._qd_l[e]
+        if len(qd) == 1:
+            d += qd[0].real
+            v += qv[0].real
+        elif qd:
             pd = qd[-1]
             pv = qv[-1]
-            dpv = 0.0
+            dpv = 0j
             for k in range(len(qd) - 2, -1, -1):
                 dpv = dpv * tau + pv
                 pd = pd * tau + qd[k]
                 pv = pv * tau + qv[k]
             d += pd.real
             v += pv.real
-            a += dpv.real if isinstance(dpv, complex) else dpv
+            a += dpv.real
         return d, v, a
 
 
