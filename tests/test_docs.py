@@ -269,7 +269,7 @@ def test_command_examples_parse():
 # Outputs
 # --------------------------------------------------------------------------------------------
 def test_every_output_column_is_documented():
-    from rattle.io import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
+    from rattle.results import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 
     text = _text("outputs.md")
     for columns in (FRF_COLUMNS, SWEEP_COLUMNS, ORBIT_COLUMNS):
@@ -337,7 +337,8 @@ def test_option_fields_are_documented():
 # --------------------------------------------------------------------------------------------
 def test_python_examples_run(tmp_path, monkeypatch):
     """Every ```python block of docs/python.md runs, in order, in one namespace."""
-    from rattle.io import FRF_COLUMNS, read_csv
+    from rattle.io import read_csv
+    from rattle.results import FRF_COLUMNS
 
     blocks = _blocks(_text("python.md"), "python")
     assert len(blocks) >= 3

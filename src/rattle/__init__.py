@@ -32,8 +32,7 @@ def _version() -> str:
 
 #: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
 _LAZY: dict[str, str] = {
-    **dict.fromkeys(["Comparison", "compare", "frequency_response", "load_case", "periodic_orbit", "time_sweep"],
-                   ".analysis"),
+    **dict.fromkeys(["compare", "frequency_response", "load_case", "periodic_orbit", "time_sweep"], ".analysis"),
     "ContinuationOptions": ".continuation",
     **dict.fromkeys(["ConfigError", "ConvergenceError", "RattleError", "Status"], ".errors"),
     **dict.fromkeys(["HBOptions", "NewtonOptions"], ".hb"),
@@ -42,8 +41,8 @@ _LAZY: dict[str, str] = {
         ".model",
     ),
     **dict.fromkeys(
-        ["FrequencyResponse", "LinearResponse", "PeriodicOrbit", "Region", "SpecialPoint", "SweepResult",
-         "linear_frequency_response"],
+        ["Comparison", "FrequencyResponse", "LinearResponse", "PeriodicOrbit", "Region", "SpecialPoint",
+         "SweepResult", "linear_frequency_response"],
         ".results",
     ),
     **dict.fromkeys(["SteadyStateOptions", "shoot_periodic_orbit", "steady_state"], ".timeint"),
@@ -86,13 +85,13 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     __version__: str
-    from .analysis import Comparison, compare, frequency_response, load_case, periodic_orbit, time_sweep
+    from .analysis import compare, frequency_response, load_case, periodic_orbit, time_sweep
     from .continuation import ContinuationOptions
     from .errors import ConfigError, ConvergenceError, RattleError, Status
     from .hb import HBOptions, NewtonOptions
     from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
     from .results import (
-        FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult,
+        Comparison, FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult,
         linear_frequency_response,
     )
     from .timeint import SteadyStateOptions, shoot_periodic_orbit, steady_state

@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rattle.analysis import Comparison, compare
+from rattle.analysis import compare
 from rattle.analysis._compare import pick_frequencies
-from rattle.io import FRF_COLUMNS, SWEEP_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import FRF_COLUMNS, SWEEP_COLUMNS, Comparison
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,8 @@ import pytest
 
 from rattle.analysis import periodic_orbit
 from rattle.analysis._orbit import _least_period, _reduce, _shift, default_search_range
-from rattle.io import ORBIT_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import ORBIT_COLUMNS
 from rattle.results import OrbitSolution, PeriodicOrbit
 from rattle.timeint import ExactIntegrator, shoot_periodic_orbit
 

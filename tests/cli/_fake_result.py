@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from rattle.io import FRF_COLUMNS, write_csv
+from rattle.io import write_csv
+from rattle.results import FRF_COLUMNS
 
 
 class FakeResponse:

@@ -12,7 +12,8 @@ import pytest
 from click.testing import Result
 
 from rattle.demo import DEMO_FIGURES
-from rattle.io import FRF_COLUMNS, SWEEP_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import FRF_COLUMNS, SWEEP_COLUMNS
 from _cli_helpers import PNG, VALID, invoke
 
 DEMO_FILES = sorted(["frf.csv", "frf.json", "frf.png", "sweep.csv", "fig4_linear_vs_nonlinear.png",

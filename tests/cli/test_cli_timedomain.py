@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from rattle.cli.output import ProgressBar
-from rattle.io import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 from _cli_helpers import PNG, VALID, assert_bad_input, invoke
 
 

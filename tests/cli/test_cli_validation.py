@@ -16,7 +16,8 @@ import pytest
 
 from rattle.cli.main import main
 from rattle.errors import ConvergenceError
-from rattle.io import FRF_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import FRF_COLUMNS
 from _cli_helpers import VALID, assert_bad_input, invoke, write_config
 from _fake_result import FakeResponse as _FakeResponse
 

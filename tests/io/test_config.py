@@ -20,9 +20,6 @@ from rattle.errors import ConfigError
 from rattle.io import (
     DEFAULT_HARMONICS,
     DEFAULT_OMEGA,
-    FRF_COLUMNS,
-    ORBIT_COLUMNS,
-    SWEEP_COLUMNS,
     AnalysisSettings,
     RunConfig,
     atomic_path,
@@ -42,6 +39,7 @@ from rattle.io import (
     write_metadata,
 )
 from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, reference_case
+from rattle.results import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 
 # The SPEC §2 example, verbatim (comments included).
 SPEC_EXAMPLE = """\

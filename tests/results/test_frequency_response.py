@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from rattle import linear_frequency_response
-from rattle.io import FRF_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import FRF_COLUMNS
 from rattle.measures import regime_of
 
 

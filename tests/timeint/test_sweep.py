@@ -11,7 +11,8 @@ import pytest
 import rattle
 from rattle.analysis import time_sweep
 from rattle.hb import HarmonicBalance, HBOptions, solve_harmonic_balance
-from rattle.io import SWEEP_COLUMNS, read_csv
+from rattle.io import read_csv
+from rattle.results import SWEEP_COLUMNS
 from rattle.model import reference_case
 from rattle.results import SweepResult
 from rattle.timeint import SteadyStateOptions, shoot_periodic_orbit

@@ -1,7 +1,7 @@
 """Front ends: one call from a model to a result."""
 
 from ._case import Case, load_case
-from ._compare import Comparison, compare
+from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
 from ._harmonics import adaptive_frequency_response, truncation_error
 from ._orbit import periodic_orbit
@@ -9,6 +9,6 @@ from ._regimes import confirm_with_sweep, label_regions
 from ._time_sweep import time_sweep
 
 __all__ = [
-    "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare", "Comparison",
+    "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
 ]

@@ -19,20 +19,7 @@ import numpy as np
 
 from ._atomic import atomic_write_text
 
-__all__ = ["FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS", "format_csv", "write_csv", "read_csv"]
-
-#: ``frf.csv`` columns (SPEC §3), one row per solution point in continuation order.
-FRF_COLUMNS: tuple[str, ...] = (
-    "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p",
-    "delta_min", "delta_max", "regime", "stable", "bifurcation", "iterations", "residual",
-)
-#: ``sweep.csv`` columns (SPEC §3); ``period`` is 0 when no period up to 8 was found.
-SWEEP_COLUMNS: tuple[str, ...] = (
-    "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period",
-)
-#: ``orbit.csv`` columns (SPEC §3).
-ORBIT_COLUMNS: tuple[str, ...] = ("t", "delta", "velocity", "acceleration")
-
+__all__ = ["format_csv", "write_csv", "read_csv"]
 
 def _format_value(value: Any) -> str:
     if value is None:
@@ -112,7 +99,7 @@ def write_csv(path: str | os.PathLike[str], columns: Mapping[str, Any], order: S
     columns : mapping of str to array-like
         One 1-D array-like per column, all of the same length.
     order : sequence of str
-        Column names in output order, e.g. :data:`FRF_COLUMNS`.
+        Column names in output order, e.g. :data:`rattle.results.FRF_COLUMNS`.
     """
     atomic_write_text(path, format_csv(columns, order))
 

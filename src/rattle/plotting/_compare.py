@@ -14,7 +14,7 @@ from ._orbit import window_periods
 from ._sweep import DIRECTION_STYLES, sweep_plot
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..analysis import Comparison
+    from ..results import Comparison
 
 
 def _steady_history(

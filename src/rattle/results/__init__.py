@@ -1,12 +1,18 @@
-"""Result objects: columnar, with .plot() and .to_csv() delegating to plotting and io."""
+"""Result objects: columnar data with their columns (SPEC §3) and provenance.
 
-from ._frequency_response import (
-    FRF_COLUMNS, FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response,
-)
+Results hold data only: ``.to_csv()`` and ``.plot()`` are thin delegates that import
+:mod:`rattle.io` and :mod:`rattle.plotting` inside the method, when called; nothing here imports
+them when loaded.
+"""
+
+from ._columns import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
+from ._comparison import Comparison
+from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._orbit import OrbitSolution, PeriodicOrbit
 from ._sweep import SweepResult
 
 __all__ = [
-    "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response", "FRF_COLUMNS",
-    "SweepResult", "PeriodicOrbit", "OrbitSolution",
+    "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
+    "SweepResult", "PeriodicOrbit", "OrbitSolution", "Comparison",
+    "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
 ]

@@ -12,7 +12,7 @@ from .._typing import ComplexArray, FloatArray
 from .._validate import as_float_array
 from ..errors import Status
 from ..hb import resize_harmonics
-from ..io._csv import FRF_COLUMNS
+from ._columns import FRF_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model, check_analysable_model
 

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
-from ..io._csv import ORBIT_COLUMNS
+from ._columns import ORBIT_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model
 

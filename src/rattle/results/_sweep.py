@@ -9,7 +9,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .._typing import BoolArray, ComplexArray, FloatArray, IntArray
-from ..io._csv import SWEEP_COLUMNS
+from ._columns import SWEEP_COLUMNS
 from ..model import Model
 
 #: Sweep directions, in the order ``both`` runs them.
