@@ -303,10 +303,13 @@ class StageSolution:
         if self.method == "expm":
             return sla.expm(self.A * tau)
         s = self.sdim
+        if self.T0_zero:
+            factors = np.ones(self.Pinv_z.shape[0], dtype=complex)
+            factors[s:] = np.exp(self.lam * tau)
+            return (self.Pz @ (factors[:, None] * self.Pinv_z)).real
         right = self.Pinv_z.copy()
         right[s:] *= np.exp(self.lam * tau)[:, None]
-        if not self.T0_zero:
-            right[:s] = _taylor_expm(self.T0, tau) @ right[:s]
+        right[:s] = _taylor_expm(self.T0, tau) @ right[:s]
         return (self.Pz @ right).real
 
     def segment(self, ts: float, z: FloatArray, tau_max: float) -> Segment:
@@ -379,16 +382,20 @@ class Segment:
         return self._Qz
 
     def floors(self) -> tuple[FloatArray, FloatArray]:
-        """Round-off floors of δ and δ' of every element over the segment, (m,) each."""
+        """Round-off floors of δ and δ' of every element over the segment, (m,) each: 8 ε times
+        the sum of the magnitudes of the terms (mode amplitudes, polynomial terms at the
+        segment's end) that make them up."""
         if self._floors is None:
-            flow = self.sol.flow
-            m, G = flow.m, flow.G
-            dmag = np.abs(self.Bd[:, :m]).sum(axis=0) + np.abs(G[:m] @ self.z0)
-            vmag = np.abs(self.Bd[:, m:]).sum(axis=0) + np.abs(G[m:] @ self.z0)
+            m = self.sol.flow.m
+            dmag = np.abs(self.Bd[:, :m]).sum(axis=0)
+            vmag = np.abs(self.Bd[:, m:]).sum(axis=0)
             if self.Qd.shape[0]:
                 powers = self.tau_max ** np.arange(self.Qd.shape[0])
-                dmag = dmag + np.abs(self.Qd[:, :m]).T @ powers
-                vmag = vmag + np.abs(self.Qd[:, m:]).T @ powers
+                q = np.abs(self.Qd).T @ powers
+                dmag, vmag = dmag + q[:m], vmag + q[m:]
+            if self.w0 is not None:
+                G = self.sol.flow.G
+                dmag, vmag = dmag + np.abs(G[:m] @ self.z0), vmag + np.abs(G[m:] @ self.z0)
             self._floors = (8.0 * _EPS * dmag, 8.0 * _EPS * vmag)
         return self._floors
 
