@@ -193,3 +193,20 @@ def test_input_checks_name_the_argument():
     traj = integ.propagate(np.zeros(6), 0.0, 1.0, 1.0)
     with pytest.raises(ValueError, match="`t`"):
         traj.sample(2.0)
+
+
+@pytest.mark.parametrize("excursion", [1e-9, -1e-9])
+def test_tangential_touch_inside_a_grid_cell(excursion):
+    """A parabola in the gap whose apex passes the breakpoint by 1e-9 (two crossings 2·sqrt(2e-9/g)
+    apart, well inside one grid cell) or misses it by 1e-9 (none)."""
+    system = free_pair(0.0, b=0.5, mean=-0.2, amp=0.0)
+    g = -float(system.mean[0])  # constant deceleration in the gap
+    v0 = 0.3
+    x0 = 0.5 - v0**2 / (2 * g) + excursion
+    traj = SystemIntegrator(system).propagate([x0, v0], 0.0, 2.0 * v0 / g, 1.0)
+    if excursion > 0:
+        apex, half = v0 / g, math.sqrt(2 * excursion / g)
+        assert traj.crossing_directions.tolist() == [1, -1]
+        np.testing.assert_allclose(traj.crossing_times, [apex - half, apex + half], rtol=0, atol=1e-9)
+    else:
+        assert traj.crossing_times.size == 0
