@@ -19,7 +19,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from rattle import Region, periodic_orbit, time_sweep  # noqa: E402
 from rattle.model import Excitation  # noqa: E402
 from rattle.demo import (  # noqa: E402
-    demo_report, hbm_vs_simulation_plot, level_difference, linear_acceleration_p2p, linear_vs_nonlinear_plot,
+    DEMO_DATA, DEMO_FIGURES, PaperDemo, demo_case, demo_report, hbm_vs_simulation_plot, level_difference, linear_acceleration_p2p, linear_vs_nonlinear_plot,
     mean_operating_point_plot, point_plot, simulated_window, stage_intervals,
 )
 from rattle.plotting import frequency_response_plot  # noqa: E402
@@ -243,3 +243,26 @@ def test_demo_report_text(frf, sweep, orbits, level) -> None:
     # figures that were not written are left out
     short = demo_report(frf, sweep, orbits={}, level=level, figures={})
     assert ".png" not in short and "## Special points" in short
+
+
+# --------------------------------------------------------------------------------------------
+# PaperDemo: what `rattle demo` computed, with its figures by key, report and metadata
+# --------------------------------------------------------------------------------------------
+def test_paper_demo_figures_report_and_metadata(reference_model, frf, sweep, orbits, level) -> None:
+    regions = tuple(frf.regions)
+    run = PaperDemo(model=reference_model, analysis=demo_case()[1], frf=frf, sweep=sweep, orbits=orbits,
+                    regions=regions, level=level, timings={"sweep": 0.5})
+    assert set(DEMO_FIGURES) == {"frf", "fig4", "fig5", "fig6", "fig7", "mean"}
+    fig, axes = run.figure("fig4")
+    assert isinstance(fig, Figure) and set(axes) >= {"response", "level"}
+    with pytest.raises(ValueError, match="`key` must be one of"):
+        run.figure("fig8")
+    figures = {"fig4": "fig4_linear_vs_nonlinear.png"}
+    assert run.report(figures=figures, version="x") == demo_report(
+        frf, sweep, orbits=orbits, level=level, figures=figures, regions=regions, data_files=list(DEMO_DATA),
+        version="x")
+    meta = run.metadata()
+    assert set(meta) == {"regions_confirmed_by_sweep", "sweep", "orbits", "level_difference"}
+    assert meta["orbits"]["A"]["omega"] == orbits["A"].omega and meta["level_difference"]["db_min"] == level.db_min
+    lines = run.summary().splitlines()
+    assert lines[-1].startswith("linear vs non-linear: ") and any(l.startswith("point B (Omega = 1.41)") for l in lines)

@@ -1,0 +1,77 @@
+"""Imports point one way: the rules of the package layout, read from the source with ``ast``.
+
+- nothing below ``rattle.demo`` imports it (only the command line runs it);
+- ``rattle.results`` holds data: it imports neither ``io``, ``plotting`` nor ``analysis`` when
+  loaded (its ``.to_csv()``/``.plot()`` delegates import them inside the method, when called);
+- ``rattle.plotting`` draws results and knows nothing of the front ends, the demo or the CLI;
+- the command line imports the demo and the numerics only inside a command (a quick front door).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "rattle"
+
+
+def _module_name(path: Path) -> str:
+    parts = ("rattle", *path.relative_to(SRC).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path: Path) -> list[tuple[str, bool]]:
+    """``(imported module, at module level)`` for every import of ``path``, relative ones resolved;
+    ``from X import name`` counts as importing ``X.name`` too (it may be a sub-module)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    package = _module_name(path) if path.name == "__init__.py" else _module_name(path).rpartition(".")[0]
+    found: list[tuple[str, bool]] = []
+
+    def visit(node: ast.AST, top: bool) -> None:
+        for child in ast.iter_child_nodes(node):
+            inside = top and not isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+            if isinstance(child, ast.Import):
+                found.extend((alias.name, top) for alias in child.names)
+            elif isinstance(child, ast.ImportFrom):
+                base = child.module or ""
+                if child.level:
+                    anchor = package.split(".")[: len(package.split(".")) - (child.level - 1)]
+                    base = ".".join([*anchor, base] if base else anchor)
+                found.append((base, top))
+                found.extend((f"{base}.{alias.name}", top) for alias in child.names)
+            visit(child, inside)
+
+    visit(tree, True)
+    return found
+
+
+MODULES = sorted(SRC.rglob("*.py"))
+
+
+def _in(name: str, package: str) -> bool:
+    return name == package or name.startswith(package + ".")
+
+
+def test_the_source_tree_is_found() -> None:
+    names = {_module_name(p) for p in MODULES}
+    assert {"rattle.demo", "rattle.results._comparison", "rattle.cli.app", "rattle.cli.commands"} <= names
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: _module_name(p))
+def test_imports_point_one_way(path: Path) -> None:
+    me = _module_name(path)
+    imports = _imports(path)
+    if not (_in(me, "rattle.demo") or _in(me, "rattle.cli")):
+        assert not [m for m, _ in imports if _in(m, "rattle.demo")], f"{me} imports rattle.demo"
+    if _in(me, "rattle.results"):
+        bad = [m for m, top in imports if top and any(_in(m, p) for p in ("rattle.io", "rattle.plotting",
+                                                                               "rattle.analysis"))]
+        assert not bad, f"{me} imports {bad} when loaded; import them inside the delegate method"
+    if _in(me, "rattle.plotting"):
+        bad = [m for m, _ in imports if any(_in(m, p) for p in ("rattle.analysis", "rattle.demo", "rattle.cli"))]
+        assert not bad, f"{me} imports {bad}"
+    if _in(me, "rattle.cli"):
+        heavy = [m for m, top in imports if top and any(_in(m, p) for p in ("rattle.demo", "rattle.analysis"))]
+        assert not heavy, f"{me} imports {heavy} when loaded; import them inside the command"
