@@ -75,3 +75,13 @@ def test_imports_point_one_way(path: Path) -> None:
     if _in(me, "rattle.cli"):
         heavy = [m for m, top in imports if top and any(_in(m, p) for p in ("rattle.demo", "rattle.analysis"))]
         assert not heavy, f"{me} imports {heavy} when loaded; import them inside the command"
+
+
+def test_moved_column_lists_still_answer_from_io_with_a_warning() -> None:
+    import rattle.io
+    import rattle.results
+
+    for name in ("FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS"):
+        with pytest.warns(DeprecationWarning, match=f"`rattle.io.{name}` is deprecated; import it from rattle.results"):
+            assert getattr(rattle.io, name) == getattr(rattle.results, name)
+    assert "FRF_COLUMNS" not in rattle.io.__all__
