@@ -45,12 +45,12 @@ class FourierBasis:
         return c
 
     def from_complex(self, c: ComplexArray) -> FloatArray:
-        """Inverse of :meth:`to_complex` (c of length H + 1)."""
+        """Inverse of :meth:`to_complex` (c of length H + 1, or rows (..., H + 1))."""
         H = self.harmonics
-        q = np.empty(2 * H + 1)
-        q[0] = c[0].real
-        q[1 : H + 1] = 2.0 * c[1 : H + 1].real
-        q[H + 1 :] = -2.0 * c[1 : H + 1].imag
+        q = np.empty(c.shape[:-1] + (2 * H + 1,))
+        q[..., 0] = c[..., 0].real
+        np.multiply(c[..., 1 : H + 1].real, 2.0, out=q[..., 1 : H + 1])
+        np.multiply(c[..., 1 : H + 1].imag, -2.0, out=q[..., H + 1 :])
         return q
 
     def synthesize(self, q: FloatArray) -> FloatArray:
@@ -62,8 +62,9 @@ class FourierBasis:
         return np.fft.irfft(spec, n=N, axis=-1)
 
     def analyze(self, x: FloatArray) -> FloatArray:
-        """Coefficients q of the samples x (length N), truncated to H harmonics (real FFT)."""
-        spec = np.fft.rfft(x)[: self.harmonics + 1] / self.samples
+        """Coefficients q of the samples x (length N, or rows (..., N)), truncated to H
+        harmonics (real FFT)."""
+        spec = np.fft.rfft(x, axis=-1)[..., : self.harmonics + 1] / self.samples
         return self.from_complex(spec)
 
     def spectrum(self, x: FloatArray, orders: int) -> ComplexArray:

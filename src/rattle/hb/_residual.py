@@ -1,19 +1,26 @@
-"""Harmonic-balance residual of the equation in δ, with its analytic Jacobians.
+"""Harmonic-balance residual of a :class:`~rattle.model.System`, with its analytic Jacobians.
 
-For a solution of period p·T (T = 2π/Ω, base frequency ω = Ω/p, p = 1 for the primary
-response, p = n for a 1/n sub-harmonic) the Galerkin residual on q (see ``_basis``) is
+The system x'' + C x' + K x + Σ_e b_e f_e(a_e · x) = F(t) has n coordinates and m clearance
+elements (``rattle.model._system``). A solution of period p·T (T = 2π/Ω, base frequency
+ω = Ω/p; p = 1 for the primary response, p = n for a 1/n sub-harmonic) is stored as
+q = vec(Q), Q (n, 2H+1) COORDINATE-MAJOR: row i holds the real series [a_0, a_1…a_H, b_1…b_H]
+of x_i (see ``_basis``). The Galerkin residual is
 
-    R(q, Ω) = ∇(ω)² q + c ∇(ω) q + k Γ*[f(Γ q)] − F,
+    R_i(q, Ω) = ∇(ω)² q_i + Σ_j C_ij ∇(ω) q_j + Σ_j K_ij q_j + Σ_e b_e,i Γ*[f_e(Γ (a_e · Q))] − F_i,
 
-with c = C/I, k = K/I, Γ the synthesis (samples of δ), Γ* the analysis (real FFT) and F the
-coefficients of the excitation (its n-th harmonic sits at harmonic n·p of ω). The non-linear
-force is evaluated by alternating frequency–time (AFT). Its Jacobian is
+with Γ the synthesis (samples of a series), Γ* the analysis (real FFT) and F_i the coefficients
+of the forcing of coordinate i (its harmonic h sits at harmonic h·p of ω). The element forces
+are evaluated by alternating frequency–time (AFT) for all elements at once: one inverse FFT for
+all deflections δ_e = a_e · x, one FFT for all force and stiffness samples. The Jacobian is
 
-    ∂(Γ* f(Γq))/∂q = Γ* diag(∂f/∂δ(t_j)) Γ,
+    ∂R/∂q = I ⊗ ∇² + C ⊗ ∇ + K ⊗ I + Σ_e (b_e a_eᵀ) ⊗ J_e,   J_e = Γ* diag(f_e'(δ_e(t_j))) Γ,
 
-which we assemble exactly from the DFT coefficients G_m of the sampled stiffness g = ∂f/∂δ:
-in complex form the product g·δ has coefficients Σ_j G_{k−j} Q_j, a Toeplitz + Hankel matrix
-in the real basis (O(N log N + H²) instead of O(N H²)). Exact identity for N ≥ 4H + 1.
+and every J_e is assembled exactly from the DFT coefficients G_m of the sampled slope
+g = f_e'(δ_e): in complex form the product g·δ has coefficients Σ_j G_{k−j} Q_j, a Toeplitz +
+Hankel matrix in the real basis (O(N log N + H²) instead of O(N H²)), exact for N ≥ 4H + 1.
+
+The single equation of SPEC §1 is the case n = m = 1 (C = [[C/I]], K = [[0]], a = [1],
+b = [K/I]); it runs through the same code and gives the same numbers as the scalar formulas.
 """
 
 from __future__ import annotations
@@ -21,52 +28,53 @@ from __future__ import annotations
 import numpy as np
 
 from .._typing import FloatArray
-from ..model import Model
 from ._basis import FourierBasis
 from ._options import HBOptions
 
 
-def _jacobian_gather_tables(H: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Index and sign tables with J[r, c] = s1 V[i1] + s2 V[i2], V = [Re G_m, Im G_m], m = −2H … 2H.
+def _jacobian_gather_tables(H: int) -> tuple[np.ndarray, np.ndarray]:
+    """Index tables with J[r, c] = X[j1] + X[j2], X = [Vr, Vi, −Vr, −Vi, 0] (blocks of length
+    L = 4H + 1, Vr_m = Re G_m, Vi_m = Im G_m, m = −2H … 2H at position 2H + m; X[4L] = 0).
 
     From the complex product rule (g δ)_k = Σ_j G_{k−j} Q_j in the real basis:
-    row a_0: G0, ½(Gr_{−j} + Gr_j), ½(Gi_{−j} − Gi_j); row cos k: 2Gr_k, Gr_{k−j} + Gr_{k+j},
-    Gi_{k−j} − Gi_{k+j}; row sin k: −2Gi_k, −(Gi_{k−j} + Gi_{k+j}), Gr_{k−j} − Gr_{k+j}.
+    row a_0: G0, ½(Gr_{−j} + Gr_j) = Gr_j, ½(Gi_{−j} − Gi_j) = −Gi_j; row cos k: 2Gr_k,
+    Gr_{k−j} + Gr_{k+j}, Gi_{k−j} − Gi_{k+j}; row sin k: −2Gi_k, −(Gi_{k−j} + Gi_{k+j}),
+    Gr_{k−j} − Gr_{k+j}. Signs sit in X, so J is two gathers and one sum (no products).
     """
-    n = 2 * H + 1
-    off = 2 * H
-    im = 4 * H + 1  # start of the imaginary parts in V
-    i1 = np.zeros((n, n), dtype=np.intp)
-    i2 = np.zeros((n, n), dtype=np.intp)
-    s1 = np.zeros((n, n))
-    s2 = np.zeros((n, n))
+    S = 2 * H + 1
+    off, L = 2 * H, 4 * H + 1
+    R, I, nR, nI, zero = off, L + off, 2 * L + off, 3 * L + off, 4 * L
+    j1 = np.empty((S, S), dtype=np.intp)
+    j2 = np.empty((S, S), dtype=np.intp)
     k = np.arange(1, H + 1)
     K, J = np.meshgrid(k, k, indexing="ij")
-    a = slice(1, H + 1)
-    b = slice(H + 1, n)
-    # row a_0
-    i1[0, 0], s1[0, 0] = off, 1.0
-    i1[0, a], s1[0, a], i2[0, a], s2[0, a] = off - k, 0.5, off + k, 0.5
-    i1[0, b], s1[0, b], i2[0, b], s2[0, b] = im + off - k, 0.5, im + off + k, -0.5
-    # rows cos k
-    i1[a, 0], s1[a, 0] = off + k, 2.0
-    i1[a, a], s1[a, a], i2[a, a], s2[a, a] = off + K - J, 1.0, off + K + J, 1.0
-    i1[a, b], s1[a, b], i2[a, b], s2[a, b] = im + off + K - J, 1.0, im + off + K + J, -1.0
-    # rows sin k
-    i1[b, 0], s1[b, 0] = im + off + k, -2.0
-    i1[b, a], s1[b, a], i2[b, a], s2[b, a] = im + off + K - J, -1.0, im + off + K + J, -1.0
-    i1[b, b], s1[b, b], i2[b, b], s2[b, b] = off + K - J, 1.0, off + K + J, -1.0
-    return i1, s1, i2, s2
+    a, b = slice(1, H + 1), slice(H + 1, S)
+    j1[0, 0], j2[0, 0] = R, zero
+    j1[0, a], j2[0, a] = R + k, zero
+    j1[0, b], j2[0, b] = nI + k, zero
+    j1[a, 0], j2[a, 0] = R + k, R + k
+    j1[b, 0], j2[b, 0] = nI + k, nI + k
+    j1[a, a], j2[a, a] = R + K - J, R + K + J
+    j1[a, b], j2[a, b] = I + K - J, nI + K + J
+    j1[b, a], j2[b, a] = nI + K - J, nI + K + J
+    j1[b, b], j2[b, b] = R + K - J, nR + K + J
+    return j1, j2
 
 
 class HarmonicBalance:
-    """The discretised problem R(q, Ω) = 0 for one model, harmonic count and period multiple."""
+    """The discretised problem R(q, Ω) = 0 for one model, harmonic count and period multiple.
 
-    def __init__(self, model: Model, options: HBOptions | None = None, *, period: int = 1) -> None:
+    ``model`` is anything with a ``system()`` method returning a :class:`~rattle.model.System`
+    (a :class:`~rattle.model.Model`, a :class:`~rattle.model.Chain`); all numerics use
+    :attr:`system`. Unknowns q: n·(2H+1) numbers, coordinate-major (:meth:`coordinate_series`).
+    """
+
+    def __init__(self, model, options: HBOptions | None = None, *, period: int = 1) -> None:
         options = HBOptions() if options is None else options
         if isinstance(period, bool) or not isinstance(period, int) or period < 1:
             raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
-        n_forced = len(model.excitation.amplitudes)
+        system = model.system()
+        n_forced = system.forced_harmonics
         if options.harmonics < n_forced * period:
             raise ValueError(
                 f"`harmonics` must be >= {n_forced * period} to hold the excitation's harmonic "
@@ -74,144 +82,359 @@ class HarmonicBalance:
                 f"frequency), got {options.harmonics}"
             )
         self.model = model
+        self.system = system
         self.options = options
         self.period = period
         self.basis = FourierBasis(options.harmonics, options.n_samples)
         H = options.harmonics
+        S = 2 * H + 1
+        n, m = system.n, system.m
+        self.n_coordinates = n
+        self.n_elements = m
+        self._S = S
         self._k2 = self.basis.k**2
-        self._gather = _jacobian_gather_tables(H)
-        self._diag = np.arange(1, H + 1)
-        self.length_scale = model.length_scale()
-        self.force_scale = model.force_scale()
-        # Excitation coefficients: F_m at a_0, F_pn cos(nΩt + φ) at harmonic n·p.
-        F = np.zeros(2 * H + 1)
-        F[0] = model.excitation.mean
-        for n, amp, phi in zip(model.excitation.orders, model.excitation.amplitudes, model.excitation.phases):  # type: ignore[arg-type]
-            m = int(n) * period
-            F[m] += amp * np.cos(phi)
-            F[H + m] += -amp * np.sin(phi)
-        self.forcing = F
-        self._c = model.c
-        self._kstiff = model.k
-        self._st = model.elastic.stages
+        self.length_scale = system.length_scale()
+        self.force_scale = system.force_scale()
+        # Forcing coefficients: F_0 at a_0, harmonic h of Ω (F_ch cos + F_sh sin) at harmonic h·p.
+        F = np.zeros((n, S))
+        F[:, 0] = system.mean
+        for h in range(1, n_forced + 1):
+            r = h * period
+            F[:, r] += system.cos[h - 1]
+            F[:, H + r] += system.sin[h - 1]
+        self.forcing = F.reshape(-1)  # flat (n·(2H+1),); analyses may rescale it (homotopy)
+        # Linear part.
+        C = np.asarray(system.damping, dtype=float)
+        K = np.asarray(system.stiffness, dtype=float)
+        self._C, self._K = C, K
+        self._has_K = bool(np.any(K != 0.0))
+        self._Ck = C[:, :, None] * self.basis.k  # (n, n, H): C_ij k for ∂/∂ω
+        self._lin_index = self._linear_pattern()
+        self._c_scalar = float(C[0, 0]) if n == 1 else None
+        self._ck = C[0, 0] * self.basis.k if n == 1 else None
+        self._m2k2 = -2.0 * self._k2
+        self._tables: dict[int, tuple] = {}
+        # Spectrum buffer of the element deflections (harmonics above H stay zero).
+        self._synth = np.zeros((m, self.basis.samples // 2 + 1), dtype=complex)
+        self._synth_re, self._synth_im = self._synth.real, self._synth.imag
+        # Elements: δ = A x, force B f(δ); W_e = b_e a_eᵀ.
+        A = system.element_rows.reshape(m, n)
+        B = system.element_columns.reshape(n, m)
+        self._A, self._B = A, B
+        self._W = np.einsum("ie,ej->eij", B, A) if m else np.zeros((0, n, n))
+        self._Wmat = np.ascontiguousarray(self._W.reshape(m, n * n).T)  # (n², m)
+        # Elements whose a_e picks one coordinate (a unit row): δ_e is a row of Q, no product.
+        unit = [int(np.flatnonzero(a)[0]) for a in A if np.count_nonzero(a) == 1 and a[np.flatnonzero(a)[0]] == 1.0]
+        self._select = np.array(unit, dtype=np.intp) if len(unit) == m else None
+        self._laws = [
+            (np.asarray(e.breakpoints, dtype=float), np.asarray(e.slopes, dtype=float), np.asarray(e.offsets, dtype=float))
+            for e in system.elements
+        ]
 
+    # --- sizes and views -----------------------------------------------------------------------
     @property
     def size(self) -> int:
-        return self.basis.size
+        """Number of real unknowns n·(2H+1)."""
+        return self.n_coordinates * self._S
+
+    @property
+    def element_weights(self) -> FloatArray:
+        """W_e = b_e a_eᵀ (m, n, n): element e adds f_e'(δ_e) W_e to the tangent stiffness."""
+        return self._W
 
     def base_frequency(self, omega: float) -> float:
         """ω = Ω / p."""
         return omega / self.period
 
-    # --- pieces ----------------------------------------------------------------------------
-    def _linear_part(self, q: FloatArray, w: float) -> FloatArray:
-        """∇² q + c ∇ q (inertia and damping), for base frequency w."""
+    def coordinate_series(self, q: FloatArray) -> FloatArray:
+        """Q (n, 2H+1): row i is the real series of coordinate x_i (a view of ``q``)."""
+        return np.asarray(q).reshape(self.n_coordinates, self._S)
+
+    def element_series(self, q: FloatArray) -> FloatArray:
+        """The deflection series of every element, A Q, shape (m, 2H+1)."""
+        Q = self.coordinate_series(q)
+        if self._select is not None:
+            return Q[self._select]
+        return self._A @ Q
+
+    def element_samples(self, q: FloatArray) -> FloatArray:
+        """δ_e(t_j) at the N sample times of the base period, shape (m, N)."""
+        return self.basis.synthesize(self.element_series(q))
+
+    def coordinate_samples(self, q: FloatArray) -> FloatArray:
+        """x_i(t_j) at the N sample times of the base period, shape (n, N)."""
+        return self.basis.synthesize(self.coordinate_series(q))
+
+    # --- linear part ---------------------------------------------------------------------------
+    def _linear_pattern(self) -> np.ndarray:
+        """Flat positions in the (n·S, n·S) Jacobian of the linear part's entries, in the order of
+        the value buffer ``_lin_values`` (filled by :meth:`_linear_values`): the inertia diagonals
+        of the harmonic rows (with K_ii folded in), the rest of K, then the damping entries
+        (a_k, b_k) and (b_k, a_k)."""
+        n, S, H = self.n_coordinates, self._S, self.basis.harmonics
+        nS = n * S
+        rows = np.arange(1, S)
+        c = np.arange(n)[:, None]
+        pos = [((c * S + rows) * nS + c * S + rows).ravel()]  # (n, 2H)
+        K = self._K
+        kvals = []
+        for i, j in zip(*np.nonzero(K)):
+            rr = np.arange(S) if i != j else np.array([0])
+            pos.append((i * S + rr) * nS + j * S + rr)
+            kvals.append(np.full(rr.size, K[i, j]))
+        ci, cj = np.nonzero(self._C)
+        self._C_nonzero = self._C[ci, cj][:, None]  # (p, 1)
+        a = np.arange(1, H + 1)
+        pos.append(((ci[:, None] * S + a) * nS + cj[:, None] * S + a + H).ravel())
+        pos.append(((ci[:, None] * S + a + H) * nS + cj[:, None] * S + a).ravel())
+        # The value buffer and its parts (views), refilled at every call.
+        nd, nk, p = n * 2 * H, sum(v.size for v in kvals), ci.size
+        vals = np.zeros(nd + nk + 2 * p * H)
+        if kvals:
+            vals[nd : nd + nk] = np.concatenate(kvals)
+        self._lin_values = vals
+        self._lin_diag = vals[:nd].reshape(n, 2, H)
+        self._lin_c1 = vals[nd + nk : nd + nk + p * H].reshape(p, H)
+        self._lin_c2 = vals[nd + nk + p * H :].reshape(p, H)
+        self._K_diag = np.diagonal(K)[:, None, None].copy()
+        return np.concatenate(pos)
+
+    def _linear_values(self, kw: FloatArray, m2: FloatArray) -> FloatArray:
+        """Values at ``_lin_index`` of I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I, from kw = kω and m2 = −(kω)².
+        Returns the (reused) buffer: add it at once."""
+        d = self._lin_diag
+        d[:] = m2
+        if self._has_K:
+            d += self._K_diag
+        np.multiply(self._C_nonzero, kw, out=self._lin_c1)
+        np.negative(self._lin_c1, out=self._lin_c2)
+        return self._lin_values
+
+    def _linear_part(self, Q: FloatArray, kw: FloatArray, m2: FloatArray) -> FloatArray:
+        """(∇² + C ∇ + K) Q for the series Q (n, S), with kw = kω and m2 = −(kω)²."""
         H = self.basis.harmonics
-        a, b = q[1 : H + 1], q[H + 1 :]
-        kw = self.basis.k * w
-        out = np.empty_like(q)
-        out[0] = 0.0
-        out[1 : H + 1] = -(kw**2) * a + self._c * kw * b
-        out[H + 1 :] = -(kw**2) * b - self._c * kw * a
+        Qa, Qb = Q[:, 1 : H + 1], Q[:, H + 1 :]
+        out = np.empty_like(Q)
+        out[:, 0] = 0.0
+        oa, ob = out[:, 1 : H + 1], out[:, H + 1 :]
+        np.multiply(m2, Qa, out=oa)
+        np.multiply(m2, Qb, out=ob)
+        if self._c_scalar is not None:  # one coordinate: c kω as a scalar product
+            ckw = self._c_scalar * kw
+            oa += ckw * Qb
+            ob -= ckw * Qa
+        else:
+            oa += self._C @ (kw * Qb)
+            ob -= self._C @ (kw * Qa)
+        if self._has_K:
+            out += self._K @ Q
         return out
 
-    def _linear_part_dw(self, q: FloatArray, w: float) -> FloatArray:
+    def _linear_part_dw(self, Q: FloatArray, w: float) -> FloatArray:
         """∂/∂ω of :meth:`_linear_part`."""
         H = self.basis.harmonics
-        a, b = q[1 : H + 1], q[H + 1 :]
-        k = self.basis.k
-        out = np.empty_like(q)
-        out[0] = 0.0
-        out[1 : H + 1] = -2.0 * self._k2 * w * a + self._c * k * b
-        out[H + 1 :] = -2.0 * self._k2 * w * b - self._c * k * a
+        Qa, Qb = Q[:, 1 : H + 1], Q[:, H + 1 :]
+        out = np.empty_like(Q)
+        out[:, 0] = 0.0
+        m2k = self._m2k2 * w
+        oa, ob = out[:, 1 : H + 1], out[:, H + 1 :]
+        np.multiply(m2k, Qa, out=oa)
+        np.multiply(m2k, Qb, out=ob)
+        if self._c_scalar is not None:
+            oa += self._ck * Qb
+            ob -= self._ck * Qa
+        else:
+            k = self.basis.k
+            oa += self._C @ (k * Qb)
+            ob -= self._C @ (k * Qa)
         return out
 
     def linear_matrix(self, omega: float) -> FloatArray:
-        """Matrix of :meth:`_linear_part` at forcing frequency Ω, shape (2H+1, 2H+1)."""
-        w = self.base_frequency(omega)
-        H = self.basis.harmonics
-        kw = self.basis.k * w
-        D = np.zeros((2 * H + 1, 2 * H + 1))
-        i = np.arange(1, H + 1)
-        D[i, i] = -(kw**2)
-        D[i + H, i + H] = -(kw**2)
-        D[i, i + H] = self._c * kw
-        D[i + H, i] = -self._c * kw
-        return D
+        """I ⊗ ∇² + C ⊗ ∇ + K ⊗ I at forcing frequency Ω, shape (n·(2H+1), n·(2H+1))."""
+        nS = self.size
+        kw = self.basis.k * self.base_frequency(omega)
+        L = np.zeros(nS * nS)
+        L[self._lin_index] = self._linear_values(kw, -(kw**2))
+        return L.reshape(nS, nS)
+
+    # --- element forces (AFT, all elements at once) ----------------------------------------------
+    def _synthesize_elements(self, D: FloatArray) -> FloatArray:
+        """δ_e(t_j) (m, N) of the deflection series D (m, S): one inverse real FFT for all."""
+        H, N = self.basis.harmonics, self.basis.samples
+        re, im = self._synth_re, self._synth_im
+        np.multiply(D[:, :1], N, out=re[:, :1])
+        np.multiply(D[:, 1 : H + 1], 0.5 * N, out=re[:, 1 : H + 1])
+        np.multiply(D[:, H + 1 :], -0.5 * N, out=im[:, 1 : H + 1])
+        return np.fft.irfft(self._synth, n=N, axis=1)
+
+    def _element_samples(self, delta: FloatArray) -> FloatArray:
+        """Rows 0…m−1: f_e(δ_e(t_j)); rows m…2m−1: f_e'(δ_e(t_j)); shape (2m, N)."""
+        m = self.n_elements
+        out = np.empty((2 * m, delta.shape[-1]))
+        for e, (bp, sl, off) in enumerate(self._laws):
+            d = delta[e]
+            j = np.searchsorted(bp, d, side="right")
+            g = np.take(sl, j, out=out[m + e])
+            np.multiply(g, d, out=out[e])
+            out[e] += off[j]
+        return out
 
     def _force_samples(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
-        st = self._st
-        j = np.searchsorted(st.breakpoints, delta, side="right")
-        s = st.slopes[j]
-        return s * delta + st.offsets[j], s
+        """f_e(δ) and f_e'(δ) for the samples δ (m, N) (or (N,) for one element)."""
+        d = np.asarray(delta, dtype=float)
+        fg = self._element_samples(d.reshape(self.n_elements, -1))
+        m = self.n_elements
+        return fg[:m].reshape(d.shape), fg[m:].reshape(d.shape)
+
+    def _element_forces(self, spec: np.ndarray) -> FloatArray:
+        """Σ_e b_e P_e (n, S) from the force spectra in the first m rows of ``spec``."""
+        P = self.basis.from_complex(spec[: self.n_elements, : self.basis.harmonics + 1] / self.basis.samples)
+        return self._B @ P
 
     def nonlinear_force(self, q: FloatArray) -> FloatArray:
-        """k Γ* f(Γ q): coefficients of the restoring force by AFT."""
-        f, _ = self._force_samples(self.basis.synthesize(q))
-        return self._kstiff * self.basis.analyze(f)
+        """Σ_e b_e Γ* f_e(Γ a_e·Q): coefficients of the element forces by AFT, flat (n·(2H+1),)."""
+        fg = self._element_samples(self._synthesize_elements(self.element_series(q)))
+        spec = np.fft.rfft(fg[: self.n_elements], axis=1)
+        return self._element_forces(spec).reshape(-1)
 
     def force_jacobian_from_stiffness(self, g: FloatArray) -> FloatArray:
-        """Γ* diag(g) Γ for stiffness samples g (length N), assembled from the DFT of g."""
-        return self._jacobian_from_spectrum(np.fft.rfft(g))
+        """Γ* diag(g) Γ for slope samples g (N,) → (2H+1, 2H+1), or rows (k, N) → (k, 2H+1, 2H+1);
+        assembled from the DFT of g."""
+        g = np.asarray(g, dtype=float)
+        J = self._jacobians_from_spectra(np.fft.rfft(g.reshape(-1, g.shape[-1]), axis=1))
+        return J[0] if g.ndim == 1 else J
 
-    def _jacobian_from_spectrum(self, spec: np.ndarray) -> FloatArray:
+    def _product_tables(self, k: int) -> tuple[FloatArray, np.ndarray, np.ndarray]:
+        """Buffer X (k, 4L+1) and gather tables for k signals at once (cached per k)."""
+        got = self._tables.get(k)
+        if got is None:
+            j1, j2 = _jacobian_gather_tables(self.basis.harmonics)
+            size = 4 * (4 * self.basis.harmonics + 1) + 1
+            shift = (size * np.arange(k))[:, None, None]
+            X = np.zeros((k, size))
+            got = self._tables[k] = (X, j1[None] + shift, j2[None] + shift)
+        return got
+
+    def _jacobians_from_spectra(self, spec: np.ndarray) -> FloatArray:
+        """J_e = Γ* diag(g_e) Γ (k, S, S) from the rfft spectra (k, ≥ 2H+1) of k slope signals
+        (see :func:`_jacobian_gather_tables`)."""
         H = self.basis.harmonics
-        G = spec[: 2 * H + 1] / self.basis.samples
-        V = np.concatenate((G.real[:0:-1], G.real, -G.imag[:0:-1], G.imag))  # Re, Im of G_m, m = −2H … 2H
-        i1, s1, i2, s2 = self._gather
-        return s1 * V[i1] + s2 * V[i2]
+        S = 2 * H + 1
+        off, L = 2 * H, 4 * H + 1
+        X, j1, j2 = self._product_tables(spec.shape[0])
+        G = spec[:, :S] / self.basis.samples
+        Gr, Gi = G.real, G.imag
+        X[:, off:L] = Gr
+        X[:, :off] = Gr[:, :0:-1]
+        X[:, L + off : 2 * L] = Gi
+        np.negative(Gi[:, :0:-1], out=X[:, L : L + off])
+        np.negative(X[:, : 2 * L], out=X[:, 2 * L : 4 * L])
+        J = np.take(X, j1)
+        J += np.take(X, j2)
+        return J
 
-    # --- residual and Jacobians ------------------------------------------------------------
+    def _assemble(self, Je: FloatArray) -> FloatArray:
+        """Σ_e W_e ⊗ J_e (n·S, n·S) from the element blocks J_e (m, S, S)."""
+        n, S, m = self.n_coordinates, self._S, self.n_elements
+        nS = n * S
+        if m == 0:
+            return np.zeros((nS, nS))
+        full = self._Wmat @ Je.reshape(m, S * S)  # (n², S²)
+        if n == 1:
+            return full.reshape(S, S)
+        return np.ascontiguousarray(full.reshape(n, n, S, S).transpose(0, 2, 1, 3)).reshape(nS, nS)
+
+    # --- residual and Jacobians ----------------------------------------------------------------
     def residual(self, q: FloatArray, omega: float) -> FloatArray:
-        """R(q, Ω), shape (2H+1,)."""
-        w = self.base_frequency(omega)
-        return self._linear_part(q, w) + self.nonlinear_force(q) - self.forcing
+        """R(q, Ω), shape (n·(2H+1),)."""
+        kw = self.basis.k * self.base_frequency(omega)
+        R = self._linear_part(self.coordinate_series(q), kw, -(kw**2))
+        if self.n_elements:
+            R += self.nonlinear_force(q).reshape(R.shape)
+        R = R.reshape(-1)
+        R -= self.forcing
+        return R
 
     def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """R, ∂R/∂q (2H+1, 2H+1) and ∂R/∂Ω (2H+1,) in one AFT pass."""
+        """R (n·S,), ∂R/∂q (n·S, n·S) and ∂R/∂Ω (n·S,) in one AFT pass (S = 2H+1)."""
         w = self.base_frequency(omega)
-        basis = self.basis
-        H = basis.harmonics
-        delta = basis.synthesize(q)
-        f, g = self._force_samples(delta)
-        spec = np.fft.rfft(np.stack((f, g)), axis=1)  # one FFT call for force and stiffness
-        R = self._linear_part(q, w) + self._kstiff * basis.from_complex(spec[0, : H + 1] / basis.samples) - self.forcing
-        Rq = self._jacobian_from_spectrum(spec[1])
-        Rq *= self._kstiff
-        # Add the linear (inertia, damping) blocks on their diagonals.
-        i = self._diag
-        kw = basis.k * w
-        Rq[i, i] -= kw**2
-        Rq[i + H, i + H] -= kw**2
-        Rq[i, i + H] += self._c * kw
-        Rq[i + H, i] -= self._c * kw
-        Rw = self._linear_part_dw(q, w) / self.period
+        m = self.n_elements
+        Q = self.coordinate_series(q)
+        kw = self.basis.k * w
+        m2 = -(kw**2)
+        R = self._linear_part(Q, kw, m2)
+        if m:
+            fg = self._element_samples(self._synthesize_elements(self.element_series(q)))
+            spec = np.fft.rfft(fg, axis=1)  # one FFT call for every element's force and slope
+            R += self._element_forces(spec)
+            Rq = self._assemble(self._jacobians_from_spectra(spec[m:]))
+        else:
+            Rq = np.zeros((self.size, self.size))
+        R = R.reshape(-1)
+        R -= self.forcing
+        Rq.reshape(-1)[self._lin_index] += self._linear_values(kw, m2)
+        Rw = self._linear_part_dw(Q, w).reshape(-1)
+        Rw /= self.period
         return R, Rq, Rw
 
+    # --- slopes along an orbit -----------------------------------------------------------------
+    def element_slopes(self, q: FloatArray) -> FloatArray:
+        """f_e'(δ_e(t_j)) (m, N): every element's law slope at the N sample times of the orbit."""
+        return self._element_samples(self.element_samples(q))[self.n_elements :]
+
+    def tangent_stiffness_samples(self, q: FloatArray) -> FloatArray:
+        """K + Σ_e f_e'(δ_e(t_j)) b_e a_eᵀ at the N sample times, shape (N, n, n)."""
+        g = self.element_slopes(q)
+        return self._K + np.tensordot(g.T, self._W, axes=(1, 0))
+
     def stiffness_samples(self, q: FloatArray) -> FloatArray:
-        """k ∂f/∂δ at the N sample times of the orbit q."""
-        return self._kstiff * self._force_samples(self.basis.synthesize(q))[1]
+        """The single coordinate's tangent stiffness K + Σ_e b_e a_e f_e'(δ_e) at the N sample
+        times (N,) — for the single equation k ∂f/∂δ; n = 1 only (else
+        :meth:`tangent_stiffness_samples`)."""
+        if self.n_coordinates != 1:
+            raise ValueError(
+                f"`stiffness_samples` is the n = 1 form; this system has n = {self.n_coordinates} "
+                "coordinates: use `tangent_stiffness_samples` (N, n, n) or `element_slopes` (m, N)"
+            )
+        g = self.element_slopes(q)
+        w = self._W[:, 0, 0]
+        out = w[0] * g[0] if self.n_elements == 1 else w @ g
+        return out + self._K[0, 0] if self._has_K else out
 
-    def linear_solution(self, omega: float, stiffness_slope: float | None = None, center: float | None = None) -> FloatArray:
-        """Closed-form solution of the equation linearised about a stage.
+    # --- linear response -----------------------------------------------------------------------
+    def linear_solution(
+        self, omega: float, stiffness_slope: float | FloatArray | None = None, center: float | FloatArray | None = None,
+    ) -> FloatArray:
+        """Closed-form steady state of the system linearised about a stage combination.
 
-        With f ≈ s (δ − δ_c) + f(δ_c) on the stage holding δ_c (default: the static equilibrium),
-        each excitation harmonic m of ω gives X_m = F_m / (k s − (mω)² + i c mω).
+        About the centre x_c (default: the static equilibrium), every element is replaced by its
+        stage holding a_e·x_c (or the slopes ``stiffness_slope``, one per element), so that
+        K_s = K + Σ_e s_e b_e a_eᵀ, and every forcing harmonic h of ω gives
+        X_h = (K_s − (hω)² I + i hω C)⁻¹ F_h; the mean is x_c. For n = m = 1: X = F/(k s − (hω)² + i c hω).
         """
-        model = self.model
-        dc = model.static_equilibrium() if center is None else center
-        s = float(model.elastic.stiffness(dc)) if stiffness_slope is None else stiffness_slope
-        H = self.basis.harmonics
+        system = self.system
+        n, H = self.n_coordinates, self.basis.harmonics
+        xc = system.static_equilibrium() if center is None else np.asarray(center, dtype=float).reshape(n)
+        if stiffness_slope is None:
+            stages = system.stages_of(xc)
+            slopes = np.array([e.slopes[s] for e, s in zip(system.elements, stages)])
+        else:
+            slopes = np.asarray(stiffness_slope, dtype=float).reshape(self.n_elements)
+        Ks = self._K + np.tensordot(slopes, self._W, axes=(0, 0)) if self.n_elements else self._K.copy()
         w = self.base_frequency(omega)
-        q = np.zeros(2 * H + 1)
-        q[0] = dc
-        m = self.basis.k * w
-        denom = model.k * s - m**2 + 1j * model.c * m
-        Fc = self.forcing[1 : H + 1] - 1j * self.forcing[H + 1 :]
-        X = Fc / denom
-        q[1 : H + 1] = X.real
-        q[H + 1 :] = -X.imag
-        return q
+        hw = self.basis.k * w
+        F = self.forcing.reshape(n, self._S)
+        Fc = F[:, 1 : H + 1] - 1j * F[:, H + 1 :]  # (n, H)
+        if n == 1:
+            X = Fc / (Ks[0, 0] - hw**2 + 1j * self._C[0, 0] * hw)
+        else:
+            Z = Ks[None] - (hw**2)[:, None, None] * np.eye(n) + 1j * hw[:, None, None] * self._C[None]
+            X = np.linalg.solve(Z, Fc.T[:, :, None])[:, :, 0].T
+        Q = np.zeros((n, self._S))
+        Q[:, 0] = xc
+        Q[:, 1 : H + 1] = X.real
+        Q[:, H + 1 :] = -X.imag
+        return Q.reshape(-1)
 
 
 __all__ = ["HarmonicBalance"]
