@@ -23,12 +23,9 @@ from typing import TYPE_CHECKING, Any
 
 
 def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version  # ~50 ms: only when asked
+    from ._release import version
 
-    try:
-        return version("rattle")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        return "0.1.0"
+    return version()
 
 #: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
 _LAZY: dict[str, str] = {

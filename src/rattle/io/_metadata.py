@@ -29,16 +29,10 @@ __all__ = ["rattle_version", "environment", "to_jsonable", "metadata_document", 
 
 
 def rattle_version() -> str:
-    """The installed rattle version: ``rattle.__version__``, else the package metadata, else ``"unknown"``."""
-    import rattle
+    """The installed rattle version (``rattle.__version__``)."""
+    from .._release import version
 
-    version = getattr(rattle, "__version__", None)
-    if isinstance(version, str) and version:
-        return version
-    try:
-        return importlib.metadata.version("rattle")
-    except importlib.metadata.PackageNotFoundError:
-        return "unknown"
+    return version()
 
 
 def _package_version(name: str) -> str | None:
