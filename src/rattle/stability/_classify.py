@@ -75,13 +75,12 @@ def critical_distance(multipliers: ComplexArray) -> float:
     """Distance of the nearest multiplier to where it would change the stability: |μ − 1| or
     |μ + 1| for every multiplier, and ||μ| − 1| for a complex one (n ≥ 2 only can reach it)."""
     mu = np.asarray(multipliers, dtype=complex)
-    if not np.all(np.isfinite(mu)):
-        return float("inf")
     d = np.minimum(np.abs(mu - 1.0), np.abs(mu + 1.0))
     if mu.shape[-1] > 2:
         cplx = np.abs(mu.imag) > COMPLEX_TOL * np.maximum(1.0, np.abs(mu))
         d = np.where(cplx, np.minimum(d, np.abs(np.abs(mu) - 1.0)), d)
-    return float(np.min(d))
+    dmin = float(np.min(d))
+    return dmin if np.isfinite(dmin) else float("inf")
 
 
 __all__ = ["is_stable", "classify_loss", "torus_ratio", "critical_distance", "UNIT_CIRCLE_TOL", "COMPLEX_TOL"]

@@ -101,25 +101,25 @@ def _crossings(
     H = (Q.shape[1] - 1) // 2
     levels = np.asarray(levels, dtype=float)
     per_row = levels.ndim == 2
-    if not per_row:
-        levels = np.atleast_1d(levels)
-    k = levels.shape[-1]
-    pts, idxs, lvls, cols = [], [], [], []
-    for i in range(k):
-        d = levels[:, i] if per_row else levels[i]
-        s = samples > (d[:, None] if per_row else d)  # a NaN level (padding) never changes sign
-        change = s != np.roll(s, -1, axis=1)
+    levels = levels if per_row else np.atleast_1d(levels)
+    pts, idxs, cols = [], [], []
+    for i in range(levels.shape[-1]):
+        # Sign of δ − d at every sample (a NaN level, padding, never changes sign); a crossing
+        # lies between samples j and j + 1 (cyclically).
+        above = samples > (levels[:, i, None] if per_row else levels[i])
+        change = np.empty_like(above)
+        np.not_equal(above[:, :-1], above[:, 1:], out=change[:, :-1])
+        np.not_equal(above[:, -1], above[:, 0], out=change[:, -1])
         p, j = np.nonzero(change)
         pts.append(p)
         idxs.append(j)
-        lvls.append(d[p] if per_row else np.full(p.size, d))
         cols.append(np.full(p.size, i))
     if not pts:
         return np.empty(0, dtype=int), np.empty(0), np.empty(0), np.empty(0, dtype=int)
     p = np.concatenate(pts)
     j = np.concatenate(idxs)
-    lvl = np.concatenate(lvls)
     col = np.concatenate(cols)
+    lvl = levels[p, col] if per_row else levels[col]
     if p.size == 0:
         return p, np.empty(0), lvl, col
     T = 2 * np.pi / omega[p]
@@ -214,7 +214,8 @@ def _padded_levels(breakpoints: Sequence[FloatArray]) -> FloatArray:
 
 
 def _segments(
-    S: FloatArray, omega: FloatArray, samples: FloatArray, breakpoints: Sequence[FloatArray]
+    S: FloatArray, omega: FloatArray, samples: FloatArray, breakpoints: Sequence[FloatArray],
+    levels: FloatArray | None = None,
 ) -> tuple[FloatArray, np.ndarray, np.ndarray]:
     """Segments of each orbit between the crossings of all its elements.
 
@@ -223,23 +224,21 @@ def _segments(
     durations (padded with zero-length segments), ``combo`` (P, G) the flat index of each
     segment's stage combination (mixed radix over the elements' stage counts, first element
     most significant) and ``counts`` (P, m, k_max) the crossings per element per breakpoint.
+    ``levels`` the breakpoints padded to (m, k_max) with NaN, if already at hand.
     """
     P, m, n_coef = S.shape
     H = (n_coef - 1) // 2
     T = 2 * np.pi / omega
-    levels = _padded_levels(breakpoints)
+    levels = _padded_levels(breakpoints) if levels is None else levels
     kmax = levels.shape[1]
-    counts_pb = np.zeros((P, m, kmax), dtype=int)
     if m == 1:  # one element: one set of levels for all rows, rows = points (sorted by time)
         p, t, _, col = _crossings(S[:, 0], omega, samples[:, 0], levels[0])
-        if p.size:
-            np.add.at(counts_pb, (p, 0, col), 1)
+        counts_pb = np.bincount(p * kmax + col, minlength=P * kmax).reshape(P, 1, kmax)
     else:
         rows, t, _, col = _crossings(S.reshape(P * m, n_coef), np.repeat(omega, m),
                                      samples.reshape(P * m, -1), np.tile(levels, (P, 1)))
-        p, e = np.divmod(rows, m)
-        if p.size:
-            np.add.at(counts_pb, (p, e, col), 1)
+        counts_pb = np.bincount(rows * kmax + col, minlength=P * m * kmax).reshape(P, m, kmax)
+        p = rows // m
         order = np.lexsort((t, p))
         p, t = p[order], t[order]
     counts = np.bincount(p, minlength=P)
@@ -254,7 +253,7 @@ def _segments(
     kw = np.arange(1, H + 1)[None, None, :] * omega[:, None, None]
     ph = kw * mids[:, :, None]
     c, s = np.cos(ph), np.sin(ph)
-    combo = np.zeros((P, G), dtype=np.intp)
+    combo = np.empty(0)
     for e, bp in enumerate(breakpoints):
         delta_mid = (
             S[:, None, e, 0]
@@ -398,7 +397,7 @@ def monodromy_and_crossings_batch(
     shape (P, k): the orbit's crossing structure, which changes where it grazes a breakpoint.
     (The single-element case of :func:`element_monodromy_batch`, stage stiffnesses given.)"""
     bp = np.atleast_1d(np.asarray(stage_breakpoints, dtype=float))
-    tau, combo, counts = _segments(Q[:, None, :], omega, samples[:, None, :], [bp])
+    tau, combo, counts = _segments(Q[:, None, :], omega, samples[:, None, :], (bp,), bp[None, :])
     phis = stage_transition(np.asarray(stage_stiffness, dtype=float)[combo], damping, tau)
     return _chain_product(phis), counts[:, 0]
 

@@ -23,6 +23,7 @@ the shifted point grazes (a different structure) the backward quotient is taken 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -74,10 +75,8 @@ class FloquetMonitor:
 
     def monodromy_and_crossings(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
         """Monodromies (P, 2n, 2n) and crossings (P, m, k_max) of the orbits ``Q`` (P, n·(2H+1))
-        at forcing frequencies ``Om`` (P,)."""
+        at forcing frequencies ``Om`` (P,) (arrays)."""
         hb = self.hb
-        Q = np.atleast_2d(np.asarray(Q, dtype=float))
-        Om = np.atleast_1d(np.asarray(Om, dtype=float))
         w = Om / hb.period
         if self._single:
             M, counts = monodromy_and_crossings_batch(Q, w, hb.basis.synthesize(Q), self._breakpoints,
@@ -88,7 +87,7 @@ class FloquetMonitor:
 
     def monodromy(self, q: FloatArray, omega: float) -> FloatArray:
         """The exact monodromy (2n, 2n) of the orbit q at forcing frequency Ω."""
-        return self.monodromy_and_crossings(q[None, :], np.array([omega]))[0][0]
+        return self.monodromy_and_crossings(np.asarray(q, dtype=float)[None, :], np.array([float(omega)]))[0][0]
 
     def test_functions(self, q: FloatArray, omega: float) -> FloatArray:
         """ψ (fold, period doubling[, Neimark–Sacker]) at one point: ``names`` gives the order."""
@@ -123,8 +122,8 @@ class FloquetMonitor:
                 slopes = (psi[0] - psi_b[0]) / eps
             else:  # grazing within ±ε: no derivative; the stepper treats the point as a kink
                 slopes = np.full(psi.shape[1], np.nan)
-        distance = critical_distance(multipliers_from_monodromy(M[0])) if np.all(np.isfinite(M[0])) else np.inf
-        return MonitorReading(psi[0], slopes, here, float(distance))
+        distance = critical_distance(multipliers_from_monodromy(M[0])) if np.isfinite(M[0]).all() else math.inf
+        return MonitorReading(psi[0], slopes, here, distance)
 
 
 __all__ = ["FloquetMonitor", "EPSILON", "hb_system"]
