@@ -14,16 +14,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..plotting._frf import (
-    branch_colors,
-    draw_branches,
-    draw_regions,
-    draw_special_points,
-    frequency_response_plot,
-    branch_label,
-    place_legend,
-    _runs,
+    branch_colors, branch_label, draw_branches, draw_regions, draw_special_points, frequency_response_plot, place_legend,
+    true_runs,
 )
-from ..plotting._orbit import _amplitudes_from_samples
+from ..plotting._orbit import amplitude_spectrum
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._report import LevelDifference
@@ -336,7 +330,7 @@ def point_plot(
                   ls="none", zorder=7, label=f"simulation at t = k·2π/Ω ({len(set(np.round(win['delta'][strobe], 6)))} distinct points)")
         if ax_s is not None and p >= 1:
             one = win["delta"][: samples * p]  # one full period, endpoint excluded
-            f, amp = _amplitudes_from_samples(one, p, SPECTRUM_ORDERS)
+            f, amp = amplitude_spectrum(one, p, SPECTRUM_ORDERS)
             keep = amp > 1e-7
             ax_s.plot(f[keep], amp[keep], "o", mfc="none", mec="black", ms=9, mew=1.2, ls="none",
                       label=f"simulation ({_sim_text(p)})")
@@ -457,7 +451,7 @@ def mean_operating_point_plot(
 
     for b, color in colors.items():
         sel = np.flatnonzero(frf.branch == b)
-        for i0, i1 in _runs(np.asarray(frf.stable[sel], dtype=bool)):
+        for i0, i1 in true_runs(np.asarray(frf.stable[sel], dtype=bool)):
             rows = sel[i0:i1]  # a stable stretch runs monotonically in Ω (folds end it)
             if rows.size >= 2:
                 ax_r.fill_between(frf.omega[rows], frf.delta_min[rows], frf.delta_max[rows], color=color,

@@ -55,7 +55,7 @@ def column(frf: "FrequencyResponse", quantity: str) -> np.ndarray:
     return np.asarray(getattr(frf, quantity), dtype=float)
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """(start, stop) index pairs of consecutive True values, stop exclusive."""
     edges = np.diff(np.concatenate(([0], mask.astype(int), [0])))
     return list(zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]))
@@ -92,7 +92,7 @@ def draw_branches(
         base = branch_label(frf, b)
         for flag, style in ((True, "-"), (False, "--")):
             first = True
-            for i0, i1 in _runs(st == flag):
+            for i0, i1 in true_runs(st == flag):
                 # Extend each run by one point so that solid and dashed pieces join.
                 j1 = min(i1 + 1, sel.size)
                 lab = None
@@ -305,5 +305,5 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
 
 __all__ = [
     "frequency_response_plot", "column", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
-    "branch_colors", "branch_label", "SPECIAL_POINT_STYLES", "QUANTITY_LABELS",
+    "branch_colors", "branch_label", "true_runs", "SPECIAL_POINT_STYLES", "QUANTITY_LABELS",
 ]

@@ -34,7 +34,7 @@ def _solution_label(orbit: "PeriodicOrbit", i: int) -> str:
     return text + (" (selected)" if i == orbit.selected else "")
 
 
-def _amplitudes_from_samples(x: np.ndarray, periods: int, orders: int) -> tuple[np.ndarray, np.ndarray]:
+def amplitude_spectrum(x: np.ndarray, periods: int, orders: int) -> tuple[np.ndarray, np.ndarray]:
     """One-sided amplitudes of samples x (one window of ``periods`` forcing periods, endpoint
     excluded) at frequencies k Ω / periods up to ``orders`` Ω: (frequency / Ω, amplitude)."""
     n = x.size
@@ -138,14 +138,14 @@ def orbit_plot(
                   label=sim_label, zorder=5)
         if p:
             n_sim = int(round(sim["t"][-1] / Tf))
-            f, amp = _amplitudes_from_samples(sim["delta"][:-1], n_sim, SPECTRUM_ORDERS)
+            f, amp = amplitude_spectrum(sim["delta"][:-1], n_sim, SPECTRUM_ORDERS)
             show = amp > 1e-7 * max(float(np.max(amp)), 1e-300)
             ax_s.plot(f[show], amp[show], "o", mfc="none", mec="black", ms=7, mew=1.2, label=sim_label)
         else:  # not periodic: a continuous spectrum over the whole recorded window, as a line
             whole = orbit.simulated_history(samples=64, periods=10**6)
             if whole is not None:
                 n_sim = max(1, int(round(whole["t"][-1] / Tf)))
-                f, amp = _amplitudes_from_samples(whole["delta"][:-1], n_sim, SPECTRUM_ORDERS)
+                f, amp = amplitude_spectrum(whole["delta"][:-1], n_sim, SPECTRUM_ORDERS)
                 ax_s.plot(f, np.maximum(amp, 1e-12), "-", color="black", lw=0.8,
                           label=f"{sim_label} ({n_sim} periods)")
 
@@ -191,4 +191,4 @@ def orbit_plot(
     return fig, axes
 
 
-__all__ = ["orbit_plot", "window_periods"]
+__all__ = ["orbit_plot", "window_periods", "amplitude_spectrum"]
