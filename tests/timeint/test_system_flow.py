@@ -210,3 +210,42 @@ def test_tangential_touch_inside_a_grid_cell(excursion):
         np.testing.assert_allclose(traj.crossing_times, [apex - half, apex + half], rtol=0, atol=1e-9)
     else:
         assert traj.crossing_times.size == 0
+
+
+@pytest.mark.parametrize("damping", [1.0, 2.0])
+def test_critically_damped_stage_equals_exact_integrator(damping):
+    """c = 1: the clutch's inner stage (k s = 0.25) is critically damped; c = 2: the outer ones.
+    A double, defective eigenvalue: kept as a Taylor-summed block, exact."""
+    from rattle.model import Clutch, Excitation, Model
+
+    model = Model(inertia=1.0, damping=damping, stiffness=1.0, elastic=Clutch(alpha=0.25, b=0.1),
+                  excitation=Excitation(mean=0.05, amplitudes=(0.5,)))
+    omega = 0.7
+    T = 2 * math.pi / omega
+    ref = ExactIntegrator(model).propagate([0.0, 0.0], 0.0, 3 * T, omega)
+    integ = SystemIntegrator(model.system())
+    traj = integ.propagate([0.0, 0.0], 0.0, 3 * T, omega)
+    assert traj.crossing_times.size == ref.crossing_times.size > 0
+    np.testing.assert_allclose(traj.crossing_times, ref.crossing_times, rtol=0, atol=1e-11)
+    np.testing.assert_allclose(traj.state1, ref.state1, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(traj.sensitivity, ref.sensitivity, rtol=0, atol=1e-12 * np.abs(ref.sensitivity).max())
+    assert any(len(sol.clusters) and sol.method == "modal" for sol in integ.stages(omega)._cache.values())
+
+
+def test_matrix_exponential_fallback_equals_block_modal_form(monkeypatch):
+    """Every stage forced onto the scipy expm fallback gives the same trajectory."""
+    import rattle.timeint._stage_flow as stage_flow
+
+    system = free_chain()
+    omega = 0.8
+    T = 2 * math.pi / omega
+    z0 = _state(system)
+    modal = SystemIntegrator(system).propagate(z0, 0.0, T, omega)
+    monkeypatch.setattr(stage_flow, "_MAX_CONDITION", 0.0)
+    integ = SystemIntegrator(system)
+    fallback = integ.propagate(z0, 0.0, T, omega)
+    assert {sol.method for sol in integ.stages(omega)._cache.values()} == {"expm"}
+    np.testing.assert_allclose(fallback.crossing_times, modal.crossing_times, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fallback.state1, modal.state1, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(fallback.sensitivity, modal.sensitivity, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fallback.measures().rms, modal.measures().rms, rtol=1e-12)

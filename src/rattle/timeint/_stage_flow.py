@@ -15,22 +15,24 @@ with A_s = [[0, I], [−K_s, −C]], g_s = (0, F_0 − Σ_e b_e o_e), c_h = (0, 
   This covers, without special cases, a singular A_s (a free sub-chain inside a backlash gap:
   ramp- and parabola-type solutions) and the constant part of the force.
 
-exp(Ā τ) is evaluated exactly (to round-off) in a split form: a complex Schur decomposition of Ā
-puts the eigenvalues of a "zero cluster" (|λ| ≤ 1e-5 ρ, ρ the spectral radius — it holds the
-augmented eigenvalue 0 and any rigid-body-like modes of the stage, possibly defective) first, a
-Sylvester equation decouples that block from the rest, and the rest is diagonalised:
+exp(Ā τ) is evaluated exactly (to round-off) in a block-modal form. The eigenvalues of Ā are
+grouped: those closer than 1e-4 ρ to one another (ρ the spectral radius of A_s) form a cluster —
+the zero modes (the augmented eigenvalue 0 with any rigid-body-like mode of the stage, possibly
+defective) or a critically damped pair — and keep one block each, on an orthonormal basis of
+their invariant subspace (a sorted complex Schur form); every other eigenvalue is diagonalised:
 
-    Ā = P diag(T_0, Λ) P⁻¹,   exp(Ā τ) = P diag(exp(T_0 τ), e^{Λ τ}) P⁻¹.
+    Ā = P diag(μ_1 I + N_1, …, μ_c I + N_c, Λ) P⁻¹,
+    exp(Ā τ) = P diag(e^{μ_1 τ} exp(N_1 τ), …, e^{Λ τ}) P⁻¹,
 
-exp(T_0 τ) is the Taylor series of a nearly nilpotent block (a polynomial in τ for an exactly
+exp(N_j τ) being the Taylor series of a nearly nilpotent block (a polynomial in τ for an exactly
 nilpotent one: ramps and parabolas), summed until its terms are below round-off over the
-segment's length; e^{Λτ} are the stage's damped modes. Where P is ill-conditioned (a stage close
-to critical damping: two nearly equal non-zero eigenvalues) the stage falls back to
+segment's length. Where P is ill-conditioned anyway (cond > 1e6) the stage falls back to
 ``scipy.linalg.expm`` of Ā τ, slower but as exact.
 
 A :class:`Segment` is the solution from a state z_s at t_s on one stage combination, written as
-z(t_s + τ) = Re[Σ_j B_j e^{μ_j τ}] + Re[Σ_k Q_k τ^k] (modes μ: the diagonalised eigenvalues and
-the harmonics ihΩ, whose phases at t_s are folded into B so that τ, not t, carries the round-off),
+z(t_s + τ) = Re[Σ_j B_j e^{λ_j τ}] (modes λ: the diagonalised eigenvalues and
+the harmonics ihΩ, whose phases at t_s are folded into B so that τ, not t, carries the round-off;
+plus Re[e^{μ_j τ} Σ_k Q_jk τ^k] for every cluster block),
 evaluated vectorised for the crossing search and at single points for the root refinement.
 """
 
@@ -46,7 +48,7 @@ from ..model import System
 
 _EPS = float(np.finfo(float).eps)
 _TWO_PI = 2.0 * math.pi
-_ZERO_CLUSTER = 1e-5  # |λ| ≤ this × spectral radius: in the Taylor-summed block
+_CLUSTER = 1e-4  # eigenvalues closer than this × spectral radius share a Taylor-summed block
 _MAX_CONDITION = 1e6  # condition number of P beyond which the stage falls back to expm
 _SEGMENT_SCALES = 64.0  # longest segment, in stage time scales (a new segment starts beyond it)
 _MAX_TAYLOR = 200
@@ -187,7 +189,8 @@ class StageSolution:
     ``Zh`` (H, 2n) complex harmonic particular amplitudes; ``eigenvalues`` of A; ``time_scale``
     the fastest time scale (highest forcing harmonic, highest natural frequency, fastest decay);
     ``grid_step`` the crossing-search step; ``max_segment`` the longest segment; ``method``
-    ``"modal"`` (split Schur form) or ``"expm"`` (ill-conditioned fallback).
+    ``"modal"`` (block-modal form: ``clusters`` (start, stop, μ, N) and the diagonalised
+    eigenvalues ``lam``) or ``"expm"`` (ill-conditioned fallback).
     """
 
     def __init__(self, flow: SystemStages, stages: tuple[int, ...]) -> None:
@@ -247,69 +250,86 @@ class StageSolution:
         self.grid_step = scale / flow.samples_per_scale
         self.max_segment = _SEGMENT_SCALES * scale
 
-        # Split form of exp(Ā τ).
+        # Block-modal form of exp(Ā τ).
         self.method = "modal"
-        ztol = _ZERO_CLUSTER * rho
         try:
-            T, Z, sdim = sla.schur(Abar, output="complex", sort=lambda x: abs(x) <= ztol)
-            T11, T12, T22 = T[:sdim, :sdim], T[:sdim, sdim:], T[sdim:, sdim:]
-            if sdim and sdim < k:
-                Y = sla.solve_sylvester(T11, -T22, -T12)
-            else:
-                Y = np.zeros((sdim, k - sdim), dtype=complex)
-            lam2, V2 = np.linalg.eig(T22) if k - sdim else (np.zeros(0, dtype=complex), np.zeros((0, 0), dtype=complex))
-            V2inv = np.linalg.inv(V2) if k - sdim else V2
-            upper = np.eye(k, dtype=complex)
-            upper[:sdim, sdim:] = Y
-            upper_inv = np.eye(k, dtype=complex)
-            upper_inv[:sdim, sdim:] = -Y
-            P = Z @ upper
-            P[:, sdim:] = P[:, sdim:] @ V2
-            Pinv = upper_inv @ Z.conj().T
-            Pinv[sdim:, :] = V2inv @ Pinv[sdim:, :]
-            cond = float(np.linalg.norm(P, 2) * np.linalg.norm(Pinv, 2))
-            if not (math.isfinite(cond) and cond <= _MAX_CONDITION):
-                self.method = "expm"
+            self._block_modal_form(Abar, rho, hw)
         except (np.linalg.LinAlgError, ValueError):
             self.method = "expm"
-        if self.method == "modal":
-            self.sdim = sdim
-            self.T0 = T11
-            self.lam = lam2
-            self.P = P
-            self.Pinv = Pinv
-            self.Pz = P[: 2 * n]  # (2n, k)
-            self.Pd = flow.G @ self.Pz  # (2m, k)
-            self.Pz_poly, self.Pz_modal = self.Pz[:, :sdim], self.Pz[:, sdim:]
-            self.Pd_poly, self.Pd_modal = self.Pd[:, :sdim], self.Pd[:, sdim:]
-            self.T0_zero = not np.any(T11)
-            self.modes = np.concatenate((lam2, 1j * hw))
-            self.Pinv_z = Pinv[:, : 2 * n]
         self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
         self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
         self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
 
-    # --- pieces ---------------------------------------------------------------------------------
-    def harmonic_state(self, t: float) -> tuple[FloatArray, np.ndarray]:
-        """z_h(t) (2n,) and the phase-folded amplitudes Z_h e^{ihΩt} (H, 2n)."""
-        if not self.flow.hw.size:
-            return np.zeros(2 * self.flow.n), self.Zh
-        ph = np.exp(1j * self.flow.hw * t)
-        amps = self.Zh * ph[:, None]
-        return amps.sum(axis=0).real, amps
+    def _block_modal_form(self, Abar: np.ndarray, rho: float, hw: FloatArray) -> None:
+        """Ā = P diag(μ_1 I + N_1, …, μ_c I + N_c, Λ) P⁻¹: clusters of eigenvalues closer than
+        1e-4 ρ to each other (zero modes, critical damping; possibly defective) keep a block each
+        (an orthonormal basis of their invariant subspace from a sorted Schur form), the others
+        are diagonalised. Sets ``method`` to "expm" when P is ill-conditioned."""
+        n2 = Abar.shape[0] - 1
+        k = n2 + 1
+        lam, V = np.linalg.eig(Abar)
+        ctol = _CLUSTER * rho if rho > 0.0 else math.inf
+        # single-linkage clusters
+        label = list(range(k))
+        for i in range(k):
+            for j in range(i + 1, k):
+                if abs(lam[i] - lam[j]) <= ctol and label[i] != label[j]:
+                    old, new = label[j], label[i]
+                    label = [new if x == old else x for x in label]
+        groups: dict[int, list[int]] = {}
+        for i, g in enumerate(label):
+            groups.setdefault(g, []).append(i)
+        blocks, singles = [], []
+        for members in groups.values():
+            (blocks if len(members) > 1 else singles).append(members)
+        cols, clusters = [], []
+        start = 0
+        for members in blocks:
+            mu = complex(np.mean(lam[members]))
+            if abs(mu) <= ctol:
+                mu = 0j
+            elif abs(mu.imag) <= ctol:
+                mu = complex(mu.real, 0.0)
+            radius = max(abs(lam[i] - mu) for i in members) + 0.5 * ctol  # the other eigenvalues are farther
+            _, Z, sdim = sla.schur(Abar.astype(complex), output="complex", sort=lambda x: abs(x - mu) <= radius)
+            if sdim != len(members):
+                raise ValueError("cluster basis")
+            cols.append(Z[:, :sdim])
+            clusters.append((start, start + sdim, mu))
+            start += sdim
+        single = [i for members in singles for i in members]
+        cols.append(V[:, single])
+        P = np.concatenate(cols, axis=1) if cols else np.zeros((k, 0), dtype=complex)
+        Pinv = np.linalg.inv(P)
+        cond = float(np.linalg.norm(P, 2) * np.linalg.norm(Pinv, 2))
+        if not (math.isfinite(cond) and cond <= _MAX_CONDITION):
+            self.method = "expm"
+            return
+        self.clusters = []
+        for a, b, mu in clusters:
+            T = Pinv[a:b] @ Abar @ P[:, a:b]
+            self.clusters.append((a, b, mu, T - mu * np.eye(b - a)))
+        sdim = start
+        self.sdim = sdim
+        self.lam = lam[single]
+        self.P, self.Pinv = P, Pinv
+        self.Pz = P[:n2]
+        self.Pd = self.flow.G @ self.Pz
+        self.Pz_modal, self.Pd_modal = self.Pz[:, sdim:], self.Pd[:, sdim:]
+        self.modes = np.concatenate((self.lam, 1j * hw))
+        self.Pinv_z = Pinv[:, :n2]
 
+    # --- pieces ---------------------------------------------------------------------------------
     def transition(self, tau: float) -> FloatArray:
         """exp(A_s τ) (2n, 2n), exact to round-off."""
         if self.method == "expm":
             return sla.expm(self.A * tau)
         s = self.sdim
-        if self.T0_zero:
-            factors = np.ones(self.Pinv_z.shape[0], dtype=complex)
-            factors[s:] = np.exp(self.lam * tau)
-            return (self.Pz @ (factors[:, None] * self.Pinv_z)).real
-        right = self.Pinv_z.copy()
-        right[s:] *= np.exp(self.lam * tau)[:, None]
-        right[:s] = _taylor_expm(self.T0, tau) @ right[:s]
+        factors = np.ones(self.Pinv_z.shape[0], dtype=complex)
+        factors[s:] = np.exp(self.lam * tau)
+        right = factors[:, None] * self.Pinv_z
+        for a, b, mu, N in self.clusters:
+            right[a:b] = (np.exp(mu * tau) * _taylor_expm(N, tau)) @ right[a:b]
         return (self.Pz @ right).real
 
     def segment(self, ts: float, z: FloatArray, tau_max: float) -> Segment:
@@ -317,15 +337,24 @@ class StageSolution:
         return Segment(self, ts, z, tau_max)
 
 
+def _horner(Q: np.ndarray, tau: np.ndarray | float) -> np.ndarray | complex:
+    """Σ_k Q[k] τ^k (Q (K, …); τ broadcast against Q[0] with a trailing axis for arrays)."""
+    acc = Q[-1]
+    for k in range(Q.shape[0] - 2, -1, -1):
+        acc = acc * tau + Q[k]
+    return acc
+
+
 class Segment:
     """The exact solution on one stage combination from (t_s, z_s) (module docstring).
 
     ``state(tau)`` gives z = (x, x') and z' = (x', x'') at local times τ = t − t_s (vector or
     scalar); ``scan(taus)`` the element deflections δ and δ' (N, m) at once; ``element_point``
-    (δ_e, δ_e', δ_e'') of one element at one τ (the root finder's hot call).
+    (δ_e, δ_e', δ_e'') of one element at one τ (the root finder's hot call); ``end_state`` z at
+    one τ.
     """
 
-    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "c", "U", "ph", "Bd", "Qd", "w0", "_Bz", "_Qz",
+    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "c", "ph", "Bd", "w0", "poly", "_Bz", "_Qz",
                  "_floors", "_mu_l", "_bd_l", "_qd_l")
 
     def __init__(self, sol: StageSolution, ts: float, z: FloatArray, tau_max: float) -> None:
@@ -342,23 +371,23 @@ class Segment:
         self.ph = ph
         self._Bz = self._Qz = self._floors = None
         self._bd_l = self._qd_l = None
+        self.poly: list[tuple[complex, np.ndarray, np.ndarray, int, int]] = []  # (μ, U, Qd, a, b)
         if sol.method == "modal":
             w0 = np.empty(z.size + 1)
             w0[:-1] = z - zh0
             w0[-1] = 1.0
             c = sol.Pinv @ w0
-            s = sol.sdim
             self.c = c
             self.mu = sol.modes
-            self.Bd = np.concatenate((sol.Pd_modal.T * c[s:, None], sol.Zh_d * ph[:, None]), axis=0)  # (K, 2m)
-            self.U = U = c[None, :s] if sol.T0_zero else _taylor_terms(sol.T0, c[:s], tau_max)  # (Kp, s)
-            self.Qd = U @ sol.Pd_poly.T  # (Kp, 2m)
+            self.Bd = np.concatenate((sol.Pd_modal.T * c[sol.sdim:, None], sol.Zh_d * ph[:, None]), axis=0)  # (K, 2m)
+            for a, b, mu, N in sol.clusters:
+                U = _taylor_terms(N, c[a:b], tau_max)  # (Kp, d)
+                self.poly.append((mu, U, U @ sol.Pd[:, a:b].T, a, b))
             self.w0 = None
         else:
             self.w0 = np.concatenate((z - zh0, [1.0]))
             self.mu = 1j * hw
             self.Bd = sol.Zh_d * ph[:, None]
-            self.Qd = np.zeros((0, 2 * flow.m), dtype=complex)
         self._mu_l = self.mu.tolist()
 
     # --- lazily built pieces ------------------------------------------------------------------
@@ -375,10 +404,10 @@ class Segment:
         return self._Bz
 
     @property
-    def Qz(self) -> np.ndarray:
-        """Polynomial coefficients of z (Kp, 2n)."""
+    def Qz(self) -> list[tuple[complex, np.ndarray]]:
+        """Per cluster block: (μ, polynomial coefficients of z (Kp, 2n))."""
         if self._Qz is None:
-            self._Qz = self.U @ self.sol.Pz_poly.T if self.w0 is None else np.zeros((0, self.z0.size), dtype=complex)
+            self._Qz = [(mu, U @ self.sol.Pz[:, a:b].T) for mu, U, _, a, b in self.poly]
         return self._Qz
 
     def floors(self) -> tuple[FloatArray, FloatArray]:
@@ -389,9 +418,9 @@ class Segment:
             m = self.sol.flow.m
             dmag = np.abs(self.Bd[:, :m]).sum(axis=0)
             vmag = np.abs(self.Bd[:, m:]).sum(axis=0)
-            if self.Qd.shape[0]:
-                powers = self.tau_max ** np.arange(self.Qd.shape[0])
-                q = np.abs(self.Qd).T @ powers
+            for mu, _, Qd, _, _ in self.poly:
+                powers = self.tau_max ** np.arange(Qd.shape[0]) * max(1.0, math.exp(min(mu.real * self.tau_max, 700.0)))
+                q = np.abs(Qd).T @ powers
                 dmag, vmag = dmag + q[:m], vmag + q[m:]
             if self.w0 is not None:
                 G = self.sol.flow.G
@@ -409,8 +438,23 @@ class Segment:
 
     # --- evaluation -----------------------------------------------------------------------------
     def _expm_w(self, taus: FloatArray) -> np.ndarray:
-        """w(τ) = exp(Ā τ) w0 by scipy's expm (fallback stages), shape (N, 2n+1)."""
-        E = sla.expm(self.sol.Abar[None] * taus[:, None, None])
+        """w(τ) = exp(Ā τ) w0 (fallback stages), shape (N, 2n+1): scipy's expm, stepped by one
+        expm of the grid step where ``taus`` is an equally spaced grid."""
+        Abar = self.sol.Abar
+        if taus.size > 3:
+            h = taus[1] - taus[0]
+            inner = taus[1:-1] - taus[0]
+            if h > 0.0 and np.allclose(np.diff(inner), h, rtol=1e-12, atol=0.0):
+                E = sla.expm(Abar * h)
+                out = np.empty((taus.size, self.w0.size))
+                w = sla.expm(Abar * taus[0]) @ self.w0
+                out[0] = w
+                for i in range(1, taus.size - 1):
+                    w = E @ w
+                    out[i] = w
+                out[-1] = sla.expm(Abar * taus[-1]) @ self.w0
+                return out
+        E = sla.expm(Abar[None] * taus[:, None, None])
         return E @ self.w0
 
     def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -420,15 +464,9 @@ class Segment:
             y = (np.exp(np.multiply.outer(taus, self.mu)) @ self.Bd).real
         else:
             y = np.zeros((taus.size, 2 * m))
-        Q = self.Qd
-        kp = Q.shape[0]
-        if kp == 1:
-            y += Q[0].real
-        elif kp > 1:
-            acc = Q[-1] * taus[:, None]
-            for k in range(kp - 2, 0, -1):
-                acc = (acc + Q[k]) * taus[:, None]
-            y += (acc + Q[0]).real
+        for mu, _, Qd, _, _ in self.poly:
+            p = Qd[0] if Qd.shape[0] == 1 else _horner(Qd, taus[:, None])
+            y += (np.exp(mu * taus)[:, None] * p).real if mu != 0 else np.real(p)
         if self.w0 is not None:
             w = self._expm_w(taus)
             y = y + w[:, :-1] @ self.sol.flow.G.T
@@ -448,15 +486,16 @@ class Segment:
         else:
             z = np.zeros((t.size, n2))
             zd = np.zeros((t.size, n2))
-        Q = self.Qz
-        kp = Q.shape[0]
-        if kp:
-            tt = t[:, None]
-            acc = np.broadcast_to(Q[-1], (t.size, n2))
+        tt = t[:, None]
+        for mu, Q in self.Qz:
+            acc = np.broadcast_to(Q[-1], (t.size, n2)).astype(complex)
             dacc = np.zeros((t.size, n2), dtype=complex)
-            for k in range(kp - 2, -1, -1):
+            for k in range(Q.shape[0] - 2, -1, -1):
                 dacc = dacc * tt + acc
                 acc = acc * tt + Q[k]
+            if mu != 0:
+                e = np.exp(mu * t)[:, None]
+                acc, dacc = e * acc, e * (mu * acc + dacc)
             z = z + acc.real
             zd = zd + dacc.real
         if self.w0 is not None:
@@ -470,20 +509,16 @@ class Segment:
         if self.w0 is not None:
             return self.state(np.array([tau]))[0][0]
         sol = self.sol
-        s = sol.sdim
         e = np.exp(self.mu * tau)
         k2 = sol.lam.size
-        z = (sol.Pz_modal @ (e[:k2] * self.c[s:])).real
+        z = (sol.Pz_modal @ (e[:k2] * self.c[sol.sdim:])).real
         if self.ph.size:
             z += ((e[k2:] * self.ph) @ sol.Zh).real
-        U = self.U
-        if U.shape[0] == 1:
-            z += (sol.Pz_poly @ U[0]).real
-        else:
-            u = U[-1]
-            for k in range(U.shape[0] - 2, -1, -1):
-                u = u * tau + U[k]
-            z += (sol.Pz_poly @ u).real
+        for mu, U, _, a, b in self.poly:
+            u = U[0] if U.shape[0] == 1 else _horner(U, tau)
+            if mu != 0:
+                u = u * complex(np.exp(mu * tau))
+            z += (sol.Pz[:, a:b] @ u).real
         return z
 
     def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
@@ -496,7 +531,8 @@ class Segment:
         if self._bd_l is None:
             m = self.sol.flow.m
             self._bd_l = [list(zip(self._mu_l, self.Bd[:, i].tolist(), self.Bd[:, m + i].tolist())) for i in range(m)]
-            self._qd_l = [(self.Qd[:, i].tolist(), self.Qd[:, m + i].tolist()) for i in range(m)]
+            self._qd_l = [[(complex(mu), Qd[:, i].tolist(), Qd[:, m + i].tolist()) for mu, _, Qd, _, _ in self.poly]
+                          for i in range(m)]
         d = v = a = 0.0
         exp, cos, sin = math.exp, math.cos, math.sin
         for mu, b0, b1 in self._bd_l[e]:
@@ -507,18 +543,17 @@ class Segment:
             d += (b0 * ez).real
             v += b1e.real
             a += (mu * b1e).real
-        qd, qv = self._qd_l[e]
-        if len(qd) == 1:
-            d += qd[0].real
-            v += qv[0].real
-        elif qd:
-            pd = qd[-1]
-            pv = qv[-1]
-            dpv = 0j
+        for mu, qd, qv in self._qd_l[e]:
+            pd, pv, dpv = qd[-1], qv[-1], 0j
             for k in range(len(qd) - 2, -1, -1):
                 dpv = dpv * tau + pv
                 pd = pd * tau + qd[k]
                 pv = pv * tau + qv[k]
+            if mu != 0:
+                r = exp(mu.real * tau)
+                ph = mu.imag * tau
+                ez = complex(r * cos(ph), r * sin(ph))
+                pd, pv, dpv = pd * ez, pv * ez, (mu * pv + dpv) * ez
             d += pd.real
             v += pv.real
             a += dpv.real
