@@ -286,3 +286,72 @@ def test_hill_agrees_with_monodromy_for_two_coordinates():
         dist = np.abs(hill[:, None] - mono[None, :]) / np.maximum(1.0, np.abs(mono))
         assert np.max(np.min(dist, axis=0)) < 0.05, (omega, hill, mono)
         assert (np.max(np.abs(hill)) < 1) == (np.max(np.abs(mono)) < 1)
+
+
+def _stand_in_hb(system: System, H: int, samples: int):
+    """What FloquetMonitor reads of a harmonic-balance problem: ``system``, ``basis``, ``period``."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(system=system, basis=FourierBasis(H, samples), period=1, model=None)
+
+
+def test_monitor_reads_three_test_functions_with_slopes_and_structure():
+    system = two_dof()
+    H = 6
+    hb = _stand_in_hb(system, H, 64)
+    mon = FloquetMonitor(hb)
+    assert mon.names == ("fold", "period_doubling", "neimark_sacker")
+    q = _pad(ORBITS[2](4), H).ravel()
+    d = np.zeros_like(q)
+    d[[1, 2 * H + 2, 3]] = [0.6, -0.5, 0.3]
+    d /= np.linalg.norm(d)
+    omega = 1.3
+    reading = mon(q, omega, d, 0.2)
+    M, crossings = system_monodromy_batch(system, q.reshape(1, 2, -1), np.array([omega]))
+    np.testing.assert_allclose(reading.values, floquet_test_functions(M[0]), rtol=1e-10)
+    assert reading.structure == tuple(crossings[0].ravel()) and len(reading.structure) == 4
+    h = 1e-5
+    plus = mon.test_functions(q + h * d, omega + 0.2 * h)
+    minus = mon.test_functions(q - h * d, omega - 0.2 * h)
+    np.testing.assert_allclose(reading.slopes, (plus - minus) / (2 * h), rtol=1e-4, atol=1e-6)
+    assert mon.test_function("neimark_sacker")(q, omega) == pytest.approx(reading.values[2], rel=1e-12)
+    mu = multipliers_from_monodromy(M[0])
+    assert reading.distance == pytest.approx(critical_distance(mu))
+
+
+def test_neimark_sacker_located_and_labelled_with_its_torus_ratio():
+    """A 2-coordinate system with modal damping c₁ on its first mode: at c₁ = 0 the first mode's
+    pair e^{±iω₁T} is on the unit circle. ψ_ns changes sign there (neither ψ_fold nor ψ_pd does),
+    the zero located by the monitor's test function is c₁ = 0, the loss is labelled
+    neimark_sacker and the torus ratio is ω₁/ω folded into [0, 0.5]."""
+    K = np.array([[2.0, -0.5], [-0.5, 1.0]])
+    lam, V = np.linalg.eigh(K)
+    w1 = np.sqrt(lam[0])
+    omega = 1.7
+
+    def system(c1):
+        C = V @ np.diag([c1, 0.1]) @ V.T
+        far = ReducedElement("clutch", np.array([1.0, -1.0]), np.array([0.0, 0.0]), Clutch(alpha=0.5, b=0.5))
+        return System(damping=C, stiffness=K, elements=(far,), mean=np.zeros(2), cos=np.zeros((1, 2)),
+                      sin=np.zeros((1, 2)), coordinates=("a", "b"), angles=np.eye(2))
+
+    H = 4
+    q = np.zeros(2 * (2 * H + 1))
+    q[1] = 0.1  # a small orbit, far from the element's breakpoints
+
+    def psi(c1, kind="neimark_sacker"):
+        return FloquetMonitor(_stand_in_hb(system(c1), H, 32)).test_function(kind)(q, omega)
+
+    assert psi(-0.01) * psi(0.01) < 0
+    for kind in ("fold", "period_doubling"):
+        assert psi(-0.01, kind) * psi(0.01, kind) > 0
+    c_star = brentq(psi, -0.01, 0.01, xtol=1e-14)
+    assert abs(c_star) < 1e-10
+    mon = FloquetMonitor(_stand_in_hb(system(0.01), H, 32))
+    before = multipliers_from_monodromy(mon.monodromy(q, omega))
+    after = multipliers_from_monodromy(FloquetMonitor(_stand_in_hb(system(-0.01), H, 32)).monodromy(q, omega))
+    assert is_stable(before) and not is_stable(after)
+    assert classify_loss(before, after) == "neimark_sacker"
+    at = multipliers_from_monodromy(FloquetMonitor(_stand_in_hb(system(c_star), H, 32)).monodromy(q, omega))
+    ratio = (w1 / omega) % 1.0
+    assert torus_ratio(at) == pytest.approx(min(ratio, 1.0 - ratio), abs=1e-10)
