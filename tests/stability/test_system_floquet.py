@@ -355,3 +355,42 @@ def test_neimark_sacker_located_and_labelled_with_its_torus_ratio():
     at = multipliers_from_monodromy(FloquetMonitor(_stand_in_hb(system(c_star), H, 32)).monodromy(q, omega))
     ratio = (w1 / omega) % 1.0
     assert torus_ratio(at) == pytest.approx(min(ratio, 1.0 - ratio), abs=1e-10)
+
+
+def test_on_harmonic_balance_orbits_of_a_forced_chain():
+    """On converged HB orbits of the forced two-inertia chain: the Hill matrix built here from the
+    System equals the HB problem's own Jacobian ∂R/∂q, the monitor reads the real HB problem
+    (``hb.system``, coordinate-major q), and Hill's multipliers agree with the monodromy's. At
+    Ω = 1.2 a complex pair is outside the unit circle (ψ_ns < 0; measured |μ| = 1.06)."""
+    from rattle.hb import NewtonOptions, solve_harmonic_balance
+    from rattle.stability import hill_multipliers
+
+    class Holder:
+        def __init__(self, system):
+            self._system = system
+
+        def system(self):
+            return self._system
+
+    system = grounded_chain([1.0, 2.0], 1.0, 0.05, [(0, 1, 0.3, 0.02)],
+                            [("clutch", [1.0, -1.0], 2.0, Clutch(alpha=0.25, b=0.15)),
+                             ("gear", [0.0, 1.0], 1.5, Backlash(b=0.1))], torque=[0.3, 0.0])
+    hb = HarmonicBalance(Holder(system), HBOptions(harmonics=16))
+    signs = []
+    for omega in (0.9, 1.2):
+        res = solve_harmonic_balance(hb, hb.linear_solution(omega), omega, NewtonOptions())
+        assert res.converged
+        q = res.q
+        X = q.reshape(2, -1)
+        J, _ = system_hill_matrices(system, hb.basis, X, omega)
+        np.testing.assert_allclose(J, hb.residual_jacobian(q, omega)[1], rtol=0, atol=1e-11)
+        M, crossings = system_monodromy_batch(system, X[None], np.array([omega]))
+        assert np.all(crossings[0] >= 2)  # both elements cross both breakpoints
+        reading = FloquetMonitor(hb)(q, omega, np.eye(q.size)[1], 0.0)
+        np.testing.assert_allclose(reading.values, floquet_test_functions(M[0]), rtol=1e-9)
+        mono = multipliers_from_monodromy(M[0])
+        hill = hill_multipliers(hb, q, omega)
+        dist = np.abs(hill[:, None] - mono[None, :])
+        assert np.max(np.min(dist, axis=0)) < 1e-2, (omega, hill, mono)
+        signs.append(np.sign(reading.values[2]))
+    assert signs == [1.0, -1.0]
