@@ -177,8 +177,11 @@ def test_single_equation_is_the_n1_case_bit_for_bit():
                                rtol=1e-13)
     assert reading.structure == tuple(int(c) for c in crossings[0, 0])
     assert mon.test_function("fold")(Q[0], w[0]) == pytest.approx(reading.values[0], rel=1e-13)
+    # n = 1: the 1 × 1 bialternate product is det M; ψ_ns = det M − 1 = e^{−cT} − 1 < 0 (not monitored)
+    assert mon.test_function("neimark_sacker")(Q[0], w[0]) == pytest.approx(np.linalg.det(ref[0]) - 1.0, rel=1e-13)
+    np.testing.assert_allclose(second_compound(ref[0]), [[np.linalg.det(ref[0])]], rtol=1e-14)
     with pytest.raises(ValueError, match="`kind`"):
-        mon.test_function("neimark_sacker")
+        mon.test_function("torus")
 
 
 def test_test_functions_are_products_of_multiplier_expressions(rng):

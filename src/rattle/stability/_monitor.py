@@ -90,16 +90,22 @@ class FloquetMonitor:
         return self.monodromy_and_crossings(np.asarray(q, dtype=float)[None, :], np.array([float(omega)]))[0][0]
 
     def test_functions(self, q: FloatArray, omega: float) -> FloatArray:
-        """ψ (fold, period doubling[, Neimark–Sacker]) at one point: ``names`` gives the order."""
+        """The monitored ψ (fold, period doubling[, Neimark–Sacker for n ≥ 2]) at one point,
+        in the order of ``names``."""
         return floquet_test_functions(self.monodromy(q, omega))
 
     def test_function(self, kind: str) -> Callable[[FloatArray, float], float]:
-        """ψ_kind(q, Ω) for ``kind`` in ``names`` ("fold", "period_doubling", "neimark_sacker"),
-        e.g. to locate the zero between two branch points."""
-        if kind not in self.names:
-            raise ValueError(f"`kind` must be one of {self.names} for a system of {self.system.n} coordinate(s), got {kind!r}")
-        i = self.names.index(kind)
-        return lambda q, omega: float(self.test_functions(q, omega)[i])
+        """ψ_kind(q, Ω) for ``kind`` "fold" (det(M − I)), "period_doubling" (det(M + I)) or
+        "neimark_sacker" (det(M ⊙ M − I); for n = 1 the 1 × 1 bialternate product is det M, so
+        this is det M − 1, which never vanishes for damping c > 0): a scalar function whose zero
+        between two branch points locates the special point (e.g. with
+        ``continuation.locate_on_segment``)."""
+        if kind not in TEST_FUNCTIONS:
+            raise ValueError(f"`kind` must be one of {TEST_FUNCTIONS}, got {kind!r}")
+        i = TEST_FUNCTIONS.index(kind)
+        if i < 2 or self.system.n > 1:
+            return lambda q, omega: float(self.test_functions(q, omega)[i])
+        return lambda q, omega: float(np.linalg.det(self.monodromy(q, omega)) - 1.0)
 
     def _evaluate(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
         M, counts = self.monodromy_and_crossings(Q, Om)
