@@ -529,13 +529,15 @@ class Segment:
             n = self.sol.flow.n
             return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
         if self._bd_l is None:
+            self._bd_l, self._qd_l = {}, {}
+        terms = self._bd_l.get(e)
+        if terms is None:  # Python numbers of this element's terms, built on first use
             m = self.sol.flow.m
-            self._bd_l = [list(zip(self._mu_l, self.Bd[:, i].tolist(), self.Bd[:, m + i].tolist())) for i in range(m)]
-            self._qd_l = [[(complex(mu), Qd[:, i].tolist(), Qd[:, m + i].tolist()) for mu, _, Qd, _, _ in self.poly]
-                          for i in range(m)]
+            terms = self._bd_l[e] = list(zip(self._mu_l, self.Bd[:, e].tolist(), self.Bd[:, m + e].tolist()))
+            self._qd_l[e] = [(complex(mu), Qd[:, e].tolist(), Qd[:, m + e].tolist()) for mu, _, Qd, _, _ in self.poly]
         d = v = a = 0.0
         exp, cos, sin = math.exp, math.cos, math.sin
-        for mu, b0, b1 in self._bd_l[e]:
+        for mu, b0, b1 in terms:
             r = exp(mu.real * tau)
             ph = mu.imag * tau
             ez = complex(r * cos(ph), r * sin(ph))
