@@ -288,14 +288,26 @@ class HarmonicBalance:
 
     def _element_forces(self, spec: np.ndarray) -> FloatArray:
         """Σ_e b_e P_e (n, S) from the force spectra in the first m rows of ``spec``."""
-        P = self.basis.from_complex(spec[: self.n_elements, : self.basis.harmonics + 1] / self.basis.samples)
-        return self._B @ P
+        m = self.n_elements
+        P = self.basis.from_complex(spec[:m, : self.basis.harmonics + 1] / self.basis.samples)
+        return self._B * P if m == 1 else self._B @ P  # (n, 1) * (1, S): b P
+
+    def _forces(self, q: FloatArray) -> FloatArray:
+        """Σ_e b_e Γ* f_e(Γ a_e·Q), shape (n, S)."""
+        delta = self._synthesize_elements(self.element_series(q))
+        f = np.empty_like(delta)
+        for e, (bp, sl, off) in enumerate(self._laws):
+            d = delta[e]
+            j = np.searchsorted(bp, d, side="right")
+            np.multiply(sl[j], d, out=f[e])
+            f[e] += off[j]
+        return self._element_forces(np.fft.rfft(f, axis=1))
 
     def nonlinear_force(self, q: FloatArray) -> FloatArray:
         """Σ_e b_e Γ* f_e(Γ a_e·Q): coefficients of the element forces by AFT, flat (n·(2H+1),)."""
-        fg = self._element_samples(self._synthesize_elements(self.element_series(q)))
-        spec = np.fft.rfft(fg[: self.n_elements], axis=1)
-        return self._element_forces(spec).reshape(-1)
+        if not self.n_elements:
+            return np.zeros(self.size)
+        return self._forces(q).reshape(-1)
 
     def force_jacobian_from_stiffness(self, g: FloatArray) -> FloatArray:
         """Γ* diag(g) Γ for slope samples g (N,) → (2H+1, 2H+1), or rows (k, N) → (k, 2H+1, 2H+1);
@@ -339,6 +351,8 @@ class HarmonicBalance:
         nS = n * S
         if m == 0:
             return np.zeros((nS, nS))
+        if m == 1:  # W ⊗ J in one broadcast product, already in (n, S, n, S) order
+            return np.multiply(self._W[0][:, None, :, None], Je[0][None, :, None, :]).reshape(nS, nS)
         full = self._Wmat @ Je.reshape(m, S * S)  # (n², S²)
         if n == 1:
             return full.reshape(S, S)
@@ -350,7 +364,7 @@ class HarmonicBalance:
         kw = self.basis.k * self.base_frequency(omega)
         R = self._linear_part(self.coordinate_series(q), kw, -(kw**2))
         if self.n_elements:
-            R += self.nonlinear_force(q).reshape(R.shape)
+            R += self._forces(q)
         R = R.reshape(-1)
         R -= self.forcing
         return R
