@@ -16,10 +16,11 @@ from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions,
 from ..continuation._detect import LocatedPoint, locate_on_segment
 from ..errors import ConvergenceError, Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
-from ..measures import measures_batch, synthesize_batch
+from ..measures import Measures, system_measures_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, SpecialPoint
-from ..stability import FloquetMonitor, classify_loss, hill_multipliers, monodromy, monodromy_batch, multipliers_from_monodromy
+from ..results._frequency_response import element_columns_from
+from ..stability import FloquetMonitor, classify_loss, hill_multipliers, multipliers_from_monodromy, torus_ratio
 from ..stability._classify import UNIT_CIRCLE_TOL
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb, scaled_hb
 
@@ -43,10 +44,11 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
     if res.converged:
         return res.q, "linear solution + Newton"
     full = hb.forcing.copy()
+    n = hb.size // hb.basis.size  # coordinates; every block's a_0 is its mean
     static = np.zeros_like(full)
-    static[0] = full[0]
+    static.reshape(n, -1)[:, 0] = full.reshape(n, -1)[:, 0]
     q = q_lin.copy()
-    q[1:] = 0.0
+    q.reshape(n, -1)[:, 1:] = 0.0
     lam, dlam = 0.0, 0.1
     try:
         while lam < 1.0 and dlam > 1e-4:
@@ -71,28 +73,25 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
     )
 
 
+def monitor_of(hb: HarmonicBalance) -> FloquetMonitor:
+    """The :class:`~rattle.stability.FloquetMonitor` of ``hb`` (one per problem: it caches the
+    stage decompositions of a chain)."""
+    mon = getattr(hb, "_floquet_monitor", None)
+    if mon is None:
+        mon = FloquetMonitor(hb)
+        hb._floquet_monitor = mon  # type: ignore[attr-defined]
+    return mon
+
+
 def _test_function(kind: str, hb: HarmonicBalance, corrector: ArclengthCorrector):
-    """ψ(q, Ω, corrected, d) whose sign change marks a ``kind`` point (see continuation._detect)."""
-    model = hb.model
-    st = model.elastic.stages
+    """ψ(q, Ω, corrected, d) whose sign change marks a ``kind`` point (see continuation._detect):
+    det(M − I) (fold), det(M + I) (period doubling), det(M ⊙ M − I) (Neimark–Sacker), from the
+    exact monodromy of the orbit (``FloquetMonitor.test_function``)."""
+    psi = monitor_of(hb).test_function(kind)
 
-    def mono(q: FloatArray, omega: float) -> FloatArray:
-        return monodromy(hb.basis, q, omega / hb.period, st.breakpoints, model.k * st.slopes, model.c)
-
-    if kind == "fold":
-        def plus_one(q, w, corr, d):  # det(M − I)
-            M = mono(q, w)
-            return 1.0 - np.trace(M) + np.linalg.det(M)
-        return plus_one
-    if kind == "period_doubling":
-        def minus_one(q, w, corr, d):  # det(M + I)
-            M = mono(q, w)
-            return 1.0 + np.trace(M) + np.linalg.det(M)
-        return minus_one
-
-    def unit_modulus(q, w, corr, d):  # det M − 1: a complex pair on the unit circle
-        return np.linalg.det(mono(q, w)) - 1.0
-    return unit_modulus
+    def test(q, w, corr, d):
+        return psi(q, w)
+    return test
 
 
 def _locate_with(hb: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
@@ -143,7 +142,8 @@ def _is_period_halved(q: FloatArray, hb: HarmonicBalance, rtol: float = 0.1) -> 
     H = hb.basis.harmonics
     k = np.arange(1, H + 1, 2)
     odd = np.concatenate((k, H + k))
-    return float(np.linalg.norm(q[odd])) <= rtol * max(float(np.linalg.norm(q[1:])), 1e-300)
+    Q = np.asarray(q).reshape(-1, 2 * H + 1)  # one row per coordinate
+    return float(np.linalg.norm(Q[:, odd])) <= rtol * max(float(np.linalg.norm(Q[:, 1:])), 1e-300)
 
 
 def _locate_changes(
@@ -343,13 +343,14 @@ def _branch_record(branch: FrequencyResponse) -> dict:
 
 
 def _multipliers(model: Model, hb: HarmonicBalance, Q: FloatArray, Om: FloatArray, X: FloatArray, stability: StabilityMethod) -> np.ndarray:
+    """Floquet multipliers (P, 2n), largest modulus first, of the orbits ``Q`` (P, n·(2H+1))."""
     P = Q.shape[0]
+    k = 2 * (hb.size // hb.basis.size)
     if P == 0:
-        return np.zeros((0, 2), dtype=complex)
+        return np.zeros((0, k), dtype=complex)
     if stability == "monodromy":
-        st = model.elastic.stages
-        return multipliers_from_monodromy(monodromy_batch(Q, Om / hb.period, X, st.breakpoints, model.k * st.slopes, model.c))
-    return np.array([hill_multipliers(hb, q, om) for q, om in zip(Q, Om)]).reshape(P, 2)
+        return multipliers_from_monodromy(monitor_of(hb).monodromy_and_crossings(Q, Om)[0])
+    return np.array([hill_multipliers(hb, q, om) for q, om in zip(Q, Om)]).reshape(P, k)
 
 
 def assemble(
@@ -389,7 +390,7 @@ def assemble(
     Om = np.array([p.omega for p in points], dtype=float)
     its = np.array([p.iterations for p in points], dtype=int)
     res = np.array([p.residual for p in points], dtype=float)
-    X = synthesize_batch(Q, hb.basis.samples) if P else np.zeros((0, hb.basis.samples))
+    X = None  # (the monodromy synthesises what it needs)
     mu = _multipliers(model, hb, Q, Om, X, stability)
     stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL if P else np.zeros(0, dtype=bool)
     labels = np.full(P, "", dtype=object)
@@ -429,9 +430,8 @@ def assemble(
         if omega2 is not None:
             refined[i] = omega2
     if inserted.any():
-        X = synthesize_batch(Q, hb.basis.samples)
-        mu_new = _multipliers(model, hb, Q[inserted], Om[inserted], X[inserted], stability)
-        mu_full = np.empty((Q.shape[0], 2), dtype=complex)
+        mu_new = _multipliers(model, hb, Q[inserted], Om[inserted], None, stability)
+        mu_full = np.empty((Q.shape[0], mu.shape[1]), dtype=complex)
         mu_full[~inserted] = mu
         mu_full[inserted] = mu_new
         mu = mu_full
@@ -443,11 +443,17 @@ def assemble(
         SpecialPoint(
             str(labels[j]), j, float(refined.get(j, Om[j])), branch_id, mu[j].copy(), located=bool(inserted[j]) or j in ends,
             omega_error=abs(refined[j] - float(Om[j])) if j in refined else None,
+            torus_ratio=torus_ratio(mu[j]) if labels[j] == "neimark_sacker" else None,
         )
         for j in range(P) if labels[j]
     ]
     t1 = time.perf_counter()
-    meas = measures_batch(model, Q, Om / hb.period, Om, X) if P else None
+    n_coord = hb.size // hb.basis.size
+    per_element = system_measures_batch(model, Q.reshape(P, n_coord, -1), Om / hb.period, Om, hb.basis.samples) if P else None
+    meas = per_element[0] if per_element else None
+    names = getattr(model, "element_names", None)
+    element_cols = element_columns_from(names, per_element) if (names and per_element) else (
+        element_columns_from(names, tuple(_empty_measures() for _ in names)) if names else {})
     t2 = time.perf_counter()
     empty = np.zeros(0)
     timings = dict(timings or {})
@@ -477,7 +483,13 @@ def assemble(
         message=message or status.message,
         settings=dict(settings or {}),
         timings=timings,
+        element_columns=element_cols,
     )
+
+
+def _empty_measures() -> Measures:
+    e = np.zeros(0)
+    return Measures(e, e, e, e, e, e, e, np.zeros(0, dtype=object))
 
 
 __all__ = ["frequency_response", "start_solution", "assemble"]

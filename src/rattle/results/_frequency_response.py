@@ -36,7 +36,9 @@ class SpecialPoint:
     when the point was located on the branch by solving the test function (a row of its own);
     otherwise it is the computed point nearest the change. When the location was repeated with
     twice the harmonics, ``omega`` is that value and ``omega_error`` = |Ω(2H) − Ω(H)| estimates
-    the truncation error of the row's Ω."""
+    the truncation error of the row's Ω. At a Neimark–Sacker point ``torus_ratio`` = θ/2π of
+    the critical pair μ = e^{±iθ} (in [0, ½]): the ratio of the torus' second frequency to the
+    orbit's base frequency."""
 
     kind: str
     index: int
@@ -45,6 +47,7 @@ class SpecialPoint:
     multipliers: ComplexArray
     located: bool = False
     omega_error: float | None = None
+    torus_ratio: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -224,6 +227,7 @@ class FrequencyResponse:
             "regions": [g.to_dict() for g in self.regions],
             "special_points": [
                 {"kind": s.kind, "omega": s.omega, "branch": s.branch, "index": s.index, "located": s.located, "omega_error": s.omega_error,
+                 **({"torus_ratio": s.torus_ratio} if s.torus_ratio is not None else {}),
                  "multipliers": [[float(m.real), float(m.imag)] for m in s.multipliers]}
                 for s in self.special_points
             ],
@@ -241,7 +245,7 @@ class FrequencyResponse:
 
         offsets = np.cumsum([0] + [len(p) for p in parts[:-1]])
         special = tuple(
-            SpecialPoint(sp.kind, sp.index + int(off), sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error)
+            SpecialPoint(sp.kind, sp.index + int(off), sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error, sp.torus_ratio)
             for p, off in zip(parts, offsets) for sp in p.special_points
         )
         cat = {name: np.concatenate([getattr(p, name) for p in parts]) for name in (
@@ -271,7 +275,7 @@ class FrequencyResponse:
             "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max",
             "regime", "stable", "bifurcation", "iterations", "residual", "multipliers", "coefficients")}
         special = tuple(
-            SpecialPoint(sp.kind, sp.index - first, sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error)
+            SpecialPoint(sp.kind, sp.index - first, sp.omega, sp.branch, sp.multipliers, sp.located, sp.omega_error, sp.torus_ratio)
             for sp in self.special_points if sp.branch == branch
         )
         fields["element_columns"] = {k: v[rows] for k, v in self.element_columns.items()}
