@@ -136,6 +136,9 @@ def test_sensitivity_equals_central_differences(which):
     z1, M = integ.advance(z0, 0.0, T, omega)
     np.testing.assert_array_equal(z1, traj.state1)
     np.testing.assert_array_equal(M, traj.sensitivity)
+    z1_only, none = integ.advance(z0, 0.0, T, omega, sensitivity=False)
+    assert none is None
+    np.testing.assert_array_equal(z1_only, traj.state1)
 
 
 def test_composition_of_intervals():

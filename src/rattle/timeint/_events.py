@@ -97,8 +97,7 @@ def first_exit(
 
     ``lo``, ``hi`` (m,) are the elements' stage bounds (±inf where open), ``step`` the grid step.
     """
-    watched = [e for e in range(lo.size) if lo[e] > -math.inf or hi[e] < math.inf]
-    if not watched or tau_end <= 0.0:
+    if tau_end <= 0.0 or not (np.any(lo > -math.inf) or np.any(hi < math.inf)):
         return tau_end, -1, 0
     if not (math.isfinite(step) and step > 0.0):
         step = max(tau_end, 1e-300) / samples_per_scale
@@ -110,26 +109,22 @@ def first_exit(
         if n < chunk or taus[-1] >= tau_end:
             taus[-1] = tau_end
         d, v = seg.scan(taus)
+        D = d[1:]
+        outside = (D >= hi) | (D < lo)  # (n, m)
+        i_out = np.where(outside.any(axis=0), outside.argmax(axis=0), n)
+        pos = v > 0.0
+        change = pos[:-1] != pos[1:]
+        change &= np.arange(n)[:, None] < i_out[None, :]
         cands: list[tuple[int, int]] = []
-        for e in watched:
-            de = d[:, e]
-            lo_e, hi_e = lo[e], hi[e]
-            outside = (de[1:] >= hi_e) | (de[1:] < lo_e)
-            i_out = int(outside.argmax())
-            if not outside[i_out]:
-                i_out = n
-            pos = v[:, e] > 0.0
-            turns = (pos[:-1] != pos[1:]).nonzero()[0]
-            for i in turns.tolist():
-                if i >= i_out:
-                    break
-                d_a, d_b, v_a, v_b = de[i], de[i + 1], v[i, e], v[i + 1, e]
-                excursion = 2.0 * float(taus[i + 1] - taus[i]) * max(abs(v_a), abs(v_b))
-                if (max(d_a, d_b) + excursion < hi_e) if v_a > 0.0 else (min(d_a, d_b) - excursion > lo_e):
-                    continue
-                cands.append((i, e))
-            if i_out < n:
-                cands.append((i_out, e))
+        if change.any():
+            ci, ce = change.nonzero()
+            d_a, d_b, v_a, v_b = d[ci, ce], d[ci + 1, ce], v[ci, ce], v[ci + 1, ce]
+            excursion = 2.0 * (taus[ci + 1] - taus[ci]) * np.maximum(np.abs(v_a), np.abs(v_b))
+            skip = np.where(v_a > 0.0, np.maximum(d_a, d_b) + excursion < hi[ce],
+                            np.minimum(d_a, d_b) - excursion > lo[ce])
+            cands = list(zip(ci[~skip].tolist(), ce[~skip].tolist()))
+        for e in np.flatnonzero(i_out < n).tolist():
+            cands.append((int(i_out[e]), e))
         if cands:
             cands.sort()
             best: tuple[float, int, int] | None = None

@@ -336,13 +336,16 @@ class SystemIntegrator:
             crossing_breakpoints=np.asarray(rec["cb"], dtype=float), segments=tuple(rec["seg"]),
         )
 
-    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float) -> tuple[FloatArray, FloatArray]:
-        """The state at ``t1`` and the sensitivity only (no record kept, no checks): the hot path
-        of a simulation or a shooting that only needs its Poincaré points."""
-        return self._march(self.stages(omega), np.asarray(z0, dtype=float), float(t0), float(t1), None)
+    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
+        """The state at ``t1`` and the sensitivity ∂z(t1)/∂z(t0) (None when ``sensitivity`` is
+        False, which skips the transition matrices) only — no record kept, no checks: the hot
+        path of a simulation or a shooting that only needs its Poincaré points."""
+        return self._march(self.stages(omega), np.asarray(z0, dtype=float), float(t0), float(t1), None,
+                           bool(sensitivity))
 
     def _march(self, flow: SystemStages, z: FloatArray, t0: float, t1: float,
-               rec: dict[str, list] | None) -> tuple[FloatArray, FloatArray]:
+               rec: dict[str, list] | None, sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
         n = flow.n
         rows = flow.rows
         stages = flow.stages_at(t0, z)
@@ -363,11 +366,12 @@ class SystemIntegrator:
                 rec["seg"].append(seg)
             if tau_c > 0.0:
                 n_seg += 1
-                M = sol.transition(tau_c) @ M
+                if sensitivity:
+                    M = sol.transition(tau_c) @ M
             zc = seg.end_state(tau_c) if tau_c > 0.0 else z
             if e < 0:
                 if tau_lim >= remaining:
-                    return zc, M
+                    return zc, (M if sensitivity else None)
                 t, z = t + tau_c, zc  # a long segment cut: continue on the same stages
                 continue
             bound = float(hi[e] if direction > 0 else lo[e])
