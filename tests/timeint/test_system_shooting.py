@@ -95,3 +95,21 @@ def test_sub_harmonic_period_and_argument_checks():
         shoot_system_orbit(system, 1.0, _rest(system), integrator=SystemIntegrator(free_chain()))
     with pytest.raises(TypeError, match="`system`"):
         shoot_system_orbit(rattle.reference_case(), 1.0, [0.0, 0.0])
+
+
+def test_linear_system_without_elements_is_its_frequency_response():
+    from rattle.model import System
+
+    C = np.array([[0.1, 0.0], [0.0, 0.2]])
+    K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    F0, F1 = np.array([0.1, 0.0]), np.array([0.1, 0.05j])  # F1: cos + i(−sin) amplitudes
+    system = System(damping=C, stiffness=K, elements=(), mean=F0, cos=F1.real[None], sin=-F1.imag[None],
+                    coordinates=("a", "b"), angles=np.eye(2), free=False)
+    omega = 1.1
+    orbit = shoot_system_orbit(system, omega, np.zeros(4))
+    X = np.linalg.solve(K - omega**2 * np.eye(2) + 1j * omega * C, F1)
+    x0 = np.linalg.solve(K, F0) + X.real
+    v0 = (1j * omega * X).real
+    assert orbit.converged and orbit.iterations == 1  # linear: one Newton step
+    np.testing.assert_allclose(orbit.state0, np.concatenate((x0, v0)), rtol=0, atol=1e-13)
+    assert orbit.measures.rms.shape == (0,)

@@ -329,7 +329,7 @@ class SystemIntegrator:
         return SystemTrajectory(
             system=self.system, omega=omega, t0=t0, t1=t1, state0=z, state1=z1, sensitivity=M,
             t_start=t_start, t_end=np.append(t_start[1:], t1),
-            stages=np.asarray(rec["st"], dtype=np.int64).reshape(-1, self.system.m),
+            stages=np.asarray(rec["st"], dtype=np.int64).reshape(len(rec["st"]), self.system.m),
             z_start=np.asarray(rec["zs"], dtype=float).reshape(-1, 2 * self.system.n),
             crossing_times=np.asarray(rec["ct"], dtype=float), crossing_elements=np.asarray(rec["ce"], dtype=np.int64),
             crossing_directions=np.asarray(rec["cd"], dtype=np.int64),
