@@ -97,7 +97,7 @@ def first_exit(
 
     ``lo``, ``hi`` (m,) are the elements' stage bounds (±inf where open), ``step`` the grid step.
     """
-    if tau_end <= 0.0 or not (np.any(lo > -math.inf) or np.any(hi < math.inf)):
+    if tau_end <= 0.0 or not seg.sol.bounded:
         return tau_end, -1, 0
     if not (math.isfinite(step) and step > 0.0):
         step = max(tau_end, 1e-300) / samples_per_scale
@@ -160,9 +160,8 @@ def _resolve_cell(
         _, v, a = state(tau)
         return v, a
 
-    d_floor = float(seg.d_floor[e]) + 8.0 * _EPS * max(abs(lo) if math.isfinite(lo) else 0.0,
-                                                       abs(hi) if math.isfinite(hi) else 0.0)
-    v_floor = float(seg.v_floor[e])
+    d_floor, v_floor = seg.element_floors(e)
+    d_floor += 8.0 * _EPS * max(abs(lo) if math.isfinite(lo) else 0.0, abs(hi) if math.isfinite(hi) else 0.0)
     tol = 4.0 * _EPS * tau_b + 1e-300
     end_up, end_down = d_b >= hi, d_b < lo
     if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):

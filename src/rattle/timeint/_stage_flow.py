@@ -259,6 +259,7 @@ class StageSolution:
         self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
         self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
         self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
+        self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
 
     def _block_modal_form(self, Abar: np.ndarray, rho: float, hw: FloatArray) -> None:
         """Ā = P diag(μ_1 I + N_1, …, μ_c I + N_c, Λ) P⁻¹: clusters of eigenvalues closer than
@@ -355,7 +356,7 @@ class Segment:
     """
 
     __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "c", "ph", "Bd", "w0", "poly", "_Bz", "_Qz",
-                 "_floors", "_mu_l", "_bd_l", "_qd_l")
+                 "_floors", "_mu_l", "_bd_l", "_qd_l", "_ef")
 
     def __init__(self, sol: StageSolution, ts: float, z: FloatArray, tau_max: float) -> None:
         flow = sol.flow
@@ -435,6 +436,14 @@ class Segment:
     @property
     def v_floor(self) -> FloatArray:
         return self.floors()[1]
+
+    def element_floors(self, e: int) -> tuple[float, float]:
+        """Round-off floors (δ_e, δ_e') of one element (as :meth:`floors`, in Python floats)."""
+        if self.w0 is not None:
+            d, v = self.floors()
+            return float(d[e]), float(v[e])
+        self.element_point(0.0, e)  # builds the element's terms
+        return self._ef[e]
 
     # --- evaluation -----------------------------------------------------------------------------
     def _expm_w(self, taus: FloatArray) -> np.ndarray:
@@ -529,12 +538,21 @@ class Segment:
             n = self.sol.flow.n
             return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
         if self._bd_l is None:
-            self._bd_l, self._qd_l = {}, {}
+            self._bd_l, self._qd_l, self._ef = {}, {}, {}
         terms = self._bd_l.get(e)
         if terms is None:  # Python numbers of this element's terms, built on first use
             m = self.sol.flow.m
             terms = self._bd_l[e] = list(zip(self._mu_l, self.Bd[:, e].tolist(), self.Bd[:, m + e].tolist()))
-            self._qd_l[e] = [(complex(mu), Qd[:, e].tolist(), Qd[:, m + e].tolist()) for mu, _, Qd, _, _ in self.poly]
+            poly = self._qd_l[e] = [(complex(mu), Qd[:, e].tolist(), Qd[:, m + e].tolist())
+                                    for mu, _, Qd, _, _ in self.poly]
+            dmag = sum(abs(b0) for _, b0, _ in terms)
+            vmag = sum(abs(b1) for _, _, b1 in terms)
+            T = self.tau_max
+            for mu, qd, qv in poly:
+                grow = max(1.0, math.exp(min(mu.real * T, 700.0)))
+                dmag += grow * sum(abs(q) * T**k for k, q in enumerate(qd))
+                vmag += grow * sum(abs(q) * T**k for k, q in enumerate(qv))
+            self._ef[e] = (8.0 * _EPS * dmag, 8.0 * _EPS * vmag)
         d = v = a = 0.0
         exp, cos, sin = math.exp, math.cos, math.sin
         for mu, b0, b1 in terms:
