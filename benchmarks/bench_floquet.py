@@ -10,8 +10,9 @@ Run:  python benchmarks/bench_floquet.py  [--repeat 7]
   and per call of the monitor-equivalent evaluation (two orbits, ψ_fold, ψ_pd, ψ_ns).
 
 Figures are best-of-``--repeat`` CPU times (the machine is shared); run with OMP_NUM_THREADS=1.
-``--single-only`` runs only the n = 1 part (it also runs against an older tree, for before/after:
-``PYTHONPATH=<old tree>/src python benchmarks/bench_floquet.py --single-only``).
+Before/after for n = 1: ``--against <older tree>/src`` times the older package interleaved with
+this one in the same process (e.g. ``git archive <commit> | tar -x -C /tmp/old``), on the same
+orbits (``--orbits file.npz`` keeps them between runs).
 """
 
 from __future__ import annotations
@@ -23,8 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import rattle
-from rattle.hb import HarmonicBalance, HBOptions
-from rattle.stability import FloquetMonitor, monodromy_batch
+from rattle.stability import FloquetMonitor
 
 
 def chain(n: int):
@@ -110,7 +110,21 @@ def best(fn, repeat: int) -> float:
     return min(times)
 
 
-def single_element(repeat: int, orbits: str | None) -> None:
+def _before_package(src: str):
+    """The package of an older tree (``src``/rattle) imported as ``rattle_before`` (its imports
+    are relative), so that both versions are timed interleaved in one process."""
+    import importlib
+    import shutil
+    import sys
+    import tempfile
+
+    tmp = tempfile.mkdtemp(prefix="bench_floquet_")
+    shutil.copytree(Path(src) / "rattle", Path(tmp) / "rattle_before")
+    sys.path.insert(0, tmp)
+    return importlib.import_module("rattle_before")
+
+
+def single_element(repeat: int, orbits: str | None, against: str | None) -> None:
     model = rattle.reference_case()
     if orbits and Path(orbits).exists():
         data = np.load(orbits)
@@ -120,33 +134,47 @@ def single_element(repeat: int, orbits: str | None) -> None:
         Q, Om = np.asarray(frf.coefficients), np.asarray(frf.omega)
         if orbits:
             np.savez(orbits, Q=Q, omega=Om)
-    hb = HarmonicBalance(model, HBOptions(harmonics=32))
-    X = hb.basis.synthesize(Q)
-    st = model.elastic.stages
+    packages = [("this tree", rattle)] + ([("before", _before_package(against))] if against else [])
     P = len(Om)
-    t = best(lambda: monodromy_batch(Q, Om, X, st.breakpoints, model.k * st.slopes, model.c), repeat)
-    print(f"n=1 (reference case, H=32, {P} orbits): batched monodromy {1e6 * t / P:8.1f} us/orbit")
-    mon = FloquetMonitor(hb)
     d = np.zeros_like(Q[0])
     d[1] = 1.0
     idx = range(0, P, max(1, P // 50))
+    timings: dict[str, dict[str, list[float]]] = {}
+    setups = []
+    for name, pkg in packages:
+        m = pkg.reference_case()
+        hb = pkg.hb.HarmonicBalance(m, pkg.hb.HBOptions(harmonics=32))
+        st = m.elastic.stages
+        X = hb.basis.synthesize(Q)
+        mon = pkg.stability.FloquetMonitor(hb)
+        batch = (lambda pkg=pkg, X=X, st=st, m=m: pkg.stability.monodromy_batch(Q, Om, X, st.breakpoints, m.k * st.slopes, m.c))
 
-    def monitor_all():
-        for i in idx:
-            mon(Q[i], float(Om[i]), d, 0.0)
+        def monitor_all(mon=mon):
+            for i in idx:
+                mon(Q[i], float(Om[i]), d, 0.0)
 
-    t = best(monitor_all, repeat)
-    print(f"n=1 FloquetMonitor call                    {1e6 * t / len(idx):8.1f} us/call")
+        setups.append((name, batch, monitor_all))
+        timings[name] = {"batch": [], "monitor": []}
+    for _ in range(repeat):  # interleaved: both versions see the same load
+        for name, batch, monitor_all in setups:
+            timings[name]["batch"].append(best(batch, 1) / P)
+            timings[name]["monitor"].append(best(monitor_all, 1) / len(idx))
+    for name, t in timings.items():
+        print(f"n=1 (reference case, H=32, {P} orbits), {name:9s}: batched monodromy {1e6 * min(t['batch']):7.1f} us/orbit "
+              f"(median {1e6 * np.median(t['batch']):6.1f}); FloquetMonitor call {1e6 * min(t['monitor']):7.1f} us "
+              f"(median {1e6 * np.median(t['monitor']):6.1f})")
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--single-only", action="store_true", help="only the n = 1 part")
+    parser.add_argument("--against", help="src directory of an older tree (e.g. from `git archive`): its n = 1 "
+                        "figures are timed interleaved with this tree's, in the same process")
     parser.add_argument("--orbits", help="a .npz file keeping the reference FRF's orbits (computed and saved "
                         "when absent), so that runs on two trees time the same orbits")
     args = parser.parse_args(argv)
-    single_element(args.repeat, args.orbits)
+    single_element(args.repeat, args.orbits, args.against)
     if not args.single_only:
         for n in (2, 3):
             n_dof(n, args.repeat)

@@ -43,7 +43,7 @@ def _critical(before: ComplexArray, after: ComplexArray) -> complex:
 def classify_loss(before: ComplexArray, after: ComplexArray) -> str:
     """Name the bifurcation between two consecutive points of different stability.
 
-    ``before``, ``after`` the 2n multipliers at either point. The critical multiplier is the
+    The arguments are the 2n multipliers at either point. The critical multiplier is the
     largest-modulus one at the unstable side: it left (or re-entered) the unit circle through
     +1 (``fold``), through −1 (``period_doubling``) or as a complex pair (``neimark_sacker``).
     """
