@@ -237,3 +237,42 @@ def test_period_and_harmonics_are_checked_for_a_chain():
         HarmonicBalance(holder, HBOptions(harmonics=5), period=3)
     with pytest.raises(ValueError, match=r"`period` must be an integer >= 1"):
         HarmonicBalance(holder, HBOptions(harmonics=8), period=0)
+
+
+# --- condensation onto the element deflections ---------------------------------------------------
+def test_condensed_newton_step_equals_the_full_step(rng):
+    system = _grounded_chain()
+    full = HarmonicBalance(_Holder(system), HBOptions(harmonics=6, samples=64))
+    cond = HarmonicBalance(_Holder(system), HBOptions(harmonics=6, samples=64, condense=True))
+    for _ in range(3):
+        q = full.linear_solution(0.9) + 0.05 * rng.standard_normal(full.size)
+        omega = rng.uniform(0.4, 2.0)
+        R1, d1 = full.newton_step(q, omega)
+        R2, d2 = cond.newton_step(q, omega)
+        np.testing.assert_array_equal(R1, R2)
+        _, Rq, _ = full.residual_jacobian(q, omega)
+        np.testing.assert_allclose(Rq @ d2, -R1, rtol=0, atol=1e-12 * np.max(np.abs(R1)))
+        np.testing.assert_allclose(d2, d1, rtol=0, atol=1e-12 * np.max(np.abs(d1)))
+    a = solve_harmonic_balance(full, full.linear_solution(1.6), 1.6)
+    b = solve_harmonic_balance(cond, cond.linear_solution(1.6), 1.6)
+    assert a.converged and b.converged
+    np.testing.assert_allclose(b.q, a.q, rtol=0, atol=1e-13)
+
+
+def test_condensation_falls_back_to_the_full_step_without_linear_stiffness(rng):
+    # Without links the linear stiffness K is singular (held only by the elements): full step.
+    s = _grounded_chain()
+    bare = System(damping=s.damping, stiffness=np.zeros((3, 3)), elements=s.elements, mean=0 * s.mean, cos=s.cos,
+                  sin=s.sin, coordinates=s.coordinates, angles=s.angles)
+    full = HarmonicBalance(_Holder(bare), HBOptions(harmonics=4))
+    cond = HarmonicBalance(_Holder(bare), HBOptions(harmonics=4, condense=True))
+    q = 0.05 * rng.standard_normal(full.size)
+    assert cond._dynamic_receptance(1.0) is None
+    R1, d1 = full.newton_step(q, 1.0)
+    R2, d2 = cond.newton_step(q, 1.0)
+    assert (d1 is None and d2 is None) or np.array_equal(d1, d2)
+
+
+def test_condense_must_be_a_bool():
+    with pytest.raises(TypeError, match="`condense` must be true or false"):
+        HBOptions(condense=1)

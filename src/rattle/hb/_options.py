@@ -28,12 +28,19 @@ class HBOptions:
     ``samples``: N, time samples per solution period in the alternating frequency–time step
     (None: :func:`default_samples`); must be ≥ 4H + 2 so that the Jacobian's harmonics up to 2H
     are not folded.
+    ``condense``: solve every Newton step of :func:`~rattle.hb.solve_harmonic_balance` condensed
+    onto the element deflections through the linear part's dynamic stiffness
+    (:meth:`~rattle.hb.HarmonicBalance.newton_step`; same solution). Off by default: it pays only
+    when the elements are few against the coordinates (``benchmarks/bench_hb_system.py``).
     """
 
     harmonics: int = 32
     samples: int | None = None
+    condense: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.condense, bool):
+            raise TypeError(f"`condense` must be true or false, got {self.condense!r}")
         # The object's own (hard) bounds are those of any single problem a run may build: the
         # 2H re-location of a branch of period p carries 2·p·H harmonics. The front ends apply the
         # tighter user-facing bounds of rattle._limits (H <= 256, H·period <= 512) before.

@@ -26,10 +26,13 @@ b = [K/I]); it runs through the same code and gives the same numbers as the scal
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg
 
 from .._typing import FloatArray
 from ._basis import FourierBasis
 from ._options import HBOptions
+
+_gesv = scipy.linalg.lapack.dgesv
 
 
 def _jacobian_gather_tables(H: int) -> tuple[np.ndarray, np.ndarray]:
@@ -122,7 +125,7 @@ class HarmonicBalance:
         B = system.element_columns.reshape(n, m)
         self._A, self._B = A, B
         self._W = np.einsum("ie,ej->eij", B, A) if m else np.zeros((0, n, n))
-        self._Wmat = np.ascontiguousarray(self._W.reshape(m, n * n).T)  # (n², m)
+        self._W_entries = [(int(e), int(i), int(j), float(self._W[e, i, j])) for e, i, j in zip(*np.nonzero(self._W))]
         # Elements whose a_e picks one coordinate (a unit row): δ_e is a row of Q, no product.
         unit = [int(np.flatnonzero(a)[0]) for a in A if np.count_nonzero(a) == 1 and a[np.flatnonzero(a)[0]] == 1.0]
         self._select = np.array(unit, dtype=np.intp) if len(unit) == m else None
@@ -351,12 +354,13 @@ class HarmonicBalance:
         nS = n * S
         if m == 0:
             return np.zeros((nS, nS))
-        if m == 1:  # W ⊗ J in one broadcast product, already in (n, S, n, S) order
+        if n == 1 and m == 1:  # w J in one product
             return np.multiply(self._W[0][:, None, :, None], Je[0][None, :, None, :]).reshape(nS, nS)
-        full = self._Wmat @ Je.reshape(m, S * S)  # (n², S²)
-        if n == 1:
-            return full.reshape(S, S)
-        return np.ascontiguousarray(full.reshape(n, n, S, S).transpose(0, 2, 1, 3)).reshape(nS, nS)
+        # Only the non-zero entries of the W_e (a chain element touches 2 × 2 blocks).
+        out = np.zeros((n, S, n, S))
+        for e, i, j, wij in self._W_entries:
+            out[i, :, j, :] += wij * Je[e]
+        return out.reshape(nS, nS)
 
     # --- residual and Jacobians ----------------------------------------------------------------
     def residual(self, q: FloatArray, omega: float) -> FloatArray:
@@ -390,6 +394,91 @@ class HarmonicBalance:
         Rw = self._linear_part_dw(Q, w).reshape(-1)
         Rw /= self.period
         return R, Rq, Rw
+
+    # --- Newton steps: full or condensed onto the element deflections ---------------------------
+    def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray]:
+        """R(q, Ω) and the Newton increment dq = −(∂R/∂q)⁻¹ R (None when the Jacobian is singular).
+
+        With ``options.condense`` (and a condensable system, see :meth:`_dynamic_receptance`) the
+        step is solved on the m·S element deflections instead of the n·S coordinates: writing
+        ∂R/∂q = L + U J V (L = I⊗∇² + C⊗∇ + K⊗I, U = B⊗I, V = A⊗I, J = diag(J_e)) and y = V dq,
+        (I + G J) y = V z with z = −L⁻¹R and G = V L⁻¹ U, then dq = z − L⁻¹U J y. L is
+        block-diagonal over the harmonics (Z_k = K − (kω)² I + i kω C, one n × n complex solve
+        per harmonic), so only an (m·S)² system is factorised.
+        """
+        if self.options.condense and self.n_elements and self.n_elements < self.n_coordinates:
+            out = self._condensed_step(q, omega)
+            if out is not None:
+                return out
+        R, Rq, _ = self.residual_jacobian(q, omega)
+        _, _, dq, info = _gesv(Rq, -R)
+        if info != 0 or not np.all(np.isfinite(dq)):
+            return R, None
+        return R, dq
+
+    def _dynamic_receptance(self, w: float) -> tuple[FloatArray, np.ndarray] | None:
+        """K⁻¹ (n, n) and Z_k⁻¹ (H, n, n) complex, or None when K or some Z_k is singular
+        (a chain held only through its clearances: no condensation)."""
+        H, n = self.basis.harmonics, self.n_coordinates
+        kw = self.basis.k * w
+        Z = self._K[None] - (kw**2)[:, None, None] * np.eye(n) + 1j * kw[:, None, None] * self._C[None]
+        try:
+            K_inv, Z_inv = np.linalg.inv(self._K), np.linalg.inv(Z)
+        except np.linalg.LinAlgError:
+            return None
+        # 1-norm condition numbers from the inverses (cheap): refuse near-singular blocks.
+        cond_K = np.abs(self._K).sum(0).max() * np.abs(K_inv).sum(0).max()
+        cond_Z = np.abs(Z).sum(1).max(1) * np.abs(Z_inv).sum(1).max(1)
+        if not (np.isfinite(cond_K) and cond_K < 1e12 and np.all(np.isfinite(cond_Z)) and cond_Z.max() < 1e12):
+            return None
+        return K_inv, Z_inv
+
+    def _apply_inverse(self, K_inv: FloatArray, Z_inv: np.ndarray, X: FloatArray) -> FloatArray:
+        """L⁻¹ X for series X (n, S, r) → (n, S, r): a_0 by K⁻¹, harmonic k by Z_k⁻¹ on a − i b."""
+        H = self.basis.harmonics
+        out = np.empty_like(X)
+        out[:, 0] = K_inv @ X[:, 0]
+        Xc = X[:, 1 : H + 1] - 1j * X[:, H + 1 :]  # (n, H, r)
+        Y = (Z_inv @ Xc.transpose(1, 0, 2)).transpose(1, 0, 2)
+        out[:, 1 : H + 1] = Y.real
+        out[:, H + 1 :] = -Y.imag
+        return out
+
+    def _condensed_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray] | None:
+        w = self.base_frequency(omega)
+        inv = self._dynamic_receptance(w)
+        if inv is None:
+            return None
+        K_inv, Z_inv = inv
+        n, m, S, H = self.n_coordinates, self.n_elements, self._S, self.basis.harmonics
+        Q = self.coordinate_series(q)
+        kw = self.basis.k * w
+        R = self._linear_part(Q, kw, -(kw**2))
+        fg = self._element_samples(self._synthesize_elements(self.element_series(q)))
+        spec = np.fft.rfft(fg, axis=1)
+        R += self._element_forces(spec)
+        R = R.reshape(-1) - self.forcing
+        Je = self._jacobians_from_spectra(spec[m:])  # (m, S, S)
+        # Receptance of the elements' deflections to their forces, per harmonic: g_k = A Z_k⁻¹ B.
+        g0 = self._A @ K_inv @ self._B  # (m, m)
+        gk = (self._A @ Z_inv @ self._B).transpose(1, 0, 2)  # (m, H, m): [e', k, e]
+        gr, gi = gk.real[:, :, :, None], gk.imag[:, :, :, None]
+        # M = I + G J, block (e', e) = G_{e'e} J_e with G_{e'e} 2×2 rotations per harmonic.
+        Ja = Je[:, 1 : H + 1, :].transpose(1, 0, 2)[None]  # (1, H, m, S)
+        Jb = Je[:, H + 1 :, :].transpose(1, 0, 2)[None]
+        M = np.empty((m, S, m, S))
+        M[:, 0] = g0[:, :, None] * Je[None, :, 0, :]
+        M[:, 1 : H + 1] = gr * Ja + gi * Jb
+        M[:, H + 1 :] = gr * Jb - gi * Ja
+        M = M.reshape(m * S, m * S)
+        M[np.diag_indices(m * S)] += 1.0
+        z = self._apply_inverse(K_inv, Z_inv, -R.reshape(n, S, 1))[:, :, 0]
+        _, _, y, info = _gesv(M, (self._A @ z).reshape(-1))
+        if info != 0 or not np.all(np.isfinite(y)):
+            return None
+        Jy = (Je @ y.reshape(m, S, 1))[:, :, 0]  # (m, S)
+        dq = z - self._apply_inverse(K_inv, Z_inv, (self._B @ Jy)[:, :, None])[:, :, 0]
+        return R, dq.reshape(-1)
 
     # --- slopes along an orbit -----------------------------------------------------------------
     def element_slopes(self, q: FloatArray) -> FloatArray:
