@@ -26,9 +26,11 @@ For a :class:`~rattle.model.System` of n ≥ 2 coordinates (q coordinate-major, 
 J the HB Jacobian ∂R/∂q, built here from the System and the element stiffness samples (the
 check does not depend on how the HB problem assembles or condenses its own). 2n exponents are
 physical; they are chosen by eigenvector centroid (|centroid| smallest first), skipping every
-candidate that is a copy λ + i m ω (m ≠ 0) of one already taken. An exponent whose phase Im λ T
-lies within ``REAL_PHASE_TOL`` of 0 or π stands for a real multiplier (±e^{Re λ T}, one slot);
-any other brings its complex conjugate (a pair, two slots).
+candidate that is a copy λ + i m ω (m ≠ 0) of one already taken. A real exponent is a real
+multiplier e^{λT}; one whose phase |Im λ| T lies within ``REAL_PHASE_TOL`` of π stands for a real
+negative multiplier −e^{Re λ T} (its conjugate is its copy shifted by −iω; truncation moves Im λ
+off ω/2 and would otherwise turn a period doubling into a complex pair); any other brings its
+complex conjugate (a pair, two slots).
 """
 
 from __future__ import annotations
@@ -113,10 +115,15 @@ def system_hill_exponents(system: System, basis: FourierBasis, X: FloatArray, w:
     chosen: list[complex] = []
 
     def is_copy(z: complex) -> bool:
-        """z is (within Hill's truncation error) λ + i m ω of an exponent already chosen."""
+        """z is an exponent already chosen (or its conjugate) or, within Hill's truncation
+        error, a copy λ + i m ω (m ≠ 0) of one (for a negative real multiplier, stored with
+        Im λ = ω/2, any m: its truncated conjugate folds to either side of ω/2)."""
         for c in chosen:
+            if abs(z - c) <= 1e-9 * max(w, abs(c)):
+                return True
             d = (z - c) / (1j * w)
-            if abs(z.real - c.real) <= 1e-3 * max(w, abs(c.real)) and abs(d.real - round(d.real)) < 0.01:
+            m = round(d.real)
+            if (m != 0 or c.imag == 0.5 * w) and abs(z.real - c.real) <= 1e-3 * max(w, abs(c.real)) and abs(d.real - m) < 0.01:
                 return True
         return False
 
@@ -126,10 +133,12 @@ def system_hill_exponents(system: System, basis: FourierBasis, X: FloatArray, w:
         z = complex(folded[i])
         if is_copy(z):
             continue
-        phase = z.imag * T
-        if abs(phase) <= REAL_PHASE_TOL or abs(abs(phase) - np.pi) <= REAL_PHASE_TOL or len(chosen) == 2 * n - 1:
-            # a real multiplier: ±e^{Re λ T} (Im λ on 0 or ω/2)
-            chosen.append(complex(z.real, 0.0 if abs(phase) < 0.5 * np.pi else 0.5 * w))
+        phase = abs(z.imag) * T
+        if z.imag == 0.0:  # a real multiplier e^{λT} > 0
+            chosen.append(z)
+        elif abs(phase - np.pi) <= REAL_PHASE_TOL or len(chosen) == 2 * n - 1:
+            # a real multiplier −e^{Re λ T} (Im λ = ω/2; its conjugate is the copy shifted by −iω)
+            chosen.append(complex(z.real, 0.5 * w))
         else:
             chosen.extend([z, z.conjugate()])
     return np.array(chosen[: 2 * n])
