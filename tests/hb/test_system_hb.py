@@ -276,3 +276,17 @@ def test_condensation_falls_back_to_the_full_step_without_linear_stiffness(rng):
 def test_condense_must_be_a_bool():
     with pytest.raises(TypeError, match="`condense` must be true or false"):
         HBOptions(condense=1)
+
+
+def test_static_forcing_and_resize_work_per_coordinate(rng):
+    system = _grounded_chain()
+    hb = HarmonicBalance(_Holder(system), HBOptions(harmonics=4))
+    st = hb.static_forcing().reshape(3, 9)
+    np.testing.assert_array_equal(st[:, 0], system.mean)
+    assert np.count_nonzero(st[:, 1:]) == 0
+    q = rng.standard_normal(hb.size)
+    q2 = hb.resize(q, 8, factor=2).reshape(3, 17)
+    Q = q.reshape(3, 9)
+    np.testing.assert_array_equal(q2[:, 0], Q[:, 0])
+    np.testing.assert_array_equal(q2[:, [2, 4, 6, 8]], Q[:, 1:5])
+    np.testing.assert_array_equal(q2[:, [10, 12, 14, 16]], Q[:, 5:9])

@@ -29,7 +29,7 @@ import numpy as np
 import scipy.linalg
 
 from .._typing import FloatArray
-from ._basis import FourierBasis
+from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions
 
 _gesv = scipy.linalg.lapack.dgesv
@@ -111,7 +111,6 @@ class HarmonicBalance:
         K = np.asarray(system.stiffness, dtype=float)
         self._C, self._K = C, K
         self._has_K = bool(np.any(K != 0.0))
-        self._Ck = C[:, :, None] * self.basis.k  # (n, n, H): C_ij k for ∂/∂ω
         self._lin_index = self._linear_pattern()
         self._c_scalar = float(C[0, 0]) if n == 1 else None
         self._ck = C[0, 0] * self.basis.k if n == 1 else None
@@ -167,6 +166,17 @@ class HarmonicBalance:
     def coordinate_samples(self, q: FloatArray) -> FloatArray:
         """x_i(t_j) at the N sample times of the base period, shape (n, N)."""
         return self.basis.synthesize(self.coordinate_series(q))
+
+    def static_forcing(self) -> FloatArray:
+        """The forcing with its harmonics removed (only every coordinate's mean F_0 at a_0), flat;
+        the start of an amplitude homotopy ``forcing = static + λ (forcing − static)``."""
+        F = np.zeros((self.n_coordinates, self._S))
+        F[:, 0] = self.forcing.reshape(self.n_coordinates, self._S)[:, 0]
+        return F.reshape(-1)
+
+    def resize(self, q: FloatArray, harmonics: int, factor: int = 1) -> FloatArray:
+        """:func:`~rattle.hb.resize_harmonics` of every coordinate's series of ``q`` (flat in, flat out)."""
+        return resize_harmonics(self.coordinate_series(q), harmonics, factor).reshape(-1)
 
     # --- linear part ---------------------------------------------------------------------------
     def _linear_pattern(self) -> np.ndarray:
