@@ -148,6 +148,14 @@ def test_eigen_route_equals_expm_and_defective_stage_falls_back():
                   angles=np.eye(2))
     E = _stage_exponentials(crit, np.array([[0]]), np.array([[3.0]]))[0, 0]
     np.testing.assert_allclose(E, scipy.linalg.expm(crit.stage_matrix((0,)) * 3.0), rtol=1e-12, atol=1e-14)
+    # No clearance element at all: the linear system's e^{AT}.
+    linear = System(damping=crit.damping, stiffness=np.array([[2.0, -0.5], [-0.5, 1.0]]), elements=(),
+                    mean=np.zeros(2), cos=np.zeros((1, 2)), sin=np.zeros((1, 2)), coordinates=("a", "b"),
+                    angles=np.eye(2))
+    M, crossings = system_monodromy_batch(linear, np.ones((2, 2, 9)), np.array([0.8, 1.9]))
+    assert crossings.shape == (2, 0, 0)
+    for Mi, w in zip(M, (0.8, 1.9)):
+        np.testing.assert_allclose(Mi, scipy.linalg.expm(linear.stage_matrix(()) * 2 * np.pi / w), rtol=1e-11, atol=1e-13)
 
 
 def test_single_equation_is_the_n1_case_bit_for_bit():

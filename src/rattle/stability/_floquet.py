@@ -231,7 +231,9 @@ def _segments(
     T = 2 * np.pi / omega
     levels = _padded_levels(breakpoints) if levels is None else levels
     kmax = levels.shape[1]
-    if m == 1:  # one element: one set of levels for all rows, rows = points (sorted by time)
+    if m == 0:  # no element: one segment, the whole period
+        p, t, counts_pb = np.empty(0, dtype=np.intp), np.empty(0), np.zeros((P, 0, 0), dtype=np.intp)
+    elif m == 1:  # one element: one set of levels for all rows, rows = points (sorted by time)
         p, t, _, col = _crossings(S[:, 0], omega, samples[:, 0], levels[0])
         counts_pb = np.bincount(p * kmax + col, minlength=P * kmax).reshape(P, 1, kmax)
     else:
@@ -253,7 +255,7 @@ def _segments(
     kw = np.arange(1, H + 1)[None, None, :] * omega[:, None, None]
     ph = kw * mids[:, :, None]
     c, s = np.cos(ph), np.sin(ph)
-    combo = np.empty(0)
+    combo = np.zeros((P, G), dtype=np.intp)  # no element: the one (empty) combination
     for e, bp in enumerate(breakpoints):
         delta_mid = (
             S[:, None, e, 0]
@@ -261,7 +263,7 @@ def _segments(
             + np.einsum("psh,ph->ps", s, S[:, e, H + 1 :])
         )
         stage = np.searchsorted(bp, delta_mid, side="right")
-        combo = combo * (len(bp) + 1) + stage if e else stage
+        combo = combo * (len(bp) + 1) + stage
     return tau, combo, counts_pb
 
 
