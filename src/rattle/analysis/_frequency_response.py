@@ -99,14 +99,14 @@ def _locate_with(hb: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, 
     return locate_on_segment(corrector, qa, wa, qb, wb, _test_function(kind, hb, corrector))
 
 
-def _refine(hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
+def _refine(hb: HarmonicBalance, hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
     """Locate the same special point with the doubled harmonic count hb2 (built with the run's
     HBOptions scaled to 2H: see ``_settings``): the end points are first corrected onto the 2H
     branch (in the plane normal to the secant)."""
     H2 = hb2.basis.harmonics
     corr2 = ArclengthCorrector(hb2, newton)
-    ya = corr2.to_scaled(resize_harmonics(qa, H2), wa)
-    yb = corr2.to_scaled(resize_harmonics(qb, H2), wb)
+    ya = corr2.to_scaled(hb.resize(qa, H2), wa)
+    yb = corr2.to_scaled(hb.resize(qb, H2), wb)
     d = (yb - ya) / np.linalg.norm(yb - ya)
     ca, cb = corr2.correct(ya, d), corr2.correct(yb, d)
     if ca is None or cb is None:
@@ -169,7 +169,7 @@ def _locate_changes(
             if hb2 is None:
                 hb_opts = hb.options if isinstance(hb.options, HBOptions) else HBOptions(harmonics=hb.basis.harmonics)
                 hb2 = HarmonicBalance(hb.model, scaled_hb(hb_opts, 2 * hb.basis.harmonics), period=hb.period)
-            loc2 = _refine(hb2, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
+            loc2 = _refine(hb, hb2, newton, kind, Q[i - 1], Om[i - 1], Q[i], Om[i])
             omega2 = None if loc2 is None else loc2.omega
         found.append((i, kind, loc, omega2))
     return found
