@@ -128,6 +128,8 @@ class HarmonicBalance:
         # Elements whose a_e picks one coordinate (a unit row): δ_e is a row of Q, no product.
         unit = [int(np.flatnonzero(a)[0]) for a in A if np.count_nonzero(a) == 1 and a[np.flatnonzero(a)[0]] == 1.0]
         self._select = np.array(unit, dtype=np.intp) if len(unit) == m else None
+        if self._select is not None and m and np.array_equal(self._select, np.arange(unit[0], unit[0] + m)):
+            self._select = slice(unit[0], unit[0] + m)  # consecutive coordinates: a view
         self._laws = [
             (np.asarray(e.breakpoints, dtype=float), np.asarray(e.slopes, dtype=float), np.asarray(e.offsets, dtype=float))
             for e in system.elements
@@ -308,12 +310,11 @@ class HarmonicBalance:
     def _forces(self, q: FloatArray) -> FloatArray:
         """Σ_e b_e Γ* f_e(Γ a_e·Q), shape (n, S)."""
         delta = self._synthesize_elements(self.element_series(q))
-        f = np.empty_like(delta)
-        for e, (bp, sl, off) in enumerate(self._laws):
-            d = delta[e]
+        rows = []
+        for d, (bp, sl, off) in zip(delta, self._laws):
             j = np.searchsorted(bp, d, side="right")
-            np.multiply(sl[j], d, out=f[e])
-            f[e] += off[j]
+            rows.append(sl[j] * d + off[j])
+        f = rows[0][None] if len(rows) == 1 else np.stack(rows)
         return self._element_forces(np.fft.rfft(f, axis=1))
 
     def nonlinear_force(self, q: FloatArray) -> FloatArray:
@@ -375,13 +376,11 @@ class HarmonicBalance:
     # --- residual and Jacobians ----------------------------------------------------------------
     def residual(self, q: FloatArray, omega: float) -> FloatArray:
         """R(q, Ω), shape (n·(2H+1),)."""
-        kw = self.basis.k * self.base_frequency(omega)
-        R = self._linear_part(self.coordinate_series(q), kw, -(kw**2))
+        kw = self.basis.k * (omega / self.period)
+        R = self._linear_part(np.asarray(q).reshape(self.n_coordinates, self._S), kw, -(kw**2))
         if self.n_elements:
             R += self._forces(q)
-        R = R.reshape(-1)
-        R -= self.forcing
-        return R
+        return R.reshape(-1) - self.forcing
 
     def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """R (n·S,), ∂R/∂q (n·S, n·S) and ∂R/∂Ω (n·S,) in one AFT pass (S = 2H+1)."""
