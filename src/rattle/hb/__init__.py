@@ -1,4 +1,5 @@
-"""Harmonic balance: Fourier basis, AFT residual with analytic Jacobians, Newton corrector."""
+"""Harmonic balance of a :class:`~rattle.model.System` (n coordinates, m clearance elements; the
+single equation is n = m = 1): Fourier basis, AFT residual with analytic Jacobians, Newton corrector."""
 
 from ._basis import FourierBasis, resize_harmonics
 from ._newton import NewtonResult, solve_harmonic_balance

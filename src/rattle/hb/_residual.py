@@ -405,7 +405,7 @@ class HarmonicBalance:
         return R, Rq, Rw
 
     # --- Newton steps: full or condensed onto the element deflections ---------------------------
-    def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray]:
+    def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
         """R(q, Ω) and the Newton increment dq = −(∂R/∂q)⁻¹ R (None when the Jacobian is singular).
 
         With ``options.condense`` (and a condensable system, see :meth:`_dynamic_receptance`) the
@@ -454,6 +454,7 @@ class HarmonicBalance:
         return out
 
     def _condensed_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray] | None:
+        """R and dq by condensation (:meth:`newton_step`); None when L or I + G J is singular."""
         w = self.base_frequency(omega)
         inv = self._dynamic_receptance(w)
         if inv is None:
