@@ -92,9 +92,9 @@ import numpy as np
 import scipy.optimize
 
 from rattle.model import Model
-from rattle.timeint import ExactIntegrator, shoot_periodic_orbit, steady_state
+from rattle.timeint import ExactIntegrator, SystemIntegrator, shoot_periodic_orbit, shoot_system_orbit, steady_state
 
-KINDS = ("fold", "period_doubling")
+KINDS = ("fold", "period_doubling", "neimark_sacker")
 
 
 class ReferenceError(RuntimeError):
@@ -131,30 +131,60 @@ class ExactBranch:
     stats: dict = field(default_factory=dict)
 
 
-def _psi(M: np.ndarray) -> tuple[float, float]:
-    tr = M[0, 0] + M[1, 1]
-    det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
-    return 1.0 - tr + det, 1.0 + tr + det
+def _bialternate(M: np.ndarray) -> np.ndarray:
+    """M ⊙ M: the 2 × 2 minors m_ir m_js − m_is m_jr, i < j, r < s (eigenvalues μ_i μ_j, i < j)."""
+    i, j = np.triu_indices(M.shape[0], 1)
+    return M[np.ix_(i, i)] * M[np.ix_(j, j)] - M[np.ix_(i, j)] * M[np.ix_(j, i)]
+
+
+def _psi(M: np.ndarray) -> tuple[float, ...]:
+    """ψ_fold = det(M − I), ψ_pd = det(M + I) and, for a state of dimension ≥ 4, ψ_ns =
+    det(M ⊙ M − I) (a complex pair on the unit circle; also zero at a neutral saddle, which
+    :func:`guard_and_locate` tells apart from the multipliers)."""
+    if M.shape[0] == 2:
+        tr = M[0, 0] + M[1, 1]
+        det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+        return 1.0 - tr + det, 1.0 + tr + det
+    eye = np.eye(M.shape[0])
+    B = _bialternate(M)
+    return (float(np.linalg.det(M - eye)), float(np.linalg.det(M + eye)),
+            float(np.linalg.det(B - np.eye(B.shape[0]))))
 
 
 class _ShootingProblem:
-    """G(y) in scaled variables, with the exact monodromy."""
+    """G(y) in scaled variables, with the exact monodromy: for a single-equation ``Model`` on the
+    closed-form :class:`~rattle.timeint.ExactIntegrator` (state (δ, δ')), for any other model (a
+    chain) on the :class:`~rattle.timeint.SystemIntegrator` of its System (state (x, x'), 2n)."""
 
-    def __init__(self, model: Model, fd_step: float = 1e-6) -> None:
+    def __init__(self, model, fd_step: float = 1e-6) -> None:
         self.model = model
-        self.integ = ExactIntegrator(model)
+        self.single = isinstance(model, Model)
+        system = model.system()
+        self.system = system
+        self.integ = ExactIntegrator(model) if self.single else SystemIntegrator(system)
         self.L = model.length_scale()
         self.wn = model.natural_frequency
-        self.sx = np.array([self.L, self.L * self.wn])
+        n = system.n
+        self.dim = 2 * n
+        self.sx = np.concatenate((np.full(n, self.L), np.full(n, self.L * self.wn)))
         self.fd_step = fd_step
         self.evaluations = 0
-        self._bp = np.asarray(model.elastic.stages.breakpoints, dtype=float)
+        if self.single:
+            self._bp = np.asarray(model.elastic.stages.breakpoints, dtype=float)
+        else:
+            self._bp = [(e, float(b)) for e, el in enumerate(system.elements) for b in el.breakpoints]
 
     def unscale(self, y: np.ndarray) -> tuple[np.ndarray, float]:
-        return y[:2] * self.sx, float(y[2] * self.wn)
+        return y[:-1] * self.sx, float(y[-1] * self.wn)
 
     def scale(self, x0: np.ndarray, omega: float) -> np.ndarray:
-        return np.array([x0[0] / self.sx[0], x0[1] / self.sx[1], omega / self.wn])
+        return np.concatenate((np.asarray(x0, dtype=float) / self.sx, [omega / self.wn]))
+
+    def shoot(self, omega: float, x0: np.ndarray):
+        """Newton shooting for the period-1 orbit at ``omega`` from ``x0``."""
+        if self.single:
+            return shoot_periodic_orbit(self.model, omega, x0, integrator=self.integ)
+        return shoot_system_orbit(self.system, omega, x0, integrator=self.integ)
 
     def evaluate(self, y: np.ndarray):
         """(scaled G, M (unscaled), scaled M, signature)."""
@@ -164,16 +194,20 @@ class _ShootingProblem:
         G = (traj.state1 - x0) / self.sx
         M = traj.sensitivity
         Ms = M * self.sx[None, :] / self.sx[:, None]
-        crossed = traj.crossed_breakpoints
-        sig = tuple(int(np.count_nonzero(crossed == b)) for b in self._bp)
+        if self.single:
+            crossed = traj.crossed_breakpoints
+            sig = tuple(int(np.count_nonzero(crossed == b)) for b in self._bp)
+        else:
+            sig = tuple(int(np.count_nonzero((traj.crossing_elements == e) & (traj.crossing_breakpoints == b)))
+                        for e, b in self._bp)
         return G, M, Ms, sig
 
     def g_omega(self, y: np.ndarray) -> np.ndarray:
         """∂G/∂(Ω/ω_n) (scaled) by central differences of the exact flow, step ``fd_step``."""
-        h = self.fd_step * max(1.0, abs(y[2]))
+        h = self.fd_step * max(1.0, abs(y[-1]))
         yp, ym = y.copy(), y.copy()
-        yp[2] += h
-        ym[2] -= h
+        yp[-1] += h
+        ym[-1] -= h
         return (self.evaluate(yp)[0] - self.evaluate(ym)[0]) / (2.0 * h)
 
 
@@ -208,10 +242,11 @@ class _Corrector:
         for it in range(self.max_iter):
             G, M, Ms, sig = self.prob.evaluate(y)
             r = np.concatenate((G, [float(d @ (y - anchor))]))
-            J = np.zeros((3, 3))
-            J[:2, :2] = Ms - np.eye(2)
-            J[:2, 2] = self.g_col
-            J[2] = d
+            k = G.size
+            J = np.zeros((k + 1, k + 1))
+            J[:k, :k] = Ms - np.eye(k)
+            J[:k, k] = self.g_col
+            J[k] = d
             try:
                 dy = np.linalg.solve(J, -r)
             except np.linalg.LinAlgError:
@@ -226,7 +261,7 @@ class _Corrector:
                 self.g_col = self.prob.g_omega(y)
                 refreshed = True
             y = y + dy
-            if y[2] <= 0.0 or float(np.max(np.abs(y - y_pred))) > 0.1:  # diverging
+            if y[-1] <= 0.0 or float(np.max(np.abs(y - y_pred))) > 0.1:  # diverging
                 return None
         return None
 
@@ -240,7 +275,7 @@ class _Corrector:
         for _ in range(self.max_iter):
             G, M, Ms, sig = self.prob.evaluate(y)
             try:
-                dx = np.linalg.solve(Ms - np.eye(2), -G)
+                dx = np.linalg.solve(Ms - np.eye(G.size), -G)
             except np.linalg.LinAlgError:
                 return None
             if not np.all(np.isfinite(dx)):
@@ -249,15 +284,23 @@ class _Corrector:
                 return BranchPoint(y, M, _psi(M), sig)
             if last_step is not None and float(np.max(np.abs(dx))) <= last_step:
                 y = y.copy()
-                y[:2] += dx
+                y[:-1] += dx
                 return BranchPoint(y, M, _psi(M), sig)
             y = y.copy()
-            y[:2] += dx
+            y[:-1] += dx
         return None
 
 
-def _linear_guess(model: Model, omega: float) -> np.ndarray:
-    """(δ(0), δ'(0)) of the linear response on the stage of the static equilibrium."""
+def _linear_guess(model, omega: float) -> np.ndarray:
+    """(δ(0), δ'(0)) (a chain: (x(0), x'(0))) of the linear response on the stage of the static
+    equilibrium (for a chain, from the harmonic-balance problem's closed-form linear solution:
+    only a start guess, which the exact shooting then closes)."""
+    if not isinstance(model, Model):
+        from rattle.hb import HarmonicBalance, HBOptions
+
+        hb = HarmonicBalance(model, HBOptions(harmonics=max(4, model.system().forced_harmonics)))
+        Q = hb.coordinate_series(hb.linear_solution(omega))
+        return np.array([float(hb.basis.evaluate(r, omega, 0.0, derivative=k)) for k in (0, 1) for r in Q])
     ds = model.static_equilibrium()
     s = float(model.elastic.stiffness(ds))
     ks = model.k * (s if s > 0 else 1.0)
@@ -310,8 +353,9 @@ def exact_special_points(
     natural_slope: float = 0.05,
     cont_tol: float = 1e-9,
     last_step: float = 1e-7,
+    x0: np.ndarray | None = None,
 ) -> ExactBranch:
-    """Folds and period doublings of the period-1 branch of ``model`` over ``omega`` = (Ω_min,
+    """Folds, period doublings (and, for chains, Neimark–Sacker points) of the period-1 branch of ``model`` over ``omega`` = (Ω_min,
     Ω_max) from the exact flow (module docstring). Raises :class:`ReferenceError` if the start
     orbit or a step cannot be computed."""
     import time
@@ -320,30 +364,30 @@ def exact_special_points(
     lo, hi = map(float, omega)
     prob = _ShootingProblem(model)
     corr = _Corrector(prob)
-    orbit = shoot_periodic_orbit(model, lo, _linear_guess(model, lo), integrator=prob.integ)
+    orbit = prob.shoot(lo, _linear_guess(model, lo) if x0 is None else np.asarray(x0, dtype=float))
     if not orbit.converged:
         raise ReferenceError(f"no start orbit at Ω_min = {lo}")
     y0 = prob.scale(orbit.state0, lo)
     # Initial direction: the null vector of [Ms − I, g_Ω], oriented towards increasing Ω.
     G, M, Ms, sig = prob.evaluate(y0)
     corr.g_col = prob.g_omega(y0)
-    J = np.hstack((Ms - np.eye(2), corr.g_col[:, None]))
+    J = np.hstack((Ms - np.eye(G.size), corr.g_col[:, None]))
     t = np.linalg.svd(J)[2][-1]
-    d = t / np.linalg.norm(t) * (1.0 if t[2] > 0 else -1.0)
+    d = t / np.linalg.norm(t) * (1.0 if t[-1] > 0 else -1.0)
     pts = [BranchPoint(y0, M, _psi(M), sig)]
     h = max_step
     steps = 0
     retry = False
     w_hi = hi / prob.wn
-    while pts[-1].y[2] < w_hi:
+    while pts[-1].y[-1] < w_hi:
         if steps >= max_steps:
-            raise ReferenceError(f"more than {max_steps} steps (reached Ω = {pts[-1].y[2] * prob.wn:.6g})")
+            raise ReferenceError(f"more than {max_steps} steps (reached Ω = {pts[-1].y[-1] * prob.wn:.6g})")
         if len(pts) >= 2:
             sec = pts[-1].y - pts[-2].y
             d_new = sec / np.linalg.norm(sec)
         else:
             d_new = d
-        hh = min(h, max_step, max_domega / max(abs(d_new[2]), 1e-300))
+        hh = min(h, max_step, max_domega / max(abs(d_new[-1]), 1e-300))
         if len(pts) >= 3 and not retry:
             # Quadratic extrapolation through the last three points (chord-length parameter):
             # an O(h³) predictor, so the corrector needs one or two Newton steps.
@@ -360,7 +404,7 @@ def exact_special_points(
             d_pred = d_new
         # Away from folds (the branch steep in Ω) the corrector works at the predicted Ω; near a
         # fold, in the plane normal to the predictor direction (pseudo-arclength).
-        if abs(d_pred[2]) > natural_slope and not retry:
+        if abs(d_pred[-1]) > natural_slope and not retry:
             p = corr.correct_fixed_omega(y_pred, tol=cont_tol, last_step=last_step)
         else:
             p = corr.correct(y_pred, d_pred, tol=cont_tol, last_step=last_step)
@@ -380,7 +424,7 @@ def exact_special_points(
             h = 0.5 * hh
             corr.g_col = prob.g_omega(pts[-1].y)
             if h < min_step:
-                raise ReferenceError(f"step below {min_step} at Ω = {pts[-1].y[2] * prob.wn:.8g}")
+                raise ReferenceError(f"step below {min_step} at Ω = {pts[-1].y[-1] * prob.wn:.8g}")
             continue
         retry = False
         pts.append(p)
@@ -390,7 +434,7 @@ def exact_special_points(
     special, states, refined, splits, guard_failures = guard_and_locate(
         corr, pts, (lo, hi), split_factor=split_factor, min_split=min_split, xtol=xtol, cont_tol=cont_tol,
         last_step=last_step)
-    points = np.array([[p.y[2] * prob.wn, *(p.y[:2] * prob.sx), *p.psi] for p in refined])
+    points = np.array([[p.y[-1] * prob.wn, *(p.y[:-1] * prob.sx), *p.psi] for p in refined])
     return ExactBranch(special=special, points=points, states=states, steps=steps, evaluations=prob.evaluations,
                        splits=splits, seconds=time.perf_counter() - t0, cpu=time.process_time() - c0,
                        stats={"guard_failures": guard_failures})
@@ -420,7 +464,7 @@ def guard_and_locate(corr: "_Corrector", pts: list[BranchPoint], omega: tuple[fl
     def flagged(a: BranchPoint, b: BranchPoint, V: np.ndarray) -> bool:
         if a.signature != b.signature:
             return True
-        for k in range(2):
+        for k in range(len(a.psi)):
             if np.sign(a.psi[k]) == np.sign(b.psi[k]) and min(abs(a.psi[k]), abs(b.psi[k])) <= split_factor * V[k]:
                 return True
         return False
@@ -433,7 +477,7 @@ def guard_and_locate(corr: "_Corrector", pts: list[BranchPoint], omega: tuple[fl
             return []
         m = correct_mid(a, b)
         if m is None:
-            guard_failures.append(float(0.5 * (a.y[2] + b.y[2]) * prob.wn))
+            guard_failures.append(float(0.5 * (a.y[-1] + b.y[-1]) * prob.wn))
             return []
         splits += 1
         Vh = np.maximum(0.5 * V, np.maximum(variation(a, m), variation(m, b)))
@@ -454,18 +498,29 @@ def guard_and_locate(corr: "_Corrector", pts: list[BranchPoint], omega: tuple[fl
     special: list[tuple[str, float]] = []
     states: list[np.ndarray] = []
     for a, b in zip(refined[:-1], refined[1:]):
-        for k, kind in enumerate(KINDS):
+        for k, kind in enumerate(KINDS[: len(a.psi)]):
             if np.sign(a.psi[k]) * np.sign(b.psi[k]) >= 0:
-                if a.psi[k] == 0.0 and lo <= a.y[2] * prob.wn <= hi:
-                    special.append((kind, float(a.y[2] * prob.wn)))
-                    states.append(a.y[:2] * prob.sx)
+                if a.psi[k] == 0.0 and lo <= a.y[-1] * prob.wn <= hi and _is_crossing(kind, a.M):
+                    special.append((kind, float(a.y[-1] * prob.wn)))
+                    states.append(a.y[:-1] * prob.sx)
                 continue
             p = _locate(corr, a, b, k, xtol)
-            w = float(p.y[2] * prob.wn)
-            if lo <= w <= hi:
+            w = float(p.y[-1] * prob.wn)
+            if lo <= w <= hi and _is_crossing(kind, p.M):
                 special.append((kind, w))
-                states.append(p.y[:2] * prob.sx)
+                states.append(p.y[:-1] * prob.sx)
     return special, states, refined, splits, guard_failures
+
+
+def _is_crossing(kind: str, M: np.ndarray) -> bool:
+    """A zero of ψ_ns is a Neimark–Sacker point only when the pair with μ_i μ_j = 1 is complex
+    (a conjugate pair on the unit circle), not a neutral saddle (two reals, μ_i μ_j = 1)."""
+    if kind != "neimark_sacker":
+        return True
+    mu = np.linalg.eigvals(M)
+    i, j = np.triu_indices(mu.size, 1)
+    k = int(np.argmin(np.abs(mu[i] * mu[j] - 1.0)))
+    return bool(abs(mu[i[k]].imag) > 1e-6 * max(1.0, abs(mu[i[k]])))
 
 
 def branch_points_at(model: Model, omegas, x0=None) -> tuple["_Corrector", list[BranchPoint]]:
@@ -477,7 +532,7 @@ def branch_points_at(model: Model, omegas, x0=None) -> tuple["_Corrector", list[
     x = _linear_guess(model, omegas[0]) if x0 is None else np.asarray(x0, dtype=float)
     pts = []
     for w in omegas:
-        orbit = shoot_periodic_orbit(model, float(w), x, integrator=prob.integ)
+        orbit = prob.shoot(float(w), x)
         if not orbit.converged:
             raise ReferenceError(f"no orbit at Ω = {w}")
         x = orbit.state0
@@ -503,7 +558,7 @@ def _locate(corr: _Corrector, a: BranchPoint, b: BranchPoint, k: int, xtol: floa
             return b.psi[k]
         p = corr.correct(a.y + s * d, d)
         if p is None:
-            raise ReferenceError(f"corrector failed while locating at Ω ≈ {a.y[2]}")
+            raise ReferenceError(f"corrector failed while locating at Ω ≈ {a.y[-1]}")
         last[s] = p
         return p.psi[k]
 
