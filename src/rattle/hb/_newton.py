@@ -5,10 +5,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 
 from .._typing import FloatArray
 from ._options import NewtonOptions
 from ._residual import HarmonicBalance
+
+
+def _full_step(problem, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
+    R, Rq, _ = problem.residual_jacobian(q, omega)
+    _, _, dq, info = scipy.linalg.lapack.dgesv(Rq, -R)
+    return R, (dq if info == 0 and np.all(np.isfinite(dq)) else None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -35,9 +42,12 @@ def solve_harmonic_balance(
     options = NewtonOptions() if options is None else options
     q = np.array(q0, dtype=float, copy=True)
     Fs, L = hb.force_scale, hb.length_scale
+    # The problem's own step (HarmonicBalance: full LAPACK gesv or condensed, HBOptions.condense);
+    # any other problem with residual_jacobian gets the full step.
+    step = getattr(hb, "newton_step", None) or (lambda q, w: _full_step(hb, q, w))
     res = np.inf
     for it in range(1, options.max_iterations + 1):
-        R, dq = hb.newton_step(q, omega)  # full (LAPACK gesv) or condensed (HBOptions.condense)
+        R, dq = step(q, omega)
         res = float(np.max(np.abs(R))) / Fs
         if not np.isfinite(res):
             return NewtonResult(q, False, it, res, "the residual became non-finite")
