@@ -1,0 +1,152 @@
+"""Chains against their exact references (issue: N inertias, several clearances, Neimark–Sacker).
+
+The references are independent of harmonic balance: the exact piecewise-linear flow of the
+chain's System (``rattle.timeint.SystemIntegrator``: stage solutions, crossings to round-off,
+monodromy from the stage matrices) continued by shooting in ``tests/_exact_branch.py``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rattle
+from rattle.model import Backlash, Chain, Clutch, Element, Link, Piecewise, Torque
+from rattle.model.library import REFERENCE_B
+from rattle.timeint import SystemIntegrator, shoot_system_orbit
+
+import _exact_branch as xb
+
+
+def two_inertia(I1: float, I2: float) -> Chain:
+    """The free two-inertia chain whose relative angle obeys the reference equation exactly."""
+    I = I1 * I2 / (I1 + I2)
+    Tm = 0.05 / (1 / I1 + 1 / I2)
+    return Chain(
+        inertias=(I1, I2), links=(Link(between=(1, 2), damping=0.05 * I),),
+        elements=(Element(name="clutch", between=(1, 2), stiffness=I, law=Clutch(alpha=0.25, b=REFERENCE_B)),),
+        torques=(Torque(inertia=1, mean=Tm, amplitudes=(0.03 * I1,)), Torque(inertia=2, mean=-Tm)),
+    )
+
+
+def grounded_clutch() -> Chain:
+    """Inertia 1 on the paper's clutch to ground, inertia 2 on a soft damped spring to inertia 1:
+    Neimark–Sacker points beside folds and period doublings."""
+    return Chain(
+        inertias=(1.0, 0.5),
+        links=(Link(between=(1, 0), damping=0.02), Link(between=(1, 2), stiffness=0.3, damping=0.03)),
+        elements=(Element(name="clutch", between=(1, 0), stiffness=1.0, law=Clutch(alpha=0.25, b=REFERENCE_B)),),
+        torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.03,)),),
+    )
+
+
+def driveline() -> Chain:
+    """Free three-inertia driveline: flywheel, four-stage asymmetric clutch damper, gearbox input,
+    gear mesh with backlash, vehicle; two engine harmonics."""
+    return Chain(
+        inertias=(1.0, 0.1, 2.0),
+        links=(Link(between=(1, 2), damping=0.02), Link(between=(2, 3), damping=0.1)),
+        elements=(
+            Element(name="clutch", between=(1, 2), stiffness=1.0,
+                    law=Piecewise(breakpoints=(-0.12, -0.04, 0.05, 0.15), slopes=(1.0, 0.3, 0.08, 0.4, 1.0))),
+            Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02)),
+        ),
+        torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.03, 0.015), phases=(0.0, 0.5)),
+                 Torque(inertia=3, mean=-0.05)),
+    )
+
+
+def _state(frf, model, i):
+    """(x(0), x'(0)) of row i's HB orbit: a start guess for exact shooting."""
+    n = model.system().n
+    H = frf.harmonics
+    Q = frf.coefficients[i].reshape(n, 2 * H + 1)
+    basis = rattle.hb.FourierBasis(H, 4 * (2 * H + 1))
+    w = float(frf.omega[i] / frf.period[i])
+    return np.array([basis.evaluate(r, w, 0.0, derivative=k) for k in (0, 1) for r in Q], dtype=float)
+
+
+def _points(frf):
+    return [(s.kind, s.omega) for s in frf.special_points]
+
+
+def _match(exact, hb, tol):
+    assert [k for k, _ in exact] == [k for k, _ in hb], (exact, hb)
+    err = max((abs(a - b) for (_, a), (_, b) in zip(exact, hb)), default=0.0)
+    assert err <= tol, (exact, hb, err)
+    return err
+
+
+@pytest.mark.parametrize("I1, I2", [(2.0, 2.0), (3.0, 1.5)])
+def test_two_inertia_chain_reproduces_the_single_equation(I1, I2):
+    """Same special points, rows and measures as the single equation, to round-off."""
+    model = rattle.reference_case()
+    f = rattle.frequency_response(model, omega=(0.1, 3.0), harmonics=16)
+    g = rattle.frequency_response(two_inertia(I1, I2), omega=(0.1, 3.0), harmonics=16)
+    assert [k for k, _ in _points(f)] == [k for k, _ in _points(g)]
+    assert np.max(np.abs(np.subtract([w for _, w in _points(f)], [w for _, w in _points(g)]))) <= 1e-8
+    assert len(f) == len(g)
+    np.testing.assert_allclose(g.rms, f.rms, rtol=1e-8)
+    np.testing.assert_allclose(g.element("clutch")["rms"], f.rms, rtol=1e-8)
+    np.testing.assert_array_equal(g.stable, f.stable)
+
+
+def test_two_inertia_chain_exact_reference_equals_the_single_equation_reference():
+    """The N-DOF reference (SystemIntegrator) finds the single-equation reference's (closed-form
+    ExactIntegrator) period doubling at 1.2426 to 1e-8."""
+    a = xb.exact_special_points(rattle.reference_case(), (1.2, 1.3))
+    b = xb.exact_special_points(two_inertia(3.0, 1.5), (1.2, 1.3))
+    assert [k for k, _ in a.special] == [k for k, _ in b.special] == ["period_doubling"]
+    assert abs(a.special[0][1] - b.special[0][1]) <= 1e-8
+
+
+@pytest.mark.parametrize("omega", [(0.45, 0.6), (0.74, 0.9)])
+def test_grounded_clutch_chain_special_points_with_neimark_sacker(omega):
+    model = grounded_clutch()
+    exact = xb.exact_special_points(model, omega).special
+    frf = rattle.frequency_response(model, omega=omega, harmonics=16)
+    assert "neimark_sacker" in {k for k, _ in exact}
+    _match(exact, _points(frf), 1e-4)
+    for sp in frf.special_points:
+        if sp.kind == "neimark_sacker":
+            assert 0.0 < sp.torus_ratio < 0.5
+            pair = sp.multipliers[np.argmin(np.abs(np.abs(sp.multipliers) - 1.0))]
+            assert abs(abs(pair) - 1.0) < 1e-6 and abs(pair.imag) > 1e-3
+
+
+@pytest.mark.parametrize("omega", [(0.55, 0.65), (0.75, 1.0)])
+def test_driveline_special_points(omega):
+    model = driveline()
+    frf = rattle.frequency_response(model, omega=omega, harmonics=16)
+    exact = xb.exact_special_points(model, omega, x0=_state(frf, model, 0)).special
+    _match(exact, _points(frf), 1e-4)
+
+
+@pytest.mark.parametrize("make, omega", [
+    (grounded_clutch, (0.45, 0.9)),
+    (driveline, (0.55, 1.0)),
+])
+def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega):
+    """At points away from special points: every element's rms within 0.1 % of the exact
+    periodic orbit closed by shooting from the HB state, and the same stability verdict."""
+    model = make()
+    system = model.system()
+    frf = rattle.frequency_response(model, omega=omega, harmonics=32)
+    special = np.array([s.omega for s in frf.special_points])
+    integ = SystemIntegrator(system)
+    rows = np.linspace(0, len(frf) - 1, 24).astype(int)
+    checked = 0
+    for i in rows:
+        w = float(frf.omega[i])
+        if special.size and np.min(np.abs(special - w)) < 5e-3:
+            continue
+        z0 = _state(frf, model, i)
+        orbit = shoot_system_orbit(system, w, z0, integrator=integ)
+        assert orbit.converged
+        assert np.max(np.abs(orbit.state0 - z0)) <= 1e-2 * model.length_scale()  # the same orbit
+        for name in model.element_names:
+            exact_rms = orbit.measures.element(name)["rms"]
+            assert frf.element(name)["rms"][i] == pytest.approx(exact_rms, rel=1e-3), (name, w)
+        assert bool(frf.stable[i]) == orbit.stable, w
+        checked += 1
+    assert checked >= 8
