@@ -114,17 +114,24 @@ def first_exit(
         i_out = np.where(outside.any(axis=0), outside.argmax(axis=0), n)
         pos = v > 0.0
         change = pos[:-1] != pos[1:]
-        change &= np.arange(n)[:, None] < i_out[None, :]
         cands: list[tuple[int, int]] = []
+        i_out_l = i_out.tolist()
         if change.any():
             ci, ce = change.nonzero()
-            d_a, d_b, v_a, v_b = d[ci, ce], d[ci + 1, ce], v[ci, ce], v[ci + 1, ce]
-            excursion = 2.0 * (taus[ci + 1] - taus[ci]) * np.maximum(np.abs(v_a), np.abs(v_b))
-            skip = np.where(v_a > 0.0, np.maximum(d_a, d_b) + excursion < hi[ce],
-                            np.minimum(d_a, d_b) - excursion > lo[ce])
-            cands = list(zip(ci[~skip].tolist(), ce[~skip].tolist()))
-        for e in np.flatnonzero(i_out < n).tolist():
-            cands.append((int(i_out[e]), e))
+            for i, e in zip(ci.tolist(), ce.tolist()):
+                if i >= i_out_l[e]:
+                    continue
+                d_a, d_b, v_a, v_b = float(d[i, e]), float(d[i + 1, e]), float(v[i, e]), float(v[i + 1, e])
+                # An extremum inside a cell can only reach a breakpoint within the cell's possible
+                # excursion (δ' passes through zero and |δ'| is at most about its end values;
+                # factor 2 for safety): refine only those.
+                excursion = 2.0 * float(taus[i + 1] - taus[i]) * max(abs(v_a), abs(v_b))
+                if (max(d_a, d_b) + excursion < hi[e]) if v_a > 0.0 else (min(d_a, d_b) - excursion > lo[e]):
+                    continue
+                cands.append((i, e))
+        for e, i in enumerate(i_out_l):
+            if i < n:
+                cands.append((i, e))
         if cands:
             cands.sort()
             best: tuple[float, int, int] | None = None
