@@ -127,6 +127,34 @@ def _gap_region(frf: FrequencyResponse, a: float, b: float, tol: float) -> Regio
     )
 
 
+def torus_regions(frf: FrequencyResponse) -> list[Region]:
+    """The stretches of each branch between two Neimark–Sacker points where it is unstable:
+    there a complex pair of multipliers is outside the unit circle, and the motion near the
+    orbit is quasi-periodic (a torus, for a supercritical Neimark–Sacker bifurcation) — kind
+    ``torus``, whatever other branch may be stable at the same Ω. ``detail``: the branch and
+    the torus frequency ratios θ/2π at both ends."""
+    out: list[Region] = []
+    for b in np.unique(frf.branch):
+        sel = np.nonzero(frf.branch == b)[0]
+        ns = [sp for sp in frf.special_points if sp.branch == int(b) and sp.kind == "neimark_sacker"]
+        for sp0, sp1 in zip(ns[:-1], ns[1:]):
+            i0, i1 = int(sp0.index), int(sp1.index)
+            inner = [i for i in sel if i0 < i < i1]
+            if not inner or np.any(frf.stable[inner]):
+                continue
+            # Between them only this pair (no other stability change on the stretch).
+            if any(sp.branch == int(b) and i0 < sp.index < i1 for sp in frf.special_points):
+                continue
+            lo, hi = sorted((float(frf.omega[i0]), float(frf.omega[i1])))
+            ratios = [sp0.torus_ratio, sp1.torus_ratio]
+            period = int(frf.period[i0])
+            text = (f"period-{period} unstable between Neimark–Sacker points: quasi-periodic motion likely "
+                    f"(torus frequency ratio ≈ {np.nanmean([r for r in ratios if r is not None]):.3g})")
+            out.append(Region("torus", lo, hi, text, {"branch": int(b), "period": period, "torus_ratio": ratios,
+                                                     "rows": [i0, i1]}))
+    return out
+
+
 def label_regions(frf: FrequencyResponse, min_gap: float = 1e-4) -> tuple[Region, ...]:
     """All regions of a (possibly multi-branch) frequency response, sorted by Ω.
 
@@ -150,6 +178,7 @@ def label_regions(frf: FrequencyResponse, min_gap: float = 1e-4) -> tuple[Region
         else:
             for lo, hi in _union(stable_intervals(frf, int(b)), sliver):
                 regions.append(Region("subharmonic", lo, hi, f"period {period} (1/{period} sub-harmonic)", {"period": period, "branch": int(b)}))
+    regions += torus_regions(frf)
     covered = _union([iv for b in np.unique(frf.branch) for iv in stable_intervals(frf, int(b))])
     lo_all, hi_all = float(frf.omega.min()), float(frf.omega.max())
     tol = 1e-6 * (hi_all - lo_all)
@@ -193,4 +222,4 @@ def confirm_with_sweep(regions: tuple[Region, ...], sweep: Any) -> tuple[Region,
     return tuple(out)
 
 
-__all__ = ["Region", "label_regions", "superharmonic_resonances", "stable_intervals", "confirm_with_sweep", "UNSTABLE_KINDS"]
+__all__ = ["torus_regions", "Region", "label_regions", "superharmonic_resonances", "stable_intervals", "confirm_with_sweep", "UNSTABLE_KINDS"]

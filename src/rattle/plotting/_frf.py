@@ -178,6 +178,17 @@ def draw_regions(
             ax.text(0.5 * (r.omega_min + r.omega_max), 0.93, short, transform=top,
                     ha="center", va="top", fontsize=7, color="0.25",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}, zorder=6)
+        elif r.kind == "torus":
+            sim = r.detail.get("simulated_periods")
+            text = ("quasi-periodic (Neimark–Sacker)" if sim is None else
+                    "Neimark–Sacker interval, simulation: " + ", ".join(f"period {p}" if p else "quasi-periodic" for p in sim))
+            ax.axvspan(r.omega_min, r.omega_max, facecolor="tab:green", alpha=0.12, edgecolor="tab:green", lw=0.8,
+                       zorder=0, label=text if labels and text not in seen else None)
+            seen.add(text)
+            short = "torus" if sim is None else ("sim: " + ",".join(f"P{p}" if p else "QP" for p in sim))
+            ax.text(0.5 * (r.omega_min + r.omega_max), 0.86, short, transform=top, ha="center", va="top", fontsize=7,
+                    color="tab:green", bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
+                    zorder=6)
         elif r.kind == "superharmonic":
             i = _resonance_rows(frf, r.omega_min)
             if i is not None:
