@@ -257,6 +257,16 @@ class StageSolution:
         except (np.linalg.LinAlgError, ValueError):
             self.method = "expm"
         self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
+        # A segment's mode amplitudes are coef[:, None] * base (coef: modal coordinates, then the
+        # harmonics' phase factors at its start).
+        if self.method == "modal":
+            self.base_d = np.concatenate((self.Pd_modal.T, self.Zh_d), axis=0)  # (K, 2m)
+            self.base_z = np.concatenate((self.Pz_modal.T, self.Zh), axis=0)  # (K, 2n)
+            self.Pinv_1 = self.Pinv[:, -1]
+        else:
+            self.modes = 1j * hw
+            self.base_d, self.base_z = self.Zh_d, self.Zh
+        self.modes_l = self.modes.tolist()
         self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
         self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
         self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
@@ -325,13 +335,10 @@ class StageSolution:
         """exp(A_s τ) (2n, 2n), exact to round-off."""
         if self.method == "expm":
             return sla.expm(self.A * tau)
-        s = self.sdim
-        factors = np.ones(self.Pinv_z.shape[0], dtype=complex)
-        factors[s:] = np.exp(self.lam * tau)
-        right = factors[:, None] * self.Pinv_z
+        M = (self.Pz_modal * np.exp(self.lam * tau)) @ self.Pinv_z[self.sdim:]
         for a, b, mu, N in self.clusters:
-            right[a:b] = (np.exp(mu * tau) * _taylor_expm(N, tau)) @ right[a:b]
-        return (self.Pz @ right).real
+            M = M + self.Pz[:, a:b] @ ((np.exp(mu * tau) * _taylor_expm(N, tau)) @ self.Pinv_z[a:b])
+        return M.real.copy()
 
     def segment(self, ts: float, z: FloatArray, tau_max: float) -> Segment:
         """The solution from state ``z`` at ``ts`` for local times 0 ≤ τ ≤ ``tau_max``."""
@@ -355,53 +362,42 @@ class Segment:
     one τ.
     """
 
-    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "c", "ph", "Bd", "w0", "poly", "_Bz", "_Qz",
+    __slots__ = ("sol", "ts", "z0", "tau_max", "mu", "c", "coef", "Bd", "w0", "poly", "_Bz", "_Qz",
                  "_floors", "_mu_l", "_bd_l", "_qd_l", "_ef")
 
     def __init__(self, sol: StageSolution, ts: float, z: FloatArray, tau_max: float) -> None:
         flow = sol.flow
         self.sol, self.ts, self.z0 = sol, float(ts), z
         self.tau_max = tau_max = float(tau_max) if math.isfinite(tau_max) else 1.0
-        hw = flow.hw
-        if hw.size:
-            ph = np.exp(1j * self.ts * hw)
-            zh0 = (ph @ sol.Zh).real
-        else:
-            ph = np.zeros(0, dtype=complex)
-            zh0 = 0.0
-        self.ph = ph
+        self.mu = sol.modes
+        self._mu_l = sol.modes_l
         self._Bz = self._Qz = self._floors = None
         self._bd_l = self._qd_l = None
         self.poly: list[tuple[complex, np.ndarray, np.ndarray, int, int]] = []  # (μ, U, Qd, a, b)
+        if flow.hw.size:
+            ph = np.exp((1j * self.ts) * flow.hw)
+            u = z - (ph @ sol.Zh).real  # the state less the harmonics' particular solution
+        else:
+            ph = np.zeros(0, dtype=complex)
+            u = z
         if sol.method == "modal":
-            w0 = np.empty(z.size + 1)
-            w0[:-1] = z - zh0
-            w0[-1] = 1.0
-            c = sol.Pinv @ w0
-            self.c = c
-            self.mu = sol.modes
-            self.Bd = np.concatenate((sol.Pd_modal.T * c[sol.sdim:, None], sol.Zh_d * ph[:, None]), axis=0)  # (K, 2m)
+            self.c = c = sol.Pinv_z @ u + sol.Pinv_1
+            self.coef = coef = np.concatenate((c[sol.sdim:], ph))
             for a, b, mu, N in sol.clusters:
                 U = _taylor_terms(N, c[a:b], tau_max)  # (Kp, d)
                 self.poly.append((mu, U, U @ sol.Pd[:, a:b].T, a, b))
             self.w0 = None
         else:
-            self.w0 = np.concatenate((z - zh0, [1.0]))
-            self.mu = 1j * hw
-            self.Bd = sol.Zh_d * ph[:, None]
-        self._mu_l = self.mu.tolist()
+            self.w0 = np.concatenate((u, [1.0]))
+            self.coef = coef = ph
+        self.Bd = coef[:, None] * sol.base_d  # (K, 2m)
 
     # --- lazily built pieces ------------------------------------------------------------------
     @property
     def Bz(self) -> np.ndarray:
         """Mode amplitudes of z (K, 2n)."""
         if self._Bz is None:
-            sol = self.sol
-            hamps = sol.Zh * self.ph[:, None]
-            if self.w0 is None:
-                self._Bz = np.concatenate((sol.Pz_modal.T * self.c[sol.sdim:, None], hamps), axis=0)
-            else:
-                self._Bz = hamps
+            self._Bz = self.coef[:, None] * self.sol.base_z
         return self._Bz
 
     @property
@@ -518,11 +514,8 @@ class Segment:
         if self.w0 is not None:
             return self.state(np.array([tau]))[0][0]
         sol = self.sol
-        e = np.exp(self.mu * tau)
-        k2 = sol.lam.size
-        z = (sol.Pz_modal @ (e[:k2] * self.c[sol.sdim:])).real
-        if self.ph.size:
-            z += ((e[k2:] * self.ph) @ sol.Zh).real
+        z = (np.exp(self.mu * tau) * self.coef) @ sol.base_z
+        z = z.real.copy()
         for mu, U, _, a, b in self.poly:
             u = U[0] if U.shape[0] == 1 else _horner(U, tau)
             if mu != 0:
