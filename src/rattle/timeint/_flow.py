@@ -162,8 +162,14 @@ class SystemTrajectory:
         flat = t.reshape(-1)
         seg = self.segment_index(flat) if segment is None else np.broadcast_to(segment, t.shape).reshape(-1)
         out = [np.empty((flat.size, n)) for _ in range(order + 1)]
-        for i in np.unique(seg).tolist():
-            sel = seg == i
+        idx = np.argsort(seg, kind="stable")
+        sorted_seg = seg[idx]
+        cuts = np.flatnonzero(sorted_seg[1:] != sorted_seg[:-1]) + 1
+        for lo_, hi_ in zip(np.concatenate(([0], cuts)).tolist(), np.concatenate((cuts, [flat.size])).tolist()):
+            if hi_ <= lo_:
+                continue
+            sel = idx[lo_:hi_]
+            i = int(sorted_seg[lo_])
             vals = self._segment_derivatives(i, flat[sel] - self.t_start[i], order)
             for o, val in zip(out, vals):
                 o[sel] = val
