@@ -14,7 +14,7 @@ construction (a crossing enters the new stage), whatever round-off says of δ th
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

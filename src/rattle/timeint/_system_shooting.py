@@ -18,7 +18,12 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from .._validate import check_omega
 from ..model import System
-from ._flow import SystemIntegrator, SystemMeasures, SystemTrajectory, check_system_state
+from ._flow import (
+    SystemIntegrator,
+    SystemMeasures,
+    SystemTrajectory,
+    check_system_state,
+)
 
 _MAX_HALVINGS = 12
 
