@@ -94,8 +94,8 @@ def main() -> None:
                 return solve_ivp(f, (0.0, 5 * T), z0, method="DOP853", rtol=1e-12, atol=1e-14, max_step=T / 50)
 
             tr, _ = best_of(1, ivp)
-            print(f"    {name:18s}  {om:5.2f}   {1e3 * ts:11.1f} ms   {b.n_segments:8d}   {1e6 * ts / b.n_segments:8.0f} us"
-                  f"   {1e3 * tr:9.0f} ms")
+            print(f"    {name:18s}  {om:5.2f}   {1e3 * ts:11.1f} ms   {b.n_segments:8d}"
+                  f"   {1e6 * ts / b.n_segments:8.0f} us   {1e3 * tr:9.0f} ms")
 
     print("\n(c) shooting (tol 1e-12, measures included)")
     for om in (0.8, 1.6):

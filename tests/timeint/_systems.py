@@ -1,4 +1,5 @@
-"""Systems built by hand for the System integrator tests (M θ'' + C_θ θ' + K_θ θ + Σ w_eᵀ K_e f_e(w_e·θ) = T)."""
+"""Systems built by hand for the System integrator tests:
+M θ'' + C_θ θ' + K_θ θ + Σ w_eᵀ K_e f_e(w_e·θ) = T, reduced as in rattle.model._system."""
 
 from __future__ import annotations
 

@@ -302,7 +302,10 @@ class StageSolution:
             elif abs(mu.imag) <= ctol:
                 mu = complex(mu.real, 0.0)
             radius = max(abs(lam[i] - mu) for i in members) + 0.5 * ctol  # the other eigenvalues are farther
-            _, Z, sdim = sla.schur(Abar.astype(complex), output="complex", sort=lambda x, mu=mu, radius=radius: abs(x - mu) <= radius)
+            def inside(x: complex, mu: complex = mu, radius: float = radius) -> bool:
+                return abs(x - mu) <= radius
+
+            _, Z, sdim = sla.schur(Abar.astype(complex), output="complex", sort=inside)
             if sdim != len(members):
                 raise ValueError("cluster basis")
             cols.append(Z[:, :sdim])

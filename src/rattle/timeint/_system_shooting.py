@@ -160,7 +160,8 @@ def shoot_system_orbit(
     traj = integ.propagate(z, 0.0, T, omega)
     evaluations += 1
     return SystemOrbit(
-        state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity, multipliers=_multipliers(traj.sensitivity),
+        state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
+        multipliers=_multipliers(traj.sensitivity),
         converged=res <= tol, iterations=iterations, residual=res, evaluations=evaluations, trajectory=traj,
         measures=traj.measures(),
     )
