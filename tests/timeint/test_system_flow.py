@@ -254,3 +254,16 @@ def test_matrix_exponential_fallback_equals_block_modal_form(monkeypatch):
     np.testing.assert_allclose(fallback.sensitivity, modal.sensitivity, rtol=0, atol=1e-12)
     t = np.linspace(0.0, T, 9)
     np.testing.assert_allclose(fallback.sample(t).acceleration, modal.sample(t).acceleration, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("x0", [(0.0, 0.0), "b+", "b-", "-b0"])
+def test_start_on_a_breakpoint_equals_exact_integrator(x0):
+    model = rattle.reference_case()
+    b = float(model.elastic.b)
+    state = {"b+": (b, 0.01), "b-": (b, -0.01), "-b0": (-b, 0.0)}.get(x0, x0)
+    omega = 1.0
+    ref = ExactIntegrator(model).propagate(state, 0.5, 12.0, omega)
+    traj = SystemIntegrator(model.system()).propagate(state, 0.5, 12.0, omega)
+    np.testing.assert_array_equal(traj.stages[0], [ref.stage[0]])
+    np.testing.assert_allclose(traj.state1, ref.state1, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(traj.crossing_times, ref.crossing_times, rtol=0, atol=1e-11)

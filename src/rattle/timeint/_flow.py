@@ -358,6 +358,7 @@ class SystemIntegrator:
         t = t0
         M = np.eye(2 * n)
         n_seg = 0
+        stuck = 0  # consecutive crossings without time passing
         while True:
             sol = flow.solution(stages)
             remaining = t1 - t
@@ -370,6 +371,13 @@ class SystemIntegrator:
                 rec["st"].append(stages)
                 rec["zs"].append(z)
                 rec["seg"].append(seg)
+            stuck = 0 if tau_c > 0.0 else stuck + 1
+            if stuck > 4 * flow.m + 8:
+                raise ConvergenceError(
+                    f"the trajectory switches element stages without advancing in time at t = {t!r} (stages "
+                    f"{stages}): a state that sits on breakpoints with no direction of motion; perturb the "
+                    "initial state `z0` slightly"
+                )
             if tau_c > 0.0:
                 n_seg += 1
                 if sensitivity:
