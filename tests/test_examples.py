@@ -16,7 +16,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 @pytest.mark.parametrize("name", sorted(p.name for p in EXAMPLES.glob("*.toml")))
 def test_example_configurations_parse(name):
     cfg = load_config(EXAMPLES / name)
-    assert cfg.analysis.harmonics >= len(cfg.model.excitation.amplitudes)
+    assert cfg.analysis.harmonics >= cfg.model.system().forced_harmonics
 
 
 def test_reference_example_is_the_reference_case():
@@ -43,7 +43,7 @@ def _stated_special_points(path: Path) -> list[tuple[str, float]]:
     text = path.read_text()
     head = text[text.index("# Special points") :]
     head = head[: head.index("\n[")]
-    return [(kind, float(w)) for kind, w in re.findall(r"(fold|period_doubling) ([0-9.]+)", head)]
+    return [(kind, float(w)) for kind, w in re.findall(r"(fold|period_doubling|neimark_sacker) ([0-9.]+)", head)]
 
 
 @pytest.mark.parametrize("name", sorted(p.name for p in EXAMPLES.glob("*.toml")))
