@@ -267,3 +267,25 @@ def test_start_on_a_breakpoint_equals_exact_integrator(x0):
     np.testing.assert_array_equal(traj.stages[0], [ref.stage[0]])
     np.testing.assert_allclose(traj.state1, ref.state1, rtol=0, atol=1e-13)
     np.testing.assert_allclose(traj.crossing_times, ref.crossing_times, rtol=0, atol=1e-11)
+
+
+@pytest.mark.parametrize("which", ["grounded", "free", "single"])
+def test_omega_derivative_equals_central_differences(which):
+    system = {"grounded": grounded_chain(), "free": free_chain(),
+              "single": rattle.reference_case().system()}[which]
+    omega, h = 0.8, 1e-6
+    z0 = _state(system) + 0.01
+    integ = SystemIntegrator(system)
+    traj = integ.propagate(z0, 0.3, 9.0, omega)
+    assert traj.crossing_times.size > 0
+    fd = (integ.propagate(z0, 0.3, 9.0, omega + h).state1 - integ.propagate(z0, 0.3, 9.0, omega - h).state1) / (2 * h)
+    np.testing.assert_allclose(traj.omega_derivative(), fd, rtol=0, atol=1e-8 * np.abs(fd).max())
+    # the period map: Ωt held fixed (t1 = 2π/Ω)
+    T = 2 * math.pi / omega
+    traj = integ.propagate(z0, 0.0, T, omega)
+    plus = integ.propagate(z0, 0.0, 2 * math.pi / (omega + h), omega + h).state1
+    minus = integ.propagate(z0, 0.0, 2 * math.pi / (omega - h), omega - h).state1
+    fd = (plus - minus) / (2 * h)
+    np.testing.assert_allclose(traj.omega_derivative("phase"), fd, rtol=0, atol=1e-8 * np.abs(fd).max())
+    with pytest.raises(ValueError, match="`fixed`"):
+        traj.omega_derivative("both")

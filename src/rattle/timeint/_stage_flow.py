@@ -334,6 +334,28 @@ class StageSolution:
         self.Pinv_z = Pinv[:, :n2]
 
     # --- pieces ---------------------------------------------------------------------------------
+    def omega_particular(self, t: float) -> FloatArray:
+        """A particular solution p(t) (2n,) of s' = A_s s + ∂F/∂Ω(t), the equation of the
+        sensitivity s = ∂z/∂Ω to the forcing frequency (times fixed):
+
+            ∂F/∂Ω = Re Σ_h i h t (c_h − i s_h) e^{ihΩt},   p(t) = Re Σ_h (X_h t + Y_h) e^{ihΩt},
+
+        with X_h = i h Z_h and Y_h = −(ihΩ I − A_s)⁻¹ X_h."""
+        hw = self.flow.hw
+        if not hw.size:
+            return np.zeros(self.A.shape[0])
+        XY = getattr(self, "_omega_xy", None)
+        if XY is None:
+            h = hw / self.flow.omega
+            X = 1j * h[:, None] * self.Zh
+            n2 = self.A.shape[0]
+            M = 1j * hw[:, None, None] * np.eye(n2)[None] - self.A[None]
+            Y = -np.linalg.solve(M, X[..., None])[..., 0]
+            XY = self._omega_xy = (X, Y)
+        X, Y = XY
+        ph = np.exp(1j * hw * t)
+        return ((X * t + Y) * ph[:, None]).sum(axis=0).real
+
     def transition(self, tau: float) -> FloatArray:
         """exp(A_s τ) (2n, 2n), exact to round-off."""
         if self.method == "expm":
