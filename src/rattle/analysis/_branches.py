@@ -34,17 +34,28 @@ def _run(run: RunSettings | None, harmonics: int, continuation: ContinuationOpti
     return RunSettings.make(HBOptions(harmonics=harmonics), newton, continuation)
 
 
-def odd_indices(harmonics: int) -> np.ndarray:
-    """Indices of the cosine and sine coefficients of the odd harmonics in q."""
+def odd_indices(harmonics: int, coordinates: int = 1) -> np.ndarray:
+    """Indices of the cosine and sine coefficients of the odd harmonics in q (every coordinate's
+    block of 2H + 1, coordinate-major)."""
     k = np.arange(1, harmonics + 1, 2)
-    return np.concatenate((k, harmonics + k))
+    one = np.concatenate((k, harmonics + k))
+    return np.concatenate([one + i * (2 * harmonics + 1) for i in range(coordinates)])
+
+
+def _coordinates(hb: HarmonicBalance) -> int:
+    return hb.size // hb.basis.size
+
+
+def _resize(q: FloatArray, coordinates: int, harmonics: int, factor: int = 1) -> FloatArray:
+    """:func:`~rattle.hb.resize_harmonics` of every coordinate block of the flat ``q``."""
+    return resize_harmonics(np.asarray(q).reshape(coordinates, -1), harmonics, factor).reshape(-1)
 
 
 def critical_mode(hb2: HarmonicBalance, q2: FloatArray, omega: float) -> FloatArray:
     """Null vector φ of the odd block of ∂R/∂q of the doubled-period problem at q2 (unit norm,
     zero outside the odd harmonics)."""
     _, Rq, _ = hb2.residual_jacobian(q2, omega)
-    odd = odd_indices(hb2.basis.harmonics)
+    odd = odd_indices(hb2.basis.harmonics, _coordinates(hb2))
     _, _, vt = np.linalg.svd(Rq[np.ix_(odd, odd)])
     phi = np.zeros(hb2.size)
     phi[odd] = vt[-1]
@@ -79,13 +90,14 @@ def switch_period_doubling(
     run = _run(run, harmonics, continuation, newton)
     newton = run.newton
     hb2 = HarmonicBalance(model, run.for_harmonics(H2), period=2 * period)
-    q2 = resize_harmonics(q_pd, H2, factor=2)
+    n = _coordinates(hb2)
+    q2 = _resize(q_pd, n, H2, factor=2)
+    odd = odd_indices(H2, n)
     # Polish the embedding on the doubled-period problem (the even block is regular there).
     res = solve_harmonic_balance(hb2, q2, omega_pd, newton)
-    if res.converged and np.max(np.abs(res.q[odd_indices(H2)])) < 1e-9 * max(1.0, np.max(np.abs(res.q))):
+    if res.converged and np.max(np.abs(res.q[odd])) < 1e-9 * max(1.0, np.max(np.abs(res.q))):
         q2 = res.q
     phi = critical_mode(hb2, q2, omega_pd)
-    odd = odd_indices(H2)
     # Tangent in scaled variables: along φ, with no change in Ω.
     tangent = np.zeros(hb2.size + 1)
     tangent[:-1] = phi  # q / L scaling is uniform, so φ's direction is unchanged
@@ -162,7 +174,7 @@ def period_doubling_branches(
                     o = min(others, key=lambda o: abs(float(parent.omega[o.index]) - w_end))
                     if abs(float(parent.omega[o.index]) - w_end) < 1e-2 * (omega_range[1] - omega_range[0]):
                         done.add(o.index)
-                        q_end = resize_harmonics(parent.coefficients[o.index], hb2.basis.harmonics, factor=2)
+                        q_end = _resize(parent.coefficients[o.index], _coordinates(hb2), hb2.basis.harmonics, factor=2)
                         last = points[-1]
                         points[-1] = BranchPoint(q_end, float(parent.omega[o.index]), 0, last.residual, last.tangent, last.step)
                         end_is_pd = True
