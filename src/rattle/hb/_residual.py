@@ -280,6 +280,8 @@ class HarmonicBalance:
         np.multiply(D[:, :1], N, out=re[:, :1])
         np.multiply(D[:, 1 : H + 1], 0.5 * N, out=re[:, 1 : H + 1])
         np.multiply(D[:, H + 1 :], -0.5 * N, out=im[:, 1 : H + 1])
+        if D.shape[0] == 1:
+            return np.fft.irfft(self._synth[0], n=N)[None]
         return np.fft.irfft(self._synth, n=N, axis=1)
 
     def _element_samples(self, delta: FloatArray) -> FloatArray:
@@ -310,12 +312,17 @@ class HarmonicBalance:
     def _forces(self, q: FloatArray) -> FloatArray:
         """Σ_e b_e Γ* f_e(Γ a_e·Q), shape (n, S)."""
         delta = self._synthesize_elements(self.element_series(q))
+        if self.n_elements == 1:  # fast path of one element: 1-D transforms, b P as an outer product
+            bp, sl, off = self._laws[0]
+            d = delta[0]
+            j = np.searchsorted(bp, d, side="right")
+            spec = np.fft.rfft(sl[j] * d + off[j])[: self.basis.harmonics + 1] / self.basis.samples
+            return self._B * self.basis.from_complex(spec)
         rows = []
         for d, (bp, sl, off) in zip(delta, self._laws):
             j = np.searchsorted(bp, d, side="right")
             rows.append(sl[j] * d + off[j])
-        f = rows[0][None] if len(rows) == 1 else np.stack(rows)
-        return self._element_forces(np.fft.rfft(f, axis=1))
+        return self._element_forces(np.fft.rfft(np.stack(rows), axis=1))
 
     def nonlinear_force(self, q: FloatArray) -> FloatArray:
         """Σ_e b_e Γ* f_e(Γ a_e·Q): coefficients of the element forces by AFT, flat (n·(2H+1),)."""
