@@ -54,7 +54,11 @@ saltation matrices are the identity because f is continuous). Nothing of harmoni
 6. Every sign change of ψ between consecutive (refined) points is located by Brent's method on the
    arclength s along the segment's secant, each trial point corrected onto the branch in the plane
    normal to the secant, to |Δs| ≤ 1e-11 (scaled; |ΔΩ| ≤ |Δs| ω_n). Roots outside [Ω_min, Ω_max]
-   are dropped.
+   are dropped. For a chain (state of dimension 2n ≥ 4) only the sign changes across which the
+   stability changes are located — the points rattle labels (its ``bifurcation`` column marks
+   where stability changes): a multiplier that crosses the unit circle while another is already
+   outside (the fold of an unstable stretch) is a bifurcation of an unstable orbit, not counted.
+   A zero of ψ_ns is a Neimark–Sacker point only where the pair is complex (not a neutral saddle).
 
 Why it can be trusted
 ---------------------
@@ -497,7 +501,15 @@ def guard_and_locate(corr: "_Corrector", pts: list[BranchPoint], omega: tuple[fl
 
     special: list[tuple[str, float]] = []
     states: list[np.ndarray] = []
+    def stable(p: BranchPoint) -> bool:
+        return bool(np.max(np.abs(np.linalg.eigvals(p.M))) < 1.0)
+
     for a, b in zip(refined[:-1], refined[1:]):
+        if len(a.psi) > 2 and stable(a) == stable(b):
+            # A chain: a multiplier may cross the unit circle while another is already outside
+            # (a fold or a torus of an already unstable orbit); as rattle's `bifurcation`
+            # column, the reference counts the crossings where stability changes.
+            continue
         for k, kind in enumerate(KINDS[: len(a.psi)]):
             if np.sign(a.psi[k]) * np.sign(b.psi[k]) >= 0:
                 if a.psi[k] == 0.0 and lo <= a.y[-1] * prob.wn <= hi and _is_crossing(kind, a.M):
