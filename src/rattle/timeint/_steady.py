@@ -49,9 +49,11 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from .. import _limits
 from .._validate import check_int, check_state, numerical_failures
-from ..model import Model, check_analysable_model
+from ..model import Chain, Model, System, check_analysable_model
 from ._exact import ExactIntegrator, ExactMeasures, Trajectory
+from ._flow import SystemIntegrator, SystemMeasures, SystemTrajectory, check_system_state
 from ._shooting import _newton_shooting, _Shot, _state_scale
+from ._system_shooting import _newton_system, _SystemShot, system_state_scale
 
 _TWO_PI = 2.0 * math.pi
 _LINEAR_CHECK = 0.1  # relative mismatch allowed between the simulation and the linearisation
@@ -205,39 +207,59 @@ class SteadyState:
     final_state: FloatArray
     cycle: FloatArray
     poincare: FloatArray
-    trajectory: Trajectory
-    measures: ExactMeasures
+    trajectory: Trajectory | SystemTrajectory
+    measures: ExactMeasures | SystemMeasures
     multipliers: ComplexArray | None
     residual: float
+    element_names: tuple[str, ...] = ()
 
-    # SPEC §1 measures, flat
+    # SPEC §1 measures, flat (a chain: of its first element)
+    def _first(self, name: str) -> float:
+        value = getattr(self.measures, name)
+        return float(value[0]) if isinstance(self.measures, SystemMeasures) else value
+
     @property
     def mean(self) -> float:
-        return self.measures.mean
+        return self._first("mean")
 
     @property
     def rms(self) -> float:
-        return self.measures.rms
+        return self._first("rms")
 
     @property
     def rms_ac(self) -> float:
-        return self.measures.rms_ac
+        return self._first("rms_ac")
 
     @property
     def p2p(self) -> float:
-        return self.measures.p2p
+        return self._first("p2p")
 
     @property
     def acc_p2p(self) -> float:
-        return self.measures.acc_p2p
+        return self._first("acc_p2p")
 
     @property
     def delta_min(self) -> float:
-        return self.measures.delta_min
+        return self._first("delta_min")
 
     @property
     def delta_max(self) -> float:
-        return self.measures.delta_max
+        return self._first("delta_max")
+
+    @property
+    def element_measures(self) -> SystemMeasures:
+        """The measures of every clearance element (a chain's, in the order of
+        ``element_names``; for the single equation one element, δ, named ``delta``)."""
+        m = self.measures
+        if isinstance(m, SystemMeasures):
+            return m
+        return SystemMeasures(names=self.element_names or ("delta",), **{
+            k: np.array([getattr(m, k)]) for k in
+            ("mean", "rms", "rms_ac", "delta_min", "delta_max", "p2p", "acc_min", "acc_max", "acc_p2p")})
+
+    def element(self, which: int | str) -> dict[str, float]:
+        """The measures of one element (index or name) as a dict of floats."""
+        return self.element_measures.element(which)
 
     @property
     def stable(self) -> bool | None:
@@ -246,21 +268,84 @@ class SteadyState:
             return None
         return bool(np.all(np.abs(self.multipliers) < 1.0))
 
+    def regimes(self) -> tuple[str, ...]:
+        """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) of every element over
+        ``trajectory``."""
+        traj = self.trajectory
+        if isinstance(traj, SystemTrajectory):
+            m = traj.system.m
+            return tuple(_regime_of(traj.crossing_breakpoints[traj.crossing_elements == e]) for e in range(m))
+        return (_regime_of(traj.crossed_breakpoints),)
+
     @property
     def regime(self) -> str:
-        """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) over ``trajectory``."""
-        crossed = self.trajectory.crossed_breakpoints
-        if crossed.size == 0:
-            return "no_impact"
-        if np.all(crossed > 0.0) or np.all(crossed < 0.0):
-            return "single_sided"
-        return "double_sided"
+        """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) over ``trajectory`` (a
+        chain: of its first element)."""
+        return self.regimes()[0]
 
     def __repr__(self) -> str:
         return (
             f"SteadyState(Ω = {self.omega:.6g}, period {self.period}, {self.method}, "
             f"rms {self.rms:.6g}, {self.periods} periods simulated + {self.shooting_periods} shooting)"
         )
+
+
+# ---------------------------------------------------------------------------------------------
+# The flow being settled: one equation (ExactIntegrator, 2 states) or a System (2n states)
+# ---------------------------------------------------------------------------------------------
+class _ModelFlow:
+    """The single equation on :class:`ExactIntegrator` (the fast path: scalar hot loop)."""
+
+    def __init__(self, model: Model, integ: ExactIntegrator, omega: float) -> None:
+        self.integ, self.omega = integ, omega
+        self.dim = 2
+        self.scale = _state_scale(model, omega)
+
+    def advance(self, x: FloatArray, T: float) -> FloatArray:
+        d, v = self.integ._advance(float(x[0]), float(x[1]), 0.0, T, self.omega)
+        return np.array([d, v])
+
+    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _Shot:
+        return _newton_shooting(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
+
+    def propagate(self, x: FloatArray, T: float) -> Trajectory:
+        return self.integ.propagate(x, 0.0, T, self.omega)
+
+    @staticmethod
+    def section(traj: Trajectory, t: FloatArray) -> FloatArray:
+        s = traj.sample(t)
+        return np.column_stack((s.delta, s.velocity))
+
+
+class _SystemFlow:
+    """A :class:`~rattle.model.System` on :class:`SystemIntegrator` (z = (x, x'), 2n states)."""
+
+    def __init__(self, system: System, integ: SystemIntegrator, omega: float) -> None:
+        self.integ, self.omega = integ, omega
+        self.dim = 2 * system.n
+        self.scale = system_state_scale(system, omega)
+
+    def advance(self, x: FloatArray, T: float) -> FloatArray:
+        return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]
+
+    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _SystemShot:
+        return _newton_system(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
+
+    def propagate(self, x: FloatArray, T: float) -> SystemTrajectory:
+        return self.integ.propagate(x, 0.0, T, self.omega)
+
+    @staticmethod
+    def section(traj: SystemTrajectory, t: FloatArray) -> FloatArray:
+        x, v = traj.derivatives(np.asarray(t, dtype=float), 1)
+        return np.concatenate((x, v), axis=-1)
+
+
+def _regime_of(crossed: FloatArray) -> str:
+    if crossed.size == 0:
+        return "no_impact"
+    if np.all(crossed > 0.0) or np.all(crossed < 0.0):
+        return "single_sided"
+    return "double_sided"
 
 
 def _proper_divisors(n: int) -> list[int]:
@@ -271,24 +356,25 @@ def _proper_divisors(n: int) -> list[int]:
 class _Candidate:
     """A stable orbit found by shooting, waiting for the simulation to come close."""
 
-    shot: _Shot
+    shot: _Shot | _SystemShot
     period: int
-    cycle: FloatArray  # (n, 2) unscaled section points
+    cycle: FloatArray  # (n, dim) unscaled section points
     created: int
 
 
 class _Settler:
     """The settling loop of :func:`steady_state` (one call)."""
 
-    def __init__(self, model: Model, omega: float, x0: FloatArray, opts: SteadyStateOptions,
-                 integ: ExactIntegrator) -> None:
-        self.model, self.omega, self.opts, self.integ = model, omega, opts, integ
+    def __init__(self, flow: _ModelFlow | _SystemFlow, omega: float, x0: FloatArray, opts: SteadyStateOptions,
+                 names: tuple[str, ...]) -> None:
+        self.flow, self.omega, self.opts, self.names = flow, omega, opts, names
         self.T = _TWO_PI / omega
-        self.scale = _state_scale(model, omega)
+        self.scale = flow.scale
         n_max = opts.max_periods
         self.N = opts.max_period_multiple
-        self.X = np.empty((n_max + 1, 2))  # section states
-        self.P = np.empty((n_max + 1, 2))  # scaled
+        dim = flow.dim
+        self.X = np.empty((n_max + 1, dim))  # section states
+        self.P = np.empty((n_max + 1, dim))  # scaled
         self.d = np.full((n_max + 1, self.N + 1), np.inf)  # d[i, n] = ‖P_i − P_{i−n}‖
         self.X[0] = x0
         self.P[0] = x0 / self.scale
@@ -306,25 +392,22 @@ class _Settler:
 
     def step(self) -> None:
         i = self.i + 1
-        d, v = self.integ._advance(float(self.X[i - 1, 0]), float(self.X[i - 1, 1]), 0.0, self.T, self.omega)
-        self.X[i] = x = np.array([d, v])
+        self.X[i] = x = self.flow.advance(self.X[i - 1], self.T)
         self.P[i] = x / self.scale
         n = min(self.N, i)
         self.d[i, 1 : n + 1] = np.max(np.abs(self.P[i] - self.P[i - n : i][::-1]), axis=1)
         self.i = i
 
-    def shoot(self, x: FloatArray, n: int) -> _Shot:
+    def shoot(self, x: FloatArray, n: int) -> _Shot | _SystemShot:
         opts = self.opts
-        shot = _newton_shooting(self.integ, self.omega, x, n, opts.shooting_tolerance,
-                                opts.shooting_iterations, self.scale, _MAX_HALVINGS)
+        shot = self.flow.shoot(x, n, opts.shooting_tolerance, opts.shooting_iterations)
         self.shooting_periods += shot.evaluations * n
         return shot
 
-    def cycle_points(self, shot: _Shot, n: int) -> FloatArray:
+    def cycle_points(self, shot: _Shot | _SystemShot, n: int) -> FloatArray:
         if n == 1:
             return shot.x[None, :].copy()
-        s = shot.trajectory.sample(np.arange(n) * self.T)
-        return np.column_stack((s.delta, s.velocity))
+        return self.flow.section(shot.trajectory, np.arange(n) * self.T)
 
     # --- plain detection --------------------------------------------------------------------
     def plain_period(self) -> int:
@@ -346,7 +429,7 @@ class _Settler:
                 return n
         return 0
 
-    def stable_orbit(self, x: FloatArray, n: int) -> tuple[_Shot, int] | None:
+    def stable_orbit(self, x: FloatArray, n: int) -> tuple[_Shot | _SystemShot, int] | None:
         """Newton shooting with period n from x; the orbit (with its minimal period) if it
         converged and is stable, else None."""
         shot = self.shoot(x, n)
@@ -355,8 +438,7 @@ class _Settler:
         if not np.all(np.abs(shot.multipliers()) < 1.0):
             return None
         for m in _proper_divisors(n):
-            s = shot.trajectory.sample(np.array([m * self.T]))
-            if self.norm(np.array([s.delta[0], s.velocity[0]]) - shot.x) <= _SAME_POINT:
+            if self.norm(self.flow.section(shot.trajectory, np.array([m * self.T]))[0] - shot.x) <= _SAME_POINT:
                 lower = self.shoot(shot.x, m)
                 if lower.residual <= self.opts.shooting_tolerance and np.all(np.abs(lower.multipliers()) < 1.0):
                     return lower, m
@@ -416,41 +498,40 @@ class _Settler:
         k = self.opts.section_points
         return self.X[max(0, self.i + 1 - k) : self.i + 1].copy()
 
-    def from_shot(self, shot: _Shot, n: int) -> SteadyState:
+    def from_shot(self, shot: _Shot | _SystemShot, n: int) -> SteadyState:
         traj = shot.trajectory
         return SteadyState(
             omega=self.omega, period=n, settled=True, method="shooting", periods=self.i,
             shooting_periods=self.shooting_periods, state0=shot.x.copy(), final_state=shot.x.copy(),
             cycle=self.cycle_points(shot, n), poincare=self.poincare(), trajectory=traj,
             measures=traj.measures(), multipliers=shot.multipliers(), residual=shot.residual,
+            element_names=self.names,
         )
 
     def from_simulation(self, n: int) -> SteadyState:
         i = self.i
         x = self.X[i].copy()
-        traj = self.integ.propagate(x, 0.0, n * self.T, self.omega)
+        traj = self.flow.propagate(x, n * self.T)
         mult = np.linalg.eigvals(traj.sensitivity).astype(complex)
         mult = mult[np.argsort(-np.abs(mult), kind="stable")]
-        cycle = x[None, :] if n == 1 else np.column_stack(
-            [(s := traj.sample(np.arange(n) * self.T)).delta, s.velocity])
+        cycle = x[None, :] if n == 1 else self.flow.section(traj, np.arange(n) * self.T)
         return SteadyState(
             omega=self.omega, period=n, settled=True, method="simulation", periods=i + n,
             shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
             cycle=cycle, poincare=self.poincare(), trajectory=traj, measures=traj.measures(),
-            multipliers=mult, residual=float(np.max(self.d[i - n : i + 1, n])),
+            multipliers=mult, residual=float(np.max(self.d[i - n : i + 1, n])), element_names=self.names,
         )
 
     def unsettled(self) -> SteadyState:
         i, rec = self.i, self.opts.record_periods
         x = self.X[i].copy()
-        traj = self.integ.propagate(x, 0.0, rec * self.T, self.omega)
-        s = traj.sample(np.arange(rec + 1) * self.T)
-        section = np.column_stack((s.delta, s.velocity))[-self.opts.section_points :]
+        traj = self.flow.propagate(x, rec * self.T)
+        section = self.flow.section(traj, np.arange(rec + 1) * self.T)[-self.opts.section_points :]
         return SteadyState(
             omega=self.omega, period=0, settled=False, method="unsettled", periods=i + rec,
             shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
-            cycle=np.empty((0, 2)), poincare=section, trajectory=traj, measures=traj.measures(),
-            multipliers=None, residual=float(np.min(self.d[i, 1:])),
+            cycle=np.empty((0, self.flow.dim)), poincare=section, trajectory=traj, measures=traj.measures(),
+            multipliers=None, residual=float(np.min(self.d[i, 1:])), element_names=self.names,
         )
 
     def run(self) -> SteadyState:
@@ -471,34 +552,59 @@ class _Settler:
         return self.unsettled()
 
 
+def static_state(model: Model | Chain | System) -> FloatArray:
+    """The static equilibrium at rest as a state: (δ_s, 0) for the single equation, (x_s, 0)
+    (2n,) for a chain or System."""
+    if isinstance(model, Model):
+        return np.array([model.static_equilibrium(), 0.0])
+    system = model.system() if isinstance(model, Chain) else model
+    return np.concatenate((system.static_equilibrium(), np.zeros(system.n)))
+
+
+def make_integrator(model: Model | Chain | System) -> ExactIntegrator | SystemIntegrator:
+    """The exact integrator :func:`steady_state` uses for ``model``: :class:`ExactIntegrator`
+    for the single equation (its fast scalar path), :class:`SystemIntegrator` of the System
+    otherwise (reuse it across calls to share its cache)."""
+    if isinstance(model, Model):
+        return ExactIntegrator(model)
+    return SystemIntegrator(model.system() if isinstance(model, Chain) else model)
+
+
 @numerical_failures
 def steady_state(
-    model: Model,
+    model: Model | Chain | System,
     omega: float,
-    x0: FloatArray | tuple[float, float],
+    x0: FloatArray | tuple[float, float] | None = None,
     *,
     options: SteadyStateOptions | None = None,
-    integrator: ExactIntegrator | None = None,
+    integrator: ExactIntegrator | SystemIntegrator | None = None,
 ) -> SteadyState:
-    """Steady motion of δ'' + c δ' + k f(δ) = F(t) reached from ``x0``, and its period.
+    """Steady motion reached from ``x0`` at the forcing frequency ``omega``, and its period.
 
     Simulates exactly, one forcing period at a time, until the Poincaré sequence (the states at
     t = m·2π/Ω) repeats with a period n·2π/Ω, n = 1 … ``max_period_multiple`` (smallest n), to the
     scaled ``tolerance``; with ``accelerate`` the settling is shortened by Newton shooting,
     accepting only the stable orbit the simulation is seen to converge to (module docstring).
 
+    The single equation δ'' + c δ' + k f(δ) = F(t) (a :class:`~rattle.model.Model`) runs on
+    :class:`ExactIntegrator`, state (δ, δ'); a :class:`~rattle.model.Chain` (or a bare
+    :class:`~rattle.model.System`) on :class:`SystemIntegrator`, state z = (x, x') of its n
+    coordinates, with the measures of every clearance element (the flat fields: the first).
+
     Parameters
     ----------
-    model : Model
-        The model (continuous piecewise-linear law).
+    model : Model, Chain or System
+        The equations of motion (continuous piecewise-linear laws).
     omega : float
         Forcing frequency Ω (rad/s), > 0.
-    x0 : array_like, shape (2,)
-        Initial state (δ, δ') (rad, rad/s) at t = 0 (forcing phase 0).
+    x0 : array_like, shape (2,) or (2n,), optional
+        Initial state at t = 0 (forcing phase 0): (δ, δ') (rad, rad/s), or (x_1 … x_n, x'_1 …
+        x'_n) for a chain; default the static equilibrium at rest.
     options : SteadyStateOptions, optional
         Tolerances and budget (default ``SteadyStateOptions()``).
-    integrator : ExactIntegrator, optional
-        The exact integrator of ``model`` (reuse one across calls to share its cache).
+    integrator : ExactIntegrator or SystemIntegrator, optional
+        The exact integrator of ``model`` (:func:`make_integrator`; reuse one across calls to
+        share its cache).
 
     Returns
     -------
@@ -506,18 +612,37 @@ def steady_state(
         Period (0 when nothing settled within ``max_periods``), orbit, measures, multipliers and
         the final state to carry to the next frequency.
     """
-    check_analysable_model(model)
-    omega = _limits.check_frequency(model, omega)
-    x = check_state(x0)
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
         raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
-    integ = ExactIntegrator(model) if integrator is None else integrator
-    if not isinstance(integ, ExactIntegrator):
-        raise TypeError(f"`integrator` must be an ExactIntegrator, got {integrator!r}")
-    if integ.model is not model and integ.model != model:
-        raise ValueError("`integrator` was built for a different model than `model`")
-    return _Settler(model, omega, x.copy(), opts, integ).run()
+    if isinstance(model, System):
+        from .._validate import check_omega
+
+        omega = check_omega(omega)
+        system = model
+    else:
+        check_analysable_model(model)
+        omega = _limits.check_frequency(model, omega)
+        system = None if isinstance(model, Model) else model.system()
+    if system is None:
+        x = check_state(x0) if x0 is not None else static_state(model)
+        integ = ExactIntegrator(model) if integrator is None else integrator
+        if not isinstance(integ, ExactIntegrator):
+            raise TypeError(f"`integrator` must be an ExactIntegrator for a Model, got {integrator!r}")
+        if integ.model is not model and integ.model != model:
+            raise ValueError("`integrator` was built for a different model than `model`")
+        flow: _ModelFlow | _SystemFlow = _ModelFlow(model, integ, omega)  # type: ignore[arg-type]
+        names: tuple[str, ...] = ()
+    else:
+        x = check_system_state(x0, system.n, "x0") if x0 is not None else static_state(system)
+        sinteg = SystemIntegrator(system) if integrator is None else integrator
+        if not isinstance(sinteg, SystemIntegrator):
+            raise TypeError(f"`integrator` must be a SystemIntegrator for a chain, got {integrator!r}")
+        if sinteg.system is not system:
+            raise ValueError("`integrator` was built for a different system than `model`")
+        flow = _SystemFlow(system, sinteg, omega)
+        names = tuple(e.name for e in system.elements)
+    return _Settler(flow, omega, x.copy(), opts, names).run()
 
 
-__all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS"]
+__all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS", "static_state", "make_integrator"]

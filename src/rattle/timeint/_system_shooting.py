@@ -129,9 +129,41 @@ def shoot_system_orbit(
     if integ.system is not system:
         raise ValueError("`integrator` was built for a different system than `system`")
 
-    T = int(period) * 2.0 * math.pi / omega
-    scale = system_state_scale(system, omega)
-    eye = np.eye(2 * system.n)
+    shot = _newton_system(integ, omega, z, int(period), float(tol), int(max_iterations),
+                          system_state_scale(system, omega))
+    traj = shot.trajectory
+    return SystemOrbit(
+        state0=shot.x, omega=omega, period=int(period), monodromy=traj.sensitivity,
+        multipliers=_multipliers(traj.sensitivity),
+        converged=shot.residual <= tol, iterations=shot.iterations, residual=shot.residual,
+        evaluations=shot.evaluations, trajectory=traj, measures=traj.measures(),
+    )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _SystemShot:
+    """A Newton shooting solve of a System before measures: last iterate ``x``, its trajectory
+    over one orbit period, scaled ``residual``, Newton ``iterations``, period maps ``evaluations``."""
+
+    x: FloatArray
+    trajectory: SystemTrajectory
+    residual: float
+    iterations: int
+    evaluations: int
+
+    def multipliers(self) -> ComplexArray:
+        """Eigenvalues of the monodromy matrix, largest modulus first."""
+        return _multipliers(self.trajectory.sensitivity)
+
+
+def _newton_system(integ: SystemIntegrator, omega: float, z0: FloatArray, period: int, tol: float,
+                   max_iterations: int, scale: FloatArray, max_halvings: int = _MAX_HALVINGS) -> _SystemShot:
+    """Newton's method on r(z0) = φ(z0; 0 → p·2π/Ω) − z0 with the exact monodromy, the period
+    maps without records (:meth:`SystemIntegrator.advance`), the last iterate's trajectory
+    recorded once (the core of :func:`shoot_system_orbit`, also used by ``steady_state``)."""
+    T = period * 2.0 * math.pi / omega
+    z = np.asarray(z0, dtype=float).copy()
+    eye = np.eye(z.size)
     z1, M = integ.advance(z, 0.0, T, omega)
     evaluations = 1
     r = z1 - z
@@ -145,7 +177,7 @@ def shoot_system_orbit(
         except np.linalg.LinAlgError:  # a multiplier exactly 1 (fold): least-squares step
             dz = np.linalg.lstsq(J, -r, rcond=None)[0]
         step = 1.0
-        for _ in range(_MAX_HALVINGS + 1):
+        for _ in range(max_halvings + 1):
             z_try = z + step * dz
             z1_try, M_try = integ.advance(z_try, 0.0, T, omega)
             evaluations += 1
@@ -159,12 +191,6 @@ def shoot_system_orbit(
         z, M, r, res = z_try, M_try, r_try, res_try
     traj = integ.propagate(z, 0.0, T, omega)
     evaluations += 1
-    return SystemOrbit(
-        state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
-        multipliers=_multipliers(traj.sensitivity),
-        converged=res <= tol, iterations=iterations, residual=res, evaluations=evaluations, trajectory=traj,
-        measures=traj.measures(),
-    )
-
+    return _SystemShot(z, traj, res, iterations, evaluations)
 
 __all__ = ["SystemOrbit", "shoot_system_orbit", "system_state_scale"]
