@@ -30,7 +30,9 @@ from .. import _limits, _validate
 from ..errors import RattleError
 from ..model import Model, check_analysable_model
 from ..results._sweep import SweepResult
-from ..timeint import ExactIntegrator, SteadyStateOptions, steady_state
+from ..results._sweep import SWEEP_ELEMENT_COLUMNS
+from ..timeint import SteadyStateOptions, steady_state
+from ..timeint._steady import make_integrator, static_state
 
 from ._frequency_response import check_range
 
@@ -57,8 +59,9 @@ def sweep_direction(
     Returns the sweep's rows as a dict of arrays (see :class:`~rattle.results.SweepResult`);
     ``report(direction)`` is called after each frequency.
     """
-    integ = ExactIntegrator(model)
-    x = np.array([model.static_equilibrium(), 0.0])
+    integ = make_integrator(model)
+    x = static_state(model)
+    dim = x.size
     n = len(omegas)
     rows: dict[str, np.ndarray] = {name: np.empty(n) for name in _ROW_SCALARS}
     rows["period"] = np.empty(n, dtype=np.int64)
@@ -66,9 +69,13 @@ def sweep_direction(
     rows["method"] = np.empty(n, dtype="<U10")
     rows["periods"] = np.empty(n, dtype=np.int64)
     rows["shooting_periods"] = np.empty(n, dtype=np.int64)
-    rows["state0"] = np.empty((n, 2))
-    rows["final_state"] = np.empty((n, 2))
-    rows["multipliers"] = np.full((n, 2), np.nan + 0j)
+    rows["state0"] = np.empty((n, dim))
+    rows["final_state"] = np.empty((n, dim))
+    rows["multipliers"] = np.full((n, dim), np.nan + 0j)
+    names = getattr(model, "element_names", None) or ()
+    for name in names:
+        for c in SWEEP_ELEMENT_COLUMNS:
+            rows[f"{name}_{c}"] = np.empty(n)
     for i, w in enumerate(omegas):
         s = steady_state(model, float(w), x, options=options, integrator=integ)
         for name in _ROW_SCALARS:
@@ -82,6 +89,12 @@ def sweep_direction(
         rows["final_state"][i] = s.final_state
         if s.multipliers is not None:
             rows["multipliers"][i] = s.multipliers
+        if names:
+            em = s.element_measures
+            for c in SWEEP_ELEMENT_COLUMNS:
+                values = getattr(em, c)
+                for k, nm in enumerate(names):
+                    rows[f"{nm}_{c}"][i] = values[k]
         x = s.final_state
         logger.debug("%s sweep Ω = %.6g: period %d (%s), rms %.6g", direction, w, s.period, s.method, s.rms)
         if report is not None:
@@ -324,6 +337,8 @@ def time_sweep(
 
     ordered = [runs[d][0] for d in DIRECTIONS[direction]]
     columns = {name: np.concatenate([r[name] for r in ordered]) for name in ordered[0]}
+    names = getattr(model, "element_names", None) or ()
+    element_columns = {f"{nm}_{c}": columns.pop(f"{nm}_{c}") for nm in names for c in SWEEP_ELEMENT_COLUMNS}
     timings = {f"{d} sweep": runs[d][1] for d in DIRECTIONS[direction]}
     timings["total"] = t_total
     settings = {
@@ -331,7 +346,7 @@ def time_sweep(
         "steady_state": options.to_dict(),
     }
     logger.info("time sweep %s: %d frequencies in %.3g s", direction, points * len(grids), t_total)
-    return SweepResult(model=model, settings=settings, timings=timings, **columns)
+    return SweepResult(model=model, settings=settings, timings=timings, element_columns=element_columns, **columns)
 
 
 __all__ = ["time_sweep", "sweep_direction", "DIRECTIONS"]

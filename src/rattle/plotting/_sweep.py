@@ -71,18 +71,41 @@ def sweep_plot(
         Join the points of each direction (False: markers only, e.g. over a frequency response).
     title : str, optional
         Axes title.
+
+    A chain's sweep (per-element columns) drawn without ``ax``: one panel per clearance element
+    (``quantity`` of its deflection), sharing Ω; returns (figure, array of axes).
     """
     import matplotlib.pyplot as plt
 
     if quantity not in _QUANTITIES:
         raise ValueError(f"`quantity` must be one of {sorted(_QUANTITIES)}, got {quantity!r}")
+    names = tuple(getattr(sweep, "element_names", ()) or ())
+    if names and ax is None:  # a chain: one panel per element, sharing Ω
+        fig, axes = plt.subplots(len(names), 1, figsize=(8, 1.5 + 3.0 * len(names)), sharex=True,
+                                 layout="constrained", squeeze=False)
+        for k, (name, ax_k) in enumerate(zip(names, axes[:, 0])):
+            first = title if title is not None else "Time-domain frequency sweep (steady state at each Ω)"
+            _draw_sweep(sweep, ax_k, np.asarray(sweep.element_columns[f"{name}_{quantity}"], dtype=float),
+                        annotate, lines, legend=k == 0)
+            ax_k.set_ylabel(f"{name}: {_QUANTITIES[quantity]}")
+            ax_k.set_title(f"{first} — element {name}" if k == 0 else f"element {name}", fontsize=10)
+            if k < len(names) - 1:
+                ax_k.set_xlabel("")
+        return fig, axes[:, 0]
     if ax is None:
         fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
     else:
         fig = ax.figure
+    _draw_sweep(sweep, ax, np.asarray(getattr(sweep, quantity), dtype=float), annotate, lines, legend=True)
+    ax.set_ylabel(_QUANTITIES[quantity])
+    ax.set_title(title if title is not None else "Time-domain frequency sweep (steady state at each Ω)")
+    return fig, ax
+
+
+def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:
+    """One sweep panel: ``y_all`` vs Ω per direction, period rings and labels."""
     direction = np.asarray(sweep.direction).astype(str)
     omega = np.asarray(sweep.omega, dtype=float)
-    y_all = np.asarray(getattr(sweep, quantity), dtype=float)
     period = np.asarray(sweep.period, dtype=int)
     names = [d for d in ("up", "down") if np.any(direction == d)] + sorted(set(direction) - {"up", "down"})
     for name in names:  # the sweeps first, so that they lead the legend
@@ -110,11 +133,9 @@ def sweep_plot(
                     fontsize=8, color=PERIOD_COLORS.get(int(per[i0]), "tab:gray"), fontweight="bold",
                 )
     ax.set_xlabel("forcing frequency Ω (rad/s)")
-    ax.set_ylabel(_QUANTITIES[quantity])
-    ax.set_title(title if title is not None else "Time-domain frequency sweep (steady state at each Ω)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
-    return fig, ax
+    if legend:
+        ax.legend(fontsize=8, loc="best")
 
 
 __all__ = ["sweep_plot", "period_label", "DIRECTION_STYLES", "PERIOD_COLORS"]

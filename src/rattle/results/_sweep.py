@@ -12,6 +12,10 @@ from .._typing import BoolArray, ComplexArray, FloatArray, IntArray
 from ._columns import SWEEP_COLUMNS
 from ..model import Model
 
+#: Per-element columns of a chain's ``sweep.csv``: ``NAME_`` + each of these (the measures of
+#: element NAME's deflection, as the SPEC columns are of the first element's).
+SWEEP_ELEMENT_COLUMNS: tuple[str, ...] = ("mean", "rms", "rms_ac", "p2p", "acc_p2p")
+
 #: Sweep directions, in the order ``both`` runs them.
 SWEEP_DIRECTIONS: tuple[str, ...] = ("up", "down")
 
@@ -52,6 +56,12 @@ class SweepResult:
     orbit's state on the Poincaré section, ``final_state`` (P, 2) the state carried to the next
     frequency, ``multipliers`` (P, 2) complex Floquet multipliers (NaN for period 0), and the
     provenance: ``model``, ``settings`` and ``timings`` (s).
+
+    A chain (:class:`~rattle.model.Chain`): the SPEC columns measure its first clearance
+    element; ``element_columns`` holds ``NAME_mean``, ``NAME_rms``, ``NAME_rms_ac``,
+    ``NAME_p2p``, ``NAME_acc_p2p`` of every element NAME (:data:`SWEEP_ELEMENT_COLUMNS`),
+    written after the SPEC columns; the states are z = (x, x') of its n coordinates ((P, 2n)),
+    the multipliers (P, 2n).
     """
 
     model: Model
@@ -74,6 +84,7 @@ class SweepResult:
     multipliers: ComplexArray
     settings: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
+    element_columns: dict[str, np.ndarray] = field(default_factory=dict)
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -94,7 +105,8 @@ class SweepResult:
             raise ValueError(f"`direction` must be one of {', '.join(SWEEP_DIRECTIONS)}, got {direction!r}")
         rows = np.flatnonzero(self.direction == direction)
         values = {name: getattr(self, name)[rows] for name in _ROW_FIELDS}
-        return SweepResult(model=self.model, settings=self.settings, timings=self.timings, **values)
+        return SweepResult(model=self.model, settings=self.settings, timings=self.timings,
+                           element_columns={k: v[rows] for k, v in self.element_columns.items()}, **values)
 
     def __repr__(self) -> str:
         parts = []
@@ -113,8 +125,20 @@ class SweepResult:
         return ", ".join(f"Ω ≈ {j.omega:.4g} ({j.direction} sweep, rms {j.kind})" for j in jumps)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The SPEC columns in order, as a dict of arrays."""
-        return {name: getattr(self, name) for name in SWEEP_COLUMNS}
+        """The SPEC columns in order, as a dict of arrays; for a chain followed by the
+        per-element columns (``NAME_mean`` … ``NAME_acc_p2p``)."""
+        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, **self.element_columns}
+
+    @property
+    def element_names(self) -> tuple[str, ...]:
+        """Names of the clearance elements whose columns this result carries (a chain's)."""
+        return tuple(k[: -len("_rms_ac")] for k in self.element_columns if k.endswith("_rms_ac"))
+
+    def element(self, name: str) -> dict[str, np.ndarray]:
+        """The measures of element ``name`` (``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``)."""
+        if name not in self.element_names:
+            raise KeyError(f"`name` must be one of the elements {list(self.element_names)}, got {name!r}")
+        return {c: self.element_columns[f"{name}_{c}"] for c in SWEEP_ELEMENT_COLUMNS}
 
     def summary(self) -> str:
         """A few lines for the terminal: points per direction, periods found, jumps, effort."""
@@ -206,7 +230,8 @@ class SweepResult:
         """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
         from ..io import write_csv
 
-        write_csv(path, self.columns(), list(SWEEP_COLUMNS))
+        cols = self.columns()
+        write_csv(path, cols, list(cols))
         return Path(path)
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
@@ -221,4 +246,4 @@ _ROW_FIELDS: tuple[str, ...] = (
     "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers",
 )
 
-__all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS"]
+__all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS", "SWEEP_ELEMENT_COLUMNS"]
