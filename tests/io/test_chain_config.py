@@ -71,3 +71,21 @@ def test_refusals_name_the_key(edit, key):
     with pytest.raises(ConfigError) as err:
         _load(TWO.replace(old, new, 1))
     assert key in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize(
+    "edit, key",
+    [
+        (("mean = -0.05", "mean = -0.04"), "`excitation.torques`"),
+        (("inertias = [2.0, 2.0]", "inertias = [2.0, 0.0]"), "`model.inertias[1]`"),
+        (("between = [1, 2]\ndamping", "between = [1, 1]\ndamping"), "`model.links[0].between`"),
+    ],
+)
+def test_command_line_refuses_a_bad_chain_with_exit_2_and_writes_nothing(tmp_path, edit, key):
+    from _cli_helpers import assert_bad_input, invoke
+
+    old, new = edit
+    (tmp_path / "chain.toml").write_text(TWO.replace(old, new, 1), encoding="utf-8")
+    result = invoke(["frf", "chain.toml", "-o", "out"], tmp_path)
+    assert_bad_input(result, key)
+    assert not (tmp_path / "out").exists()
