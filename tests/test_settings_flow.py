@@ -43,7 +43,7 @@ def record(monkeypatch):
         st_init(self, hb, q0, omega0, omega_range, options, newton, *args, **kwargs)
 
     def mu_spy(model, hb, Q, Om, X, stability):
-        seen["stability"].append(stability)
+        seen["stability"].append(stability.name)  # a rattle.stability method object
         return multipliers(model, hb, Q, Om, X, stability)
 
     def hill_spy(hb, q, omega):

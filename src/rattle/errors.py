@@ -30,7 +30,15 @@ class ConvergenceError(RattleError, RuntimeError):
 
 
 class Status(enum.Enum):
-    """How a continuation run ended. ``.message`` explains, ``.success`` tells if it is complete."""
+    """How a computation ended: the one status type of rattle (a value, not an exception).
+
+    ``.message`` explains, ``.success`` tells whether the result is complete. A continuation run
+    (``FrequencyResponse.status``, ``ContinuationStepper.status``) ends with ``SUCCESS``,
+    ``RETURNED``, ``STOPPED`` (complete), ``MAX_STEPS``, ``MAX_TIME``, ``STEP_TOO_SMALL`` or
+    ``START_FAILED``; a Newton solve at a fixed parameter
+    (:class:`~rattle.continuation.NewtonResult`) with ``CONVERGED`` (complete), ``SINGULAR``,
+    ``NON_FINITE`` or ``MAX_ITERATIONS``.
+    """
 
     SUCCESS = "the branch was followed across the whole frequency range"
     RETURNED = "the branch turned back and left the range at the side it started from"
@@ -39,6 +47,10 @@ class Status(enum.Enum):
     STEP_TOO_SMALL = "the corrector failed even at the smallest allowed step"
     START_FAILED = "no periodic solution could be found at the start of the range"
     STOPPED = "the branch ended where it rejoined another branch"
+    CONVERGED = "Newton's method converged"
+    SINGULAR = "singular Jacobian"
+    NON_FINITE = "the residual became non-finite"
+    MAX_ITERATIONS = "maximum iterations reached"
 
     @property
     def message(self) -> str:
@@ -46,7 +58,10 @@ class Status(enum.Enum):
 
     @property
     def success(self) -> bool:
-        return self in (Status.SUCCESS, Status.RETURNED, Status.STOPPED)
+        return self in _COMPLETE
+
+
+_COMPLETE = frozenset({Status.SUCCESS, Status.RETURNED, Status.STOPPED, Status.CONVERGED})
 
 
 __all__ = ["RattleError", "ConfigError", "ConvergenceError", "Status"]

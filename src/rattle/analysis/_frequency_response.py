@@ -20,7 +20,7 @@ from ..measures import Measures, system_measures_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, SpecialPoint
 from ..results._frequency_response import element_columns_from
-from ..stability import FloquetMonitor, classify_loss, hill_multipliers, multipliers_from_monodromy, torus_ratio
+from ..stability import FloquetMonitor, classify_loss, stability_method, torus_ratio
 from ..stability._classify import UNIT_CIRCLE_TOL
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb, scaled_hb
 
@@ -194,6 +194,7 @@ def frequency_response(
     seeds: Sequence[tuple[float, int, FloatArray]] = (),
     throw: bool = True,
     callback: Callable[[BranchPoint], None] | None = None,
+    confirm_tori: bool = True,
 ) -> FrequencyResponse:
     """Non-linear frequency response of ``model`` over ``omega`` = (Ω_min, Ω_max) rad/s.
 
@@ -217,6 +218,12 @@ def frequency_response(
     If the run ends before the far end of the range, ``throw=True`` raises ConvergenceError
     with the points computed so far in ``.partial``; ``throw=False`` returns them with the status.
 
+    ``confirm_tori`` (default True): every ``torus`` region (an unstable stretch between two
+    Neimark–Sacker points; only chains have them) is confirmed by one simulation from the
+    perturbed unstable orbit in its middle (:func:`rattle.analysis._tori.confirm_tori`): its
+    label says what the motion settles on, ``detail["simulated_periods"]`` the period (0:
+    quasi-periodic). About 1–1.5 s per region.
+
     Every sub-problem (the 2H re-location of special points, period-doubling branches, seeded
     branches) gets the same HBOptions (its sample count scaled with its harmonic count, see
     ``rattle.analysis._settings``), NewtonOptions, ContinuationOptions and stability method;
@@ -226,7 +233,7 @@ def frequency_response(
     check_analysable_model(model)
     lo, hi = _limits.check_frequency_range(model, *check_range(omega))
     _validate.check_choice(start, "start", ("low", "high"))
-    _validate.check_choice(stability, "stability", ("monodromy", "hill"))
+    stability = stability_method(stability)  # a name becomes its method object (rattle.stability)
     period = _limits.check_period(period)
     subharmonics = _validate.check_bool(subharmonics, "subharmonics")
     max_period = _limits.check_period(max_period, "max_period")
@@ -239,10 +246,18 @@ def frequency_response(
     _validate.check_instance(newton, "newton", NewtonOptions, "a NewtonOptions")
     _limits.check_callback(callback)
     run = RunSettings.make(resolve_hb(harmonics, samples, hb), newton, continuation, stability)
-    return _frequency_response(
+    confirm_tori = _validate.check_bool(confirm_tori, "confirm_tori")
+    result = _frequency_response(
         model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,
         sweep=sweep, seeds=seeds, throw=throw, callback=callback,
     )
+    if confirm_tori and any(r.kind == "torus" for r in result.regions):
+        from ._tori import confirm_tori as _confirm  # time domain: only when there is a torus
+
+        t0 = time.perf_counter()
+        result = replace(result, regions=_confirm(result), timings={
+            **result.timings, "torus_simulations": time.perf_counter() - t0})
+    return result
 
 
 def _frequency_response(
@@ -344,13 +359,7 @@ def _branch_record(branch: FrequencyResponse) -> dict:
 
 def _multipliers(model: Model, hb: HarmonicBalance, Q: FloatArray, Om: FloatArray, X: FloatArray, stability: StabilityMethod) -> np.ndarray:
     """Floquet multipliers (P, 2n), largest modulus first, of the orbits ``Q`` (P, n·(2H+1))."""
-    P = Q.shape[0]
-    k = 2 * (hb.size // hb.basis.size)
-    if P == 0:
-        return np.zeros((0, k), dtype=complex)
-    if stability == "monodromy":
-        return multipliers_from_monodromy(monitor_of(hb).monodromy_and_crossings(Q, Om)[0])
-    return np.array([hill_multipliers(hb, q, om) for q, om in zip(Q, Om)]).reshape(P, k)
+    return stability.multipliers(hb, Q, Om)  # a rattle.stability method object
 
 
 def assemble(
@@ -391,6 +400,7 @@ def assemble(
     its = np.array([p.iterations for p in points], dtype=int)
     res = np.array([p.residual for p in points], dtype=float)
     X = None  # (the monodromy synthesises what it needs)
+    stability = stability_method(stability)  # assemble() is public: a name is still accepted
     mu = _multipliers(model, hb, Q, Om, X, stability)
     stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL if P else np.zeros(0, dtype=bool)
     labels = np.full(P, "", dtype=object)
@@ -404,7 +414,7 @@ def assemble(
         labels[P - 1] = "period_doubling"
         k = _vertex_stretch(Q, hb, range(P - 1, -1, -1))
         stable_for_changes[P - 1 - k :] = stable[max(P - 2 - k, 0)]
-    changes = _locate_changes(hb, newton, Q, Om, mu, stable_for_changes, refine) if locate and stability == "monodromy" else [
+    changes = _locate_changes(hb, newton, Q, Om, mu, stable_for_changes, refine) if locate and stability.locates else [
         (i, classify_loss(mu[i - 1], mu[i]), None, None) for i in range(1, P) if stable_for_changes[i] != stable_for_changes[i - 1]
     ]
     if P > 1 and branch_points[0]:

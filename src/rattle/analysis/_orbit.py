@@ -46,7 +46,9 @@ from ..measures import measures_batch, synthesize_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
-from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, hill_multipliers, monodromy_batch, multipliers_from_monodromy
+from ..stability import (
+    UNIT_CIRCLE_TOL, FloquetMonitor, Hill, hill_multipliers, monodromy_batch, multipliers_from_monodromy,
+)
 from ..timeint import ExactIntegrator, shoot_periodic_orbit
 from ..timeint._steady import SteadyState, SteadyStateOptions, steady_state
 from ._frequency_response import check_range, frequency_response
@@ -513,7 +515,7 @@ def periodic_orbit(
             "omega": W, "period": period, "harmonics": harmonics, "simulate": simulate,
             "search_range": [lo, hi], "x0": start_state.tolist(),
             "samples": {p: hb.basis.samples for p, hb in solver._hb.items()},
-            "samples_given": hb_opts.samples, "stability": stability,
+            "samples_given": hb_opts.samples, "stability": stability.name,
             "newton": asdict(newton_opts), "continuation": asdict(cont_opts),
             "primary_branch_status": primary.status.name.lower(),
             "extra_simulations": extra_runs,
@@ -543,7 +545,7 @@ def _assembled(model: Model, solver: _Solver, cands: list[_Candidate],
         w = np.full(len(idx), solver.omega / p)
         Om = np.full(len(idx), solver.omega)
         X = synthesize_batch(Q, hb.basis.samples)
-        if stability == "hill":
+        if isinstance(stability, Hill):  # method objects (rattle.stability), chosen by type
             mu = np.array([hill_multipliers(hb, q, solver.omega) for q in Q]).reshape(len(idx), 2)
         else:
             mu = multipliers_from_monodromy(monodromy_batch(Q, w, X, st.breakpoints, model.k * st.slopes, model.c))

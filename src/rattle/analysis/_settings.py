@@ -1,8 +1,10 @@
 """The settings of a run, carried whole into every sub-problem.
 
 One options object per concern — :class:`~rattle.hb.HBOptions` (harmonics, AFT samples),
-:class:`~rattle.hb.NewtonOptions`, :class:`~rattle.continuation.ContinuationOptions` and the
-stability method — is resolved once by a front end and handed unchanged to every problem it
+:class:`~rattle.continuation.NewtonOptions`, :class:`~rattle.continuation.ContinuationOptions`
+and the stability method object (:class:`~rattle.stability.Monodromy`,
+:class:`~rattle.stability.Hill`; a name given at the boundary, ``stability="hill"``, is converted
+here, once) — is resolved once by a front end and handed unchanged to every problem it
 spawns: the 2H re-location of special points, period-doubling branch switching, seeded and
 sweep-seeded branches, the orbits of :func:`~rattle.analysis.periodic_orbit`.
 
@@ -18,14 +20,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
-from typing import Any, Literal
+from typing import Any, Literal, Union
 
 import numpy as np
 
-from ..continuation import ContinuationOptions
-from ..hb import HBOptions, NewtonOptions
+from ..continuation import ContinuationOptions, NewtonOptions
+from ..hb import HBOptions
+from ..stability import AbstractStabilityMethod, Monodromy, stability_method
 
-StabilityMethod = Literal["monodromy", "hill"]
+#: What a front end accepts as ``stability``: a method object or its name.
+StabilityMethod = Union[AbstractStabilityMethod, Literal["monodromy", "hill"]]
 
 
 class _DefaultHarmonics(int):
@@ -89,10 +93,9 @@ def scaled_hb(hb: HBOptions, harmonics: int) -> HBOptions:
     return HBOptions(harmonics=harmonics, samples=n)
 
 
-def check_stability(stability: object) -> StabilityMethod:
-    if stability not in ("monodromy", "hill"):
-        raise ValueError(f"`stability` must be 'monodromy' or 'hill', got {stability!r}")
-    return stability  # type: ignore[return-value]
+def check_stability(stability: object) -> AbstractStabilityMethod:
+    """The stability method object of ``stability`` (a method object, or ``"monodromy"``/``"hill"``)."""
+    return stability_method(stability, "stability")
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,11 +105,13 @@ class RunSettings:
     hb: HBOptions
     newton: NewtonOptions
     continuation: ContinuationOptions
-    stability: StabilityMethod = "monodromy"
+    stability: AbstractStabilityMethod = Monodromy()
 
     @classmethod
     def make(cls, hb: HBOptions, newton: NewtonOptions | None, continuation: ContinuationOptions | None,
              stability: StabilityMethod = "monodromy") -> "RunSettings":
+        """The settings of a run from the front end's arguments: ``None`` options take their
+        defaults, a stability method's name becomes its object (the one conversion)."""
         if continuation is not None and not isinstance(continuation, ContinuationOptions):
             raise TypeError(f"`continuation` must be a ContinuationOptions, got {continuation!r}")
         if newton is not None and not isinstance(newton, NewtonOptions):
@@ -122,7 +127,7 @@ class RunSettings:
         h = self.hb if hb is None else hb
         return {
             "harmonics": h.harmonics, "samples": h.n_samples, "samples_given": h.samples,
-            "stability": self.stability, "newton": asdict(self.newton), "continuation": asdict(self.continuation),
+            "stability": self.stability.name, "newton": asdict(self.newton), "continuation": asdict(self.continuation),
             **extra,
         }
 

@@ -1,11 +1,25 @@
-"""Pseudo-arclength continuation in the forcing frequency with self-adjusting steps."""
+"""Pseudo-arclength continuation of any problem R(q, p) = 0 in one parameter, with self-adjusting steps.
+
+A problem is anything that implements :class:`ContinuationProblem` (harmonic balance,
+:class:`~rattle.hb.HarmonicBalance`; shooting, :class:`~rattle.timeint.ShootingProblem`); this
+package knows nothing of how its residual is computed. :func:`solve_fixed` solves it at a fixed
+parameter, :class:`ContinuationStepper` follows its branch (predictor objects :class:`Tangent`,
+:class:`Secant`; bordered corrector :class:`ArclengthCorrector`; test-function monitoring
+:func:`check_segment`; special points located by :func:`locate_on_segment`).
+"""
 
 from ._corrector import ArclengthCorrector, Corrected
+from ._detect import LocatedPoint, locate_on_segment
 from ._monitor import Monitor, MonitorReading, SegmentVerdict, check_segment
-from ._options import ContinuationOptions
+from ._newton import NewtonResult, solve_fixed
+from ._options import ContinuationOptions, NewtonOptions
+from ._predictor import PREDICTORS, AbstractPredictor, Secant, Tangent, predictor
+from ._problem import ContinuationProblem, SupportsNewtonStep
 from ._stepper import BranchPoint, ContinuationStepper
 
 __all__ = [
-    "ContinuationOptions", "ContinuationStepper", "BranchPoint", "ArclengthCorrector", "Corrected",
+    "ContinuationProblem", "SupportsNewtonStep", "ContinuationOptions", "NewtonOptions", "NewtonResult",
+    "solve_fixed", "ContinuationStepper", "BranchPoint", "AbstractPredictor", "Tangent", "Secant",
+    "PREDICTORS", "predictor", "ArclengthCorrector", "Corrected", "LocatedPoint", "locate_on_segment",
     "Monitor", "MonitorReading", "SegmentVerdict", "check_segment",
 ]

@@ -1,12 +1,13 @@
 """The bordered Newton corrector of pseudo-arclength continuation, in scaled variables.
 
-Variables y = (q / L, Ω / ω_s) with L the model's length scale and ω_s = sqrt(K/I). Given a
-predicted point y_p and a unit direction t, the corrector solves
+Variables y = (q / L, p / p_s) with L the problem's ``length_scale`` (a number or one per
+unknown) and p_s its ``parameter_scale`` (see :mod:`._problem`). Given a predicted point y_p and a
+unit direction t, the corrector solves
 
-    R(q, Ω) = 0,    t · (y − y_p) = 0
+    R(q, p) = 0,    t · (y − y_p) = 0
 
-by Newton on the bordered Jacobian [∂R/∂q L, ∂R/∂Ω ω_s; tᵀ]; the tangent at a solution is the
-null vector of [∂R/∂q L, ∂R/∂Ω ω_s], normalised and oriented along a reference direction.
+by Newton on the bordered Jacobian [∂R/∂q L, ∂R/∂p p_s; tᵀ]; the tangent at a solution is the
+null vector of [∂R/∂q L, ∂R/∂p p_s], normalised and oriented along a reference direction.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ import numpy as np
 import scipy.linalg
 
 from .._typing import FloatArray
-from ..hb import HarmonicBalance, NewtonOptions
+from ._options import NewtonOptions
+from ._problem import ContinuationProblem
 
 _gesv = scipy.linalg.lapack.dgesv
 
@@ -26,7 +28,7 @@ _gesv = scipy.linalg.lapack.dgesv
 @dataclass(slots=True)
 class Corrected:
     """A converged corrector result: scaled ``y``, Newton ``iterations``, scaled ``residual`` and
-    the Jacobians at ``y``."""
+    the Jacobians ``Rq`` = ∂R/∂q and ``Rw`` = ∂R/∂p (the parameter, Ω in rattle) at ``y``."""
 
     y: FloatArray
     iterations: int
@@ -38,28 +40,33 @@ class Corrected:
 class ArclengthCorrector:
     """Scaling, bordered solves, tangents and the plane-constrained Newton corrector."""
 
-    def __init__(self, hb: HarmonicBalance, newton: NewtonOptions) -> None:
-        self.hb = hb
+    def __init__(self, problem: ContinuationProblem, newton: NewtonOptions) -> None:
+        self.problem = problem
         self.newton = newton
-        n = hb.size
+        n = problem.size
         self.scale = np.empty(n + 1)
-        self.scale[:n] = hb.length_scale
-        self.scale[n] = hb.model.natural_frequency
+        L = problem.length_scale
+        self.scale[:n] = L
+        self.scale[n] = problem.parameter_scale
+        # ∂R/∂q L: one number scales every column (the common case), else one per column.
+        self._q_scale = self.scale[0] if np.ndim(L) == 0 else self.scale[:n]
 
     def to_scaled(self, q: FloatArray, omega: float) -> FloatArray:
+        """y = (q / L, p / p_s) of the point (q, p = ``omega``)."""
         y = np.empty(q.size + 1)
         y[:-1] = q
         y[-1] = omega
         return y / self.scale
 
     def unscale(self, y: FloatArray) -> tuple[FloatArray, float]:
+        """(q, p) of the scaled point y."""
         return y[:-1] * self.scale[:-1], float(y[-1] * self.scale[-1])
 
     def bordered_solve(self, Rq: FloatArray, Rw: FloatArray, t: FloatArray, rhs: FloatArray) -> FloatArray | None:
-        """Solve [∂R/∂q L, ∂R/∂Ω ω_s; tᵀ] x = rhs (LAPACK gesv; None if singular)."""
+        """Solve [∂R/∂q L, ∂R/∂p p_s; tᵀ] x = rhs (LAPACK gesv; None if singular)."""
         n = Rq.shape[0]
         A = np.empty((n + 1, n + 1), order="F")
-        np.multiply(Rq, self.scale[0], out=A[:n, :n])
+        np.multiply(Rq, self._q_scale, out=A[:n, :n])
         np.multiply(Rw, self.scale[n], out=A[:n, n])
         A[n] = t
         _, _, x, info = _gesv(A, rhs, overwrite_a=1, overwrite_b=0)
@@ -76,18 +83,18 @@ class ArclengthCorrector:
 
     def correct(self, y_pred: FloatArray, t: FloatArray) -> Corrected | None:
         """Newton on R = 0, t·(y − y_pred) = 0 from y_pred; None when it fails."""
-        hb, opts = self.hb, self.newton
-        Fs = hb.force_scale
+        problem, opts = self.problem, self.newton
+        Fs = problem.force_scale
         y = y_pred.copy()
         step_norm = np.inf
-        n = hb.size
+        n = problem.size
         rhs = np.empty(n + 1)
         first_res = None
         for it in range(opts.max_iterations + 1):
             q, w = self.unscale(y)
-            if w <= 0:
+            if w <= 0:  # the parameter is a frequency: positive
                 return None
-            R, Rq, Rw = hb.residual_jacobian(q, w)
+            R, Rq, Rw = problem.residual_jacobian(q, w)
             res = float(np.max(np.abs(R))) / Fs
             if not math.isfinite(res):
                 return None

@@ -2,18 +2,20 @@
 
 Between accepted points y_a and y_b (scaled variables) the branch is parametrised by the arc
 length s along the secant d = (y_b − y_a)/|y_b − y_a|: each trial point y_a + s d is corrected
-back onto the branch in the plane normal to d (the arc-length corrector), and a scalar test
-function ψ that changes sign at the special point is solved for s by Brent's method:
+back onto the branch in the plane normal to d (the arc-length corrector, on any
+:class:`~rattle.continuation.ContinuationProblem`), and a scalar test function ψ that changes
+sign at the special point, supplied by the caller, is solved for s by Brent's method. For
+periodic orbits with monodromy M (``rattle.stability``):
 
 * fold: ψ = det(M − I) = 1 − tr M + det M (a multiplier at +1);
 * period doubling: ψ = det(M + I) = 1 + tr M + det M (a multiplier at −1);
-* Neimark–Sacker: ψ = det M − 1 (a complex pair on the unit circle, 2×2 monodromy).
+* Neimark–Sacker: ψ = det(M ⊙ M − I) (a complex pair on the unit circle).
 
-M is the exact monodromy of the HB orbit, a smooth function of the orbit between crossing-
-structure changes, so Brent's method converges superlinearly. (The Ω-component of the HB
-tangent is no good test: the AFT residual is piecewise linear in q, so the HB curve is a fine
-polyline whose tangent jumps — at a fold it flips sign in a single kink.) At a fold Ω is
-stationary in s, so an error in s changes the located Ω only to second order.
+Where M is a smooth function of the orbit (between crossing-structure changes) Brent's method
+converges superlinearly. (The parameter component of the tangent is no good test when the
+residual is only piecewise smooth — a harmonic-balance curve of a piecewise-linear law is a fine
+polyline whose tangent jumps, at a fold it flips sign in a single kink.) At a fold the
+parameter is stationary in s, so an error in s changes the located parameter only to second order.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from ._corrector import ArclengthCorrector, Corrected
 
 @dataclass(frozen=True, slots=True)
 class LocatedPoint:
-    """A located special point: coefficients ``q``, frequency ``omega``, the test function's
+    """A located special point: unknowns ``q``, parameter ``omega``, the test function's
     ``value`` there, corrector ``iterations`` and scaled ``residual``."""
 
     q: FloatArray

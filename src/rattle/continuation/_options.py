@@ -1,4 +1,4 @@
-"""Options of the pseudo-arclength continuation in the forcing frequency."""
+"""Options of the continuation: the Newton corrector and the arc-length step control."""
 
 from __future__ import annotations
 
@@ -6,15 +6,17 @@ import math
 from numbers import Integral
 from dataclasses import dataclass
 
-from .._limits import check_max_points
+from .._limits import MAX_NEWTON_ITERATIONS, check_max_points
+from .._validate import check_int, check_real
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ContinuationOptions:
     """Step control and budgets of the arc-length continuation.
 
-    Arc length is measured in scaled variables (q / L, Ω / ω_n), L the model's length scale
-    and ω_n = sqrt(K/I), so the defaults suit any unit system.
+    Arc length is measured in scaled variables (q / L, p / p_s), L and p_s the problem's
+    ``length_scale`` and ``parameter_scale`` (harmonic balance: the model's length scale and
+    ω_n = sqrt(K/I)), so the defaults suit any unit system.
 
     ``initial_step``, ``min_step``, ``max_step``: arc-length step bounds.
     ``target_iterations``: Newton iterations per point the step controller aims for.
@@ -70,4 +72,34 @@ class ContinuationOptions:
             raise ValueError(f"`max_time` must be None or a number of seconds > 0, got {self.max_time!r}")
 
 
-__all__ = ["ContinuationOptions"]
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NewtonOptions:
+    """Newton–Raphson corrector settings.
+
+    Converged when the scaled residual ‖R‖∞ / F_s ≤ ``residual_tol`` and the scaled step
+    max_i |Δq_i| / L_i ≤ ``step_tol`` (F_s, L: the problem's ``force_scale`` and
+    ``length_scale``, see :class:`~rattle.continuation.ContinuationProblem`; for harmonic
+    balance F_s = |F_m| + Σ|F_pn| and L the model's length scale). At most ``max_iterations``
+    corrections.
+    """
+
+    residual_tol: float = 1e-10
+    step_tol: float = 1e-8
+    max_iterations: int = 12
+
+    def __post_init__(self) -> None:
+        for name in ("residual_tol", "step_tol"):
+            v = check_real(getattr(self, name), name)
+            if not 0 < v < 1:
+                raise ValueError(f"`{name}` must be a number in (0, 1), got {v!r}")
+            object.__setattr__(self, name, v)
+        m = check_int("max_iterations", self.max_iterations, 1)
+        if m > MAX_NEWTON_ITERATIONS:
+            raise ValueError(
+                f"`max_iterations` must be <= {MAX_NEWTON_ITERATIONS}, got {m}: Newton converges in 2–5 "
+                "iterations where it converges at all, and every iteration is a dense solve; use e.g. 12"
+            )
+        object.__setattr__(self, "max_iterations", m)
+
+
+__all__ = ["ContinuationOptions", "NewtonOptions"]

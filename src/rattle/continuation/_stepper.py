@@ -1,9 +1,12 @@
-"""Pseudo-arclength continuation of R(q, Ω) = 0 in the forcing frequency Ω.
+"""Pseudo-arclength continuation of R(q, p) = 0 in its parameter p (in rattle: the forcing frequency Ω).
 
-Keller's method in scaled variables y = (q / L, Ω / ω_s) (see ``_corrector``):
+Keller's method on any :class:`~rattle.continuation.ContinuationProblem`, in scaled variables
+y = (q / L, p / p_s) (see ``_problem`` and ``_corrector``):
 
-* predictor along the unit tangent t: y_pred = y_i + Δs t;
-* corrector: Newton on the bordered system  R(y) = 0,  t·(y − y_pred) = 0;
+* predictor (a ``predictor`` object, see ``_predictor``): by default along the unit tangent t,
+  y_pred = y_i + Δs t;
+* corrector: Newton on the bordered system  R(y) = 0,  d·(y − y_pred) = 0 (d the predictor's
+  direction: t for the default);
 * step control: Δs is scaled by the ratio of the target to the actual number of Newton
   iterations and by the ratio of the target to the actual turn of the tangent (angle between
   successive tangents); a step whose corrector fails, or whose tangent turns by more than the
@@ -30,16 +33,19 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..errors import Status
-from ..hb import HarmonicBalance, NewtonOptions, solve_harmonic_balance
 from ._corrector import ArclengthCorrector
 from ._monitor import Monitor, MonitorReading, check_segment
-from ._options import ContinuationOptions
+from ._newton import solve_fixed
+from ._options import ContinuationOptions, NewtonOptions
+from ._predictor import AbstractPredictor, Tangent
+from ._problem import ContinuationProblem
 
 
 @dataclass(frozen=True, slots=True)
 class BranchPoint:
-    """An accepted solution: coefficients ``q``, frequency ``omega``, Newton ``iterations``,
-    scaled ``residual``, unit ``tangent`` (scaled variables) and the ``step`` that reached it."""
+    """An accepted solution: unknowns ``q``, parameter ``omega`` (the forcing frequency in rattle),
+    Newton ``iterations``, scaled ``residual``, unit ``tangent`` (scaled variables), the ``step``
+    that reached it and the monitor's ``reading`` there (None without a monitor)."""
 
     q: FloatArray
     omega: float
@@ -54,16 +60,19 @@ class BranchPoint:
 class ContinuationStepper:
     """Step-by-step pseudo-arclength continuation (the low-level API).
 
-    ``hb`` the discretised problem, ``q0`` a solution (or good guess) at ``omega0``. Without
+    ``problem`` any :class:`~rattle.continuation.ContinuationProblem` (harmonic balance, shooting),
+    ``q0`` a solution (or good guess) at the parameter ``omega0``; ``omega_range`` the parameter's
+    range (0 < min < max; the parameter is a frequency in rattle). Without
     ``tangent`` the start must be one end of ``omega_range`` and the branch is followed into
     the range; with ``tangent`` (a direction in scaled variables, e.g. the critical eigenvector
     at a branch point) the start may be anywhere in the range and the branch is followed along
     that direction. ``stop(point) -> str | None`` may end the run (status ``STOPPED``) with the
     returned reason. ``monitor(q, Ω, dq/ds, dΩ/ds)`` returns the test functions whose zeros
-    are the special points (see ``_monitor``); with it no zero is stepped over.
+    are the special points (see ``_monitor``); with it no zero is stepped over. ``predictor``
+    a :class:`~rattle.continuation.AbstractPredictor` (default :class:`~rattle.continuation.Tangent`).
     """
 
-    hb: HarmonicBalance
+    problem: ContinuationProblem
     q0: FloatArray
     omega0: float
     omega_range: tuple[float, float]
@@ -72,6 +81,7 @@ class ContinuationStepper:
     tangent: FloatArray | None = None
     stop: Callable[[BranchPoint], str | None] | None = None
     monitor: Monitor | None = None
+    predictor: AbstractPredictor = field(default_factory=Tangent)
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
@@ -80,6 +90,7 @@ class ContinuationStepper:
     corrector: ArclengthCorrector = field(init=False, repr=False)
     _y: FloatArray = field(init=False, repr=False)
     _t: FloatArray = field(init=False, repr=False)
+    _y_prev: FloatArray | None = field(init=False, repr=False, default=None)
     _ds: float = field(init=False, repr=False)
     _start_time: float = field(init=False, repr=False)
     _direction: float = field(init=False, repr=False)
@@ -99,8 +110,12 @@ class ContinuationStepper:
             self._direction = -1.0
         else:
             raise ValueError(f"`omega0` must be one end of `omega_range` {self.omega_range}, got {self.omega0}")
+        if not isinstance(self.predictor, AbstractPredictor):
+            raise TypeError(
+                f"`predictor` must be a predictor object (rattle.continuation.Tangent(), Secant()), got {self.predictor!r}"
+            )
         self._start_time = time.perf_counter()
-        self.corrector = ArclengthCorrector(self.hb, self.newton)
+        self.corrector = ArclengthCorrector(self.problem, self.newton)
         self._ds = self.options.initial_step
 
     def _finish(self, status: Status, message: str = "") -> None:
@@ -123,7 +138,7 @@ class ContinuationStepper:
         where ∂R/∂q is singular and a Newton step would be ill-posed) is taken as it is.
         """
         if self.tangent is not None:
-            r0 = float(np.max(np.abs(self.hb.residual(self.q0, self.omega0)))) / self.hb.force_scale
+            r0 = float(np.max(np.abs(self.problem.residual(self.q0, self.omega0)))) / self.problem.force_scale
             if r0 <= self.newton.residual_tol:
                 self._t = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
                 self._y = self.corrector.to_scaled(np.asarray(self.q0, dtype=float), self.omega0)
@@ -131,19 +146,19 @@ class ContinuationStepper:
                 pt = BranchPoint(np.array(self.q0, dtype=float), self.omega0, 0, r0, self._t.copy(), 0.0, self._reading)
                 self.points.append(pt)
                 return pt
-        res = solve_harmonic_balance(self.hb, self.q0, self.omega0, self.newton)
+        res = solve_fixed(self.problem, self.q0, self.omega0, self.newton)
         if not res.converged:
             self._finish(
                 Status.START_FAILED,
                 f"Newton did not converge at Ω = {self.omega0:g} ({res.message}, scaled residual {res.residual:.3g})",
             )
             return None
-        R, Rq, Rw = self.hb.residual_jacobian(res.q, self.omega0)
+        R, Rq, Rw = self.problem.residual_jacobian(res.q, self.omega0)
         if self.tangent is not None:
             reference = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
             t0: FloatArray | None = reference
         else:
-            reference = np.zeros(self.hb.size + 1)
+            reference = np.zeros(self.problem.size + 1)
             reference[-1] = self._direction
             t0 = self.corrector.tangent(Rq, Rw, reference)
         if t0 is None:
@@ -173,8 +188,8 @@ class ContinuationStepper:
         lo, hi = self.omega_range
         while True:
             ds = self._ds
-            y_pred = self._y + ds * self._t
-            corr = corr_.correct(y_pred, self._t)
+            y_pred, normal = self.predictor.predict(self._y, self._t, ds, self._y_prev)
+            corr = corr_.correct(y_pred, normal)
             t_new = None if corr is None else corr_.tangent(corr.Rq, corr.Rw, self._t)
             at_floor = ds <= opts.min_step * 1.0000001
             if corr is not None and t_new is not None:
@@ -209,11 +224,11 @@ class ContinuationStepper:
             _, w_prev = corr_.unscale(self._y)
             frac = (bound - w_prev) / (w - w_prev)
             y_guess = self._y + frac * (corr.y - self._y)
-            end = solve_harmonic_balance(self.hb, corr_.unscale(y_guess)[0], bound, self.newton)
+            end = solve_fixed(self.problem, corr_.unscale(y_guess)[0], bound, self.newton)
             start_side = self._direction != 0.0 and (bound == lo) == (self._direction > 0)
             status = Status.RETURNED if start_side else Status.SUCCESS
             if end.converged:
-                R, Rq, Rw = self.hb.residual_jacobian(end.q, bound)
+                R, Rq, Rw = self.problem.residual_jacobian(end.q, bound)
                 t_end = corr_.tangent(Rq, Rw, self._t)
                 t_end = t_new if t_end is None else t_end
                 pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_end, ds * frac,
@@ -225,6 +240,7 @@ class ContinuationStepper:
             return pt
         pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds, reading)
         self.points.append(pt)
+        self._y_prev = self._y
         self._y, self._t, self._reading = corr.y, t_new, reading
         # Step control from the iteration count and the tangent's turn.
         f_it = opts.target_iterations / max(corr.iterations, 1)

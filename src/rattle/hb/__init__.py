@@ -2,11 +2,20 @@
 single equation is n = m = 1): Fourier basis, AFT residual with analytic Jacobians, Newton corrector."""
 
 from ._basis import FourierBasis, resize_harmonics
-from ._newton import NewtonResult, solve_harmonic_balance
-from ._options import HBOptions, NewtonOptions, default_samples
+from ._options import HBOptions, default_samples
 from ._residual import HarmonicBalance
 
-__all__ = [
-    "FourierBasis", "resize_harmonics", "HarmonicBalance", "HBOptions", "NewtonOptions", "NewtonResult",
-    "solve_harmonic_balance", "default_samples",
-]
+__all__ = ["FourierBasis", "resize_harmonics", "HarmonicBalance", "HBOptions", "default_samples"]
+
+#: Names whose home moved to :mod:`rattle.continuation` (Newton at a fixed parameter is the same
+#: for every continuation problem): still importable from here, resolved when first used, so that
+#: this package does not import the continuation layer above it.
+_MOVED = {"NewtonOptions": "NewtonOptions", "NewtonResult": "NewtonResult", "solve_harmonic_balance": "solve_fixed"}
+
+
+def __getattr__(name: str):
+    if name in _MOVED:
+        import importlib
+
+        return getattr(importlib.import_module("rattle.continuation"), _MOVED[name])
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

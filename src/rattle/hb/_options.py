@@ -1,11 +1,11 @@
-"""Options of the harmonic balance discretisation and of the Newton corrector."""
+"""Options of the harmonic balance discretisation (the Newton corrector's are in :mod:`rattle.continuation`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .._limits import MAX_NEWTON_ITERATIONS, PROBLEM_MAX_HARMONICS, PROBLEM_MAX_SAMPLES
-from .._validate import check_int, check_real
+from .._limits import PROBLEM_MAX_HARMONICS, PROBLEM_MAX_SAMPLES
+from .._validate import check_int
 
 
 def default_samples(harmonics: int) -> int:
@@ -28,7 +28,7 @@ class HBOptions:
     ``samples``: N, time samples per solution period in the alternating frequency–time step
     (None: :func:`default_samples`); must be ≥ 4H + 2 so that the Jacobian's harmonics up to 2H
     are not folded.
-    ``condense``: solve every Newton step of :func:`~rattle.hb.solve_harmonic_balance` condensed
+    ``condense``: solve every Newton step of :func:`~rattle.continuation.solve_fixed` condensed
     onto the element deflections through the linear part's dynamic stiffness
     (:meth:`~rattle.hb.HarmonicBalance.newton_step`; same solution). Off by default: it pays only
     when the elements are few against the coordinates (``benchmarks/bench_hb_system.py``).
@@ -71,32 +71,4 @@ class HBOptions:
         return self.samples if self.samples is not None else default_samples(self.harmonics)
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class NewtonOptions:
-    """Newton–Raphson corrector settings.
-
-    Converged when the scaled residual ‖R‖∞ / F_s ≤ ``residual_tol`` and the scaled step
-    ‖Δq‖∞ / L ≤ ``step_tol`` (F_s: force scale |F_m| + Σ|F_pn|, L: the model's length scale).
-    At most ``max_iterations`` corrections.
-    """
-
-    residual_tol: float = 1e-10
-    step_tol: float = 1e-8
-    max_iterations: int = 12
-
-    def __post_init__(self) -> None:
-        for name in ("residual_tol", "step_tol"):
-            v = check_real(getattr(self, name), name)
-            if not 0 < v < 1:
-                raise ValueError(f"`{name}` must be a number in (0, 1), got {v!r}")
-            object.__setattr__(self, name, v)
-        m = check_int("max_iterations", self.max_iterations, 1)
-        if m > MAX_NEWTON_ITERATIONS:
-            raise ValueError(
-                f"`max_iterations` must be <= {MAX_NEWTON_ITERATIONS}, got {m}: Newton converges in 2–5 "
-                "iterations where it converges at all, and every iteration is a dense solve; use e.g. 12"
-            )
-        object.__setattr__(self, "max_iterations", m)
-
-
-__all__ = ["HBOptions", "NewtonOptions", "default_samples"]
+__all__ = ["HBOptions", "default_samples"]

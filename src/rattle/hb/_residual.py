@@ -142,6 +142,12 @@ class HarmonicBalance:
         return self.n_coordinates * self._S
 
     @property
+    def parameter_scale(self) -> float:
+        """Scale of the continuation parameter Ω: the model's natural frequency ω_n (a
+        :class:`~rattle.continuation.ContinuationProblem` with ``length_scale`` and ``force_scale``)."""
+        return self.model.natural_frequency
+
+    @property
     def element_weights(self) -> FloatArray:
         """W_e = b_e a_eᵀ (m, n, n): element e adds f_e'(δ_e) W_e to the tangent stiffness."""
         return self._W

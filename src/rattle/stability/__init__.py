@@ -7,6 +7,7 @@ from ._floquet import (
     system_monodromy_batch,
 )
 from ._hill import hill_exponents, hill_multipliers
+from ._methods import STABILITY_METHODS, AbstractStabilityMethod, Hill, Monodromy, floquet_monitor, stability_method
 from ._monitor import FloquetMonitor, hb_system
 
 __all__ = [
@@ -14,5 +15,6 @@ __all__ = [
     "monodromy_and_crossings_batch", "element_monodromy_batch", "system_monodromy_batch",
     "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "TEST_FUNCTIONS",
     "hill_exponents", "hill_multipliers", "FloquetMonitor", "hb_system",
+    "AbstractStabilityMethod", "Monodromy", "Hill", "STABILITY_METHODS", "stability_method", "floquet_monitor",
     "is_stable", "classify_loss", "torus_ratio", "critical_distance", "UNIT_CIRCLE_TOL", "COMPLEX_TOL",
 ]

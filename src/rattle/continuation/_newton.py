@@ -1,0 +1,81 @@
+"""Newton–Raphson at a fixed parameter: q ← q − (∂R/∂q)⁻¹ R(q, p), for any continuation problem."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from .._typing import FloatArray
+from ..errors import Status
+from ._options import NewtonOptions
+from ._problem import ContinuationProblem
+
+
+def _full_step(problem: ContinuationProblem, q: FloatArray, p: float) -> tuple[FloatArray, FloatArray | None]:
+    R, Rq, _ = problem.residual_jacobian(q, p)
+    _, _, dq, info = scipy.linalg.lapack.dgesv(Rq, -R)
+    return R, (dq if info == 0 and np.all(np.isfinite(dq)) else None)
+
+
+@dataclass(frozen=True, slots=True)
+class NewtonResult:
+    """Outcome of a Newton solve: the last iterate ``q``, how it ended (``status``, a
+    :class:`~rattle.errors.Status`: ``CONVERGED``, ``SINGULAR``, ``NON_FINITE`` or
+    ``MAX_ITERATIONS``), Newton ``iterations`` and the scaled ``residual`` ‖R‖∞ / F_s."""
+
+    q: FloatArray
+    status: Status
+    iterations: int
+    residual: float
+
+    @property
+    def converged(self) -> bool:
+        """True when the solve converged (``status.success``)."""
+        return self.status.success
+
+    @property
+    def message(self) -> str:
+        """How the solve ended, in words (``status.message``)."""
+        return self.status.message
+
+
+def solve_fixed(
+    problem: ContinuationProblem,
+    q0: FloatArray,
+    parameter: float,
+    options: NewtonOptions | None = None,
+) -> NewtonResult:
+    """Solve R(q, p) = 0 at the fixed parameter p = ``parameter`` from the guess ``q0`` by Newton–Raphson.
+
+    Convergence: ‖R‖∞ / F_s ≤ ``residual_tol`` and max_i |Δq_i| / L_i ≤ ``step_tol`` (F_s, L the
+    problem's ``force_scale`` and ``length_scale``; see :class:`NewtonOptions`). The step is the
+    problem's own ``newton_step`` when it has one (:class:`~rattle.continuation.SupportsNewtonStep`;
+    harmonic balance: full or condensed), else the full LAPACK solve from ``residual_jacobian``.
+    A failure is returned, not raised: check ``converged``.
+    """
+    options = NewtonOptions() if options is None else options
+    q = np.array(q0, dtype=float, copy=True)
+    Fs, L = problem.force_scale, problem.length_scale
+    uniform = np.ndim(L) == 0
+    step = getattr(problem, "newton_step", None) or (lambda q, p: _full_step(problem, q, p))
+    res = np.inf
+    for it in range(1, options.max_iterations + 1):
+        R, dq = step(q, parameter)
+        res = float(np.max(np.abs(R))) / Fs
+        if not np.isfinite(res):
+            return NewtonResult(q, Status.NON_FINITE, it, res)
+        if dq is None:
+            return NewtonResult(q, Status.SINGULAR, it, res)
+        q += dq
+        size = float(np.max(np.abs(dq))) / L if uniform else float(np.max(np.abs(dq) / L))
+        if res <= options.residual_tol and size <= options.step_tol:
+            res = float(np.max(np.abs(problem.residual(q, parameter)))) / Fs
+            return NewtonResult(q, Status.CONVERGED, it, res)
+    res = float(np.max(np.abs(problem.residual(q, parameter)))) / Fs
+    ok = res <= options.residual_tol
+    return NewtonResult(q, Status.CONVERGED if ok else Status.MAX_ITERATIONS, options.max_iterations, res)
+
+
+__all__ = ["NewtonResult", "solve_fixed"]
