@@ -10,6 +10,13 @@ bifurcation labels for torsional sub-systems with clearance non-linearities:
 >>> model = rattle.reference_case()
 >>> frf = rattle.frequency_response(model, omega=(0.1, 3.0), harmonics=32)
 
+The curated public API (``__all__``): the front ends and their result types, the model types
+(``Model``, ``Chain``, ``System``), the option objects, and the extension points — the elastic
+law base class ``AbstractElastic``, the integrators (``ExactIntegrator``, ``SystemIntegrator``),
+the continuation core (``ContinuationProblem``, implemented by ``HarmonicBalance`` and
+``ShootingProblem``; ``ContinuationStepper``) and the stability method objects (``Monodromy``,
+``Hill``). Everything else lives in the sub-packages.
+
 The names below are re-exported lazily (PEP 562): ``import rattle`` is cheap, and a name's
 sub-package (numpy, scipy) is imported the first time the name is used — so ``rattle --help``
 and a refused input answer without loading the numerics. ``from rattle import X``,
@@ -30,19 +37,27 @@ def _version() -> str:
 #: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
 _LAZY: dict[str, str] = {
     **dict.fromkeys(["compare", "frequency_response", "load_case", "periodic_orbit", "time_sweep"], ".analysis"),
-    "ContinuationOptions": ".continuation",
-    **dict.fromkeys(["ConfigError", "ConvergenceError", "RattleError", "Status"], ".errors"),
-    **dict.fromkeys(["HBOptions", "NewtonOptions"], ".hb"),
     **dict.fromkeys(
-        ["Backlash", "Clutch", "Excitation", "Linear", "Model", "Piecewise", "backlash_case", "reference_case"],
+        ["ContinuationOptions", "ContinuationProblem", "ContinuationStepper", "NewtonOptions"], ".continuation"
+    ),
+    **dict.fromkeys(["ConfigError", "ConvergenceError", "RattleError", "Status"], ".errors"),
+    **dict.fromkeys(["HBOptions", "HarmonicBalance"], ".hb"),
+    **dict.fromkeys(
+        ["AbstractElastic", "Backlash", "Chain", "Clutch", "Element", "Excitation", "Linear", "Link", "Model",
+         "Piecewise", "System", "Torque", "backlash_case", "reference_case"],
         ".model",
     ),
     **dict.fromkeys(
-        ["Comparison", "FrequencyResponse", "LinearResponse", "PeriodicOrbit", "Region", "SpecialPoint",
-         "SweepResult", "linear_frequency_response"],
+        ["Comparison", "FrequencyResponse", "LinearResponse", "OrbitSolution", "PeriodicOrbit", "Region",
+         "SpecialPoint", "SweepResult", "linear_frequency_response"],
         ".results",
     ),
-    **dict.fromkeys(["SteadyStateOptions", "shoot_periodic_orbit", "steady_state"], ".timeint"),
+    **dict.fromkeys(["Hill", "Monodromy"], ".stability"),
+    **dict.fromkeys(
+        ["ExactIntegrator", "ShootingProblem", "SteadyStateOptions", "SystemIntegrator", "shoot_periodic_orbit",
+         "steady_state"],
+        ".timeint",
+    ),
 }
 
 #: Sub-packages reachable as attributes of ``rattle`` (imported on first use, as eagerly before).
@@ -53,11 +68,19 @@ _SUBPACKAGES = frozenset({
 
 __all__ = [
     "__version__",
-    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "reference_case", "backlash_case",
-    "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
-    "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions", "shoot_periodic_orbit",
-    "periodic_orbit", "PeriodicOrbit", "compare", "Comparison",
-    "HBOptions", "NewtonOptions", "ContinuationOptions",
+    # models
+    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "AbstractElastic", "reference_case",
+    "backlash_case", "Chain", "Link", "Element", "Torque", "System",
+    # front ends and their results
+    "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse",
+    "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
+    "shoot_periodic_orbit", "periodic_orbit", "PeriodicOrbit", "OrbitSolution", "compare", "Comparison",
+    # options and method objects
+    "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
+    # extension points: problems, the stepper, the integrators
+    "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
+    "SystemIntegrator",
+    # status and errors
     "Status", "RattleError", "ConfigError", "ConvergenceError",
 ]
 
@@ -83,12 +106,18 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     __version__: str
     from .analysis import compare, frequency_response, load_case, periodic_orbit, time_sweep
-    from .continuation import ContinuationOptions
+    from .continuation import ContinuationOptions, ContinuationProblem, ContinuationStepper, NewtonOptions
     from .errors import ConfigError, ConvergenceError, RattleError, Status
-    from .hb import HBOptions, NewtonOptions
-    from .model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
-    from .results import (
-        Comparison, FrequencyResponse, LinearResponse, PeriodicOrbit, Region, SpecialPoint, SweepResult,
-        linear_frequency_response,
+    from .hb import HarmonicBalance, HBOptions
+    from .model import (
+        AbstractElastic, Backlash, Chain, Clutch, Element, Excitation, Linear, Link, Model, Piecewise, System, Torque,
+        backlash_case, reference_case,
     )
-    from .timeint import SteadyStateOptions, shoot_periodic_orbit, steady_state
+    from .results import (
+        Comparison, FrequencyResponse, LinearResponse, OrbitSolution, PeriodicOrbit, Region, SpecialPoint,
+        SweepResult, linear_frequency_response,
+    )
+    from .stability import Hill, Monodromy
+    from .timeint import (
+        ExactIntegrator, ShootingProblem, SteadyStateOptions, SystemIntegrator, shoot_periodic_orbit, steady_state,
+    )
