@@ -42,15 +42,16 @@ from .._validate import check_state
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
-from ..measures import measures_batch, synthesize_batch
+from ..measures import measures_batch, synthesize_batch, system_measures_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
 from ..stability import (
     UNIT_CIRCLE_TOL, FloquetMonitor, Hill, hill_multipliers, monodromy_batch, multipliers_from_monodromy,
 )
-from ..timeint import ExactIntegrator, shoot_periodic_orbit
-from ..timeint._steady import SteadyState, SteadyStateOptions, steady_state
+from ..timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
+from ..timeint._flow import check_system_state
+from ..timeint._steady import SteadyState, SteadyStateOptions, make_integrator, steady_state
 from ._frequency_response import check_range, frequency_response
 from ._settings import DEFAULT_HARMONICS, StabilityMethod, check_stability, resolve_hb
 
@@ -86,8 +87,10 @@ def default_search_range(model: Model, omega: float) -> tuple[float, float]:
 # --------------------------------------------------------------------------------------------
 
 
-def _shift(q: FloatArray, fraction: float) -> FloatArray:
-    """Coefficients of δ(t + fraction·T_p), T_p the series' own period."""
+def _shift(q: FloatArray, fraction: float, n: int = 1) -> FloatArray:
+    """Coefficients of δ(t + fraction·T_p), T_p the series' own period (n coordinate blocks)."""
+    if n > 1:
+        return np.concatenate([_shift(b, fraction) for b in q.reshape(n, -1)])
     H = (q.size - 1) // 2
     k = np.arange(1, H + 1)
     c, s = np.cos(2 * np.pi * k * fraction), np.sin(2 * np.pi * k * fraction)
@@ -98,10 +101,12 @@ def _shift(q: FloatArray, fraction: float) -> FloatArray:
     return out
 
 
-def _least_period(q: FloatArray, period: int) -> int:
-    """The least d dividing ``period`` for which the series (base Ω/period) has period d·2π/Ω."""
-    H = (q.size - 1) // 2
-    amp = np.hypot(q[1 : H + 1], q[H + 1 :])
+def _least_period(q: FloatArray, period: int, n: int = 1) -> int:
+    """The least d dividing ``period`` for which the series (base Ω/period; n coordinate
+    blocks) has period d·2π/Ω."""
+    Qb = q.reshape(n, -1)
+    H = (Qb.shape[1] - 1) // 2
+    amp = np.sqrt(np.sum(Qb[:, 1 : H + 1] ** 2 + Qb[:, H + 1 :] ** 2, axis=0))
     total = float(np.sqrt(np.sum(amp**2)))
     if total == 0.0:
         return 1
@@ -115,8 +120,11 @@ def _least_period(q: FloatArray, period: int) -> int:
     return period
 
 
-def _reduce(q: FloatArray, period: int, d: int) -> FloatArray:
-    """Series of base Ω/period with period d·2π/Ω, rewritten with base Ω/d (same H, zero-padded)."""
+def _reduce(q: FloatArray, period: int, d: int, n: int = 1) -> FloatArray:
+    """Series of base Ω/period with period d·2π/Ω, rewritten with base Ω/d (same H, zero-padded;
+    n coordinate blocks)."""
+    if n > 1:
+        return np.concatenate([_reduce(b, period, d) for b in q.reshape(n, -1)])
     H = (q.size - 1) // 2
     m = period // d
     h = H // m
@@ -150,6 +158,9 @@ class _Solver:
         self._hb: dict[int, HarmonicBalance] = {}
         self.found: list[_Candidate] = []
         self.scale = model.length_scale()
+        #: The System of a chain (None: the single equation) and its coordinate count.
+        self.system = None if isinstance(model, Model) else model.system()
+        self.n = 1 if self.system is None else self.system.n
 
     def hb(self, period: int) -> HarmonicBalance:
         if period not in self._hb:
@@ -163,9 +174,9 @@ class _Solver:
         if not res.converged:
             logger.info("periodic_orbit: Newton from a %s start failed at Ω = %g (%s)", source, self.omega, res.message)
             return None
-        d = _least_period(res.q, period)
+        d = _least_period(res.q, period, self.n)
         if d < period:
-            res = solve_harmonic_balance(self.hb(d), _reduce(res.q, period, d), self.omega, self.newton)
+            res = solve_harmonic_balance(self.hb(d), _reduce(res.q, period, d, self.n), self.omega, self.newton)
             if not res.converged:  # pragma: no cover - the reduced series is already a solution
                 return None
             period = d
@@ -177,7 +188,8 @@ class _Solver:
         hb = self.hb(cand.period)
         Tf = 2 * np.pi / self.omega
         t = (np.arange(64 * periods) / 64.0 + shift) * Tf
-        return hb.basis.evaluate(cand.q, self.omega / cand.period, t)
+        w = self.omega / cand.period
+        return np.concatenate([hb.basis.evaluate(b, w, t) for b in cand.q.reshape(self.n, -1)])
 
     def same(self, a: _Candidate, b: _Candidate) -> bool:
         """True when a and b are the same orbit (also up to a shift by whole forcing periods)."""
@@ -223,7 +235,7 @@ def _simulation_seed(solver: _Solver, steady: Any, integrator: ExactIntegrator |
     traj = getattr(steady, "trajectory", None)
     if not 1 <= n <= MAX_PERIOD or traj is None:
         return None
-    if solver.harmonics < n * len(solver.model.excitation.amplitudes):
+    if solver.harmonics < n * _forced_harmonics(solver.model):
         logger.info("periodic_orbit: %d harmonics cannot hold a period-%d orbit; not seeded", solver.harmonics, n)
         return None
     W = solver.omega
@@ -234,14 +246,22 @@ def _simulation_seed(solver: _Solver, steady: Any, integrator: ExactIntegrator |
         ts = math.floor(traj.t1 / Tf + 1e-9) * Tf
         if ts < traj.t0:
             return None
-    state = traj.sample(min(max(ts, traj.t0), traj.t1))  # round-off may put ts just outside
-    x_s = np.array([float(state.delta), float(state.velocity)])
-    integ = ExactIntegrator(solver.model) if integrator is None else integrator
-    orbit = shoot_periodic_orbit(solver.model, W, x_s, period=n, integrator=integ)
-    path = orbit.trajectory if orbit.converged else integ.propagate(x_s, 0.0, n * Tf, W)
+    ts = min(max(ts, traj.t0), traj.t1)  # round-off may put ts just outside
+    integ = make_integrator(solver.model) if integrator is None else integrator
     hb = solver.hb(n)
     t = hb.basis.times(n * Tf)
-    q0 = hb.basis.analyze(np.asarray(path.sample(t).delta))
+    if solver.system is None:
+        state = traj.sample(ts)
+        x_s = np.array([float(state.delta), float(state.velocity)])
+        orbit = shoot_periodic_orbit(solver.model, W, x_s, period=n, integrator=integ)
+        path = orbit.trajectory if orbit.converged else integ.propagate(x_s, 0.0, n * Tf, W)
+        q0 = hb.basis.analyze(np.asarray(path.sample(t).delta))
+    else:
+        x, v = traj.derivatives(np.array(ts), 1)
+        x_s = np.concatenate((x, v))
+        orbit = shoot_system_orbit(solver.system, W, x_s, period=n, integrator=integ)
+        path = orbit.trajectory if orbit.converged else integ.propagate(x_s, 0.0, n * Tf, W)
+        q0 = hb.basis.analyze(path.derivatives(t, 0)[0].T).reshape(-1)  # coordinate-major blocks
     cand = solver.polish(q0, n, "simulation")
     if cand is None and orbit.converged:
         # The simulated motion is a solution whatever Newton on the truncated series does: keep
@@ -395,7 +415,7 @@ def periodic_orbit(
     hb_opts = resolve_hb(harmonics, samples, hb)  # validates `harmonics` and `samples`
     harmonics = hb_opts.harmonics
     stability = check_stability(stability)
-    forced = len(model.excitation.amplitudes)
+    forced = _forced_harmonics(model)
     if harmonics < forced * period:
         raise ValueError(
             f"`harmonics` must be >= {forced * period} to hold the excitation's harmonic {forced} at "
@@ -421,10 +441,13 @@ def periodic_orbit(
         lo, hi = _limits.check_frequency_range(model, *check_range(search_range, "search_range"),
                                                ("search_range", "search_range"))
     lo, hi = min(lo, W), max(hi, W)
+    dim = 2 if isinstance(model, Model) else 2 * model.system().n
     if x0 is None:
-        start_state = np.zeros(2)
-    else:
+        start_state = np.zeros(dim)
+    elif dim == 2:
         start_state = check_state(x0)
+    else:
+        start_state = check_system_state(x0, dim // 2, "x0")
     newton_opts = newton or NewtonOptions()
     cont_opts = continuation or ContinuationOptions()
     timings: dict[str, float] = {}
@@ -435,13 +458,13 @@ def periodic_orbit(
     primary = frf
     if primary is None:
         primary = frequency_response(model, omega=(lo, hi), hb=hb_opts, newton=newton_opts, continuation=cont_opts,
-                                     stability=stability, throw=False)
+                                     stability=stability, throw=False, confirm_tori=False)
     for b in np.unique(primary.branch):
         sel = np.nonzero(primary.branch == b)[0]
         p_branch = int(primary.period[sel[0]])
         Q = primary.coefficients[sel]
         for i, s in _brackets(primary.omega[sel], W):
-            q_start = resize_harmonics((1 - s) * Q[i] + s * Q[i + 1], harmonics)
+            q_start = _resized(solver, (1 - s) * Q[i] + s * Q[i + 1], p_branch, harmonics)
             solver.add(solver.polish(q_start, p_branch, "continuation"))
     t1 = time.perf_counter()
     timings["primary"] = t1 - t0
@@ -450,7 +473,7 @@ def periodic_orbit(
     steady = None
     extra_runs: list[dict[str, Any]] = []  # simulations started next to unstable orbits
     if simulate:
-        integ = ExactIntegrator(model)
+        integ = make_integrator(model)
         runs_done = 0
 
         def simulate_from(x: FloatArray) -> SteadyState:
@@ -490,7 +513,8 @@ def periodic_orbit(
             ts = time.perf_counter()
             run = simulate_from(x_start)
             t_sim += time.perf_counter() - ts
-            extra_runs.append({"from_period": cand.period, "from_rms": float(np.sqrt(cand.q[0] ** 2 + 0.5 * np.sum(cand.q[1:] ** 2))),
+            q1 = cand.q.reshape(solver.n, -1)[0]
+            extra_runs.append({"from_period": cand.period, "from_rms": float(np.sqrt(q1[0] ** 2 + 0.5 * np.sum(q1[1:] ** 2))),
                                "period": int(getattr(run, "period", 0) or 0)})
             take(run)
         timings["simulation"] = t_sim
@@ -526,16 +550,36 @@ def periodic_orbit(
     )
 
 
+def _forced_harmonics(model: Any) -> int:
+    """The highest forcing harmonic of a Model or a Chain."""
+    if isinstance(model, Model):
+        return len(model.excitation.amplitudes)
+    return int(model.forced_harmonics)
+
+
+def _resized(solver: _Solver, q: FloatArray, period: int, harmonics: int) -> FloatArray:
+    """``q`` (any H) with ``harmonics`` harmonics, block-wise for a chain."""
+    if solver.n == 1:
+        return resize_harmonics(q, harmonics)
+    return np.concatenate([resize_harmonics(b, harmonics) for b in q.reshape(solver.n, -1)])
+
+
 def _state_at_zero(solver: _Solver, cand: _Candidate) -> FloatArray:
+    """(x(0), x'(0)) of a candidate: (δ, δ') for the single equation, (x, x') (2n,) for a chain."""
     basis = solver.hb(cand.period).basis
     w = solver.omega / cand.period
-    return np.array([float(basis.evaluate(cand.q, w, 0.0)), float(basis.evaluate(cand.q, w, 0.0, derivative=1))])
+    blocks = cand.q.reshape(solver.n, -1)
+    x = [float(basis.evaluate(b, w, 0.0)) for b in blocks]
+    v = [float(basis.evaluate(b, w, 0.0, derivative=1)) for b in blocks]
+    return np.array(x + v)
 
 
 def _assembled(model: Model, solver: _Solver, cands: list[_Candidate],
                stability: StabilityMethod = "monodromy") -> list[OrbitSolution]:
     """Floquet multipliers (exact monodromy of the linearisation about each orbit, or Hill's
     method) and SPEC measures of each candidate, batched per period."""
+    if solver.system is not None:
+        return _assembled_chain(model, solver, cands, stability)
     out: list[OrbitSolution | None] = [None] * len(cands)
     st = model.elastic.stages
     for p in sorted({c.period for c in cands}):
@@ -561,6 +605,42 @@ def _assembled(model: Model, solver: _Solver, cands: list[_Candidate],
                 regime=str(meas.regime[j]), source=cands[i].source,
                 iterations=int(cands[i].iterations), residual=float(cands[i].residual),
                 simulated=bool(cands[i].simulated),
+            )
+    return [s for s in out if s is not None]
+
+
+def _assembled_chain(model: Any, solver: _Solver, cands: list[_Candidate],
+                     stability: StabilityMethod) -> list[OrbitSolution]:
+    """:func:`_assembled` for a chain: the stability method's multipliers (2n per orbit), the
+    measures of every element (the flat fields: the first element's)."""
+    out: list[OrbitSolution | None] = [None] * len(cands)
+    names = tuple(e.name for e in solver.system.elements)
+    for p in sorted({c.period for c in cands}):
+        idx = [i for i, c in enumerate(cands) if c.period == p]
+        hb = solver.hb(p)
+        Q = np.array([cands[i].q for i in idx])
+        P = len(idx)
+        w = np.full(P, solver.omega / p)
+        Om = np.full(P, solver.omega)
+        mu = stability.multipliers(hb, Q, Om)
+        stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL
+        per_element = system_measures_batch(model, Q.reshape(P, solver.n, -1), w, Om, hb.basis.samples)
+        meas = per_element[0]
+        for j, i in enumerate(idx):
+            elements = {
+                name: {k: (str(getattr(m, k)[j]) if k == "regime" else float(getattr(m, k)[j])) for k in
+                       ("mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max", "regime")}
+                for name, m in zip(names, per_element)
+            }
+            out[i] = OrbitSolution(
+                omega=solver.omega, period=p, coefficients=Q[j].copy(),
+                stable=bool(stable[j]), multipliers=mu[j].copy(),
+                mean=float(meas.mean[j]), rms=float(meas.rms[j]), rms_ac=float(meas.rms_ac[j]),
+                p2p=float(meas.p2p[j]), acc_p2p=float(meas.acc_p2p[j]),
+                delta_min=float(meas.delta_min[j]), delta_max=float(meas.delta_max[j]),
+                regime=str(meas.regime[j]), source=cands[i].source,
+                iterations=int(cands[i].iterations), residual=float(cands[i].residual),
+                simulated=bool(cands[i].simulated), elements=elements,
             )
     return [s for s in out if s is not None]
 

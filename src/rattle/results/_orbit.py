@@ -12,7 +12,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ._columns import ORBIT_COLUMNS
-from ..measures import acceleration_batch, evaluate_batch
+from ..measures import acceleration_batch, element_accelerations, evaluate_batch
 from ..model import Model
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -56,6 +56,11 @@ class OrbitSolution:
     simulated : bool
         A simulation (from the given initial state, or from next to an unstable orbit) settled
         on this orbit, whatever ``source`` first found it.
+    elements : dict
+        A chain's: element name → its measures (``mean``, ``rms``, ``rms_ac``, ``p2p``,
+        ``acc_p2p``, ``delta_min``, ``delta_max``, ``regime``); the flat fields above are the
+        first element's, and ``coefficients`` holds the n coordinate blocks (n·(2H+1),
+        coordinate-major). Empty for the single equation.
     """
 
     omega: float
@@ -75,11 +80,18 @@ class OrbitSolution:
     iterations: int = 0
     residual: float = 0.0
     simulated: bool = False
+    elements: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def harmonics(self) -> int:
         """H, the number of harmonics of the base frequency kept."""
-        return (self.coefficients.size - 1) // 2
+        return (self.coefficients.size // self._blocks - 1) // 2
+
+    @property
+    def _blocks(self) -> int:
+        """Coordinate blocks of ``coefficients`` (1 for the single equation)."""
+        n = self.multipliers.size // 2
+        return n if self.elements else 1
 
     @property
     def base_frequency(self) -> float:
@@ -90,7 +102,7 @@ class OrbitSolution:
         """One-sided amplitudes |δ_k| = sqrt(a_k² + b_k²) of harmonics k = 0 … H of the base
         frequency (|a_0| for k = 0), shape (H+1,), rad."""
         H = self.harmonics
-        q = self.coefficients
+        q = self.coefficients[: 2 * H + 1]  # a chain: its first coordinate
         out = np.empty(H + 1)
         out[0] = abs(q[0])
         out[1:] = np.hypot(q[1 : H + 1], q[H + 1 :])
@@ -107,6 +119,8 @@ class OrbitSolution:
 def _measures_of(simulation: Any) -> Any:
     """The object holding a SteadyState's measures (the state itself or its ``measures``)."""
     inner = getattr(simulation, "measures", None)
+    if inner is not None and np.ndim(getattr(inner, "rms", None)) == 1:  # a chain's: per element
+        return simulation  # (its flat fields are the first element's)
     return inner if inner is not None and hasattr(inner, "rms") else simulation
 
 
@@ -237,6 +251,8 @@ class PeriodicOrbit:
         dict of str to numpy.ndarray
             ``t`` (s), ``delta`` (rad), ``velocity`` (rad/s), ``acceleration`` (rad/s², from the
             equation of motion), each of length ``samples * periods + 1`` (both ends included).
+            A chain: those of its first element, then ``NAME_delta`` and ``NAME_acceleration``
+            of every element NAME.
         """
         i = self._index(solution)
         if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
@@ -247,15 +263,33 @@ class PeriodicOrbit:
             raise ValueError(f"`periods` must be an integer >= 1, got {periods!r}")
         Tf = 2.0 * math.pi / self.omega
         t = np.linspace(0.0, periods * Tf, int(samples) * int(periods) + 1)
-        Q = sol.coefficients[None, :]
         w = np.array([sol.base_frequency])
         tt = t[None, :]
+        if sol.elements:
+            return self._chain_history(sol, t)
+        Q = sol.coefficients[None, :]
         return {
             "t": t,
             "delta": evaluate_batch(Q, w, tt)[0],
             "velocity": evaluate_batch(Q, w, tt, derivative=1)[0],
             "acceleration": acceleration_batch(self.model, Q, w, np.array([self.omega]), tt)[0],
         }
+
+    def _chain_history(self, sol: OrbitSolution, t: FloatArray) -> dict[str, FloatArray]:
+        system = self.model.system()
+        n = system.n
+        Qx = sol.coefficients.reshape(n, -1)
+        w = np.full(n, sol.base_frequency)
+        tt = np.broadcast_to(t, (n, t.size))
+        A = system.element_rows
+        delta = A @ evaluate_batch(Qx, w, tt)
+        velocity = A @ evaluate_batch(Qx, w, tt, derivative=1)
+        acc = element_accelerations(system, Qx[None], w[:1], np.array([self.omega]), t[None, :])[0]
+        out = {"t": t, "delta": delta[0], "velocity": velocity[0], "acceleration": acc[0]}
+        for k, e in enumerate(system.elements):
+            out[f"{e.name}_delta"] = delta[k]
+            out[f"{e.name}_acceleration"] = acc[k]
+        return out
 
     def simulated_history(self, samples: int = 256, periods: int | None = None) -> dict[str, FloatArray] | None:
         """The simulated steady state sampled like :meth:`time_history` (t from 0), or None.
@@ -281,6 +315,13 @@ class PeriodicOrbit:
         n = int(samples) * periods + 1
         t = np.linspace(start, end, n)
         s = traj.sample(np.clip(t, traj.t0, traj.t1))  # round-off may put the ends just outside
+        if hasattr(s, "deflection"):  # a chain: the first element, then every element's
+            out = {"t": t - start, "delta": s.deflection[:, 0], "velocity": s.deflection_velocity[:, 0],
+                   "acceleration": s.deflection_acceleration[:, 0]}
+            for k, e in enumerate(traj.system.elements):
+                out[f"{e.name}_delta"] = s.deflection[:, k]
+                out[f"{e.name}_acceleration"] = s.deflection_acceleration[:, k]
+            return out
         return {
             "t": t - start,
             "delta": np.asarray(s.delta),
@@ -344,6 +385,7 @@ class PeriodicOrbit:
                     "delta_min": s.delta_min, "delta_max": s.delta_max, "regime": s.regime,
                     "multipliers": [[float(z.real), float(z.imag)] for z in s.multipliers],
                     "residual": s.residual,
+                    **({"elements": s.elements} if s.elements else {}),
                 }
                 for s in self.solutions
             ],
@@ -356,11 +398,12 @@ class PeriodicOrbit:
     def to_csv(self, path: str | Path, *, solution: int | None = None, samples: int = 256) -> Path:
         """Write one orbit to ``path`` atomically: the SPEC columns ``t, delta, velocity,
         acceleration`` over one full solution period (``samples`` per forcing period, both ends
-        included), for ``solution`` (default the :attr:`selected` one). No extra columns."""
+        included), for ``solution`` (default the :attr:`selected` one). A chain: those of its
+        first element, then ``NAME_delta``, ``NAME_acceleration`` of every element NAME."""
         from ..io import write_csv
 
         hist = self.time_history(solution, samples=samples)
-        write_csv(path, hist, list(ORBIT_COLUMNS))
+        write_csv(path, hist, [*ORBIT_COLUMNS, *(k for k in hist if k not in ORBIT_COLUMNS)])
         return Path(path)
 
     def plot(
