@@ -79,19 +79,36 @@ def orbit_plot(
     -------
     (figure, axes)
         ``axes`` is a dict with keys ``delta``, ``velocity``, ``acceleration``, ``phase`` and
-        ``spectrum``.
+        ``spectrum``. A chain: one pair of panels per clearance element NAME, δ and δ'' of its
+        deflection (keys ``NAME_delta``, ``NAME_acceleration``; ``delta``, ``velocity`` and
+        ``acceleration`` are the first element's panels), the phase portrait and the spectrum
+        of the first element.
     """
     import matplotlib.pyplot as plt
 
+    system = orbit.model.system() if hasattr(orbit.model, "elements") else None
+    if system is None:
+        rows = [("delta", "δ (rad)"), ("velocity", "δ' (rad/s)"), ("acceleration", "δ'' (rad/s²)")]
+        breakpoints_of = {"delta": np.asarray(orbit.model.elastic.stages.breakpoints, dtype=float)}
+    else:
+        rows = [r for e in system.elements for r in ((f"{e.name}_delta", f"{e.name}: δ (rad)"),
+                                                      (f"{e.name}_acceleration", f"{e.name}: δ'' (rad/s²)"))]
+        breakpoints_of = {f"{e.name}_delta": np.asarray(e.breakpoints, dtype=float) for e in system.elements}
+    n_rows = max(3 if system is None else 2, len(rows))
     if fig is None:
-        fig = plt.figure(figsize=(12, 8), layout="constrained")
-    gs = fig.add_gridspec(3, 2, width_ratios=(1.55, 1.0))
+        fig = plt.figure(figsize=(12, 8 if system is None else max(7.0, 2.2 * n_rows + 2.5)), layout="constrained")
+    gs = fig.add_gridspec(n_rows, 2, width_ratios=(1.55, 1.0))
     ax_d = fig.add_subplot(gs[0, 0])
-    ax_v = fig.add_subplot(gs[1, 0], sharex=ax_d)
-    ax_a = fig.add_subplot(gs[2, 0], sharex=ax_d)
-    ax_p = fig.add_subplot(gs[0:2, 1])
-    ax_s = fig.add_subplot(gs[2, 1])
-    axes = {"delta": ax_d, "velocity": ax_v, "acceleration": ax_a, "phase": ax_p, "spectrum": ax_s}
+    hist_axes = {rows[0][0]: ax_d}
+    for r, (key, _) in enumerate(rows[1:], start=1):
+        hist_axes[key] = fig.add_subplot(gs[r, 0], sharex=ax_d)
+    ax_p = fig.add_subplot(gs[0 : n_rows - 1, 1])
+    ax_s = fig.add_subplot(gs[n_rows - 1, 1])
+    axes = {**hist_axes, "phase": ax_p, "spectrum": ax_s}
+    if system is not None:  # the first element's panels under the single-equation names too
+        axes["delta"] = hist_axes[rows[0][0]]
+        axes["acceleration"] = hist_axes[rows[1][0]]
+        axes["velocity"] = hist_axes[rows[1][0]]
 
     sim_period = orbit.simulated_period
     n_win = periods if periods is not None else window_periods(
@@ -110,12 +127,15 @@ def orbit_plot(
         style = "-" if sol.stable else "--"
         lw = 2.2 if i == selected else 1.3
         label = _solution_label(orbit, i)
-        for ax, key in ((ax_d, "delta"), (ax_v, "velocity"), (ax_a, "acceleration")):
-            ax.plot(h["t"], h[key], style, color=color, lw=lw, label=label if key == "delta" else None)
+        for key, ax in hist_axes.items():
+            ax.plot(h["t"], h[key], style, color=color, lw=lw, label=label if ax is ax_d else None)
         one = orbit.time_history(i, samples=samples)  # one closed orbit for the phase portrait
         ax_p.plot(one["delta"], one["velocity"], style, color=color, lw=lw, label=label)
-        f = np.arange(sol.harmonics + 1) / sol.period
-        amp = sol.amplitudes()
+        if system is None:
+            f = np.arange(sol.harmonics + 1) / sol.period
+            amp = sol.amplitudes()
+        else:  # the first element's deflection (exact for the truncated series)
+            f, amp = amplitude_spectrum(one["delta"][:-1], sol.period, SPECTRUM_ORDERS)
         keep = f <= SPECTRUM_ORDERS + 1e-9
         f, amp = f[keep], amp[keep]
         offset = (i - (len(orbit.solutions) - 1) / 2) * 0.035  # side by side, not on top
@@ -131,9 +151,9 @@ def orbit_plot(
         p = sim_period
         sim_label = "simulation, " + (f"period {p}" if p else "no period ≤ 8")
         step = max(1, samples // 32)
-        for ax, key in ((ax_d, "delta"), (ax_v, "velocity"), (ax_a, "acceleration")):
+        for key, ax in hist_axes.items():
             ax.plot(sim["t"][::step], sim[key][::step], "o", color="black", ms=2.6,
-                    label=sim_label if key == "delta" else None, zorder=5)
+                    label=sim_label if ax is ax_d else None, zorder=5)
         ax_p.plot(sim["delta"][::step], sim["velocity"][::step], "o", color="black", ms=2.2,
                   label=sim_label, zorder=5)
         if p:
@@ -150,20 +170,21 @@ def orbit_plot(
                           label=f"{sim_label} ({n_sim} periods)")
 
     # --- decoration ----------------------------------------------------------------------------
-    breakpoints = np.asarray(orbit.model.elastic.stages.breakpoints, dtype=float)
-    for k, b in enumerate(breakpoints):
-        ax_d.axhline(b, color="0.5", ls=":", lw=0.9, label="breakpoints" if k == 0 else None)
-        ax_p.axvline(b, color="0.5", ls=":", lw=0.9, label="breakpoints" if k == 0 else None)
+    for key, breakpoints in breakpoints_of.items():
+        for k, b in enumerate(breakpoints):
+            hist_axes[key].axhline(b, color="0.5", ls=":", lw=0.9, label="breakpoints" if k == 0 and key == rows[0][0] else None)
+            if key == rows[0][0]:
+                ax_p.axvline(b, color="0.5", ls=":", lw=0.9, label="breakpoints" if k == 0 else None)
     for m in range(1, n_win):
-        for ax in (ax_d, ax_v, ax_a):
+        for ax in hist_axes.values():
             ax.axvline(m * Tf, color="0.8", lw=0.8, zorder=0)
-    ax_d.set_ylabel("δ (rad)")
-    ax_v.set_ylabel("δ' (rad/s)")
-    ax_a.set_ylabel("δ'' (rad/s²)")
-    ax_a.set_xlabel(f"time t (s); grey lines every forcing period 2π/Ω = {Tf:.4g} s")
+    for key, ylabel in rows:
+        hist_axes[key].set_ylabel(ylabel)
+    last = hist_axes[rows[-1][0]]
+    last.set_xlabel(f"time t (s); grey lines every forcing period 2π/Ω = {Tf:.4g} s")
     ax_d.set_xlim(0.0, n_win * Tf)
-    plt.setp(ax_d.get_xticklabels(), visible=False)
-    plt.setp(ax_v.get_xticklabels(), visible=False)
+    for key, _ in rows[:-1]:
+        plt.setp(hist_axes[key].get_xticklabels(), visible=False)
     ax_d.set_title("time histories", fontsize=10)
     ax_p.set_xlabel("δ (rad)")
     ax_p.set_ylabel("δ' (rad/s)")
@@ -173,7 +194,9 @@ def orbit_plot(
     ax_s.set_ylabel("amplitude of δ (rad)")
     ax_s.set_title("amplitude spectrum of δ", fontsize=10)
     ax_s.set_xlim(-0.25, SPECTRUM_ORDERS + 0.25)
-    ymax = max([float(np.max(s.amplitudes())) for s in orbit.solutions] + [1e-6])
+    ymax = max([float(np.max(s.amplitudes())) for s in orbit.solutions] + [1e-6]) if system is None else max(
+        [float(np.max(np.abs(orbit.time_history(i, samples=64)["delta"]))) for i in range(len(orbit.solutions))]
+        + [1e-6])
     ax_s.set_ylim(max(1e-7, ymax * 1e-6), ymax * 3.0)
     for ax in axes.values():
         ax.grid(True, alpha=0.3)
