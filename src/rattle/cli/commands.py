@@ -259,7 +259,8 @@ def orbit_command(
     the analysis range, widened to include W; sub-harmonics are seeded from a simulation) and its
     stability computed. orbit.csv holds t, delta, velocity, acceleration over one period of the
     selected solution: the stable one closest in rms to the simulated steady state (preferring
-    the requested period); orbit.json lists them all.
+    the requested period); orbit.json lists them all. A chain: those of its first clearance
+    element, then NAME_delta and NAME_acceleration of every element.
     """
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
@@ -268,7 +269,9 @@ def orbit_command(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
     check_omega(omega, model=run_config.model)
-    check_period(period, analysis.harmonics, len(run_config.model.excitation.amplitudes))
+    model = run_config.model
+    forced = len(model.excitation.amplitudes) if hasattr(model, "excitation") else int(model.forced_harmonics)
+    check_period(period, analysis.harmonics, forced)
     t_start = time.perf_counter()
     from ..analysis import periodic_orbit  # only now: all input has been validated
 
