@@ -34,7 +34,8 @@ from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
 from ..model import Model, check_analysable_model
 from ..results import Comparison, FrequencyResponse, PeriodicOrbit, SweepResult
-from ..timeint import ExactIntegrator, SteadyState, SteadyStateOptions, steady_state
+from ..timeint import SteadyState, SteadyStateOptions, steady_state
+from ..timeint._steady import make_integrator
 from ._frequency_response import frequency_response
 from ._frequency_response import check_range
 from ._orbit import MAX_PERIOD, periodic_orbit
@@ -207,7 +208,7 @@ def compare(
     # by the periods the simulation found there).
     frf = replace(frf, regions=confirm_with_sweep(frf.regions, sweep))
     picks = pick_frequencies(frf, sweep) if chosen is None else [(w, "requested") for w in chosen]
-    integ = ExactIntegrator(model)
+    integ = make_integrator(model)
     grid = np.unique(sweep.omega)
     spacing = float(np.min(np.diff(grid))) if grid.size > 1 else math.inf
     orbits: list[PeriodicOrbit] = []

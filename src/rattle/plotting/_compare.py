@@ -18,10 +18,11 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 def _steady_history(
-    state: Any, omega: float, periods: int, samples: int, shift: int = 0
+    state: Any, omega: float, periods: int, samples: int, shift: int = 0, element: int = 0
 ) -> tuple[np.ndarray, np.ndarray]:
     """(t, δ(t + shift·2π/Ω)) of a SteadyState over ``periods`` forcing periods from t = 0 (its
-    trajectory starts at forcing phase 0; a periodic one is repeated, a non-periodic one cut)."""
+    trajectory starts at forcing phase 0; a periodic one is repeated, a non-periodic one cut);
+    a chain's: the deflection of element ``element``."""
     traj = state.trajectory
     Tf = 2.0 * math.pi / omega
     t = np.linspace(0.0, periods * Tf, samples * periods + 1)
@@ -32,7 +33,10 @@ def _steady_history(
         t = t[t <= span]
         local = t
     local = np.clip(traj.t0 + local, traj.t0, traj.t1)
-    return t, np.asarray(traj.sample(local).delta)
+    s = traj.sample(local)
+    if hasattr(s, "deflection"):
+        return t, np.asarray(s.deflection[:, element])
+    return t, np.asarray(s.delta)
 
 
 def _align(t: np.ndarray, x: np.ndarray, state: Any, orbit: Any, omega: float, samples: int) -> tuple[np.ndarray, int]:
@@ -82,66 +86,100 @@ def compare_plot(
     -------
     (figure, axes)
         ``axes`` is a dict: ``frf`` (the top axes) and ``histories`` (list of the panel axes).
+        A chain: one frequency-response panel and one row of time histories per clearance
+        element; ``frf`` and ``histories`` are the first element's, ``frf_panels`` (list) and
+        ``element_histories`` (element name → list of panels) all of them.
     """
     import matplotlib.pyplot as plt
 
-    n = len(comparison.at)
-    if fig is None:
-        fig = plt.figure(figsize=(13, 9 if n else 6), layout="constrained")
-    if n:
-        gs = fig.add_gridspec(2, n, height_ratios=(1.5, 1.0))
-        ax_frf = fig.add_subplot(gs[0, :])
-        panels = [fig.add_subplot(gs[1, j]) for j in range(n)]
-    else:
-        ax_frf = fig.add_subplot(1, 1, 1)
-        panels = []
+    from ._frf import _draw_panel
+    from ._sweep import _draw_sweep
 
     frf, sweep = comparison.frf, comparison.sweep
-    frequency_response_plot(frf, ax=ax_frf, linear=False, title="")
-    sweep_plot(sweep, ax=ax_frf, lines=False, title="")
+    names = tuple(getattr(sweep, "element_names", ()) or ())
+    m = max(1, len(names))
+    n = len(comparison.at)
+    if fig is None:
+        fig = plt.figure(figsize=(13, (9 if n else 6) if m == 1 else 2.6 + 3.4 * m * (2 if n else 1)),
+                         layout="constrained")
+    if n:
+        gs = fig.add_gridspec(2 * m, n, height_ratios=(1.5,) * m + (1.0,) * m)
+        frf_axes = [fig.add_subplot(gs[k, :]) for k in range(m)]
+        rows = [[fig.add_subplot(gs[m + k, j]) for j in range(n)] for k in range(m)]
+    else:
+        gs = fig.add_gridspec(m, 1)
+        frf_axes = [fig.add_subplot(gs[k, 0]) for k in range(m)]
+        rows = [[] for _ in range(m)]
+    ax_frf = frf_axes[0]
+
+    if not names:
+        frequency_response_plot(frf, ax=ax_frf, linear=False, title="")
+        sweep_plot(sweep, ax=ax_frf, lines=False, title="")
+    else:
+        for k, (name, ax_k) in enumerate(zip(names, frf_axes)):
+            _draw_panel(frf, ax_k, f"{name}_rms", "rms", False, True, frf.regions, "none", element=k,
+                        label=f"{name}: ")
+            _draw_sweep(sweep, ax_k, np.asarray(sweep.element_columns[f"{name}_rms"], dtype=float), True, False,
+                        legend=False)
+            ax_k.set_ylabel(f"{name}: δ rms (rad)")
     letters = string.ascii_lowercase
-    for j, w in enumerate(comparison.at):
-        ax_frf.axvline(w, color="0.35", lw=0.9, ls="-.", zorder=0)
-        ax_frf.annotate(f"({letters[j % 26]})", (w, 1.0), xycoords=("data", "axes fraction"),
-                        xytext=(3, -12), textcoords="offset points", fontsize=10, fontweight="bold")
+    for ax_k in frf_axes:
+        for j, w in enumerate(comparison.at):
+            ax_k.axvline(w, color="0.35", lw=0.9, ls="-.", zorder=0)
+            ax_k.annotate(f"({letters[j % 26]})", (w, 1.0), xycoords=("data", "axes fraction"),
+                          xytext=(3, -12), textcoords="offset points", fontsize=10, fontweight="bold")
     ax_frf.set_title(
         f"Frequency response: harmonic balance (H = {frf.harmonics}, lines) against the time-domain sweep "
         f"({int(np.sum(sweep.direction == 'up'))} frequencies per direction)"
+        + (f" — element {names[0]}" if names else "")
     )
+    for k, name in enumerate(names[1:], start=1):
+        frf_axes[k].set_title(f"element {name}", fontsize=10)
     ax_frf.legend(fontsize=8, loc="upper right", ncol=2, framealpha=0.9)
 
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for j, (ax, w, why, orbit, sims) in enumerate(
-        zip(panels, comparison.at, comparison.reasons, comparison.orbits, comparison.simulations)
-    ):
-        n_win = window_periods([s.period for s in orbit.solutions] + [s.period for s in sims.values()])
-        Tf = 2.0 * math.pi / w
-        for i, sol in enumerate(orbit.solutions):
-            h = orbit.time_history(i, samples=samples, periods=n_win)
-            ax.plot(h["t"], h["delta"], "-" if sol.stable else "--", color=colors[i % len(colors)],
-                    lw=1.8 if sol.stable else 1.2,
-                    label=f"HB P{sol.period} {'stable' if sol.stable else 'unstable'} (rms {sol.rms:.3g})")
-        step = max(1, samples // 24)
-        for d, state in sims.items():
-            marker, color, _ = DIRECTION_STYLES.get(d, ("o", "black", d))
-            t, x = _steady_history(state, w, n_win, samples)
-            x, k = _align(t, x, state, orbit, w, samples)
-            per = f"P{state.period}" if state.period else "no period ≤ 8"
-            moved = f", shifted {k}·2π/Ω" if k else ""
-            ax.plot(t[::step], x[::step], marker, color=color, mec="black", mew=0.4, ms=5, ls="none",
-                    label=f"{d} sweep: {per} (rms {state.rms:.3g}{moved})", zorder=5)
-        for m in range(1, n_win):
-            ax.axvline(m * Tf, color="0.85", lw=0.8, zorder=0)
-        ax.set_xlim(0.0, n_win * Tf)
-        ax.set_title(f"({letters[j % 26]}) Ω = {w:.4g} rad/s: {why}", fontsize=10)
-        ax.set_xlabel("time t (s)")
-        if j == 0:
-            ax.set_ylabel("δ (rad)")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7, loc="best", framealpha=0.85)
+    for e in range(m):
+        key = f"{names[e]}_delta" if names else "delta"
+        for j, (ax, w, why, orbit, sims) in enumerate(
+            zip(rows[e], comparison.at, comparison.reasons, comparison.orbits, comparison.simulations)
+        ):
+            n_win = window_periods([s.period for s in orbit.solutions] + [s.period for s in sims.values()])
+            Tf = 2.0 * math.pi / w
+            for i, sol in enumerate(orbit.solutions):
+                h = orbit.time_history(i, samples=samples, periods=n_win)
+                rms = sol.elements[names[e]]["rms"] if names else sol.rms
+                ax.plot(h["t"], h[key], "-" if sol.stable else "--", color=colors[i % len(colors)],
+                        lw=1.8 if sol.stable else 1.2,
+                        label=f"HB P{sol.period} {'stable' if sol.stable else 'unstable'} (rms {rms:.3g})")
+            step = max(1, samples // 24)
+            for d, state in sims.items():
+                marker, color, _ = DIRECTION_STYLES.get(d, ("o", "black", d))
+                t, x = _steady_history(state, w, n_win, samples)
+                x, k = _align(t, x, state, orbit, w, samples)
+                if e:
+                    t, x = _steady_history(state, w, n_win, samples, shift=k, element=e)
+                per = f"P{state.period}" if state.period else "no period ≤ 8"
+                moved = f", shifted {k}·2π/Ω" if k else ""
+                rms = float(state.element_measures.rms[e]) if names else state.rms
+                ax.plot(t[::step], x[::step], marker, color=color, mec="black", mew=0.4, ms=5, ls="none",
+                        label=f"{d} sweep: {per} (rms {rms:.3g}{moved})", zorder=5)
+            for mm in range(1, n_win):
+                ax.axvline(mm * Tf, color="0.85", lw=0.8, zorder=0)
+            ax.set_xlim(0.0, n_win * Tf)
+            if e == 0:
+                ax.set_title(f"({letters[j % 26]}) Ω = {w:.4g} rad/s: {why}", fontsize=10)
+            ax.set_xlabel("time t (s)")
+            if j == 0:
+                ax.set_ylabel(f"{names[e]}: δ (rad)" if names else "δ (rad)")
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=7, loc="best", framealpha=0.85)
     if title is not None:
         fig.suptitle(title)
-    return fig, {"frf": ax_frf, "histories": panels}
+    axes: dict[str, Any] = {"frf": ax_frf, "histories": rows[0]}
+    if names:
+        axes["frf_panels"] = frf_axes
+        axes["element_histories"] = dict(zip(names, rows))
+    return fig, axes
 
 
 __all__ = ["compare_plot"]
