@@ -138,3 +138,53 @@ def test_hill_multipliers_keep_the_single_dof_structure():
     complex_pair = np.abs(frf.multipliers[:, 0].imag) > 0
     expected = np.exp(-0.5 * model.c * T[complex_pair])[:, None] * np.ones((1, 2))
     np.testing.assert_allclose(np.abs(frf.multipliers[complex_pair]), expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize("slopes,c", [((1.0, 0.25, 1.0), 0.05), ((1.0, 0.0, 3.0), 0.3), ((0.01, 0.0, 0.01), 0.5)])
+def test_compiled_monodromy_matches_array_code(rng, monkeypatch, slopes, c):
+    """The compiled single-element kernel (stability._kernels) and the array code of _floquet
+    give the same crossings and monodromies (oscillatory, free, overdamped and critically
+    damped stages) on random orbits."""
+    from rattle.hb import FourierBasis
+    from rattle.stability import _kernels, monodromy_and_crossings_batch
+
+    if not _kernels.AVAILABLE:
+        pytest.skip("numba not installed: only the array code runs")
+    H, N, P = 12, 128, 60
+    basis = FourierBasis(H, N)
+    k = np.arange(1, H + 1)
+    Q = np.zeros((P, 2 * H + 1))
+    Q[:, 0] = rng.uniform(-0.2, 0.2, P)
+    Q[:, 1:] = rng.standard_normal((P, 2 * H)) / np.concatenate([k, k]) ** 2
+    w = rng.uniform(0.2, 3.0, P)
+    X = basis.synthesize(Q)
+    bp = np.array([-0.1, 0.1])
+    kappa = np.array(slopes)
+    kappa[1] = c**2 / 4 if slopes[1] == 0.0 and c == 0.5 else kappa[1]  # one critically damped stage
+    M_k, n_k = _kernels.monodromies(Q, w, X, bp, kappa, c)
+    monkeypatch.setattr(_kernels, "AVAILABLE", False)
+    M_a, n_a = monodromy_and_crossings_batch(Q, w, X, bp, kappa, c)
+    assert n_k.sum() > P  # the orbits do cross the breakpoints
+    np.testing.assert_array_equal(n_k, n_a)
+    scale = np.abs(M_a).max(axis=(1, 2), keepdims=True)
+    np.testing.assert_allclose(M_k / scale, M_a / scale, rtol=0, atol=1e-12)
+
+
+def test_single_equation_reading_matches_the_general_one(reference_frf):
+    """FloquetMonitor's 2 × 2 closed forms (ψ, slopes, distance) for the single equation agree
+    with the general formulas (determinants, multipliers) that chains use."""
+    from rattle.stability import FloquetMonitor, critical_distance, floquet_test_functions
+
+    frf = reference_frf
+    mon = FloquetMonitor(HarmonicBalance(frf.model, HBOptions(harmonics=32)))
+    d = np.linspace(-1.0, 1.0, frf.coefficients.shape[1]) * 1e-3
+    for i in range(0, len(frf), 97):
+        q, w = frf.coefficients[i], frf.omega[i]
+        reading = mon(q, w, d, 1e-3)
+        M = mon.monodromy(q, w)
+        psi = floquet_test_functions(M)
+        np.testing.assert_allclose(reading.values, psi, rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(psi, [np.linalg.det(M - np.eye(2)), np.linalg.det(M + np.eye(2))], rtol=1e-10, atol=1e-13)
+        slopes = (floquet_test_functions(mon.monodromy(q + 1e-7 * d, w + 1e-10)) - psi) / 1e-7
+        np.testing.assert_allclose(reading.slopes, slopes, rtol=1e-6, atol=1e-8)
+        assert reading.distance == pytest.approx(critical_distance(multipliers_from_monodromy(M)), rel=1e-12, abs=1e-14)

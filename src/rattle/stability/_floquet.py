@@ -19,7 +19,9 @@ times of each element's deflection series are found on its samples and refined t
 Newton (safeguarded where needed) on the Fourier series.
 
 One core serves every size: for n = 1 (the single equation, A_j = [[0, 1], [−κ_j, −c]])
-exp(A τ) is the closed form :func:`stage_transition`; for n > 1 each stage combination met is
+exp(A τ) is the closed form :func:`stage_transition` (with one element, the whole monodromy runs
+compiled, orbit by orbit, in ``_kernels``: the same formulas without numpy's per-call cost, which
+dominates for the one or two orbits of a continuation step); for n > 1 each stage combination met is
 diagonalised once, exp(A τ) = V diag(e^{λτ}) V⁻¹ for all its segments, and a combination whose
 eigenvector matrix is ill-conditioned (near-defective, e.g. a critically damped mode) goes
 through ``scipy.linalg.expm`` instead. (``rattle.timeint._exact`` keeps a second closed form of
@@ -36,6 +38,7 @@ import scipy.linalg
 from .._typing import ComplexArray, FloatArray
 from ..hb import FourierBasis
 from ..model import System
+from . import _kernels
 
 #: A stage combination whose eigenvector matrix has a condition number above this goes through
 #: ``scipy.linalg.expm`` instead of V diag(e^{λτ}) V⁻¹ (whose relative error is ~ cond · eps).
@@ -82,15 +85,30 @@ def stage_transition(stiffness: FloatArray, damping: float, tau: FloatArray) -> 
     return out
 
 
-def _series(Q: FloatArray, kw: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """δ(t) and δ'(t) of the series rows Q (m, 2H+1) with kω rows kw (m, H) at times t (m,)."""
+def _series_weights(Q: FloatArray, kw: FloatArray) -> FloatArray:
+    """Weights W (r, 2H, 2) of the series rows Q (r, 2H+1) with kω rows kw (r, H) such that
+    [cos kωt, sin kωt] @ W = [δ(t) − a_0, δ'(t)] (:func:`_series`)."""
+    H = kw.shape[1]
+    a, b = Q[:, 1 : H + 1], Q[:, H + 1 :]
+    W = np.empty((Q.shape[0], 2 * H, 2))
+    W[:, :H, 0] = a
+    W[:, H:, 0] = b
+    np.multiply(kw, b, out=W[:, :H, 1])
+    np.multiply(kw, a, out=W[:, H:, 1])
+    np.negative(W[:, H:, 1], out=W[:, H:, 1])
+    return W
+
+
+def _series(a0: FloatArray, W: FloatArray, kw: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """δ(t) and δ'(t) of r series (means ``a0`` (r,), weights ``W`` from :func:`_series_weights`,
+    kω rows ``kw`` (r, H)) at the times t (r,): one stacked product for both."""
     H = kw.shape[1]
     ph = kw * t[:, None]
-    c, s = np.cos(ph), np.sin(ph)
-    a, b = Q[:, 1 : H + 1], Q[:, H + 1 :]
-    delta = Q[:, 0] + np.einsum("ij,ij->i", c, a) + np.einsum("ij,ij->i", s, b)
-    vel = np.einsum("ij,ij->i", c, kw * b) - np.einsum("ij,ij->i", s, kw * a)
-    return delta, vel
+    cs = np.empty((t.size, 1, 2 * H))
+    np.cos(ph, out=cs[:, 0, :H])
+    np.sin(ph, out=cs[:, 0, H:])
+    out = np.matmul(cs, W)[:, 0]
+    return a0 + out[:, 0], out[:, 1]
 
 
 def _crossings(
@@ -102,23 +120,13 @@ def _crossings(
     levels = np.asarray(levels, dtype=float)
     per_row = levels.ndim == 2
     levels = levels if per_row else np.atleast_1d(levels)
-    pts, idxs, cols = [], [], []
-    for i in range(levels.shape[-1]):
-        # Sign of δ − d at every sample (a NaN level, padding, never changes sign); a crossing
-        # lies between samples j and j + 1 (cyclically).
-        above = samples > (levels[:, i, None] if per_row else levels[i])
-        change = np.empty_like(above)
-        np.not_equal(above[:, :-1], above[:, 1:], out=change[:, :-1])
-        np.not_equal(above[:, -1], above[:, 0], out=change[:, -1])
-        p, j = np.nonzero(change)
-        pts.append(p)
-        idxs.append(j)
-        cols.append(np.full(p.size, i))
-    if not pts:
-        return np.empty(0, dtype=int), np.empty(0), np.empty(0), np.empty(0, dtype=int)
-    p = np.concatenate(pts)
-    j = np.concatenate(idxs)
-    col = np.concatenate(cols)
+    # Sign of δ − d at every sample for every level at once (a NaN level, padding, never changes
+    # sign); a crossing lies between samples j and j + 1 (cyclically).
+    above = samples[:, None, :] > (levels[:, :, None] if per_row else levels[None, :, None])  # (P, k, N)
+    change = np.empty_like(above)
+    np.not_equal(above[:, :, :-1], above[:, :, 1:], out=change[:, :, :-1])
+    np.not_equal(above[:, :, -1], above[:, :, 0], out=change[:, :, -1])
+    p, col, j = np.nonzero(change)
     lvl = levels[p, col] if per_row else levels[col]
     if p.size == 0:
         return p, np.empty(0), lvl, col
@@ -129,15 +137,16 @@ def _crossings(
     a = j * dt
     b = a + dt
     t = a + dt * fa / (fa - fb)  # linear interpolation of the samples
-    Qp = Q[p]
     kw = np.arange(1, H + 1)[None, :] * omega[p][:, None]
+    a0 = Q[p, 0]
+    W = _series_weights(Q[p], kw)
     tol = 64 * np.finfo(float).eps * T
     # Fast path: plain Newton from the interpolated guess (quadratic convergence, 2–3 steps for a
     # simple root); only what has not converged inside its bracket goes the safeguarded way.
     t_fast = t.copy()
     done = np.zeros(p.size, dtype=bool)
     for _ in range(4):
-        f, fp = _series(Qp, kw, t_fast)
+        f, fp = _series(a0, W, kw, t_fast)
         with np.errstate(divide="ignore", invalid="ignore"):
             step = (f - lvl) / fp
         t_fast = t_fast - step
@@ -149,7 +158,7 @@ def _crossings(
     side = np.zeros(p.size, dtype=int)  # which end moved last (Illinois rule): -1 a, +1 b
     active = np.nonzero(~done)[0]
     for _ in range(60 if active.size else 0):
-        f, fp = _series(Qp[active], kw[active], t[active])
+        f, fp = _series(a0[active], W[active], kw[active], t[active])
         f = f - lvl[active]
         left = (f > 0) == (fa[active] > 0)
         ta = t[active]
@@ -350,6 +359,15 @@ def element_monodromy_batch(
         H = (S.shape[2] - 1) // 2
         N = n_samples or int(2 ** np.ceil(np.log2(4 * (2 * H + 1))))
         samples = FourierBasis(H, N).synthesize(S)
+    if system.n == 1 and system.m == 1 and _kernels.AVAILABLE:  # the single equation: compiled
+        cache = {} if cache is None else cache
+        kappa = cache.get(("kappa",))
+        if kappa is None:
+            kappa = cache[("kappa",)] = np.array([system.stage_stiffness((j,))[0, 0]
+                                                  for j in range(system.stage_counts()[0])])
+        M, counts = _kernels.monodromies(S[:, 0], omega, samples[:, 0], np.asarray(system.elements[0].breakpoints,
+                                         dtype=float), kappa, float(system.damping[0, 0]))
+        return M, counts[:, None, :]
     tau, combo, counts = _segments(S, omega, samples, [e.breakpoints for e in system.elements])
     return _chain_product(_stage_exponentials(system, combo, tau, cache)), counts
 
@@ -399,11 +417,12 @@ def monodromy_and_crossings_batch(
     shape (P, k): the orbit's crossing structure, which changes where it grazes a breakpoint.
     (The single-element case of :func:`element_monodromy_batch`, stage stiffnesses given.)"""
     bp = np.atleast_1d(np.asarray(stage_breakpoints, dtype=float))
+    kappa = np.asarray(stage_stiffness, dtype=float)
+    if _kernels.AVAILABLE:  # compiled, orbit by orbit (the same formulas; see _kernels)
+        return _kernels.monodromies(Q, omega, samples, bp, kappa, damping)
     tau, combo, counts = _segments(Q[:, None, :], omega, samples[:, None, :], (bp,), bp[None, :])
-    phis = stage_transition(np.asarray(stage_stiffness, dtype=float)[combo], damping, tau)
+    phis = stage_transition(kappa[combo], damping, tau)
     return _chain_product(phis), counts[:, 0]
-
-
 
 
 def crossing_times(
@@ -491,6 +510,11 @@ def floquet_test_functions(M: FloatArray) -> FloatArray:
     """
     M = np.asarray(M, dtype=float)
     k = M.shape[-1]
+    if k == 2:  # closed form: (m00 ∓ 1)(m11 ∓ 1) − m01 m10
+        with np.errstate(over="ignore", invalid="ignore"):
+            a, b, c, d = M[..., 0, 0], M[..., 0, 1], M[..., 1, 0], M[..., 1, 1]
+            bc = b * c
+            return np.stack([(a - 1.0) * (d - 1.0) - bc, (a + 1.0) * (d + 1.0) - bc], axis=-1)
     eye = np.eye(k)
     with np.errstate(over="ignore", invalid="ignore"):
         parts = [np.linalg.det(M - eye), np.linalg.det(M + eye)]

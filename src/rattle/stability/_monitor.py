@@ -118,6 +118,8 @@ class FloquetMonitor:
 
     def __call__(self, q: FloatArray, omega: float, dq: FloatArray, domega: float) -> MonitorReading:
         eps = EPSILON
+        if self._single:
+            return self._single_reading(q, omega, dq, domega)
         psi, counts, M = self._evaluate(np.stack([q, q + eps * dq]), np.array([omega, omega + eps * domega]))
         here = self._structure(counts[0])
         if self._structure(counts[1]) == here:
@@ -131,5 +133,52 @@ class FloquetMonitor:
         distance = critical_distance(multipliers_from_monodromy(M[0])) if np.isfinite(M[0]).all() else math.inf
         return MonitorReading(psi[0], slopes, here, distance)
 
+    def _single_reading(self, q: FloatArray, omega: float, dq: FloatArray, domega: float) -> MonitorReading:
+        """:meth:`__call__` of the single equation: the same reading from 2 × 2 closed forms in
+        Python floats (ψ, the multipliers' distance), as numpy's per-call cost dominates there."""
+        eps = EPSILON
+        Q = np.empty((2, q.size))
+        Q[0] = q
+        np.multiply(dq, eps, out=Q[1])
+        Q[1] += q
+        M, counts = self.monodromy_and_crossings(Q, np.array([omega, omega + eps * domega]))
+        here = tuple(counts[0, 0].tolist())
+        m = M.tolist()
+        psi = _psi_2x2(m[0])
+        if tuple(counts[1, 0].tolist()) == here:
+            psi_f = _psi_2x2(m[1])
+            slopes = ((psi_f[0] - psi[0]) / eps, (psi_f[1] - psi[1]) / eps)
+        else:  # the forward point grazes: take the backward difference
+            Mb, counts_b = self.monodromy_and_crossings((q - eps * dq)[None, :], np.array([omega - eps * domega]))
+            if tuple(counts_b[0, 0].tolist()) == here:
+                psi_b = _psi_2x2(Mb[0].tolist())
+                slopes = ((psi[0] - psi_b[0]) / eps, (psi[1] - psi_b[1]) / eps)
+            else:  # grazing within ±ε: no derivative; the stepper treats the point as a kink
+                slopes = (math.nan, math.nan)
+        return MonitorReading(np.array(psi), np.array(slopes), here, _distance_2x2(m[0]))
+
+
+def _psi_2x2(m: list) -> tuple[float, float]:
+    """det(M − I), det(M + I) of a 2 × 2 monodromy given as nested lists."""
+    (a, b), (c, d) = m
+    return (a - 1.0) * (d - 1.0) - b * c, (a + 1.0) * (d + 1.0) - b * c
+
+
+def _distance_2x2(m: list) -> float:
+    """:func:`~rattle.stability.critical_distance` of the multipliers of a 2 × 2 monodromy
+    (nested lists), from the closed form of :func:`multipliers_from_monodromy`."""
+    (a, b), (c, d) = m
+    tr, det = a + d, a * d - b * c
+    if not all(math.isfinite(v) for v in (a, b, c, d)):
+        return math.inf
+    disc = 0.25 * (tr * tr) - det
+    root = math.sqrt(abs(disc))
+    if disc >= 0:
+        big = 0.5 * tr + math.copysign(root, tr)
+        small = det / big if big != 0 else 0.0
+        out = min(abs(big - 1.0), abs(big + 1.0), abs(small - 1.0), abs(small + 1.0))
+    else:
+        out = min(math.hypot(0.5 * tr - 1.0, root), math.hypot(0.5 * tr + 1.0, root))
+    return out if math.isfinite(out) else math.inf
 
 __all__ = ["FloquetMonitor", "EPSILON", "hb_system"]
