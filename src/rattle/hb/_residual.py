@@ -29,6 +29,7 @@ import numpy as np
 import scipy.linalg
 
 from .._typing import FloatArray
+from . import _kernels
 from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions
 
@@ -134,6 +135,17 @@ class HarmonicBalance:
             (np.asarray(e.breakpoints, dtype=float), np.asarray(e.slopes, dtype=float), np.asarray(e.offsets, dtype=float))
             for e in system.elements
         ]
+        # One coordinate, one element: residual and Jacobian through the compiled kernels
+        # (``_kernels``; the same operations, identical results), with their buffers.
+        self._compiled = n == 1 and m == 1 and _kernels.AVAILABLE
+        if self._compiled:
+            N = self.basis.samples
+            self._delta = np.empty((1, N))
+            self._fg = np.empty((2, N))
+            self._spec = np.empty((2, N // 2 + 1), dtype=complex)
+            X, j1, j2 = self._product_tables(1)
+            self._kernel_tables = (X[0], j1[0], j2[0])
+            self._kernel_scalars = (float(C[0, 0]), float(K[0, 0]), self._has_K, float(B[0, 0]), float(self._W[0, 0, 0]))
 
     # --- sizes and views -----------------------------------------------------------------------
     @property
@@ -397,6 +409,8 @@ class HarmonicBalance:
 
     def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """R (n·S,), ∂R/∂q (n·S, n·S) and ∂R/∂Ω (n·S,) in one AFT pass (S = 2H+1)."""
+        if self._compiled:
+            return self._residual_jacobian_compiled(q, omega)
         w = self.base_frequency(omega)
         m = self.n_elements
         Q = self.coordinate_series(q)
@@ -415,6 +429,27 @@ class HarmonicBalance:
         Rq.reshape(-1)[self._lin_index] += self._linear_values(kw, m2)
         Rw = self._linear_part_dw(Q, w).reshape(-1)
         Rw /= self.period
+        return R, Rq, Rw
+
+    def _residual_jacobian_compiled(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:meth:`residual_jacobian` of one coordinate and one element: the samples and spectra by
+        the FFTs into buffers, the rest in the compiled kernels (``_kernels``), bit-identical."""
+        H, N, S = self.basis.harmonics, self.basis.samples, self._S
+        q = np.ascontiguousarray(q, dtype=float)
+        D = self.element_series(q)
+        re, im = self._synth_re, self._synth_im
+        np.multiply(D[:, :1], N, out=re[:, :1])
+        np.multiply(D[:, 1 : H + 1], 0.5 * N, out=re[:, 1 : H + 1])
+        np.multiply(D[:, H + 1 :], -0.5 * N, out=im[:, 1 : H + 1])
+        _kernels.irfft(self._synth, self._delta)
+        bp, sl, off = self._laws[0]
+        _kernels.force_samples(self._delta[0], bp, sl, off, self._fg)
+        G = _kernels.rfft(self._fg, self._spec)[:, :S] / N
+        R, Rq, Rw = np.empty(S), np.empty((S, S)), np.empty(S)
+        c, K, has_K, b, wq = self._kernel_scalars
+        X, j1, j2 = self._kernel_tables
+        _kernels.residual_jacobian(q, omega / self.period, float(self.period), G, c, K, has_K, b, wq, self.forcing,
+                                   X, j1, j2, R, Rq, Rw)
         return R, Rq, Rw
 
     # --- Newton steps: full or condensed onto the element deflections ---------------------------
