@@ -31,9 +31,9 @@ from .._typing import FloatArray
 from ..results import FrequencyResponse
 from ..results._frequency_response import Region
 from ..timeint import SteadyStateOptions, steady_state
+from ..timeint._shooting import _newton_shooting, _state_scale
 from ..timeint._steady import make_integrator
 from ..timeint._system_shooting import _newton_system, system_state_scale
-from ..timeint._shooting import _newton_shooting, _state_scale
 
 #: Settling options of the confirmation run: 600 periods to settle (the unstable orbit is left in
 #: tens of periods), a long recorded window (the

@@ -19,13 +19,13 @@ times of each element's deflection series are found on its samples and refined t
 Newton (safeguarded where needed) on the Fourier series.
 
 One core serves every size: for n = 1 (the single equation, A_j = [[0, 1], [−κ_j, −c]])
-exp(A τ) is the closed form :func:`stage_transition` (with one element, the whole monodromy runs
-compiled, orbit by orbit, in ``_kernels``: the same formulas without numpy's per-call cost, which
-dominates for the one or two orbits of a continuation step); for n > 1 each stage combination met is
+exp(A τ) is the closed form :func:`stage_transition` of :mod:`rattle.model._stage_matrix`, the one
+the exact integrator of :mod:`rattle.timeint` uses too (with one element, the whole monodromy runs
+compiled, orbit by orbit, in ``_kernels``: the same formula compiled, without numpy's per-call cost,
+which dominates for the one or two orbits of a continuation step); for n > 1 each stage combination met is
 diagonalised once, exp(A τ) = V diag(e^{λτ}) V⁻¹ for all its segments, and a combination whose
 eigenvector matrix is ill-conditioned (near-defective, e.g. a critically damped mode) goes
-through ``scipy.linalg.expm`` instead. (``rattle.timeint._exact`` keeps a second closed form of
-the 2 × 2 exponential, with the particular solutions it needs; issue 8 wants them merged.)
+through ``scipy.linalg.expm`` instead.
 """
 
 from __future__ import annotations
@@ -38,51 +38,12 @@ import scipy.linalg
 from .._typing import ComplexArray, FloatArray
 from ..hb import FourierBasis
 from ..model import System
+from ..model._stage_matrix import stage_transition  # the one closed form of exp(A τ) (re-exported)
 from . import _kernels
 
 #: A stage combination whose eigenvector matrix has a condition number above this goes through
 #: ``scipy.linalg.expm`` instead of V diag(e^{λτ}) V⁻¹ (whose relative error is ~ cond · eps).
 EIG_CONDITION_LIMIT = 1e4
-
-
-def stage_transition(stiffness: FloatArray, damping: float, tau: FloatArray) -> FloatArray:
-    """exp(A τ) for A = [[0, 1], [−κ, −c]], elementwise over κ = ``stiffness`` and ``tau``.
-
-    With σ = −c/2 and D = c²/4 − κ:  exp(Aτ) = e^{στ} [C(τ) I + S(τ) (A − σ I)], where
-    C = cosh(√D τ), S = sinh(√D τ)/√D (D > 0); C = cos(√−D τ), S = sin(√−D τ)/√−D (D < 0);
-    C = 1, S = τ (D = 0). Overdamped stages are evaluated without overflow (exponentials of
-    non-positive arguments only, for stiffness ≥ 0). Returns shape (..., 2, 2).
-    """
-    kappa = np.asarray(stiffness, dtype=float)
-    tau = np.asarray(tau, dtype=float)
-    kappa, tau = np.broadcast_arrays(kappa, tau)
-    sigma = -0.5 * damping
-    D = 0.25 * damping**2 - kappa
-    root = np.sqrt(np.abs(D))
-    x = root * tau
-    over = D > 0
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
-        # D > 0 (overdamped stage): e^{στ} cosh(√D τ) and e^{στ} sinh(√D τ)/√D written with
-        # e^{(σ+√D)τ} and expm1(−2√D τ), which neither overflow (cosh of a large argument times
-        # a vanishing e^{στ} would give inf·0) nor cancel for small √D τ.
-        grow = np.exp((sigma + root) * tau)
-        decay = np.expm1(-2.0 * x)
-        eC_over = grow * (1.0 + 0.5 * decay)
-        eS_over = grow * (-0.5 * decay) / np.where(root > 0, root, 1.0)
-        e = np.exp(sigma * tau)
-        eC_osc = e * np.cos(x)
-        eS_osc = e * np.sin(x) / np.where(root > 0, root, 1.0)
-    eC = np.where(over, eC_over, eC_osc)
-    eS = np.where(over, eS_over, eS_osc)
-    flat = root == 0  # critically damped stage: C = 1, S = τ
-    eC = np.where(flat, e, eC)
-    eS = np.where(flat, e * tau, eS)
-    out = np.empty(kappa.shape + (2, 2))
-    out[..., 0, 0] = eC - sigma * eS
-    out[..., 0, 1] = eS
-    out[..., 1, 0] = -kappa * eS
-    out[..., 1, 1] = eC + sigma * eS
-    return out
 
 
 def _series_weights(Q: FloatArray, kw: FloatArray) -> FloatArray:

@@ -5,7 +5,7 @@ For one coordinate and one element, :func:`monodromies` does per orbit what the 
 sign changes of the samples, refined by Newton on the Fourier series (safeguarded by Illinois
 regula falsi and bisection where Newton leaves its bracket), the segments' stages read at their
 mid-points, the product of the closed-form stage transitions exp(A τ) of
-:func:`~rattle.stability.stage_transition` — with the same formulas, in scalar loops. On the one
+:func:`rattle.model._stage_matrix.transition_scalar` compiled — in scalar loops. On the one
 or two orbits of a continuation step the array code spends its time in numpy's per-call cost
 (some hundred calls on arrays of a few elements); compiled, one orbit costs a few microseconds
 beyond its samples. The results agree with the array code to round-off (tests/stability).
@@ -23,6 +23,8 @@ try:  # numba is a dependency; the array code stays the fallback (and the refere
     import numba
 except ImportError:  # pragma: no cover - exercised only without numba
     numba = None
+
+from ..model._stage_matrix import stage_constants, transition_scalar
 
 AVAILABLE = numba is not None
 
@@ -89,19 +91,12 @@ def _refine(a0, a, b, w, lvl, fa, fb, ta, tb, t, tol):
     return t
 
 
-def _monodromies(Q, omega, samples, bp, kappa, damping, M, counts):
-    """Fill M (P, 2, 2) and counts (P, k) for the orbits Q (P, 2H+1) with samples (P, N)."""
+def _monodromies(Q, omega, samples, bp, kappa, sigma, under, wd, gamma, lam1, lam2, M, counts):
+    """Fill M (P, 2, 2) and counts (P, k) for the orbits Q (P, 2H+1) with samples (P, N); the
+    stages' exp(A τ) from their constants (:func:`rattle.model._stage_matrix.stage_constants`)."""
     P, N = samples.shape
     H = (Q.shape[1] - 1) // 2
     k = bp.size
-    sigma = -0.5 * damping
-    n_stage = kappa.size
-    roots = np.empty(n_stage)
-    kinds = np.empty(n_stage, dtype=np.int64)
-    for s in range(n_stage):
-        D = 0.25 * damping**2 - kappa[s]
-        roots[s] = math.sqrt(abs(D))
-        kinds[s] = 0 if roots[s] == 0 else (1 if D > 0 else -1)
     times = np.empty(max(1, 4 * k * 16))
     for p in range(P):
         a0 = Q[p, 0]
@@ -151,25 +146,8 @@ def _monodromies(Q, omega, samples, bp, kappa, damping, M, counts):
             else:
                 while stage < k and bp[stage] <= d_mid:
                     stage += 1
-            kap = kappa[stage]
-            root = roots[stage]
-            kind = kinds[stage]
-            if kind > 0:  # overdamped: e^{(σ+√D)τ}, expm1(−2√D τ) (see stage_transition)
-                grow = math.exp((sigma + root) * tau)
-                decay = math.expm1(-2.0 * (root * tau))
-                eC = grow * (1.0 + 0.5 * decay)
-                eS = grow * (-0.5 * decay) / root
-            elif kind < 0:  # oscillatory
-                e = math.exp(sigma * tau)
-                eC = e * math.cos(root * tau)
-                eS = e * math.sin(root * tau) / root
-            else:  # critically damped
-                eC = math.exp(sigma * tau)
-                eS = eC * tau
-            f00 = eC - sigma * eS
-            f01 = eS
-            f10 = -kap * eS
-            f11 = eC + sigma * eS
+            f00, f01, f10, f11 = _transition(sigma, under[stage], wd[stage], gamma[stage], lam1[stage],
+                                             lam2[stage], kappa[stage], tau)
             m00, m01, m10, m11 = (f00 * m00 + f01 * m10, f00 * m01 + f01 * m11,
                                   f10 * m00 + f11 * m10, f10 * m01 + f11 * m11)
         M[p, 0, 0] = m00
@@ -180,9 +158,12 @@ def _monodromies(Q, omega, samples, bp, kappa, damping, M, counts):
 
 if AVAILABLE:
     _jit = numba.njit(cache=True, error_model="numpy", nogil=True)
+    _transition = _jit(transition_scalar)  # the one closed form of exp(A τ), compiled
     _series = _jit(_series)
     _refine = _jit(_refine)
     _monodromies = _jit(_monodromies)
+else:  # pragma: no cover - the array code is taken then
+    _transition = transition_scalar
 
 
 def monodromies(
@@ -194,12 +175,13 @@ def monodromies(
     sorted, ``stiffness`` (k+1,) the stage stiffnesses, ``damping`` c (see
     :func:`~rattle.stability.monodromy_and_crossings_batch`)."""
     Q = np.ascontiguousarray(Q, dtype=float)
+    const = stage_constants(np.ascontiguousarray(stiffness, dtype=float), damping)
     P = Q.shape[0]
     M = np.empty((P, 2, 2))
     counts = np.zeros((P, breakpoints.size), dtype=np.intp)
     _monodromies(Q, np.ascontiguousarray(omega, dtype=float), np.ascontiguousarray(samples, dtype=float),
-                 np.ascontiguousarray(breakpoints, dtype=float), np.ascontiguousarray(stiffness, dtype=float),
-                 float(damping), M, counts)
+                 np.ascontiguousarray(breakpoints, dtype=float), const.kappa, const.sigma, const.under, const.wd,
+                 const.gamma, const.lam1, const.lam2, M, counts)
     return M, counts
 
 

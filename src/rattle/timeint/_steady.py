@@ -46,12 +46,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._typing import ComplexArray, FloatArray
 from .. import _limits
+from .._typing import ComplexArray, FloatArray
 from .._validate import check_int, check_state, numerical_failures
 from ..model import Chain, Model, System, check_analysable_model
 from ._exact import ExactIntegrator, ExactMeasures, Trajectory
-from ._flow import SystemIntegrator, SystemMeasures, SystemTrajectory, check_system_state
+from ._flow import (
+    SystemIntegrator,
+    SystemMeasures,
+    SystemTrajectory,
+    check_system_state,
+)
 from ._shooting import _newton_shooting, _Shot, _state_scale
 from ._system_shooting import _newton_system, _SystemShot, system_state_scale
 

@@ -1,0 +1,346 @@
+"""Exact integrator of the single equation for continuous piecewise-linear laws.
+
+The equation (c = C/I, k = K/I)
+
+    δ'' + c δ' + k f(δ) = F(t) = F_m + Σ_n F_pn cos(n Ω t + φ_n)
+
+is linear on every stage j of the law, f(δ) = s_j δ + e_j:
+
+    δ'' + c δ' + k s_j δ = F(t) − k e_j.
+
+Its solution from a state x_s = (δ_s, δ'_s) at time t_s is, with τ = t − t_s,
+
+    x(t) = p(t) + Φ_j(τ) (x_s − p(t_s)),      Φ_j(τ) = exp(A_j τ),  A_j = [[0, 1], [−k s_j, −c]],
+
+where p is a particular solution: the constant (F_m − k e_j)/(k s_j) (a ramp ((F_m − k e_j)/c) τ on a
+zero-stiffness stage with c > 0, a parabola ½ (F_m − k e_j) τ² when also c = 0) plus
+Re[X_jn e^{i n Ω t}], X_jn = F_pn e^{iφ_n} / (k s_j − (nΩ)² + i c nΩ) for every harmonic. Φ_j is
+written in closed form (under-, critically and over-damped, zero stiffness), so nothing here is
+approximated: the only numerical step is locating the times where δ(t) reaches a breakpoint,
+which is done to round-off.
+
+Crossings are bracketed on a grid of ``samples_per_scale`` points per fastest time scale of the
+stage (the period of the highest forcing harmonic, the stage's natural period and the damping
+time 1/c). Between grid points the extrema of δ (sign changes of δ') are refined too, so a
+trajectory that touches a breakpoint tangentially inside a grid cell is not missed. An excursion
+beyond a breakpoint that is below round-off (an exact graze) does not switch the stage.
+
+Because f is continuous, the vector field is continuous across a breakpoint: the saltation matrix
+of a crossing is the identity, and the sensitivity ∂x(t1)/∂x(t0) of a trajectory is the product
+of the stage transition matrices exp(A_j Δt_j) of its segments.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import numpy as np
+
+from .._typing import FloatArray
+from .._validate import check_state
+from ..errors import ConvergenceError
+from ..model import Model
+from ..model._stage_matrix import transition_scalar
+from ._roots import bracketed_newton
+from ._stage_solutions import StageSolutions
+from ._trajectory import Trajectory
+
+_EPS = float(np.finfo(float).eps)
+_FIRST_CHUNK = 48  # grid cells scanned at once for the first crossing; doubled up to _MAX_CHUNK
+_MAX_CHUNK = 4096
+
+
+# ---------------------------------------------------------------------------------------------
+# One segment of a trajectory (hot loop)
+# ---------------------------------------------------------------------------------------------
+class _Segment:
+    """The exact solution on stage j from (t_s, x_s), in modal form for fast evaluation:
+
+        δ(τ) = P + r τ + ½ a τ² + Re Σ_m A_m e^{μ_m τ},   τ = t − t_s,
+
+    the modes μ_m being the stage's eigenvalue(s) and i nΩ for the forcing harmonics (whose
+    phases at t_s are folded into A_m, so the local time τ carries no round-off of large t).
+    For an underdamped stage the form is as well conditioned as Φ(τ) h (|A| is the amplitude of
+    the free oscillation); near critical damping the two real modes nearly coincide and their
+    amplitudes blow up, so there the segment falls back to the transition-matrix form.
+    """
+
+    __slots__ = ("sol", "j", "ts", "h0", "h1", "P", "r", "a", "mu", "amp", "mu_l", "a0_l", "a1_l", "a2_l",
+                 "d_floor", "v_floor")
+
+    def __init__(self, sol: StageSolutions, j: int, ts: float, delta: float, velocity: float) -> None:
+        self.sol, self.j, self.ts = sol, j, ts
+        self.h0, self.h1 = h0, h1 = sol.homogeneous_start(j, ts, delta, velocity)
+        under, wd, gamma, lam1, lam2, _, _, self.P, self.r, self.a = sol._stage_l[j]
+        sigma = sol.sigma
+        if under:
+            mu = [complex(-sigma, wd)]
+            amp = [complex(h0, -(h1 + sigma * h0) / wd)]
+        elif gamma > 0.01 * sigma:
+            den = lam1 - lam2
+            mu = [complex(lam1), complex(lam2)]
+            amp = [complex((h1 - lam2 * h0) / den), complex((lam1 * h0 - h1) / den)]
+        else:
+            mu = None
+        if mu is None:
+            self.mu = None
+            self.d_floor = 8.0 * _EPS * (abs(delta) + abs(self.P) + abs(h0) + abs(h1) * sol.time_scale[j])
+            self.v_floor = 8.0 * _EPS * (abs(velocity) + abs(h0) / sol.time_scale[j] + abs(h1))
+            return
+        for (xr, xi), w in zip(sol._x_l[j], sol._nw_l):
+            mu.append(1j * w)
+            amp.append(complex(xr, xi) * cmath.exp(1j * w * ts))
+        self.mu_l, self.a0_l = mu, amp
+        self.a1_l = [m * x for m, x in zip(mu, amp)]
+        self.a2_l = [m * x for m, x in zip(mu, self.a1_l)]
+        self.mu = np.array(mu)
+        self.amp = np.array([amp, self.a1_l]).T  # (K, 2): δ and δ' amplitudes
+        # Round-off floors of δ and δ' (for the root finder's stopping test).
+        self.d_floor = 8.0 * _EPS * (abs(delta) + abs(self.P) + sum(map(abs, amp)))
+        self.v_floor = 8.0 * _EPS * (abs(self.r) + sum(map(abs, self.a1_l)))
+
+    def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """δ and δ' at local times ``taus`` (vectorised)."""
+        if self.mu is None:
+            d, v = self.sol.evaluate(self.j, self.ts + taus, self.ts, self.h0, self.h1, order=1)
+            return d, v
+        z = np.exp(taus[:, None] * self.mu) @ self.amp
+        d = z[:, 0].real + self.P
+        v = z[:, 1].real
+        if self.r != 0.0 or self.a != 0.0:
+            d += taus * (self.r + 0.5 * self.a * taus)
+            v += self.r + self.a * taus
+        return d, v
+
+    def state(self, tau: float) -> tuple[float, float, float]:
+        """(δ, δ', δ'') at local time ``tau``."""
+        if self.mu is None:
+            return self.sol.point(self.j, self.ts + tau, self.ts, self.h0, self.h1)
+        d = self.P + tau * (self.r + 0.5 * self.a * tau)
+        v = self.r + self.a * tau
+        acc = self.a
+        for m, x0, x1, x2 in zip(self.mu_l, self.a0_l, self.a1_l, self.a2_l):
+            e = cmath.exp(m * tau)
+            d += (x0 * e).real
+            v += (x1 * e).real
+            acc += (x2 * e).real
+        return d, v, acc
+
+
+# ---------------------------------------------------------------------------------------------
+# Integrator
+# ---------------------------------------------------------------------------------------------
+class ExactIntegrator:
+    """Exact integrator of δ'' + c δ' + k f(δ) = F(t) for a model with a continuous
+    piecewise-linear law (see the module docstring).
+
+    Parameters
+    ----------
+    model
+        The model (c = C/I, k = K/I, law f, excitation F).
+    samples_per_scale
+        Grid points per fastest time scale of a stage used to bracket crossings (≥ 8).
+    max_segments
+        Budget of segments of one ``propagate`` call; exceeding it raises ``ConvergenceError``.
+    """
+
+    def __init__(self, model: Model, *, samples_per_scale: int = 40, max_segments: int = 1_000_000) -> None:
+        if not isinstance(model, Model):
+            raise TypeError(f"`model` must be a rattle Model, got {model!r}")
+        for name, value, low in (("samples_per_scale", samples_per_scale, 8), ("max_segments", max_segments, 1)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+                raise TypeError(f"`{name}` must be an integer, got {value!r}")
+            if value < low:
+                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
+        self.model = model
+        self.samples_per_scale = int(samples_per_scale)
+        self.max_segments = int(max_segments)
+        self._cache: tuple[float, StageSolutions] | None = None
+
+    def solutions(self, omega: float) -> StageSolutions:
+        """The closed-form stage solutions at forcing frequency ``omega`` (the last one is cached)."""
+        if self._cache is not None and self._cache[0] == omega:
+            return self._cache[1]
+        sol = StageSolutions(self.model, omega, self.samples_per_scale)
+        self._cache = (float(omega), sol)
+        return sol
+
+    def propagate(self, x0: FloatArray | tuple[float, float], t0: float, t1: float, omega: float) -> Trajectory:
+        """Integrate exactly from state ``x0`` = (δ, δ') (rad, rad/s) at ``t0`` to ``t1`` ≥ t0 (s)
+        at forcing frequency ``omega`` (rad/s).
+
+        Returns the :class:`Trajectory`: its segments, final state and sensitivity ∂x(t1)/∂x0.
+        """
+        x0 = check_state(x0)
+        t0, t1 = float(t0), float(t1)
+        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
+            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        sol = self.solutions(omega)
+        starts: list[float] = []
+        stages: list[int] = []
+        states: list[tuple[float, float]] = []
+        homog: list[tuple[float, float]] = []
+        d, v, m = self._march(sol, float(x0[0]), float(x0[1]), t0, t1, (starts, stages, states, homog))
+        t_start = np.asarray(starts)
+        t_end = np.append(t_start[1:], t1)
+        return Trajectory(
+            omega=float(omega), t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
+            sensitivity=np.array([[m[0], m[1]], [m[2], m[3]]]), t_start=t_start, t_end=t_end,
+            stage=np.asarray(stages, dtype=np.int64), x_start=np.asarray(states, dtype=float).reshape(-1, 2),
+            solutions=sol, homogeneous=np.asarray(homog, dtype=float).reshape(-1, 2),
+        )
+
+    def _advance(self, delta: float, velocity: float, t0: float, t1: float, omega: float) -> tuple[float, float]:
+        """The state (δ, δ') at t1 only, from (δ, δ') at t0 (no checks, no record): the hot path of
+        a simulation that only needs its Poincaré points."""
+        d, v, _ = self._march(self.solutions(omega), delta, velocity, t0, t1, None)
+        return d, v
+
+    def _march(
+        self, sol: StageSolutions, d: float, v: float, t0: float, t1: float,
+        record: tuple[list, list, list, list] | None,
+    ) -> tuple[float, float, tuple[float, float, float, float]]:
+        """Segment by segment from (δ, δ') = (d, v) at t0 to t1: the final state and the
+        sensitivity (Φ11, Φ12, Φ21, Φ22); the segments are appended to ``record`` (starts,
+        stages, start states, homogeneous parts) when given."""
+        j = sol.stage_of(t0, d, v)
+        trans = sol._trans_l
+        t = t0
+        n_seg = 0
+        m11, m12, m21, m22 = 1.0, 0.0, 0.0, 1.0
+        while True:
+            seg = _Segment(sol, j, t, d, v)
+            tau_c, j_new, d_c, v_c = self._first_exit(seg, t1 - t)
+            if tau_c > 0.0 or (j_new < 0 and n_seg == 0):  # zero-length segments (round-off) are dropped
+                n_seg += 1
+                if record is not None:
+                    record[0].append(t)
+                    record[1].append(j)
+                    record[2].append((d, v))
+                    record[3].append((seg.h0, seg.h1))
+            f11, f12, f21, f22 = transition_scalar(*trans[j], tau_c)
+            m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
+                                  f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
+            if j_new < 0:
+                return d_c, v_c, (m11, m12, m21, m22)
+            # Exactly on the breakpoint: snap δ (the root is located to round-off).
+            d = float(sol.upper[j] if j_new > j else sol.lower[j])
+            v = v_c
+            j, t = j_new, t + tau_c
+            if n_seg > self.max_segments:
+                raise ConvergenceError(
+                    f"more than `max_segments` = {self.max_segments} segments between t0 = {t0!r} and "
+                    f"t1 = {t1!r}: raise `max_segments` or shorten the interval"
+                )
+
+    # --- crossing search -----------------------------------------------------------------------
+    def _first_exit(self, seg: _Segment, tau_end: float) -> tuple[float, int, float, float]:
+        """First local time in (0, tau_end] where δ leaves the segment's stage: (τ, stage entered,
+        δ, δ' there); stage −1 and τ = tau_end when it stays.
+
+        The segment start is inside the stage by construction (a crossing enters the new stage),
+        whatever round-off says of δ there.
+        """
+        sol, j = seg.sol, seg.j
+        lo, hi = float(sol.lower[j]), float(sol.upper[j])
+        if lo > -math.inf or hi < math.inf:
+            step = float(sol.grid_step[j])
+            if not math.isfinite(step):
+                step = max(tau_end, 1e-300) / self.samples_per_scale
+            tau_a = 0.0
+            chunk = _FIRST_CHUNK
+            while tau_a < tau_end:
+                n = max(1, min(chunk, math.ceil((tau_end - tau_a) / step)))
+                taus = tau_a + step * np.arange(n + 1)  # the cell starts, then the last end
+                if n < chunk or taus[-1] >= tau_end:
+                    taus[-1] = tau_end
+                d, v = seg.scan(taus)
+                if lo == -math.inf:
+                    outside = d[1:] >= hi
+                elif hi == math.inf:
+                    outside = d[1:] < lo
+                else:
+                    outside = (d[1:] >= hi) | (d[1:] < lo)
+                i_out = int(outside.argmax())
+                if not outside[i_out]:
+                    i_out = n
+                pos = v > 0.0
+                turns = (pos[:-1] != pos[1:]).nonzero()[0].tolist()
+                for i in [i for i in turns if i < i_out] + ([i_out] if i_out < n else []):
+                    d_a, d_b, v_a, v_b = float(d[i]), float(d[i + 1]), float(v[i]), float(v[i + 1])
+                    if i != i_out:
+                        # An extremum inside a cell can only reach a breakpoint within the cell's
+                        # possible excursion (δ' passes through zero and |δ'| is at most about its
+                        # end values; factor 2 for safety): refine only those.
+                        excursion = 2.0 * float(taus[i + 1] - taus[i]) * max(abs(v_a), abs(v_b))
+                        if (max(d_a, d_b) + excursion < hi) if v_a > 0.0 else (min(d_a, d_b) - excursion > lo):
+                            continue
+                    hit = self._resolve_cell(seg, lo, hi, float(taus[i]), float(taus[i + 1]), d_a, d_b, v_a, v_b,
+                                             at_start=(i == 0 and tau_a == 0.0))
+                    if hit is not None and hit[0] < tau_end:
+                        return hit
+                tau_a = float(taus[-1])
+                chunk = min(2 * chunk, _MAX_CHUNK)
+        d_end, v_end, _ = seg.state(tau_end)
+        return tau_end, -1, d_end, v_end
+
+    @staticmethod
+    def _resolve_cell(
+        seg: _Segment, lo: float, hi: float, tau_a: float, tau_b: float,
+        d_a: float, d_b: float, v_a: float, v_b: float, at_start: bool,
+    ) -> tuple[float, int, float, float] | None:
+        """The exit from the segment's stage inside the grid cell [tau_a, tau_b], if any:
+        (τ, stage entered, δ, δ' there); None when δ stays inside or only grazes a breakpoint
+        (an excursion beyond it below round-off)."""
+        state = seg.state
+
+        def velocity_and_acceleration(tau: float) -> tuple[float, float]:
+            _, v, a = state(tau)
+            return v, a
+
+        tol = 4.0 * _EPS * tau_b + 1e-300
+        end_up, end_down = d_b >= hi, d_b < lo
+        if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):
+            # δ has an extremum in the cell: refine it (a tangential touch may hide inside).
+            tau_e = tau_b if v_b == 0.0 else bracketed_newton(
+                velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol, seg.v_floor)
+            d_e = state(tau_e)[0]
+            graze = seg.d_floor
+            if v_a > 0.0:  # a maximum: beyond hi, cross before it; else maybe down after it
+                if d_e - hi > graze or end_up:
+                    up, a_, b_, d_a_, d_b_ = True, tau_a, tau_e, d_a, d_e
+                elif end_down:
+                    up, a_, b_, d_a_, d_b_ = False, tau_e, tau_b, d_e, d_b
+                else:
+                    return None
+            else:  # a minimum
+                if lo - d_e > graze or end_down:
+                    up, a_, b_, d_a_, d_b_ = False, tau_a, tau_e, d_a, d_e
+                elif end_up:
+                    up, a_, b_, d_a_, d_b_ = True, tau_e, tau_b, d_e, d_b
+                else:
+                    return None
+        elif end_up or end_down:
+            up, a_, b_, d_a_, d_b_ = end_up, tau_a, tau_b, d_a, d_b
+        else:
+            return None
+        bound = hi if up else lo
+        fa, fb = d_a_ - bound, d_b_ - bound
+        if (fa >= 0.0) if up else (fa < 0.0):
+            if not (at_start and a_ == 0.0):
+                tau_c = a_  # round-off at a graze: the crossing is at the bracket's start
+            else:
+                fa = -1e-300 if up else 1e-300  # the segment start is inside by construction
+        if (fa < 0.0) if up else (fa >= 0.0):
+
+            def gap(tau: float) -> tuple[float, float]:
+                d, v, _ = state(tau)
+                return d - bound, v
+
+            tau_c = bracketed_newton(gap, a_, b_, fa, fb, tol, seg.d_floor)
+        _, v_c, _ = state(tau_c)
+        return tau_c, seg.j + 1 if up else seg.j - 1, bound, v_c
+
+
+__all__ = ["ExactIntegrator"]
