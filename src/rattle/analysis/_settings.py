@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
-from typing import Any, Literal, Union
+from typing import Any, Literal
 
 import numpy as np
 
@@ -29,7 +29,7 @@ from ..hb import HBOptions
 from ..stability import AbstractStabilityMethod, Monodromy, stability_method
 
 #: What a front end accepts as ``stability``: a method object or its name.
-StabilityMethod = Union[AbstractStabilityMethod, Literal["monodromy", "hill"]]
+StabilityMethod = AbstractStabilityMethod | Literal["monodromy", "hill"]
 
 
 class _DefaultHarmonics(int):

@@ -1,5 +1,7 @@
 """Harmonic balance of a :class:`~rattle.model.System` (n coordinates, m clearance elements; the
-single equation is n = m = 1): Fourier basis, AFT residual with analytic Jacobians, Newton corrector."""
+single equation is n = m = 1): Fourier basis, AFT residual with analytic Jacobians. :class:`HarmonicBalance` is a
+:class:`~rattle.continuation.ContinuationProblem`: it is solved by :func:`rattle.continuation.solve_fixed`
+and continued by :class:`rattle.continuation.ContinuationStepper`."""
 
 from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions, default_samples
