@@ -166,6 +166,10 @@ else:  # pragma: no cover - the array code is taken then
     _transition = transition_scalar
 
 
+#: Stage constants of the laws met, keyed by (stage stiffnesses, damping).
+_CONSTANTS: dict = {}
+
+
 def monodromies(
     Q: np.ndarray, omega: np.ndarray, samples: np.ndarray, breakpoints: np.ndarray, stiffness: np.ndarray,
     damping: float,
@@ -175,7 +179,13 @@ def monodromies(
     sorted, ``stiffness`` (k+1,) the stage stiffnesses, ``damping`` c (see
     :func:`~rattle.stability.monodromy_and_crossings_batch`)."""
     Q = np.ascontiguousarray(Q, dtype=float)
-    const = stage_constants(np.ascontiguousarray(stiffness, dtype=float), damping)
+    stiffness = np.ascontiguousarray(stiffness, dtype=float)
+    key = (stiffness.tobytes(), float(damping))
+    const = _CONSTANTS.get(key)
+    if const is None:  # a dozen numpy calls: once per law, not once per orbit
+        if len(_CONSTANTS) > 64:
+            _CONSTANTS.clear()
+        const = _CONSTANTS[key] = stage_constants(stiffness, damping)
     P = Q.shape[0]
     M = np.empty((P, 2, 2))
     counts = np.zeros((P, breakpoints.size), dtype=np.intp)
