@@ -172,16 +172,29 @@ def confirm_tori(frf: FrequencyResponse, options: SteadyStateOptions | None = No
     (0: none ≤ 8), ``detail["simulation"]`` the whole record, and the label saying what the
     simulation found (quasi-periodic with its rotation number, or the period it jumped to)."""
     out = []
+    done: list[tuple[float, float, dict[str, Any]]] = []
     for r in frf.regions:
         if r.kind != "torus" or "rows" not in r.detail or "simulated_periods" in r.detail:
             out.append(r)
             continue
         sim = simulate_torus(frf, r, options)
+        done.append((r.omega_min, r.omega_max, sim))
         detail = dict(r.detail, simulated_periods=[sim["period"]], simulation=sim)
         head = r.label.split(": quasi-periodic motion likely")[0]
         ratios = [x for x in r.detail.get("torus_ratio", []) if x is not None]
         ratio = f" (torus frequency ratio at the Neimark–Sacker points ≈ {np.mean(ratios):.3g})" if ratios else ""
         out.append(replace(r, label=f"{head}{ratio}; {_verdict(sim)}", detail=detail))
+    # An interval without a stable computed orbit that is such a torus stretch says what the
+    # simulation found instead of "quasi-periodic motion likely".
+    for k, r in enumerate(out):
+        if r.kind == "unstable_not_computed" and "quasi-periodic motion likely" in r.label:
+            for lo, hi, sim in done:
+                if lo - 1e-9 <= r.omega_min and r.omega_max <= hi + 1e-9:
+                    what = "quasi-periodic" if sim["period"] == 0 and sim.get("closed_curve") else (
+                        f"period {sim['period']}" if sim["period"] else "no period ≤ 8, not on a closed curve")
+                    out[k] = replace(r, label=r.label.replace(
+                        "quasi-periodic motion likely", f"simulation from the unstable orbit: {what}"),
+                        detail=dict(r.detail, simulated_periods=[sim["period"]]))
     return tuple(out)
 
 
