@@ -36,8 +36,11 @@ def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
 def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> tuple[FloatArray, str]:
     """A converged solution at Ω from the linear solution about the static equilibrium.
 
-    If Newton fails from there, the dynamic forcing is raised from zero to its value in
-    steps (a homotopy in the amplitude), each step started from the previous solution.
+    If Newton fails from there, the dynamic forcing λ·(F − F_0) is raised from λ = 0 (the
+    static solution) to 1: first in natural steps, each started from the previous solution;
+    where that stalls (the solution turns back in λ: a fold of the amplitude response, common
+    inside a bent resonance), by pseudo-arclength continuation in (q, λ), which follows the
+    solution curve through such folds (:func:`_amplitude_continuation`).
     """
     q_lin = hb.linear_solution(omega)
     res = solve_harmonic_balance(hb, q_lin, omega, newton)
@@ -50,6 +53,7 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
     q = q_lin.copy()
     q.reshape(n, -1)[:, 1:] = 0.0
     lam, dlam = 0.0, 0.1
+    q_static = None
     try:
         while lam < 1.0 and dlam > 1e-4:
             trial = min(1.0, lam + dlam)
@@ -57,6 +61,8 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
             r = solve_harmonic_balance(hb, q, omega, newton)
             if r.converged:
                 q, lam = r.q, trial
+                if q_static is None:
+                    q_static = (r.q, trial)
                 dlam = min(0.5, 1.5 * dlam)
             else:
                 dlam *= 0.5
@@ -64,13 +70,99 @@ def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> 
         hb.forcing = full
     if lam >= 1.0:
         return q, "amplitude homotopy"
+    stalled = lam
+    q_cont = _amplitude_continuation(hb, omega, q, lam, static, full, newton)
+    if q_cont is not None:
+        return q_cont, "amplitude continuation (through folds in the amplitude)"
     raise ConvergenceError(
         f"no periodic solution found at Ω = {omega:g}: Newton from the linear solution failed "
         f"({res.message}, scaled residual {res.residual:.3g}) and the amplitude homotopy stalled at "
-        f"{lam:.3g} of the forcing; with {hb.basis.harmonics} harmonics the truncated problem may have "
+        f"{stalled:.3g} of the forcing (also followed by arclength through folds); with "
+        f"{hb.basis.harmonics} harmonics the truncated problem may have "
         "no solution there (a slow orbit through the stages needs many harmonics): give more "
         "harmonics or start the range higher"
     )
+
+
+def _amplitude_continuation(
+    hb: HarmonicBalance, omega: float, q0: FloatArray, lam0: float, static: FloatArray, full: FloatArray,
+    newton: NewtonOptions, max_steps: int = 2000,
+) -> FloatArray | None:
+    """Pseudo-arclength continuation of R(q, Ω) with the forcing F_0 + λ (F − F_0), from the
+    converged (q0, λ0) to λ = 1, through folds in λ; the solution at λ = 1 (Newton at the full
+    forcing from the point interpolated where the curve crosses it), or None.
+
+    Variables y = (q / L, λ); the corrector solves R = 0 with tᵀ(y − y_pred) = 0 on the
+    bordered Jacobian [∂R/∂q L, −(F − F_0)]; the tangent is its null vector, oriented along the
+    previous one (initially towards increasing λ).
+    """
+    L, Fs = hb.length_scale, hb.force_scale
+    D = full - static
+    size = hb.size
+
+    def rj(y: FloatArray) -> tuple[FloatArray, FloatArray]:
+        hb.forcing = static + y[-1] * D
+        R, Rq, _ = hb.residual_jacobian(y[:-1] * L, omega)
+        J = np.empty((size, size + 1))
+        J[:, :size] = Rq * L
+        J[:, size] = -D
+        return R, J
+
+    def tangent(J: FloatArray, ref: FloatArray) -> FloatArray | None:
+        A = np.vstack((J, ref))
+        rhs = np.zeros(size + 1)
+        rhs[-1] = 1.0
+        try:
+            t = np.linalg.solve(A, rhs)
+        except np.linalg.LinAlgError:
+            return None
+        return t / np.linalg.norm(t) if np.all(np.isfinite(t)) else None
+
+    try:
+        y = np.concatenate((q0 / L, [lam0]))
+        _, J = rj(y)
+        ref = np.zeros(size + 1)
+        ref[-1] = 1.0
+        t = tangent(J, ref)
+        h = 0.05
+        for _ in range(max_steps if t is not None else 0):
+            yp = y + h * t
+            ok = False
+            yc = yp.copy()
+            for _it in range(newton.max_iterations):
+                R, J = rj(yc)
+                A = np.vstack((J, t))
+                rhs = np.concatenate((-R, [-float(t @ (yc - yp))]))
+                try:
+                    dy = np.linalg.solve(A, rhs)
+                except np.linalg.LinAlgError:
+                    break
+                yc = yc + dy
+                if not np.all(np.isfinite(yc)):
+                    break
+                if float(np.max(np.abs(R))) / Fs <= newton.residual_tol and float(np.max(np.abs(dy))) <= newton.step_tol:
+                    ok = True
+                    break
+            if not ok or float(np.linalg.norm(yc - y)) > 2.0 * h:
+                h *= 0.5
+                if h < 1e-7:
+                    return None
+                continue
+            if yc[-1] >= 1.0:  # crossed the full forcing: Newton there from the interpolated point
+                s = (1.0 - y[-1]) / (yc[-1] - y[-1])
+                q_guess = ((1.0 - s) * y[:-1] + s * yc[:-1]) * L
+                hb.forcing = full
+                r = solve_harmonic_balance(hb, q_guess, omega, newton)
+                return r.q if r.converged else None
+            _, J = rj(yc)
+            t_new = tangent(J, t)
+            if t_new is None:
+                return None
+            y, t = yc, t_new
+            h = min(2.0 * h, 0.25)
+        return None
+    finally:
+        hb.forcing = full
 
 
 def monitor_of(hb: HarmonicBalance) -> FloquetMonitor:
