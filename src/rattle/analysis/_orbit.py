@@ -360,7 +360,10 @@ def periodic_orbit(
 
     Parameters
     ----------
-    model : Model
+    model : Model or Chain
+        A chain's solutions carry its n coordinate blocks (``coefficients``), the measures of
+        every element (``OrbitSolution.elements``; the flat fields the first element's) and
+        its 2n multipliers.
     omega : float
         Forcing frequency Ω (rad/s), finite and > 0.
     period : int, default 1
@@ -379,7 +382,8 @@ def periodic_orbit(
         An already computed period-1 frequency response through (or near) Ω to take the
         primary branch from, instead of computing it.
     x0 : (float, float), optional
-        Initial state (δ, δ') of the simulation (rad, rad/s); default rest (0, 0).
+        Initial state (δ, δ') of the simulation (rad, rad/s), (x, x') (2n numbers) for a chain;
+        default rest (zeros).
     samples : int, optional
         AFT samples per solution period (default :func:`rattle.hb.default_samples`).
     hb : HBOptions, optional

@@ -283,8 +283,9 @@ def time_sweep(
 
     Parameters
     ----------
-    model : Model
-        The model.
+    model : Model or Chain
+        The model; a chain is simulated on all its coordinates (state (x, x')), its rows measure
+        the first clearance element and ``element_columns`` every element.
     omega : (float, float)
         Frequency range (Ω_min, Ω_max) in rad/s, 0 < Ω_min < Ω_max.
     points : int

@@ -1,4 +1,11 @@
-"""Steady state of δ'' + c δ' + k f(δ) = F(t) by simulation, with period detection (1 … 8).
+"""Steady state of δ'' + c δ' + k f(δ) = F(t) — or of a chain's System, x'' + C x' + K x +
+Σ b_e f_e(a_e·x) = F(t) — by simulation, with period detection (1 … 8).
+
+One settling loop serves both: the single equation runs on :class:`ExactIntegrator` (state
+(δ, δ'), its fast scalar path), a chain on :class:`SystemIntegrator` (state z = (x, x') of its
+n coordinates; the scaled norm below then takes every coordinate by the System's length scale
+and every velocity by that times ν, :func:`system_state_scale`); shooting is
+:func:`_newton_shooting` or :func:`_newton_system` on the same exact flows.
 
 The state is integrated exactly (:class:`ExactIntegrator`) one forcing period T = 2π/Ω at a time,
 from t = 0 to T (F is T-periodic, so every period starts at forcing phase 0). The states at the
@@ -180,9 +187,10 @@ class SteadyState:
         Forcing periods simulated (settling, checks and, for period 0, the record).
     shooting_periods : int
         Forcing periods integrated inside the Newton shooting solves.
-    state0 : ndarray, shape (2,)
+    state0 : ndarray, shape (2,) or (2n,)
         (δ, δ') (rad, rad/s) at the start of ``trajectory``, on the Poincaré section (forcing
-        phase 0): for a periodic motion, a point of the orbit.
+        phase 0): for a periodic motion, a point of the orbit. A chain: (x, x') of its n
+        coordinates (likewise ``final_state``, ``cycle`` and ``poincare`` rows).
     final_state : ndarray, shape (2,)
         The state on the Poincaré section to carry to the next frequency of a sweep.
     cycle : ndarray, shape (period, 2)
@@ -190,16 +198,19 @@ class SteadyState:
     poincare : ndarray, shape (m, 2)
         The latest Poincaré points of the simulation, oldest first (for period 0, those of the
         recorded window).
-    trajectory : Trajectory
+    trajectory : Trajectory or SystemTrajectory
         Exact trajectory over one orbit period from ``state0`` (period·2π/Ω), or over the
         ``record_periods`` window for period 0 (time starts at 0).
-    measures : ExactMeasures
-        SPEC §1 measures over ``trajectory``.
-    multipliers : ndarray, shape (2,), complex, or None
+    measures : ExactMeasures or SystemMeasures
+        SPEC §1 measures over ``trajectory`` (a chain: of every element; the flat properties
+        ``mean``, ``rms``, … are the first element's, ``element_measures`` all of them).
+    multipliers : ndarray, shape (2,) or (2n,), complex, or None
         Floquet multipliers of the orbit (largest modulus first); None for period 0.
     residual : float
         Scaled shooting residual (``shooting``), settling distance d_n (``simulation``) or the
         smallest d_n at the end (``unsettled``).
+    element_names : tuple of str
+        A chain's clearance elements, in order (empty for the single equation).
     """
 
     omega: float
