@@ -153,10 +153,13 @@ def _system_of(model: object) -> System:
     return model if isinstance(model, System) else model.system()  # type: ignore[attr-defined]
 
 
-def coordinate_accelerations(system: System, X: FloatArray, V: FloatArray, t: FloatArray, forcing_omega: FloatArray) -> FloatArray:
+def coordinate_accelerations(
+    system: System, X: FloatArray, V: FloatArray, t: FloatArray, forcing_omega: FloatArray, F: FloatArray | None = None,
+) -> FloatArray:
     """x'' = F(t) − C x' − K x − Σ_j b_j f_j(a_j·x) from positions X and velocities V
-    (P, n, m) at times t (P, m), forcing frequencies Ω (P,). Returns (P, n, m)."""
-    F = system.forcing(t, forcing_omega[:, None])  # (P, m, n)
+    (P, n, m) at times t (P, m), forcing frequencies Ω (P,). Returns (P, n, m). ``F`` the
+    forcing at those times (P or 1, m, n) if already at hand."""
+    F = system.forcing(t, forcing_omega[:, None]) if F is None else F  # (P, m, n)
     acc = np.moveaxis(F, -1, 1) - np.einsum("ij,pjm->pim", system.damping, V) - np.einsum("ij,pjm->pim", system.stiffness, X)
     for e in system.elements:
         d = np.einsum("j,pjm->pm", e.a, X)
@@ -181,6 +184,19 @@ def element_accelerations(system: System, Qx: FloatArray, omega: FloatArray, for
     return np.einsum("ej,pjm->pem", system.element_rows, acc)
 
 
+def _sample_forcing(system: System, omega: FloatArray, forcing_omega: FloatArray, N: int) -> FloatArray | None:
+    """F at the N samples t_j = j T_p / N of every orbit, (1, N, n), when all orbits have the same
+    period multiple p = Ω/ω: then Ω t_j = 2π p j / N whatever Ω, so one row serves all (instead
+    of P·N evaluations of every forcing harmonic). None when the multiples differ."""
+    if omega.size == 0:
+        return None
+    ratio = forcing_omega / omega
+    p = float(np.rint(ratio[0]))
+    if p < 1 or not np.allclose(ratio, p, rtol=1e-12, atol=0.0):
+        return None
+    return system.forcing(np.arange(N) * (2 * np.pi / N), p)[None]
+
+
 def system_measures_batch(model: object, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: int) -> tuple[Measures, ...]:
     """SPEC §1 measures of every element's deflection, one :class:`Measures` per element, for P
     orbits with coefficient blocks Qx (P, n, 2H+1) (coordinate-major), base frequencies ω (P,),
@@ -202,7 +218,8 @@ def system_measures_batch(model: object, Qx: FloatArray, omega: FloatArray, forc
     dt = T / N
     rows = np.arange(P)
     times = np.arange(N)[None, :] * dt[:, None]
-    acc_all = np.einsum("ej,pjm->pem", A, coordinate_accelerations(system, X, V, times, forcing_omega))
+    acc_all = np.einsum("ej,pjm->pem", A, coordinate_accelerations(system, X, V, times, forcing_omega,
+                                                                   _sample_forcing(system, omega, forcing_omega, N)))
     out = []
     for e_idx, e in enumerate(system.elements):
         Q = Qe[:, e_idx]
