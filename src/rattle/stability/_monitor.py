@@ -31,6 +31,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..continuation import MonitorReading
 from ..hb import HarmonicBalance
+from ..hb import _kernels as fft
 from ..model import System
 from ._classify import critical_distance
 from ._floquet import (
@@ -64,6 +65,7 @@ class FloquetMonitor:
         system = self.system
         self.names = TEST_FUNCTIONS[:2] if system.n == 1 else TEST_FUNCTIONS
         self._cache: dict = {}
+        self._buffers: dict = {}
         # The single element of the single equation: the closed-form path on q itself.
         self._single = system.n == 1 and system.m == 1 and float(system.element_rows[0, 0]) == 1.0
         if self._single:
@@ -79,11 +81,30 @@ class FloquetMonitor:
         hb = self.hb
         w = Om / hb.period
         if self._single:
-            M, counts = monodromy_and_crossings_batch(Q, w, hb.basis.synthesize(Q), self._breakpoints,
+            M, counts = monodromy_and_crossings_batch(Q, w, self._samples(Q), self._breakpoints,
                                                       self._stiffness, self._damping)
             return M, counts[:, None, :]
         S = np.einsum("en,pnk->pek", self._rows, Q.reshape(Q.shape[0], self.system.n, -1))
         return element_monodromy_batch(self.system, S, w, hb.basis.synthesize(S), cache=self._cache)
+
+    def _samples(self, Q: FloatArray) -> FloatArray:
+        """``hb.basis.synthesize(Q)`` (P, N); for the one or two orbits of a reading into buffers
+        kept between calls, by the inverse FFT without numpy.fft's wrapper (the array returned
+        is overwritten by the next call)."""
+        P = Q.shape[0]
+        if P > 2:
+            return self.hb.basis.synthesize(Q)
+        basis = self.hb.basis
+        H, N = basis.harmonics, basis.samples
+        buffers = self._buffers.get(P)
+        if buffers is None:
+            buffers = self._buffers[P] = (np.zeros((P, N // 2 + 1), dtype=complex), np.empty((P, N)))
+        spec, out = buffers
+        re, im = spec.real, spec.imag
+        np.multiply(Q[:, :1], N, out=re[:, :1])
+        np.multiply(Q[:, 1 : H + 1], 0.5 * N, out=re[:, 1 : H + 1])
+        np.multiply(Q[:, H + 1 :], -0.5 * N, out=im[:, 1 : H + 1])
+        return fft.irfft(spec, out)
 
     def monodromy(self, q: FloatArray, omega: float) -> FloatArray:
         """The exact monodromy (2n, 2n) of the orbit q at forcing frequency Ω."""
