@@ -358,9 +358,11 @@ def exact_special_points(
     cont_tol: float = 1e-9,
     last_step: float = 1e-7,
     x0: np.ndarray | None = None,
+    start: str = "low",
 ) -> ExactBranch:
     """Folds, period doublings (and, for chains, Neimark–Sacker points) of the period-1 branch of ``model`` over ``omega`` = (Ω_min,
-    Ω_max) from the exact flow (module docstring). Raises :class:`ReferenceError` if the start
+    Ω_max) from the exact flow (module docstring), starting at the ``start`` end ("low": Ω_min,
+    "high": Ω_max) from the orbit shot from ``x0`` (default: the linear guess) there. Raises :class:`ReferenceError` if the start
     orbit or a step cannot be computed."""
     import time
 
@@ -368,22 +370,24 @@ def exact_special_points(
     lo, hi = map(float, omega)
     prob = _ShootingProblem(model)
     corr = _Corrector(prob)
-    orbit = prob.shoot(lo, _linear_guess(model, lo) if x0 is None else np.asarray(x0, dtype=float))
+    w0 = lo if start == "low" else hi
+    orbit = prob.shoot(w0, _linear_guess(model, w0) if x0 is None else np.asarray(x0, dtype=float))
     if not orbit.converged:
-        raise ReferenceError(f"no start orbit at Ω_min = {lo}")
-    y0 = prob.scale(orbit.state0, lo)
+        raise ReferenceError(f"no start orbit at Ω = {w0} (the {start} end)")
+    y0 = prob.scale(orbit.state0, w0)
     # Initial direction: the null vector of [Ms − I, g_Ω], oriented towards increasing Ω.
     G, M, Ms, sig = prob.evaluate(y0)
     corr.g_col = prob.g_omega(y0)
     J = np.hstack((Ms - np.eye(G.size), corr.g_col[:, None]))
     t = np.linalg.svd(J)[2][-1]
-    d = t / np.linalg.norm(t) * (1.0 if t[-1] > 0 else -1.0)
+    sense = 1.0 if start == "low" else -1.0  # into the range
+    d = t / np.linalg.norm(t) * (sense if t[-1] > 0 else -sense)
     pts = [BranchPoint(y0, M, _psi(M), sig)]
     h = max_step
     steps = 0
     retry = False
-    w_hi = hi / prob.wn
-    while pts[-1].y[-1] < w_hi:
+    w_lo, w_hi = lo / prob.wn, hi / prob.wn
+    while (pts[-1].y[-1] < w_hi) if start == "low" else (pts[-1].y[-1] > w_lo):
         if steps >= max_steps:
             raise ReferenceError(f"more than {max_steps} steps (reached Ω = {pts[-1].y[-1] * prob.wn:.6g})")
         if len(pts) >= 2:

@@ -100,10 +100,17 @@ def test_two_inertia_chain_exact_reference_equals_the_single_equation_reference(
     assert abs(a.special[0][1] - b.special[0][1]) <= 1e-8
 
 
+#: Reference continuation steps for these tests: the located points' accuracy comes from Brent's
+#: method on the test functions (1e-11) and the hidden-pair guard, not from the step, which only
+#: bounds how far apart the computed points of the reference branch are (the default 2e-3 is 5×
+#: slower for the same points, measured on both chains).
+REFERENCE_STEPS = {"max_step": 2e-2, "max_domega": 1e-2}
+
+
 @pytest.mark.parametrize("omega", [(0.45, 0.6), (0.74, 0.9)])
 def test_grounded_clutch_chain_special_points_with_neimark_sacker(omega):
     model = grounded_clutch()
-    exact = xb.exact_special_points(model, omega).special
+    exact = xb.exact_special_points(model, omega, **REFERENCE_STEPS).special
     frf = rattle.frequency_response(model, omega=omega, harmonics=16)
     assert "neimark_sacker" in {k for k, _ in exact}
     _match(exact, _points(frf), 1e-4)
@@ -114,11 +121,18 @@ def test_grounded_clutch_chain_special_points_with_neimark_sacker(omega):
             assert abs(abs(pair) - 1.0) < 1e-6 and abs(pair.imag) > 1e-3
 
 
-@pytest.mark.parametrize("omega", [(0.55, 0.65), (0.75, 1.0)])
-def test_driveline_special_points(omega):
+@pytest.mark.parametrize("omega, start, kinds", [
+    ((0.55, 0.65), "low", {"period_doubling"}),
+    ((0.84, 0.88), "low", {"neimark_sacker"}),    # starts inside the bent resonance (amplitude continuation)
+    ((0.81, 0.845), "high", {"fold"}),            # the lower fold, reached from the high end
+])
+def test_driveline_special_points(omega, start, kinds):
+    """Folds, period doublings and Neimark–Sacker points of the driveline, each in a short range
+    (the reference follows the branch HB starts on: from the HB orbit at the same end)."""
     model = driveline()
-    frf = rattle.frequency_response(model, omega=omega, harmonics=16)
-    exact = xb.exact_special_points(model, omega, x0=_state(frf, model, 0)).special
+    frf = rattle.frequency_response(model, omega=omega, harmonics=16, start=start)
+    exact = xb.exact_special_points(model, omega, x0=_state(frf, model, 0), start=start, **REFERENCE_STEPS).special
+    assert {k for k, _ in exact} == kinds
     _match(exact, _points(frf), 1e-4)
 
 
@@ -134,7 +148,7 @@ def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega)
     frf = rattle.frequency_response(model, omega=omega, harmonics=32)
     special = np.array([s.omega for s in frf.special_points])
     integ = SystemIntegrator(system)
-    rows = np.linspace(0, len(frf) - 1, 24).astype(int)
+    rows = np.linspace(0, len(frf) - 1, 14).astype(int)
     checked = 0
     for i in rows:
         w = float(frf.omega[i])
@@ -149,4 +163,4 @@ def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega)
             assert frf.element(name)["rms"][i] == pytest.approx(exact_rms, rel=1e-3), (name, w)
         assert bool(frf.stable[i]) == orbit.stable, w
         checked += 1
-    assert checked >= 8
+    assert checked >= 6
