@@ -6,6 +6,7 @@ Jacobian. Here the work between the two FFTs is done in two compiled loops, with
 floating-point operations in the same order as the array code of ``_residual`` (elementwise
 products and sums only), so the results are identical to the last bit:
 
+* :func:`fill_spectrum` — the spectrum of the deflection series for the inverse FFT;
 * :func:`force_samples` — f(δ_j) and f'(δ_j) of the samples (the stage by ``searchsorted``'s rule);
 * :func:`residual_jacobian` — R, ∂R/∂q (the Toeplitz + Hankel product of the slope spectrum,
   gathered from the same tables, plus the linear part) and ∂R/∂Ω from the two spectra.
@@ -76,11 +77,15 @@ def _force_samples(delta, bp, slopes, offsets, out):
         out[0, i] = g * d + offsets[j]
 
 
-def _residual_jacobian(q, w, period, G, c, K, has_K, b, wq, forcing, X, j1, j2, R, Rq, Rw):
-    """R, ∂R/∂q, ∂R/∂Ω of the single equation from ``G`` (2, 2H+1) the force and slope spectra
-    divided by the sample count (see ``HarmonicBalance.residual_jacobian``: the same operations
-    in the same order)."""
+def _residual_jacobian(q, w, period, spec, n, c, K, has_K, b, wq, forcing, X, j1, j2):
+    """R, ∂R/∂q, ∂R/∂Ω of the single equation from ``spec`` (2, ≥ 2H+1) the force and slope
+    spectra of n samples (see ``HarmonicBalance.residual_jacobian``: the same operations in the
+    same order; numpy divides a complex array by n as a product with 1/n)."""
     S = q.size
+    R = np.empty(S)
+    Rq = np.empty((S, S))
+    Rw = np.empty(S)
+    inv = 1.0 / n
     H = (S - 1) // 2
     off = 2 * H
     L = 4 * H + 1
@@ -104,16 +109,16 @@ def _residual_jacobian(q, w, period, G, c, K, has_K, b, wq, forcing, X, j1, j2, 
         for i in range(S):
             R[i] += K * q[i]
     # Element force b Γ*[f]: coefficients of the force spectrum.
-    R[0] += b * G[0, 0].real
+    R[0] += b * (spec[0, 0].real * inv)
     for i in range(H):
-        R[1 + i] += b * (G[0, 1 + i].real * 2.0)
-        R[1 + H + i] += b * (G[0, 1 + i].imag * -2.0)
+        R[1 + i] += b * ((spec[0, 1 + i].real * inv) * 2.0)
+        R[1 + H + i] += b * ((spec[0, 1 + i].imag * inv) * -2.0)
     for i in range(S):
         R[i] -= forcing[i]
     # Jacobian of the element: J = Γ* diag(f') Γ from the slope spectrum G (tables of _residual).
     for m in range(S):
-        gr = G[1, m].real
-        gi = G[1, m].imag
+        gr = spec[1, m].real * inv
+        gi = spec[1, m].imag * inv
         X[off + m] = gr
         X[L + off + m] = gi
         if m > 0:
@@ -137,13 +142,25 @@ def _residual_jacobian(q, w, period, G, c, K, has_K, b, wq, forcing, X, j1, j2, 
         ckw = c * kw
         Rq[1 + i, 1 + H + i] += ckw
         Rq[1 + H + i, 1 + i] += -ckw
+    return R, Rq, Rw
+
+
+def _fill_spectrum(D, n, spec):
+    """spec[0] = the one-sided spectrum n·(a_0, (a_k − i b_k)/2) of the series D, as
+    ``HarmonicBalance._synthesize_elements`` writes it (harmonics above H are left as they are)."""
+    H = (D.size - 1) // 2
+    spec[0, 0] = complex(D[0] * n, spec[0, 0].imag)
+    half = 0.5 * n
+    for i in range(H):
+        spec[0, 1 + i] = complex(D[1 + i] * half, D[1 + H + i] * -half)
 
 
 if AVAILABLE:
     _jit = numba.njit(cache=True, error_model="numpy", nogil=True)
     force_samples = _jit(_force_samples)
     residual_jacobian = _jit(_residual_jacobian)
+    fill_spectrum = _jit(_fill_spectrum)
 else:  # pragma: no cover
-    force_samples = residual_jacobian = None
+    force_samples = residual_jacobian = fill_spectrum = None
 
-__all__ = ["AVAILABLE", "rfft", "irfft", "force_samples", "residual_jacobian"]
+__all__ = ["AVAILABLE", "rfft", "irfft", "fill_spectrum", "force_samples", "residual_jacobian"]

@@ -434,23 +434,18 @@ class HarmonicBalance:
     def _residual_jacobian_compiled(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """:meth:`residual_jacobian` of one coordinate and one element: the samples and spectra by
         the FFTs into buffers, the rest in the compiled kernels (``_kernels``), bit-identical."""
-        H, N, S = self.basis.harmonics, self.basis.samples, self._S
+        N = self.basis.samples
         q = np.ascontiguousarray(q, dtype=float)
         D = self.element_series(q)
-        re, im = self._synth_re, self._synth_im
-        np.multiply(D[:, :1], N, out=re[:, :1])
-        np.multiply(D[:, 1 : H + 1], 0.5 * N, out=re[:, 1 : H + 1])
-        np.multiply(D[:, H + 1 :], -0.5 * N, out=im[:, 1 : H + 1])
+        _kernels.fill_spectrum(np.ascontiguousarray(D[0]), N, self._synth)
         _kernels.irfft(self._synth, self._delta)
         bp, sl, off = self._laws[0]
         _kernels.force_samples(self._delta[0], bp, sl, off, self._fg)
-        G = _kernels.rfft(self._fg, self._spec)[:, :S] / N
-        R, Rq, Rw = np.empty(S), np.empty((S, S)), np.empty(S)
+        _kernels.rfft(self._fg, self._spec)
         c, K, has_K, b, wq = self._kernel_scalars
         X, j1, j2 = self._kernel_tables
-        _kernels.residual_jacobian(q, omega / self.period, float(self.period), G, c, K, has_K, b, wq, self.forcing,
-                                   X, j1, j2, R, Rq, Rw)
-        return R, Rq, Rw
+        return _kernels.residual_jacobian(q, omega / self.period, float(self.period), self._spec, N, c, K, has_K, b, wq,
+                                          self.forcing, X, j1, j2)
 
     # --- Newton steps: full or condensed onto the element deflections ---------------------------
     def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
