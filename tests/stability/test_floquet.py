@@ -188,3 +188,25 @@ def test_single_equation_reading_matches_the_general_one(reference_frf):
         slopes = (floquet_test_functions(mon.monodromy(q + 1e-7 * d, w + 1e-10)) - psi) / 1e-7
         np.testing.assert_allclose(reading.slopes, slopes, rtol=1e-6, atol=1e-8)
         assert reading.distance == pytest.approx(critical_distance(multipliers_from_monodromy(M)), rel=1e-12, abs=1e-14)
+
+
+def test_frequency_response_without_the_compiled_kernels_is_the_same(monkeypatch):
+    """Without numba (hb._kernels and stability._kernels unavailable) the array code gives the
+    same branch and special points (the compiled kernels are accelerators, not a second method)."""
+    from rattle import reference_case
+    from rattle.hb import _kernels as hb_kernels
+    from rattle.stability import _kernels as st_kernels
+
+    if not (hb_kernels.AVAILABLE and st_kernels.AVAILABLE):
+        pytest.skip("numba not installed: only the array code runs")
+    model = reference_case()
+    compiled = frequency_response(model, omega=(0.3, 1.5), harmonics=12)
+    monkeypatch.setattr(hb_kernels, "AVAILABLE", False)
+    monkeypatch.setattr(st_kernels, "AVAILABLE", False)
+    array = frequency_response(model, omega=(0.3, 1.5), harmonics=12)
+    assert len(compiled.special_points) >= 2
+    assert [s.kind for s in compiled.special_points] == [s.kind for s in array.special_points]
+    # Round-off in the monodromy moves the continuation's steps by ~1e-14; the located points
+    # are roots of the test functions, the same to the locator's tolerance.
+    np.testing.assert_allclose([s.omega for s in compiled.special_points], [s.omega for s in array.special_points],
+                               rtol=0, atol=1e-9)
