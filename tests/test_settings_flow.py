@@ -12,7 +12,7 @@ import pytest
 
 import rattle
 from rattle import ContinuationOptions, HBOptions, NewtonOptions
-from rattle.analysis import _frequency_response as frf_module
+from rattle.analysis import _assemble as frf_module
 from rattle.analysis import _orbit as orbit_module
 from rattle.analysis import adaptive_frequency_response
 from rattle.continuation import ContinuationStepper

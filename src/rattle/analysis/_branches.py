@@ -23,6 +23,7 @@ from ..model import Model
 from ..results import FrequencyResponse
 from ..stability import FloquetMonitor
 from ..timeint import ExactIntegrator
+from ._assemble import assemble
 from ._settings import RunSettings
 
 
@@ -139,8 +140,6 @@ def period_doubling_branches(
     period-doubling point ends exactly there, and that point is not switched at again.
     ``run`` (the parent run's settings) goes unchanged to every branch; each branch's
     ``settings`` records what it used."""
-    from ._frequency_response import assemble
-
     run = _run(run, primary.harmonics, continuation, newton)
     model = primary.model
     out: list[FrequencyResponse] = []
@@ -212,8 +211,6 @@ def branch_from_seed(
     both ways in Ω, joined into one branch. An isola is closed once (the run stops when it comes
     back to the seed). None if the seed does not converge. ``run``: the run's settings (HB
     options scaled to ``harmonics``, Newton, continuation, stability method)."""
-    from ._frequency_response import assemble
-
     run = _run(run, harmonics, continuation, newton)
     newton = run.newton
     hb_opts = run.for_harmonics(harmonics)
