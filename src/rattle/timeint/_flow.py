@@ -341,12 +341,13 @@ class SystemIntegrator:
         self.samples_per_scale = int(samples_per_scale)
         self.max_segments = int(max_segments)
         self._cache: tuple[float, SystemStages] | None = None
+        self._modal: dict = {}  # stage combination -> its Ω-independent modal form (SystemStages)
 
     def stages(self, omega: float) -> SystemStages:
         """The stage solutions at forcing frequency ``omega`` (the last one is cached)."""
         if self._cache is not None and self._cache[0] == omega:
             return self._cache[1]
-        flow = SystemStages(self.system, omega, self.samples_per_scale)
+        flow = SystemStages(self.system, omega, self.samples_per_scale, modal_cache=self._modal)
         self._cache = (float(omega), flow)
         return flow
 

@@ -95,6 +95,10 @@ def _taylor_expm(T: np.ndarray, tau: float) -> np.ndarray:
     return out
 
 
+#: What :meth:`StageSolution._block_modal_form` computes (Ω-independent; kept across Ω).
+_MODAL_FIELDS = ("method", "clusters", "sdim", "lam", "P", "Pinv", "Pz", "Pd", "Pz_modal", "Pd_modal", "Pinv_z")
+
+
 class SystemStages:
     """Forcing data of ``system`` at forcing frequency ``omega`` and the cache of its stage
     solutions (:meth:`solution`).
@@ -102,9 +106,14 @@ class SystemStages:
     ``samples_per_scale`` grid points per stage time scale bracket the crossings.
     """
 
-    def __init__(self, system: System, omega: float, samples_per_scale: int = 40) -> None:
+    def __init__(self, system: System, omega: float, samples_per_scale: int = 40,
+                 modal_cache: dict | None = None) -> None:
         self.system = system
         self.omega = float(omega)
+        # The stage matrices and their (block-)modal forms do not depend on Ω: an integrator
+        # keeps them across frequencies (``modal_cache``); only the harmonic particular
+        # solutions are made anew for each Ω.
+        self.modal_cache: dict = {} if modal_cache is None else modal_cache
         self.samples_per_scale = int(samples_per_scale)
         n, m = system.n, system.m
         self.n, self.m = n, m
@@ -213,7 +222,8 @@ class StageSolution:
         Abar[: 2 * n, : 2 * n] = A
         Abar[: 2 * n, 2 * n] = g
         self.Abar = Abar
-        lam = np.linalg.eigvals(A)
+        cached = flow.modal_cache.get(stages)
+        lam = np.linalg.eigvals(A) if cached is None else cached["eigenvalues"]
         self.eigenvalues = lam
         rho = float(np.max(np.abs(lam))) if lam.size else 0.0
 
@@ -251,11 +261,22 @@ class StageSolution:
         self.max_segment = _SEGMENT_SCALES * scale
 
         # Block-modal form of exp(Ā τ).
-        self.method = "modal"
-        try:
-            self._block_modal_form(Abar, rho, hw)
-        except (np.linalg.LinAlgError, ValueError):
-            self.method = "expm"
+        if cached is None:
+            self.method = "modal"
+            try:
+                self._block_modal_form(Abar, rho)
+            except (np.linalg.LinAlgError, ValueError):
+                self.method = "expm"
+            cached = {"eigenvalues": lam, "method": self.method}
+            if self.method == "modal":
+                cached.update({k: getattr(self, k) for k in _MODAL_FIELDS})
+            flow.modal_cache[stages] = cached
+        else:
+            for k, v in cached.items():
+                if k != "eigenvalues":
+                    setattr(self, k, v)
+        if self.method == "modal":
+            self.modes = np.concatenate((self.lam, 1j * hw))
         self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
         # A segment's mode amplitudes are coef[:, None] * base (coef: modal coordinates, then the
         # harmonics' phase factors at its start).
@@ -271,7 +292,7 @@ class StageSolution:
         self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
         self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
 
-    def _block_modal_form(self, Abar: np.ndarray, rho: float, hw: FloatArray) -> None:
+    def _block_modal_form(self, Abar: np.ndarray, rho: float) -> None:
         """Ā = P diag(μ_1 I + N_1, …, μ_c I + N_c, Λ) P⁻¹: clusters of eigenvalues closer than
         1e-4 ρ to each other (zero modes, critical damping; possibly defective) keep a block each
         (an orthonormal basis of their invariant subspace from a sorted Schur form), the others
@@ -330,7 +351,6 @@ class StageSolution:
         self.Pz = P[:n2]
         self.Pd = self.flow.G @ self.Pz
         self.Pz_modal, self.Pd_modal = self.Pz[:, sdim:], self.Pd[:, sdim:]
-        self.modes = np.concatenate((self.lam, 1j * hw))
         self.Pinv_z = Pinv[:, :n2]
 
     # --- pieces ---------------------------------------------------------------------------------
