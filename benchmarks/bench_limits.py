@@ -29,11 +29,12 @@ print(f"{{len(frf)}} {{dt:.2f}} {{resource.getrusage(resource.RUSAGE_SELF).ru_ma
 
 _STEADY = """
 import time, numpy as np, rattle
-from rattle.timeint import ExactIntegrator, SteadyStateOptions
-from rattle.timeint._steady import _Settler  # below the bound, steady_state() refuses: run the settler
+from rattle.analysis._steady import SteadyStateOptions, _ModelFlow, _Settler
+from rattle.timeint import ExactIntegrator
 m = rattle.reference_case()
 t = time.perf_counter()
-s = _Settler(m, {W}, np.zeros(2), SteadyStateOptions(), ExactIntegrator(m)).run()
+# below the bound, steady_state() refuses: run the settler
+s = _Settler(_ModelFlow(m, ExactIntegrator(m), {W}), {W}, np.zeros(2), SteadyStateOptions(), ()).run()
 print(f"{{s.period}} {{time.perf_counter() - t:.2f}}")
 """
 

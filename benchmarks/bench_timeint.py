@@ -46,7 +46,8 @@ from scipy.integrate import solve_ivp, trapezoid
 
 import rattle
 from rattle.analysis import time_sweep
-from rattle.timeint import ExactIntegrator, SteadyStateOptions, integrate_general, shoot_periodic_orbit, steady_state
+from rattle.analysis import SteadyStateOptions, steady_state
+from rattle.timeint import ExactIntegrator, integrate_general, shoot_periodic_orbit
 from rattle.timeint._shooting import _state_scale
 
 RTOL, ATOL = 1e-8, 1e-10

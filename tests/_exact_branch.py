@@ -96,7 +96,8 @@ import numpy as np
 import scipy.optimize
 
 from rattle.model import Model
-from rattle.timeint import ExactIntegrator, SystemIntegrator, shoot_periodic_orbit, shoot_system_orbit, steady_state
+from rattle.analysis import steady_state
+from rattle.timeint import ExactIntegrator, SystemIntegrator, shoot_periodic_orbit, shoot_system_orbit
 
 KINDS = ("fold", "period_doubling", "neimark_sacker")
 

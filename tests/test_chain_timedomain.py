@@ -15,7 +15,8 @@ from rattle.analysis import frequency_response, periodic_orbit, time_sweep
 from rattle.analysis._tori import confirm_tori, section_curve
 from rattle.model import Chain, Clutch, reference_case
 from rattle.model._stage_matrix import stage_transition
-from rattle.timeint import SteadyStateOptions, SystemIntegrator, steady_state
+from rattle.analysis import SteadyStateOptions, steady_state
+from rattle.timeint import SystemIntegrator
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

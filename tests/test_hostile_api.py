@@ -25,7 +25,7 @@ from rattle import (
 from rattle import _limits
 from rattle.analysis._harmonics import adaptive_frequency_response, truncation_error
 from rattle.io import config_from_dict, load_config
-from rattle.timeint import steady_state
+from rattle.analysis import steady_state
 from _cases import clutch_toml  # tests/_cases.py (tests/ is on sys.path through its conftest)
 
 if sys.version_info >= (3, 11):

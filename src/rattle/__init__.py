@@ -36,7 +36,11 @@ def _version() -> str:
 
 #: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
 _LAZY: dict[str, str] = {
-    **dict.fromkeys(["compare", "frequency_response", "load_case", "periodic_orbit", "time_sweep"], ".analysis"),
+    **dict.fromkeys(
+        ["SteadyStateOptions", "compare", "frequency_response", "load_case", "periodic_orbit", "steady_state",
+         "time_sweep"],
+        ".analysis",
+    ),
     **dict.fromkeys(
         ["ContinuationOptions", "ContinuationProblem", "ContinuationStepper", "NewtonOptions"], ".continuation"
     ),
@@ -54,9 +58,7 @@ _LAZY: dict[str, str] = {
     ),
     **dict.fromkeys(["Hill", "Monodromy"], ".stability"),
     **dict.fromkeys(
-        ["ExactIntegrator", "ShootingProblem", "SteadyStateOptions", "SystemIntegrator", "shoot_periodic_orbit",
-         "steady_state"],
-        ".timeint",
+        ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
     ),
 }
 
@@ -105,7 +107,9 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     __version__: str
-    from .analysis import compare, frequency_response, load_case, periodic_orbit, time_sweep
+    from .analysis import (
+        SteadyStateOptions, compare, frequency_response, load_case, periodic_orbit, steady_state, time_sweep,
+    )
     from .continuation import ContinuationOptions, ContinuationProblem, ContinuationStepper, NewtonOptions
     from .errors import ConfigError, ConvergenceError, RattleError, Status
     from .hb import HarmonicBalance, HBOptions
@@ -118,6 +122,4 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
         SweepResult, linear_frequency_response,
     )
     from .stability import Hill, Monodromy
-    from .timeint import (
-        ExactIntegrator, ShootingProblem, SteadyStateOptions, SystemIntegrator, shoot_periodic_orbit, steady_state,
-    )
+    from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit

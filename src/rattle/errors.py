@@ -37,7 +37,9 @@ class Status(enum.Enum):
     ``RETURNED``, ``STOPPED`` (complete), ``MAX_STEPS``, ``MAX_TIME``, ``STEP_TOO_SMALL`` or
     ``START_FAILED``; a Newton solve at a fixed parameter
     (:class:`~rattle.continuation.NewtonResult`) with ``CONVERGED`` (complete), ``SINGULAR``,
-    ``NON_FINITE`` or ``MAX_ITERATIONS``.
+    ``NON_FINITE`` or ``MAX_ITERATIONS``; a simulated steady state
+    (:class:`~rattle.results.SteadyState`) with ``CONVERGED`` (the orbit polished by Newton
+    shooting), ``SETTLED`` (complete) or ``MAX_PERIODS`` (nothing periodic found: period 0).
     """
 
     SUCCESS = "the branch was followed across the whole frequency range"
@@ -51,6 +53,8 @@ class Status(enum.Enum):
     SINGULAR = "singular Jacobian"
     NON_FINITE = "the residual became non-finite"
     MAX_ITERATIONS = "maximum iterations reached"
+    SETTLED = "the simulation settled on a periodic motion"
+    MAX_PERIODS = "no periodic motion settled within the maximum number of forcing periods"
 
     @property
     def message(self) -> str:
@@ -61,7 +65,7 @@ class Status(enum.Enum):
         return self in _COMPLETE
 
 
-_COMPLETE = frozenset({Status.SUCCESS, Status.RETURNED, Status.STOPPED, Status.CONVERGED})
+_COMPLETE = frozenset({Status.SUCCESS, Status.RETURNED, Status.STOPPED, Status.CONVERGED, Status.SETTLED})
 
 
 __all__ = ["RattleError", "ConfigError", "ConvergenceError", "Status"]

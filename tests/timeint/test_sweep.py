@@ -15,7 +15,8 @@ from rattle.io import read_csv
 from rattle.results import SWEEP_COLUMNS
 from rattle.model import reference_case
 from rattle.results import SweepResult
-from rattle.timeint import SteadyStateOptions, shoot_periodic_orbit
+from rattle.analysis import SteadyStateOptions
+from rattle.timeint import shoot_periodic_orbit
 
 # The exact fold of the primary resonance's lower branch (shooting: the small orbit exists at
 # Ω = 0.7540 and not at 0.7530).
@@ -184,6 +185,7 @@ def test_result_columns_csv_and_metadata(jump_sweep, tmp_path):
     assert "SweepResult(" in repr(r) and "jumps at" in repr(r)
     assert r.final_state.shape == (160, 2) and r.multipliers.shape == (160, 2)
     assert r.settled.all() and set(r.method) <= {"shooting", "simulation"}
+    assert all(st.success for st in r.status) and set(r.status) <= {rattle.Status.CONVERGED, rattle.Status.SETTLED}
     with pytest.raises(ValueError, match="`direction`"):
         r.select("both")
     with pytest.raises(ValueError, match="`threshold`"):

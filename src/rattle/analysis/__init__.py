@@ -6,9 +6,11 @@ from ._frequency_response import assemble, frequency_response, start_solution
 from ._harmonics import adaptive_frequency_response, truncation_error
 from ._orbit import periodic_orbit
 from ._regimes import confirm_with_sweep, label_regions
+from ._steady import SteadyStateOptions, steady_state
 from ._time_sweep import time_sweep
 
 __all__ = [
     "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare",
+    "steady_state", "SteadyStateOptions",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
 ]

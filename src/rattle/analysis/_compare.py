@@ -33,14 +33,13 @@ from .. import _limits, _validate
 from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
 from ..model import Model, check_analysable_model
-from ..results import Comparison, FrequencyResponse, PeriodicOrbit, SweepResult
-from ..timeint import SteadyState, SteadyStateOptions, steady_state
-from ..timeint._steady import make_integrator
+from ..results import Comparison, FrequencyResponse, PeriodicOrbit, SteadyState, SweepResult
 from ._frequency_response import frequency_response
 from ._frequency_response import check_range
 from ._orbit import MAX_PERIOD, periodic_orbit
 from ._regimes import confirm_with_sweep
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
+from ._steady import SteadyStateOptions, make_integrator, steady_state
 from ._time_sweep import time_sweep
 
 #: Automatic picks: the up/down sweeps must differ by this fraction of the largest rms for the

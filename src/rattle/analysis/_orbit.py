@@ -46,14 +46,15 @@ from ..measures import measures_batch, synthesize_batch, system_measures_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
+from ..results._steady import SteadyState
 from ..stability import (
     UNIT_CIRCLE_TOL, FloquetMonitor, Hill, hill_multipliers, monodromy_batch, multipliers_from_monodromy,
 )
 from ..timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
 from ..timeint._flow import check_system_state
-from ..timeint._steady import SteadyState, SteadyStateOptions, make_integrator, steady_state
 from ._frequency_response import check_range, frequency_response
 from ._settings import DEFAULT_HARMONICS, StabilityMethod, check_stability, resolve_hb
+from ._steady import SteadyStateOptions, make_integrator, steady_state
 
 logger = logging.getLogger("rattle")
 

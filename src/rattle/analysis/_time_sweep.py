@@ -4,7 +4,7 @@ At N equally spaced forcing frequencies Ω_1 < … < Ω_N (up) or Ω_N > … > �
 
     δ'' + c δ' + k f(δ) = F_m + Σ_n F_pn cos(n Ω t + φ_n)
 
-is simulated to its steady state (:func:`rattle.timeint.steady_state`), each frequency starting
+is simulated to its steady state (:func:`rattle.analysis.steady_state`), each frequency starting
 from the state the previous one ended in (on the Poincaré section, forcing phase 0), the first
 from the static equilibrium at rest. Where several stable motions coexist the sweep therefore
 follows the one it is on until it disappears, and jumps there: the up sweep of a softening
@@ -31,10 +31,9 @@ from ..errors import RattleError
 from ..model import Model, check_analysable_model
 from ..results._sweep import SweepResult
 from ..results._sweep import SWEEP_ELEMENT_COLUMNS
-from ..timeint import SteadyStateOptions, steady_state
-from ..timeint._steady import make_integrator, static_state
 
 from ._frequency_response import check_range
+from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state
 
 logger = logging.getLogger("rattle")
 
@@ -277,7 +276,7 @@ def time_sweep(
     At ``points`` equally spaced frequencies the equation
     δ'' + c δ' + k f(δ) = F_m + Σ_n F_pn cos(n Ω t + φ_n) is simulated exactly until its
     steady state (period 1 … 8 of the forcing period, or 0 when none settles; see
-    :func:`rattle.timeint.steady_state`), the state carried from each frequency to the next as in
+    :func:`rattle.analysis.steady_state`), the state carried from each frequency to the next as in
     a rig run-up (``up``) or run-down (``down``). Each direction starts from the static
     equilibrium at rest; ``both`` runs the up sweep, then the down sweep.
 

@@ -10,7 +10,7 @@ coexisting stable orbit, a locked period-n orbit on the torus, chaos).
 :func:`confirm_tori` answers it with one simulation per region: at the branch row nearest the
 middle of the interval the unstable orbit is closed by exact shooting (z*, its monodromy M),
 the state is perturbed by 10⁻³ of the length scale along the unstable complex eigenvector and
-simulated to its steady state (:func:`rattle.timeint.steady_state`, with a long recorded
+simulated to its steady state (:func:`rattle.analysis.steady_state`, with a long recorded
 window). The Poincaré points of an unsettled motion (period 0) are then examined
 (:func:`section_curve`): projected on the plane of the unstable eigenvector pair about z*, a
 torus shows as points that wind around z* in one sense with a steady angle step and lie on one
@@ -30,10 +30,9 @@ import numpy as np
 from .._typing import FloatArray
 from ..results import FrequencyResponse
 from ..results._frequency_response import Region
-from ..timeint import SteadyStateOptions, steady_state
 from ..timeint._shooting import _newton_shooting, _state_scale
-from ..timeint._steady import make_integrator
 from ..timeint._system_shooting import _newton_system, system_state_scale
+from ._steady import SteadyStateOptions, make_integrator, steady_state
 
 #: Settling options of the confirmation run: 600 periods to settle (the unstable orbit is left in
 #: tens of periods), a long recorded window (the

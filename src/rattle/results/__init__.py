@@ -9,10 +9,11 @@ from ._columns import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 from ._comparison import Comparison
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._orbit import OrbitSolution, PeriodicOrbit
+from ._steady import SteadyState
 from ._sweep import SweepResult
 
 __all__ = [
     "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
-    "SweepResult", "PeriodicOrbit", "OrbitSolution", "Comparison",
+    "SweepResult", "SteadyState", "PeriodicOrbit", "OrbitSolution", "Comparison",
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
 ]

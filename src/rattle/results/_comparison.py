@@ -13,7 +13,7 @@ from ._orbit import PeriodicOrbit
 from ._sweep import SweepResult
 
 if TYPE_CHECKING:  # annotations only
-    from ..timeint import SteadyState
+    from ._steady import SteadyState
 
 __all__ = ["Comparison"]
 

@@ -16,7 +16,7 @@ from ..measures import acceleration_batch, element_accelerations, evaluate_batch
 from ..model import Model
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..timeint._steady import SteadyState
+    from ._steady import SteadyState
 
 #: Where a harmonic-balance solution came from (``OrbitSolution.source``).
 ORBIT_SOURCES: tuple[str, ...] = ("continuation", "simulation", "subharmonic_branch")

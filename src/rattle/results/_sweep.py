@@ -10,6 +10,7 @@ import numpy as np
 
 from .._typing import BoolArray, ComplexArray, FloatArray, IntArray
 from ._columns import SWEEP_COLUMNS
+from ._steady import METHOD_STATUS
 from ..model import Model
 
 #: Per-element columns of a chain's ``sweep.csv``: ``NAME_`` + each of these (the measures of
@@ -51,7 +52,8 @@ class SweepResult:
     ``down``), ``omega`` (rad/s), ``mean``, ``rms``, ``rms_ac``, ``p2p`` (rad), ``acc_p2p``
     (rad/s²), ``period`` (multiple of the forcing period, 0 when none up to the detection limit
     was found). Also ``delta_min``, ``delta_max`` (rad), ``settled`` (bool), ``method``
-    (``shooting``/``simulation``/``unsettled``), ``periods`` and ``shooting_periods`` (forcing
+    (``shooting``/``simulation``/``unsettled``; ``status`` the same as :class:`~rattle.errors.Status`
+    values, as ``SteadyState.status``), ``periods`` and ``shooting_periods`` (forcing
     periods simulated and integrated by Newton shooting: the effort), ``state0`` (P, 2) the
     orbit's state on the Poincaré section, ``final_state`` (P, 2) the state carried to the next
     frequency, ``multipliers`` (P, 2) complex Floquet multipliers (NaN for period 0), and the
@@ -93,6 +95,13 @@ class SweepResult:
     def __getitem__(self, index: int) -> dict[str, Any]:
         """Row ``index`` as a dict of the SPEC columns."""
         return {name: getattr(self, name)[index] for name in SWEEP_COLUMNS}
+
+    @property
+    def status(self) -> np.ndarray:
+        """How each row's steady state ended: an object array of :class:`~rattle.errors.Status`
+        (``CONVERGED``, ``SETTLED`` or ``MAX_PERIODS``, as ``SteadyState.status``), read from
+        ``method``."""
+        return np.array([METHOD_STATUS[str(m)] for m in self.method], dtype=object)
 
     @property
     def directions(self) -> tuple[str, ...]:

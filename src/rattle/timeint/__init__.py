@@ -1,18 +1,41 @@
-"""Time integration: exact piecewise-linear integration, a general event-located integrator,
-periodic orbits by shooting and the steady state of a simulation with period detection."""
+"""Time integration: exact piecewise-linear integration, a general event-located integrator and
+periodic orbits by shooting — the numerical methods and their raw solution objects
+(:class:`Trajectory`, :class:`SystemTrajectory`, :class:`ShootingOrbit`, :class:`SystemOrbit`).
+
+The steady state of a simulation with period detection is an analysis built on these:
+:func:`rattle.analysis.steady_state`, returning a :class:`rattle.results.SteadyState`.
+"""
+
+from typing import Any
 
 from ._exact import ExactIntegrator, ExactMeasures, StageSolutions, StateSamples, Trajectory
 from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory
 from ._general import GeneralSolution, integrate_general
 from ._shooting import ShootingOrbit, shoot_periodic_orbit
 from ._shooting_problem import ShootingProblem
-from ._steady import SteadyState, SteadyStateOptions, steady_state
 from ._system_shooting import SystemOrbit, shoot_system_orbit
 
 __all__ = [
     "ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
     "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem",
     "integrate_general", "GeneralSolution",
-    "SteadyStateOptions", "SteadyState", "steady_state",
     "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
 ]
+
+#: Names that moved out of ``rattle.timeint`` (the steady state is an analysis, its result a
+#: result). Still served here, with a DeprecationWarning; imported when asked for, so that
+#: nothing here depends on the layers above.
+_MOVED: dict[str, str] = {
+    "steady_state": "rattle.analysis", "SteadyStateOptions": "rattle.analysis", "SteadyState": "rattle.results",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _MOVED:
+        import importlib
+        import warnings
+
+        warnings.warn(f"`rattle.timeint.{name}` is deprecated; import it from {_MOVED[name]}", DeprecationWarning,
+                      stacklevel=2)
+        return getattr(importlib.import_module(_MOVED[name]), name)
+    raise AttributeError(f"module 'rattle.timeint' has no attribute {name!r}")

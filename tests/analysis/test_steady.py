@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 from scipy.integrate import trapezoid
 
+from rattle.analysis import SteadyStateOptions, steady_state
+from rattle.errors import Status
 from rattle.model import Backlash, Excitation, Linear, Model, reference_case
-from rattle.timeint import (
-    ExactIntegrator, SteadyState, SteadyStateOptions, shoot_periodic_orbit, steady_state,
-)
+from rattle.results import SteadyState
+from rattle.timeint import ExactIntegrator, shoot_periodic_orbit
 
 PLAIN = SteadyStateOptions(accelerate=False)
 
@@ -43,6 +44,7 @@ def test_linear_law_settles_on_the_closed_form_orbit(accelerate):
     assert isinstance(s, SteadyState)
     assert s.period == 1 and s.settled
     assert s.method == ("shooting" if accelerate else "simulation")
+    assert s.status is (Status.CONVERGED if accelerate else Status.SETTLED) and s.status.success
     mean = 0.3 / model.k
     rms_ac = math.sqrt(0.5 * np.sum(np.abs(X) ** 2))
     # accelerated: the exact orbit (round-off); plain: within the settling tolerance 1e-8 · L.
@@ -162,6 +164,7 @@ def test_chaotic_motion_is_period_zero():
     opts = SteadyStateOptions(max_periods=300, record_periods=40)
     s = steady_state(model, 1.2, _rest(model), options=opts)
     assert s.period == 0 and not s.settled and s.method == "unsettled"
+    assert s.status is Status.MAX_PERIODS and not s.status.success
     assert s.multipliers is None and s.stable is None
     assert s.cycle.shape == (0, 2)
     assert s.periods == 300 + 40
@@ -227,3 +230,19 @@ def test_arguments_are_checked():
         steady_state(model, 1.0, (0.0, 0.0), options={"tolerance": 1e-6})
     with pytest.raises(TypeError):
         steady_state(model, 1.0, (0.0, 0.0), tolerance=1e-6)  # unknown keyword
+
+
+def test_the_old_timeint_names_answer_with_a_deprecation_warning():
+    """The steady state moved from ``rattle.timeint`` to ``rattle.analysis`` (its result to
+    ``rattle.results``); the old names still answer, with a warning naming the new place."""
+    import rattle.results
+    import rattle.timeint
+
+    for name, where in (("steady_state", "rattle.analysis"), ("SteadyStateOptions", "rattle.analysis"),
+                        ("SteadyState", "rattle.results")):
+        with pytest.warns(DeprecationWarning, match=f"`rattle.timeint.{name}` is deprecated; import it from {where}"):
+            old = getattr(rattle.timeint, name)
+        assert old is getattr(rattle.analysis if where == "rattle.analysis" else rattle.results, name)
+        assert name not in rattle.timeint.__all__
+    with pytest.raises(AttributeError, match="no attribute 'steady'"):
+        rattle.timeint.steady  # noqa: B018

@@ -1,6 +1,9 @@
 """Steady state of δ'' + c δ' + k f(δ) = F(t) — or of a chain's System, x'' + C x' + K x +
 Σ b_e f_e(a_e·x) = F(t) — by simulation, with period detection (1 … 8).
 
+An analysis on top of :mod:`rattle.timeint`: it runs the exact integrators and Newton shooting
+there and returns a :class:`~rattle.results.SteadyState` (whose ``status`` tells how it ended).
+
 One settling loop serves both: the single equation runs on :class:`ExactIntegrator` (state
 (δ, δ'), its fast scalar path), a chain on :class:`SystemIntegrator` (state z = (x, x') of its
 n coordinates; the scaled norm below then takes every coordinate by the System's length scale
@@ -54,18 +57,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _limits
-from .._typing import ComplexArray, FloatArray
+from .._typing import FloatArray
 from .._validate import check_int, check_state, numerical_failures
+from ..errors import Status
 from ..model import Chain, Model, System, check_analysable_model
-from ._exact import ExactIntegrator, ExactMeasures, Trajectory
-from ._flow import (
-    SystemIntegrator,
-    SystemMeasures,
-    SystemTrajectory,
-    check_system_state,
-)
-from ._shooting import _newton_shooting, _Shot, _state_scale
-from ._system_shooting import _newton_system, _SystemShot, system_state_scale
+from ..results._steady import METHODS, SteadyState
+from ..timeint import ExactIntegrator, SystemIntegrator, SystemTrajectory, Trajectory
+from ..timeint._flow import check_system_state
+from ..timeint._shooting import _newton_shooting, _Shot, _state_scale
+from ..timeint._system_shooting import _newton_system, _SystemShot, system_state_scale
 
 _TWO_PI = 2.0 * math.pi
 _LINEAR_CHECK = 0.1  # relative mismatch allowed between the simulation and the linearisation
@@ -75,13 +75,6 @@ _MAX_WAIT = 128  # longest wait (forcing periods) between two acceleration attem
 # Step halvings per Newton iteration: an attempt from too far away should fail cheaply (the
 # simulation goes on and a later attempt starts closer).
 _MAX_HALVINGS = 3
-
-METHODS: dict[str, str] = {
-    "shooting": "a stable periodic orbit approached by the simulation, polished by Newton shooting",
-    "simulation": "the Poincaré sequence of the plain simulation settled to the tolerance",
-    "unsettled": "nothing settled within `max_periods` forcing periods (period 0)",
-}
-
 
 def _check_positive(name: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -168,144 +161,6 @@ class SteadyStateOptions:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
 
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class SteadyState:
-    """The steady motion reached from an initial state at one forcing frequency.
-
-    Attributes
-    ----------
-    omega : float
-        Forcing frequency Ω (rad/s).
-    period : int
-        Period of the motion as a multiple of the forcing period 2π/Ω (1 … ``max_period_multiple``),
-        0 when none was found (quasi-periodic, chaotic or longer).
-    settled : bool
-        True when a periodic motion was found (period ≥ 1).
-    method : str
-        ``shooting``, ``simulation`` or ``unsettled`` (see :data:`METHODS`).
-    periods : int
-        Forcing periods simulated (settling, checks and, for period 0, the record).
-    shooting_periods : int
-        Forcing periods integrated inside the Newton shooting solves.
-    state0 : ndarray, shape (2,) or (2n,)
-        (δ, δ') (rad, rad/s) at the start of ``trajectory``, on the Poincaré section (forcing
-        phase 0): for a periodic motion, a point of the orbit. A chain: (x, x') of its n
-        coordinates (likewise ``final_state``, ``cycle`` and ``poincare`` rows).
-    final_state : ndarray, shape (2,)
-        The state on the Poincaré section to carry to the next frequency of a sweep.
-    cycle : ndarray, shape (period, 2)
-        The orbit's section points x(m·2π/Ω), m = 0 … period − 1 (empty for period 0).
-    poincare : ndarray, shape (m, 2)
-        The latest Poincaré points of the simulation, oldest first (for period 0, those of the
-        recorded window).
-    trajectory : Trajectory or SystemTrajectory
-        Exact trajectory over one orbit period from ``state0`` (period·2π/Ω), or over the
-        ``record_periods`` window for period 0 (time starts at 0).
-    measures : ExactMeasures or SystemMeasures
-        SPEC §1 measures over ``trajectory`` (a chain: of every element; the flat properties
-        ``mean``, ``rms``, … are the first element's, ``element_measures`` all of them).
-    multipliers : ndarray, shape (2,) or (2n,), complex, or None
-        Floquet multipliers of the orbit (largest modulus first); None for period 0.
-    residual : float
-        Scaled shooting residual (``shooting``), settling distance d_n (``simulation``) or the
-        smallest d_n at the end (``unsettled``).
-    element_names : tuple of str
-        A chain's clearance elements, in order (empty for the single equation).
-    """
-
-    omega: float
-    period: int
-    settled: bool
-    method: str
-    periods: int
-    shooting_periods: int
-    state0: FloatArray
-    final_state: FloatArray
-    cycle: FloatArray
-    poincare: FloatArray
-    trajectory: Trajectory | SystemTrajectory
-    measures: ExactMeasures | SystemMeasures
-    multipliers: ComplexArray | None
-    residual: float
-    element_names: tuple[str, ...] = ()
-
-    # SPEC §1 measures, flat (a chain: of its first element)
-    def _first(self, name: str) -> float:
-        value = getattr(self.measures, name)
-        return float(value[0]) if isinstance(self.measures, SystemMeasures) else value
-
-    @property
-    def mean(self) -> float:
-        return self._first("mean")
-
-    @property
-    def rms(self) -> float:
-        return self._first("rms")
-
-    @property
-    def rms_ac(self) -> float:
-        return self._first("rms_ac")
-
-    @property
-    def p2p(self) -> float:
-        return self._first("p2p")
-
-    @property
-    def acc_p2p(self) -> float:
-        return self._first("acc_p2p")
-
-    @property
-    def delta_min(self) -> float:
-        return self._first("delta_min")
-
-    @property
-    def delta_max(self) -> float:
-        return self._first("delta_max")
-
-    @property
-    def element_measures(self) -> SystemMeasures:
-        """The measures of every clearance element (a chain's, in the order of
-        ``element_names``; for the single equation one element, δ, named ``delta``)."""
-        m = self.measures
-        if isinstance(m, SystemMeasures):
-            return m
-        return SystemMeasures(names=self.element_names or ("delta",), **{
-            k: np.array([getattr(m, k)]) for k in
-            ("mean", "rms", "rms_ac", "delta_min", "delta_max", "p2p", "acc_min", "acc_max", "acc_p2p")})
-
-    def element(self, which: int | str) -> dict[str, float]:
-        """The measures of one element (index or name) as a dict of floats."""
-        return self.element_measures.element(which)
-
-    @property
-    def stable(self) -> bool | None:
-        """True when every Floquet multiplier is inside the unit circle; None for period 0."""
-        if self.multipliers is None:
-            return None
-        return bool(np.all(np.abs(self.multipliers) < 1.0))
-
-    def regimes(self) -> tuple[str, ...]:
-        """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) of every element over
-        ``trajectory``."""
-        traj = self.trajectory
-        if isinstance(traj, SystemTrajectory):
-            m = traj.system.m
-            return tuple(_regime_of(traj.crossing_breakpoints[traj.crossing_elements == e]) for e in range(m))
-        return (_regime_of(traj.crossed_breakpoints),)
-
-    @property
-    def regime(self) -> str:
-        """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) over ``trajectory`` (a
-        chain: of its first element)."""
-        return self.regimes()[0]
-
-    def __repr__(self) -> str:
-        return (
-            f"SteadyState(Ω = {self.omega:.6g}, period {self.period}, {self.method}, "
-            f"rms {self.rms:.6g}, {self.periods} periods simulated + {self.shooting_periods} shooting)"
-        )
-
-
 # ---------------------------------------------------------------------------------------------
 # The flow being settled: one equation (ExactIntegrator, 2 states) or a System (2n states)
 # ---------------------------------------------------------------------------------------------
@@ -354,14 +209,6 @@ class _SystemFlow:
     def section(traj: SystemTrajectory, t: FloatArray) -> FloatArray:
         x, v = traj.derivatives(np.asarray(t, dtype=float), 1)
         return np.concatenate((x, v), axis=-1)
-
-
-def _regime_of(crossed: FloatArray) -> str:
-    if crossed.size == 0:
-        return "no_impact"
-    if np.all(crossed > 0.0) or np.all(crossed < 0.0):
-        return "single_sided"
-    return "double_sided"
 
 
 def _proper_divisors(n: int) -> list[int]:
@@ -517,7 +364,7 @@ class _Settler:
     def from_shot(self, shot: _Shot | _SystemShot, n: int) -> SteadyState:
         traj = shot.trajectory
         return SteadyState(
-            omega=self.omega, period=n, settled=True, method="shooting", periods=self.i,
+            omega=self.omega, period=n, status=Status.CONVERGED, periods=self.i,
             shooting_periods=self.shooting_periods, state0=shot.x.copy(), final_state=shot.x.copy(),
             cycle=self.cycle_points(shot, n), poincare=self.poincare(), trajectory=traj,
             measures=traj.measures(), multipliers=shot.multipliers(), residual=shot.residual,
@@ -532,7 +379,7 @@ class _Settler:
         mult = mult[np.argsort(-np.abs(mult), kind="stable")]
         cycle = x[None, :] if n == 1 else self.flow.section(traj, np.arange(n) * self.T)
         return SteadyState(
-            omega=self.omega, period=n, settled=True, method="simulation", periods=i + n,
+            omega=self.omega, period=n, status=Status.SETTLED, periods=i + n,
             shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
             cycle=cycle, poincare=self.poincare(), trajectory=traj, measures=traj.measures(),
             multipliers=mult, residual=float(np.max(self.d[i - n : i + 1, n])), element_names=self.names,
@@ -544,7 +391,7 @@ class _Settler:
         traj = self.flow.propagate(x, rec * self.T)
         section = self.flow.section(traj, np.arange(rec + 1) * self.T)[-self.opts.section_points :]
         return SteadyState(
-            omega=self.omega, period=0, settled=False, method="unsettled", periods=i + rec,
+            omega=self.omega, period=0, status=Status.MAX_PERIODS, periods=i + rec,
             shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
             cycle=np.empty((0, self.flow.dim)), poincare=section, trajectory=traj, measures=traj.measures(),
             multipliers=None, residual=float(np.min(self.d[i, 1:])), element_names=self.names,
