@@ -136,3 +136,14 @@ def test_front_end_argument_validation(kwargs, match):
 def test_unknown_keyword_raises():
     with pytest.raises(TypeError):
         frequency_response(reference_case(), omega=(0.1, 1.0), harmonic=8)  # type: ignore[call-arg]
+
+
+def test_frequency_response_stopped_by_a_failing_corrector_says_to_raise_the_harmonics(reference_model, monkeypatch):
+    from rattle.analysis import _frequency_response as frf_module
+
+    monkeypatch.setattr(frf_module, "HarmonicBalance", _NoSolutionAbove)
+    frf = frequency_response(reference_model, omega=(0.1, 3.0), harmonics=16, throw=False,
+                             continuation=ContinuationOptions(min_step=1e-4, max_step=0.05))
+    assert frf.status is Status.STEP_TOO_SMALL
+    assert "give more harmonics (e.g. 32)" in frf.message
+    assert frf.omega.max() <= 0.5  # what was computed is kept

@@ -281,9 +281,17 @@ def _frequency_response(
     t_cont = time.perf_counter()
     points = stepper.points
     status = stepper.status or Status.START_FAILED
-    logger.info("continuation: %d points, %s (%s)", len(points), status.name, stepper.message)
+    message = stepper.message
+    if status is Status.STEP_TOO_SMALL:
+        # Where the corrector fails even at the smallest step, the truncated problem usually has
+        # no solution there: an orbit through stiff stages (a gear mesh stiffer than the rest of
+        # the chain) needs more harmonics than the range's low end can be resolved with.
+        message += (f"; with {harmonics} harmonics the truncated problem may have no solution beyond this "
+                    f"point (impacts on a stiff stage need many harmonics): give more harmonics "
+                    f"(e.g. {min(2 * harmonics, _limits.MAX_HARMONICS)}) or start the range elsewhere")
+    logger.info("continuation: %d points, %s (%s)", len(points), status.name, message)
     result = assemble(
-        model, hb, points, stability=stability, newton=newton_opts, status=status, message=stepper.message,
+        model, hb, points, stability=stability, newton=newton_opts, status=status, message=message,
         settings={
             "omega": [lo, hi], **run.record(), "period": period,
             "start": start, "start_solution": how, "rejected_steps": stepper.rejected,
@@ -332,7 +340,7 @@ def _frequency_response(
             regions = confirm_with_sweep(regions, sweep)
         result = replace(result, regions=regions)
     if throw and not status.success:
-        raise ConvergenceError(f"frequency response incomplete: {stepper.message}", partial=result)
+        raise ConvergenceError(f"frequency response incomplete: {message}", partial=result)
     return result
 
 
