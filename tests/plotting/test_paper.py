@@ -66,7 +66,7 @@ def _texts(ax: Axes) -> list[str]:
 # --------------------------------------------------------------------------------------------
 def test_frf_plot_draws_every_branch_special_points_and_regions(frf) -> None:
     fig, ax = frequency_response_plot(frf)
-    assert isinstance(fig, Figure) and isinstance(ax, Axes)
+    assert isinstance(fig, Figure) and isinstance(ax.primary, Axes) and list(ax) == ["response"]
     labels = _legend(ax)
     for text in ("branch 0, stable", "branch 0, unstable", "branch 1 (period 2), stable",
                  "branch 2 (period 2), stable", "fold ○", "period doubling □", "linear system (f = δ)",
@@ -103,7 +103,7 @@ def test_frf_plot_options(frf) -> None:
     fig2, ax2 = plt.subplots()
     out = frequency_response_plot(frf, ax=ax2, regions=False, special_points=False, linear=False, legend="none",
                                   quantity="mean", title="t")
-    assert out == (fig2, ax2)
+    assert out[0] is fig2 and out[1].primary is ax2
     assert not ax2.patches and not ax2.texts and ax2.get_legend() is None
     assert ax2.get_ylabel() == "δ mean δ_m (rad)" and ax2.get_title() == "t"
     # regions given explicitly (e.g. confirmed by a sweep) replace frf.regions
@@ -179,7 +179,7 @@ def test_linear_vs_nonlinear_plot(frf, level) -> None:
 
 def test_hbm_vs_simulation_plot_annotates_the_jumps(frf, sweep) -> None:
     fig, ax = hbm_vs_simulation_plot(frf, sweep)
-    assert isinstance(fig, Figure) and isinstance(ax, Axes)
+    assert isinstance(fig, Figure) and isinstance(ax.primary, Axes)
     labels = _legend(ax)
     assert "sweep up (Ω increasing)" in labels and "sweep down (Ω decreasing)" in labels
     assert "branch 0, unstable" in labels

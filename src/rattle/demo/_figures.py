@@ -1,6 +1,7 @@
 """The paper's figures (Figures 4–7 and the mean operating point) for ``rattle demo``.
 
-Each function draws one figure from result objects and returns ``(figure, axes)``; the numbers
+Each function draws one figure from result objects and returns ``(figure, axes)``, ``axes`` a
+:class:`rattle.plotting.PlotAxes` (panel name → matplotlib Axes, with a primary one); the numbers
 (level differences, stage intervals) come from :mod:`rattle.demo._report`, which holds no
 plotting. The building blocks (branch colours, special-point markers, sweep styles) are those
 of :mod:`rattle.plotting`.
@@ -17,6 +18,7 @@ from ..plotting._frf import (
     branch_colors, branch_label, draw_branches, draw_regions, draw_special_points, frequency_response_plot, place_legend,
     true_runs,
 )
+from ..plotting._axes import PlotAxes, unwrap
 from ..plotting._orbit import amplitude_spectrum
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -38,7 +40,7 @@ _SIM_STYLE = {"color": "black", "ms": 3.0, "ls": "none", "marker": "o", "zorder"
 # --------------------------------------------------------------------------------------------
 def linear_vs_nonlinear_plot(
     frf: "FrequencyResponse", level: "LevelDifference", fig: Any = None, *, title: str | None = None
-) -> tuple[Any, dict[str, Any]]:
+) -> tuple[Any, PlotAxes]:
     """Non-linear rms of δ along every branch against the linear system (top), and the level
     difference ΔL = 20 log10(p2p δ''_non-linear / p2p δ''_linear) over ``level.band`` (bottom).
 
@@ -54,8 +56,8 @@ def linear_vs_nonlinear_plot(
 
     Returns
     -------
-    (figure, axes)
-        ``axes`` is a dict with keys ``response`` and ``level``.
+    (figure, PlotAxes)
+        Panels ``response`` (the primary) and ``level``.
     """
     import matplotlib.pyplot as plt
 
@@ -104,7 +106,7 @@ def linear_vs_nonlinear_plot(
     ax_l.grid(True, alpha=0.3)
     place_legend(ax_l, "inside")
     fig.suptitle(title if title is not None else "Figure 4 — linear vs non-linear frequency response")
-    return fig, {"response": ax_r, "level": ax_l}
+    return fig, PlotAxes({"response": ax_r, "level": ax_l})
 
 
 # --------------------------------------------------------------------------------------------
@@ -150,17 +152,19 @@ def _draw_sweep_points(sweep: "SweepResult", ax: Any) -> None:
 
 def hbm_vs_simulation_plot(
     frf: "FrequencyResponse", sweep: "SweepResult", ax: Any = None, *, title: str | None = None
-) -> tuple[Any, Any]:
+) -> tuple[Any, PlotAxes]:
     """The frequency response (every branch, stable solid, unstable dashed, special points and
     regions) with the up (▲) and down (▼) sweep points over it; each jump of the sweep is drawn
     as an arrow and annotated with its Ω and the nearest HB fold.
 
     Returns
     -------
-    (figure, axes)
+    (figure, PlotAxes)
+        One panel ``response`` (the given ``ax`` when there is one).
     """
     import matplotlib.pyplot as plt
 
+    ax = unwrap(ax)
     if ax is None:
         fig, ax = plt.subplots(figsize=(12, 6), layout="constrained")
     else:
@@ -187,7 +191,7 @@ def hbm_vs_simulation_plot(
                  f"time-domain sweep up and down ({n} frequencies each way)")
     ax.set_ylabel("δ rms (rad)")
     place_legend(ax, "outside")
-    return fig, ax
+    return fig, PlotAxes.single(ax)
 
 
 # --------------------------------------------------------------------------------------------
@@ -254,7 +258,7 @@ def point_plot(
     samples: int = 256,
     note: str = "",
     title: str | None = None,
-) -> tuple[Any, dict[str, Any]]:
+) -> tuple[Any, PlotAxes]:
     """Time history at one forcing frequency: the simulated steady state (black dots) against
     every HB orbit there (stable solid, unstable dashed): δ(t) over ``periods`` forcing periods,
     the phase portrait (δ, δ') with the simulation's stroboscopic points (t = k·2π/Ω: p points
@@ -281,8 +285,8 @@ def point_plot(
 
     Returns
     -------
-    (figure, axes)
-        ``axes`` is a dict with keys ``delta``, ``phase`` and (with ``spectrum``) ``spectrum``.
+    (figure, PlotAxes)
+        Panels ``delta`` (the primary), ``phase`` and (with ``spectrum``) ``spectrum``.
     """
     import matplotlib.pyplot as plt
 
@@ -376,7 +380,7 @@ def point_plot(
         if note:
             title += "\n" + note
     fig.suptitle(title)
-    return fig, axes
+    return fig, PlotAxes(axes)
 
 
 # --------------------------------------------------------------------------------------------
@@ -412,7 +416,7 @@ def _stage_decoration(ax: Any, model: Any, *, labels: bool) -> None:
 
 def mean_operating_point_plot(
     frf: "FrequencyResponse", fig: Any = None, *, title: str | None = None
-) -> tuple[Any, dict[str, Any]]:
+) -> tuple[Any, PlotAxes]:
     """The mean operating point δ_m along every branch vs Ω (top; stable solid, unstable dashed,
     special points, the static equilibrium and the stage boundary it crosses), and below it the
     range of δ (min … max) of the stable solutions against all stage boundaries (±b for a
@@ -420,8 +424,8 @@ def mean_operating_point_plot(
 
     Returns
     -------
-    (figure, axes)
-        ``axes`` is a dict with keys ``mean`` and ``range``.
+    (figure, PlotAxes)
+        Panels ``mean`` (the primary) and ``range``.
     """
     import matplotlib.pyplot as plt
 
@@ -472,4 +476,4 @@ def mean_operating_point_plot(
     fig.suptitle(title if title is not None else
                  "Mean operating point: at rest on the second stage; under the pulsating torque δ_m moves into the "
                  "first stage")
-    return fig, {"mean": ax, "range": ax_r}
+    return fig, PlotAxes({"mean": ax, "range": ax_r})

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._axes import PlotAxes
 from ._frf import frequency_response_plot
 from ._orbit import window_periods
 from ._sweep import DIRECTION_STYLES, sweep_plot
@@ -66,7 +67,7 @@ def compare_plot(
     *,
     samples: int = 256,
     title: str | None = None,
-) -> tuple[Any, dict[str, Any]]:
+) -> tuple[Any, PlotAxes]:
     """Draw the frequency response (stable solid, unstable dashed) with the up (▲) and down (▼)
     sweep points over it, the examined frequencies marked (a), (b), …, and below it one panel
     per examined frequency: δ(t) of every HB orbit there (solid stable, dashed unstable) and the
@@ -84,11 +85,14 @@ def compare_plot(
 
     Returns
     -------
-    (figure, axes)
-        ``axes`` is a dict: ``frf`` (the top axes) and ``histories`` (list of the panel axes).
-        A chain: one frequency-response panel and one row of time histories per clearance
-        element; ``frf`` and ``histories`` are the first element's, ``frf_panels`` (list) and
-        ``element_histories`` (element name → list of panels) all of them.
+    (figure, PlotAxes)
+        Panels ``frf`` (the top axes, the primary) and ``history_a``, ``history_b``, … (one per
+        examined frequency, lettered as in the figure); the alias ``histories`` is the list of
+        the history panels. A chain: one frequency-response panel and one row of time
+        histories per clearance element NAME (``NAME_frf``, ``NAME_history_a``, …; the primary
+        is the first element's ``NAME_frf``); the aliases ``frf`` and ``histories`` are the
+        first element's, ``frf_panels`` (list) and ``element_histories`` (element name → list
+        of panels) all of them.
     """
     import matplotlib.pyplot as plt
 
@@ -175,11 +179,15 @@ def compare_plot(
             ax.legend(fontsize=7, loc="best", framealpha=0.85)
     if title is not None:
         fig.suptitle(title)
-    axes: dict[str, Any] = {"frf": ax_frf, "histories": rows[0]}
-    if names:
-        axes["frf_panels"] = frf_axes
-        axes["element_histories"] = dict(zip(names, rows))
-    return fig, axes
+    tags = [f"history_{letters[j]}" if j < 26 else f"history_{j}" for j in range(n)]
+    if not names:
+        return fig, PlotAxes({"frf": ax_frf, **dict(zip(tags, rows[0]))}, aliases={"histories": rows[0]})
+    panels: dict[str, Any] = {f"{name}_frf": ax_k for name, ax_k in zip(names, frf_axes)}
+    for name, row in zip(names, rows):
+        panels.update({f"{name}_{tag}": ax for tag, ax in zip(tags, row)})
+    aliases = {"frf": ax_frf, "histories": rows[0], "frf_panels": frf_axes,
+               "element_histories": dict(zip(names, rows))}
+    return fig, PlotAxes(panels, aliases=aliases)
 
 
 __all__ = ["compare_plot"]

@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._axes import PlotAxes, unwrap
+
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import FrequencyResponse, Region
 
@@ -227,7 +229,7 @@ def frequency_response_plot(
     regions: "bool | Sequence[Region]" = True,
     legend: str = "outside",
     title: str | None = None,
-) -> tuple[Any, Any]:
+) -> tuple[Any, PlotAxes]:
     """Draw ``quantity`` (a SPEC column, default rms) vs Ω along every branch.
 
     Each branch has its colour (its period in the legend), stable stretches solid and unstable
@@ -242,8 +244,8 @@ def frequency_response_plot(
     Parameters
     ----------
     frf : FrequencyResponse
-    ax : matplotlib.axes.Axes, optional
-        Axes to draw into (default: a new 9.5 × 5 in figure).
+    ax : matplotlib.axes.Axes or PlotAxes, optional
+        Axes to draw into (default: a new 9.5 × 5 in figure; a :class:`PlotAxes`: its primary).
     quantity : str, default "rms"
         One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``, ``delta_min``, ``delta_max``.
     linear : bool, default True
@@ -260,10 +262,14 @@ def frequency_response_plot(
 
     Returns
     -------
-    (figure, axes)
+    (figure, PlotAxes)
+        One panel ``response`` (the given ``ax`` when there is one). A chain drawn without
+        ``ax``: one panel per clearance element, keyed by its name, sharing Ω; the primary is
+        the first element's.
     """
     import matplotlib.pyplot as plt
 
+    ax = unwrap(ax)
     if quantity not in QUANTITY_LABELS:
         raise ValueError(f"`quantity` must be a numeric SPEC column ({', '.join(QUANTITY_LABELS)}), got {quantity!r}")
     if legend not in _LEGEND_PLACES:
@@ -284,14 +290,14 @@ def frequency_response_plot(
             ax_k.set_title(f"{first} — element {name}" if k == 0 else f"element {name}", fontsize=10)
             if k < len(names) - 1:
                 ax_k.set_xlabel("")
-        return fig, axes[:, 0]
+        return fig, PlotAxes(zip(names, axes[:, 0]))
     if ax is None:
         fig, ax = plt.subplots(figsize=(9.5, 5), layout="constrained")
     else:
         fig = ax.figure
     _draw_panel(frf, ax, quantity, quantity, linear, special_points, shown, legend)
     ax.set_title(title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})")
-    return fig, ax
+    return fig, PlotAxes.single(ax)
 
 
 def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, linear: bool, special_points: bool,

@@ -7,6 +7,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._axes import PlotAxes
+
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import PeriodicOrbit
 
@@ -53,7 +55,7 @@ def orbit_plot(
     samples: int = 256,
     periods: int | None = None,
     title: str | None = None,
-) -> tuple[Any, dict[str, Any]]:
+) -> tuple[Any, PlotAxes]:
     """Draw the HB orbits at one frequency against the simulated steady state.
 
     Panels: δ(t), δ'(t) and δ''(t) over ``periods`` forcing periods (default: enough for every
@@ -77,12 +79,12 @@ def orbit_plot(
 
     Returns
     -------
-    (figure, axes)
-        ``axes`` is a dict with keys ``delta``, ``velocity``, ``acceleration``, ``phase`` and
+    (figure, PlotAxes)
+        Panels ``delta`` (the primary), ``velocity``, ``acceleration``, ``phase`` and
         ``spectrum``. A chain: one pair of panels per clearance element NAME, δ and δ'' of its
-        deflection (keys ``NAME_delta``, ``NAME_acceleration``; ``delta``, ``velocity`` and
-        ``acceleration`` are the first element's panels), the phase portrait and the spectrum
-        of the first element.
+        deflection (``NAME_delta``, ``NAME_acceleration``; the primary is the first element's
+        δ), the phase portrait and the spectrum of the first element; ``delta``, ``velocity``
+        and ``acceleration`` are aliases of the first element's panels.
     """
     import matplotlib.pyplot as plt
 
@@ -104,11 +106,11 @@ def orbit_plot(
         hist_axes[key] = fig.add_subplot(gs[r, 0], sharex=ax_d)
     ax_p = fig.add_subplot(gs[0 : n_rows - 1, 1])
     ax_s = fig.add_subplot(gs[n_rows - 1, 1])
-    axes = {**hist_axes, "phase": ax_p, "spectrum": ax_s}
+    aliases: dict[str, Any] = {}
     if system is not None:  # the first element's panels under the single-equation names too
-        axes["delta"] = hist_axes[rows[0][0]]
-        axes["acceleration"] = hist_axes[rows[1][0]]
-        axes["velocity"] = hist_axes[rows[1][0]]
+        aliases = {"delta": hist_axes[rows[0][0]], "acceleration": hist_axes[rows[1][0]],
+                   "velocity": hist_axes[rows[1][0]]}
+    axes = PlotAxes({**hist_axes, "phase": ax_p, "spectrum": ax_s}, aliases=aliases)
 
     sim_period = orbit.simulated_period
     n_win = periods if periods is not None else window_periods(

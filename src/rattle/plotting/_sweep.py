@@ -6,6 +6,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._axes import PlotAxes, unwrap
+
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import SweepResult
 
@@ -48,8 +50,8 @@ def sweep_plot(
     annotate: bool = True,
     lines: bool = True,
     title: str | None = None,
-) -> tuple[Any, Any]:
-    """Draw ``quantity`` (default rms of δ) vs Ω for each sweep direction; returns (figure, axes).
+) -> tuple[Any, PlotAxes]:
+    """Draw ``quantity`` (default rms of δ) vs Ω for each sweep direction; returns (figure, PlotAxes).
 
     The up sweep is drawn with ▲ markers, the down sweep with ▼ markers, each in its colour and
     joined in sweep order, so that the jumps at the ends of a multi-valued region show as
@@ -61,8 +63,8 @@ def sweep_plot(
     ----------
     sweep : SweepResult
         Columns ``direction``, ``omega``, the measures and ``period``.
-    ax : matplotlib.axes.Axes, optional
-        Axes to draw into (default: a new 8 × 5 in figure).
+    ax : matplotlib.axes.Axes or PlotAxes, optional
+        Axes to draw into (default: a new 8 × 5 in figure; a :class:`PlotAxes`: its primary).
     quantity : str, default "rms"
         One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``.
     annotate : bool, default True
@@ -72,11 +74,17 @@ def sweep_plot(
     title : str, optional
         Axes title.
 
-    A chain's sweep (per-element columns) drawn without ``ax``: one panel per clearance element
-    (``quantity`` of its deflection), sharing Ω; returns (figure, array of axes).
+    Returns
+    -------
+    (figure, PlotAxes)
+        One panel ``response`` (the given ``ax`` when there is one). A chain's sweep
+        (per-element columns) drawn without ``ax``: one panel per clearance element
+        (``quantity`` of its deflection), keyed by its name, sharing Ω; the primary is the
+        first element's.
     """
     import matplotlib.pyplot as plt
 
+    ax = unwrap(ax)
     if quantity not in _QUANTITIES:
         raise ValueError(f"`quantity` must be one of {sorted(_QUANTITIES)}, got {quantity!r}")
     names = tuple(getattr(sweep, "element_names", ()) or ())
@@ -91,7 +99,7 @@ def sweep_plot(
             ax_k.set_title(f"{first} — element {name}" if k == 0 else f"element {name}", fontsize=10)
             if k < len(names) - 1:
                 ax_k.set_xlabel("")
-        return fig, axes[:, 0]
+        return fig, PlotAxes(zip(names, axes[:, 0]))
     if ax is None:
         fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
     else:
@@ -99,7 +107,7 @@ def sweep_plot(
     _draw_sweep(sweep, ax, np.asarray(getattr(sweep, quantity), dtype=float), annotate, lines, legend=True)
     ax.set_ylabel(_QUANTITIES[quantity])
     ax.set_title(title if title is not None else "Time-domain frequency sweep (steady state at each Ω)")
-    return fig, ax
+    return fig, PlotAxes.single(ax)
 
 
 def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:

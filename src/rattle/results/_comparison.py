@@ -92,9 +92,9 @@ class Comparison:
         directory = Path(directory)
         return self.frf.to_csv(directory / "frf.csv"), self.sweep.to_csv(directory / "sweep.csv")
 
-    def plot(self, fig: Any = None, *, samples: int = 256, title: str | None = None) -> tuple[Any, dict[str, Any]]:
+    def plot(self, fig: Any = None, *, samples: int = 256, title: str | None = None) -> tuple[Any, Any]:
         """The FRF with the sweep points over it, and a row of time histories; returns
-        (figure, axes dict). See :func:`rattle.plotting.compare_plot`."""
+        (figure, :class:`rattle.plotting.PlotAxes`). See :func:`rattle.plotting.compare_plot`."""
         from ..plotting import compare_plot
 
         return compare_plot(self, fig=fig, samples=samples, title=title)

@@ -320,7 +320,8 @@ class FrequencyResponse:
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """rms vs Ω (stable solid, unstable dashed, bifurcations marked, linear overlaid);
-        returns (figure, axes). See :func:`rattle.plotting.frequency_response_plot`."""
+        returns (figure, :class:`rattle.plotting.PlotAxes`). See
+        :func:`rattle.plotting.frequency_response_plot`."""
         from ..plotting import frequency_response_plot
 
         return frequency_response_plot(self, ax=ax, **kwargs)

@@ -408,9 +408,9 @@ class PeriodicOrbit:
 
     def plot(
         self, fig: Any = None, *, samples: int = 256, periods: int | None = None, title: str | None = None
-    ) -> tuple[Any, dict[str, Any]]:
+    ) -> tuple[Any, Any]:
         """δ(t), δ'(t), δ''(t), the phase portrait and the amplitude spectrum; returns
-        (figure, axes dict). See :func:`rattle.plotting.orbit_plot`."""
+        (figure, :class:`rattle.plotting.PlotAxes`). See :func:`rattle.plotting.orbit_plot`."""
         from ..plotting import orbit_plot
 
         return orbit_plot(self, fig=fig, samples=samples, periods=periods, title=title)

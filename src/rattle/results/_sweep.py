@@ -244,7 +244,8 @@ class SweepResult:
         return Path(path)
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
-        """rms vs Ω of each direction; see :func:`rattle.plotting.sweep_plot` (returns its handles)."""
+        """rms vs Ω of each direction; returns (figure, :class:`rattle.plotting.PlotAxes`). See
+        :func:`rattle.plotting.sweep_plot`."""
         from ..plotting import sweep_plot  # type: ignore[attr-defined]
 
         return sweep_plot(self, ax=ax, **kwargs)
