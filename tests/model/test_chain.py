@@ -111,3 +111,21 @@ def test_chain_refusals():
         Element(name="my clutch", between=(1, 2), stiffness=1.0, law=Backlash(b=0.1))
     with pytest.raises(ValueError, match="damping"):
         rattle.model.check_analysable_model(Chain(inertias=(1.0, 1.0), elements=el))
+
+
+def test_parts_refuse_malformed_arguments_naming_them():
+    el = (Element(name="e", between=(1, 2), stiffness=1.0, law=Backlash(b=0.1)),)
+    with pytest.raises(TypeError, match="`links` must be a list or tuple of Link"):
+        Chain(inertias=(1.0, 1.0), links=Link(between=(1, 2), damping=0.1), elements=el)
+    with pytest.raises(TypeError, match="`elements` must be a list or tuple of Element"):
+        Chain(inertias=(1.0, 1.0), elements=el[0])
+    with pytest.raises(TypeError, match=r"`between` must be a pair"):
+        Link(between=(1, 2, 3))
+    with pytest.raises(TypeError, match=r"`between\[1\]` must be an integer"):
+        Element(name="e", between=(1, "2"), stiffness=1.0, law=Backlash(b=0.1))
+    with pytest.raises(TypeError, match=r"`between\[0\]` must be an integer"):
+        Link(between=(True, 2))
+    with pytest.raises(TypeError, match="`law` must be an elastic law"):
+        Element(name="e", between=(1, 2), stiffness=1.0, law="clutch")
+    with pytest.raises(ValueError, match=r"`inertias\[1\]` must be finite"):
+        Chain(inertias=(1.0, float("nan")), elements=el)

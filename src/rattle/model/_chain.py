@@ -30,7 +30,8 @@ from ._system import ReducedElement, System
 BALANCE_RTOL = 1e-9
 
 
-def _check_between(name: str, value: object, n_inertias: int) -> tuple[int, int]:
+def _pair(name: str, value: object) -> tuple[int, int]:
+    """A pair (i, j) of integer inertia numbers (range checked by the chain)."""
     if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 2:  # type: ignore[arg-type]
         raise TypeError(f"`{name}` must be a pair [i, j] of inertia numbers (j = 0: ground), got {value!r}")
     out = []
@@ -38,7 +39,18 @@ def _check_between(name: str, value: object, n_inertias: int) -> tuple[int, int]
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
             raise TypeError(f"`{name}[{k}]` must be an integer inertia number, got {v!r}")
         out.append(int(v))
-    i, j = out
+    return out[0], out[1]
+
+
+def _items(name: str, value: object, kind: type) -> tuple:
+    """``value`` as a tuple of ``kind`` (a list or tuple of them)."""
+    if isinstance(value, kind) or isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"`{name}` must be a list or tuple of {kind.__name__} objects, got {value!r}")
+    return tuple(value)  # type: ignore[call-overload]
+
+
+def _check_between(name: str, value: object, n_inertias: int) -> tuple[int, int]:
+    i, j = _pair(name, value)
     if not 1 <= i <= n_inertias:
         raise ValueError(f"`{name}[0]` must be an inertia number 1 … {n_inertias}, got {i}")
     if not 0 <= j <= n_inertias:
@@ -65,7 +77,7 @@ class Link:
             raise ValueError(f"`damping` of a link must be >= 0, got {c!r}")
         object.__setattr__(self, "stiffness", k)
         object.__setattr__(self, "damping", c)
-        object.__setattr__(self, "between", tuple(self.between))
+        object.__setattr__(self, "between", _pair("between", self.between))
 
     def to_dict(self) -> dict[str, object]:
         return {"between": list(self.between), "stiffness": self.stiffness, "damping": self.damping}
@@ -93,7 +105,7 @@ class Element:
         if not isinstance(self.law, AbstractElastic):
             raise TypeError(f"`law` must be an elastic law (Linear, Backlash, Clutch, Piecewise), got {self.law!r}")
         object.__setattr__(self, "stiffness", k)
-        object.__setattr__(self, "between", tuple(self.between))
+        object.__setattr__(self, "between", _pair("between", self.between))
 
     def to_dict(self) -> dict[str, object]:
         return {"name": self.name, "between": list(self.between), "stiffness": self.stiffness, **self.law.to_dict()}
@@ -153,9 +165,9 @@ class Chain:
             if v <= 0:
                 raise ValueError(f"`inertias[{i}]` must be > 0, got {v!r}")
         N = len(inertias)
-        links = tuple(self.links)
-        elements = tuple(self.elements)
-        torques = tuple(self.torques)
+        links = _items("links", self.links, Link)
+        elements = _items("elements", self.elements, Element)
+        torques = _items("torques", self.torques, Torque)
         for k, link in enumerate(links):
             if not isinstance(link, Link):
                 raise TypeError(f"`links[{k}]` must be a Link, got {link!r}")
