@@ -62,6 +62,8 @@ def test_reads_the_spec_example_and_round_trips():
         (("inertias = [2.0, 2.0]", "inertias = [2.0, 2.0]\ninertia = 1.0"), "`model.inertia`"),
         (("stiffness = 1.0\n", "stiffness = \"1\"\n"), "`model.elements[0].stiffness`"),
         (("name = \"clutch\"", "name = \"my clutch\""), "`model.elements[0].name`"),
+        (("inertias = [2.0, 2.0]", "inertias = []"), "`model.inertias` must hold at least one"),
+        (("b = 0.174533", "b = 0.174533\nfoo = 1"), "allows only name, between, stiffness, type, alpha, b"),
         (("damping = 0.05", "damping = 0.0"), "`model.links`"),
     ],
 )

@@ -654,6 +654,8 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         check.keys(analysis_t, "analysis", _ANALYSIS_KEYS, required=())
     check.array(model_t["inertias"], "model.inertias")
     n = len(model_t["inertias"])
+    if n == 0:
+        raise check.error("`model.inertias` must hold at least one inertia, got []; write e.g. inertias = [2.0, 2.0]")
 
     links = []
     for k, t in enumerate(_tables(check, model_t, "links", "model.links") if "links" in model_t else []):
@@ -676,7 +678,9 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         try:
             law, law_params = _elastic_structure(check, law_t)
         except ConfigError as exc:
-            raise check.error(str(exc).split(": ", 1)[1].replace("model.elastic", where)) from None
+            message = str(exc).split(": ", 1)[1].replace("model.elastic", where)
+            message = message.replace("allows only type,", f"allows only {', '.join(_MODEL_ELEMENTS_KEYS)}, type,")
+            raise check.error(message) from None
         name = t.get("name", f"element{k + 1}")
         if not isinstance(name, str):
             raise check.error(f"`{where}.name` must be a string, got {_show(name)} ({_kind(name)}); write e.g. name = \"clutch\"")
