@@ -164,3 +164,30 @@ def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega)
         assert bool(frf.stable[i]) == orbit.stable, w
         checked += 1
     assert checked >= 6
+
+
+def test_fold_and_period_doubling_in_one_step_are_not_stepped_over():
+    """A random grounded three-inertia chain (three elements) where a fold and a period doubling
+    lie 4e-4 apart on an unstable stretch: with one step over both, stability is the same at the
+    two ends (the fold restores it, the period doubling takes it again) and both were missed at
+    H = 32. The monitor now rejects a step over which two test functions change sign; the exact
+    reference has both (fold 1.196827, period doubling 1.197249)."""
+    model = Chain(
+        inertias=(0.5533651283864341, 0.6631797283936953, 0.6454648320607042),
+        links=(Link(between=(1, 2), damping=0.03303268413498679), Link(between=(2, 3), damping=0.04097022846036987),
+               Link(between=(1, 0), stiffness=0.20837086657238452, damping=0.02465619195625529)),
+        elements=(
+            Element(name="e0", between=(1, 2), stiffness=1.5205126745691961,
+                    law=Clutch(alpha=0.25028001659188465, b=0.2852395205773986)),
+            Element(name="e1", between=(2, 3), stiffness=1.5601613067108846,
+                    law=Piecewise(breakpoints=(-0.13540850249354247, 0.06770425124677124),
+                                  slopes=(1.0, 0.338400629524995, 1.0))),
+            Element(name="e2", between=(3, 0), stiffness=0.8459733556082574,
+                    law=Piecewise(breakpoints=(-0.17627631327509302, 0.08813815663754651),
+                                  slopes=(1.0, 0.30387041108407914, 1.0))),
+        ),
+        torques=(Torque(inertia=1, mean=0.05209958088486248, amplitudes=(0.032644853971424775,)),),
+    )
+    frf = rattle.frequency_response(model, omega=(1.1, 1.3), harmonics=32, confirm_tori=False)
+    found = [(k, round(w, 5)) for k, w in _points(frf)]
+    assert ("fold", 1.19683) in found and ("period_doubling", 1.19725) in found, found

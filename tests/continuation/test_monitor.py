@@ -136,3 +136,17 @@ def test_gear_example_period_doubling_pair_at_default_settings():
     assert hi - lo >= 2
     assert not frf.stable[lo + 1 : hi].any()
     assert np.all(frf.multipliers[lo + 1 : hi, 0].real < -1.0)
+
+
+def test_a_step_over_which_two_test_functions_change_sign_is_rejected():
+    from rattle.continuation._monitor import MonitorReading, check_segment
+
+    a = MonitorReading(np.array([0.3, -0.2]), np.array([-1.0, 1.0]), (2,), 0.2)
+    b = MonitorReading(np.array([-0.2, 0.3]), np.array([-1.0, 1.0]), (2,), 0.2)
+    verdict = check_segment(a, b, 0.5, tolerance=0.5, max_change=1.0, resolved=False)
+    assert not verdict.accept and "two test functions" in verdict.reason
+    # One crossing alone is fine; at the resolution floor nothing is rejected.
+    one = MonitorReading(np.array([-0.2, -0.3]), np.array([-1.0, -1.0]), (2,), 0.2)
+    assert check_segment(MonitorReading(np.array([0.3, -0.2]), np.array([-1.0, -1.0]), (2,), 0.2), one, 0.5,
+                         tolerance=0.5, max_change=1.0, resolved=False).accept
+    assert check_segment(a, b, 0.5, tolerance=0.5, max_change=1.0, resolved=True).accept

@@ -31,7 +31,10 @@ end slope (a lower-order model's error, which vanishes at both ends). For each t
   shrink, and grows only while |ψ| / |ψ'| exceeds the present step (at the present rate no
   test function could reach zero within it);
 * movement: ψ may change by at most ``max_change`` × (1 + min(|ψ_a|, |ψ_b|)) per step (twice
-  that rejects the step): this bounds how far the multipliers move in one step.
+  that rejects the step): this bounds how far the multipliers move in one step;
+* two kinds at once: when two test functions change sign over one step (a fold and a period
+  doubling close together, with several multipliers) the step is rejected: their effects on
+  stability could cancel between the ends, hiding both changes of stability.
 
 Rejection stops once the step is down to ``resolution``: a pair of zeros closer together than
 that is below what a continuation can resolve and is reported by the locator as one interval.
@@ -142,6 +145,7 @@ def check_segment(
     """
     factor = 2.0
     smooth = a.structure == b.structure
+    crossed = 0  # test functions that change sign over the step
     for pa, ga, pb, gb in zip(a.values, a.slopes, b.values, b.slopes):
         pa, ga, pb, gb = float(pa), float(ga), float(pb), float(gb)
         if not (math.isfinite(pa) and math.isfinite(pb)):
@@ -154,6 +158,13 @@ def check_segment(
             # An end sits on a zero (a branch started at a located special point): its sign is
             # round-off, and a second zero within the same step cannot be told from it.
             continue
+        if change:
+            crossed += 1
+            if crossed >= 2 and not resolved:
+                # Two multipliers cross the unit circle within one step (e.g. a fold and a period
+                # doubling close together): their effects on stability may cancel between the
+                # ends, so the stability of the stretch between them would be hidden.
+                return SegmentVerdict(False, 0.5, "two test functions change sign in one step")
         if move > max_change * scale:
             factor = min(factor, max_change * scale / move)
             if move > 2.0 * max_change * scale and not resolved:
