@@ -129,3 +129,11 @@ def test_parts_refuse_malformed_arguments_naming_them():
         Element(name="e", between=(1, 2), stiffness=1.0, law="clutch")
     with pytest.raises(ValueError, match=r"`inertias\[1\]` must be finite"):
         Chain(inertias=(1.0, float("nan")), elements=el)
+
+
+def test_grounded_chain_whose_mean_torque_nothing_can_hold_is_refused():
+    """Tied to ground by a damper only: the mean torque turns it without end (no equilibrium)."""
+    with pytest.raises(ValueError, match="`torques`: the mean torques cannot be balanced"):
+        Chain(inertias=(1.0, 1.0), links=(Link(between=(1, 0), damping=0.1),),
+              elements=(Element(name="e", between=(1, 2), stiffness=1.0, law=Backlash(b=0.1)),),
+              torques=(Torque(inertia=1, mean=0.1),))

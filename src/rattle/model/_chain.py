@@ -205,6 +205,15 @@ class Chain:
                 )
         object.__setattr__(self, "_system", self._reduce())
         self._check_scales()
+        try:
+            self._system.static_equilibrium()
+        except ValueError:
+            raise ValueError(
+                "`torques`: the mean torques cannot be balanced by the chain's stiffness: no position "
+                "of the inertias holds them (an inertia is tied to ground only by dampers or by a "
+                "clearance element without stiffness there), so the chain would turn without end and "
+                "has no periodic motion; add a stiff link to ground, or balance the mean torques"
+            ) from None
 
     # --- structure --------------------------------------------------------------------------
     @property
