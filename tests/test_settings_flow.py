@@ -13,7 +13,7 @@ import pytest
 import rattle
 from rattle import ContinuationOptions, HBOptions, NewtonOptions
 from rattle.analysis import _assemble as frf_module
-from rattle.analysis import _orbit as orbit_module
+from rattle.stability import _methods as methods_module  # Hill.multipliers, used by every analysis
 from rattle.analysis import adaptive_frequency_response
 from rattle.continuation import ContinuationStepper
 from rattle.hb import HarmonicBalance
@@ -32,7 +32,7 @@ def record(monkeypatch):
     hb_init = HarmonicBalance.__init__
     st_init = ContinuationStepper.__init__
     multipliers = frf_module._multipliers
-    hill = orbit_module.hill_multipliers
+    hill = methods_module.hill_multipliers
 
     def hb_spy(self, model, options=None, *, period=1):
         seen["hb"].append((options, period))
@@ -53,7 +53,7 @@ def record(monkeypatch):
     monkeypatch.setattr(HarmonicBalance, "__init__", hb_spy)
     monkeypatch.setattr(ContinuationStepper, "__init__", st_spy)
     monkeypatch.setattr(frf_module, "_multipliers", mu_spy)
-    monkeypatch.setattr(orbit_module, "hill_multipliers", hill_spy)
+    monkeypatch.setattr(methods_module, "hill_multipliers", hill_spy)
     return seen
 
 

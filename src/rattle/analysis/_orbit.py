@@ -42,14 +42,12 @@ from .._validate import check_state
 from ..continuation import ArclengthCorrector, BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
-from ..measures import measures_batch, synthesize_batch, system_measures_batch
+from ..measures import system_measures_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
 from ..results._steady import SteadyState
-from ..stability import (
-    UNIT_CIRCLE_TOL, FloquetMonitor, Hill, hill_multipliers, monodromy_batch, multipliers_from_monodromy,
-)
+from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, stability_method
 from ..timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
 from ..timeint._flow import check_system_state
 from ._frequency_response import check_range, frequency_response
@@ -581,45 +579,13 @@ def _state_at_zero(solver: _Solver, cand: _Candidate) -> FloatArray:
 
 def _assembled(model: Model, solver: _Solver, cands: list[_Candidate],
                stability: StabilityMethod = "monodromy") -> list[OrbitSolution]:
-    """Floquet multipliers (exact monodromy of the linearisation about each orbit, or Hill's
-    method) and SPEC measures of each candidate, batched per period."""
-    if solver.system is not None:
-        return _assembled_chain(model, solver, cands, stability)
+    """Floquet multipliers (the stability method's: the exact monodromy of the linearisation
+    about each orbit, or Hill's method; 2n per orbit) and the SPEC measures of each candidate,
+    batched per period. The flat fields are the first element's; a chain also gets every
+    element's measures in ``elements``."""
+    method = stability_method(stability)
     out: list[OrbitSolution | None] = [None] * len(cands)
-    st = model.elastic.stages
-    for p in sorted({c.period for c in cands}):
-        idx = [i for i, c in enumerate(cands) if c.period == p]
-        hb = solver.hb(p)
-        Q = np.array([cands[i].q for i in idx])
-        w = np.full(len(idx), solver.omega / p)
-        Om = np.full(len(idx), solver.omega)
-        X = synthesize_batch(Q, hb.basis.samples)
-        if isinstance(stability, Hill):  # method objects (rattle.stability), chosen by type
-            mu = np.array([hill_multipliers(hb, q, solver.omega) for q in Q]).reshape(len(idx), 2)
-        else:
-            mu = multipliers_from_monodromy(monodromy_batch(Q, w, X, st.breakpoints, model.k * st.slopes, model.c))
-        stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL
-        meas = measures_batch(model, Q, w, Om, X)
-        for j, i in enumerate(idx):
-            out[i] = OrbitSolution(
-                omega=solver.omega, period=p, coefficients=Q[j].copy(),
-                stable=bool(stable[j]), multipliers=mu[j].copy(),
-                mean=float(meas.mean[j]), rms=float(meas.rms[j]), rms_ac=float(meas.rms_ac[j]),
-                p2p=float(meas.p2p[j]), acc_p2p=float(meas.acc_p2p[j]),
-                delta_min=float(meas.delta_min[j]), delta_max=float(meas.delta_max[j]),
-                regime=str(meas.regime[j]), source=cands[i].source,
-                iterations=int(cands[i].iterations), residual=float(cands[i].residual),
-                simulated=bool(cands[i].simulated),
-            )
-    return [s for s in out if s is not None]
-
-
-def _assembled_chain(model: Any, solver: _Solver, cands: list[_Candidate],
-                     stability: StabilityMethod) -> list[OrbitSolution]:
-    """:func:`_assembled` for a chain: the stability method's multipliers (2n per orbit), the
-    measures of every element (the flat fields: the first element's)."""
-    out: list[OrbitSolution | None] = [None] * len(cands)
-    names = tuple(e.name for e in solver.system.elements)
+    names = tuple(e.name for e in solver.system.elements) if solver.system is not None else ()
     for p in sorted({c.period for c in cands}):
         idx = [i for i, c in enumerate(cands) if c.period == p]
         hb = solver.hb(p)
@@ -627,9 +593,10 @@ def _assembled_chain(model: Any, solver: _Solver, cands: list[_Candidate],
         P = len(idx)
         w = np.full(P, solver.omega / p)
         Om = np.full(P, solver.omega)
-        mu = stability.multipliers(hb, Q, Om)
+        mu = method.multipliers(hb, Q, Om)
         stable = np.max(np.abs(mu), axis=1) < 1.0 - UNIT_CIRCLE_TOL
-        per_element = system_measures_batch(model, Q.reshape(P, solver.n, -1), w, Om, hb.basis.samples)
+        per_element = system_measures_batch(model, Q.reshape(P, hb.size // hb.basis.size, -1), w, Om,
+                                            hb.basis.samples)
         meas = per_element[0]
         for j, i in enumerate(idx):
             elements = {
