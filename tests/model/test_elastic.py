@@ -79,7 +79,7 @@ def test_stage_arrays_are_read_only():
     [
         (lambda: Backlash(b=0.0), r"`b` \(backlash\) must be > 0"),
         (lambda: Backlash(b=float("nan")), r"`b` must be finite"),
-        (lambda: Clutch(alpha=1.0, b=0.1), r"`alpha` .* 0 < alpha < 1"),
+        (lambda: Clutch(alpha=1.0, b=0.1), r"`alpha` .* 0 <= alpha < 1"),
         (lambda: Clutch(alpha=0.2, b=-0.1), r"`b` \(clutch"),
         (lambda: Clutch(alpha=True, b=0.1), r"`alpha` must be a real number"),
         (lambda: Piecewise(breakpoints=(0.1, 0.0), slopes=(1, 1, 1)), r"`breakpoints` must be strictly increasing"),
@@ -126,3 +126,12 @@ def test_reference_case_coefficients_and_equilibrium():
     # F_m = f(δ_s) on the second stage: δ_s − (1 − α) b = F_m.
     assert m.static_equilibrium() == pytest.approx(0.05 + 0.75 * math.radians(10.0), rel=1e-15)
     assert m.static_equilibrium() > math.radians(10.0)  # "its mean operating point lies on the second stage"
+
+
+def test_clutch_alpha_zero_is_the_backlash():
+    """α = 0 (a design map varies α from 0) is the backlash law of the same gap, exactly."""
+    from rattle.model import Backlash, Clutch
+
+    d = np.linspace(-0.6, 0.6, 241)
+    np.testing.assert_array_equal(Clutch(alpha=0.0, b=0.2).force(d), Backlash(b=0.2).force(d))
+    np.testing.assert_array_equal(Clutch(alpha=0.0, b=0.2).stiffness(d), Backlash(b=0.2).stiffness(d))

@@ -23,7 +23,7 @@ The ``[analysis]`` table holds numerical settings, not physics, so it may be lef
 defaults are the SPEC §2 example values and end up in the run metadata. Every physical
 quantity is required; nothing physical is defaulted.
 
-The value rules (positive inertia, increasing breakpoints, 0 < alpha < 1, …) live in the model
+The value rules (positive inertia, increasing breakpoints, 0 <= alpha < 1, …) live in the model
 dataclasses, the single source of truth; this module checks only what they cannot see (the
 table structure, unknown and missing keys, the TOML type of each value, the ``[analysis]``
 table) and re-raises their errors as :class:`~rattle.errors.ConfigError` with the full key.

@@ -163,7 +163,10 @@ class Backlash(AbstractElastic):
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Clutch(AbstractElastic):
-    """Two-stage clutch damper: f = α δ for |δ| ≤ b, δ − (1 − α) b sign δ outside (0 < α < 1).
+    """Two-stage clutch damper: f = α δ for |δ| ≤ b, δ − (1 − α) b sign δ outside (0 ≤ α < 1).
+
+    α = 0 is the backlash law of gap b (a free first stage), so that a design map may vary α
+    from 0; it behaves exactly as :class:`Backlash` with the same b.
 
     ::
 
@@ -181,10 +184,10 @@ class Clutch(AbstractElastic):
     def __post_init__(self) -> None:
         alpha = _check_real("alpha", self.alpha)
         b = _check_real("b", self.b)
-        if not 0.0 < alpha < 1.0:
+        if not 0.0 <= alpha < 1.0:
             raise ValueError(
-                f"`alpha` (clutch first-stage slope) must satisfy 0 < alpha < 1, got {alpha!r}; "
-                "use type = \"backlash\" for alpha = 0 or type = \"piecewise\" for other laws"
+                f"`alpha` (clutch first-stage slope) must satisfy 0 <= alpha < 1, got {alpha!r} "
+                "(alpha = 0 is the backlash; use type = \"piecewise\" for other laws)"
             )
         if b <= 0:
             raise ValueError(f"`b` (clutch first-stage half-width) must be > 0 rad, got {b!r}")
