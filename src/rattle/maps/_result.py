@@ -1,0 +1,247 @@
+"""The result of a response map: one :class:`CellResult` per combination, gathered in a
+:class:`ResponseMap` (an xarray Dataset over the varied parameters × Ω, SPEC §7).
+
+A *combination* is one value of every varied parameter; its *cell result* is what the frequency
+response and the attractor search found there, evaluated on the map's Ω grid:
+
+======================  =====================================================================
+``n_solutions``         period-1 solutions of the primary branch at Ω (all)
+``n_stable``            … of them stable
+``rms_max_stable``      largest rms over the stable period-1 solutions at Ω (any branch; NaN if none)
+``rms_ac_max_stable``   rms_ac of that solution
+``regime_max_stable``   that solution's regime (``""`` if none)
+``periods_stable``      the periods of every stable solution found at Ω, ``;``-joined (``1;2``),
+                        with ``0`` for a non-periodic attractor
+``rattle``              some attractor found at Ω crosses a breakpoint (impacts)
+======================  =====================================================================
+
+A cell result is exactly JSON-serialisable (:meth:`CellResult.to_dict` / :meth:`from_dict`
+round-trip every float bit for bit): that is how a finished combination is stored and read
+back when a map resumes.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    import xarray as xr
+
+#: Per-frequency columns of a cell (SPEC §7 ``map.csv`` after the varied parameters and ``omega``).
+GRID_COLUMNS: tuple[str, ...] = (
+    "n_solutions", "n_stable", "rms_max_stable", "rms_ac_max_stable", "regime_max_stable", "periods_stable",
+    "rattle",
+)
+#: ``map.csv`` columns after the varied parameters' names.
+MAP_COLUMNS: tuple[str, ...] = ("omega", *GRID_COLUMNS)
+#: The interval kinds of a cell's design summary.
+INTERVAL_KINDS: tuple[str, ...] = ("impact", "rattle_free", "subharmonic", "nonperiodic")
+
+
+def _float(x: Any) -> float | None:
+    x = float(x)
+    return None if math.isnan(x) else x
+
+
+@dataclass(frozen=True)
+class CellResult:
+    """What one combination of the varied parameters gives on the map's Ω grid.
+
+    Attributes
+    ----------
+    values : dict[str, float]
+        The varied parameters' values, by their NAME.
+    omega : ndarray (N,)
+        The map's frequency grid.
+    n_solutions, n_stable : ndarray of int (N,)
+    rms_max_stable, rms_ac_max_stable : ndarray of float (N,), NaN where no stable period-1 solution
+    regime_max_stable : ndarray of str (N,)
+    periods_stable : ndarray of str (N,)
+    rattle : ndarray of bool (N,)
+    special_points : list of dict
+        ``kind``, ``omega``, ``branch``, ``period``, ``rms`` of every labelled point of every branch.
+    intervals : dict[str, list[[lo, hi]]]
+        Ω intervals (grid-resolved: first and last grid frequency of a run) of every kind in
+        :data:`INTERVAL_KINDS`: ``impact`` (rattle true), ``rattle_free`` (false), ``subharmonic``
+        (a stable solution of period ≥ 2), ``nonperiodic`` (a non-periodic attractor, period 0).
+    attractors : list of dict
+        What the attractor search found that the branches did not explain (``omega``,
+        ``period``, ``origin``, ``branch``: the id of the branch continued from it, or None).
+    search : dict
+        The search's budget and counts (simulations run, seeds, branches added).
+    status : str
+        ``"ok"``, or ``"partial"`` (the primary branch stopped early; ``message`` says why), or
+        ``"failed"`` (nothing computed; ``message``).
+    message : str
+    timings : dict[str, float]
+        Seconds per stage (``frequency_response``, ``grid``, ``search``, ``total``).
+    resumed : bool
+        Read back from a finished earlier run instead of computed.
+    """
+
+    values: dict[str, float]
+    omega: np.ndarray
+    n_solutions: np.ndarray
+    n_stable: np.ndarray
+    rms_max_stable: np.ndarray
+    rms_ac_max_stable: np.ndarray
+    regime_max_stable: np.ndarray
+    periods_stable: np.ndarray
+    rattle: np.ndarray
+    special_points: list[dict[str, Any]] = field(default_factory=list)
+    intervals: dict[str, list[list[float]]] = field(default_factory=dict)
+    attractors: list[dict[str, Any]] = field(default_factory=list)
+    search: dict[str, Any] = field(default_factory=dict)
+    status: str = "ok"
+    message: str = ""
+    timings: dict[str, float] = field(default_factory=dict)
+    resumed: bool = False
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The per-frequency columns (``omega`` and :data:`GRID_COLUMNS`)."""
+        return {"omega": self.omega, **{k: getattr(self, k) for k in GRID_COLUMNS}}
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (floats exact: ``json`` writes ``repr``; NaN as null)."""
+        return {
+            "values": dict(self.values),
+            "omega": [float(x) for x in self.omega],
+            "n_solutions": [int(x) for x in self.n_solutions],
+            "n_stable": [int(x) for x in self.n_stable],
+            "rms_max_stable": [_float(x) for x in self.rms_max_stable],
+            "rms_ac_max_stable": [_float(x) for x in self.rms_ac_max_stable],
+            "regime_max_stable": [str(x) for x in self.regime_max_stable],
+            "periods_stable": [str(x) for x in self.periods_stable],
+            "rattle": [bool(x) for x in self.rattle],
+            "special_points": self.special_points,
+            "intervals": self.intervals,
+            "attractors": self.attractors,
+            "search": self.search,
+            "status": self.status,
+            "message": self.message,
+            "timings": self.timings,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], *, resumed: bool = False) -> "CellResult":
+        """The inverse of :meth:`to_dict` (``resumed`` marks a result read back from disk)."""
+        nan = float("nan")
+        return cls(
+            values={str(k): float(v) for k, v in data["values"].items()},
+            omega=np.asarray(data["omega"], dtype=float),
+            n_solutions=np.asarray(data["n_solutions"], dtype=int),
+            n_stable=np.asarray(data["n_stable"], dtype=int),
+            rms_max_stable=np.asarray([nan if x is None else x for x in data["rms_max_stable"]], dtype=float),
+            rms_ac_max_stable=np.asarray([nan if x is None else x for x in data["rms_ac_max_stable"]], dtype=float),
+            regime_max_stable=np.asarray(data["regime_max_stable"], dtype=object),
+            periods_stable=np.asarray(data["periods_stable"], dtype=object),
+            rattle=np.asarray(data["rattle"], dtype=bool),
+            special_points=list(data.get("special_points", [])),
+            intervals={k: [list(map(float, iv)) for iv in v] for k, v in data.get("intervals", {}).items()},
+            attractors=list(data.get("attractors", [])),
+            search=dict(data.get("search", {})),
+            status=str(data.get("status", "ok")),
+            message=str(data.get("message", "")),
+            timings={k: float(v) for k, v in data.get("timings", {}).items()},
+            resumed=resumed,
+        )
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), allow_nan=False)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A varied parameter: its NAME (as given: a short name or a dotted key), the dotted key of
+    the configuration it sets, and its values."""
+
+    name: str
+    key: str
+    values: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class ResponseMap:
+    """A response map (SPEC §7): the cells of every combination of the varied ``parameters``
+    (C order: the last parameter varies fastest), on the Ω grid ``omega``.
+
+    ``dataset`` is the same content as an :class:`xarray.Dataset` with one dimension per varied
+    parameter (named by its NAME) and ``omega``.
+    """
+
+    parameters: tuple[Parameter, ...]
+    omega: np.ndarray
+    cells: tuple[CellResult, ...]
+    settings: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+    config: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(p.values) for p in self.parameters)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    def cell(self, *index: int) -> CellResult:
+        """The cell of the combination with these parameter indices."""
+        return self.cells[int(np.ravel_multi_index(index, self.shape))]
+
+    def combinations(self) -> list[tuple[tuple[int, ...], dict[str, float]]]:
+        """(index, values by NAME) of every combination, in cell order."""
+        out = []
+        for flat in range(len(self.cells)):
+            idx = tuple(int(i) for i in np.unravel_index(flat, self.shape))
+            out.append((idx, {p.name: p.values[i] for p, i in zip(self.parameters, idx)}))
+        return out
+
+    @property
+    def dataset(self) -> "xr.Dataset":
+        """The map as an xarray Dataset: dims (NAME…, omega); data variables the
+        :data:`GRID_COLUMNS`, plus per combination ``status`` and ``seconds``; attributes: the
+        settings and the varied keys (JSON)."""
+        import xarray as xr
+
+        shape = self.shape + (self.omega.size,)
+        dims = (*self.names, "omega")
+        data: dict[str, Any] = {}
+        for col in GRID_COLUMNS:
+            stack = np.stack([np.asarray(getattr(c, col)) for c in self.cells]) if self.cells else np.empty((0,))
+            if col in ("regime_max_stable", "periods_stable"):
+                stack = stack.astype(str)
+            data[col] = (dims, stack.reshape(shape))
+        data["status"] = (self.names, np.asarray([c.status for c in self.cells], dtype=str).reshape(self.shape))
+        data["seconds"] = (self.names, np.asarray([c.timings.get("total", np.nan) for c in self.cells],
+                                                  dtype=float).reshape(self.shape))
+        coords = {p.name: np.asarray(p.values, dtype=float) for p in self.parameters}
+        coords["omega"] = self.omega
+        attrs = {
+            "title": "rattle response map",
+            "varied_keys": json.dumps({p.name: p.key for p in self.parameters}),
+            "settings": json.dumps(self.settings, default=str),
+        }
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    def rows(self) -> list[dict[str, Any]]:
+        """``map.csv`` rows: per (combination, frequency) the varied values by NAME, then
+        :data:`MAP_COLUMNS`."""
+        out = []
+        for (_, values), c in zip(self.combinations(), self.cells):
+            cols = c.columns()
+            for j in range(self.omega.size):
+                out.append({**values, **{k: cols[k][j] for k in MAP_COLUMNS}})
+        return out
+
+    def rattle_free_region(self) -> list[dict[str, Any]]:
+        """Per combination, its values and its rattle-free Ω intervals."""
+        return [{"values": v, "rattle_free": c.intervals.get("rattle_free", [])}
+                for (_, v), c in zip(self.combinations(), self.cells)]
+
+
+__all__ = ["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"]
