@@ -1,0 +1,467 @@
+"""The varied parameters of a response map (SPEC §7): names, grids, and the models they give.
+
+A parameter is named by a dotted key of the configuration tables or by a short name:
+
+==============  =================================  ==========================================
+short name      single equation (SPEC §2)          chain (SPEC §5): resolved when unambiguous
+==============  =================================  ==========================================
+``alpha``       ``model.elastic.alpha``            the one element with an ``alpha``
+``b``           ``model.elastic.b``                the one element with a ``b``
+``damping``     ``model.damping``                  the one link with a damping (the one > 0)
+``mean``        ``excitation.mean``                the one torque with a mean ≠ 0
+``amplitude``   ``excitation.amplitudes.1``        the one torque with a first harmonic ≠ 0
+==============  =================================  ==========================================
+
+In a dotted key, list positions count from 1 (``excitation.amplitudes.1`` is F_p1, the first
+harmonic; ``model.elements.2.b`` the second element's clearance), and an element may be named
+by its ``name`` (``model.elements.clutch.alpha``). Keys are resolved to their canonical form
+(numbers, not names).
+
+The grid of one parameter is ``NAME=START:STOP:COUNT`` (COUNT equally spaced values, START
+alone when COUNT is 1) or an explicit list ``NAME=v1,v2,v3``. Every combination's model is
+built and validated (:func:`build_all`) before any work, so that a value the model refuses is
+refused at once, naming the parameter, the value and the model's rule.
+
+Every refusal is a :class:`~rattle.errors.ConfigError` naming ```--vary```.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import itertools
+import math
+import re
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+from ._result import Parameter
+
+__all__ = [
+    "SHORT_NAMES", "MAX_VALUES", "MAX_COMBINATIONS", "parse_vary", "parse_all", "resolve", "numeric_keys",
+    "get_value", "apply", "parameters", "combinations", "build_all",
+]
+
+#: Short names and the dotted key they mean for a single-equation configuration (SPEC §7).
+SHORT_NAMES: dict[str, str] = {
+    "alpha": "model.elastic.alpha",
+    "b": "model.elastic.b",
+    "damping": "model.damping",
+    "mean": "excitation.mean",
+    "amplitude": "excitation.amplitudes.1",
+}
+#: Values one parameter may take (a grid of more is a typo: 1e6 values would be 1e6 frequency
+#: responses).
+MAX_VALUES = 10_000
+#: Combinations a map may have (each is a frequency response with its attractor search).
+MAX_COMBINATIONS = 100_000
+
+#: Keys that are numbers but not quantities a map can vary: indices of inertias, the
+#: analysis settings (the map's own axes and options).
+_NOT_PARAMETERS = {
+    "inertia": "it is the number of the inertia the torque acts on, not a quantity",
+    "between": "it numbers the inertias joined, not a quantity",
+    "harmonics": "it is a setting of the computation; give --harmonics instead",
+    "omega": "the frequency is the map's own axis; give --omega-min / --omega-max instead",
+}
+
+_OPTION = "`--vary`"
+
+
+def _err(message: str) -> ConfigError:
+    return ConfigError(f"{_OPTION} {message}")
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.10g}"
+
+
+# --------------------------------------------------------------------------------------------
+# NAME=START:STOP:COUNT
+# --------------------------------------------------------------------------------------------
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*(\.[A-Za-z0-9_\-]+)*$")
+
+
+def _number(text: str, what: str, whole: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise _err(f"{whole!r}: {what} must be a number, got {text!r}; write e.g. alpha=0.1:0.4:7") from None
+    if not math.isfinite(value):
+        raise _err(f"{whole!r}: {what} must be finite, got {text!r}; write e.g. alpha=0.1:0.4:7")
+    return value
+
+
+def parse_vary(text: str) -> tuple[str, tuple[float, ...]]:
+    """One ``--vary`` argument: ``NAME=START:STOP:COUNT`` or ``NAME=v1,v2,…``.
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    (name, values)
+        ``values``: COUNT equally spaced values from START to STOP (both included; START alone
+        when COUNT is 1), or the listed values in the order given.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``--vary``: no ``=``, an empty or malformed NAME, a START, STOP or value that is
+        not a finite number, a COUNT that is not an integer >= 1 (or above :data:`MAX_VALUES`),
+        a value given twice.
+    """
+    if not isinstance(text, str):
+        raise _err(f"must be a string NAME=START:STOP:COUNT, got {text!r} ({type(text).__name__})")
+    whole = text.strip()
+    name, eq, spec = whole.partition("=")
+    name, spec = name.strip(), spec.strip()
+    if not eq:
+        raise _err(f"{whole!r} has no `=`: write NAME=START:STOP:COUNT (e.g. alpha=0.1:0.4:7) or "
+                   "NAME=v1,v2,v3 (e.g. alpha=0.1,0.25)")
+    if not name or not _NAME.match(name):
+        raise _err(f"{whole!r}: NAME must be a short name ({', '.join(SHORT_NAMES)}) or a dotted key of the "
+                   f"configuration such as model.elastic.alpha, got {name!r}")
+    if not spec:
+        raise _err(f"{whole!r} gives no values after `=`: write {name}=START:STOP:COUNT (e.g. {name}=0.1:0.4:7)")
+    if ":" in spec:
+        parts = [p.strip() for p in spec.split(":")]
+        if len(parts) != 3:
+            raise _err(f"{whole!r}: the range must be START:STOP:COUNT (three parts), got {len(parts)} "
+                       f"part(s); write e.g. {name}=0.1:0.4:7")
+        start = _number(parts[0], "START", whole)
+        stop = _number(parts[1], "STOP", whole)
+        try:
+            count_f = float(parts[2])
+        except ValueError:
+            raise _err(f"{whole!r}: COUNT must be an integer >= 1, got {parts[2]!r}; write e.g. "
+                       f"{name}={parts[0]}:{parts[1]}:7") from None
+        if not math.isfinite(count_f) or count_f != int(count_f) or not re.fullmatch(r"[+]?\d+", parts[2]):
+            raise _err(f"{whole!r}: COUNT must be an integer >= 1 (the number of values), got {parts[2]!r}; "
+                       f"write e.g. {name}={parts[0]}:{parts[1]}:7")
+        count = int(count_f)
+        if count < 1:
+            raise _err(f"{whole!r}: COUNT must be an integer >= 1 (the number of values), got {count}; "
+                       f"write e.g. {name}={parts[0]}:{parts[1]}:7, or {name}={parts[0]}:{parts[0]}:1 for one value")
+        if count > MAX_VALUES:
+            raise _err(f"{whole!r}: COUNT must be <= {MAX_VALUES}, got {count}: every value is a frequency "
+                       "response per combination; use fewer values")
+        if count > 1 and start == stop:
+            raise _err(f"{whole!r}: START and STOP are equal ({_fmt(start)}) with COUNT {count}: the values would "
+                       f"repeat; give COUNT 1 or a STOP different from START")
+        values = tuple(float(v) for v in np.linspace(start, stop, count)) if count > 1 else (start,)
+    else:
+        parts = [p.strip() for p in spec.split(",")]
+        if any(not p for p in parts):
+            raise _err(f"{whole!r}: the list of values has an empty entry; write e.g. {name}=0.1,0.25,0.4")
+        if len(parts) > MAX_VALUES:
+            raise _err(f"{whole!r}: at most {MAX_VALUES} values, got {len(parts)}")
+        values = tuple(_number(p, "every value", whole) for p in parts)
+        seen: set[float] = set()
+        for v in values:
+            if v in seen:
+                raise _err(f"{whole!r}: the value {_fmt(v)} is given twice; list every value once")
+            seen.add(v)
+    return name, values
+
+
+def parse_all(texts: Iterable[str]) -> list[tuple[str, tuple[float, ...]]]:
+    """Every ``--vary`` argument (:func:`parse_vary`); at least one, each NAME once."""
+    out: list[tuple[str, tuple[float, ...]]] = []
+    for text in texts:
+        name, values = parse_vary(text)
+        if any(name == n for n, _ in out):
+            raise _err(f"gives {name!r} twice; give every parameter once (NAME=START:STOP:COUNT, or NAME=v1,v2,…)")
+        out.append((name, values))
+    if not out:
+        raise _err("is required: give at least one parameter, e.g. --vary alpha=0.1:0.4:7")
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Keys of the configuration tables
+# --------------------------------------------------------------------------------------------
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def numeric_keys(tables: Mapping[str, Any]) -> list[str]:
+    """Every dotted key (positions from 1) of ``tables`` whose value is a number a map may vary."""
+    out: list[str] = []
+
+    def walk(value: Any, path: list[str]) -> None:
+        if isinstance(value, Mapping):
+            for k, v in value.items():
+                if str(k) in _NOT_PARAMETERS or (not path and str(k) == "analysis"):
+                    continue
+                walk(v, [*path, str(k)])
+        elif isinstance(value, (list, tuple)):
+            for i, v in enumerate(value):
+                walk(v, [*path, str(i + 1)])
+        elif _is_number(value):
+            out.append(".".join(path))
+
+    walk(tables, [])
+    return out
+
+
+def _nearest(name: str, tables: Mapping[str, Any]) -> str:
+    keys = numeric_keys(tables)
+    close = difflib.get_close_matches(name, keys, n=4, cutoff=0.5)
+    if not close:
+        tail = name.rsplit(".", 1)[-1]
+        close = [k for k in keys if k.rsplit(".", 1)[-1] == tail][:4] or keys[:6]
+    return ", ".join(close) if close else "(none)"
+
+
+def _walk(tables: Mapping[str, Any], key: str, name: str) -> tuple[list[str], Any]:
+    """Follow ``key`` through the tables: (canonical path, value); refusals name ``name``."""
+    node: Any = tables
+    path: list[str] = []
+    shown = f"{name!r}" if name == key else f"{name!r} (key {key})"
+    for part in key.split("."):
+        here = ".".join(path) or "the configuration"
+        if isinstance(node, Mapping):
+            if part not in node:
+                raise _err(f"{shown}: {here} has no key {part!r}; the nearest keys a map can vary are: "
+                           f"{_nearest(key, tables)}")
+            node = node[part]
+            path.append(part)
+        elif isinstance(node, (list, tuple)):
+            if re.fullmatch(r"[+-]?\d+", part):
+                i = int(part)
+                if not 1 <= i <= len(node):
+                    if len(node) == 0:
+                        rule = f"{here} is empty"
+                    else:
+                        rule = f"{here} has {len(node)} entr{'y' if len(node) == 1 else 'ies'} (positions 1 … {len(node)})"
+                    extra = ""
+                    if i < 1:
+                        extra = "; positions count from 1"
+                    elif path and path[-1] in ("amplitudes", "phases"):
+                        extra = ("; a map does not add harmonics: write the harmonic into the configuration "
+                                 "file (e.g. amplitudes = [0.03, 0.0]) and vary it there")
+                    raise _err(f"{shown}: position {i} is out of range: {rule}{extra}")
+                node = node[i - 1]
+                path.append(str(i))
+            else:
+                named = [j for j, t in enumerate(node) if isinstance(t, Mapping) and t.get("name") == part]
+                if len(named) != 1:
+                    names = [str(t.get("name")) for t in node if isinstance(t, Mapping) and "name" in t]
+                    known = f"its names are {', '.join(names)}" if names else "its entries have no names"
+                    raise _err(f"{shown}: {here} is a list: give a position 1 … {len(node)}, or an entry's name "
+                               f"({known}), got {part!r}")
+                node = node[named[0]]
+                path.append(str(named[0] + 1))
+        else:
+            raise _err(f"{shown}: {here} is a number, it has no key {part!r}; the nearest keys a map can vary "
+                       f"are: {_nearest(key, tables)}")
+    return path, node
+
+
+def _short_on_chain(tables: Mapping[str, Any], name: str) -> str:
+    """A short name on a chain: the one table that holds that quantity, or a refusal listing the
+    dotted keys to use."""
+    model = tables.get("model", {})
+    excitation = tables.get("excitation", {})
+    elements = list(model.get("elements", []) or [])
+    links = list(model.get("links", []) or [])
+    torques = list(excitation.get("torques", []) or [])
+    if name in ("alpha", "b"):
+        cands = [f"model.elements.{i + 1}.{name}" for i, e in enumerate(elements) if _is_number(e.get(name))]
+        what, probe = f"elements with `{name}`", f"model.elements.1.{name}"
+    elif name == "damping":
+        cands = [f"model.links.{i + 1}.damping" for i, t in enumerate(links) if _is_number(t.get("damping"))]
+        if len(cands) > 1:
+            nonzero = [c for c, t in zip(cands, [t for t in links if _is_number(t.get("damping"))])
+                       if float(t["damping"]) != 0.0]
+            cands = nonzero if nonzero else cands
+        what, probe = "links with a damping", "model.links.1.damping"
+    elif name == "mean":
+        cands = [f"excitation.torques.{i + 1}.mean" for i, t in enumerate(torques)
+                 if _is_number(t.get("mean")) and float(t["mean"]) != 0.0]
+        what, probe = "torques with a mean ≠ 0", "excitation.torques.1.mean"
+    else:  # amplitude
+        cands = [f"excitation.torques.{i + 1}.amplitudes.1" for i, t in enumerate(torques)
+                 if t.get("amplitudes") and _is_number(t["amplitudes"][0]) and float(t["amplitudes"][0]) != 0.0]
+        what, probe = "torques with a first harmonic ≠ 0", "excitation.torques.1.amplitudes.1"
+    if len(cands) == 1:
+        return cands[0]
+    if not cands:
+        raise _err(f"{name!r}: this chain has no {what[:-1] if what.endswith('s') else what}; give a dotted "
+                   f"key instead, e.g. one of: {_nearest(probe, tables)}")
+    hint = ""
+    if name == "mean":
+        hint = " (the mean torques of a free chain must sum to zero: varying one alone is refused)"
+    raise _err(f"{name!r} is ambiguous on this chain, which has {len(cands)} {what}; give the dotted key of the "
+               f"one to vary: {', '.join(cands)}{hint}")
+
+
+def resolve(tables: Mapping[str, Any], name: str) -> str:
+    """The canonical dotted key (positions from 1) that ``name`` sets in ``tables``.
+
+    Parameters
+    ----------
+    tables : mapping
+        The configuration tables (a parsed TOML file, or :func:`rattle.io.model_to_toml_dict`).
+    name : str
+        A short name (:data:`SHORT_NAMES`) or a dotted key.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``--vary``: an unknown key (with the nearest valid keys), a key whose value is not
+        a number (a table, a list, the elastic ``type``), a position out of range, a short name
+        that is ambiguous on a chain (with the dotted keys to use), an analysis setting.
+    """
+    if not isinstance(name, str) or not name:
+        raise _err(f"NAME must be a non-empty string, got {name!r}")
+    chain = "inertias" in tables.get("model", {}) if isinstance(tables.get("model"), Mapping) else False
+    if name in SHORT_NAMES:
+        key = _short_on_chain(tables, name) if chain else SHORT_NAMES[name]
+    else:
+        key = name
+    if key.split(".")[0] == "analysis":
+        raise _err(f"{name!r}: the analysis settings are not design parameters: "
+                   f"{_NOT_PARAMETERS['omega']}, and --harmonics for the harmonics")
+    path, value = _walk(tables, key, name)
+    last = path[-1]
+    if last in _NOT_PARAMETERS or (last.isdigit() and len(path) > 1 and path[-2] in _NOT_PARAMETERS):
+        field = last if last in _NOT_PARAMETERS else path[-2]
+        raise _err(f"{name!r}: `{'.'.join(path)}` cannot be varied: {_NOT_PARAMETERS[field]}")
+    if not _is_number(value):
+        if isinstance(value, Mapping):
+            inner = [k for k in numeric_keys({"x": value}) if k.count(".") == 1]
+            opts = ", ".join(".".join(path) + k[1:] for k in inner) or _nearest(key, tables)
+            raise _err(f"{name!r}: `{'.'.join(path)}` is a table, not a number; vary one of its numbers: {opts}")
+        if isinstance(value, (list, tuple)):
+            n = len(value)
+            raise _err(f"{name!r}: `{'.'.join(path)}` is a list, not a number; vary one entry by its position "
+                       f"(from 1), e.g. {'.'.join(path)}.1" + (f" … {'.'.join(path)}.{n}" if n > 1 else ""))
+        raise _err(f"{name!r}: `{'.'.join(path)}` is {value!r} ({type(value).__name__}), not a number; a map varies "
+                   f"numbers only, e.g. {_nearest(key, tables)}")
+    return ".".join(path)
+
+
+def get_value(tables: Mapping[str, Any], key: str) -> float:
+    """The number at the canonical dotted ``key`` (from :func:`resolve`)."""
+    _, value = _walk(tables, key, key)
+    return float(value)
+
+
+def apply(tables: Mapping[str, Any], values: Mapping[str, float]) -> dict[str, Any]:
+    """A deep copy of ``tables`` with every dotted key in ``values`` set to its value.
+
+    Keys are resolved as by :func:`resolve` (short names included). Nothing is ever added: a
+    position beyond a list's end is refused (``excitation.amplitudes.2`` on a one-harmonic
+    excitation: write the harmonic into the file first), so that a map never changes the
+    structure of the configuration it was given.
+    """
+    out = copy.deepcopy(dict(tables))
+    for name, value in values.items():
+        key = resolve(out, name)
+        parts = key.split(".")
+        node: Any = out
+        for part in parts[:-1]:
+            node = node[int(part) - 1] if isinstance(node, list) else node[part]
+        last = parts[-1]
+        if isinstance(node, tuple):  # pragma: no cover - parsed TOML has lists
+            raise _err(f"{name!r}: `{key}` sits in a tuple; give the tables as parsed TOML (lists)")
+        if isinstance(node, list):
+            node[int(last) - 1] = float(value)
+        else:
+            node[last] = float(value)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Parameters, combinations and their models
+# --------------------------------------------------------------------------------------------
+def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | Sequence[Any]) -> tuple[Parameter, ...]:
+    """The :class:`Parameter` objects of ``vary`` (``{NAME: values}``, a sequence of
+    ``(NAME, values)`` or of Parameter), each NAME resolved in ``tables``; two NAMEs setting the
+    same key are refused, and so is a map of more than :data:`MAX_COMBINATIONS` combinations."""
+    items: list[tuple[str, Sequence[float]]] = []
+    if isinstance(vary, Mapping):
+        items = [(str(k), v) for k, v in vary.items()]
+    else:
+        for item in vary:
+            if isinstance(item, Parameter):
+                items.append((item.name, item.values))
+            else:
+                n, v = item
+                items.append((str(n), v))
+    if not items:
+        raise _err("is required: give at least one parameter, e.g. --vary alpha=0.1:0.4:7")
+    out: list[Parameter] = []
+    for name, values in items:
+        try:
+            vals = tuple(float(v) for v in np.asarray(values, dtype=float).ravel())
+        except (TypeError, ValueError):
+            raise _err(f"{name!r}: the values must be numbers, got {values!r}") from None
+        if not vals:
+            raise _err(f"{name!r}: give at least one value")
+        bad = [v for v in vals if not math.isfinite(v)]
+        if bad:
+            raise _err(f"{name!r}: every value must be finite, got {bad[0]!r}")
+        if len(set(vals)) != len(vals):
+            raise _err(f"{name!r}: a value is given twice ({vals}); give every value once")
+        key = resolve(tables, name)
+        for p in out:
+            if p.name == name:
+                raise _err(f"gives {name!r} twice; give every parameter once")
+            if p.key == key:
+                raise _err(f"{p.name!r} and {name!r} both set `{key}`; give it once")
+        out.append(Parameter(name=name, key=key, values=vals))
+    total = math.prod(len(p.values) for p in out)
+    if total > MAX_COMBINATIONS:
+        raise _err(f"gives {total} combinations ({' × '.join(str(len(p.values)) for p in out)}), more than "
+                   f"{MAX_COMBINATIONS}: each is a frequency response; use fewer values")
+    return tuple(out)
+
+
+def combinations(params: Sequence[Parameter]) -> Iterator[dict[str, float]]:
+    """``{key: value}`` of every combination, in C order (the last parameter varies fastest:
+    the order of :meth:`ResponseMap.combinations <rattle.maps.ResponseMap.combinations>`)."""
+    for values in itertools.product(*(p.values for p in params)):
+        yield {p.key: v for p, v in zip(params, values)}
+
+
+def _build(tables: Mapping[str, Any], setting: Mapping[str, float], shown: str) -> Any:
+    from ..io import config_from_dict  # the configuration reader: numpy and the model
+
+    try:
+        return config_from_dict(apply(tables, setting), source_name="<map>").model
+    except ConfigError as exc:
+        reason = str(exc)
+        if reason.startswith("<map>: "):
+            reason = reason[len("<map>: "):]
+        raise _err(f"{shown}: the model refuses this value: {reason}") from None
+
+
+def build_all(tables: Mapping[str, Any], params: Sequence[Parameter]) -> list[Any]:
+    """The model of every combination (C order), all built and validated before any work.
+
+    Each parameter's values are tried first on their own (the others at the configuration's
+    values), so that a refused value is named alone; then every combination.
+
+    Raises
+    ------
+    ConfigError
+        ``--vary NAME = VALUE (key): the model refuses this value: <the model's rule>``.
+    """
+    built: dict[tuple[tuple[str, float], ...], Any] = {}
+    for p in params:
+        for v in p.values:
+            built[((p.key, v),)] = _build(tables, {p.key: v}, f"{p.name} = {_fmt(v)} (`{p.key}`)")
+    if len(params) == 1:
+        return [built[((params[0].key, v),)] for v in params[0].values]
+    models = []
+    for setting in combinations(params):
+        shown = " with ".join(f"{p.name} = {_fmt(setting[p.key])}" for p in params)
+        models.append(_build(tables, setting, shown))
+    return models
