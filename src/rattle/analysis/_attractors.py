@@ -1,0 +1,311 @@
+"""A search for the attractors that a frequency response's branches do not explain.
+
+Continuation from the linear solution, with branch switching at period doublings, finds every
+solution connected to the primary branch. It misses what is not connected: isolated branches of
+period 1 (isolas), sub-harmonics born elsewhere (a saddle-node pair of period 3, say), and
+non-periodic (quasi-periodic, chaotic) attractors. This module looks for them by exact
+simulation (:func:`~rattle.analysis.steady_state`) on a frequency grid, and continues every new
+periodic attractor as a branch of its own (:func:`~rattle.analysis._branches.branch_from_seed`:
+followed both ways in Ω, an isola closed once).
+
+Where the simulations start (the budget, :class:`AttractorSearch`):
+
+1. **From unstable orbits, wherever no stable solution is known.** On every run of grid
+   frequencies where no branch has a stable solution, the simulation starts from the unstable
+   orbit there (its section state, nudged by ``nudge`` of the orbit's half peak-to-peak) and
+   then walks through the run carrying its state from one frequency to the next, like a time
+   sweep, restarting from an unstable orbit where a new branch has made the previous one
+   stable. What it settles on decides the grid frequency: a periodic attractor (continued as a
+   branch unless known) or a non-periodic one (period 0, SPEC §7).
+2. **A modest multi-start per frequency band.** The range is cut into ``bands`` equal bands;
+   at the middle grid frequency of each, ``starts`` initial states are simulated: points on
+   rings around the static equilibrium whose radii are fixed multiples (½, 1, 2, 3…) of the
+   largest half peak-to-peak of the solutions known there, at angles spread by the golden
+   ratio, velocities scaled by Ω (deterministic: the same starts on every engine).
+
+A simulated periodic attractor of period n is *explained* when a stable known solution of
+period n at the same Ω passes through its section state (scaled max-norm, ``match``, on the
+scales of :func:`~rattle.timeint.system_state_scale`); a non-periodic one is recorded at its
+grid frequency. Every unexplained periodic attractor is continued (at most ``max_branches``
+new branches per response), and its branch's solutions join the grid.
+
+What it may still miss, stated: an attractor whose basin none of the starts of its band reaches
+(small basins, bands where another attractor dominates), a sub-harmonic of period above
+``max_period`` (8 at most: the simulation's period detection), a non-periodic attractor
+coexisting with stable periodic ones outside the multi-start frequencies, and anything beyond
+``max_periods`` forcing periods of transient (reported as period 0).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..hb import HarmonicBalance
+from ..results import FrequencyResponse
+from ..timeint import SystemTrajectory
+from ..timeint._system_shooting import system_state_scale
+from ._branches import branch_from_seed
+from ._grid import GridSolution, solutions_on_grid
+from ._settings import RunSettings
+from ._steady import SteadyStateOptions, make_integrator, steady_state
+
+_GOLDEN = 0.5 * (1.0 + math.sqrt(5.0))
+#: Ring radii of the multi-start, as multiples of the largest known half peak-to-peak.
+_RADII = (0.5, 1.0, 2.0, 3.0, 1.5, 4.0, 0.25, 2.5)
+
+
+@dataclass(frozen=True)
+class AttractorSearch:
+    """Budget of the attractor search (module docstring).
+
+    Parameters
+    ----------
+    bands : int
+        Frequency bands of the multi-start (default 8; 0 switches the multi-start off).
+    starts : int
+        Initial states simulated per band (default 4).
+    from_unstable : bool
+        Simulate from the unstable orbits wherever no stable solution is known (default True).
+    max_branches : int
+        New branches continued per frequency response at most (default 8).
+    max_period : int
+        Largest period a simulation detects (default 8).
+    max_periods : int
+        Forcing periods a simulation may take to settle before it counts as non-periodic
+        (default 600).
+    match : float
+        Scaled distance under which a simulated orbit is a known solution (default 1e-3; HB
+        truncation errors are ~1e-6, distinct coexisting orbits differ by O(1)).
+    nudge : float
+        Start offset from an unstable orbit, relative to its half peak-to-peak (default 1e-2).
+    """
+
+    bands: int = 8
+    starts: int = 4
+    from_unstable: bool = True
+    max_branches: int = 8
+    max_period: int = 8
+    max_periods: int = 600
+    match: float = 1e-3
+    nudge: float = 1e-2
+
+    def __post_init__(self) -> None:
+        for name in ("bands", "starts", "max_branches", "max_period", "max_periods"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise ValueError(f"`{name}` must be an integer >= 0, got {value!r}")
+        if not 1 <= self.max_period <= 8:
+            raise ValueError(f"`max_period` must be in 1 … 8, got {self.max_period!r}")
+        for name in ("match", "nudge"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"`{name}` must be a number > 0, got {value!r}")
+
+    def steady_options(self) -> SteadyStateOptions:
+        return SteadyStateOptions(max_periods=self.max_periods, max_period_multiple=self.max_period,
+                                  record_periods=20)
+
+
+@dataclass(frozen=True)
+class NonPeriodic:
+    """A non-periodic attractor (period 0) seen at grid frequency ``omega`` (index ``index``):
+    its first element's measures over the recorded window, and whether some element impacts."""
+
+    index: int
+    omega: float
+    rms: float
+    rms_ac: float
+    impacts: bool
+    origin: str
+
+
+@dataclass
+class Census:
+    """Everything known on the grid after the search: the solutions of every branch (old and
+    new), the non-periodic attractors, the new branches, and a log of what was found."""
+
+    solutions: list[GridSolution]
+    nonperiodic: list[NonPeriodic] = field(default_factory=list)
+    branches: list[FrequencyResponse] = field(default_factory=list)
+    found: list[dict[str, Any]] = field(default_factory=list)
+    counts: dict[str, int] = field(default_factory=dict)
+
+
+def _impacts(state: Any) -> bool:
+    names = getattr(state, "element_names", ())
+    if names:
+        return any(str(m.regime) != "no_impact" for m in state.measures.element_measures)
+    return str(state.regime) != "no_impact"
+
+
+def _coefficients(model: Any, state: Any, hb: HarmonicBalance) -> FloatArray:
+    """HB coefficients (coordinate-major) of a settled periodic motion's exact trajectory."""
+    T = state.period * 2.0 * math.pi / state.omega
+    t = hb.basis.times(T)
+    traj = state.trajectory
+    if isinstance(traj, SystemTrajectory):
+        x = traj.sample(t).x  # (N, n)
+        return hb.basis.analyze(np.asarray(x).T).reshape(-1)
+    return hb.basis.analyze(np.asarray(traj.sample(t).delta))
+
+
+class _Search:
+    def __init__(self, frf: FrequencyResponse, grid: FloatArray, run: RunSettings, options: AttractorSearch,
+                 solutions: list[GridSolution]) -> None:
+        self.frf = frf
+        self.model = frf.model
+        self.system = self.model.system() if hasattr(self.model, "system") else self.model
+        self.grid = np.asarray(grid, dtype=float)
+        self.run = run
+        self.opts = options
+        self.steady = options.steady_options()
+        self.integ = make_integrator(self.model)
+        self.census = Census(solutions=list(solutions))
+        self.counts = {"simulations": 0, "periods": 0, "unexplained": 0, "branches": 0, "nonperiodic": 0}
+        self.next_branch = int(np.max(frf.branch)) + 1 if len(frf) else 1
+        self.range = (float(self.grid[0]), float(self.grid[-1]))
+        self.by_index: dict[int, list[GridSolution]] = {}
+        for s in self.census.solutions:
+            self.by_index.setdefault(s.index, []).append(s)
+
+    # --- what is known ------------------------------------------------------------------
+    def stable_at(self, j: int) -> list[GridSolution]:
+        return [s for s in self.by_index.get(j, []) if s.stable]
+
+    def scale(self, j: int) -> FloatArray:
+        return system_state_scale(self.system, float(self.grid[j]))
+
+    def explained(self, j: int, state: Any) -> bool:
+        n = int(state.period)
+        point = np.asarray(state.cycle[0], dtype=float)
+        sc = self.scale(j)
+        for s in self.stable_at(j):
+            if s.period != n:
+                continue
+            d = np.max(np.abs(s.section - point[None, :]) / sc[None, :], axis=1)
+            if float(np.min(d)) < self.opts.match:
+                return True
+        return False
+
+    # --- simulation ---------------------------------------------------------------------
+    def simulate(self, j: int, x0: FloatArray, origin: str) -> Any:
+        w = float(self.grid[j])
+        state = steady_state(self.model, w, x0, options=self.steady, integrator=self.integ)
+        self.counts["simulations"] += 1
+        self.counts["periods"] += int(state.periods)
+        if state.period == 0:
+            self.census.nonperiodic.append(NonPeriodic(j, w, float(state.rms), float(state.rms_ac),
+                                                       _impacts(state), origin))
+            self.counts["nonperiodic"] += 1
+        elif not self.explained(j, state):
+            self.counts["unexplained"] += 1
+            self.add_branch(j, state, origin)
+        return state
+
+    def add_branch(self, j: int, state: Any, origin: str) -> None:
+        w = float(self.grid[j])
+        record: dict[str, Any] = {"omega": w, "period": int(state.period), "origin": origin, "branch": None,
+                                  "rms": float(state.rms)}
+        self.census.found.append(record)
+        if self.counts["branches"] >= self.opts.max_branches:
+            record["note"] = "branch budget spent: not continued"
+            return
+        n = int(state.period)
+        H = n * self.run.hb.harmonics
+        hb = HarmonicBalance(self.model, self.run.for_harmonics(H), period=n)
+        q = _coefficients(self.model, state, hb)
+        branch = branch_from_seed(self.model, w, q, n, self.range, H, run=self.run, branch_id=self.next_branch)
+        if branch is None or len(branch) < 2:
+            record["note"] = "the seed did not converge in harmonic balance"
+            return
+        branch = replace(branch, settings=dict(branch.settings, branches=[{"branch": self.next_branch,
+                                                                           "harmonics": H, "period": n}]))
+        self.next_branch += 1
+        self.counts["branches"] += 1
+        record["branch"] = int(branch.branch[0])
+        self.census.branches.append(branch)
+        for s in solutions_on_grid(branch, self.grid, self.run):
+            self.census.solutions.append(s)
+            self.by_index.setdefault(s.index, []).append(s)
+        if not self.explained(j, state):
+            # The branch does not pass through the simulated orbit (HB with these harmonics
+            # converged elsewhere): keep the record honest.
+            record["note"] = "continued branch does not pass through the simulated orbit"
+
+    # --- 1. from unstable orbits ----------------------------------------------------------
+    def start_near(self, j: int) -> FloatArray | None:
+        """A state next to the unstable orbit at grid index j (the primary branch's, else any)."""
+        sols = sorted(self.by_index.get(j, []), key=lambda s: (s.branch, -s.rms))
+        if not sols:
+            return None
+        s = sols[0]
+        x = np.array(s.section[0], dtype=float)
+        n = x.size // 2
+        amp = max(0.5 * s.p2p, 1e-3 * float(self.system.length_scale()))
+        x[:n] += self.opts.nudge * amp
+        return x
+
+    def unstable_runs(self) -> None:
+        j = 0
+        N = self.grid.size
+        state = None
+        while j < N:
+            if self.stable_at(j):
+                state = None
+                j += 1
+                continue
+            x0 = self.start_near(j) if state is None or state.period != 0 else np.asarray(state.final_state)
+            if x0 is None:
+                x0 = None  # no solution known at all: start from rest at equilibrium
+            state = self.simulate(j, x0, "unstable orbit" if state is None else "carried from the previous frequency")
+            j += 1
+
+    # --- 2. multi-start ---------------------------------------------------------------------
+    def multistart(self) -> None:
+        B, K = self.opts.bands, self.opts.starts
+        if B == 0 or K == 0:
+            return
+        N = self.grid.size
+        edges = np.linspace(0, N, B + 1)
+        x_eq = np.asarray(self.system.static_equilibrium(), dtype=float)
+        n = x_eq.size
+        for b in range(B):
+            j = int(min(N - 1, (edges[b] + edges[b + 1]) // 2))
+            w = float(self.grid[j])
+            known = self.by_index.get(j, [])
+            amp = max([0.5 * s.p2p for s in known], default=0.0)
+            amp = max(amp, float(self.system.length_scale()))
+            for k in range(K):
+                angle = 2.0 * math.pi * ((k + b * K) * _GOLDEN % 1.0)
+                r = _RADII[k % len(_RADII)] * amp
+                x0 = np.concatenate((x_eq, np.zeros(n)))
+                # the first element's direction carries the offset (a free chain: the relative
+                # coordinates; a grounded chain: every coordinate alike)
+                x0[:n] += r * math.cos(angle)
+                x0[n:] += r * w * math.sin(angle)
+                self.simulate(j, x0, f"multi-start {k + 1}/{K} of band {b + 1}/{B}")
+
+
+def find_attractors(frf: FrequencyResponse, grid: FloatArray, run: RunSettings,
+                    options: AttractorSearch | None = None,
+                    solutions: list[GridSolution] | None = None) -> Census:
+    """The attractors on ``grid`` that the branches of ``frf`` do not explain (module
+    docstring), with every branch's solutions on the grid (``solutions``: those of ``frf``'s
+    branches if already computed)."""
+    options = options or AttractorSearch()
+    if solutions is None:
+        solutions = solutions_on_grid(frf, grid, run)
+    search = _Search(frf, grid, run, options, solutions)
+    if options.from_unstable:
+        search.unstable_runs()
+    search.multistart()
+    search.census.counts = dict(search.counts)
+    return search.census
+
+
+__all__ = ["AttractorSearch", "Census", "NonPeriodic", "find_attractors"]

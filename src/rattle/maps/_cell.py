@@ -1,0 +1,158 @@
+"""One combination of a response map: its frequency response, every attractor, on the Ω grid.
+
+:func:`compute_cell` is what an engine runs for every combination (a module-level function of
+plain, picklable arguments, so that local processes and Dask workers run the very same code and
+give the same bits). It
+
+1. builds the combination's model from its configuration tables
+   (:func:`rattle.io.config_from_dict`, the same validation as a file);
+2. computes its frequency response with sub-harmonic branch switching
+   (:func:`~rattle.analysis.frequency_response`, ``subharmonics=True``) — a response that stops
+   early keeps what it computed (status ``partial``);
+3. solves every branch exactly at the grid frequencies (:mod:`rattle.analysis._grid`);
+4. searches the attractors the branches do not explain and continues each new one as a branch
+   (:mod:`rattle.analysis._attractors`);
+5. summarises each grid frequency per SPEC §7 (:func:`summarise`) and the combination's
+   intervals and special points.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from ..analysis._attractors import AttractorSearch, Census, find_attractors
+from ..analysis._frequency_response import _frequency_response
+from ..analysis._grid import solutions_on_grid
+from ..analysis._settings import RunSettings
+from ..errors import RattleError
+from ..results import FrequencyResponse
+from ._result import INTERVAL_KINDS, CellResult
+
+
+def _runs(mask: np.ndarray, grid: np.ndarray) -> list[list[float]]:
+    """[first, last] grid frequency of every run of True in ``mask``."""
+    out: list[list[float]] = []
+    j, N = 0, mask.size
+    while j < N:
+        if mask[j]:
+            k = j
+            while k + 1 < N and mask[k + 1]:
+                k += 1
+            out.append([float(grid[j]), float(grid[k])])
+            j = k + 1
+        else:
+            j += 1
+    return out
+
+
+def summarise(census: Census, grid: np.ndarray) -> dict[str, Any]:
+    """The SPEC §7 columns on the grid, and the intervals of :data:`INTERVAL_KINDS`."""
+    N = grid.size
+    n_solutions = np.zeros(N, dtype=int)
+    n_stable = np.zeros(N, dtype=int)
+    rms_max = np.full(N, np.nan)
+    rms_ac_max = np.full(N, np.nan)
+    regime = np.full(N, "", dtype=object)
+    periods: list[set[int]] = [set() for _ in range(N)]
+    rattle = np.zeros(N, dtype=bool)
+    for s in census.solutions:
+        j = s.index
+        if s.branch == 0 and s.period == 1:
+            n_solutions[j] += 1
+            n_stable[j] += int(s.stable)
+        if not s.stable:
+            continue
+        periods[j].add(s.period)
+        rattle[j] |= s.impacts
+        if s.period == 1 and not (s.rms <= rms_max[j]):  # NaN compares False: the first one wins
+            rms_max[j], rms_ac_max[j], regime[j] = s.rms, s.rms_ac, s.regime
+    for p in census.nonperiodic:
+        periods[p.index].add(0)
+        rattle[p.index] |= p.impacts
+    periods_text = np.array([";".join(str(p) for p in sorted(ps)) for ps in periods], dtype=object)
+    intervals = {
+        "impact": _runs(rattle, grid),
+        "rattle_free": _runs(~rattle, grid),
+        "subharmonic": _runs(np.array([any(p >= 2 for p in ps) for ps in periods]), grid),
+        "nonperiodic": _runs(np.array([0 in ps for ps in periods]), grid),
+    }
+    assert set(intervals) == set(INTERVAL_KINDS)
+    return {
+        "n_solutions": n_solutions, "n_stable": n_stable, "rms_max_stable": rms_max,
+        "rms_ac_max_stable": rms_ac_max, "regime_max_stable": regime, "periods_stable": periods_text,
+        "rattle": rattle, "intervals": intervals,
+    }
+
+
+def _special_points(parts: list[FrequencyResponse]) -> list[dict[str, Any]]:
+    out = []
+    for frf in parts:
+        for sp in frf.special_points:
+            out.append({"kind": sp.kind, "omega": float(sp.omega), "branch": int(sp.branch),
+                        "period": int(frf.period[sp.index]), "rms": float(frf.rms[sp.index])})
+    return out
+
+
+def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
+    """One combination (``task``: ``tables`` — its configuration tables with the varied values
+    set —, ``values`` by NAME, ``omega`` (lo, hi), ``omega_points``, ``run`` the RunSettings,
+    ``max_period``, ``search`` the AttractorSearch) → :meth:`CellResult.to_dict`.
+
+    A combination whose frequency response fails numerically is not an error of the map: its
+    cell says ``failed`` (or ``partial``) with the reason, and the map goes on."""
+    from ..io import config_from_dict
+
+    t0 = time.perf_counter()
+    lo, hi = (float(x) for x in task["omega"])
+    grid = np.linspace(lo, hi, int(task["omega_points"]))
+    run: RunSettings = task["run"]
+    search: AttractorSearch = task["search"]
+    values = dict(task["values"])
+    model = config_from_dict(task["tables"], "<map combination>").model
+    timings: dict[str, float] = {}
+    status, message = "ok", ""
+    try:
+        frf = _frequency_response(model, (lo, hi), run, subharmonics=True, max_period=int(task["max_period"]),
+                                  throw=False)
+    except RattleError as exc:  # nothing computed: the cell says why
+        return _failed(values, grid, f"{type(exc).__name__}: {exc}", time.perf_counter() - t0)
+    if not frf.status.success:
+        status, message = "partial", frf.message
+    t1 = time.perf_counter()
+    timings["frequency_response"] = t1 - t0
+    solutions = solutions_on_grid(frf, grid, run)
+    t2 = time.perf_counter()
+    timings["grid"] = t2 - t1
+    census = find_attractors(frf, grid, run, search, solutions)
+    t3 = time.perf_counter()
+    timings["search"] = t3 - t2
+    summary = summarise(census, grid)
+    timings["total"] = time.perf_counter() - t0
+    intervals = summary.pop("intervals")
+    cell = CellResult(
+        values=values, omega=grid, **summary, special_points=_special_points([frf, *census.branches]),
+        intervals=intervals, attractors=census.found,
+        search={**census.counts, "bands": search.bands, "starts": search.starts,
+                "from_unstable": search.from_unstable, "max_branches": search.max_branches,
+                "max_periods": search.max_periods, "branches_of_response": int(len(np.unique(frf.branch)))},
+        status=status, message=message, timings=timings,
+    )
+    return cell.to_dict()
+
+
+def _failed(values: dict[str, float], grid: np.ndarray, message: str, seconds: float) -> dict[str, Any]:
+    N = grid.size
+    cell = CellResult(
+        values=values, omega=grid, n_solutions=np.zeros(N, dtype=int), n_stable=np.zeros(N, dtype=int),
+        rms_max_stable=np.full(N, np.nan), rms_ac_max_stable=np.full(N, np.nan),
+        regime_max_stable=np.full(N, "", dtype=object), periods_stable=np.full(N, "", dtype=object),
+        rattle=np.zeros(N, dtype=bool), intervals={k: [] for k in INTERVAL_KINDS}, status="failed",
+        message=message, timings={"total": seconds},
+    )
+    return cell.to_dict()
+
+
+__all__ = ["compute_cell", "summarise"]
