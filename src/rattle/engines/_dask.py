@@ -1,0 +1,187 @@
+"""The Dask engine: the tasks on a Dask distributed cluster (``rattle map --scheduler ADDRESS``).
+
+Each task is submitted with ``pure=False`` under a readable key (``rattle-<task key>-<run>``);
+results come back through ``distributed.as_completed`` and ``on_result`` is called in the calling
+thread as each arrives. A worker lost mid-task is the scheduler's business: it runs the task again
+on another worker (up to its ``distributed.scheduler.allowed-failures``, default 3; then the run
+fails with :class:`~rattle.engines.EngineError`). A task that raises is not retried: the run ends
+with :class:`~rattle.engines.TaskError`, every unfinished task cancelled.
+
+``distributed`` is imported here only when a run needs it (an optional dependency: ``pip install
+'rattle[dask]'``). Workers of a remote cluster must have rattle installed (the same version: the
+function is sent by reference).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import time
+import uuid
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from ..errors import ConfigError
+from ._base import EngineError, ProgressCallback, ResultCallback, Task, TaskError, check_run, check_workers, cpu_count
+
+#: Seconds to wait for a scheduler to answer before giving up.
+CONNECT_TIMEOUT = 10.0
+
+_INSTALL = "install it with `pip install 'rattle[dask]'` (or `pip install 'dask[distributed]'`)"
+
+
+def dask_available() -> bool:
+    """Whether ``distributed`` can be imported (without importing it)."""
+    return importlib.util.find_spec("distributed") is not None
+
+
+def _key_text(key: Any) -> str:
+    return re.sub(r"[^A-Za-z0-9_.=,+-]+", "_", str(key))[:120]
+
+
+class DaskEngine:
+    """Runs the tasks on a Dask distributed cluster.
+
+    Parameters
+    ----------
+    scheduler : str, distributed.Client or distributed.LocalCluster (or any cluster), optional
+        The scheduler's address (``tcp://host:8786``), a connected client (used, not closed), or
+        a cluster object (a client is opened on it and closed after each run). None: a
+        ``LocalCluster`` of ``workers`` single-threaded worker processes is started for each run
+        and closed after it.
+    workers : int, optional
+        Only with ``scheduler=None``: the LocalCluster's worker processes (default: the CPUs).
+    timeout : float
+        Seconds to wait for the scheduler (default 10).
+
+    ``workers`` is, after :meth:`connect`, the number of worker threads of the cluster.
+    """
+
+    name = "dask"
+
+    def __init__(self, scheduler: Any = None, workers: int | None = None, *,
+                 timeout: float = CONNECT_TIMEOUT) -> None:
+        if not dask_available():
+            raise ConfigError(f"`--scheduler` runs a map on Dask distributed, which is not installed: {_INSTALL}")
+        requested = check_workers(workers)
+        if scheduler is not None and requested is not None:
+            raise ValueError(
+                f"`workers` ({requested}) applies only to the LocalCluster started when no `scheduler` is given; "
+                "a cluster's size is set where the cluster is started"
+            )
+        if scheduler is not None and not isinstance(scheduler, str) and not hasattr(scheduler, "submit") \
+                and not hasattr(scheduler, "scheduler_address"):
+            raise TypeError(
+                f"`scheduler` must be an address ('tcp://host:8786'), a distributed.Client or a cluster, got {scheduler!r}"
+            )
+        if isinstance(scheduler, str) and not scheduler.strip():
+            raise ConfigError("`--scheduler` must be a Dask scheduler address such as tcp://host:8786, got ''")
+        self.scheduler = scheduler
+        self.timeout = float(timeout)
+        self.workers = requested if requested is not None else (cpu_count() if scheduler is None else 0)
+        self.last_run: dict[str, Any] = {}
+
+    def __repr__(self) -> str:
+        where = "LocalCluster" if self.scheduler is None else repr(self.scheduler)
+        return f"DaskEngine({where}, workers={self.workers})"
+
+    # -----------------------------------------------------------------------------------------
+    def connect(self) -> tuple[Any, Callable[[], None]]:
+        """A client on the cluster and the function that releases what this call opened.
+
+        Raises ConfigError naming ``--scheduler`` when the scheduler cannot be reached within
+        ``timeout`` seconds.
+        """
+        try:
+            import distributed
+        except ImportError as exc:  # pragma: no cover - find_spec said yes
+            raise ConfigError(f"`--scheduler` needs Dask distributed, which cannot be imported ({exc}): {_INSTALL}") \
+                from None
+        s = self.scheduler
+        if isinstance(s, distributed.Client):
+            self.workers = self._threads(s) or self.workers
+            return s, lambda: None
+        if s is None:
+            cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
+                                               dashboard_address=None)
+            try:
+                client = distributed.Client(cluster, timeout=self.timeout)
+            except BaseException:
+                cluster.close()
+                raise
+
+            def release() -> None:
+                client.close()
+                cluster.close()
+
+            return client, release
+        where = s if isinstance(s, str) else getattr(s, "scheduler_address", s)
+        try:
+            client = distributed.Client(s, timeout=self.timeout, set_as_default=False)
+        except (OSError, TimeoutError) as exc:
+            raise ConfigError(
+                f"`--scheduler` {where!r}: no Dask scheduler answered within {self.timeout:g} s ({exc}); "
+                "start one (`dask scheduler`, then `dask worker ADDRESS`) or give the address it prints, "
+                "e.g. tcp://127.0.0.1:8786"
+            ) from None
+        except ValueError as exc:
+            raise ConfigError(f"`--scheduler` {where!r} is not a Dask scheduler address ({exc}); "
+                              "use e.g. tcp://127.0.0.1:8786") from None
+        self.workers = self._threads(client) or self.workers
+        return client, client.close
+
+    @staticmethod
+    def _threads(client: Any) -> int:
+        try:
+            return int(sum(client.nthreads().values()))
+        except Exception:  # pragma: no cover - information only
+            return 0
+
+    # -----------------------------------------------------------------------------------------
+    def run(self, fn: Callable[[Any], Any], tasks: Sequence[Task], on_result: ResultCallback,
+            progress: ProgressCallback | None = None) -> None:
+        items = check_run(fn, tasks, on_result, progress, pickled=True)
+        total = len(items)
+        t0 = time.time()
+        self.last_run = {"wall": 0.0, "startup": None}
+        if total == 0:
+            return
+        import distributed
+
+        client, release = self.connect()
+        self.last_run["startup"] = time.time() - t0
+        futures: dict[Any, Any] = {}
+        try:
+            run_id = uuid.uuid4().hex[:8]
+            for key, payload in items:
+                future = client.submit(fn, payload, key=f"rattle-{_key_text(key)}-{run_id}", pure=False)
+                futures[future] = key
+            done = 0
+            for future in distributed.as_completed(list(futures)):
+                key = futures[future]
+                if future.status == "error":
+                    exc = future.exception()
+                    if isinstance(exc, distributed.KilledWorker):
+                        raise EngineError(
+                            f"task `{key}` was lost: the Dask workers running it died too often ({exc}); "
+                            "a task that kills its process needs a fix or more memory; run with the serial "
+                            "engine (--workers 1) to see the error", key,
+                        ) from exc
+                    raise TaskError(key, exc) from exc
+                if future.status == "cancelled":
+                    raise EngineError(f"task `{key}` was cancelled on the Dask cluster (by someone else?)", key)
+                result = future.result()
+                future.release()
+                del futures[future]
+                done += 1
+                on_result(key, result)
+                if progress is not None:
+                    progress(done, total)
+        finally:
+            if futures:
+                try:
+                    client.cancel(list(futures), force=True)
+                except Exception:  # pragma: no cover - the client is going anyway
+                    pass
+            release()
+            self.last_run["wall"] = time.time() - t0
