@@ -71,6 +71,15 @@ _NOT_PARAMETERS = {
 _OPTION = "`--vary`"
 
 
+def _not_parameter(path: Sequence[str]) -> str | None:
+    """Why the key at ``path`` cannot be varied (its field's entry in ``_NOT_PARAMETERS``), or None.
+    ``inertia`` is an index only in a torque (``model.inertia`` of SPEC §2 is a quantity)."""
+    for k, part in enumerate(path):
+        if part in _NOT_PARAMETERS and not (part == "inertia" and "torques" not in path[:k]):
+            return part
+    return None
+
+
 def _err(message: str) -> ConfigError:
     return ConfigError(f"{_OPTION} {message}")
 
@@ -196,7 +205,7 @@ def numeric_keys(tables: Mapping[str, Any]) -> list[str]:
     def walk(value: Any, path: list[str]) -> None:
         if isinstance(value, Mapping):
             for k, v in value.items():
-                if str(k) in _NOT_PARAMETERS or (not path and str(k) == "analysis"):
+                if _not_parameter([*path, str(k)]) or (not path and str(k) == "analysis"):
                     continue
                 walk(v, [*path, str(k)])
         elif isinstance(value, (list, tuple)):
@@ -329,9 +338,8 @@ def resolve(tables: Mapping[str, Any], name: str) -> str:
         raise _err(f"{name!r}: the analysis settings are not design parameters: "
                    f"{_NOT_PARAMETERS['omega']}, and --harmonics for the harmonics")
     path, value = _walk(tables, key, name)
-    last = path[-1]
-    if last in _NOT_PARAMETERS or (last.isdigit() and len(path) > 1 and path[-2] in _NOT_PARAMETERS):
-        field = last if last in _NOT_PARAMETERS else path[-2]
+    field = _not_parameter(path)
+    if field is not None:
         raise _err(f"{name!r}: `{'.'.join(path)}` cannot be varied: {_NOT_PARAMETERS[field]}")
     if not _is_number(value):
         if isinstance(value, Mapping):
