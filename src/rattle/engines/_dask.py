@@ -105,7 +105,7 @@ class DaskEngine:
             cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
                                                dashboard_address=None)
             try:
-                client = distributed.Client(cluster, timeout=self.timeout)
+                client = distributed.Client(cluster, timeout=self.timeout, set_as_default=False)
             except BaseException:
                 cluster.close()
                 raise
@@ -157,7 +157,7 @@ class DaskEngine:
                 future = client.submit(fn, payload, key=f"rattle-{_key_text(key)}-{run_id}", pure=False)
                 futures[future] = key
             done = 0
-            for future in distributed.as_completed(list(futures)):
+            for future in distributed.as_completed(list(futures), loop=client.loop):
                 key = futures[future]
                 if future.status == "error":
                     exc = future.exception()
