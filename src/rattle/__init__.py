@@ -57,6 +57,7 @@ _LAZY: dict[str, str] = {
         ".results",
     ),
     **dict.fromkeys(["Hill", "Monodromy"], ".stability"),
+    **dict.fromkeys(["AttractorSearch", "ResponseMap", "response_map"], ".maps"),
     **dict.fromkeys(
         ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
     ),
@@ -64,7 +65,8 @@ _LAZY: dict[str, str] = {
 
 #: Sub-packages reachable as attributes of ``rattle`` (imported on first use, as eagerly before).
 _SUBPACKAGES = frozenset({
-    "analysis", "continuation", "demo", "errors", "hb", "io", "measures", "model", "plotting", "results",
+    "analysis", "continuation", "demo", "engines", "errors", "hb", "io", "maps", "measures", "model", "plotting",
+    "results",
     "stability", "timeint",
 })
 
@@ -77,6 +79,7 @@ __all__ = [
     "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse",
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
     "shoot_periodic_orbit", "periodic_orbit", "PeriodicOrbit", "OrbitSolution", "compare", "Comparison",
+    "response_map", "ResponseMap", "AttractorSearch",
     # options and method objects
     "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     # extension points: problems, the stepper, the integrators
@@ -121,5 +124,6 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
         Comparison, FrequencyResponse, LinearResponse, OrbitSolution, PeriodicOrbit, Region, SpecialPoint,
         SweepResult, linear_frequency_response,
     )
+    from .maps import AttractorSearch, ResponseMap, response_map
     from .stability import Hill, Monodromy
     from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit

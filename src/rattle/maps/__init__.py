@@ -6,6 +6,9 @@ Layer: above :mod:`rattle.analysis` (which computes one combination) and :mod:`r
 (configuration tables, atomic writes); below the command line.
 """
 
+from ..analysis._attractors import AttractorSearch
+from ._map import DEFAULT_OMEGA_POINTS, response_map
 from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap
 
-__all__ = ["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"]
+__all__ = ["response_map", "AttractorSearch", "CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS",
+           "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS"]

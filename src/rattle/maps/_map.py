@@ -1,0 +1,213 @@
+"""``response_map``: a frequency response with every attractor for every combination of the
+varied parameters, on one Ω grid (SPEC §7).
+
+The map is embarrassingly parallel over combinations: every combination is one task,
+:func:`rattle.maps._cell.compute_cell` of plain arguments (its configuration tables with the
+varied values set, the run's settings), run by an engine (:mod:`rattle.engines`: serial, local
+processes — the default —, or a Dask cluster). Each finished combination is handed back at
+once and, with a ``store``, written to disk atomically as it completes; a rerun with the same
+arguments into the same store reads finished combinations back instead of recomputing them (a
+combination is identified by a hash of everything that determines its result: its tables,
+the grid, the settings and the rattle version). The assembled map is the same, bit for bit,
+whichever engine ran it and however often it was interrupted.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict
+from typing import Any
+
+import numpy as np
+
+from .._validate import check_int
+from ..analysis._attractors import AttractorSearch
+from ..analysis._frequency_response import check_range
+from ..analysis._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
+from ..continuation import ContinuationOptions, NewtonOptions
+from ..hb import HBOptions
+from ._cell import compute_cell
+from ._result import CellResult, Parameter, ResponseMap
+
+#: Default number of grid frequencies (SPEC §7).
+DEFAULT_OMEGA_POINTS = 146
+
+ProgressCallback = Callable[[int, int, int], None]
+
+
+def _tables_of(model: Any, tables: Mapping[str, Any] | None) -> tuple[dict[str, Any], Any]:
+    """The configuration tables of the map and the analysis settings they carry (or None)."""
+    from ..io import RunConfig, model_to_toml_dict
+
+    config = getattr(model, "config", None)
+    if isinstance(model, RunConfig):
+        config = model
+    if tables is not None:
+        return {k: v for k, v in dict(tables).items()}, getattr(config, "analysis", None)
+    if config is not None:  # a Case (load_case) or a RunConfig: the resolved file
+        return model_to_toml_dict(config.model), config.analysis
+    return model_to_toml_dict(model), None
+
+
+def _version() -> str:
+    from .._release import version
+
+    return version()
+
+
+def response_map(
+    model: Any,
+    vary: Mapping[str, Sequence[float]] | Sequence[Parameter] | Sequence[tuple[str, Sequence[float]]],
+    omega: tuple[float, float] | None = None,
+    omega_points: int = DEFAULT_OMEGA_POINTS,
+    harmonics: int = DEFAULT_HARMONICS,
+    *,
+    samples: int | None = None,
+    hb: HBOptions | None = None,
+    stability: StabilityMethod = "monodromy",
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    max_period: int = 4,
+    search: AttractorSearch | None = None,
+    engine: Any = None,
+    workers: int | None = None,
+    scheduler: Any = None,
+    store: str | os.PathLike[str] | Any = None,
+    progress: ProgressCallback | None = None,
+    tables: Mapping[str, Any] | None = None,
+) -> ResponseMap:
+    """Response map of ``model`` over the varied parameters and the forcing frequency.
+
+    For every combination of the values in ``vary`` (``{NAME: values}``; NAME a dotted key of
+    the configuration — ``model.elastic.alpha``, ``excitation.amplitudes.1``,
+    ``model.elements.clutch.b`` — or a short name ``alpha``, ``b``, ``damping``, ``mean``,
+    ``amplitude``; see :mod:`rattle.maps._vary`): the frequency response over ``omega`` with
+    sub-harmonic branches up to period ``max_period``, every branch solved exactly at
+    ``omega_points`` equally spaced frequencies, and the attractor search of ``search``
+    (:class:`~rattle.analysis._attractors.AttractorSearch`: simulations from unstable orbits
+    wherever nothing stable is known and a multi-start per band; every new periodic attractor
+    continued as a branch). Summarised per grid frequency as SPEC §7's ``map.csv`` columns.
+
+    Every combination's model is built and validated first: a name that resolves to nothing,
+    or a value the model refuses, raises :class:`~rattle.errors.ConfigError` before any work.
+
+    Parameters
+    ----------
+    model : Model, Chain, or a Case (:func:`rattle.load_case`)
+        The base model; a Case also gives the default range (its ``analysis.omega``) and harmonics.
+    omega : (float, float), optional
+        Frequency range (default: the case's, else (0.1, 3.0)).
+    omega_points : int
+        Grid frequencies (default 146).
+    harmonics, samples, hb, stability, continuation, newton
+        The run's settings, as :func:`rattle.frequency_response`; carried whole into every
+        combination (and into the store's identity of a combination).
+    engine : "serial", "processes", "dask" or an Engine, optional
+        Default: local processes (serial for one combination); ``dask`` with a ``scheduler``.
+    workers : int, optional
+        Worker processes (default: the CPUs, at most one per combination).
+    scheduler : str or distributed.Client, optional
+        A Dask scheduler address: run on that cluster.
+    store : path or MapStore, optional
+        Where finished combinations are kept (``<store>/map.parts``): written as each finishes,
+        read back by a rerun.
+    progress : callable(done, total, resumed), optional
+        Called once with the combinations read back, then after each finished combination.
+    tables : dict, optional
+        The configuration tables to vary (a parsed TOML file); default from ``model``.
+
+    Returns
+    -------
+    ResponseMap
+    """
+    from ..engines import make_engine
+    from ._store import MapStore
+    from ._vary import apply, build_all, combinations, parameters
+
+    t_start = time.perf_counter()
+    base, analysis = _tables_of(model, tables)
+    if omega is None:
+        omega = analysis.omega if analysis is not None else (0.1, 3.0)
+    lo, hi = check_range(omega, "omega")
+    omega_points = check_int("omega_points", omega_points, 2)
+    if analysis is not None and harmonics is DEFAULT_HARMONICS and hb is None:
+        harmonics = analysis.harmonics
+    hb_opts = resolve_hb(harmonics, samples, hb)
+    run = RunSettings.make(hb_opts, newton, continuation, stability)
+    max_period = check_int("max_period", max_period, 1)
+    if search is None:
+        search = AttractorSearch()
+    elif not isinstance(search, AttractorSearch):
+        raise TypeError(f"`search` must be an AttractorSearch or None, got {search!r}")
+    params = parameters(base, vary)
+    build_all(base, params)  # every combination's model, validated before any work
+
+    settings = {**run.record(), "omega": [lo, hi], "omega_points": omega_points, "max_period": max_period,
+                "search": asdict(search)}
+    version = _version()
+    tasks: list[tuple[int, dict[str, Any]]] = []
+    keys: list[str] = []
+    names = [p.name for p in params]
+    for flat, setting in enumerate(combinations(params)):
+        values = {name: setting[p.key] for name, p in zip(names, params)}
+        cell_tables = apply(base, setting)
+        task = {"tables": cell_tables, "values": values, "omega": (lo, hi), "omega_points": omega_points,
+                "run": run, "max_period": max_period, "search": search}
+        tasks.append((flat, task))
+        keys.append(_fingerprint_key(cell_tables, values, settings, version))
+
+    the_store = None
+    if store is not None:
+        the_store = store if isinstance(store, MapStore) else MapStore(store)
+    results: dict[int, CellResult] = {}
+    if the_store is not None:
+        for flat, key in enumerate(keys):
+            data = the_store.load(key)
+            if data is not None:
+                results[flat] = CellResult.from_dict(data, resumed=True)
+    todo = [(flat, task) for flat, task in tasks if flat not in results]
+    total = len(tasks)
+    resumed = len(results)
+    if progress is not None:
+        progress(resumed, total, resumed)
+
+    def on_result(flat: int, data: dict[str, Any]) -> None:
+        if the_store is not None:
+            the_store.save(keys[flat], data)
+        results[flat] = CellResult.from_dict(data)
+        if progress is not None:
+            progress(len(results), total, resumed)
+
+    engine_used = "none"
+    if todo:
+        if engine is None and scheduler is None and workers is None and len(todo) == 1:
+            engine = "serial"
+        runner = make_engine(engine, workers=workers, scheduler=scheduler)
+        engine_used = runner.name
+        runner.run(compute_cell, todo, on_result)
+    cells = tuple(results[flat] for flat in range(total))
+    grid = np.linspace(lo, hi, omega_points)
+    wall = time.perf_counter() - t_start
+    computed = [c.timings.get("total", math.nan) for c in cells if not c.resumed]
+    return ResponseMap(
+        parameters=params, omega=grid, cells=cells,
+        settings={**settings, "engine": engine_used, "workers": getattr(locals().get("runner"), "workers", 0),
+                  "version": version},
+        timings={"wall": wall, "combinations": float(np.nansum(computed)) if computed else 0.0,
+                 "computed": len(computed), "resumed": resumed},
+        config=base,
+    )
+
+
+def _fingerprint_key(tables: dict[str, Any], values: dict[str, float], settings: dict[str, Any],
+                     version: str) -> str:
+    """The store's identity of one combination: a hash of everything its result depends on."""
+    from ._store import MapStore
+
+    return MapStore.key({"tables": tables, "values": values, "settings": settings, "version": version})
+
+
+__all__ = ["response_map", "DEFAULT_OMEGA_POINTS"]
