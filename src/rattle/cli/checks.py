@@ -30,7 +30,12 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 __all__ = [
     "MAX_PERIOD", "DIRECTIONS", "VIRTUAL_FILESYSTEMS", "output_path", "override_analysis", "check_output_dir",
     "precheck", "as_bad_input", "check_points", "check_workers", "check_omega", "check_period", "parse_at",
+    "MAX_OMEGA_POINTS", "check_omega_points", "check_scheduler",
 ]
+
+#: Most grid frequencies ``rattle map --omega-points`` accepts (each is an exact solve of every
+#: branch per combination).
+MAX_OMEGA_POINTS = 10_000
 
 #: Largest period (multiple of the forcing period) that ``rattle orbit --period`` accepts.
 MAX_PERIOD = 8
@@ -269,6 +274,31 @@ def check_workers(workers: int) -> int:
 
     with as_bad_input():
         return _limits.check_workers(workers, "--workers")
+
+
+def check_omega_points(points: int) -> int:
+    """``rattle map --omega-points`` N: an integer 2 … :data:`MAX_OMEGA_POINTS`."""
+    if not 2 <= points <= MAX_OMEGA_POINTS:
+        raise ConfigError(
+            f"`--omega-points` must be an integer 2 … {MAX_OMEGA_POINTS} (frequencies of the map's grid), got "
+            f"{points}; use e.g. 146"
+        )
+    return points
+
+
+def check_scheduler(scheduler: str | None) -> str | None:
+    """``rattle map --scheduler ADDRESS``: a non-blank address, and Dask distributed installed."""
+    if scheduler is None:
+        return None
+    if not scheduler.strip():
+        raise ConfigError(f"`--scheduler` must be a Dask scheduler address such as tcp://10.0.0.5:8786, got "
+                          f"{scheduler!r}; leave it out to run on local processes")
+    import importlib.util
+
+    if importlib.util.find_spec("distributed") is None:
+        raise ConfigError(f"`--scheduler` {scheduler!r} needs Dask distributed, which is not installed: "
+                          "pip install 'rattle[dask]', or leave --scheduler out to run on local processes")
+    return scheduler.strip()
 
 
 def check_omega(omega: float, option: str = "--omega", model: Model | None = None) -> float:

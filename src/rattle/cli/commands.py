@@ -17,11 +17,13 @@ import click
 
 from ..errors import ConfigError, ConvergenceError
 from .checks import (
-    DIRECTIONS, MAX_PERIOD, check_omega, check_period, output_path, override_analysis, parse_at, precheck,
+    DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, output_path,
+    override_analysis, parse_at, precheck,
 )
 from .output import (
-    COMPARE_FILES, FRF_FILES, ORBIT_FILES, SWEEP_FILES, ProgressBar, echo_written, logger, metadata_writer,
-    one_line, save_figure, save_plot, sections, set_verbose, write_frf, write_set,
+    COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
+    map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections,
+    set_verbose, warning, write_frf, write_set,
 )
 
 if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
@@ -30,7 +32,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 
 __all__ = [
     "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf",
-    "frf_command", "sweep_command", "orbit_command", "compare_command", "demo_command",
+    "frf_command", "sweep_command", "orbit_command", "compare_command", "map_command", "demo_command",
 ]
 
 #: Output directory when ``-o`` is not given.
@@ -339,6 +341,101 @@ def compare_command(
 
 
 # --------------------------------------------------------------------------------------------
+# rattle map: a frequency response with every attractor for every combination of parameters
+# --------------------------------------------------------------------------------------------
+@click.command("map", short_help="Response map over design parameters and frequency (where rattle is avoided).")
+@common_options
+@click.argument("config", type=click.Path(path_type=Path))
+@_output_option
+@click.option("--vary", "vary", type=str, multiple=True, metavar="NAME=START:STOP:COUNT",
+              help="A varied parameter: a short name (alpha, b, damping, mean, amplitude) or a dotted key of the "
+                   "configuration (model.elastic.alpha, excitation.amplitudes.1, model.elements.clutch.b), "
+                   "COUNT values from START to STOP, or NAME=v1,v2,v3. Repeat for more parameters.")
+@click.option("--omega-points", "omega_points", type=int, default=146, show_default=True, metavar="N",
+              help="Frequencies of the map's grid over the analysis range.")
+@click.option("--workers", type=int, default=None, metavar="W",
+              help="Local worker processes (default: the CPUs); 1 runs serially.")
+@click.option("--scheduler", type=str, default=None, metavar="ADDRESS",
+              help="Run on a Dask distributed cluster at ADDRESS (tcp://host:8786); needs rattle[dask].")
+@_harmonics_option
+@_omega_min_option
+@_omega_max_option
+@click.option("--report", is_flag=True, default=False,
+              help="Also write map.md, the design summary (special points, rattle-free intervals, the search).")
+@_quiet_option
+def map_command(
+    config: Path, output: Path, vary: tuple[str, ...], omega_points: int, workers: int | None,
+    scheduler: str | None, harmonics: int | None, omega_min: float | None, omega_max: float | None,
+    report: bool, quiet: bool,
+) -> None:
+    """Response map of the model in CONFIG over the --vary parameters and the frequency: map.csv,
+    map.nc, map.json, map.png (and map.md with --report) in OUTPUT.
+
+    For every combination of the varied values: the frequency response with its sub-harmonic
+    branches, every branch solved on the grid of N frequencies, and a search for the attractors
+    the branches miss. Every combination finished is kept in OUTPUT/map.parts: a rerun of the
+    same command into the same folder reads them back instead of recomputing them.
+    """
+    from ..maps import _vary
+
+    parsed = _vary.parse_all(vary)  # first: a malformed --vary needs no file
+    precheck(config, output, harmonics=harmonics, workers=workers)
+    check_omega_points(omega_points)
+    scheduler = check_scheduler(scheduler)
+    run_config = _io().load_config(config)
+    analysis = override_analysis(
+        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+    )
+    tables = _io().model_to_toml_dict(run_config.model, analysis)
+    params = _vary.parameters(tables, parsed)
+    _vary.build_all(tables, params)  # every combination's model, before any work
+    t_start = time.perf_counter()
+    from ..maps import response_map  # only now: all input has been validated
+
+    logger.info("response map: %d combinations × %d frequencies over %g … %g rad/s",
+                len(list(_vary.combinations(params))), omega_points, analysis.omega_min, analysis.omega_max)
+    bar = MapProgress("map", enabled=not quiet)
+    try:
+        result = response_map(run_config.model, params, omega=analysis.omega, omega_points=omega_points,
+                              harmonics=analysis.harmonics, workers=workers, scheduler=scheduler, store=output,
+                              progress=bar, tables=tables)
+    finally:
+        bar.close()
+    from ..maps._report import map_report
+    from ..plotting._map import map_plot_names, plot_map
+
+    figures = map_plot_names(result)
+    meta = sections("map", config, run_config, analysis, {
+        "vary": list(vary), "omega_points": omega_points, "workers": workers, "scheduler": scheduler,
+        "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "report": True if report else None,
+    })
+
+    def write_nc(path: Path) -> None:
+        with _io().atomic_path(path) as tmp:
+            result.dataset.to_netcdf(tmp, engine="scipy")
+
+    steps: list[tuple[str, Any]] = [
+        ("map.csv", map_csv_writer(result)),
+        ("map.nc", write_nc),
+        ("map.json", map_json_writer(result, meta, t_start)),
+        *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y), path)) for name, name_y in figures],
+    ]
+    if report:
+        steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
+    names = (*MAP_FILES, *(name for name, _ in figures[1:]))
+    written = write_set(output, names, steps)
+    failed = [c for c in result.cells if c.status == "failed"]
+    echo_written(map_summary(result), written, output)
+    if failed and len(failed) == len(result.cells):
+        raise ConvergenceError(f"every combination failed; the first: {failed[0].message}; the files written say "
+                               "which (status in map.json)")
+    for c in failed[:5]:
+        warning(f"combination {', '.join(f'{k} = {v:g}' for k, v in c.values.items())} failed: {c.message}")
+    if len(failed) > 5:
+        warning(f"{len(failed) - 5} further combinations failed (status in map.json)")
+
+
+# --------------------------------------------------------------------------------------------
 # rattle demo: the paper's reference case end to end (rattle.demo computes, this writes)
 # --------------------------------------------------------------------------------------------
 @click.command("demo", short_help="The paper's reference case end to end, with its figures and a report.")
@@ -421,4 +518,4 @@ def demo_command(output: Path, quiet: bool) -> None:
 
 
 #: Every command of ``rattle``, in the order of the documentation.
-COMMANDS = (frf_command, sweep_command, orbit_command, compare_command, demo_command)
+COMMANDS = (frf_command, sweep_command, orbit_command, compare_command, map_command, demo_command)

@@ -24,7 +24,8 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 __all__ = [
     "FRF_FILES", "SWEEP_FILES", "ORBIT_FILES", "COMPARE_FILES", "Writer", "ProgressBar", "write_set", "save_figure",
     "save_plot", "frf_steps", "write_frf", "metadata_writer", "sections", "echo_written", "error", "warning",
-    "one_line", "set_verbose", "reset_verbose", "logger",
+    "one_line", "set_verbose", "reset_verbose", "logger", "MAP_FILES", "MapProgress", "map_csv_writer",
+    "map_json_writer", "map_summary",
 ]
 
 logger = logging.getLogger("rattle")
@@ -36,6 +37,9 @@ FRF_FILES = ("frf.csv", "frf.json", "frf.png")
 SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")
 ORBIT_FILES = ("orbit.csv", "orbit.json", "orbit.png")
 COMPARE_FILES = ("frf.csv", "sweep.csv", "compare.json", "compare.png")
+#: ``rattle map``: with two or more varied parameters also ``map_<NAME>.png`` for each one after
+#: the first (:func:`rattle.plotting._map.map_plot_names`); ``map.md`` with ``--report``.
+MAP_FILES = ("map.csv", "map.nc", "map.json", "map.png", "map.md")
 
 
 def _io() -> Any:
@@ -103,6 +107,38 @@ class ProgressBar:
                 return
             self._bar = tqdm(total=total, desc=self.description, unit="Ω", file=sys.stderr, leave=False,
                              dynamic_ncols=True)
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+
+class MapProgress:
+    """``progress(done, total, resumed)`` of a response map drawing a tqdm bar on stderr, counting
+    finished combinations: those read back from an earlier run are counted at once (the bar
+    starts there, so that its rate and time left are those of the combinations computed now).
+    A no-op when stderr is not a terminal, with ``--quiet``, or without tqdm."""
+
+    def __init__(self, description: str, enabled: bool) -> None:
+        self.description = description
+        self.enabled = enabled and sys.stderr.isatty()
+        self._bar: Any = None
+
+    def __call__(self, done: int, total: int, resumed: int = 0) -> None:
+        if not self.enabled:
+            return
+        if self._bar is None:
+            try:
+                from tqdm import tqdm
+            except ImportError:  # pragma: no cover - tqdm is a dependency
+                self.enabled = False
+                return
+            desc = f"{self.description} ({resumed} resumed)" if resumed else self.description
+            self._bar = tqdm(total=total, initial=min(done, total), desc=desc, unit="combination",
+                             file=sys.stderr, leave=False, dynamic_ncols=True)
+            return
         self._bar.update(done - self._bar.n)
 
     def close(self) -> None:
@@ -210,3 +246,76 @@ def write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: floa
     """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output`` as one set (``names``: the
     command's whole set, see :func:`write_set`); return the names written."""
     return write_set(output, names, frf_steps(result, sections, t_start))
+
+
+# --------------------------------------------------------------------------------------------
+# rattle map
+# --------------------------------------------------------------------------------------------
+def map_csv_writer(response_map: Any) -> Writer:
+    """A writer of ``map.csv``: one row per (combination, grid frequency), the varied NAMEs then
+    :data:`rattle.maps.MAP_COLUMNS`; ``rms_max_stable``/``rms_ac_max_stable`` empty where NaN."""
+
+    def write(path: Path) -> None:
+        import math
+
+        from ..maps import MAP_COLUMNS
+
+        order = [*response_map.names, *MAP_COLUMNS]
+        rows = response_map.rows()
+        columns: dict[str, list[Any]] = {name: [] for name in order}
+        for row in rows:
+            for name in order:
+                value = row[name]
+                if isinstance(value, float) and math.isnan(value):
+                    value = None
+                elif hasattr(value, "item"):  # numpy scalar -> Python
+                    value = value.item()
+                    if isinstance(value, float) and math.isnan(value):
+                        value = None
+                columns[name].append(value)
+        _io().write_csv(path, columns, order)
+
+    return write
+
+
+def map_json_writer(response_map: Any, sections: dict[str, Any], t_start: float) -> Writer:
+    """A writer of ``map.json``: the command's ``sections`` (config, options, analysis), the map's
+    settings and timings, the varied parameters, and per combination its values, special
+    points, intervals, attractors, search, status, timings and whether it was read back."""
+
+    def write(path: Path) -> None:
+        from ..maps._report import common_intervals
+
+        combos = []
+        for (index, values), cell in zip(response_map.combinations(), response_map.cells):
+            combos.append({
+                "index": list(index), "values": values, "status": cell.status, "message": cell.message,
+                "special_points": cell.special_points, "intervals": cell.intervals, "attractors": cell.attractors,
+                "search": cell.search, "timings": cell.timings, "resumed": cell.resumed,
+            })
+        timings = dict(response_map.timings)
+        timings["cli_wall_time"] = time.perf_counter() - t_start
+        _io().write_metadata(
+            path, **sections, settings=response_map.settings, timings=timings,
+            parameters=[{"name": p.name, "key": p.key, "values": list(p.values)} for p in response_map.parameters],
+            omega=list(map(float, response_map.omega)), region=common_intervals(response_map), combinations=combos,
+        )
+
+    return write
+
+
+def map_summary(response_map: Any) -> str:
+    """What ``rattle map`` prints: the map's size, what was read back or failed, and the Ω
+    intervals rattle-free at every combination."""
+    from ..maps._report import common_intervals, format_intervals
+
+    cells = response_map.cells
+    resumed = sum(1 for c in cells if c.resumed)
+    failed = sum(1 for c in cells if c.status == "failed")
+    partial = sum(1 for c in cells if c.status == "partial")
+    sizes = " × ".join(f"{len(p.values)} {p.name}" for p in response_map.parameters)
+    lines = [f"response map: {len(cells)} combinations ({sizes}) × {len(response_map.omega)} frequencies; "
+             f"{len(cells) - resumed} computed, {resumed} read back, {partial} partial, {failed} failed"]
+    common = common_intervals(response_map)
+    lines.append(f"rattle-free at every combination: Ω = {format_intervals(common['rattle_free_everywhere'])} rad/s")
+    return "\n".join(lines)
