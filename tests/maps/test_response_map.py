@@ -1,0 +1,169 @@
+"""response_map and one combination's pipeline: branches on the grid, attractor search, summary."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+import rattle
+from rattle.analysis._attractors import AttractorSearch, Census, NonPeriodic, find_attractors
+from rattle.analysis._grid import GridSolution, section_states, solutions_on_grid
+from rattle.analysis._settings import RunSettings
+from rattle.errors import ConfigError
+from rattle.hb import HBOptions
+from rattle.maps import CellResult, response_map
+from rattle.maps._cell import summarise
+from rattle.model import Clutch
+from rattle.timeint import shoot_periodic_orbit
+
+SMALL_SEARCH = AttractorSearch(bands=2, starts=2)
+
+
+def _clutch(alpha: float) -> rattle.Model:
+    m = rattle.reference_case()
+    return dataclasses.replace(m, elastic=Clutch(alpha=alpha, b=m.elastic.b))
+
+
+@pytest.fixture(scope="module")
+def small_map() -> rattle.ResponseMap:
+    return response_map(rattle.reference_case(), {"alpha": [0.2, 0.3]}, omega=(0.6, 1.2), omega_points=13,
+                        harmonics=12, search=SMALL_SEARCH, engine="serial")
+
+
+def test_map_shape_columns_and_rows(small_map):
+    m = small_map
+    assert m.shape == (2,) and m.names == ("alpha",)
+    assert m.parameters[0].key == "model.elastic.alpha"
+    assert [c.values["alpha"] for c in m.cells] == [0.2, 0.3]
+    np.testing.assert_array_equal(m.omega, np.linspace(0.6, 1.2, 13))
+    rows = m.rows()
+    assert len(rows) == 2 * 13
+    assert list(rows[0]) == ["alpha", "omega", "n_solutions", "n_stable", "rms_max_stable", "rms_ac_max_stable",
+                             "regime_max_stable", "periods_stable", "rattle"]
+    ds = m.dataset
+    assert ds["rms_max_stable"].dims == ("alpha", "omega")
+    for c in m.cells:
+        assert c.status == "ok"
+        has = c.n_stable > 0
+        assert np.all(np.isfinite(c.rms_max_stable[has]))
+        assert all("1" in p.split(";") for p in c.periods_stable[has])
+        # the resonance of the reference clutch bends: three period-1 solutions inside the fold
+        assert c.n_solutions.max() == 3
+        assert any(sp["kind"] == "fold" for sp in c.special_points)
+
+
+def test_grid_solutions_are_exact_orbits():
+    """Every grid solution is the HB orbit at exactly that Ω: exact shooting from its section
+    state closes an orbit of the same period, same rms (H = 16: truncation ≪ 1e-3) and stability."""
+    model = _clutch(0.25)
+    run = RunSettings.make(HBOptions(harmonics=16), None, None)
+    frf = rattle.frequency_response(model, omega=(0.3, 1.2), harmonics=16, subharmonics=True)
+    grid = np.linspace(0.3, 1.2, 19)
+    sols = solutions_on_grid(frf, grid, run)
+    assert {s.period for s in sols} == {1, 2}
+    for s in sols:
+        assert s.converged and s.omega == grid[s.index]
+        orbit = shoot_periodic_orbit(model, s.omega, s.section[0], period=s.period)
+        assert orbit.converged
+        assert abs(orbit.rms / s.rms - 1) < 1e-3
+        assert bool(orbit.stable) == s.stable
+    # inside the fold, three primary solutions at one grid frequency: one unstable between two stable
+    by = {}
+    for s in sols:
+        if s.branch == 0:
+            by.setdefault(s.index, []).append(s)
+    three = [v for v in by.values() if len(v) == 3]
+    assert three and all(sum(x.stable for x in v) == 2 for v in three)
+
+
+def test_section_states_of_a_series():
+    q = np.array([0.1, 0.5, 0.2, 0.3, -0.4])  # a_0, a_1, a_2, b_1, b_2 with base frequency Ω/2
+    omega = 1.3
+    x = section_states(q, 1, omega, 2)
+    w = omega / 2
+    for m in range(2):
+        t = m * 2 * np.pi / omega
+        d = 0.1 + 0.5 * np.cos(w * t) + 0.2 * np.cos(2 * w * t) + 0.3 * np.sin(w * t) - 0.4 * np.sin(2 * w * t)
+        v = (-0.5 * w * np.sin(w * t) - 0.4 * w * np.sin(2 * w * t) + 0.3 * w * np.cos(w * t)
+             - 0.8 * w * np.cos(2 * w * t))
+        np.testing.assert_allclose(x[m], [d, v], atol=1e-14)
+
+
+def test_search_finds_the_isolated_subharmonics():
+    """α = 0.1: stable period-2 and period-3 motions near Ω = 1.36 that no period doubling of
+    the primary branch reaches; the multi-start finds them and continues each as a branch."""
+    model = _clutch(0.1)
+    run = RunSettings.make(HBOptions(harmonics=16), None, None)
+    grid = np.linspace(1.3, 1.42, 7)
+    frf = rattle.frequency_response(model, omega=(1.3, 1.42), harmonics=16, subharmonics=True)
+    assert set(frf.period) == {1}  # nothing but period 1 is connected here
+    census = find_attractors(frf, grid, run, AttractorSearch(bands=1, starts=12))
+    periods = {f["period"] for f in census.found}
+    assert {2, 3} <= periods
+    assert all(f["branch"] is not None for f in census.found)
+    stable_periods = {s.period for s in census.solutions if s.stable}
+    assert {1, 2, 3} <= stable_periods
+    # each new branch passes through the simulated orbit it was seeded from (no "note")
+    assert not [f for f in census.found if "note" in f]
+
+
+def _sol(j, branch, period, stable, rms, impacts, regime="double_sided"):
+    return GridSolution(index=j, omega=float(j), branch=branch, period=period, stable=stable, rms=rms, rms_ac=rms / 2,
+                        p2p=1.0, acc_p2p=1.0, delta_min=0.0, delta_max=1.0, regime=regime, impacts=impacts,
+                        section=np.zeros((period, 2)), q=np.zeros(3))
+
+
+def test_summarise_follows_spec_7():
+    grid = np.array([1.0, 2.0, 3.0, 4.0])
+    census = Census(solutions=[
+        _sol(0, 0, 1, True, 0.1, False, "no_impact"),
+        _sol(1, 0, 1, True, 0.2, False, "no_impact"), _sol(1, 0, 1, False, 0.3, True), _sol(1, 0, 1, True, 0.4, True),
+        _sol(1, 5, 1, True, 0.5, True),  # an isola's stable period-1 solution: largest rms, not counted in n_*
+        _sol(2, 0, 1, False, 0.3, True), _sol(2, 1, 2, True, 0.35, True),
+    ], nonperiodic=[NonPeriodic(3, 4.0, 0.2, 0.1, True, "test")])
+    s = summarise(census, grid)
+    np.testing.assert_array_equal(s["n_solutions"], [1, 3, 1, 0])
+    np.testing.assert_array_equal(s["n_stable"], [1, 2, 0, 0])
+    np.testing.assert_array_equal(s["rms_max_stable"][:2], [0.1, 0.5])
+    assert np.isnan(s["rms_max_stable"][2]) and np.isnan(s["rms_max_stable"][3])
+    assert list(s["regime_max_stable"]) == ["no_impact", "double_sided", "", ""]
+    assert list(s["periods_stable"]) == ["1", "1", "2", "0"]
+    np.testing.assert_array_equal(s["rattle"], [False, True, True, True])
+    assert s["intervals"] == {"impact": [[2.0, 4.0]], "rattle_free": [[1.0, 1.0]], "subharmonic": [[3.0, 3.0]],
+                              "nonperiodic": [[4.0, 4.0]]}
+
+
+def test_store_resumes_and_settings_change_recomputes(tmp_path):
+    kw = dict(omega=(0.8, 1.0), omega_points=5, harmonics=8, search=AttractorSearch(bands=1, starts=1),
+              engine="serial")
+    seen = []
+    first = response_map(rattle.reference_case(), {"alpha": [0.25, 0.3]}, store=tmp_path, **kw)
+    again = response_map(rattle.reference_case(), {"alpha": [0.25, 0.3]}, store=tmp_path,
+                         progress=lambda d, t, r: seen.append((d, t, r)), **kw)
+    assert seen == [(2, 2, 2)]  # everything read back, nothing computed
+    assert all(c.resumed for c in again.cells) and again.timings["computed"] == 0
+    for a, b in zip(first.cells, again.cells):
+        assert json.dumps(a.to_dict()) == json.dumps(b.to_dict())
+    other = response_map(rattle.reference_case(), {"alpha": [0.25, 0.3]}, store=tmp_path,
+                         **{**kw, "harmonics": 10})
+    assert not any(c.resumed for c in other.cells)
+
+
+def test_bad_vary_is_refused_before_any_work(tmp_path):
+    store = tmp_path / "out"
+    with pytest.raises(ConfigError, match="--vary"):
+        response_map(rattle.reference_case(), {"model.elastic.gamma": [0.1]}, store=store, engine="serial")
+    with pytest.raises(ConfigError, match="alpha"):
+        response_map(rattle.reference_case(), {"alpha": [0.2, 1.5]}, store=store, engine="serial")
+    assert not store.exists()
+
+
+def test_cell_result_json_round_trip_is_exact(small_map):
+    for c in small_map.cells:
+        back = CellResult.from_dict(json.loads(c.to_json()))
+        for col in ("rms_max_stable", "rms_ac_max_stable"):
+            np.testing.assert_array_equal(getattr(back, col), getattr(c, col))
+        assert back.intervals == c.intervals and back.special_points == c.special_points
