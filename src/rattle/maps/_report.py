@@ -103,15 +103,15 @@ def _settings(response_map: ResponseMap) -> list[str]:
     if omega.size:
         lines.append(f"- Ω grid: {omega.size} frequencies, {_g(omega[0])} … {_g(omega[-1])} rad/s")
     for key, value in response_map.settings.items():
-        if isinstance(value, (dict, list)) and len(str(value)) > 120:
-            continue
+        if value is None or isinstance(value, dict) or key in ("omega", "omega_points"):
+            continue  # the option tables are in map.json; the grid is said above
         lines.append(f"- {key}: {value}")
     status = {s: sum(1 for c in cells if c.status == s) for s in ("ok", "partial", "failed")}
     resumed = sum(1 for c in cells if c.resumed)
     lines.append(f"- combinations: {len(cells)} ({status['ok']} complete, {status['partial']} partial, "
                  f"{status['failed']} failed; {resumed} read back from an earlier run)")
-    total = response_map.timings.get("total")
-    if total is not None and math.isfinite(total):
+    total = response_map.timings.get("total", response_map.timings.get("wall"))
+    if isinstance(total, (int, float)) and math.isfinite(total):
         lines.append(f"- wall time: {total:.1f} s")
     return lines
 
@@ -174,7 +174,7 @@ def _cell_section(values: dict[str, float], c: CellResult) -> list[str]:
         lines.append("- attractors the branches did not explain: none found")
     if c.search:
         counts = ", ".join(f"{k} {v}" for k, v in c.search.items() if isinstance(v, (int, float))
-                           and not isinstance(v, bool))
+                           and not isinstance(v, bool) and k not in _BUDGET_KEYS)
         if counts:
             lines.append(f"- search: {counts}")
     if c.timings.get("total") is not None:

@@ -154,8 +154,7 @@ def plot_map(
     if vmax <= vmin:
         vmax = vmin + (abs(vmin) * 1e-3 or 1e-3)
     norm = Normalize(vmin=vmin, vmax=vmax)
-    cmap = plt.get_cmap("viridis").copy()
-    cmap.set_bad(NO_SOLUTION_COLOR)
+    cmap = plt.get_cmap("viridis").with_extremes(bad=NO_SOLUTION_COLOR)
 
     if ax is not None:
         axes_list = [unwrap(ax)]
