@@ -230,12 +230,16 @@ class ResponseMap:
 
     def rows(self) -> list[dict[str, Any]]:
         """``map.csv`` rows: per (combination, frequency) the varied values by NAME, then
-        :data:`MAP_COLUMNS`."""
+        :data:`MAP_COLUMNS`. A combination whose frequency response failed (status
+        ``failed``) knows nothing: its grid columns are None (empty in the CSV), never a
+        ``rattle`` = false it did not establish."""
         out = []
         for (_, values), c in zip(self.combinations(), self.cells):
             cols = c.columns()
+            known = c.status != "failed"
             for j in range(self.omega.size):
-                out.append({**values, **{k: cols[k][j] for k in MAP_COLUMNS}})
+                out.append({**values, "omega": cols["omega"][j],
+                            **{k: (cols[k][j] if known else None) for k in GRID_COLUMNS}})
         return out
 
     def rattle_free_region(self) -> list[dict[str, Any]]:
