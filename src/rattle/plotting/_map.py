@@ -23,12 +23,14 @@ from ._axes import PlotAxes, unwrap
 if TYPE_CHECKING:  # pragma: no cover
     from ..maps import ResponseMap
 
-__all__ = ["plot_map", "map_plot_names", "NO_SOLUTION_COLOR", "RATTLE_HATCH"]
+__all__ = ["plot_map", "map_plot_names", "NO_SOLUTION_COLOR", "RATTLE_HATCH", "RATTLE_COLOR"]
 
 #: Colour of the cells with no stable period-1 solution (``rms_max_stable`` NaN).
 NO_SOLUTION_COLOR = "0.78"
 #: Hatch of the cells where an attractor impacts (``rattle`` true).
 RATTLE_HATCH = "////"
+#: Colour of that hatching (visible on every colour of viridis and on the grey).
+RATTLE_COLOR = "#d62728"
 #: Most panels one figure draws (more: the first ones, and the figure says so).
 MAX_PANELS = 36
 
@@ -186,7 +188,7 @@ def plot_map(
                     while k + 1 < row.size and row[k + 1]:
                         k += 1
                     a.add_patch(Rectangle((xe[j], ye[i]), xe[k + 1] - xe[j], ye[i + 1] - ye[i], fill=False,
-                                          hatch=RATTLE_HATCH, edgecolor="white", linewidth=0, alpha=0.75))
+                                          hatch=RATTLE_HATCH, edgecolor=RATTLE_COLOR, linewidth=0))
                     j = k + 1
                 else:
                     j += 1
@@ -205,7 +207,7 @@ def plot_map(
         cbar.set_label("largest stable period-1 rms of δ (rad)")
         cax = cbar.ax
     handles = [
-        Patch(facecolor="none", edgecolor="0.2", hatch=RATTLE_HATCH, label="impacts (rattle)"),
+        Patch(facecolor="none", edgecolor=RATTLE_COLOR, hatch=RATTLE_HATCH, label="impacts (rattle)"),
         Line2D([], [], color="black", linewidth=1.6, label="rattle-free boundary"),
         Patch(facecolor=NO_SOLUTION_COLOR, edgecolor="0.5", label="no stable period-1 solution"),
     ]
