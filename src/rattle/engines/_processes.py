@@ -209,11 +209,15 @@ class ProcessEngine:
 
     @staticmethod
     def _stop(workers: Sequence[_Worker]) -> None:
-        """Ask every worker to end, SIGTERM the ones that do not, SIGKILL what is left; reap all."""
+        """Ask every idle worker to end and SIGTERM the busy ones (a run ended early: their tasks
+        are not wanted), SIGTERM what has not ended after ``_GRACE`` s, then SIGKILL; reap all."""
         for w in workers:
             if w.process.is_alive():
-                with contextlib.suppress(OSError, ValueError):
-                    w.conn.send(None)
+                if w.current is None:
+                    with contextlib.suppress(OSError, ValueError):
+                        w.conn.send(None)
+                else:
+                    w.process.terminate()
         deadline = time.monotonic() + _GRACE
         for w in workers:
             w.process.join(max(0.0, deadline - time.monotonic()))
