@@ -251,10 +251,10 @@ def test_worker_watchdog_without_prctl_ends_an_orphan(tmp_path: Path) -> None:
     script = tmp_path / "orphan.py"
     script.write_text(
         "import multiprocessing, os, sys, time\n"
-        "from rattle.analysis import _time_sweep as ts\n"
+        "from rattle.engines import _parent as ts\n"
         "def work(parent):\n"
         "    ts.sys.platform = 'not-linux'  # no prctl: only the watch thread\n"
-        "    ts._die_with_parent(parent)\n"
+        "    ts.die_with_parent(parent)\n"
         "    time.sleep(60)\n"
         "if __name__ == '__main__':\n"
         "    p = multiprocessing.Process(target=work, args=(os.getpid(),))\n"

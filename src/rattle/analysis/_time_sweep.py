@@ -18,7 +18,6 @@ import os
 import pickle
 import queue as queue_module
 import signal
-import sys
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -27,6 +26,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .. import _limits, _validate
+from ..engines import die_with_parent
 from ..errors import RattleError
 from ..model import Model, check_analysable_model
 from ..results._sweep import SweepResult
@@ -118,35 +118,6 @@ _WATCH_INTERVAL = 0.2
 _TERMINATE_GRACE = 1.0
 
 
-def _die_with_parent(parent: int) -> None:
-    """Make this worker end when the process ``parent`` ends, however it ends (SIGKILL included).
-
-    Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)`` asks the kernel to kill us with our parent. Every
-    platform: a daemon thread that sees ``os.getppid()`` change (we were re-parented, so the
-    parent is gone) and ends the process at once.
-    """
-    import threading
-
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
-        except (OSError, AttributeError):  # pragma: no cover - no prctl: the thread below is enough
-            pass
-
-    def watch() -> None:
-        while True:
-            if os.getppid() != parent:
-                os._exit(1)
-            time.sleep(_WATCH_INTERVAL)
-
-    if os.getppid() != parent:  # the parent died before we got here
-        os._exit(1)
-    threading.Thread(target=watch, name="rattle-parent-watch", daemon=True).start()
-
-
 def _worker_main(parent: int, messages: Any, model: Model, omegas: FloatArray, direction: str,
                  options: SteadyStateOptions) -> None:
     """A worker process: one direction, progress and the result sent back on ``messages``.
@@ -159,7 +130,7 @@ def _worker_main(parent: int, messages: Any, model: Model, omegas: FloatArray, d
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(signal, "SIGHUP"):
         signal.signal(signal.SIGHUP, signal.SIG_DFL)
-    _die_with_parent(parent)
+    die_with_parent(parent, _WATCH_INTERVAL)
     try:
         result = _run_timed(model, omegas, direction, options, lambda d: messages.put(("progress", d, None)))
     except BaseException as exc:  # sent back whole when it pickles, else as text
@@ -198,7 +169,7 @@ def _run_parallel(
     KeyboardInterrupt (SIGINT), a SIGTERM turned into an exception by the command line, any other
     exception — they are terminated and reaped in ``finally``. The parent waits on the queue in
     short slices, so a signal is acted on within ``_WATCH_INTERVAL`` s. A parent killed outright
-    (SIGKILL) is noticed by the workers themselves (:func:`_die_with_parent`).
+    (SIGKILL) is noticed by the workers themselves (:func:`rattle.engines.die_with_parent`).
     """
     import multiprocessing
 
