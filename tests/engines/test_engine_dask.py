@@ -29,6 +29,7 @@ def client(cluster):
 
 
 def _run(engine, tasks) -> dict:
+    """The results without pid and environment (checked here: one BLAS thread in every worker)."""
     results: dict = {}
     ticks = []
 
@@ -38,6 +39,8 @@ def _run(engine, tasks) -> dict:
 
     engine.run(compute, tasks, on_result, progress=lambda done, total: ticks.append((done, total)))
     assert ticks == [(i, len(tasks)) for i in range(1, len(tasks) + 1)]
+    if engine.name == "dask":
+        assert {r["omp"] for r in results.values()} == {"1"}
     return {k: comparable(v) for k, v in results.items()}
 
 

@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -160,6 +161,20 @@ def test_an_interrupt_in_the_parent_stops_and_reaps_every_worker() -> None:
     with pytest.raises(KeyboardInterrupt):
         ProcessEngine(2).run(compute, make_tasks(6, sleep=0.2), on_result)
     assert len(seen) == 1
+    assert _children() - before == set()
+
+
+def test_ctrl_c_while_waiting_on_busy_workers_stops_them_at_once() -> None:
+    before = _children()
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            ProcessEngine(2).run(compute, make_tasks(4, sleep=60), lambda k, r: None)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - t0 < 30  # not waiting for the 60 s tasks
     assert _children() - before == set()
 
 
