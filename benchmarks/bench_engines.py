@@ -11,8 +11,8 @@ Run:  python benchmarks/bench_engines.py  [--tasks 22] [--seconds 0.5] [--worker
     and the overhead against the ideal ceil(tasks / workers) × seconds (best of ``--repeat``
     rounds, the engines interleaved in each round). Dask twice: a LocalCluster
     started and closed by the run (what ``engine="dask"`` without a scheduler does) and one that
-    is already running (what ``--scheduler ADDRESS`` meets). Every engine's results are checked
-    equal to the serial ones.
+    is already running (what ``--scheduler ADDRESS`` meets); ``concurrent.futures``'
+    ProcessPoolExecutor as a reference. Every engine's results are checked equal to the serial ones.
 
 The machine's other load shows in the figures: run it on a quiet machine for clean numbers.
 """
@@ -76,6 +76,21 @@ def timed(engine, fn, tasks) -> tuple[float, dict]:
     return time.perf_counter() - t0, results
 
 
+def executor(workers: int, fn, tasks) -> tuple[float, dict]:
+    """The same tasks on concurrent.futures.ProcessPoolExecutor (spawn): the reference pool the
+    processes engine was measured against (it cannot tell which task a lost worker held)."""
+    import concurrent.futures as cf
+    import multiprocessing
+
+    results: dict = {}
+    t0 = time.perf_counter()
+    with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        futures = {pool.submit(fn, payload): key for key, payload in tasks}
+        for f in cf.as_completed(futures):
+            results[futures[f]] = f.result()
+    return time.perf_counter() - t0, results
+
+
 def dask_running(workers: int, fn, tasks) -> tuple[float, dict]:
     """The tasks on a LocalCluster started (and its workers up) before the clock starts."""
     import distributed
@@ -124,6 +139,8 @@ def main() -> None:
     engines = [("serial", lambda: timed(SerialEngine(), busy, tasks), "")]
     pe = ProcessEngine(args.workers)
     engines.append((f"processes ({args.workers})", lambda: timed(pe, busy, tasks), "worker start-up included"))
+    engines.append((f"ProcessPoolExecutor ({args.workers})", lambda: executor(args.workers, busy, tasks),
+                    "reference: concurrent.futures, spawn"))
     if use_dask:
         engines.append((f"dask, new LocalCluster ({args.workers})",
                         lambda: timed(DaskEngine(None, args.workers), busy, tasks), "cluster start + stop included"))

@@ -1,6 +1,6 @@
 """The Dask engine: the tasks on a Dask distributed cluster (``rattle map --scheduler ADDRESS``).
 
-Each task is submitted with ``pure=False`` under a readable key (``rattle-<task key>-<run>``);
+Each task is submitted with ``pure=False`` under a readable key (``rattle-<task key>-<index>-<run>``);
 results come back through ``distributed.as_completed`` and ``on_result`` is called in the calling
 thread as each arrives. A worker lost mid-task is the scheduler's business: it runs the task again
 on another worker (up to its ``distributed.scheduler.allowed-failures``, default 3; then the run
@@ -153,8 +153,8 @@ class DaskEngine:
         futures: dict[Any, Any] = {}
         try:
             run_id = uuid.uuid4().hex[:8]
-            for key, payload in items:
-                future = client.submit(fn, payload, key=f"rattle-{_key_text(key)}-{run_id}", pure=False)
+            for i, (key, payload) in enumerate(items):
+                future = client.submit(fn, payload, key=f"rattle-{_key_text(key)}-{i}-{run_id}", pure=False)
                 futures[future] = key
             done = 0
             for future in distributed.as_completed(list(futures), loop=client.loop):
