@@ -167,3 +167,26 @@ def test_cell_result_json_round_trip_is_exact(small_map):
         for col in ("rms_max_stable", "rms_ac_max_stable"):
             np.testing.assert_array_equal(getattr(back, col), getattr(c, col))
         assert back.intervals == c.intervals and back.special_points == c.special_points
+
+
+def test_chain_map_finds_the_quasi_periodic_motion_and_its_locking():
+    """The grounded two-inertia example has no stable period-1 orbit between its Neimark–Sacker
+    points 0.811 and 0.857 (torus ratio ≈ 0.3): simulation decides there. At 0.82 the motion is
+    non-periodic (period 0); at 0.84 it locks onto a period-3 orbit (ratio 1/3), which the search
+    continues as a branch of its own (born at a fold near 0.8376)."""
+    from pathlib import Path
+
+    case = rattle.load_case(Path(__file__).resolve().parents[2] / "examples" / "grounded_two_inertia.toml")
+    m = response_map(case, {"model.links.1.damping": [0.02]}, omega=(0.80, 0.84), omega_points=3, harmonics=12,
+                     search=AttractorSearch(bands=0), engine="serial")
+    c = m.cells[0]
+    assert c.status == "ok"
+    assert list(c.n_stable) == [1, 0, 0]
+    assert list(c.periods_stable) == ["1", "0", "3"]
+    assert np.all(np.isnan(c.rms_max_stable[1:]))
+    assert np.all(c.rattle[1:])
+    assert c.intervals["nonperiodic"] == [[0.82, 0.82]]
+    (found,) = c.attractors
+    assert found["period"] == 3 and found["branch"] is not None and "note" not in found
+    folds = [sp["omega"] for sp in c.special_points if sp["kind"] == "fold" and sp["period"] == 3]
+    assert folds and 0.82 < folds[0] < 0.84

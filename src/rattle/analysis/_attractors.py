@@ -137,10 +137,8 @@ class Census:
 
 
 def _impacts(state: Any) -> bool:
-    names = getattr(state, "element_names", ())
-    if names:
-        return any(str(m.regime) != "no_impact" for m in state.measures.element_measures)
-    return str(state.regime) != "no_impact"
+    """Whether some element of a simulated motion crosses one of its breakpoints."""
+    return any(r != "no_impact" for r in state.regimes())
 
 
 def _coefficients(model: Any, state: Any, hb: HarmonicBalance) -> FloatArray:
