@@ -185,7 +185,7 @@ def test_chain_map_finds_the_quasi_periodic_motion_and_its_locking():
     assert list(c.periods_stable) == ["1", "0", "3"]
     assert np.all(np.isnan(c.rms_max_stable[1:]))
     assert np.all(c.rattle[1:])
-    assert c.intervals["nonperiodic"] == [[0.82, 0.82]]
+    np.testing.assert_allclose(c.intervals["nonperiodic"], [[0.82, 0.82]], rtol=1e-12)
     (found,) = c.attractors
     assert found["period"] == 3 and found["branch"] is not None and "note" not in found
     folds = [sp["omega"] for sp in c.special_points if sp["kind"] == "fold" and sp["period"] == 3]
