@@ -7,8 +7,8 @@ from __future__ import annotations
 import socket
 
 import pytest
-
 from _engine_tasks import comparable, compute, make_tasks
+
 from rattle.engines import EngineError, SerialEngine, TaskError, make_engine
 from rattle.errors import ConfigError
 

@@ -13,9 +13,15 @@ from pathlib import Path
 
 import psutil
 import pytest
-
 from _engine_tasks import comparable, compute, make_tasks
-from rattle.engines import EngineError, ProcessEngine, SerialEngine, TaskError, make_engine
+
+from rattle.engines import (
+    EngineError,
+    ProcessEngine,
+    SerialEngine,
+    TaskError,
+    make_engine,
+)
 from rattle.errors import RattleError
 from rattle.maps._store import MapStore
 
@@ -87,6 +93,8 @@ def test_make_engine_names_and_refusals() -> None:
         make_engine("serial", workers=2)
     with pytest.raises(TypeError, match="picklable"):
         ProcessEngine(2).run(lambda p: p, [("a", 1)], lambda k, r: None)
+    with pytest.raises(TypeError, match="task `b`: its payload cannot be sent"):
+        ProcessEngine(1).run(compute, [("a", {"name": "a", "x": 1.0}), ("b", lambda: 0)], lambda k, r: None)
     with pytest.raises(ValueError, match="unique"):
         SerialEngine().run(compute, [("a", {}), ("a", {})], lambda k, r: None)
 

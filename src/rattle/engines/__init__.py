@@ -21,7 +21,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._base import Engine, EngineError, ProgressCallback, ResultCallback, Task, TaskError, cpu_count
+from ._base import (
+    Engine,
+    EngineError,
+    ProgressCallback,
+    ResultCallback,
+    Task,
+    TaskError,
+    cpu_count,
+)
 from ._parent import die_with_parent
 from ._processes import MAX_RETRIES, WORKER_ENVIRONMENT, ProcessEngine
 from ._serial import SerialEngine

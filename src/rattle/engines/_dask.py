@@ -22,7 +22,16 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..errors import ConfigError
-from ._base import EngineError, ProgressCallback, ResultCallback, Task, TaskError, check_run, check_workers, cpu_count
+from ._base import (
+    EngineError,
+    ProgressCallback,
+    ResultCallback,
+    Task,
+    TaskError,
+    check_run,
+    check_workers,
+    cpu_count,
+)
 
 #: Seconds to wait for a scheduler to answer before giving up.
 CONNECT_TIMEOUT = 10.0

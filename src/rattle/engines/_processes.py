@@ -48,9 +48,19 @@ import traceback
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
-from ._base import EngineError, ProgressCallback, ResultCallback, Task, TaskError, check_run, check_workers, cpu_count
+from ._base import (
+    EngineError,
+    ProgressCallback,
+    ResultCallback,
+    Task,
+    TaskError,
+    check_run,
+    check_workers,
+    cpu_count,
+)
 from ._parent import die_with_parent
 
 logger = logging.getLogger("rattle")
@@ -323,7 +333,12 @@ class ProcessEngine:
                     if w.current is None and pending:
                         index = pending.popleft()
                         try:
-                            w.conn.send((index, items[index][1]))
+                            data = ForkingPickler.dumps((index, items[index][1]))
+                        except Exception as exc:
+                            raise TypeError(f"task `{items[index][0]}`: its payload cannot be sent to a worker "
+                                            f"process (it must pickle): {exc}") from exc
+                        try:
+                            w.conn.send_bytes(data)
                         except (OSError, ValueError):  # its pipe broke: it is dying; bury() requeues
                             pass
                         w.current = index
