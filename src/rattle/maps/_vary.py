@@ -220,6 +220,14 @@ def numeric_keys(tables: Mapping[str, Any]) -> list[str]:
 
 def _nearest(name: str, tables: Mapping[str, Any]) -> str:
     keys = numeric_keys(tables)
+    if "." not in name:  # a misspelt short name: compare with the short names and the keys' last parts
+        short = [f"{n} ({SHORT_NAMES[n]})" for n in difflib.get_close_matches(name, list(SHORT_NAMES), n=2, cutoff=0.6)
+                 if SHORT_NAMES[n] in keys]
+        tails = {k.rsplit(".", 1)[-1]: k for k in reversed(keys)}
+        near = [tails[t] for t in difflib.get_close_matches(name, list(tails), n=4, cutoff=0.6)
+                if not any(s.endswith(f"({tails[t]})") for s in short)]
+        if short or near:
+            return ", ".join(dict.fromkeys([*short, *near]))
     close = difflib.get_close_matches(name, keys, n=4, cutoff=0.5)
     if not close:
         tail = name.rsplit(".", 1)[-1]
