@@ -181,6 +181,25 @@ def test_two_parameters_and_the_report(tmp_path, fake):
     assert not (out / "map.md").exists()
 
 
+def test_scheduler_is_passed_on_and_needs_dask(tmp_path, fake, monkeypatch):
+    config = write_config(tmp_path)
+    out = tmp_path / "out"
+    result = invoke(["map", str(config), "-o", str(out), "--vary", "alpha=0.1,0.2", "--omega-points", "5",
+                     "--scheduler", "tcp://127.0.0.1:8786"], tmp_path)
+    assert result.exit_code == 0, result.stderr
+    assert fake.calls[-1]["scheduler"] == "tcp://127.0.0.1:8786" and fake.calls[-1]["workers"] is None
+
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name, *a))
+    out2 = tmp_path / "out2"
+    result = invoke(["map", str(config), "-o", str(out2), "--vary", "alpha=0.1,0.2", "--scheduler", "tcp://h:8786"],
+                    tmp_path)
+    assert_bad_input(result, "`--scheduler`", "rattle[dask]")
+    assert _nothing_written(out2) and len(fake.calls) == 1
+
+
 def test_every_combination_failing_exits_1_with_the_files(tmp_path, monkeypatch):
     front = FakeFrontEnd(fail=True)
     monkeypatch.setattr(rattle.maps, "response_map", front, raising=False)
