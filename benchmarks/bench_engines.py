@@ -13,6 +13,7 @@ Run:  python benchmarks/bench_engines.py  [--tasks 22] [--seconds 0.5] [--worker
     started and closed by the run (what ``engine="dask"`` without a scheduler does) and one that
     is already running (what ``--scheduler ADDRESS`` meets); ``concurrent.futures``'
     ProcessPoolExecutor as a reference. Every engine's results are checked equal to the serial ones.
+(c) The dispatch cost per task: 200 empty tasks.
 
 The machine's other load shows in the figures: run it on a quiet machine for clean numbers.
 """
@@ -164,6 +165,23 @@ def main() -> None:
         rel = f"; {t / t_proc:.2f}x local processes" if name.startswith("dask") else ""
         print(f"    {name:34s} {t:8.2f} {t_serial / t:8.2f}x {over:11.2f}  {note}{rel}")
     print("    (every engine's results equal the serial ones)")
+
+    n_tiny = 200
+    tiny = [(f"u{i}", {"i": i, "n": 1}) for i in range(n_tiny)]
+    print(f"\n(c) dispatch cost: {n_tiny} empty tasks on {args.workers} workers (start-up excluded)")
+    t, _ = timed(pe, busy, tiny)
+    t_start = pe.last_run["startup"] or 0.0
+    print(f"    processes: {1e3 * (t - t_start) / n_tiny:.2f} ms per task "
+          f"({t:.2f} s in all, of which ~{t_start:.2f} s worker start-up)")
+    if use_dask:
+        import distributed
+
+        with distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, \
+                distributed.Client(cluster, set_as_default=False) as client:
+            client.wait_for_workers(args.workers)
+            t, _ = timed(DaskEngine(client), busy, tiny)
+        print(f"    dask (running cluster): {1e3 * t / n_tiny:.2f} ms per task ({t:.2f} s in all)")
 
 
 if __name__ == "__main__":
