@@ -10,18 +10,34 @@ followed both ways in Ω, an isola closed once).
 
 Where the simulations start (the budget, :class:`AttractorSearch`):
 
-1. **From unstable orbits, wherever no stable solution is known.** On every run of grid
+1. **From unstable orbits.** (a) Wherever no stable solution is known: on every run of grid
    frequencies where no branch has a stable solution, the simulation starts from the unstable
    orbit there (its section state, nudged by ``nudge`` of the orbit's half peak-to-peak) and
    then walks through the run carrying its state from one frequency to the next, like a time
    sweep, restarting from an unstable orbit where a new branch has made the previous one
    stable. What it settles on decides the grid frequency: a periodic attractor (continued as a
-   branch unless known) or a non-periodic one (period 0, SPEC §7).
+   branch unless known) or a non-periodic one (period 0, SPEC §7). (b) From the middle of
+   every unstable stretch of every branch, nudged both ways off the orbit: where its unstable
+   manifold leads (usually the known destination of a jump; sometimes an attractor no branch
+   reaches).
 2. **A modest multi-start per frequency band.** The range is cut into ``bands`` equal bands;
    at the middle grid frequency of each, ``starts`` initial states are simulated: points on
    rings around the static equilibrium whose radii are fixed multiples (½, 1, 2, 3…) of the
    largest half peak-to-peak of the solutions known there, at angles spread by the golden
    ratio, velocities scaled by Ω (deterministic: the same starts on every engine).
+
+3. **Sub-harmonic starts in harmonic balance.** A sub-harmonic of order 1/n is an orbit with
+   strong content at Ω/n, born in a saddle-node pair (not by period doubling) wherever Ω/n
+   meets a resonance of the bent backbone. Its basin may be small, but its harmonic-balance
+   equations have a solution whatever the basin: at ``hb_points`` frequencies spread over the
+   grid, for each n in
+   ``hb_periods``, Newton (period n, n·H harmonics) starts from the stable period-1 orbit
+   there plus a component A cos(Ωt/n + φ) in the first element's deflection (A = 1, 2 × the
+   length scale, φ = 0, π/2). A converged solution that is truly of period n (its harmonics
+   that are not multiples of n carry ≥ 1e-3 of its dynamic content) and that no known
+   solution explains is checked by exact shooting (the orbit must close on the exact flow,
+   within ``match``) and continued as a branch, stable or not — its stable stretches are
+   attractors whatever their basins.
 
 A simulated periodic attractor of period n is *explained* when a stable known solution of
 period n at the same Ω passes through its section state (scaled max-norm, ``match``, on the
@@ -29,9 +45,11 @@ scales of :func:`~rattle.timeint.system_state_scale`); a non-periodic one is rec
 grid frequency. Every unexplained periodic attractor is continued (at most ``max_branches``
 new branches per response), and its branch's solutions join the grid.
 
-What it may still miss, stated: an attractor whose basin none of the starts of its band reaches
-(small basins, bands where another attractor dominates), a sub-harmonic of period above
-``max_period`` (8 at most: the simulation's period detection), a non-periodic attractor
+What it may still miss, stated: a sub-harmonic branch whose whole existence interval lies
+between two of the ``hb_points`` frequencies (with the default 24, narrower than
+(Ω_max − Ω_min)/24) and whose basin none of the simulations reaches; a period not in ``hb_periods`` reached by no
+simulation; a period above ``max_period`` (8 at most: the simulation's period detection); a
+period-1 isola no simulation reaches; a non-periodic attractor
 coexisting with stable periodic ones outside the multi-start frequencies, and anything beyond
 ``max_periods`` forcing periods of transient (reported as period 0).
 """
@@ -50,7 +68,7 @@ from ..results import FrequencyResponse
 from ..timeint import SystemTrajectory
 from ..timeint._system_shooting import system_state_scale
 from ._branches import branch_from_seed
-from ._grid import GridSolution, solutions_on_grid
+from ._grid import GridSolution, section_states, solutions_on_grid
 from ._settings import RunSettings
 from ._steady import SteadyStateOptions, make_integrator, steady_state
 
@@ -83,6 +101,12 @@ class AttractorSearch:
         truncation errors are ~1e-6, distinct coexisting orbits differ by O(1)).
     nudge : float
         Start offset from an unstable orbit, relative to its half peak-to-peak (default 1e-2).
+    hb_periods : tuple of int
+        Periods of the harmonic-balance sub-harmonic starts (default (2, 3); empty switches
+        them off).
+    hb_points : int
+        Grid frequencies (equally spread) of the harmonic-balance sub-harmonic starts
+        (default 24; 0 switches them off).
     """
 
     bands: int = 8
@@ -93,14 +117,20 @@ class AttractorSearch:
     max_periods: int = 600
     match: float = 1e-3
     nudge: float = 1e-2
+    hb_periods: tuple[int, ...] = (2, 3)
+    hb_points: int = 24
 
     def __post_init__(self) -> None:
-        for name in ("bands", "starts", "max_branches", "max_period", "max_periods"):
+        for name in ("bands", "starts", "max_branches", "max_period", "max_periods", "hb_points"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
                 raise ValueError(f"`{name}` must be an integer >= 0, got {value!r}")
         if not 1 <= self.max_period <= 8:
             raise ValueError(f"`max_period` must be in 1 … 8, got {self.max_period!r}")
+        periods = tuple(self.hb_periods)
+        if any(isinstance(p, bool) or not isinstance(p, (int, np.integer)) or not 2 <= p <= 8 for p in periods):
+            raise ValueError(f"`hb_periods` must be periods in 2 … 8, got {self.hb_periods!r}")
+        object.__setattr__(self, "hb_periods", tuple(int(p) for p in periods))
         for name in ("match", "nudge"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
@@ -164,7 +194,8 @@ class _Search:
         self.steady = options.steady_options()
         self.integ = make_integrator(self.model)
         self.census = Census(solutions=list(solutions))
-        self.counts = {"simulations": 0, "periods": 0, "unexplained": 0, "branches": 0, "nonperiodic": 0}
+        self.counts = {"simulations": 0, "periods": 0, "hb_starts": 0, "unexplained": 0, "branches": 0,
+                       "nonperiodic": 0}
         self.next_branch = int(np.max(frf.branch)) + 1 if len(frf) else 1
         self.range = (float(self.grid[0]), float(self.grid[-1]))
         self.by_index: dict[int, list[GridSolution]] = {}
@@ -206,21 +237,29 @@ class _Search:
         return state
 
     def add_branch(self, j: int, state: Any, origin: str) -> None:
-        w = float(self.grid[j])
-        record: dict[str, Any] = {"omega": w, "period": int(state.period), "origin": origin, "branch": None,
-                                  "rms": float(state.rms)}
-        self.census.found.append(record)
-        if self.counts["branches"] >= self.opts.max_branches:
-            record["note"] = "branch budget spent: not continued"
-            return
         n = int(state.period)
         H = n * self.run.hb.harmonics
         hb = HarmonicBalance(self.model, self.run.for_harmonics(H), period=n)
         q = _coefficients(self.model, state, hb)
+        record = self.add_branch_from(j, n, q, H, origin, float(state.rms))
+        if record.get("branch") is not None and not self.explained(j, state):
+            # The branch does not pass through the simulated orbit (HB with these harmonics
+            # converged elsewhere): keep the record honest.
+            record["note"] = "continued branch does not pass through the simulated orbit"
+
+    def add_branch_from(self, j: int, n: int, q: FloatArray, H: int, origin: str, rms: float) -> dict[str, Any]:
+        """Continue the period-n branch through the coefficients q (H harmonics of Ω/n) at grid
+        index j; its solutions join the grid. Returns the record of :attr:`Census.found`."""
+        w = float(self.grid[j])
+        record: dict[str, Any] = {"omega": w, "period": n, "origin": origin, "branch": None, "rms": rms}
+        self.census.found.append(record)
+        if self.counts["branches"] >= self.opts.max_branches:
+            record["note"] = "branch budget spent: not continued"
+            return record
         branch = branch_from_seed(self.model, w, q, n, self.range, H, run=self.run, branch_id=self.next_branch)
         if branch is None or len(branch) < 2:
             record["note"] = "the seed did not converge in harmonic balance"
-            return
+            return record
         branch = replace(branch, settings=dict(branch.settings, branches=[{"branch": self.next_branch,
                                                                            "harmonics": H, "period": n}]))
         self.next_branch += 1
@@ -230,10 +269,11 @@ class _Search:
         for s in solutions_on_grid(branch, self.grid, self.run):
             self.census.solutions.append(s)
             self.by_index.setdefault(s.index, []).append(s)
-        if not self.explained(j, state):
-            # The branch does not pass through the simulated orbit (HB with these harmonics
-            # converged elsewhere): keep the record honest.
-            record["note"] = "continued branch does not pass through the simulated orbit"
+        if math.isnan(rms):
+            mine = [s for s in self.by_index.get(j, []) if s.branch == record["branch"]]
+            if mine:
+                record["rms"] = float(mine[0].rms)
+        return record
 
     # --- 1. from unstable orbits ----------------------------------------------------------
     def start_near(self, j: int) -> FloatArray | None:
@@ -263,17 +303,128 @@ class _Search:
             state = self.simulate(j, x0, "unstable orbit" if state is None else "carried from the previous frequency")
             j += 1
 
+    def unstable_stretches(self) -> None:
+        """From the middle of every unstable stretch of every branch (grid frequencies where the
+        branch's solution is unstable, in a run), both ways off the orbit: where the unstable
+        orbit's manifold leads is an attractor — usually a known one (the jump's destination),
+        sometimes one no branch reaches."""
+        runs: dict[tuple[int, int], list[GridSolution]] = {}
+        for s in self.census.solutions:
+            if not s.stable and s.converged:
+                runs.setdefault((s.branch, s.period), []).append(s)
+        for (branch, _), sols in sorted(runs.items()):
+            sols = sorted(sols, key=lambda s: (s.index, s.rms))
+            stretch: list[GridSolution] = []
+            for s in sols + [None]:  # type: ignore[list-item]
+                if s is not None and (not stretch or s.index <= stretch[-1].index + 1):
+                    stretch.append(s)
+                    continue
+                if stretch:
+                    mid = stretch[len(stretch) // 2]
+                    # a non-periodic attractor already seen there: its basin is where this
+                    # orbit's manifold most likely leads, and it costs max_periods to see again
+                    chaotic = any(p.index == mid.index for p in self.census.nonperiodic)
+                    for sign in (() if chaotic else (1.0, -1.0)):
+                        x = np.array(mid.section[0], dtype=float)
+                        n = x.size // 2
+                        x[:n] += sign * self.opts.nudge * max(0.5 * mid.p2p, 1e-3 * float(self.system.length_scale()))
+                        self.simulate(mid.index, x, f"off the unstable orbit of branch {branch}")
+                stretch = [s] if s is not None else []
+
+    # --- 3. sub-harmonic starts in harmonic balance ---------------------------------------------
+    def band_indices(self) -> list[int]:
+        N, B = self.grid.size, self.opts.bands
+        edges = np.linspace(0, N, B + 1)
+        return [int(min(N - 1, (edges[b] + edges[b + 1]) // 2)) for b in range(B)]
+
+    def closes_exactly(self, w: float, x0: FloatArray, period: int) -> bool:
+        """Whether exact shooting from x0 closes a period-``period`` orbit through x0 (within
+        ``match``, scaled): the harmonic-balance solution is a true orbit."""
+        from ..timeint import shoot_periodic_orbit
+        from ..timeint._system_shooting import shoot_system_orbit
+
+        if self.model is self.system or not hasattr(self.model, "elastic"):
+            orbit = shoot_system_orbit(self.system, w, x0, period=period)
+        else:
+            orbit = shoot_periodic_orbit(self.model, w, x0, period=period, integrator=self.integ)
+        if not orbit.converged:
+            return False
+        sc = system_state_scale(self.system, w)
+        return float(np.max(np.abs(np.asarray(orbit.state0) - x0) / sc)) < self.opts.match
+
+    def hb_subharmonics(self) -> None:
+        from ..continuation import solve_fixed
+        from ..hb import resize_harmonics
+
+        if not self.opts.hb_periods or self.opts.hb_points == 0:
+            return
+        H = self.run.hb.harmonics
+        n_coord = len(self.system.coordinates)
+        row = np.asarray(self.system.element_rows[0], dtype=float)
+        direction = row / float(row @ row)  # x along it moves the first element's δ by 1
+        L = float(self.system.length_scale())
+        newton = replace(self.run.newton, max_iterations=max(self.run.newton.max_iterations, 40))
+        problems: dict[int, HarmonicBalance] = {}
+        N, P = self.grid.size, self.opts.hb_points
+        for j in sorted({int(min(N - 1, (k + 0.5) * N // P)) for k in range(P)}):
+            w = float(self.grid[j])
+            base = [s for s in self.by_index.get(j, []) if s.period == 1]
+            if not base:
+                continue
+            s1 = max(base, key=lambda s: (s.stable, s.rms))
+            H1 = (np.asarray(s1.q).size // n_coord - 1) // 2
+            for n in self.opts.hb_periods:
+                Hn = n * H
+                if n not in problems:
+                    problems[n] = HarmonicBalance(self.model, self.run.for_harmonics(Hn), period=n)
+                hb = problems[n]
+                q_base = resize_harmonics(np.asarray(s1.q).reshape(n_coord, 2 * H1 + 1), Hn, factor=n)
+                not_multiple = np.array([k % n != 0 for k in range(1, Hn + 1)])
+                sub = np.concatenate(([False], not_multiple, not_multiple))
+                for amp in (1.0 * L, 2.0 * L):
+                    for phase in (0.0, 0.5 * math.pi):
+                        q0 = q_base.copy()
+                        q0[:, 1] += amp * math.cos(phase) * direction
+                        q0[:, Hn + 1] -= amp * math.sin(phase) * direction
+                        self.counts["hb_starts"] += 1
+                        res = solve_fixed(hb, q0.reshape(-1), w, newton)
+                        if not res.converged:
+                            continue
+                        Q = res.q.reshape(n_coord, -1)
+                        dynamic = float(np.linalg.norm(Q[:, 1:]))
+                        if dynamic == 0.0 or float(np.linalg.norm(Q[:, sub])) < 1e-3 * dynamic:
+                            continue  # a period-1 (or shorter) solution written with period n
+                        sec = section_states(res.q, n_coord, w, n)
+                        if self.known(j, n, sec):
+                            continue
+                        if not self.closes_exactly(w, sec[0], n):
+                            self.census.found.append({"omega": w, "period": n, "origin": "harmonic-balance start",
+                                                      "branch": None, "rms": float("nan"),
+                                                      "note": "not an orbit of the exact flow: not continued"})
+                            continue
+                        self.counts["unexplained"] += 1
+                        self.add_branch_from(j, n, res.q, Hn, "harmonic-balance start", float("nan"))
+
+    def known(self, j: int, n: int, section: FloatArray) -> bool:
+        """Whether any known solution (stable or not) of period n at grid index j passes
+        through the section point ``section[0]``."""
+        sc = self.scale(j)
+        for s in self.by_index.get(j, []):
+            if s.period != n:
+                continue
+            d = np.max(np.abs(s.section - section[0][None, :]) / sc[None, :], axis=1)
+            if float(np.min(d)) < self.opts.match:
+                return True
+        return False
+
     # --- 2. multi-start ---------------------------------------------------------------------
     def multistart(self) -> None:
         B, K = self.opts.bands, self.opts.starts
         if B == 0 or K == 0:
             return
-        N = self.grid.size
-        edges = np.linspace(0, N, B + 1)
         x_eq = np.asarray(self.system.static_equilibrium(), dtype=float)
         n = x_eq.size
-        for b in range(B):
-            j = int(min(N - 1, (edges[b] + edges[b + 1]) // 2))
+        for b, j in enumerate(self.band_indices()):
             w = float(self.grid[j])
             known = self.by_index.get(j, [])
             amp = max([0.5 * s.p2p for s in known], default=0.0)
@@ -301,6 +452,8 @@ def find_attractors(frf: FrequencyResponse, grid: FloatArray, run: RunSettings,
     search = _Search(frf, grid, run, options, solutions)
     if options.from_unstable:
         search.unstable_runs()
+        search.unstable_stretches()
+    search.hb_subharmonics()
     search.multistart()
     search.census.counts = dict(search.counts)
     return search.census
