@@ -422,7 +422,9 @@ def map_command(
     ]
     if report:
         steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
-    names = (*MAP_FILES, *(name for name, _ in figures[1:]))
+    # the set: also every map_<NAME>.png of an earlier map in OUTPUT, so that none is left beside the new one
+    earlier = sorted(p.name for p in output.glob("map_*.png")) if output.is_dir() else []
+    names = tuple(dict.fromkeys([*MAP_FILES, *(name for name, _ in figures[1:]), *earlier]))
     written = write_set(output, names, steps)
     failed = [c for c in result.cells if c.status == "failed"]
     echo_written(map_summary(result), written, output)
