@@ -31,6 +31,8 @@ def test_report_holds_settings_region_points_intervals_and_search():
     assert f"- non-periodic attractor (period 0): {format_intervals(cell.intervals['nonperiodic'])}" in text
     assert "period 2 at Ω = 1.7 (from simulation), continued as branch 1" in text
     assert "What it may still miss" in text and "basin" in text
+    assert "| 0.1 – 0.7 | 0.1 – 0.2 | none |" in text  # read along Ω: both values rattle-free there
+    assert "| 0.8 | 0.2 | 0.1 |" in text  # alpha = 0.1 impacts from 0.8, alpha = 0.2 only from 0.9
     common = common_intervals(m)
     assert f"- Ω rattle-free at every combination: {format_intervals(common['rattle_free_everywhere'])}" in text
 

@@ -133,12 +133,42 @@ def _region(response_map: ResponseMap) -> list[str]:
     common = common_intervals(response_map)
     free_everywhere = [_values_text(v) for (_, v), c in zip(response_map.combinations(), response_map.cells)
                        if c.status != "failed" and not np.asarray(c.rattle, bool).any()]
+    lines += _by_frequency(response_map)
     lines += ["",
               f"- Ω rattle-free at every combination: {format_intervals(common['rattle_free_everywhere'])}",
               f"- Ω with impacts at every combination: {format_intervals(common['impact_everywhere'])}",
               "- combinations rattle-free over the whole Ω range: "
               + ("; ".join(free_everywhere) if free_everywhere else "none")]
     return lines
+
+
+def _value_runs(mask: Sequence[bool], values: Sequence[float]) -> str:
+    """The parameter values where ``mask`` holds, as runs of consecutive values (``0 – 0.1, 0.5``)."""
+    return format_intervals(_runs(np.asarray(mask, bool), np.asarray(values, float)))
+
+
+def _by_frequency(response_map: ResponseMap) -> list[str]:
+    """With one varied parameter: the same region read along Ω — for every run of grid
+    frequencies over which the set of rattle-free values does not change, those values."""
+    if len(response_map.parameters) != 1 or not response_map.cells:
+        return []
+    p = response_map.parameters[0]
+    omega = np.asarray(response_map.omega, dtype=float)
+    ok = np.array([c.status != "failed" for c in response_map.cells])
+    rattle = np.array([np.asarray(c.rattle, bool) for c in response_map.cells])
+    free = (~rattle) & ok[:, None]
+    rows = []
+    j = 0
+    while j < omega.size:
+        k = j
+        while k + 1 < omega.size and np.array_equal(free[:, k + 1], free[:, j]):
+            k += 1
+        band = format_intervals([[float(omega[j]), float(omega[k])]])
+        rows.append([band, _value_runs(free[:, j], p.values), _value_runs((~free[:, j]) & ok, p.values)])
+        j = k + 1
+    return ["", f"Read along Ω: over each band of grid frequencies, the values of `{p.name}` that are rattle-free "
+            "there and those where some attractor impacts (runs of consecutive values).", "",
+            *_table(["Ω (rad/s)", f"rattle-free {p.name}", f"impacts at {p.name}"], rows)]
 
 
 def _cell_section(values: dict[str, float], c: CellResult) -> list[str]:
@@ -148,10 +178,12 @@ def _cell_section(values: dict[str, float], c: CellResult) -> list[str]:
     if c.status == "failed":
         return lines
     if c.special_points:
+        lines += ["Special points, the primary branch (0) first, then each further branch:", ""]
         lines += _table(["kind", "Ω (rad/s)", "branch", "period", "rms (rad)"],
                         [[sp.get("kind", ""), f"{float(sp.get('omega', math.nan)):.5g}", sp.get("branch", ""),
                           sp.get("period", ""), f"{float(sp.get('rms', math.nan)):.4g}"]
-                         for sp in sorted(c.special_points, key=lambda s: (float(s.get("omega", 0.0)),
+                         for sp in sorted(c.special_points, key=lambda s: (int(s.get("branch", 0) or 0),
+                                                                           float(s.get("omega", 0.0)),
                                                                            str(s.get("kind", ""))))])
     else:
         lines.append("No special points (no fold, period doubling or Neimark–Sacker point in the range).")
