@@ -40,6 +40,11 @@ def test_range_is_linspace_with_both_ends():
     assert values[0] == 0.1 and values[-1] == 0.4
 
 
+def test_range_values_are_the_decimal_ones_meant():
+    _, values = vary.parse_vary("alpha=0:0.5:11")
+    assert values == (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5)
+
+
 def test_count_one_gives_start_and_a_list_keeps_its_order():
     assert vary.parse_vary("b=0.2:0.9:1") == ("b", (0.2,))
     assert vary.parse_vary("model.elastic.alpha = 0.3, 0.1,0.2") == ("model.elastic.alpha", (0.3, 0.1, 0.2))

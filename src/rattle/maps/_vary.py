@@ -115,7 +115,8 @@ def parse_vary(text: str) -> tuple[str, tuple[float, ...]]:
     -------
     (name, values)
         ``values``: COUNT equally spaced values from START to STOP (both included; START alone
-        when COUNT is 1), or the listed values in the order given.
+        when COUNT is 1; rounded to 15 significant digits, so that 0:0.5:11 gives 0.3, not
+        0.30000000000000004), or the listed values in the order given.
 
     Raises
     ------
@@ -162,7 +163,8 @@ def parse_vary(text: str) -> tuple[str, tuple[float, ...]]:
         if count > 1 and start == stop:
             raise _err(f"{whole!r}: START and STOP are equal ({_fmt(start)}) with COUNT {count}: the values would "
                        f"repeat; give COUNT 1 or a STOP different from START")
-        values = tuple(float(v) for v in np.linspace(start, stop, count)) if count > 1 else (start,)
+        # 15 significant digits: the decimal values meant (0.3, not linspace's 0.30000000000000004)
+        values = tuple(float(f"{v:.15g}") for v in np.linspace(start, stop, count)) if count > 1 else (start,)
     else:
         parts = [p.strip() for p in spec.split(",")]
         if any(not p for p in parts):
