@@ -4,7 +4,6 @@ end built from synthetic cells, and one small real run."""
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 from pathlib import Path
@@ -280,16 +279,6 @@ _BLOCKED = (
 )
 
 
-@functools.cache
-def _maps_package_is_lazy() -> bool:
-    import subprocess
-    import sys
-
-    code = "import sys, rattle.maps._vary; print('rattle.analysis' in sys.modules)"
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    return proc.stdout.strip() == "False"
-
-
 @pytest.mark.parametrize("args, fragment", [
     (["--vary", "alpha"], "`--vary` 'alpha' has no `=`"),
     (["--vary", "alpha=0.2:1.5:3"], "the model refuses this value"),
@@ -298,10 +287,6 @@ def test_a_refused_map_needs_no_numerics(tmp_path, args, fragment):
     import os
     import subprocess
     import sys
-
-    if not _maps_package_is_lazy():
-        pytest.xfail("rattle/maps/__init__.py imports the numerics when loaded (make it lazy, PEP 562, as "
-                     "rattle.io is), so `--vary` cannot be checked without them")
 
     config = write_config(tmp_path)
     src = Path(__file__).resolve().parents[2] / "src"
