@@ -317,5 +317,6 @@ def map_summary(response_map: Any) -> str:
     lines = [f"response map: {len(cells)} combinations ({sizes}) × {len(response_map.omega)} frequencies; "
              f"{len(cells) - resumed} computed, {resumed} read back, {partial} partial, {failed} failed"]
     common = common_intervals(response_map)
-    lines.append(f"rattle-free at every combination: Ω = {format_intervals(common['rattle_free_everywhere'])} rad/s")
+    free = format_intervals(common["rattle_free_everywhere"])
+    lines.append(f"Ω rattle-free at every combination: {free}{'' if free == 'none' else ' rad/s'}")
     return "\n".join(lines)
