@@ -311,7 +311,8 @@ def _short_on_chain(tables: Mapping[str, Any], name: str) -> str:
     if len(cands) == 1:
         return cands[0]
     if not cands:
-        raise _err(f"{name!r}: this chain has no {what}; give a dotted key instead, e.g. one of: {_nearest(probe, tables)}")
+        raise _err(f"{name!r}: this chain has no {what}; give a dotted key instead, e.g. one of: "
+                   f"{_nearest(probe, tables)}")
     hint = ""
     if name == "mean":
         hint = " (the mean torques of a free chain must sum to zero: varying one alone is refused)"
