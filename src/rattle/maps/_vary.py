@@ -257,7 +257,8 @@ def _walk(tables: Mapping[str, Any], key: str, name: str) -> tuple[list[str], An
                     if len(node) == 0:
                         rule = f"{here} is empty"
                     else:
-                        rule = f"{here} has {len(node)} entr{'y' if len(node) == 1 else 'ies'} (positions 1 … {len(node)})"
+                        entries = "entry" if len(node) == 1 else "entries"
+                        rule = f"{here} has {len(node)} {entries} (positions 1 … {len(node)})"
                     extra = ""
                     if i < 1:
                         extra = "; positions count from 1"
