@@ -1,6 +1,7 @@
 """Benchmark: the map engines' overhead — serial, local processes, Dask LocalCluster — side by side.
 
-Run:  python benchmarks/bench_engines.py  [--tasks 22] [--seconds 0.5] [--workers 2] [--repeat 1] [--no-dask]
+Run:  python benchmarks/bench_engines.py  [--tasks 22] [--seconds 0.5] [--workers 2] [--repeat 1] [--sleep]
+                                          [--no-dask]
 
 (a) Start-up of one worker process: spawn → ready (a fresh interpreter that has loaded the task
     function), importing ``rattle.maps._cell`` there (numpy, scipy, numba, the analysis), and the
@@ -13,6 +14,8 @@ Run:  python benchmarks/bench_engines.py  [--tasks 22] [--seconds 0.5] [--worker
     started and closed by the run (what ``engine="dask"`` without a scheduler does) and one that
     is already running (what ``--scheduler ADDRESS`` meets); ``concurrent.futures``'
     ProcessPoolExecutor as a reference. Every engine's results are checked equal to the serial ones.
+    With ``--sleep`` the tasks sleep instead of computing: the engines' own overhead, free of the
+    CPU contention of a loaded machine (the speed-up then is what idle cores would give).
 (c) The dispatch cost per task: 200 empty tasks.
 
 The machine's other load shows in the figures: run it on a quiet machine for clean numbers.
@@ -27,7 +30,10 @@ import time
 
 
 def busy(payload: dict) -> dict:
-    """CPU-bound work: ``payload["n"]`` iterations of a pure-Python recurrence."""
+    """CPU-bound work: ``payload["n"]`` iterations of a pure-Python recurrence (after sleeping
+    ``payload["sleep"]`` seconds, if given)."""
+    if payload.get("sleep"):
+        time.sleep(payload["sleep"])
     x, n = float(payload["i"]) * 1e-3 + 0.5, int(payload["n"])
     acc = 0.0
     for k in range(n):
@@ -112,6 +118,7 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=0.5)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--sleep", action="store_true", help="tasks sleep instead of computing")
     ap.add_argument("--no-dask", action="store_true")
     args = ap.parse_args()
 
@@ -132,10 +139,14 @@ def main() -> None:
           f"(first-use cost {w['first'] - w['second']:.3f} s)")
     print(f"    whole run of that one task (spawn, import, 2 FRFs, stop)  {e.last_run['wall']:.3f} s")
 
-    n_iter = calibrate(args.seconds)
-    tasks = [(f"t{i}", {"i": i, "n": n_iter}) for i in range(args.tasks)]
+    if args.sleep:
+        n_iter, kind = 1, "sleeping"
+        tasks = [(f"t{i}", {"i": i, "n": 1, "sleep": args.seconds}) for i in range(args.tasks)]
+    else:
+        n_iter, kind = calibrate(args.seconds), "CPU-bound"
+        tasks = [(f"t{i}", {"i": i, "n": n_iter}) for i in range(args.tasks)]
     ideal = math.ceil(args.tasks / args.workers) * args.seconds
-    print(f"\n(b) {args.tasks} CPU-bound tasks of ~{args.seconds:g} s on {args.workers} workers "
+    print(f"\n(b) {args.tasks} {kind} tasks of ~{args.seconds:g} s on {args.workers} workers "
           f"(ideal {ideal:.2f} s; {n_iter} iterations each)")
     engines = [("serial", lambda: timed(SerialEngine(), busy, tasks), "")]
     pe = ProcessEngine(args.workers)

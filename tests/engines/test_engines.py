@@ -172,16 +172,26 @@ def test_an_interrupt_in_the_parent_stops_and_reaps_every_worker() -> None:
     assert _children() - before == set()
 
 
-def test_ctrl_c_while_waiting_on_busy_workers_stops_them_at_once() -> None:
+def test_ctrl_c_while_waiting_on_busy_workers_stops_them_at_once(tmp_path) -> None:
     before = _children()
-    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    stop = threading.Event()
+
+    def interrupt_when_both_run() -> None:  # SIGINT once both workers are inside a task
+        while not stop.is_set():
+            if len(list(tmp_path.iterdir())) >= 2:
+                os.kill(os.getpid(), signal.SIGINT)
+                return
+            time.sleep(0.02)
+
+    watcher = threading.Thread(target=interrupt_when_both_run, daemon=True)
     t0 = time.monotonic()
-    timer.start()
+    watcher.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            ProcessEngine(2).run(compute, make_tasks(4, sleep=60), lambda k, r: None)
+            ProcessEngine(2).run(compute, make_tasks(4, sleep=60, calls=str(tmp_path)), lambda k, r: None)
     finally:
-        timer.cancel()
+        stop.set()
+        watcher.join()
     assert time.monotonic() - t0 < 30  # not waiting for the 60 s tasks
     assert _children() - before == set()
 

@@ -47,7 +47,7 @@ import time
 import traceback
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
@@ -164,10 +164,11 @@ class _Worker:
     current: int | None = None  # index of the task it holds
     ready: float | None = None  # when it reported ready (time.time() in the worker)
     dead: bool = False
-    sentinel: int = field(init=False)
+    sentinel: int = -1  # the process's sentinel, once started
 
-    def __post_init__(self) -> None:
-        self.sentinel = self.process.sentinel
+    @property
+    def spawned(self) -> bool:
+        return self.process.pid is not None
 
 
 class ProcessEngine:
@@ -206,21 +207,33 @@ class ProcessEngine:
         return f"ProcessEngine(workers={self.workers})"
 
     # -----------------------------------------------------------------------------------------
-    def _start(self, ctx: Any, fn_bytes: bytes) -> _Worker:
+    def _start(self, ctx: Any, fn_bytes: bytes, everyone: list[_Worker]) -> _Worker:
+        """A new worker, registered in ``everyone`` before it starts (an interrupt during the
+        start still finds it for the clean-up)."""
         parent_end, child_end = ctx.Pipe(duplex=True)
         process = ctx.Process(target=_worker_main, name="rattle-worker", daemon=True,
                               args=(os.getpid(), child_end, fn_bytes, WORKER_ENVIRONMENT))
-        with _environment(WORKER_ENVIRONMENT):
-            process.start()
-        child_end.close()
+        w = _Worker(process, parent_end, time.time())
+        everyone.append(w)
+        try:
+            with _environment(WORKER_ENVIRONMENT):
+                process.start()
+        finally:
+            child_end.close()
+        w.sentinel = process.sentinel
         self.last_run["workers_started"] += 1
         logger.debug("engine worker process %d started", process.pid)
-        return _Worker(process, parent_end, time.time())
+        return w
 
     @staticmethod
     def _stop(workers: Sequence[_Worker]) -> None:
         """Ask every idle worker to end and SIGTERM the busy ones (a run ended early: their tasks
         are not wanted), SIGTERM what has not ended after ``_GRACE`` s, then SIGKILL; reap all."""
+        for w in workers:
+            if not w.spawned:  # interrupted before it started
+                with contextlib.suppress(OSError):
+                    w.conn.close()
+        workers = [w for w in workers if w.spawned]
         for w in workers:
             if w.process.is_alive():
                 if w.current is None:
@@ -318,16 +331,12 @@ class ProcessEngine:
 
         try:
             for _ in range(size):
-                w = self._start(ctx, fn_bytes)
-                live.append(w)
-                everyone.append(w)
+                live.append(self._start(ctx, fn_bytes, everyone))
             while done < total:
                 # fresh workers for requeued tasks, then work for every idle worker
                 idle = sum(1 for w in live if w.current is None)
                 while len(live) < size and len(pending) > idle:
-                    w = self._start(ctx, fn_bytes)
-                    live.append(w)
-                    everyone.append(w)
+                    live.append(self._start(ctx, fn_bytes, everyone))
                     idle += 1
                 for w in live:
                     if w.current is None and pending:
