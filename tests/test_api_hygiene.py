@@ -61,6 +61,7 @@ PUBLIC_API = {
     "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse",
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
     "shoot_periodic_orbit", "periodic_orbit", "PeriodicOrbit", "OrbitSolution", "compare", "Comparison",
+    "response_map", "ResponseMap", "AttractorSearch",
     "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
     "SystemIntegrator",
@@ -73,7 +74,8 @@ def test_public_api_snapshot():
     assert len(rattle.__all__) == len(PUBLIC_API)  # no name listed twice
 
 
-@pytest.mark.parametrize("package", ["analysis", "continuation", "hb", "model", "results", "stability", "timeint"])
+@pytest.mark.parametrize("package", ["analysis", "continuation", "engines", "hb", "maps", "model", "results", "stability",
+                                     "timeint"])
 def test_subpackage_exports_exist(package):
     import importlib
 

@@ -19,7 +19,6 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from ..results import FrequencyResponse, Region
 
@@ -68,6 +67,8 @@ def superharmonic_resonances(frf: FrequencyResponse, branch: int = 0, prominence
     low = np.nonzero(om < 0.6 * omega_r)[0]
     if low.size < 3:
         return []
+    from scipy.signal import find_peaks  # here: scipy.signal costs ~1 s to import (map workers)
+
     peaks, props = find_peaks(ac[low], prominence=prominence * float(np.ptp(ac)))
     out = []
     for p, prom in zip(peaks, props["prominences"]):
