@@ -190,3 +190,23 @@ def test_chain_map_finds_the_quasi_periodic_motion_and_its_locking():
     assert found["period"] == 3 and found["branch"] is not None and "note" not in found
     folds = [sp["omega"] for sp in c.special_points if sp["kind"] == "fold" and sp["period"] == 3]
     assert folds and 0.82 < folds[0] < 0.84
+
+
+def test_result_methods_write_csv_netcdf_report_and_plot(small_map, tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import xarray as xr
+
+    from rattle.io import read_csv
+
+    path = small_map.to_csv(tmp_path / "map.csv")
+    table = read_csv(path)
+    assert list(table) == small_map.column_names and len(table["omega"]) == 26
+    ds = xr.open_dataset(small_map.to_netcdf(tmp_path / "map.nc"), engine="scipy")
+    np.testing.assert_array_equal(ds["rms_max_stable"].values, small_map.dataset["rms_max_stable"].values)
+    ds.close()
+    text = small_map.report()
+    assert "Rattle-free region" in text and "alpha" in text
+    fig, axes = small_map.plot()
+    assert axes.primary is not None

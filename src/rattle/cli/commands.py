@@ -401,7 +401,6 @@ def map_command(
                               progress=bar, tables=tables)
     finally:
         bar.close()
-    from ..maps._report import map_report
     from ..plotting._map import map_plot_names, plot_map
 
     figures = map_plot_names(result)
@@ -410,18 +409,14 @@ def map_command(
         "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "report": True if report else None,
     })
 
-    def write_nc(path: Path) -> None:
-        with _io().atomic_path(path) as tmp:
-            result.dataset.to_netcdf(tmp, engine="scipy")
-
     steps: list[tuple[str, Any]] = [
         ("map.csv", map_csv_writer(result)),
-        ("map.nc", write_nc),
+        ("map.nc", result.to_netcdf),
         ("map.json", map_json_writer(result, meta, t_start)),
         *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y), path)) for name, name_y in figures],
     ]
     if report:
-        steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
+        steps.append(("map.md", lambda path: _io().atomic_write_text(path, result.report())))
     # the set: also every map_<NAME>.png of an earlier map in OUTPUT, so that none is left beside the new one
     earlier = sorted(p.name for p in output.glob("map_*.png")) if output.is_dir() else []
     names = tuple(dict.fromkeys([*MAP_FILES, *(name for name, _ in figures[1:]), *earlier]))

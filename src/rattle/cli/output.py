@@ -256,24 +256,7 @@ def map_csv_writer(response_map: Any) -> Writer:
     :data:`rattle.maps.MAP_COLUMNS`; ``rms_max_stable``/``rms_ac_max_stable`` empty where NaN."""
 
     def write(path: Path) -> None:
-        import math
-
-        from ..maps import MAP_COLUMNS
-
-        order = [*response_map.names, *MAP_COLUMNS]
-        rows = response_map.rows()
-        columns: dict[str, list[Any]] = {name: [] for name in order}
-        for row in rows:
-            for name in order:
-                value = row[name]
-                if isinstance(value, float) and math.isnan(value):
-                    value = None
-                elif hasattr(value, "item"):  # numpy scalar -> Python
-                    value = value.item()
-                    if isinstance(value, float) and math.isnan(value):
-                        value = None
-                columns[name].append(value)
-        _io().write_csv(path, columns, order)
+        response_map.to_csv(path)
 
     return write
 

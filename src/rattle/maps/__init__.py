@@ -17,11 +17,12 @@ from typing import TYPE_CHECKING, Any
 _LAZY: dict[str, str] = {
     "AttractorSearch": "..analysis._attractors",
     **dict.fromkeys(["response_map", "DEFAULT_OMEGA_POINTS"], "._map"),
+    "map_report": "._report",
     **dict.fromkeys(["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"],
                     "._result"),
 }
 
-__all__ = ["response_map", "AttractorSearch", "CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS",
+__all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS",
            "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS"]
 
 
@@ -41,4 +42,5 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:
     from ..analysis._attractors import AttractorSearch
     from ._map import DEFAULT_OMEGA_POINTS, response_map
+    from ._report import map_report
     from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap

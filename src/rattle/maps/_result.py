@@ -242,6 +242,59 @@ class ResponseMap:
                             **{k: (cols[k][j] if known else None) for k in GRID_COLUMNS}})
         return out
 
+    @property
+    def column_names(self) -> list[str]:
+        """``map.csv`` header: the varied NAMEs, then :data:`MAP_COLUMNS`."""
+        return [*self.names, *MAP_COLUMNS]
+
+    def columns(self) -> dict[str, list[Any]]:
+        """``map.csv`` as columns of plain Python values (None where empty: NaN rms, and every
+        grid column of a failed combination)."""
+        out: dict[str, list[Any]] = {name: [] for name in self.column_names}
+        for row in self.rows():
+            for name in out:
+                value = row[name]
+                if hasattr(value, "item"):  # numpy scalar → Python
+                    value = value.item()
+                if isinstance(value, float) and math.isnan(value):
+                    value = None
+                out[name].append(value)
+        return out
+
+    def to_csv(self, path: Any) -> Any:
+        """Write ``map.csv`` (SPEC §7) to ``path`` atomically; returns the path."""
+        from pathlib import Path
+
+        from ..io import write_csv
+
+        write_csv(path, self.columns(), self.column_names)
+        return Path(path)
+
+    def to_netcdf(self, path: Any) -> Any:
+        """Write :attr:`dataset` to ``path`` as NetCDF (version 3 through scipy: no extra
+        dependency), atomically; returns the path."""
+        from pathlib import Path
+
+        from ..io import atomic_path
+
+        with atomic_path(path) as tmp:
+            self.dataset.to_netcdf(tmp, engine="scipy")
+        return Path(path)
+
+    def plot(self, parameter: str | None = None, **kwargs: Any) -> Any:
+        """Heat map of the largest stable rms over (parameter, Ω), impacts hatched, the
+        rattle-free region outlined; returns (figure, PlotAxes). See
+        :func:`rattle.plotting.plot_map`."""
+        from ..plotting._map import plot_map
+
+        return plot_map(self, parameter=parameter, **kwargs)
+
+    def report(self) -> str:
+        """The design summary as markdown (what ``rattle map --report`` writes as ``map.md``)."""
+        from ._report import map_report
+
+        return map_report(self)
+
     def rattle_free_region(self) -> list[dict[str, Any]]:
         """Per combination, its values and its rattle-free Ω intervals."""
         return [{"values": v, "rattle_free": c.intervals.get("rattle_free", [])}
