@@ -28,6 +28,12 @@ def _cells(result) -> list[str]:
     return [json.dumps({k: v for k, v in c.to_dict().items() if k != "timings"}) for c in result.cells]
 
 
+def _loads(name: str, result) -> None:
+    t = [c.timings.get("total", 0.0) for c in result.cells]
+    print(f"    {name}: Σ cell time {sum(t):.1f} s, longest {max(t):.1f} s; per cell "
+          + " ".join(f"{x:.1f}" for x in t), flush=True)
+
+
 def main() -> None:
     import rattle
     from rattle.maps import response_map
@@ -51,10 +57,12 @@ def main() -> None:
         r = response_map(model, vary, engine="serial", **kw)
         runs["serial"] = (time.perf_counter() - t0, _cells(r))
         print(f"serial               {runs['serial'][0]:7.1f} s", flush=True)
+        _loads("serial", r)
     t0 = time.perf_counter()
     r = response_map(model, vary, engine="processes", workers=args.workers, **kw)
     runs["processes"] = (time.perf_counter() - t0, _cells(r))
     print(f"processes ({args.workers} workers) {runs['processes'][0]:7.1f} s  (worker start-up included)", flush=True)
+    _loads("processes", r)
     if not args.no_dask:
         from distributed import Client, LocalCluster
 
@@ -68,6 +76,7 @@ def main() -> None:
             t0 = time.perf_counter()
             r = response_map(model, vary, engine="dask", scheduler=client, **kw)
             runs["dask"] = (time.perf_counter() - t0, _cells(r))
+            _loads("dask", r)
         finally:
             client.close()
             cluster.close()

@@ -162,11 +162,26 @@ class DaskEngine:
         futures: dict[Any, Any] = {}
         try:
             run_id = uuid.uuid4().hex[:8]
-            for i, (key, payload) in enumerate(items):
+            # At most one task per worker thread is handed to the scheduler at a time (the next
+            # when one finishes): given them all, the scheduler assigns some ahead of time, and a
+            # long task can wait behind another on a busy worker while another worker idles.
+            window = max(1, self._threads(client) or self.workers or 1)
+            pending = iter(enumerate(items))
+            completed = distributed.as_completed(loop=client.loop)
+
+            def submit_next() -> None:
+                item = next(pending, None)
+                if item is None:
+                    return
+                i, (key, payload) = item
                 future = client.submit(fn, payload, key=f"rattle-{_key_text(key)}-{i}-{run_id}", pure=False)
                 futures[future] = key
+                completed.add(future)
+
+            for _ in range(window):
+                submit_next()
             done = 0
-            for future in distributed.as_completed(list(futures), loop=client.loop):
+            for future in completed:
                 key = futures[future]
                 if future.status == "error":
                     exc = future.exception()
@@ -182,6 +197,7 @@ class DaskEngine:
                 result = future.result()
                 future.release()
                 del futures[future]
+                submit_next()
                 done += 1
                 on_result(key, result)
                 if progress is not None:
