@@ -7,7 +7,8 @@ harmonics. Measured side by side in one run:
 - serial (one process, the caller's);
 - local processes, ``--workers`` (default 2): the default engine, start-up included;
 - Dask: a ``LocalCluster`` of ``--workers`` single-threaded worker processes, already running
-  (as ``--scheduler ADDRESS`` meets it; its start-up is printed apart).
+  (as ``--scheduler ADDRESS`` meets it; its start-up is printed apart), with rattle's worker
+  settings (:data:`rattle.engines.WORKER_CONFIG`; ``--dask-defaults``: Dask's own).
 
 Prints wall times, the speed-ups over serial, Dask against local processes, and whether the
 three maps are identical bit for bit (every cell's JSON but its timings).
@@ -44,6 +45,9 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=146)
     ap.add_argument("--no-dask", action="store_true")
     ap.add_argument("--skip-serial", action="store_true")
+    ap.add_argument("--dask-defaults", action="store_true",
+                    help="start the LocalCluster with Dask's default worker settings instead of rattle's "
+                         "(rattle.engines.WORKER_CONFIG: no statistical profiler, no MALLOC_TRIM_THRESHOLD_)")
     args = ap.parse_args()
     model = rattle.reference_case()
     vary = {"alpha": np.linspace(0.0, 0.5, args.alphas)}
@@ -64,12 +68,18 @@ def main() -> None:
     print(f"processes ({args.workers} workers) {runs['processes'][0]:7.1f} s  (worker start-up included)", flush=True)
     _loads("processes", r)
     if not args.no_dask:
+        import dask
         from distributed import Client, LocalCluster
 
+        from rattle.engines import local_cluster
+
         t0 = time.perf_counter()
-        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
-                                                            "MKL_NUM_THREADS": "1"})
+        if args.dask_defaults:  # Dask's own worker settings (profiler on, MALLOC_TRIM_THRESHOLD_ set)
+            with dask.config.set({}):
+                cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+        else:  # rattle's worker settings (rattle.engines.WORKER_CONFIG)
+            cluster = local_cluster(args.workers)
         client = Client(cluster)
         t_start = time.perf_counter() - t0
         try:

@@ -37,7 +37,7 @@ from ._serial import SerialEngine
 __all__ = [
     "Engine", "EngineError", "TaskError", "SerialEngine", "ProcessEngine", "DaskEngine", "make_engine",
     "ENGINES", "die_with_parent", "cpu_count", "MAX_RETRIES", "WORKER_ENVIRONMENT", "ResultCallback",
-    "ProgressCallback", "Task",
+    "ProgressCallback", "Task", "local_cluster", "WORKER_CONFIG",
 ]
 
 #: The engine names :func:`make_engine` knows.
@@ -45,10 +45,10 @@ ENGINES: tuple[str, ...] = ("serial", "processes", "dask")
 
 
 def __getattr__(name: str) -> Any:
-    if name == "DaskEngine":  # its module is light, but keep `import rattle.engines` minimal
-        from ._dask import DaskEngine
+    if name in ("DaskEngine", "local_cluster", "WORKER_CONFIG"):  # keep `import rattle.engines` minimal
+        from . import _dask
 
-        return DaskEngine
+        return getattr(_dask, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
