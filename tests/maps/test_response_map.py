@@ -210,3 +210,13 @@ def test_result_methods_write_csv_netcdf_report_and_plot(small_map, tmp_path):
     assert "Rattle-free region" in text and "alpha" in text
     fig, axes = small_map.plot()
     assert axes.primary is not None
+
+
+def test_cell_special_points_are_those_frf_locates(small_map):
+    """Every fold and period doubling of a combination is the one frequency_response locates
+    with the same settings (the same computation, to the bit)."""
+    frf = rattle.frequency_response(_clutch(0.2), omega=(0.6, 1.2), harmonics=12, subharmonics=True)
+    want = sorted((sp.kind, sp.omega, sp.branch) for sp in frf.special_points)
+    got = sorted((sp["kind"], sp["omega"], sp["branch"]) for sp in small_map.cells[0].special_points
+                 if sp["branch"] in set(frf.branch.tolist()))
+    assert got == want and want
