@@ -88,41 +88,13 @@ def reset_verbose() -> None:
 
 
 class ProgressBar:
-    """``callback(done, total)`` drawing a tqdm bar on stderr; a no-op when stderr is not a
-    terminal, with ``--quiet``, or without tqdm. The library never draws one itself."""
+    """``callback(done, total)`` drawing a tqdm bar on stderr, counting ``unit``s; a no-op when
+    stderr is not a terminal, with ``--quiet``, or without tqdm. The library never draws one
+    itself."""
 
-    def __init__(self, description: str, enabled: bool) -> None:
+    def __init__(self, description: str, enabled: bool, unit: str = "Ω") -> None:
         self.description = description
-        self.enabled = enabled and sys.stderr.isatty()
-        self._bar: Any = None
-
-    def __call__(self, done: int, total: int) -> None:
-        if not self.enabled:
-            return
-        if self._bar is None:
-            try:
-                from tqdm import tqdm
-            except ImportError:  # pragma: no cover - tqdm is a dependency
-                self.enabled = False
-                return
-            self._bar = tqdm(total=total, desc=self.description, unit="Ω", file=sys.stderr, leave=False,
-                             dynamic_ncols=True)
-        self._bar.update(done - self._bar.n)
-
-    def close(self) -> None:
-        if self._bar is not None:
-            self._bar.close()
-            self._bar = None
-
-
-class MapProgress:
-    """``progress(done, total, resumed)`` of a response map drawing a tqdm bar on stderr, counting
-    finished combinations: those read back from an earlier run are counted at once (the bar
-    starts there, so that its rate and time left are those of the combinations computed now).
-    A no-op when stderr is not a terminal, with ``--quiet``, or without tqdm."""
-
-    def __init__(self, description: str, enabled: bool) -> None:
-        self.description = description
+        self.unit = unit
         self.enabled = enabled and sys.stderr.isatty()
         self._bar: Any = None
 
@@ -136,8 +108,8 @@ class MapProgress:
                 self.enabled = False
                 return
             desc = f"{self.description} ({resumed} resumed)" if resumed else self.description
-            self._bar = tqdm(total=total, initial=min(done, total), desc=desc, unit="combination",
-                             file=sys.stderr, leave=False, dynamic_ncols=True)
+            self._bar = tqdm(total=total, initial=min(done, total), desc=desc, unit=self.unit, file=sys.stderr,
+                             leave=False, dynamic_ncols=True)
             return
         self._bar.update(done - self._bar.n)
 
@@ -145,6 +117,15 @@ class MapProgress:
         if self._bar is not None:
             self._bar.close()
             self._bar = None
+
+
+class MapProgress(ProgressBar):
+    """``progress(done, total, resumed)`` of a response map: a bar of finished combinations;
+    those read back from an earlier run are counted at once (the bar starts there, so that its
+    rate and time left are those of the combinations computed now)."""
+
+    def __init__(self, description: str, enabled: bool) -> None:
+        super().__init__(description, enabled, unit="combination")
 
 
 def echo_written(summary: str, written: Sequence[str], output: Path) -> None:

@@ -241,19 +241,15 @@ class ProcessEngine:
                         w.conn.send(None)
                 else:
                     w.process.terminate()
-        deadline = time.monotonic() + _GRACE
+        for escalate in ("terminate", "kill"):  # after each grace period, a harder signal
+            deadline = time.monotonic() + _GRACE
+            for w in workers:
+                w.process.join(max(0.0, deadline - time.monotonic()))
+            for w in workers:
+                if w.process.is_alive():
+                    getattr(w.process, escalate)()
         for w in workers:
-            w.process.join(max(0.0, deadline - time.monotonic()))
-        for w in workers:
-            if w.process.is_alive():
-                w.process.terminate()
-        deadline = time.monotonic() + _GRACE
-        for w in workers:
-            w.process.join(max(0.0, deadline - time.monotonic()))
-        for w in workers:
-            if w.process.is_alive():
-                w.process.kill()
-                w.process.join(5.0)
+            w.process.join(5.0)
         for w in workers:
             with contextlib.suppress(OSError):
                 w.conn.close()

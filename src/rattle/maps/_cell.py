@@ -29,23 +29,7 @@ from ..analysis._grid import solutions_on_grid
 from ..analysis._settings import RunSettings
 from ..errors import RattleError
 from ..results import FrequencyResponse
-from ._result import INTERVAL_KINDS, CellResult
-
-
-def _runs(mask: np.ndarray, grid: np.ndarray) -> list[list[float]]:
-    """[first, last] grid frequency of every run of True in ``mask``."""
-    out: list[list[float]] = []
-    j, N = 0, mask.size
-    while j < N:
-        if mask[j]:
-            k = j
-            while k + 1 < N and mask[k + 1]:
-                k += 1
-            out.append([float(grid[j]), float(grid[k])])
-            j = k + 1
-        else:
-            j += 1
-    return out
+from ._result import INTERVAL_KINDS, CellResult, grid_runs
 
 
 def summarise(census: Census, grid: np.ndarray) -> dict[str, Any]:
@@ -74,10 +58,10 @@ def summarise(census: Census, grid: np.ndarray) -> dict[str, Any]:
         rattle[p.index] |= p.impacts
     periods_text = np.array([";".join(str(p) for p in sorted(ps)) for ps in periods], dtype=object)
     intervals = {
-        "impact": _runs(rattle, grid),
-        "rattle_free": _runs(~rattle, grid),
-        "subharmonic": _runs(np.array([any(p >= 2 for p in ps) for ps in periods]), grid),
-        "nonperiodic": _runs(np.array([0 in ps for ps in periods]), grid),
+        "impact": grid_runs(rattle, grid),
+        "rattle_free": grid_runs(~rattle, grid),
+        "subharmonic": grid_runs(np.array([any(p >= 2 for p in ps) for ps in periods]), grid),
+        "nonperiodic": grid_runs(np.array([0 in ps for ps in periods]), grid),
     }
     assert set(intervals) == set(INTERVAL_KINDS)
     return {

@@ -14,7 +14,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from ._result import INTERVAL_KINDS, CellResult, ResponseMap
+from ._result import INTERVAL_KINDS, CellResult, ResponseMap, grid_runs
 
 __all__ = ["map_report", "format_intervals", "common_intervals", "SEARCH_CAVEATS"]
 
@@ -48,21 +48,6 @@ def format_intervals(intervals: Iterable[Sequence[float]]) -> str:
     return ", ".join(parts) if parts else "none"
 
 
-def _runs(mask: np.ndarray, grid: np.ndarray) -> list[list[float]]:
-    out: list[list[float]] = []
-    j, n = 0, mask.size
-    while j < n:
-        if mask[j]:
-            k = j
-            while k + 1 < n and mask[k + 1]:
-                k += 1
-            out.append([float(grid[j]), float(grid[k])])
-            j = k + 1
-        else:
-            j += 1
-    return out
-
-
 def _computed(cells: Sequence[CellResult]) -> list[CellResult]:
     return [c for c in cells if c.status != "failed"]
 
@@ -75,8 +60,8 @@ def common_intervals(response_map: ResponseMap) -> dict[str, list[list[float]]]:
     if not cells:
         return {"rattle_free_everywhere": [], "impact_everywhere": []}
     rattle = np.array([np.asarray(c.rattle, bool) for c in cells])
-    return {"rattle_free_everywhere": _runs(~rattle.any(axis=0), omega),
-            "impact_everywhere": _runs(rattle.all(axis=0), omega)}
+    return {"rattle_free_everywhere": grid_runs(~rattle.any(axis=0), omega),
+            "impact_everywhere": grid_runs(rattle.all(axis=0), omega)}
 
 
 def _values_text(values: dict[str, float]) -> str:
@@ -141,9 +126,9 @@ def _region(response_map: ResponseMap) -> list[str]:
     return lines
 
 
-def _value_runs(mask: Sequence[bool], values: Sequence[float]) -> str:
+def _valuegrid_runs(mask: Sequence[bool], values: Sequence[float]) -> str:
     """The parameter values where ``mask`` holds, as runs of consecutive values (``0 – 0.1, 0.5``)."""
-    return format_intervals(_runs(np.asarray(mask, bool), np.asarray(values, float)))
+    return format_intervals(grid_runs(np.asarray(mask, bool), np.asarray(values, float)))
 
 
 def _by_frequency(response_map: ResponseMap) -> list[str]:
@@ -163,7 +148,7 @@ def _by_frequency(response_map: ResponseMap) -> list[str]:
         while k + 1 < omega.size and np.array_equal(free[:, k + 1], free[:, j]):
             k += 1
         band = format_intervals([[float(omega[j]), float(omega[k])]])
-        rows.append([band, _value_runs(free[:, j], p.values), _value_runs((~free[:, j]) & ok, p.values)])
+        rows.append([band, _valuegrid_runs(free[:, j], p.values), _valuegrid_runs((~free[:, j]) & ok, p.values)])
         j = k + 1
     return ["", f"Read along Ω: over each band of grid frequencies, the values of `{p.name}` that are rattle-free "
             "there and those where some attractor impacts (runs of consecutive values).", "",

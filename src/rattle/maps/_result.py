@@ -43,6 +43,23 @@ MAP_COLUMNS: tuple[str, ...] = ("omega", *GRID_COLUMNS)
 INTERVAL_KINDS: tuple[str, ...] = ("impact", "rattle_free", "subharmonic", "nonperiodic")
 
 
+def grid_runs(mask: np.ndarray, grid: np.ndarray) -> list[list[float]]:
+    """[first, last] grid frequency of every run of consecutive True in ``mask`` (the
+    grid-resolved intervals of a cell)."""
+    out: list[list[float]] = []
+    j, n = 0, mask.size
+    while j < n:
+        if mask[j]:
+            k = j
+            while k + 1 < n and mask[k + 1]:
+                k += 1
+            out.append([float(grid[j]), float(grid[k])])
+            j = k + 1
+        else:
+            j += 1
+    return out
+
+
 def _float(x: Any) -> float | None:
     x = float(x)
     return None if math.isnan(x) else x
@@ -301,4 +318,4 @@ class ResponseMap:
                 for (_, v), c in zip(self.combinations(), self.cells)]
 
 
-__all__ = ["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"]
+__all__ = ["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS", "grid_runs"]
