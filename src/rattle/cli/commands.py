@@ -401,6 +401,7 @@ def map_command(
                               progress=bar, tables=tables)
     finally:
         bar.close()
+    from ..maps import map_report
     from ..plotting._map import map_plot_names, plot_map
 
     figures = map_plot_names(result)
@@ -416,7 +417,7 @@ def map_command(
         *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y), path)) for name, name_y in figures],
     ]
     if report:
-        steps.append(("map.md", lambda path: _io().atomic_write_text(path, result.report())))
+        steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
     # the set: also every map_<NAME>.png of an earlier map in OUTPUT, so that none is left beside the new one
     earlier = sorted(p.name for p in output.glob("map_*.png")) if output.is_dir() else []
     names = tuple(dict.fromkeys([*MAP_FILES, *(name for name, _ in figures[1:]), *earlier]))

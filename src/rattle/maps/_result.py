@@ -306,12 +306,6 @@ class ResponseMap:
 
         return plot_map(self, parameter=parameter, **kwargs)
 
-    def report(self) -> str:
-        """The design summary as markdown (what ``rattle map --report`` writes as ``map.md``)."""
-        from ._report import map_report
-
-        return map_report(self)
-
     def rattle_free_region(self) -> list[dict[str, Any]]:
         """Per combination, its values and its rattle-free Ω intervals."""
         return [{"values": v, "rattle_free": c.intervals.get("rattle_free", [])}

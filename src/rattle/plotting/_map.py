@@ -14,14 +14,15 @@ scale; :func:`map_plot_names` gives the other figures the command line writes.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ._axes import PlotAxes, unwrap
 
-if TYPE_CHECKING:  # pragma: no cover
-    from ..maps import ResponseMap
+#: The response map type (:class:`rattle.maps.ResponseMap`): plotting reads its fields and does
+#: not import the maps layer above it.
+ResponseMap = Any
 
 __all__ = ["plot_map", "map_plot_names", "NO_SOLUTION_COLOR", "RATTLE_HATCH", "RATTLE_COLOR"]
 
@@ -60,12 +61,12 @@ def _outline(free: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[list[tupl
     return segs
 
 
-def _label(response_map: "ResponseMap", name: str) -> str:
+def _label(response_map: ResponseMap, name: str) -> str:
     key = next((p.key for p in response_map.parameters if p.name == name), name)
     return name if name == key else f"{name} ({key})"
 
 
-def _panels(response_map: "ResponseMap", name: str) -> list[tuple[str, list[int]]]:
+def _panels(response_map: ResponseMap, name: str) -> list[tuple[str, list[int]]]:
     """(title, cell indices along ``name`` in value order) for every combination of the others."""
     params = response_map.parameters
     axis = [p.name for p in params].index(name)
@@ -85,7 +86,7 @@ def _panels(response_map: "ResponseMap", name: str) -> list[tuple[str, list[int]
     return out
 
 
-def map_plot_names(response_map: "ResponseMap") -> list[tuple[str, str]]:
+def map_plot_names(response_map: ResponseMap) -> list[tuple[str, str]]:
     """(file name, parameter on the y axis) of the figures ``rattle map`` writes: ``map.png``
     with the first parameter, and with two or more varied ``map_<NAME>.png`` for each further
     parameter (its NAME with characters other than letters, digits, ``.``, ``-``, ``_`` as ``_``)."""
@@ -98,7 +99,7 @@ def map_plot_names(response_map: "ResponseMap") -> list[tuple[str, str]]:
 
 
 def plot_map(
-    response_map: "ResponseMap", parameter: str | None = None, ax: Any = None, *, title: str | None = None,
+    response_map: ResponseMap, parameter: str | None = None, ax: Any = None, *, title: str | None = None,
 ) -> tuple[Any, PlotAxes]:
     """Heat map of the largest stable rms over Ω (x) and one varied parameter (y).
 
