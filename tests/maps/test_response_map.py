@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import rattle
-from rattle.analysis._attractors import AttractorSearch, Census, NonPeriodic, find_attractors
+from rattle.analysis._attractors import AttractorSearch, Census, SimulatedAttractor, find_attractors
 from rattle.analysis._grid import GridSolution, section_states, solutions_on_grid
 from rattle.analysis._settings import RunSettings
 from rattle.errors import ConfigError
@@ -123,16 +123,18 @@ def test_summarise_follows_spec_7():
         _sol(1, 0, 1, True, 0.2, False, "no_impact"), _sol(1, 0, 1, False, 0.3, True), _sol(1, 0, 1, True, 0.4, True),
         _sol(1, 5, 1, True, 0.5, True),  # an isola's stable period-1 solution: largest rms, not counted in n_*
         _sol(2, 0, 1, False, 0.3, True), _sol(2, 1, 2, True, 0.35, True),
-    ], nonperiodic=[NonPeriodic(3, 4.0, 0.2, 0.1, True, "test")])
+    ], simulated=[SimulatedAttractor(3, 4.0, 0, 0.2, 0.1, "double_sided", True, "test"),
+                  SimulatedAttractor(0, 1.0, 1, 0.3, 0.2, "single_sided", True, "budget spent")])
     s = summarise(census, grid)
     np.testing.assert_array_equal(s["n_solutions"], [1, 3, 1, 0])
     np.testing.assert_array_equal(s["n_stable"], [1, 2, 0, 0])
-    np.testing.assert_array_equal(s["rms_max_stable"][:2], [0.1, 0.5])
+    # grid 0: a period-1 attractor seen by simulation only (its branch not continued) counts too
+    np.testing.assert_array_equal(s["rms_max_stable"][:2], [0.3, 0.5])
     assert np.isnan(s["rms_max_stable"][2]) and np.isnan(s["rms_max_stable"][3])
-    assert list(s["regime_max_stable"]) == ["no_impact", "double_sided", "", ""]
+    assert list(s["regime_max_stable"]) == ["single_sided", "double_sided", "", ""]
     assert list(s["periods_stable"]) == ["1", "1", "2", "0"]
-    np.testing.assert_array_equal(s["rattle"], [False, True, True, True])
-    assert s["intervals"] == {"impact": [[2.0, 4.0]], "rattle_free": [[1.0, 1.0]], "subharmonic": [[3.0, 3.0]],
+    np.testing.assert_array_equal(s["rattle"], [True, True, True, True])
+    assert s["intervals"] == {"impact": [[1.0, 4.0]], "rattle_free": [], "subharmonic": [[3.0, 3.0]],
                               "nonperiodic": [[4.0, 4.0]]}
 
 

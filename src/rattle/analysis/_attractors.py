@@ -146,25 +146,35 @@ class AttractorSearch:
 
 
 @dataclass(frozen=True)
-class NonPeriodic:
-    """A non-periodic attractor (period 0) seen at grid frequency ``omega`` (index ``index``):
-    its first element's measures over the recorded window, and whether some element impacts."""
+class SimulatedAttractor:
+    """An attractor seen by simulation at grid frequency ``omega`` (index ``index``) that no
+    branch accounts for: a non-periodic one (``period`` 0), or a periodic one whose branch could
+    not be continued (the branch budget was spent, or harmonic balance did not converge to it).
+    Its first element's measures (over the recorded window for period 0), its regime, and
+    whether some element impacts — a map counts it like any other attractor there."""
 
     index: int
     omega: float
+    period: int
     rms: float
     rms_ac: float
+    regime: str
     impacts: bool
     origin: str
+
+
+#: Former name of :class:`SimulatedAttractor` (the non-periodic ones have period 0).
+NonPeriodic = SimulatedAttractor
 
 
 @dataclass
 class Census:
     """Everything known on the grid after the search: the solutions of every branch (old and
-    new), the non-periodic attractors, the new branches, and a log of what was found."""
+    new), the attractors seen only by simulation (non-periodic ones, and periodic ones no branch
+    accounts for), the new branches, and a log of what was found."""
 
     solutions: list[GridSolution]
-    nonperiodic: list[NonPeriodic] = field(default_factory=list)
+    simulated: list[SimulatedAttractor] = field(default_factory=list)
     branches: list[FrequencyResponse] = field(default_factory=list)
     found: list[dict[str, Any]] = field(default_factory=list)
     counts: dict[str, int] = field(default_factory=dict)
@@ -232,13 +242,19 @@ class _Search:
         self.counts["simulations"] += 1
         self.counts["periods"] += int(state.periods)
         if state.period == 0:
-            self.census.nonperiodic.append(NonPeriodic(j, w, float(state.rms), float(state.rms_ac),
-                                                       _impacts(state), origin))
+            self.record(j, state, origin)
             self.counts["nonperiodic"] += 1
         elif not self.explained(j, state):
             self.counts["unexplained"] += 1
             self.add_branch(j, state, origin)
+            if not self.explained(j, state):  # no branch accounts for it: it still counts here
+                self.record(j, state, origin)
         return state
+
+    def record(self, j: int, state: Any, origin: str) -> None:
+        self.census.simulated.append(SimulatedAttractor(
+            j, float(self.grid[j]), int(state.period), float(state.rms), float(state.rms_ac), str(state.regimes()[0]),
+            _impacts(state), origin))
 
     def add_branch(self, j: int, state: Any, origin: str) -> None:
         n = int(state.period)
@@ -327,7 +343,7 @@ class _Search:
                     mid = stretch[len(stretch) // 2]
                     # a non-periodic attractor already seen there: its basin is where this
                     # orbit's manifold most likely leads, and it costs max_periods to see again
-                    chaotic = any(p.index == mid.index for p in self.census.nonperiodic)
+                    chaotic = any(p.index == mid.index and p.period == 0 for p in self.census.simulated)
                     for sign in (() if chaotic else (1.0, -1.0)):
                         x = np.array(mid.section[0], dtype=float)
                         n = x.size // 2
@@ -488,4 +504,4 @@ def find_attractors(frf: FrequencyResponse, grid: FloatArray, run: RunSettings,
     return search.census
 
 
-__all__ = ["AttractorSearch", "Census", "NonPeriodic", "find_attractors"]
+__all__ = ["AttractorSearch", "Census", "SimulatedAttractor", "NonPeriodic", "find_attractors"]

@@ -53,9 +53,11 @@ def summarise(census: Census, grid: np.ndarray) -> dict[str, Any]:
         rattle[j] |= s.impacts
         if s.period == 1 and not (s.rms <= rms_max[j]):  # NaN compares False: the first one wins
             rms_max[j], rms_ac_max[j], regime[j] = s.rms, s.rms_ac, s.regime
-    for p in census.nonperiodic:
-        periods[p.index].add(0)
-        rattle[p.index] |= p.impacts
+    for a in census.simulated:  # attractors seen by simulation only (period 0: non-periodic)
+        periods[a.index].add(a.period)
+        rattle[a.index] |= a.impacts
+        if a.period == 1 and not (a.rms <= rms_max[a.index]):
+            rms_max[a.index], rms_ac_max[a.index], regime[a.index] = a.rms, a.rms_ac, a.regime
     periods_text = np.array([";".join(str(p) for p in sorted(ps)) for ps in periods], dtype=object)
     intervals = {
         "impact": grid_runs(rattle, grid),
