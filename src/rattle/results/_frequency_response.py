@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -153,6 +153,8 @@ class FrequencyResponse:
     settings: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
     element_columns: dict[str, np.ndarray] = field(default_factory=dict)
+    #: Further per-row columns written after the element columns (``spl_db``: :meth:`with_sound`).
+    extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -174,12 +176,12 @@ class FrequencyResponse:
     def columns(self) -> dict[str, np.ndarray]:
         """The SPEC columns in order, as a dict of arrays; for a chain also, per element NAME,
         ``NAME_mean … NAME_regime`` (SPEC §5, :data:`ELEMENT_COLUMNS`)."""
-        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **self.element_columns}
+        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **self.element_columns, **self.extra_columns}
 
     @property
     def column_names(self) -> list[str]:
         """Names of :meth:`columns` in file order."""
-        return [*FRF_COLUMNS, *self.element_columns]
+        return [*FRF_COLUMNS, *self.element_columns, *self.extra_columns]
 
     @property
     def element_names(self) -> tuple[str, ...]:
@@ -252,6 +254,8 @@ class FrequencyResponse:
             "branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "delta_min", "delta_max",
             "regime", "stable", "bifurcation", "iterations", "residual", "multipliers")}
         cat["element_columns"] = {k: np.concatenate([p.element_columns[k] for p in parts]) for k in parts[0].element_columns}
+        cat["extra_columns"] = {k: np.concatenate([p.extra_columns[k] for p in parts]) for k in parts[0].extra_columns
+                                if all(k in p.extra_columns for p in parts)}
         n_coord = parts[0].coefficients.shape[1] // (2 * parts[0].harmonics + 1) if len(parts[0]) else 1
 
         def padded(p: "FrequencyResponse") -> FloatArray:
@@ -279,6 +283,7 @@ class FrequencyResponse:
             for sp in self.special_points if sp.branch == branch
         )
         fields["element_columns"] = {k: v[rows] for k, v in self.element_columns.items()}
+        fields["extra_columns"] = {k: v[rows] for k, v in self.extra_columns.items()}
         return type(self)(model=self.model, harmonics=self.harmonics, special_points=special, status=self.status,
                           message=self.message, settings=self.settings, timings=self.timings, **fields)
 
@@ -309,6 +314,15 @@ class FrequencyResponse:
         if omega is None:
             omega = np.linspace(self.omega.min(), self.omega.max(), points)
         return linear_frequency_response(self.model, omega, element)
+
+    def with_sound(self, paths: Any, *, a_weighting: bool = False) -> "FrequencyResponse":
+        """A copy with the column ``spl_db`` (sound pressure level at the receiver, dB re 20 µPa)
+        of the sound ``paths`` (:class:`rattle.model.SoundPath` objects); see
+        :func:`rattle.results.sound_pressure`."""
+        from ._sound import sound_pressure
+
+        spl = sound_pressure(self, paths, a_weighting=a_weighting).spl_db
+        return replace(self, extra_columns={**self.extra_columns, "spl_db": spl})
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
