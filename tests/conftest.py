@@ -13,6 +13,15 @@ from pathlib import Path
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+# Ctrl-C as an interactive shell delivers it: a suite started in the background by a shell
+# without job control (`bash .ci/run &` in a script) inherits SIGINT *ignored*, and so would
+# every process the signal tests start — their SIGINT would never arrive. A Python handler here
+# is reset to the default in every child at exec, where Python installs KeyboardInterrupt again.
+import signal
+
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+
 import matplotlib
 import numpy as np
 import pytest
