@@ -42,6 +42,7 @@ from rattle.hb import HBOptions
 from rattle.maps._cell import summarise
 from rattle.model import Clutch
 from rattle.timeint import shoot_periodic_orbit
+from rattle.timeint._system_shooting import shoot_system_orbit
 
 
 def cell(model, grid, run):
@@ -61,31 +62,41 @@ def check_model(model, grid, run, *, every: int, starts: int, rtol: float, rng, 
     misses: list[str] = []
     census, summary = cell(model, grid, run)
     integ = make_integrator(model)
+    system = model.system()
+    single = hasattr(model, "elastic")
+
+    def shoot(w, x0, period):
+        if single:
+            return shoot_periodic_orbit(model, w, x0, period=period, integrator=integ)
+        return shoot_system_orbit(system, w, x0, period=period, integrator=integ)
+
     for j in range(0, grid.size, every):
         w = float(grid[j])
         stable = [s for s in census.solutions if s.index == j and s.stable]
         for s in stable:
-            orbit = shoot_periodic_orbit(model, w, s.section[0], period=s.period, integrator=integ)
+            orbit = shoot(w, s.section[0], s.period)
             totals["shot"] += 1
             if not orbit.converged:
                 totals["period_bad"] += 1
                 misses.append(f"{label} Ω={w:.3f}: shooting from the period-{s.period} HB orbit failed")
                 continue
-            err = abs(orbit.rms / s.rms - 1.0)
+            rms = float(orbit.rms) if single else float(orbit.measures.rms[0])
+            err = abs(rms / s.rms - 1.0)
             totals["worst_rms"] = max(totals["worst_rms"], err)
             if err > rtol:
                 totals["rms_bad"] += 1
-                misses.append(f"{label} Ω={w:.3f}: rms {s.rms:.6g} vs exact {orbit.rms:.6g}")
+                misses.append(f"{label} Ω={w:.3f}: rms {s.rms:.6g} vs exact {rms:.6g}")
             if bool(orbit.stable) != s.stable:
                 totals["stab_bad"] += 1
                 misses.append(f"{label} Ω={w:.3f}: stability differs (period {s.period})")
-        amp = max([0.5 * s.p2p for s in census.solutions if s.index == j] + [float(model.length_scale())])
-        x_eq = float(model.system().static_equilibrium()[0])
+        amp = max([0.5 * s.p2p for s in census.solutions if s.index == j] + [float(system.length_scale())])
+        x_eq = np.asarray(system.static_equilibrium(), dtype=float)
+        n = x_eq.size
         seen: list[tuple[int, float, bool]] = []
         for _ in range(starts):
-            x0 = (x_eq + rng.uniform(-4, 4) * amp, rng.uniform(-4, 4) * amp * w)
+            x0 = np.concatenate((x_eq + rng.uniform(-4, 4, n) * amp, rng.uniform(-4, 4, n) * amp * w))
             st = steady_state(model, w, x0, options=dense_opts, integrator=integ)
-            key = (int(st.period), round(float(st.rms), 4), str(st.regime) != "no_impact")
+            key = (int(st.period), round(float(st.rms), 4), any(r != "no_impact" for r in st.regimes()))
             if key not in seen:
                 seen.append(key)
         periods = set(int(p) for p in str(summary["periods_stable"][j]).split(";") if p != "")
