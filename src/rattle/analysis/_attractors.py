@@ -33,8 +33,8 @@ Where the simulations start (the budget, :class:`AttractorSearch`):
    their harmonic-balance equations have solutions whatever the basins: at ``hb_points`` frequencies spread over the
    grid, for each n in
    ``hb_periods``, Newton (period n, n·H harmonics) starts from the stable period-1 orbit
-   there plus a component A cos(Ωt/n + φ) in the first element's deflection (A = ¼, 1 × the
-   length scale, φ = 0, π/2, π, 3π/2), first with 8 harmonics per forcing period, then
+   there plus a component A cos(Ωt/n + φ) in the first element's deflection (A = the
+   length scale × ¼, ½, 1, φ = 0, π/2, π, 3π/2), first with 8 harmonics per forcing period, then
    polished with the run's. A converged solution that is truly of period n (n ≥ 2: its
    harmonics that are not multiples of n carry ≥ 1e-3 of its dynamic content) and that no known
    solution explains is checked by exact shooting (the orbit must close on the exact flow,
@@ -407,7 +407,7 @@ class _Search:
                 Hs = n * Hc
                 q_base = resize_harmonics(np.asarray(s1.q).reshape(n_coord, 2 * H1 + 1), Hs, factor=n)
                 seen: list[FloatArray] = []
-                for amp in (0.25 * L, 1.0 * L):
+                for amp in (0.25 * L, 0.5 * L, 1.0 * L):
                     for phase in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi):
                         q0 = q_base.copy()
                         q0[:, 1] += amp * math.cos(phase) * direction
