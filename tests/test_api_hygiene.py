@@ -65,6 +65,7 @@ PUBLIC_API = {
     "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
     "SystemIntegrator",
+    "sound_pressure", "linear_sound_pressure", "SoundPressure", "SoundPath",
     "Status", "RattleError", "ConfigError", "ConvergenceError",
 }
 

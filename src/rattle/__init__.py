@@ -61,6 +61,8 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(
         ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
     ),
+    **dict.fromkeys(["SoundPath"], ".model"),
+    **dict.fromkeys(["SoundPressure", "linear_sound_pressure", "sound_pressure"], ".results"),
 }
 
 #: Sub-packages reachable as attributes of ``rattle`` (imported on first use, as eagerly before).
@@ -85,6 +87,8 @@ __all__ = [
     # extension points: problems, the stepper, the integrators
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
     "SystemIntegrator",
+    # sound pressure at a receiver (SPEC §6)
+    "sound_pressure", "linear_sound_pressure", "SoundPressure", "SoundPath",
     # status and errors
     "Status", "RattleError", "ConfigError", "ConvergenceError",
 ]
@@ -127,3 +131,5 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .maps import AttractorSearch, ResponseMap, response_map
     from .stability import Hill, Monodromy
     from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit
+    from .model import SoundPath
+    from .results import SoundPressure, linear_sound_pressure, sound_pressure

@@ -18,6 +18,7 @@ _LAZY: dict[str, str] = {
                      "config_from_dict", "dumps_toml", "load_config", "model_to_toml_dict",
                      "rename_keys"], "._config"),
     **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
+    **dict.fromkeys(["read_path_csv", "PATH_COLUMNS"], "._paths"),
     **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
                     "._metadata"),
@@ -57,6 +58,7 @@ if TYPE_CHECKING:
         load_config, model_to_toml_dict, rename_keys,
     )
     from ._csv import format_csv, read_csv, write_csv
+    from ._paths import PATH_COLUMNS, read_path_csv
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
     from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
 
@@ -67,6 +69,8 @@ __all__ = [
     "check_harmonics",
     # csv
     "write_csv", "read_csv", "format_csv",
+    # sound path tables ([[paths]], SPEC §6)
+    "read_path_csv", "PATH_COLUMNS",
     # metadata
     "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
     # atomic writes, output sets, bounded reads

@@ -143,6 +143,8 @@ class RunConfig:
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     source: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
     source_name: str = field(default="<dict>", compare=False)
+    #: ``[[paths]]`` (SPEC §6): the sound paths (:class:`rattle.model.SoundPath`), read by ``rattle.io._paths``.
+    paths: tuple[Any, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved configuration (defaults filled in) as a TOML-shaped dict."""
@@ -445,6 +447,11 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
     check = _Checker(source_name)
     if not isinstance(data, Mapping):
         raise check.error(f"the configuration must be a table of tables, got {_kind(data)}")
+    if "paths" in data:  # [[paths]] (SPEC §6): the rest first, then the path tables checked against its model
+        from ._paths import with_paths
+
+        rest = config_from_dict({k: v for k, v in data.items() if k != "paths"}, source_name)
+        return with_paths(rest, data["paths"], source_name)
 
     # Structure of every table first, so that a misspelt key is reported before its values.
     check.keys(data, "", _TOP_KEYS, required=("model", "excitation"))

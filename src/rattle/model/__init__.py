@@ -4,10 +4,12 @@ from ._chain import Chain, Element, Link, Torque
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Backlash, Clutch, Linear, Piecewise, Stages
 from ._excitation import Excitation
 from ._model import Model, check_analysable_model
+from ._paths import SoundPath
 from ._system import ReducedElement, System
 from .library import backlash_case, reference_case
 
 __all__ = [
     "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "Stages", "ELASTIC_LAWS",
     "Excitation", "Model", "System", "ReducedElement", "Chain", "Link", "Element", "Torque", "check_analysable_model", "reference_case", "backlash_case",
+    "SoundPath",
 ]

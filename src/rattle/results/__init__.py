@@ -9,6 +9,7 @@ from ._columns import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 from ._comparison import Comparison
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._orbit import OrbitSolution, PeriodicOrbit
+from ._sound import SoundPressure, a_weighting_db, linear_sound_pressure, sound_pressure
 from ._steady import SteadyState
 from ._sweep import SweepResult
 
@@ -16,4 +17,5 @@ __all__ = [
     "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
     "SweepResult", "SteadyState", "PeriodicOrbit", "OrbitSolution", "Comparison",
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
+    "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db",
 ]

@@ -1,0 +1,179 @@
+"""Sound paths: a measured (or computed) linear transfer from a rattle source to a receiver.
+
+A :class:`SoundPath` carries one frequency response function H(f) = p / q'' (Pa per rad/s²) from
+a source's torsional acceleration q'' to the sound pressure p at the receiver, as a table of
+frequency (Hz), magnitude and phase (degrees) — the path terms (p/q'')_ij of the paper's eq. (1).
+
+Between table rows H is interpolated linearly in magnitude and linearly in the *unwrapped*
+phase (so a phase that runs through ±180° between two rows is not interpolated the long way
+round). Outside the table's frequency range the transmission is taken as zero — nothing is
+extrapolated — and :func:`rattle.results.sound_pressure` reports how much of the source's
+content fell outside (and warns).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+
+__all__ = ["SoundPath", "parse_source", "check_source"]
+
+_INERTIA = re.compile(r"inertia:([0-9]+)")
+
+#: Largest number of rows of a path table.
+MAX_PATH_ROWS = 1_000_000
+
+
+def parse_source(source: str) -> tuple[str, int | str]:
+    """``("inertia", N)`` for ``"inertia:N"`` (1-based), else ``("element", name)``."""
+    if not isinstance(source, str) or not source:
+        raise TypeError(f"`source` must be an element name or \"inertia:N\", got {source!r}")
+    m = _INERTIA.fullmatch(source.strip())
+    if m:
+        return "inertia", int(m.group(1))
+    if source.startswith("inertia"):
+        raise ValueError(f"`source` {source!r} must be \"inertia:N\" with N a whole inertia number (from 1), "
+                         "e.g. \"inertia:2\"")
+    return "element", source
+
+
+def _vector(name: str, value: object) -> FloatArray:
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"`{name}` must be a sequence of numbers, got {value!r}") from None
+    if arr.ndim != 1:
+        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}")
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise ValueError(f"`{name}` must hold finite numbers, got {arr[bad[0]]!r} at row {int(bad[0])}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class SoundPath:
+    """A path from a rattle source to the receiver: H(f) = p / q'' tabulated at ``frequency_hz``.
+
+    Parameters
+    ----------
+    source : str
+        An element name (its deflection acceleration δ''; the single-equation model's element is
+        ``"delta"``) or ``"inertia:N"`` (the absolute angular acceleration θ''_N of inertia N,
+        numbered from 1; chains only).
+    frequency_hz : sequence of float, shape (R,)
+        Frequencies (Hz), finite, > 0, strictly increasing; R ≥ 1.
+    magnitude : sequence of float, shape (R,)
+        |H| (Pa per rad/s²), finite, ≥ 0.
+    phase_deg : sequence of float, shape (R,)
+        arg H (degrees), finite; unwrapped before interpolation.
+    name : str, optional
+        A label for messages (e.g. the CSV file it was read from).
+
+    Notes
+    -----
+    ``response(f)`` interpolates linearly in |H| and in the unwrapped phase; outside
+    [frequency_hz[0], frequency_hz[-1]] it is 0 (no extrapolation; see :meth:`covers`). A table
+    of one row is a single frequency: only that frequency is transmitted.
+    """
+
+    source: str
+    frequency_hz: FloatArray
+    magnitude: FloatArray
+    phase_deg: FloatArray
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        parse_source(self.source)
+        if not isinstance(self.name, str):
+            raise TypeError(f"`name` must be a string, got {self.name!r}")
+        f = _vector("frequency_hz", self.frequency_hz)
+        mag = _vector("magnitude", self.magnitude)
+        ph = _vector("phase_deg", self.phase_deg)
+        if f.size == 0:
+            raise ValueError("`frequency_hz` must hold at least one frequency, got none")
+        if f.size > MAX_PATH_ROWS:
+            raise ValueError(f"`frequency_hz` must hold at most {MAX_PATH_ROWS} rows, got {f.size}")
+        if mag.size != f.size or ph.size != f.size:
+            raise ValueError(f"`magnitude` and `phase_deg` must have one entry per frequency ({f.size}), "
+                             f"got {mag.size} and {ph.size}")
+        if f[0] <= 0:
+            raise ValueError(f"`frequency_hz` must be > 0 Hz, got {f[0]!r} at row 0")
+        steps = np.flatnonzero(np.diff(f) <= 0)
+        if steps.size:
+            i = int(steps[0])
+            raise ValueError(f"`frequency_hz` must be strictly increasing, got {f[i]!r} then {f[i + 1]!r} "
+                             f"at rows {i} and {i + 1}; sort the table and remove repeated frequencies")
+        neg = np.flatnonzero(mag < 0)
+        if neg.size:
+            raise ValueError(f"`magnitude` must be >= 0 (a modulus; put the sign in `phase_deg`), got "
+                             f"{mag[neg[0]]!r} at row {int(neg[0])}")
+        object.__setattr__(self, "source", self.source.strip())
+        object.__setattr__(self, "frequency_hz", f)
+        object.__setattr__(self, "magnitude", mag)
+        object.__setattr__(self, "phase_deg", ph)
+
+    @property
+    def kind(self) -> str:
+        """``"element"`` or ``"inertia"``."""
+        return parse_source(self.source)[0]
+
+    @property
+    def target(self) -> int | str:
+        """The element name, or the inertia number (from 1)."""
+        return parse_source(self.source)[1]
+
+    @property
+    def frequency_range(self) -> tuple[float, float]:
+        """(lowest, highest) tabulated frequency in Hz."""
+        return float(self.frequency_hz[0]), float(self.frequency_hz[-1])
+
+    def covers(self, f_hz: FloatArray | float) -> np.ndarray:
+        """True where ``f_hz`` lies within the table's range (boolean array of f_hz's shape)."""
+        f = np.asarray(f_hz, dtype=float)
+        lo, hi = self.frequency_range
+        return (f >= lo) & (f <= hi)
+
+    def response(self, f_hz: FloatArray | float) -> np.ndarray | complex:
+        """H(f) (Pa per rad/s², complex) at frequencies ``f_hz`` (Hz, any shape): |H| and the
+        unwrapped phase interpolated linearly between rows; 0 outside the table's range."""
+        f = np.asarray(f_hz, dtype=float)
+        mag = np.interp(f, self.frequency_hz, self.magnitude)
+        ph = np.interp(f, self.frequency_hz, np.unwrap(self.phase_deg, period=360.0))
+        out = np.where(self.covers(f), mag * np.exp(1j * np.deg2rad(ph)), 0.0 + 0.0j)
+        return complex(out) if out.ndim == 0 else out
+
+    def __repr__(self) -> str:
+        lo, hi = self.frequency_range
+        label = f", {self.name!r}" if self.name else ""
+        return f"SoundPath({self.source!r}{label}, {self.frequency_hz.size} rows, {lo:g} … {hi:g} Hz)"
+
+    def to_dict(self) -> dict[str, object]:
+        """Source, name, row count and frequency range (for run metadata)."""
+        return {"source": self.source, "name": self.name, "rows": int(self.frequency_hz.size),
+                "frequency_range_hz": list(self.frequency_range)}
+
+
+def check_source(source: str, model: Any, name: str = "source") -> None:
+    """Refuse a source that names no element of ``model`` or an inertia out of range."""
+    kind, target = parse_source(source)
+    system = model.system()
+    if kind == "element":
+        names = [e.name for e in system.elements]
+        if target not in names:
+            raise ValueError(f"`{name}` must name an element of the model ({', '.join(map(repr, names))}) or be "
+                             f"\"inertia:N\", got {source!r}")
+        return
+    if not hasattr(model, "inertias"):
+        raise ValueError(
+            f"`{name}` {source!r}: the single-equation model knows only the effective inertia, not I1 and I2, "
+            "so an inertia's absolute acceleration is not defined; use the element \"delta\", or write the model "
+            "as a two-inertia chain ([model] inertias = [I1, I2], SPEC §5)")
+    n_inertias = system.angles.shape[0]
+    if not 1 <= int(target) <= n_inertias:
+        raise ValueError(f"`{name}` {source!r} must name an inertia 1 … {n_inertias}, got inertia {target}")
