@@ -155,6 +155,9 @@ class Chain:
     links: tuple[Link, ...] = ()
     elements: tuple[Element, ...]
     torques: tuple[Torque, ...] = ()
+    #: The engine order of the forcing frequency Ω (set by ``[engine]``, SPEC §6): the crankshaft
+    #: speed is rpm = Ω · 60 / (2π · speed_order). None: no engine, results carry no rpm.
+    speed_order: float | None = None
     _system: System | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -192,6 +195,11 @@ class Chain:
         object.__setattr__(self, "links", links)
         object.__setattr__(self, "elements", elements)
         object.__setattr__(self, "torques", torques)
+        if self.speed_order is not None:
+            q = _check_real("speed_order", self.speed_order)
+            if not q > 0:
+                raise ValueError(f"`speed_order` must be > 0 (an engine order), got {q!r}")
+            object.__setattr__(self, "speed_order", q)
         self._check_connected()
         if self.free:
             total = sum(t.mean for t in torques)
@@ -375,7 +383,14 @@ class Chain:
             "links": [x.to_dict() for x in self.links],
             "elements": [x.to_dict() for x in self.elements],
             "torques": [x.to_dict() for x in self.torques],
+            **({"speed_order": self.speed_order} if self.speed_order is not None else {}),
         }
+
+    def speed_rpm(self, omega: Any) -> Any:
+        """Crankshaft speed (rpm) at forcing frequency ``omega`` (rad/s), or None without an engine."""
+        if self.speed_order is None:
+            return None
+        return np.asarray(omega, dtype=float) * (60.0 / (2.0 * math.pi * self.speed_order))
 
 
 __all__ = ["Chain", "Link", "Element", "Torque", "BALANCE_RTOL"]
