@@ -145,16 +145,23 @@ class RunConfig:
     source_name: str = field(default="<dict>", compare=False)
     #: ``[[paths]]`` (SPEC §6): the sound paths (:class:`rattle.model.SoundPath`), read by ``rattle.io._paths``.
     paths: tuple[Any, ...] = ()
+    #: ``[model] units`` (SPEC §6): ``"dimensionless"`` or ``"SI"``; the model holds the numbers as given
+    #: (angles converted to rad) either way.
+    units: str = "dimensionless"
 
     def to_dict(self) -> dict[str, Any]:
-        """The resolved configuration (defaults filled in) as a TOML-shaped dict."""
-        return model_to_toml_dict(self.model, self.analysis)
+        """The resolved configuration (defaults filled in) as a TOML-shaped dict (angles in rad, an
+        ``[engine]`` resolved into its torque and ``[model] speed_order``)."""
+        out = model_to_toml_dict(self.model, self.analysis)
+        if self.units != "dimensionless":
+            out["model"] = {"units": self.units, **out["model"]}
+        return out
 
 
 # --------------------------------------------------------------------------------------------
 # Schema
 # --------------------------------------------------------------------------------------------
-_TOP_KEYS = ("model", "excitation", "analysis")
+_TOP_KEYS = ("model", "excitation", "analysis", "engine")
 _MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
 _EXCITATION_KEYS = ("mean", "amplitudes", "phases")
 _ANALYSIS_KEYS = ("omega", "harmonics")
@@ -279,8 +286,12 @@ class _Checker:
 
     def __init__(self, source_name: str) -> None:
         self.source_name = source_name
+        #: full rad key -> the ``_deg`` key the user wrote (``model.elastic.b`` -> ``model.elastic.b_deg``)
+        self.degree_keys: dict[str, str] = {}
 
     def error(self, message: str) -> ConfigError:
+        for rad, deg in self.degree_keys.items():  # name the key the user wrote
+            message = message.replace(f"`{rad}`", f"`{deg}` (converted to rad)").replace(f"`{rad}[", f"`{deg}[")
         return ConfigError(f"{self.source_name}: {message}")
 
     # --- structure ---------------------------------------------------------------------------
@@ -454,10 +465,21 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         return with_paths(rest, data["paths"], source_name)
 
     # Structure of every table first, so that a misspelt key is reported before its values.
-    check.keys(data, "", _TOP_KEYS, required=("model", "excitation"))
+    check.keys(data, "", _TOP_KEYS, required=("model",) if "engine" in data else ("model", "excitation"))
     model_t = check.table(data, "model", "model")
+    units = _units(check, model_t)
+    model_t = _model_in_radians(check, model_t)
     if "inertias" in model_t:  # SPEC §5: a chain of inertias
-        return _chain_config(check, data, model_t)
+        return _chain_config(check, data, model_t, units)
+    if "engine" in data:
+        raise check.error(
+            "`engine` needs a chain of inertias (SPEC §5–6): the engine torque acts on one inertia, but [model] "
+            "is the single equation (inertia, damping, stiffness); use `[model] inertias` with [[model.links]] "
+            "and [[model.elements]] (a two-inertia free chain is the single equation), or give the excitation "
+            "in [excitation] instead of [engine]"
+        )
+    if "excitation" not in data:
+        check.keys(data, "", _TOP_KEYS, required=("model", "excitation"))
     check.keys(model_t, "model", _MODEL_KEYS, required=_MODEL_KEYS)
     elastic_t = check.table(model_t, "elastic", "model.elastic")
     law, law_params = _elastic_structure(check, elastic_t)
@@ -499,7 +521,8 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         check_analysis(model, analysis)
     except ConfigError as exc:
         raise check.error(str(exc)) from None
-    return RunConfig(model=model, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name)
+    return RunConfig(model=model, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name,
+                     units=units)
 
 
 def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonics") -> None:
@@ -598,9 +621,147 @@ def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
 
 
 # --------------------------------------------------------------------------------------------
+# Units (SPEC §6): ``[model] units``, angles in degrees through ``_deg`` keys
+# --------------------------------------------------------------------------------------------
+#: ``[model] units``: the numbers are taken as given either way (the numerics are scale-aware);
+#: ``"SI"`` declares kg m², N m/rad, N m s/rad, N m and rad, and is required by ``[engine]``.
+UNITS = ("dimensionless", "SI")
+#: Keys holding angles (rad) that may be given in degrees as ``KEY_deg``: in ``[model.elastic]``
+#: and every ``[[model.elements]]``.
+ANGLE_KEYS = ("b", "breakpoints")
+
+
+def _units(check: _Checker, model_t: Mapping[str, Any]) -> str:
+    if "units" not in model_t:
+        return "dimensionless"
+    value = model_t["units"]
+    if not isinstance(value, str) or value not in UNITS:
+        hint = _did_you_mean(value, UNITS).replace("`", '"') if isinstance(value, str) else ""
+        raise check.error(
+            f"`model.units` must be one of {_join([json.dumps(u) for u in UNITS])}, got {_show(value)} "
+            f"({_kind(value)}); {hint}write units = \"SI\" (kg m², N m/rad, N m s/rad, N m, rad) or leave it out "
+            "(dimensionless)"
+        )
+    return value
+
+
+def _in_radians(check: _Checker, table: Mapping[str, Any], where: str, known: Sequence[str]) -> dict[str, Any]:
+    """``table`` with every ``KEY_deg`` (an angle in degrees) replaced by ``KEY`` in rad."""
+    out = dict(table)
+    for key in table:
+        if not (isinstance(key, str) and key.endswith("_deg")):
+            continue
+        twin = key[: -len("_deg")]
+        if twin not in ANGLE_KEYS:
+            why = (f"`{twin}` is not an angle" if twin in known else f"`{where}.{twin}` is not a known key")
+            raise check.error(
+                f"`{where}.{key}` is not a known key: {why}, so it has no value in degrees (the `_deg` keys are "
+                f"{_join([a + '_deg' for a in ANGLE_KEYS])}); remove it or correct its spelling"
+            )
+        if twin in table:
+            raise check.error(
+                f"`{where}.{twin}` and `{where}.{key}` are both given: one angle in rad and in degrees; "
+                f"keep one of them"
+            )
+        value = table[key]
+        if isinstance(value, (list, tuple)):
+            check.array(value, f"{where}.{key}")
+            out[twin] = [math.radians(float(v)) for v in value]
+        else:
+            check.number(value, f"{where}.{key}")
+            out[twin] = math.radians(float(value))
+        del out[key]
+        check.degree_keys[f"{where}.{twin}"] = f"{where}.{key}"
+    return out
+
+
+def _model_in_radians(check: _Checker, model_t: Mapping[str, Any]) -> dict[str, Any]:
+    """``[model]`` without ``units``, its angles in rad (``[model.elastic]``, ``[[model.elements]]``)."""
+    out = {k: v for k, v in model_t.items() if k != "units"}
+    laws = sorted({p for law in ELASTIC_LAWS.values() for p in _law_params(law)} | {"type"})
+    if isinstance(out.get("elastic"), Mapping):
+        out["elastic"] = _in_radians(check, out["elastic"], "model.elastic", laws)
+    elements = out.get("elements")
+    if isinstance(elements, (list, tuple)) and all(isinstance(t, Mapping) for t in elements):
+        out["elements"] = [_in_radians(check, t, f"model.elements[{k}]", [*_MODEL_ELEMENTS_KEYS, *laws])
+                           for k, t in enumerate(elements)]
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# [engine] (SPEC §6): the engine torque by order on one inertia, the analysis axis in rpm
+# --------------------------------------------------------------------------------------------
+_ENGINE_KEYS = ("inertia", "cylinders", "speed_rpm", "mean_torque", "orders", "amplitudes", "phases")
+_EXAMPLES.update({
+    "engine": "[engine] with inertia = 1, speed_rpm = [600, 3000], orders = [2.0], amplitudes = [60.0]",
+    "engine.inertia": "inertia = 1",
+    "engine.cylinders": "cylinders = 4",
+    "engine.speed_rpm": "speed_rpm = [600, 3000]",
+    "engine.mean_torque": "mean_torque = 0.0",
+    "engine.orders": "orders = [2.0, 4.0]",
+    "engine.amplitudes": "amplitudes = [60.0, 15.0]",
+    "engine.phases": "phases = [0.0, 0.0]",
+})
+
+
+@dataclass(frozen=True, slots=True)
+class _Engine:
+    torque: Any
+    base_order: float
+    harmonics: int
+    rpm: tuple[float, float]
+
+
+def _engine(check: _Checker, data: Mapping[str, Any], n: int, units: str) -> _Engine:
+    from ..model._engine import engine_torque
+
+    t = check.table(data, "engine", "engine")
+    if units != "SI":
+        raise check.error(
+            f"`engine` needs `model.units` = \"SI\" (got {json.dumps(units)}): its speeds are in rpm and its "
+            "torques in N m; add units = \"SI\" to [model] and give the model in SI units"
+        )
+    t = _in_radians(check, t, "engine", _ENGINE_KEYS) if any(str(k) == "phases_deg" for k in t) else dict(t)
+    check.keys(t, "engine", _ENGINE_KEYS, required=("inertia", "speed_rpm", "orders", "amplitudes"))
+    check.integer(t["inertia"], "engine.inertia")
+    if not 1 <= t["inertia"] <= n:
+        raise check.error(f"`engine.inertia` must be an inertia number 1 … {n} (`model.inertias` has {n}), "
+                          f"got {t['inertia']}; give the inertia the engine drives (the flywheel)")
+    if "cylinders" in t:
+        check.integer(t["cylinders"], "engine.cylinders")
+        if t["cylinders"] < 1:
+            raise check.error(f"`engine.cylinders` must be an integer >= 1, got {t['cylinders']}")
+    rpm = t["speed_rpm"]
+    check.array(rpm, "engine.speed_rpm")
+    if len(rpm) != 2 or not 0 < rpm[0] < rpm[1]:
+        raise check.error(
+            f"`engine.speed_rpm` must be [lowest, highest] crankshaft speed in rpm with 0 < lowest < highest, got "
+            f"{_show(rpm)}; write e.g. {_example('engine.speed_rpm')}"
+        )
+    if "mean_torque" in t:
+        check.number(t["mean_torque"], "engine.mean_torque")
+    for key in ("orders", "amplitudes", "phases"):
+        if key in t:
+            check.array(t[key], f"engine.{key}")
+    if not t["orders"]:
+        raise check.error(f"`engine.orders` must hold at least one engine order, got []; write e.g. "
+                          f"{_example('engine.orders')}")
+    for i, q in enumerate(t["orders"]):
+        if not q > 0:
+            raise check.error(f"`engine.orders[{i}]` must be > 0 (a multiple of the crankshaft speed), got {_show(q)}")
+    torque, q0 = check.build(
+        engine_torque, {"inertia": "engine.inertia", "orders": "engine.orders", "amplitudes": "engine.amplitudes",
+                        "phases": "engine.phases", "mean": "engine.mean_torque"},
+        inertia=t["inertia"], orders=t["orders"], amplitudes=t["amplitudes"], phases=t.get("phases"),
+        mean=t.get("mean_torque", 0.0),
+    )
+    return _Engine(torque=torque, base_order=q0, harmonics=len(torque.amplitudes), rpm=(float(rpm[0]), float(rpm[1])))
+
+
+# --------------------------------------------------------------------------------------------
 # Chains (SPEC §5)
 # --------------------------------------------------------------------------------------------
-_CHAIN_MODEL = ("inertias", "links", "elements")
+_CHAIN_MODEL = ("inertias", "links", "elements", "speed_order")
 _MODEL_LINKS_KEYS = ("between", "stiffness", "damping")
 _MODEL_ELEMENTS_KEYS = ("name", "between", "stiffness")
 _EXCITATION_TORQUES_KEYS = ("inertia", "mean", "amplitudes", "phases")
@@ -640,7 +801,8 @@ def _between(check: _Checker, value: Any, key: str, n: int) -> None:
         raise check.error(f"`{key}` must join two different inertias, got {_show(value)}")
 
 
-def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str, Any]) -> RunConfig:
+def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str, Any],
+                  units: str = "dimensionless") -> RunConfig:
     """The SPEC §5 chain: ``[model] inertias``, ``[[model.links]]``, ``[[model.elements]]``,
     ``[[excitation.torques]]``."""
     from ..model import Chain, Element, Link, Torque
@@ -653,12 +815,27 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                 f"[[model.elements]]) and remove `model.{key}`"
             )
     check.keys(model_t, "model", _CHAIN_MODEL, required=("inertias", "elements"))
-    excitation_t = check.table(data, "excitation", "excitation")
-    check.keys(excitation_t, "excitation", ("torques",), required=("torques",))
+    has_engine = "engine" in data
+    excitation_t: Mapping[str, Any] = {}
+    if "excitation" in data or not has_engine:
+        excitation_t = check.table(data, "excitation", "excitation")
+        check.keys(excitation_t, "excitation", ("torques",), required=() if has_engine else ("torques",))
     analysis_t: Mapping[str, Any] = {}
     if "analysis" in data:
         analysis_t = check.table(data, "analysis", "analysis")
         check.keys(analysis_t, "analysis", _ANALYSIS_KEYS, required=())
+    if has_engine and "omega" in analysis_t:
+        raise check.error(
+            "`analysis.omega` and `engine.speed_rpm` are both given: with [engine] the analysis axis is the "
+            "crankshaft speed; remove `analysis.omega` (engine.speed_rpm sets the range)"
+        )
+    if has_engine and "speed_order" in model_t:
+        raise check.error(
+            "`model.speed_order` and [engine] are both given: [engine] sets the base order from its orders; "
+            "remove `model.speed_order`"
+        )
+    if "speed_order" in model_t:
+        check.number(model_t["speed_order"], "model.speed_order")
     check.array(model_t["inertias"], "model.inertias")
     n = len(model_t["inertias"])
     if n == 0:
@@ -703,7 +880,7 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                                     name=name, between=t["between"], stiffness=t["stiffness"], law=elastic))
 
     torques = []
-    for k, t in enumerate(_tables(check, excitation_t, "torques", "excitation.torques")):
+    for k, t in enumerate(_tables(check, excitation_t, "torques", "excitation.torques") if "torques" in excitation_t else []):
         where = f"excitation.torques[{k}]"
         check.keys(t, where, _EXCITATION_TORQUES_KEYS, required=("inertia",))
         check.integer(t["inertia"], f"{where}.inertia")
@@ -718,16 +895,35 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         torques.append(check.build(Torque, {f: f"{where}.{f}" for f in _EXCITATION_TORQUES_KEYS}, **dict(t)))
 
     names = {"inertias": "model.inertias", "links": "model.links", "elements": "model.elements",
-             "torques": "excitation.torques"}
+             "torques": "excitation.torques", "speed_order": "model.speed_order"}
+    engine = _engine(check, data, n, units) if has_engine else None
+    speed_order = model_t.get("speed_order")
+    omega_names = None
+    if engine is not None:  # its torque joins the others (on the same inertia they add up)
+        from ..model._engine import forcing_frequency
+
+        torques.append(engine.torque)
+        speed_order = engine.base_order
+        if engine.torque.mean:
+            names["torques"] = "engine.mean_torque` with `excitation.torques"
+        analysis_t = {**analysis_t, "omega": [float(forcing_frequency(r, speed_order)) for r in engine.rpm]}
+        omega_names = {"omega_min": "engine.speed_rpm[0]", "omega_max": "engine.speed_rpm[1]"}
     chain = check.build(Chain, names, inertias=model_t["inertias"], links=tuple(links), elements=tuple(elements),
-                        torques=tuple(torques))
+                        torques=tuple(torques), speed_order=speed_order)
     analysis = _analysis(check, analysis_t)
+    if engine is not None and analysis.harmonics < engine.harmonics:
+        raise check.error(
+            f"`analysis.harmonics` must be >= {engine.harmonics}: the highest of `engine.orders` is harmonic "
+            f"{engine.harmonics} of their base order {engine.base_order:g}, got {analysis.harmonics}; raise "
+            "`analysis.harmonics`"
+        )
     check_harmonics(chain, analysis.harmonics)
     try:
-        check_analysis(chain, analysis)
+        check_analysis(chain, analysis, omega_names)
     except ConfigError as exc:
         raise check.error(str(exc)) from None
-    return RunConfig(model=chain, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=check.source_name)
+    return RunConfig(model=chain, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=check.source_name,
+                     units=units)
 
 
 # --------------------------------------------------------------------------------------------
@@ -754,6 +950,8 @@ def model_to_toml_dict(model: Model, analysis: AnalysisSettings | None = None) -
         elements = [{k: v for k, v in e.items()} for e in d["elements"]]
         out_c: dict[str, Any] = {"model": {"inertias": d["inertias"], "links": d["links"], "elements": elements},
                                  "excitation": {"torques": d["torques"]}}
+        if d.get("speed_order") is not None:  # an [engine]'s base order: results keep their rpm
+            out_c["model"]["speed_order"] = d["speed_order"]
         if not d["links"]:
             del out_c["model"]["links"]
         if analysis is not None:
