@@ -175,13 +175,25 @@ class FrequencyResponse:
 
     def columns(self) -> dict[str, np.ndarray]:
         """The SPEC columns in order, as a dict of arrays; for a chain also, per element NAME,
-        ``NAME_mean … NAME_regime`` (SPEC §5, :data:`ELEMENT_COLUMNS`)."""
-        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **self.element_columns, **self.extra_columns}
+        ``NAME_mean … NAME_regime`` (SPEC §5, :data:`ELEMENT_COLUMNS`); with an engine
+        (SPEC §6) ``speed_rpm``; then the extra columns (``spl_db``)."""
+        rpm = self.speed_rpm
+        speed = {} if rpm is None else {"speed_rpm": rpm}
+        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **self.element_columns, **speed,
+                **self.extra_columns}
 
     @property
     def column_names(self) -> list[str]:
         """Names of :meth:`columns` in file order."""
-        return [*FRF_COLUMNS, *self.element_columns, *self.extra_columns]
+        speed = [] if getattr(self.model, "speed_order", None) is None else ["speed_rpm"]
+        return [*FRF_COLUMNS, *self.element_columns, *speed, *self.extra_columns]
+
+    @property
+    def speed_rpm(self) -> FloatArray | None:
+        """Crankshaft speed (rpm) of each row when the model has an engine (``[engine]``,
+        ``Chain.speed_order`` q_0): Ω · 60 / (2π q_0); None otherwise."""
+        order = getattr(self.model, "speed_order", None)
+        return None if order is None else np.asarray(self.omega, dtype=float) * (60.0 / (2.0 * np.pi * order))
 
     @property
     def element_names(self) -> tuple[str, ...]:

@@ -135,8 +135,17 @@ class SweepResult:
 
     def columns(self) -> dict[str, np.ndarray]:
         """The SPEC columns in order, as a dict of arrays; for a chain followed by the
-        per-element columns (``NAME_mean`` … ``NAME_acc_p2p``)."""
-        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, **self.element_columns}
+        per-element columns (``NAME_mean`` … ``NAME_acc_p2p``), then ``speed_rpm`` with an engine."""
+        rpm = self.speed_rpm
+        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, **self.element_columns,
+                **({} if rpm is None else {"speed_rpm": rpm})}
+
+    @property
+    def speed_rpm(self) -> FloatArray | None:
+        """Crankshaft speed (rpm) of each row when the model has an engine (``Chain.speed_order``
+        q_0): Ω · 60 / (2π q_0); None otherwise."""
+        order = getattr(self.model, "speed_order", None)
+        return None if order is None else np.asarray(self.omega, dtype=float) * (60.0 / (2.0 * np.pi * order))
 
     @property
     def element_names(self) -> tuple[str, ...]:
