@@ -128,7 +128,8 @@ def compute_frf(
 
 
 def run_frf(
-    model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False
+    model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False,
+    paths: Sequence[Any] = (),
 ) -> None:
     """Compute the frequency response, write the three files and print the summary.
 
@@ -143,6 +144,8 @@ def run_frf(
         Extra metadata sections for ``frf.json`` (``config``, ``command``, …).
     subharmonics : bool, default False
         Also follow the period-doubled branches (every branch goes into the files).
+    paths : sequence of SoundPath, default ()
+        The configuration's ``[[paths]]``: when given, frf.csv gets the column ``spl_db``.
 
     Raises
     ------
@@ -152,6 +155,8 @@ def run_frf(
     """
     t_start = time.perf_counter()
     result = compute_frf(model, analysis, output, sections, t_start, subharmonics=subharmonics)
+    if paths:  # SPEC §6: the sound pressure level at the receiver, per point
+        result = result.with_sound(tuple(paths))
     written = write_frf(result, output, sections, t_start)
     echo_written(result.summary(), written, output)
 
@@ -183,7 +188,7 @@ def frf_command(
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "subharmonics": True if subharmonics else None}
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
-            subharmonics=subharmonics)
+            subharmonics=subharmonics, paths=run_config.paths)
 
 
 # --------------------------------------------------------------------------------------------
@@ -332,7 +337,7 @@ def compare_command(
         "omega_min": omega_min, "omega_max": omega_max,
     })
     written = write_set(output, COMPARE_FILES, [
-        ("frf.csv", result.frf.to_csv),
+        ("frf.csv", (result.frf.with_sound(run_config.paths) if run_config.paths else result.frf).to_csv),
         ("sweep.csv", result.sweep.to_csv),
         ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
         ("compare.png", lambda path: save_plot(result, path)),

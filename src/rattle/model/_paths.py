@@ -29,15 +29,15 @@ _INERTIA = re.compile(r"inertia:([0-9]+)")
 MAX_PATH_ROWS = 1_000_000
 
 
-def parse_source(source: str) -> tuple[str, int | str]:
+def parse_source(source: str, name: str = "source") -> tuple[str, int | str]:
     """``("inertia", N)`` for ``"inertia:N"`` (1-based), else ``("element", name)``."""
     if not isinstance(source, str) or not source:
-        raise TypeError(f"`source` must be an element name or \"inertia:N\", got {source!r}")
+        raise TypeError(f"`{name}` must be an element name or \"inertia:N\", got {source!r}")
     m = _INERTIA.fullmatch(source.strip())
     if m:
         return "inertia", int(m.group(1))
     if source.startswith("inertia"):
-        raise ValueError(f"`source` {source!r} must be \"inertia:N\" with N a whole inertia number (from 1), "
+        raise ValueError(f"`{name}` {source!r} must be \"inertia:N\" with N a whole inertia number (from 1), "
                          "e.g. \"inertia:2\"")
     return "element", source
 
@@ -161,7 +161,7 @@ class SoundPath:
 
 def check_source(source: str, model: Any, name: str = "source") -> None:
     """Refuse a source that names no element of ``model`` or an inertia out of range."""
-    kind, target = parse_source(source)
+    kind, target = parse_source(source, name)
     system = model.system()
     if kind == "element":
         names = [e.name for e in system.elements]
