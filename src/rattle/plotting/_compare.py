@@ -96,7 +96,7 @@ def compare_plot(
     """
     import matplotlib.pyplot as plt
 
-    from ._frf import _draw_panel
+    from ._frf import _draw_panel, speed_axis
     from ._sweep import _draw_sweep
 
     frf, sweep = comparison.frf, comparison.sweep
@@ -127,10 +127,11 @@ def compare_plot(
                         legend=False)
             ax_k.set_ylabel(f"{name}: δ rms (rad)")
     letters = string.ascii_lowercase
+    sx = speed_axis(frf)[0]  # crankshaft rpm with an engine
     for ax_k in frf_axes:
         for j, w in enumerate(comparison.at):
-            ax_k.axvline(w, color="0.35", lw=0.9, ls="-.", zorder=0)
-            ax_k.annotate(f"({letters[j % 26]})", (w, 1.0), xycoords=("data", "axes fraction"),
+            ax_k.axvline(w * sx, color="0.35", lw=0.9, ls="-.", zorder=0)
+            ax_k.annotate(f"({letters[j % 26]})", (w * sx, 1.0), xycoords=("data", "axes fraction"),
                           xytext=(3, -12), textcoords="offset points", fontsize=10, fontweight="bold")
     ax_frf.set_title(
         f"Frequency response: harmonic balance (H = {frf.harmonics}, lines) against the time-domain sweep "
@@ -171,7 +172,8 @@ def compare_plot(
                 ax.axvline(mm * Tf, color="0.85", lw=0.8, zorder=0)
             ax.set_xlim(0.0, n_win * Tf)
             if e == 0:
-                ax.set_title(f"({letters[j % 26]}) Ω = {w:.4g} rad/s: {why}", fontsize=10)
+                rpm = f" ({w * sx:.5g} rpm)" if sx != 1.0 else ""
+                ax.set_title(f"({letters[j % 26]}) Ω = {w:.4g} rad/s{rpm}: {why}", fontsize=10)
             ax.set_xlabel("time t (s)")
             if j == 0:
                 ax.set_ylabel(f"{names[e]}: δ (rad)" if names else "δ (rad)")

@@ -49,6 +49,15 @@ SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {
 _ELEMENT_SUFFIX = {"delta_min": "min", "delta_max": "max"}
 
 
+def speed_axis(result: Any) -> tuple[float, str]:
+    """(x-axis units per rad/s, x-axis label) of a result's plots: crankshaft rpm when its model
+    has an engine (``speed_order`` q_0: rpm = Ω · 60 / (2π q_0)), else Ω in rad/s."""
+    order = getattr(getattr(result, "model", None), "speed_order", None)
+    if order is None:
+        return 1.0, "forcing frequency Ω (rad/s)"
+    return 60.0 / (2.0 * np.pi * float(order)), "engine speed (rpm)"
+
+
 def column(frf: "FrequencyResponse", quantity: str) -> np.ndarray:
     """The values of ``quantity``: a SPEC column (``rms``) or an element's (``clutch_rms``)."""
     cols = getattr(frf, "element_columns", {}) or {}
@@ -88,9 +97,10 @@ def draw_branches(
     """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours."""
     y_all = column(frf, quantity)
     colors = branch_colors(frf)
+    x_all = np.asarray(frf.omega, dtype=float) * speed_axis(frf)[0]
     for b, color in colors.items():
         sel = np.nonzero(frf.branch == b)[0]
-        om, y, st = frf.omega[sel], y_all[sel], np.asarray(frf.stable[sel], dtype=bool)
+        om, y, st = x_all[sel], y_all[sel], np.asarray(frf.stable[sel], dtype=bool)
         base = branch_label(frf, b)
         for flag, style in ((True, "-"), (False, "--")):
             first = True
@@ -118,7 +128,7 @@ def draw_special_points(frf: "FrequencyResponse", ax: Any, quantity: str, *, lab
         rows.setdefault(sp.kind, []).append(int(sp.index))
     for kind, idx in rows.items():
         marker, color, text = SPECIAL_POINT_STYLES.get(kind, ("X", "black", kind.replace("_", " ")))
-        ax.plot(frf.omega[idx], y_all[idx], marker, color=color, ms=6.5, mfc="none", mew=1.5, ls="none",
+        ax.plot(np.asarray(frf.omega, dtype=float)[idx] * speed_axis(frf)[0], y_all[idx], marker, color=color, ms=6.5, mfc="none", mew=1.5, ls="none",
                 label=text if labels else None, zorder=5)
 
 
@@ -151,6 +161,7 @@ def draw_regions(
 
     top = blended_transform_factory(ax.transData, ax.transAxes)
     y_all = column(frf, quantity)
+    sx = speed_axis(frf)[0]  # x in rpm with an engine
     seen: set[str] = set()
     peaks: list[tuple[int, str]] = []
     for r in regions:
@@ -158,10 +169,10 @@ def draw_regions(
             period = int(r.detail.get("period", 2))
             band, text_color = SUBHARMONIC_COLORS.get(period, ("#bbbbbb", "0.25"))
             key = f"sub{period}"
-            ax.axvspan(r.omega_min, r.omega_max, color=band, alpha=0.22, lw=0, zorder=0,
+            ax.axvspan(sx * r.omega_min, sx * r.omega_max, color=band, alpha=0.22, lw=0, zorder=0,
                        label=f"period {period} stable (1/{period} sub-harmonic)" if labels and key not in seen else None)
             seen.add(key)
-            ax.text(0.5 * (r.omega_min + r.omega_max), 0.985, f"period {period}", transform=top,
+            ax.text(0.5 * sx * (r.omega_min + r.omega_max), 0.985, f"period {period}", transform=top,
                     ha="center", va="top", fontsize=8, color=text_color, fontweight="bold",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8}, zorder=6)
         elif r.kind in UNSTABLE_REGION_STYLES:
@@ -170,25 +181,25 @@ def draw_regions(
             if sim and r.kind != "no_stable_periodic":  # what the simulation saw replaces the guess
                 seen_text = ", ".join(f"period {p}" if p else "no period ≤ 8" for p in sim)
                 legend_text = legend_text.split(":")[0].split(";")[0] + f":\nsimulation: {seen_text}"
-            ax.axvspan(r.omega_min, r.omega_max, facecolor="none", edgecolor=edge, hatch=hatch, lw=0,
+            ax.axvspan(sx * r.omega_min, sx * r.omega_max, facecolor="none", edgecolor=edge, hatch=hatch, lw=0,
                        zorder=0, label=legend_text if labels and legend_text not in seen else None)
             seen.add(legend_text)
             if r.kind == "unstable_period_doubling":
                 short = f"period {2 * int(r.detail.get('period', 1))}\nlikely"
             if sim and r.kind != "no_stable_periodic":
                 short = "sim: " + ",".join(f"P{p}" if p else "none" for p in sim)
-            ax.text(0.5 * (r.omega_min + r.omega_max), 0.93, short, transform=top,
+            ax.text(0.5 * sx * (r.omega_min + r.omega_max), 0.93, short, transform=top,
                     ha="center", va="top", fontsize=7, color="0.25",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}, zorder=6)
         elif r.kind == "torus":
             sim = r.detail.get("simulated_periods")
             text = ("quasi-periodic (Neimark–Sacker)" if sim is None else
                     "Neimark–Sacker interval, simulation: " + ", ".join(f"period {p}" if p else "quasi-periodic" for p in sim))
-            ax.axvspan(r.omega_min, r.omega_max, facecolor="tab:green", alpha=0.12, edgecolor="tab:green", lw=0.8,
+            ax.axvspan(sx * r.omega_min, sx * r.omega_max, facecolor="tab:green", alpha=0.12, edgecolor="tab:green", lw=0.8,
                        zorder=0, label=text if labels and text not in seen else None)
             seen.add(text)
             short = "torus" if sim is None else ("sim: " + ",".join(f"P{p}" if p else "QP" for p in sim))
-            ax.text(0.5 * (r.omega_min + r.omega_max), 0.86, short, transform=top, ha="center", va="top", fontsize=7,
+            ax.text(0.5 * sx * (r.omega_min + r.omega_max), 0.86, short, transform=top, ha="center", va="top", fontsize=7,
                     color="tab:green", bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
                     zorder=6)
         elif r.kind == "superharmonic":
@@ -201,7 +212,7 @@ def draw_regions(
     lo, hi = ax.get_xlim()
     level, last = 0, -np.inf
     for i, text in sorted(peaks, key=lambda p: frf.omega[p[0]]):
-        w = float(frf.omega[i])
+        w = float(frf.omega[i]) * sx
         level = level + 1 if w - last < 0.03 * (hi - lo) else 0
         last = w
         ax.annotate(text, (w, y_all[i]), xytext=(0, 9 + 11 * (level % 3)), textcoords="offset points",
@@ -308,10 +319,10 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
         draw_special_points(frf, ax, key)
     if linear and quantity in ("mean", "rms", "rms_ac"):
         lin = frf.linear_response() if element == 0 else frf.linear_response(element=element)
-        ax.plot(lin.omega, getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
+        ax.plot(lin.omega * speed_axis(frf)[0], getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
     if shown:
         draw_regions(frf, ax, key, shown, colors)
-    ax.set_xlabel("forcing frequency Ω (rad/s)")
+    ax.set_xlabel(speed_axis(frf)[1])
     ax.set_ylabel(QUANTITY_LABELS[quantity] if not label else QUANTITY_LABELS[quantity].replace("δ", label.strip(": ").split()[-1] + " δ", 1))
     ax.grid(True, alpha=0.3)
     if shown:  # room for the "period p" labels at the top
@@ -321,6 +332,6 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
 
 
 __all__ = [
-    "frequency_response_plot", "column", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
+    "frequency_response_plot", "column", "speed_axis", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
     "branch_colors", "branch_label", "true_runs", "SPECIAL_POINT_STYLES", "QUANTITY_LABELS",
 ]

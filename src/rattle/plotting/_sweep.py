@@ -113,7 +113,10 @@ def sweep_plot(
 def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:
     """One sweep panel: ``y_all`` vs Ω per direction, period rings and labels."""
     direction = np.asarray(sweep.direction).astype(str)
-    omega = np.asarray(sweep.omega, dtype=float)
+    from ._frf import speed_axis
+
+    sx, xlabel = speed_axis(sweep)  # crankshaft rpm with an engine
+    omega = np.asarray(sweep.omega, dtype=float) * sx
     period = np.asarray(sweep.period, dtype=int)
     names = [d for d in ("up", "down") if np.any(direction == d)] + sorted(set(direction) - {"up", "down"})
     for name in names:  # the sweeps first, so that they lead the legend
@@ -140,7 +143,7 @@ def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool
                     textcoords="offset points", ha="center", va="bottom" if up else "top",
                     fontsize=8, color=PERIOD_COLORS.get(int(per[i0]), "tab:gray"), fontweight="bold",
                 )
-    ax.set_xlabel("forcing frequency Ω (rad/s)")
+    ax.set_xlabel(xlabel)
     ax.grid(True, alpha=0.3)
     if legend:
         ax.legend(fontsize=8, loc="best")
