@@ -218,8 +218,14 @@ class FrequencyResponse:
             lines.append("branches: " + ", ".join(
                 f"{b} (period {int(self.period[self.branch == b][0])}, Ω = {self.omega[self.branch == b].min():.4g}…{self.omega[self.branch == b].max():.4g})"
                 for b in np.unique(self.branch)))
+        order = getattr(self.model, "speed_order", None)
+        if order is not None:
+            rpm = self.speed_rpm
+            lines.append(f"engine speed {rpm.min():.5g} … {rpm.max():.5g} rpm (Ω = {order:g} × crankshaft speed)")
         if self.special_points:
-            lines.append("stability changes: " + ", ".join(f"{s.kind} at Ω = {s.omega:.5g}" for s in self.special_points))
+            lines.append("stability changes: " + ", ".join(
+                f"{s.kind} at Ω = {s.omega:.5g}" + ("" if order is None else f" ({s.omega * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
+                for s in self.special_points))
         if self.regions:
             lines.append("regions: " + "; ".join(
                 f"{g.label} at Ω = {g.omega_min:.4g}" if g.omega_min == g.omega_max else f"{g.label} Ω = {g.omega_min:.4g}…{g.omega_max:.4g}"

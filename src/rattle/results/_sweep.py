@@ -174,10 +174,13 @@ class SweepResult:
                 f"largest rms {self.rms[m][i]:.5g} rad at Ω = {w[i]:.5g}"
             )
         jumps = self.jumps()
+        order = getattr(self.model, "speed_order", None)
+        rpm = (lambda w: "") if order is None else (lambda w: f" ({w * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
         if jumps:
             lines.append("jumps: " + "; ".join(
                 f"{j.direction} sweep, rms {j.kind} {j.rms_before:.4g} → {j.rms_after:.4g} rad "
-                f"between Ω = {j.omega_before:.5g} and {j.omega_after:.5g}" for j in jumps))
+                f"between Ω = {j.omega_before:.5g}{rpm(j.omega_before)} and {j.omega_after:.5g}{rpm(j.omega_after)}"
+                for j in jumps))
         else:
             lines.append("jumps: none")
         lines.append(
