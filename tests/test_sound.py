@@ -316,3 +316,22 @@ def test_with_sound_adds_the_spl_column(two_inertia_frf, tmp_path):
 
     table = read_csv(frf.to_csv(tmp_path / "frf.csv"))
     np.testing.assert_array_equal(table["spl_db"], frf.extra_columns["spl_db"])
+
+
+def test_paths_example_as_stated():
+    """examples/clutch_with_paths.toml: the levels its header states."""
+    from rattle.io import load_config
+
+    cfg = load_config(EXAMPLES / "clutch_with_paths.toml")
+    frf = rattle.frequency_response(cfg.model, omega=cfg.analysis.omega, harmonics=cfg.analysis.harmonics)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the tables cover every harmonic: no warning
+        sp = sound_pressure(frf, cfg.paths)
+    stable = frf.stable
+    assert np.max(sp.spl_db[stable]) == pytest.approx(71.5, abs=0.05)
+    assert frf.omega[stable][np.argmax(sp.spl_db[stable])] == pytest.approx(87.3, abs=0.1)
+    for w, (low, high) in ((75.4, (61.0, 65.0)), (87.4, (55.6, 71.4))):
+        near = stable & (np.abs(frf.omega - w) < 0.6)
+        assert np.min(sp.spl_db[near]) == pytest.approx(low, abs=0.5)
+        assert np.max(sp.spl_db[near]) == pytest.approx(high, abs=0.5)
+    assert np.max(sp.linear_spl_db) == pytest.approx(72.3, abs=0.05)
