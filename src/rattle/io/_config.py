@@ -921,7 +921,14 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
     try:
         check_analysis(chain, analysis, omega_names)
     except ConfigError as exc:
-        raise check.error(str(exc)) from None
+        if engine is None:
+            raise check.error(str(exc)) from None
+        rpm = 60.0 / (2.0 * math.pi * engine.base_order)  # rpm per rad/s of Ω
+        w_s = chain.natural_frequency
+        raise check.error(
+            f"{exc} (rad/s of Ω = {engine.base_order:g} × crankshaft speed; in rpm the range must lie within "
+            f"{_limits.MIN_OMEGA_RATIO * w_s * rpm:.4g} … {_limits.MAX_OMEGA_RATIO * w_s * rpm:.4g} rpm)"
+        ) from None
     return RunConfig(model=chain, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=check.source_name,
                      units=units)
 
