@@ -335,3 +335,17 @@ def test_paths_example_as_stated():
         assert np.min(sp.spl_db[near]) == pytest.approx(low, abs=0.5)
         assert np.max(sp.spl_db[near]) == pytest.approx(high, abs=0.5)
     assert np.max(sp.linear_spl_db) == pytest.approx(72.3, abs=0.05)
+
+
+def test_frf_plot_gets_an_spl_panel(two_inertia_frf, reference_frf):
+    import matplotlib.pyplot as plt
+
+    for frf, source in ((two_inertia_frf, "clutch"), (reference_frf, "delta")):
+        fig, axes = frf.with_sound([constant_path(source, 1e-3)]).plot()
+        assert list(axes)[-1] == "spl_db"
+        y = np.concatenate([line.get_ydata() for line in axes["spl_db"].get_lines() if len(line.get_ydata()) > 1])
+        assert np.nanmax(y) == pytest.approx(np.max(sound_pressure(frf, [constant_path(source, 1e-3)]).spl_db))
+        plt.close(fig)
+        fig, axes = frf.plot()  # without paths: no SPL panel
+        assert "spl_db" not in axes
+        plt.close(fig)

@@ -60,7 +60,7 @@ def speed_axis(result: Any) -> tuple[float, str]:
 
 def column(frf: "FrequencyResponse", quantity: str) -> np.ndarray:
     """The values of ``quantity``: a SPEC column (``rms``) or an element's (``clutch_rms``)."""
-    cols = getattr(frf, "element_columns", {}) or {}
+    cols = {**(getattr(frf, "element_columns", {}) or {}), **(getattr(frf, "extra_columns", {}) or {})}
     if quantity in cols:
         return np.asarray(cols[quantity], dtype=float)
     return np.asarray(getattr(frf, quantity), dtype=float)
@@ -290,8 +290,9 @@ def frequency_response_plot(
     else:
         shown = tuple(regions)
     names = tuple(getattr(frf, "element_names", ()) or ())
+    sound = ax is None and "spl_db" in (getattr(frf, "extra_columns", {}) or {})  # [[paths]]: an SPL panel below
     if names and ax is None:  # a chain: one panel per element, sharing Ω
-        fig, axes = plt.subplots(len(names), 1, figsize=(9.5, 2.2 + 2.6 * len(names)), sharex=True,
+        fig, axes = plt.subplots(len(names) + sound, 1, figsize=(9.5, 2.2 + 2.6 * (len(names) + sound)), sharex=True,
                                  layout="constrained", squeeze=False)
         for k, (name, ax_k) in enumerate(zip(names, axes[:, 0])):
             key = f"{name}_{_ELEMENT_SUFFIX.get(quantity, quantity)}"
@@ -299,16 +300,36 @@ def frequency_response_plot(
                         element=k, label=f"{name}: ")
             first = title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})"
             ax_k.set_title(f"{first} — element {name}" if k == 0 else f"element {name}", fontsize=10)
-            if k < len(names) - 1:
+            if k < len(names) - 1 or sound:
                 ax_k.set_xlabel("")
+        if sound:
+            _draw_sound_panel(frf, axes[-1, 0], special_points)
+            return fig, PlotAxes([*zip(names, axes[:-1, 0]), ("spl_db", axes[-1, 0])])
         return fig, PlotAxes(zip(names, axes[:, 0]))
-    if ax is None:
+    if ax is None and sound:
+        fig, (ax, ax_spl) = plt.subplots(2, 1, figsize=(9.5, 7.6), sharex=True, layout="constrained")
+    elif ax is None:
         fig, ax = plt.subplots(figsize=(9.5, 5), layout="constrained")
     else:
         fig = ax.figure
     _draw_panel(frf, ax, quantity, quantity, linear, special_points, shown, legend)
     ax.set_title(title if title is not None else f"Non-linear frequency response ({_harmonics_text(frf)})")
+    if sound:
+        ax.set_xlabel("")
+        _draw_sound_panel(frf, ax_spl, special_points)
+        return fig, PlotAxes([("response", ax), ("spl_db", ax_spl)])
     return fig, PlotAxes.single(ax)
+
+
+def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -> None:
+    """The sound pressure level ``spl_db`` at the receiver (``frf.with_sound(paths)``) along every branch."""
+    draw_branches(frf, ax, "spl_db", labels=False)
+    if special_points:
+        draw_special_points(frf, ax, "spl_db", labels=False)
+    ax.set_xlabel(speed_axis(frf)[1])
+    ax.set_ylabel("sound pressure level (dB re 20 µPa)")
+    ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)
+    ax.grid(True, alpha=0.3)
 
 
 def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, linear: bool, special_points: bool,
