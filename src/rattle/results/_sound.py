@@ -228,7 +228,7 @@ def _warn_uncovered(result: SoundPressure) -> None:
                      f"{f[0]:.4g} … {f[-1]:.4g} Hz) lies outside the table")
     warnings.warn(
         "sound paths transmit nothing outside their tables (no extrapolation), so the levels there are lower "
-        "bounds: " + "; ".join(lines) + "; extend the path tables to cover the harmonics, or fewer harmonics",
+        "bounds: " + "; ".join(lines) + "; extend the path tables to cover the harmonics, or keep fewer harmonics",
         stacklevel=3)
 
 
