@@ -204,3 +204,48 @@ def test_load_config_of_the_example(tmp_path):
     example = Path(__file__).resolve().parents[2] / "examples" / "engine_clutch_si.toml"
     cfg = load_config(example)
     assert cfg.units == "SI" and cfg.model.speed_order == 2.0
+
+
+def _invoke(args):
+    try:
+        runner = CliRunner(mix_stderr=False)  # type: ignore[call-arg]
+    except TypeError:
+        runner = CliRunner()
+    return runner.invoke(cli, args)
+
+
+@pytest.mark.parametrize(
+    "options, key",
+    [
+        (["--rpm-min", "700", "--omega-min", "100"], "`--omega-min` and `--rpm-min`"),
+        (["--rpm-min", "0"], "`--rpm-min`"),
+        (["--rpm-min", "900", "--rpm-max", "800"], "`--rpm-min` must be < `--rpm-max`"),
+    ],
+)
+def test_cli_rpm_options_refused(tmp_path, options, key):
+    (tmp_path / "case.toml").write_text(SI, encoding="utf-8")
+    result = _invoke(["frf", str(tmp_path / "case.toml"), "-o", str(tmp_path / "out"), *options])
+    assert result.exit_code == 2 and key in result.stderr, (result.exit_code, result.stderr)
+
+
+def test_cli_rpm_options_need_an_engine(tmp_path):
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "reference_clutch.toml"
+    result = _invoke(["frf", str(example), "-o", str(tmp_path / "out"), "--rpm-min", "100"])
+    assert result.exit_code == 2 and "`--rpm-min` needs a model with an engine" in result.stderr
+
+
+def test_cli_frf_in_rpm_writes_speed_rpm(tmp_path):
+    import csv
+
+    (tmp_path / "case.toml").write_text(SI, encoding="utf-8")
+    result = _invoke(["frf", str(tmp_path / "case.toml"), "-o", str(tmp_path / "out"), "--harmonics", "4",
+                      "--rpm-min", "2000", "--rpm-max", "2400"])
+    assert result.exit_code == 0, result.stderr
+    rows = list(csv.DictReader((tmp_path / "out" / "frf.csv").open()))
+    rpm = np.array([float(r["speed_rpm"]) for r in rows])
+    omega = np.array([float(r["omega"]) for r in rows])
+    assert rpm.min() == pytest.approx(2000.0, rel=1e-12) and rpm.max() == pytest.approx(2400.0, rel=1e-12)
+    assert np.allclose(rpm, omega * 60.0 / (2.0 * math.pi * 2.0), rtol=1e-12)
+    assert "rpm" in result.stdout

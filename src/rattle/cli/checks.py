@@ -30,7 +30,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 __all__ = [
     "MAX_PERIOD", "DIRECTIONS", "VIRTUAL_FILESYSTEMS", "output_path", "override_analysis", "check_output_dir",
     "precheck", "as_bad_input", "check_points", "check_workers", "check_omega", "check_period", "parse_at",
-    "MAX_OMEGA_POINTS", "check_omega_points", "check_scheduler",
+    "MAX_OMEGA_POINTS", "check_omega_points", "check_scheduler", "speed_options",
 ]
 
 #: Most grid frequencies ``rattle map --omega-points`` accepts (each is an exact solve of every
@@ -56,7 +56,41 @@ def output_path(_ctx: click.Context, _param: click.Parameter, value: str) -> Pat
     return Path(value)
 
 
-def override_analysis(base: AnalysisSettings, model: Model | None = None, **options: Any) -> AnalysisSettings:
+def speed_options(
+    model: Any, omega_min: float | None, omega_max: float | None, rpm_min: float | None, rpm_max: float | None
+) -> tuple[float | None, float | None, dict[str, str]]:
+    """``--rpm-min`` / ``--rpm-max`` (crankshaft rpm) as the forcing frequencies Ω (rad/s) of the
+    model's engine (``speed_order`` q_0: Ω = q_0 · 2π/60 · rpm), with the option names for the
+    messages (``{"omega_min": "--rpm-min"}``) to pass to :func:`override_analysis` as ``labels``.
+
+    Refused (ConfigError): an rpm option without an engine in the model, both ``--omega-min`` and
+    ``--rpm-min`` (or the max pair), an rpm that is not a finite number > 0.
+    """
+    labels: dict[str, str] = {}
+    out = {"min": omega_min, "max": omega_max}
+    if rpm_min is not None and rpm_max is not None and not rpm_min < rpm_max:
+        raise ConfigError(f"`--rpm-min` must be < `--rpm-max`, got {rpm_min!r} and {rpm_max!r} rpm: the speed range is "
+                          "empty; give the lower speed first and make the upper one larger")
+    for which, rpm in (("min", rpm_min), ("max", rpm_max)):
+        if rpm is None:
+            continue
+        option = f"--rpm-{which}"
+        if out[which] is not None:
+            raise ConfigError(f"`--omega-{which}` and `{option}` are both given: one end of the range in rad/s and "
+                              "in rpm; give one of them")
+        order = getattr(model, "speed_order", None)
+        if order is None:
+            raise ConfigError(f"`{option}` needs a model with an engine ([engine] in the configuration): without "
+                              f"engine orders there is no crankshaft speed; give `--omega-{which}` in rad/s instead")
+        if not (math.isfinite(rpm) and rpm > 0):
+            raise ConfigError(f"`{option}` must be a finite crankshaft speed > 0 rpm, got {rpm!r}; use e.g. 800")
+        out[which] = rpm * float(order) * 2.0 * math.pi / 60.0
+        labels[f"omega_{which}"] = option
+    return out["min"], out["max"], labels
+
+
+def override_analysis(base: AnalysisSettings, model: Model | None = None, *, labels: dict[str, str] | None = None,
+                      **options: Any) -> AnalysisSettings:
     """``base`` with the command-line options that were given (not None) replacing its fields.
 
     Parameters
@@ -81,6 +115,7 @@ def override_analysis(base: AnalysisSettings, model: Model | None = None, **opti
     given = {name: value for name, value in options.items() if value is not None}
     names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics"}
     names.update({name: "--" + name.replace("_", "-") for name in given})
+    names.update({name: label for name, label in (labels or {}).items() if name in given})
     try:
         analysis = dataclasses.replace(base, **given)
     except (ValueError, TypeError) as exc:

@@ -18,7 +18,7 @@ import click
 from ..errors import ConfigError, ConvergenceError
 from .checks import (
     DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, output_path,
-    override_analysis, parse_at, precheck,
+    override_analysis, parse_at, precheck, speed_options,
 )
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
@@ -81,6 +81,14 @@ _omega_min_option = click.option(
 _omega_max_option = click.option(
     "--omega-max", type=float, default=None, metavar="Y",
     help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].",
+)
+_rpm_min_option = click.option(
+    "--rpm-min", type=float, default=None, metavar="N1",
+    help="Lower crankshaft speed in rpm, for a configuration with [engine]; instead of --omega-min.",
+)
+_rpm_max_option = click.option(
+    "--rpm-max", type=float, default=None, metavar="N2",
+    help="Upper crankshaft speed in rpm, for a configuration with [engine]; instead of --omega-max.",
 )
 _quiet_option = click.option(
     "-q", "--quiet", is_flag=True,
@@ -168,12 +176,14 @@ def run_frf(
 @_harmonics_option
 @_omega_min_option
 @_omega_max_option
+@_rpm_min_option
+@_rpm_max_option
 @click.option("--subharmonics", is_flag=True, default=False,
               help="Also follow the sub-harmonic (period-doubled) branches born at every period-doubling "
                    "point; all branches go into frf.csv (columns branch, period) and frf.png.")
 def frf_command(
     config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
-    subharmonics: bool,
+    rpm_min: float | None, rpm_max: float | None, subharmonics: bool,
 ) -> None:
     """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
 
@@ -182,11 +192,12 @@ def frf_command(
     """
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
+    w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
-        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+        run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
     )
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
-               "subharmonics": True if subharmonics else None}
+               "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None}
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
             subharmonics=subharmonics, paths=run_config.paths)
 
@@ -207,10 +218,12 @@ def frf_command(
               help="Processes: 2 runs the up and down sweeps of --direction both at once.")
 @_omega_min_option
 @_omega_max_option
+@_rpm_min_option
+@_rpm_max_option
 @_quiet_option
 def sweep_command(
     config: Path, output: Path, direction: str | None, points: int, workers: int,
-    omega_min: float | None, omega_max: float | None, quiet: bool,
+    omega_min: float | None, omega_max: float | None, rpm_min: float | None, rpm_max: float | None, quiet: bool,
 ) -> None:
     """Time-domain frequency sweep of the model in CONFIG: sweep.csv, sweep.png, sweep.json in OUTPUT.
 
@@ -222,7 +235,8 @@ def sweep_command(
         raise ConfigError("`--direction` is required: give --direction up, down or both")
     precheck(config, output, points=points, workers=workers)
     run_config = _io().load_config(config)
-    analysis = override_analysis(run_config.analysis, run_config.model, omega_min=omega_min, omega_max=omega_max)
+    w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
+    analysis = override_analysis(run_config.analysis, run_config.model, labels=labels, omega_min=w_min, omega_max=w_max)
     t_start = time.perf_counter()
     from ..analysis import time_sweep  # only now: all input has been validated
 
@@ -234,7 +248,7 @@ def sweep_command(
         bar.close()
     meta = sections("sweep", config, run_config, analysis, {
         "direction": direction, "points": points, "workers": workers,
-        "omega_min": omega_min, "omega_max": omega_max,
+        "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
     })
     written = write_set(output, SWEEP_FILES, [
         ("sweep.csv", result.to_csv),
@@ -310,17 +324,20 @@ def orbit_command(
 @_harmonics_option
 @_omega_min_option
 @_omega_max_option
+@_rpm_min_option
+@_rpm_max_option
 @_quiet_option
 def compare_command(
     config: Path, output: Path, points: int, at: str | None, workers: int, harmonics: int | None,
-    omega_min: float | None, omega_max: float | None, quiet: bool,
+    omega_min: float | None, omega_max: float | None, rpm_min: float | None, rpm_max: float | None, quiet: bool,
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
     compare.png, frf.csv, sweep.csv, compare.json in OUTPUT."""
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
     run_config = _io().load_config(config)
+    w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
-        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+        run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
     )
     at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
     t_start = time.perf_counter()
@@ -334,7 +351,7 @@ def compare_command(
         bar.close()
     meta = sections("compare", config, run_config, analysis, {
         "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
-        "omega_min": omega_min, "omega_max": omega_max,
+        "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
     })
     written = write_set(output, COMPARE_FILES, [
         ("frf.csv", (result.frf.with_sound(run_config.paths) if run_config.paths else result.frf).to_csv),
@@ -365,13 +382,15 @@ def compare_command(
 @_harmonics_option
 @_omega_min_option
 @_omega_max_option
+@_rpm_min_option
+@_rpm_max_option
 @click.option("--report", is_flag=True, default=False,
               help="Also write map.md, the design summary (special points, rattle-free intervals, the search).")
 @_quiet_option
 def map_command(
     config: Path, output: Path, vary: tuple[str, ...], omega_points: int, workers: int | None,
     scheduler: str | None, harmonics: int | None, omega_min: float | None, omega_max: float | None,
-    report: bool, quiet: bool,
+    rpm_min: float | None, rpm_max: float | None, report: bool, quiet: bool,
 ) -> None:
     """Response map of the model in CONFIG over the --vary parameters and the frequency: map.csv,
     map.nc, map.json, map.png (and map.md with --report) in OUTPUT.
@@ -388,8 +407,9 @@ def map_command(
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
     run_config = _io().load_config(config)
+    w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
-        run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
+        run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
     )
     tables = _io().model_to_toml_dict(run_config.model, analysis)
     params = _vary.parameters(tables, parsed)
@@ -412,7 +432,8 @@ def map_command(
     figures = map_plot_names(result)
     meta = sections("map", config, run_config, analysis, {
         "vary": list(vary), "omega_points": omega_points, "workers": workers, "scheduler": scheduler,
-        "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "report": True if report else None,
+        "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min,
+        "rpm_max": rpm_max, "report": True if report else None,
     })
 
     steps: list[tuple[str, Any]] = [
