@@ -94,7 +94,8 @@ class AttractorSearch:
     from_unstable : bool
         Simulate from the unstable orbits wherever no stable solution is known (default True).
     max_branches : int
-        New branches continued per frequency response at most (default 8).
+        New branches continued per frequency response at most (default 16; a random multi-stage
+        case needed 11). What is found beyond is counted (``not_continued``) and said.
     max_period : int
         Largest period a simulation detects (default 8).
     max_periods : int
@@ -116,7 +117,7 @@ class AttractorSearch:
     bands: int = 8
     starts: int = 4
     from_unstable: bool = True
-    max_branches: int = 8
+    max_branches: int = 16
     max_period: int = 8
     max_periods: int = 600
     match: float = 1e-3
@@ -209,7 +210,7 @@ class _Search:
         self.integ = make_integrator(self.model)
         self.census = Census(solutions=list(solutions))
         self.counts = {"simulations": 0, "periods": 0, "hb_starts": 0, "unexplained": 0, "branches": 0,
-                       "nonperiodic": 0}
+                       "not_continued": 0, "nonperiodic": 0}
         self.next_branch = int(np.max(frf.branch)) + 1 if len(frf) else 1
         self.range = (float(self.grid[0]), float(self.grid[-1]))
         self.by_index: dict[int, list[GridSolution]] = {}
@@ -275,6 +276,7 @@ class _Search:
         self.census.found.append(record)
         if self.counts["branches"] >= self.opts.max_branches:
             record["note"] = "branch budget spent: not continued"
+            self.counts["not_continued"] += 1
             return record
         branch = branch_from_seed(self.model, w, q, n, self.range, H, run=self.run, branch_id=self.next_branch)
         if branch is None or len(branch) < 2:

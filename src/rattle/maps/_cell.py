@@ -116,6 +116,11 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     t3 = time.perf_counter()
     timings["search"] = t3 - t2
     summary = summarise(census, grid)
+    if census.counts.get("not_continued"):
+        message = "; ".join(x for x in (message, (
+            f"attractor search: the branch budget ({search.max_branches}) was spent and "
+            f"{census.counts['not_continued']} attractors found beyond it were not continued as branches (those seen "
+            "by simulation still count where they were seen); raise AttractorSearch(max_branches=…)")) if x)
     timings["total"] = time.perf_counter() - t0
     intervals = summary.pop("intervals")
     cell = CellResult(
