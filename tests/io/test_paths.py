@@ -122,6 +122,7 @@ BAD_TABLES = [
     ("frequency_hz,magnitude,phase_deg\n1,1\n", "has 2 fields, the header has 3"),
     ("frequency_hz,magnitude,phase_deg\n", "no rows"),
     ("", "is empty"),
+    ("frequency_hz;magnitude;phase_deg\n1;1;0\n", "is not comma-separated"),
     (b"frequency_hz,magnitude,phase_deg\n1,\xff,0\n", "not UTF-8"),
 ]
 

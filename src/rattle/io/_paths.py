@@ -90,6 +90,9 @@ def read_path_csv(file: str | os.PathLike[str], source: str, *, key: str = "file
         raise _fail(prefix, f"{where} is empty; it needs the header line {','.join(PATH_COLUMNS)} and one row per "
                             "frequency")
     line, header = rows[0]
+    if len(header) == 1 and any(sep in header[0] for sep in ";\t"):
+        raise _fail(prefix, f"{where} line {line}: the header {header[0]!r} is not comma-separated; separate the "
+                            f"columns {', '.join(PATH_COLUMNS)} with commas (and use a point as the decimal separator)")
     for col in header:
         if col not in PATH_COLUMNS:
             raise _fail(prefix, f"{where} line {line}: column {col!r} is not known; the header must name exactly "
