@@ -224,3 +224,20 @@ def test_cell_special_points_are_those_frf_locates(small_map):
     got = sorted((sp["kind"], sp["omega"], sp["branch"]) for sp in small_map.cells[0].special_points
                  if sp["branch"] in set(frf.branch.tolist()))
     assert got == want and want
+
+
+def test_attractors_beyond_the_branch_budget_still_count_where_seen():
+    """With no branch budget the isolated period-2/3 motions of α = 0.1 near Ω = 1.36 are not
+    continued, but the frequency where the simulations saw them reports their periods and
+    impacts, and the count of what was not continued is kept."""
+    model = _clutch(0.1)
+    run = RunSettings.make(HBOptions(harmonics=16), None, None)
+    grid = np.linspace(1.3, 1.42, 7)
+    frf = rattle.frequency_response(model, omega=(1.3, 1.42), harmonics=16, subharmonics=True)
+    census = find_attractors(frf, grid, run, AttractorSearch(bands=1, starts=12, hb_points=0, max_branches=0))
+    assert census.counts["branches"] == 0 and census.counts["not_continued"] >= 2
+    seen = {a.period for a in census.simulated if a.index == 3}
+    assert {2, 3} <= seen
+    s = summarise(census, grid)
+    assert {"1", "2", "3"} <= set(s["periods_stable"][3].split(";"))
+    assert s["rattle"][3]
