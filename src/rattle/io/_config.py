@@ -12,6 +12,15 @@ Schema (every other key is refused)::
     [analysis]           omega                            [min, max] in rad/s, optional (default [0.1, 3.0])
                          harmonics                        integer 1 … 256, optional (default 32)
 
+SPEC §5 chains (``[model] inertias``, ``[[model.links]]``, ``[[model.elements]]``,
+``[[excitation.torques]]``) and SPEC §6: ``[model] units`` ("dimensionless" or "SI", a
+declaration: the numbers are used as given); angles in degrees through ``b_deg`` and
+``breakpoints_deg`` in ``[model.elastic]`` and every ``[[model.elements]]``, converted here, once,
+to the radian keys (both given: refused); ``[engine]`` (chains in SI only: inertia, cylinders,
+speed_rpm, mean_torque, orders, amplitudes, phases) resolved here into an ordinary torque in
+harmonics of the orders' base order (:mod:`rattle.model._engine`), ``Chain.speed_order`` and the
+analysis range Ω = base order · 2π/60 · rpm.
+
 Bounds shared with the library (:mod:`rattle._limits`, the reasons are in the messages): every
 number finite with magnitude <= 1e50 (and K/I, C/I, the force and deflection scales too);
 ``model.damping`` > 0 (an undamped system has no stable periodic orbit to analyse);
@@ -939,7 +948,9 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
 def model_to_toml_dict(model: Model, analysis: AnalysisSettings | None = None) -> dict[str, Any]:
     """The SPEC §2 tables describing ``model`` (and ``analysis`` if given).
 
-    ``config_from_dict(model_to_toml_dict(m)).model == m`` for every valid model.
+    ``config_from_dict(model_to_toml_dict(m)).model == m`` for every valid model. Angles are
+    written in rad (``b``, ``breakpoints``; never the ``_deg`` keys), a chain's engine as its
+    torques and ``[model] speed_order``.
 
     Parameters
     ----------
