@@ -305,11 +305,14 @@ def test_sources_are_checked(reference_frf, two_inertia_frf):
 
 def test_with_sound_adds_the_spl_column(two_inertia_frf, tmp_path):
     frf = two_inertia_frf.with_sound([constant_path("clutch", 1e-3)])
-    assert frf.column_names[-1] == "spl_db"
-    np.testing.assert_array_equal(frf.extra_columns["spl_db"],
-                                  sound_pressure(two_inertia_frf, [constant_path("clutch", 1e-3)]).spl_db)
+    assert frf.column_names[-3:] == ["spl_db", "spl_dba", "spl_linear_db"]
+    sp = sound_pressure(two_inertia_frf, [constant_path("clutch", 1e-3)])
+    np.testing.assert_array_equal(frf.extra_columns["spl_db"], sp.spl_db)
+    np.testing.assert_array_equal(frf.extra_columns["spl_linear_db"], sp.linear_spl_db)
+    np.testing.assert_array_equal(frf.extra_columns["spl_dba"],
+                                  sound_pressure(two_inertia_frf, [constant_path("clutch", 1e-3)], a_weighting=True).spl_db)
     branch = frf.select(int(frf.branch[0]))
-    assert branch.column_names[-1] == "spl_db" and len(branch.extra_columns["spl_db"]) == len(branch)
+    assert branch.column_names[-3] == "spl_db" and len(branch.extra_columns["spl_db"]) == len(branch)
     both = type(frf).concatenate([frf, frf])
     assert len(both.extra_columns["spl_db"]) == 2 * len(frf)
     from rattle.io import read_csv
@@ -343,8 +346,11 @@ def test_frf_plot_gets_an_spl_panel(two_inertia_frf, reference_frf):
     for frf, source in ((two_inertia_frf, "clutch"), (reference_frf, "delta")):
         fig, axes = frf.with_sound([constant_path(source, 1e-3)]).plot()
         assert list(axes)[-1] == "spl_db"
-        y = np.concatenate([line.get_ydata() for line in axes["spl_db"].get_lines() if len(line.get_ydata()) > 1])
-        assert np.nanmax(y) == pytest.approx(np.max(sound_pressure(frf, [constant_path(source, 1e-3)]).spl_db))
+        sp = sound_pressure(frf, [constant_path(source, 1e-3)])
+        y = np.concatenate([line.get_ydata() for line in axes["spl_db"].get_lines() if line.get_color() != "0.55"])
+        assert np.nanmax(y) == pytest.approx(np.max(sp.spl_db))
+        (linear,) = [line for line in axes["spl_db"].get_lines() if line.get_color() == "0.55"]
+        assert np.max(linear.get_ydata()) == pytest.approx(np.max(sp.linear_spl_db))
         plt.close(fig)
         fig, axes = frf.plot()  # without paths: no SPL panel
         assert "spl_db" not in axes

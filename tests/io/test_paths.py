@@ -188,7 +188,7 @@ def test_frf_writes_the_spl_column(tmp_path):
     result = _invoke(["frf", "case/case.toml", "-o", "out"], tmp_path)
     assert result.exit_code == 0, result.stderr
     table = read_csv(tmp_path / "out" / "frf.csv")
-    assert list(table)[-1] == "spl_db"
+    assert list(table)[-3:] == ["spl_db", "spl_dba", "spl_linear_db"]
     # a constant 1e-3 Pa per rad/s² path on the clutch: spl = 20 log10(1e-3 rms_ac(δ'') / 20 µPa)
     cfg = load_config(tmp_path / "case" / "case.toml")
     import rattle

@@ -326,6 +326,12 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
     draw_branches(frf, ax, "spl_db", labels=False)
     if special_points:
         draw_special_points(frf, ax, "spl_db", labels=False)
+    linear = frf.extra_columns.get("spl_linear_db")
+    if linear is not None:  # the linear system at each row's Ω, in Ω order (one curve)
+        order = np.argsort(frf.omega, kind="stable")
+        ax.plot(np.asarray(frf.omega)[order] * speed_axis(frf)[0], np.asarray(linear)[order], color="0.55", lw=1.0,
+                label="linear system (f = δ)", zorder=1)
+        ax.legend(fontsize=8, loc="best", framealpha=0.9)
     ax.set_xlabel(speed_axis(frf)[1])
     ax.set_ylabel("sound pressure level (dB re 20 µPa)")
     ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -333,14 +334,19 @@ class FrequencyResponse:
             omega = np.linspace(self.omega.min(), self.omega.max(), points)
         return linear_frequency_response(self.model, omega, element)
 
-    def with_sound(self, paths: Any, *, a_weighting: bool = False) -> "FrequencyResponse":
-        """A copy with the column ``spl_db`` (sound pressure level at the receiver, dB re 20 µPa)
-        of the sound ``paths`` (:class:`rattle.model.SoundPath` objects); see
-        :func:`rattle.results.sound_pressure`."""
+    def with_sound(self, paths: Any) -> "FrequencyResponse":
+        """A copy with the columns of the sound ``paths`` (:class:`rattle.model.SoundPath`
+        objects; :func:`rattle.results.sound_pressure`): ``spl_db`` (sound pressure level at the
+        receiver, dB re 20 µPa), ``spl_dba`` (A-weighted, dB(A)) and ``spl_linear_db`` (the linear
+        system's level at the same Ω)."""
         from ._sound import sound_pressure
 
-        spl = sound_pressure(self, paths, a_weighting=a_weighting).spl_db
-        return replace(self, extra_columns={**self.extra_columns, "spl_db": spl})
+        sp = sound_pressure(self, paths)
+        with warnings.catch_warnings():  # the same harmonics: warned about once, above
+            warnings.simplefilter("ignore")
+            dba = sound_pressure(self, paths, a_weighting=True, linear=False).spl_db
+        return replace(self, extra_columns={**self.extra_columns, "spl_db": sp.spl_db, "spl_dba": dba,
+                                            "spl_linear_db": sp.linear_spl_db})
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
