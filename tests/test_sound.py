@@ -338,6 +338,8 @@ def test_paths_example_as_stated():
         assert np.min(sp.spl_db[near]) == pytest.approx(low, abs=0.5)
         assert np.max(sp.spl_db[near]) == pytest.approx(high, abs=0.5)
     assert np.max(sp.linear_spl_db) == pytest.approx(72.3, abs=0.05)
+    dba = sound_pressure(frf, cfg.paths, a_weighting=True, linear=False).spl_db
+    assert np.max(dba[stable]) == pytest.approx(30.7, abs=0.05)
 
 
 def test_frf_plot_gets_an_spl_panel(two_inertia_frf, reference_frf):
