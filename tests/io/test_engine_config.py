@@ -249,3 +249,11 @@ def test_cli_frf_in_rpm_writes_speed_rpm(tmp_path):
     assert rpm.min() == pytest.approx(2000.0, rel=1e-12) and rpm.max() == pytest.approx(2400.0, rel=1e-12)
     assert np.allclose(rpm, omega * 60.0 / (2.0 * math.pi * 2.0), rtol=1e-12)
     assert "rpm" in result.stdout
+
+
+def test_engine_phases_in_degrees():
+    chain = _load(SI.replace("phases = [0.0, 0.5]", "phases_deg = [0.0, 90.0]")).model
+    engine = [t for t in chain.torques if t.inertia == 1][0]
+    assert engine.phases == (0.0, math.pi / 2)
+    with pytest.raises(ConfigError, match="`engine.orders_deg`"):
+        _load(SI.replace("phases = [0.0, 0.5]", "orders_deg = [1.0]"))

@@ -654,18 +654,19 @@ def _units(check: _Checker, model_t: Mapping[str, Any]) -> str:
     return value
 
 
-def _in_radians(check: _Checker, table: Mapping[str, Any], where: str, known: Sequence[str]) -> dict[str, Any]:
-    """``table`` with every ``KEY_deg`` (an angle in degrees) replaced by ``KEY`` in rad."""
+def _in_radians(check: _Checker, table: Mapping[str, Any], where: str, known: Sequence[str],
+                angles: Sequence[str] = ANGLE_KEYS) -> dict[str, Any]:
+    """``table`` with every ``KEY_deg`` (``KEY`` one of ``angles``, in degrees) replaced by ``KEY`` in rad."""
     out = dict(table)
     for key in table:
         if not (isinstance(key, str) and key.endswith("_deg")):
             continue
         twin = key[: -len("_deg")]
-        if twin not in ANGLE_KEYS:
+        if twin not in angles:
             why = (f"`{twin}` is not an angle" if twin in known else f"`{where}.{twin}` is not a known key")
             raise check.error(
-                f"`{where}.{key}` is not a known key: {why}, so it has no value in degrees (the `_deg` keys are "
-                f"{_join([a + '_deg' for a in ANGLE_KEYS])}); remove it or correct its spelling"
+                f"`{where}.{key}` is not a known key: {why}, so it has no value in degrees (the `_deg` keys here "
+                f"are {_join([a + '_deg' for a in angles])}); remove it or correct its spelling"
             )
         if twin in table:
             raise check.error(
@@ -730,7 +731,7 @@ def _engine(check: _Checker, data: Mapping[str, Any], n: int, units: str) -> _En
             f"`engine` needs `model.units` = \"SI\" (got {json.dumps(units)}): its speeds are in rpm and its "
             "torques in N m; add units = \"SI\" to [model] and give the model in SI units"
         )
-    t = _in_radians(check, t, "engine", _ENGINE_KEYS) if any(str(k) == "phases_deg" for k in t) else dict(t)
+    t = _in_radians(check, t, "engine", _ENGINE_KEYS, angles=("phases",))
     check.keys(t, "engine", _ENGINE_KEYS, required=("inertia", "speed_rpm", "orders", "amplitudes"))
     check.integer(t["inertia"], "engine.inertia")
     if not 1 <= t["inertia"] <= n:
