@@ -241,3 +241,27 @@ def test_attractors_beyond_the_branch_budget_still_count_where_seen():
     s = summarise(census, grid)
     assert {"1", "2", "3"} <= set(s["periods_stable"][3].split(";"))
     assert s["rattle"][3]
+
+
+def test_map_of_an_engine_config_gives_speed_rpm(tmp_path):
+    """A map of an SI configuration with [engine]: the grid also as crankshaft speed (map.csv's
+    last column, the dataset's coordinate, the plot's axis), rpm = Ω · 60 / (2π · base order)."""
+    from pathlib import Path
+
+    from rattle.io import read_csv
+
+    case = rattle.load_case(Path(__file__).resolve().parents[2] / "examples" / "engine_clutch_si.toml")
+    order = case.model.speed_order
+    assert order is not None
+    lo, hi = case.analysis.omega
+    m = response_map(case, {"model.elements.1.alpha": [case.model.elements[0].law.alpha]}, omega=(lo, lo * 1.2),
+                     omega_points=4, harmonics=8, search=AttractorSearch(bands=0, hb_points=0, from_unstable=False),
+                     engine="serial")
+    assert m.speed_order == order
+    np.testing.assert_allclose(m.speed_rpm, m.omega * 60 / (2 * np.pi * order), rtol=1e-15)
+    table = read_csv(m.to_csv(tmp_path / "map.csv"))
+    assert list(table)[-1] == "speed_rpm"
+    np.testing.assert_allclose(np.asarray(table["speed_rpm"], float), m.speed_rpm, rtol=1e-12)
+    np.testing.assert_allclose(m.dataset["speed_rpm"].values, m.speed_rpm)
+    fig, axes = m.plot()
+    assert axes.primary.get_xlabel() == "engine speed (rpm)"

@@ -38,18 +38,23 @@ DEFAULT_OMEGA_POINTS = 146
 ProgressCallback = Callable[[int, int, int], None]
 
 
-def _tables_of(model: Any, tables: Mapping[str, Any] | None) -> tuple[dict[str, Any], Any]:
-    """The configuration tables of the map and the analysis settings they carry (or None)."""
-    from ..io import RunConfig, model_to_toml_dict
+def _source_of(model: Any) -> tuple[Any, Any]:
+    """The model and the analysis settings of a Model/Chain, a Case or a RunConfig (None: none)."""
+    from ..io import RunConfig
 
-    config = getattr(model, "config", None)
-    if isinstance(model, RunConfig):
-        config = model
-    if tables is not None:
-        return {k: v for k, v in dict(tables).items()}, getattr(config, "analysis", None)
+    config = model if isinstance(model, RunConfig) else getattr(model, "config", None)
     if config is not None:  # a Case (load_case) or a RunConfig: the resolved file
-        return model_to_toml_dict(config.model), config.analysis
-    return model_to_toml_dict(model), None
+        return config.model, config.analysis
+    return model, None
+
+
+def _tables_of(model: Any, lo: float, hi: float, harmonics: int) -> dict[str, Any]:
+    """The configuration tables of ``model`` with the run's range and harmonics as its
+    ``[analysis]``: every combination's model is then validated against the range it is run on
+    (an engine's chain writes its speed order and the range in rad/s)."""
+    from ..io import AnalysisSettings, model_to_toml_dict
+
+    return model_to_toml_dict(model, AnalysisSettings(omega_min=lo, omega_max=hi, harmonics=harmonics))
 
 
 def _version() -> str:
@@ -128,7 +133,7 @@ def response_map(
     from ._vary import apply, build_all, combinations, parameters
 
     t_start = time.perf_counter()
-    base, analysis = _tables_of(model, tables)
+    model, analysis = _source_of(model)
     if omega is None:
         omega = analysis.omega if analysis is not None else (0.1, 3.0)
     lo, hi = check_range(omega, "omega")
@@ -142,8 +147,13 @@ def response_map(
         search = AttractorSearch()
     elif not isinstance(search, AttractorSearch):
         raise TypeError(f"`search` must be an AttractorSearch or None, got {search!r}")
+    # the tables to vary: the caller's (a parsed file, validated with its own [analysis]), or
+    # the model's with the run's range and harmonics
+    base = dict(tables) if tables is not None else _tables_of(model, lo, hi, hb_opts.harmonics)
     params = parameters(base, vary)
-    build_all(base, params)  # every combination's model, validated before any work
+    models = build_all(base, params)  # every combination's model, validated before any work
+    orders = {getattr(m, "speed_order", None) for m in models}
+    speed_order = orders.pop() if len(orders) == 1 else None  # rpm only when one order holds for all
 
     settings = {**run.record(), "omega": [lo, hi], "omega_points": omega_points, "max_period": max_period,
                 "search": asdict(search)}
@@ -198,7 +208,7 @@ def response_map(
                   "version": version},
         timings={"wall": wall, "combinations": float(np.nansum(computed)) if computed else 0.0,
                  "computed": len(computed), "resumed": resumed},
-        config=base,
+        config=base, speed_order=speed_order,
     )
 
 

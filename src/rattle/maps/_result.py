@@ -197,6 +197,15 @@ class ResponseMap:
     settings: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
     config: dict[str, Any] = field(default_factory=dict)
+    speed_order: float | None = None
+
+    @property
+    def speed_rpm(self) -> np.ndarray | None:
+        """The grid as crankshaft speed (rpm) when the model has an engine (``[engine]``: Ω is
+        ``speed_order`` × the crankshaft speed), else None: rpm = Ω · 60 / (2π · order)."""
+        if self.speed_order is None:
+            return None
+        return np.asarray(self.omega, dtype=float) * 60.0 / (2.0 * math.pi * float(self.speed_order))
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -236,8 +245,10 @@ class ResponseMap:
         data["status"] = (self.names, np.asarray([c.status for c in self.cells], dtype=str).reshape(self.shape))
         data["seconds"] = (self.names, np.asarray([c.timings.get("total", np.nan) for c in self.cells],
                                                   dtype=float).reshape(self.shape))
-        coords = {p.name: np.asarray(p.values, dtype=float) for p in self.parameters}
+        coords: dict[str, Any] = {p.name: np.asarray(p.values, dtype=float) for p in self.parameters}
         coords["omega"] = self.omega
+        if self.speed_order is not None:
+            coords["speed_rpm"] = ("omega", self.speed_rpm)
         attrs = {
             "title": "rattle response map",
             "varied_keys": json.dumps({p.name: p.key for p in self.parameters}),
@@ -247,22 +258,26 @@ class ResponseMap:
 
     def rows(self) -> list[dict[str, Any]]:
         """``map.csv`` rows: per (combination, frequency) the varied values by NAME, then
-        :data:`MAP_COLUMNS`. A combination whose frequency response failed (status
+        :data:`MAP_COLUMNS` (and ``speed_rpm`` last when the model has an engine). A combination whose frequency response failed (status
         ``failed``) knows nothing: its grid columns are None (empty in the CSV), never a
         ``rattle`` = false it did not establish."""
         out = []
+        rpm = self.speed_rpm
         for (_, values), c in zip(self.combinations(), self.cells):
             cols = c.columns()
             known = c.status != "failed"
             for j in range(self.omega.size):
-                out.append({**values, "omega": cols["omega"][j],
-                            **{k: (cols[k][j] if known else None) for k in GRID_COLUMNS}})
+                row = {**values, "omega": cols["omega"][j], **{k: (cols[k][j] if known else None) for k in GRID_COLUMNS}}
+                if rpm is not None:
+                    row["speed_rpm"] = float(rpm[j])
+                out.append(row)
         return out
 
     @property
     def column_names(self) -> list[str]:
-        """``map.csv`` header: the varied NAMEs, then :data:`MAP_COLUMNS`."""
-        return [*self.names, *MAP_COLUMNS]
+        """``map.csv`` header: the varied NAMEs, then :data:`MAP_COLUMNS`, then ``speed_rpm`` when
+        the model has an engine."""
+        return [*self.names, *MAP_COLUMNS, *(["speed_rpm"] if self.speed_order is not None else [])]
 
     def columns(self) -> dict[str, list[Any]]:
         """``map.csv`` as columns of plain Python values (None where empty: NaN rms, and every

@@ -147,7 +147,8 @@ def plot_map(
         raise ValueError(f"`ax` draws one panel, but this map has {len(shown)} (one per combination of the other "
                          "parameters); leave `ax` out")
     yvalues = np.asarray(response_map.parameters[names.index(parameter)].values, dtype=float)
-    omega = np.asarray(response_map.omega, dtype=float)
+    rpm = getattr(response_map, "speed_rpm", None)  # an engine: the crankshaft speed on the x axis
+    omega = np.asarray(response_map.omega if rpm is None else rpm, dtype=float)
     xe, ye = _edges(omega), _edges(yvalues)
 
     rms_all = np.concatenate([np.asarray(c.rms_max_stable, float) for c in response_map.cells]) \
@@ -201,7 +202,7 @@ def plot_map(
         if panel_title:
             a.set_title(panel_title, fontsize=9)
     for a in axes_list:
-        a.set_xlabel("Ω (rad/s)")
+        a.set_xlabel("Ω (rad/s)" if rpm is None else "engine speed (rpm)")
         a.set_ylabel(_label(response_map, parameter))
     if mesh is not None:
         cbar = fig.colorbar(mesh, ax=axes_list, shrink=0.9)
