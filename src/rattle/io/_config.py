@@ -170,7 +170,7 @@ class RunConfig:
 # --------------------------------------------------------------------------------------------
 # Schema
 # --------------------------------------------------------------------------------------------
-_TOP_KEYS = ("model", "excitation", "analysis", "engine")
+_TOP_KEYS = ("model", "excitation", "analysis", "engine", "paths")
 _MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
 _EXCITATION_KEYS = ("mean", "amplitudes", "phases")
 _ANALYSIS_KEYS = ("omega", "harmonics")

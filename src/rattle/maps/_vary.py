@@ -66,6 +66,7 @@ _NOT_PARAMETERS = {
     "between": "it numbers the inertias joined, not a quantity",
     "harmonics": "it is a setting of the computation; give --harmonics instead",
     "omega": "the frequency is the map's own axis; give --omega-min / --omega-max instead",
+    "speed_order": "it is the engine order of the forcing frequency (what turns Ω into rpm), not a design quantity",
 }
 
 _OPTION = "`--vary`"
