@@ -44,6 +44,19 @@ def check_real(value: object, name: str) -> float:
     return x
 
 
+def check_positive(value: object, name: str) -> float:
+    """A real number (not a bool or a string), finite and > 0."""
+    if _is_bool(value) or not isinstance(value, Real):
+        raise TypeError(f"`{name}` must be a real number, got {value!r} ({type(value).__name__})")
+    try:
+        x = float(value)
+    except OverflowError:  # an int beyond the float range
+        x = math.inf
+    if not (math.isfinite(x) and x > 0.0):
+        raise ValueError(f"`{name}` must be a finite number > 0, got {x!r}")
+    return x
+
+
 def check_omega(value: object, name: str = "omega") -> float:
     """A forcing frequency: a real number, finite and > 0 (rad/s)."""
     if _is_bool(value) or not isinstance(value, Real):

@@ -58,7 +58,7 @@ import numpy as np
 
 from .. import _limits
 from .._typing import FloatArray
-from .._validate import check_int, check_state, numerical_failures
+from .._validate import check_int, check_positive, check_state, numerical_failures
 from ..errors import Status
 from ..model import Chain, Model, System, check_analysable_model
 from ..results._steady import METHODS, SteadyState
@@ -75,15 +75,6 @@ _MAX_WAIT = 128  # longest wait (forcing periods) between two acceleration attem
 # Step halvings per Newton iteration: an attempt from too far away should fail cheaply (the
 # simulation goes on and a later attempt starts closer).
 _MAX_HALVINGS = 3
-
-def _check_positive(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"`{name}` must be a real number, got {value!r} ({type(value).__name__})")
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}")
-    return value
-
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SteadyStateOptions:
@@ -134,7 +125,7 @@ class SteadyStateOptions:
 
     def __post_init__(self) -> None:
         for name in ("tolerance", "capture_distance", "trigger_distance", "shooting_tolerance"):
-            object.__setattr__(self, name, _check_positive(name, getattr(self, name)))
+            object.__setattr__(self, name, check_positive(getattr(self, name), name))
         for name, low in (("max_periods", 1), ("max_period_multiple", 1), ("record_periods", 1),
                           ("shooting_iterations", 0), ("section_points", 1)):
             object.__setattr__(self, name, check_int(name, getattr(self, name), low))

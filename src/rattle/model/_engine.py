@@ -21,6 +21,7 @@ from fractions import Fraction
 import numpy as np
 
 from .._limits import MAX_HARMONICS
+from .._validate import check_positive
 from ._chain import Torque
 
 #: Largest denominator of an order written as a fraction (1/2: half orders; up to 1/12).
@@ -31,25 +32,16 @@ ORDER_RTOL = 1e-9
 RAD_PER_S_PER_RPM = 2.0 * math.pi / 60.0
 
 
-def _positive(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"`{name}` must be a number, got {value!r}")
-    x = float(value)
-    if not (math.isfinite(x) and x > 0):
-        raise ValueError(f"`{name}` must be a finite number > 0, got {x!r}")
-    return x
-
-
 def forcing_frequency(rpm: float | np.ndarray, order: float) -> float | np.ndarray:
     """Ω (rad/s) of engine order ``order`` at crankshaft speed ``rpm``: Ω = order · 2π/60 · rpm."""
-    q = _positive("order", order)
+    q = check_positive(order, "order")
     return q * RAD_PER_S_PER_RPM * np.asarray(rpm, dtype=float) if np.ndim(rpm) else q * RAD_PER_S_PER_RPM * float(rpm)
 
 
 def engine_speed(omega: float | np.ndarray, order: float) -> float | np.ndarray:
     """Crankshaft speed (rpm) at which engine order ``order`` has frequency ``omega`` (rad/s):
     rpm = Ω · 60 / (2π · order)."""
-    q = _positive("order", order)
+    q = check_positive(order, "order")
     return np.asarray(omega, dtype=float) / (q * RAD_PER_S_PER_RPM) if np.ndim(omega) else float(omega) / (q * RAD_PER_S_PER_RPM)
 
 
@@ -75,7 +67,7 @@ def firing_orders(cylinders: int, strokes: int = 4, count: int = 3) -> tuple[flo
 def as_fraction(order: float, name: str = "order") -> Fraction:
     """``order`` as a fraction with a denominator <= :data:`MAX_DENOMINATOR`, matching it to
     :data:`ORDER_RTOL` relative; ValueError otherwise."""
-    q = _positive(name, order)
+    q = check_positive(order, name)
     f = Fraction(q).limit_denominator(MAX_DENOMINATOR)
     if f <= 0 or abs(float(f) - q) > ORDER_RTOL * q:
         raise ValueError(
