@@ -319,10 +319,11 @@ class _Search:
                 state = None
                 j += 1
                 continue
-            x0 = self.start_near(j) if state is None or state.period != 0 else np.asarray(state.final_state)
-            if x0 is None:
-                x0 = None  # no solution known at all: start from rest at equilibrium
-            state = self.simulate(j, x0, "unstable orbit" if state is None else "carried from the previous frequency")
+            # a non-periodic motion is carried on; otherwise start next to the unstable orbit here
+            # (None: no solution known at all, steady_state starts from rest at equilibrium)
+            carried = state is not None and state.period == 0
+            x0 = np.asarray(state.final_state) if carried else self.start_near(j)
+            state = self.simulate(j, x0, "carried from the previous frequency" if carried else "unstable orbit")
             j += 1
 
     def unstable_stretches(self) -> None:

@@ -167,7 +167,8 @@ def response_map(
         task = {"tables": cell_tables, "values": values, "omega": (lo, hi), "omega_points": omega_points,
                 "run": run, "max_period": max_period, "search": search}
         tasks.append((flat, task))
-        keys.append(_fingerprint_key(cell_tables, values, settings, version))
+        # the store's identity of a combination: everything its result depends on
+        keys.append(MapStore.key({"tables": cell_tables, "values": values, "settings": settings, "version": version}))
 
     the_store = None
     if store is not None:
@@ -191,33 +192,24 @@ def response_map(
         if progress is not None:
             progress(len(results), total, resumed)
 
-    engine_used = "none"
+    engine_used, workers_used = "none", 0  # everything read back: no engine ran
     if todo:
         if engine is None and scheduler is None and workers is None and len(todo) == 1:
             engine = "serial"
         runner = make_engine(engine, workers=workers, scheduler=scheduler)
-        engine_used = runner.name
         runner.run(compute_cell, todo, on_result)
+        engine_used, workers_used = runner.name, runner.workers
     cells = tuple(results[flat] for flat in range(total))
     grid = np.linspace(lo, hi, omega_points)
     wall = time.perf_counter() - t_start
     computed = [c.timings.get("total", math.nan) for c in cells if not c.resumed]
     return ResponseMap(
         parameters=params, omega=grid, cells=cells,
-        settings={**settings, "engine": engine_used, "workers": getattr(locals().get("runner"), "workers", 0),
-                  "version": version},
+        settings={**settings, "engine": engine_used, "workers": workers_used, "version": version},
         timings={"wall": wall, "combinations": float(np.nansum(computed)) if computed else 0.0,
                  "computed": len(computed), "resumed": resumed},
         config=base, speed_order=speed_order,
     )
-
-
-def _fingerprint_key(tables: dict[str, Any], values: dict[str, float], settings: dict[str, Any],
-                     version: str) -> str:
-    """The store's identity of one combination: a hash of everything its result depends on."""
-    from ._store import MapStore
-
-    return MapStore.key({"tables": tables, "values": values, "settings": settings, "version": version})
 
 
 __all__ = ["response_map", "DEFAULT_OMEGA_POINTS"]
