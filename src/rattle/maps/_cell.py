@@ -4,8 +4,8 @@
 plain, picklable arguments, so that local processes and Dask workers run the very same code and
 give the same bits). It
 
-1. builds the combination's model from its configuration tables
-   (:func:`rattle.io.config_from_dict`, the same validation as a file);
+1. takes the combination's model (built and validated from its configuration tables, with
+   :func:`rattle.io.config_from_dict`, once, before any work: :func:`rattle.maps.response_map`);
 2. computes its frequency response with sub-harmonic branch switching
    (:func:`~rattle.analysis.frequency_response`, ``subharmonics=True``) — a response that stops
    early keeps what it computed (status ``partial``);
@@ -83,21 +83,19 @@ def _special_points(parts: list[FrequencyResponse]) -> list[dict[str, Any]]:
 
 
 def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
-    """One combination (``task``: ``tables`` — its configuration tables with the varied values
-    set —, ``values`` by NAME, ``omega`` (lo, hi), ``omega_points``, ``run`` the RunSettings,
+    """One combination (``task``: ``model`` — built from its configuration tables with the varied
+    values set —, ``values`` by NAME, ``omega`` (lo, hi), ``omega_points``, ``run`` the RunSettings,
     ``max_period``, ``search`` the AttractorSearch) → :meth:`CellResult.to_dict`.
 
     A combination whose frequency response fails numerically is not an error of the map: its
     cell says ``failed`` (or ``partial``) with the reason, and the map goes on."""
-    from ..io import config_from_dict
-
     t0 = time.perf_counter()
     lo, hi = (float(x) for x in task["omega"])
     grid = np.linspace(lo, hi, int(task["omega_points"]))
     run: RunSettings = task["run"]
     search: AttractorSearch = task["search"]
     values = dict(task["values"])
-    model = config_from_dict(task["tables"], "<map combination>").model
+    model = task["model"]
     timings: dict[str, float] = {}
     status, message = "ok", ""
     try:

@@ -164,7 +164,7 @@ def response_map(
     for flat, setting in enumerate(combinations(params)):
         values = {name: setting[p.key] for name, p in zip(names, params)}
         cell_tables = apply(base, setting)
-        task = {"tables": cell_tables, "values": values, "omega": (lo, hi), "omega_points": omega_points,
+        task = {"model": models[flat], "values": values, "omega": (lo, hi), "omega_points": omega_points,
                 "run": run, "max_period": max_period, "search": search}
         tasks.append((flat, task))
         # the store's identity of a combination: everything its result depends on
