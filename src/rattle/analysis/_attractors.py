@@ -224,17 +224,21 @@ class _Search:
     def scale(self, j: int) -> FloatArray:
         return system_state_scale(self.system, float(self.grid[j]))
 
-    def explained(self, j: int, state: Any) -> bool:
-        n = int(state.period)
-        point = np.asarray(state.cycle[0], dtype=float)
+    def passes(self, j: int, n: int, point: FloatArray, stable_only: bool) -> bool:
+        """Whether a known solution of period n at grid index j (a stable one, with
+        ``stable_only``) passes through the section point ``point`` (scaled distance < match)."""
         sc = self.scale(j)
-        for s in self.stable_at(j):
-            if s.period != n:
+        for s in self.by_index.get(j, []):
+            if s.period != n or (stable_only and not s.stable):
                 continue
-            d = np.max(np.abs(s.section - point[None, :]) / sc[None, :], axis=1)
+            d = np.max(np.abs(s.section - np.asarray(point, dtype=float)[None, :]) / sc[None, :], axis=1)
             if float(np.min(d)) < self.opts.match:
                 return True
         return False
+
+    def explained(self, j: int, state: Any) -> bool:
+        """Whether a stable known solution is the simulated periodic motion ``state``."""
+        return self.passes(j, int(state.period), state.cycle[0], stable_only=True)
 
     # --- simulation ---------------------------------------------------------------------
     def simulate(self, j: int, x0: FloatArray, origin: str) -> Any:
@@ -444,7 +448,7 @@ class _Search:
         if dynamic == 0.0 or (n > 1 and float(np.linalg.norm(Q[:, sub])) < 1e-3 * dynamic):
             return  # a solution of a shorter period written with period n
         sec = section_states(res.q, n_coord, w, n)
-        if self.known(j, n, sec):
+        if self.passes(j, n, sec[0], stable_only=False):
             return
         if not self.closes_exactly(w, sec[0], n):
             self.census.found.append({"omega": w, "period": n, "origin": "harmonic-balance start", "branch": None,
@@ -453,17 +457,6 @@ class _Search:
         self.counts["unexplained"] += 1
         self.add_branch_from(j, n, res.q, Hn, "harmonic-balance start", float("nan"))
 
-    def known(self, j: int, n: int, section: FloatArray) -> bool:
-        """Whether any known solution (stable or not) of period n at grid index j passes
-        through the section point ``section[0]``."""
-        sc = self.scale(j)
-        for s in self.by_index.get(j, []):
-            if s.period != n:
-                continue
-            d = np.max(np.abs(s.section - section[0][None, :]) / sc[None, :], axis=1)
-            if float(np.min(d)) < self.opts.match:
-                return True
-        return False
 
     # --- 2. multi-start ---------------------------------------------------------------------
     def multistart(self) -> None:
