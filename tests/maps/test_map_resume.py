@@ -18,6 +18,7 @@ import pytest
 
 import rattle
 from rattle.maps import AttractorSearch, response_map
+from rattle.maps._store import MapStore
 
 ALPHAS = [0.2, 0.25, 0.3, 0.35, 0.4, 0.45]
 KW = dict(omega=(0.3, 1.5), omega_points=9, harmonics=10, search=AttractorSearch(bands=1, starts=2))
@@ -38,6 +39,13 @@ def _cells(result) -> list[str]:
     return [json.dumps({k: v for k, v in c.to_dict().items() if k != "timings"}) for c in result.cells]
 
 
+def _running(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
 @pytest.mark.slow
 def test_sigkill_mid_map_then_resume(tmp_path):
     store = tmp_path / "out"
@@ -54,7 +62,7 @@ def test_sigkill_mid_map_then_resume(tmp_path):
                 workers |= {c.pid for c in psutil.Process(proc.pid).children(recursive=True)}
             except psutil.NoSuchProcess:
                 break
-            if parts.is_dir() and len(list(parts.glob("*.json"))) >= 2:
+            if len(MapStore(store).finished()) >= 2:  # finished parts, not a write in flight
                 break
             time.sleep(0.05)
         assert proc.poll() is None, "the map finished before it could be killed: make its cells slower"
@@ -65,13 +73,13 @@ def test_sigkill_mid_map_then_resume(tmp_path):
         if proc.poll() is None:
             proc.kill()
         proc.stdout.close()
-    finished = {p.name: p.stat().st_mtime_ns for p in parts.glob("*.json")}
+    finished = {f"{k}.json": (parts / f"{k}.json").stat().st_mtime_ns for k in MapStore(store).finished()}
     assert 2 <= len(finished) < len(ALPHAS)
     # no worker outlives its killed parent
     t_end = time.monotonic() + 10
     alive = workers
     while alive and time.monotonic() < t_end:
-        alive = {pid for pid in alive if psutil.pid_exists(pid) and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE}
+        alive = {pid for pid in alive if _running(pid)}
         time.sleep(0.1)
     assert not alive, f"worker processes {alive} outlived the killed map"
     # resume (serial, in this process): the finished combinations are read back, not recomputed

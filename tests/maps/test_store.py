@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import time
 
 import numpy as np
 import pytest
@@ -143,3 +144,18 @@ def test_finished_and_clear_stale(tmp_path) -> None:
     with pytest.raises(ValueError, match="`key`"):
         store.load("../escape")
     assert MapStore(tmp_path / "nothing").finished() == set()
+
+
+def test_clear_orphans_removes_only_old_temporaries(tmp_path) -> None:
+    store = MapStore(tmp_path)
+    key = store.key({"i": 1})
+    store.save(key, {"k": 1})
+    old = store.parts / f".{key}.json.abc.tmp.json"
+    fresh = store.parts / f".{key}.json.xyz.tmp.json"
+    old.write_text("{")
+    fresh.write_text("{")
+    past = time.time() - 3600
+    os.utime(old, (past, past))
+    assert store.clear_orphans(min_age=60.0) == [old.name]
+    assert fresh.exists() and not old.exists() and store.finished() == {key}
+    assert MapStore(tmp_path / "nothing").clear_orphans() == []

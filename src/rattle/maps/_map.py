@@ -173,6 +173,7 @@ def response_map(
     the_store = None
     if store is not None:
         the_store = store if isinstance(store, MapStore) else MapStore(store)
+        the_store.clear_orphans()  # temporaries of a write killed in an earlier run
     results: dict[int, CellResult] = {}
     if the_store is not None:
         for flat, key in enumerate(keys):

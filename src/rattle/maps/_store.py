@@ -24,6 +24,7 @@ import json
 import logging
 import os
 import re
+import time
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -170,6 +171,27 @@ class MapStore:
         """Remove the part of ``key`` (if any)."""
         with contextlib.suppress(FileNotFoundError):
             self.path(key).unlink()
+
+    def clear_orphans(self, min_age: float = 60.0) -> list[str]:
+        """Remove the temporary files a killed write left in the parts folder (a run killed by
+        SIGKILL cannot remove its own) and return their names. Only temporaries not modified for
+        ``min_age`` seconds are touched: a part is written in milliseconds, so an older one has
+        no writer left, and a run writing into the same folder at this moment keeps its own."""
+        removed: list[str] = []
+        try:
+            entries = list(self.parts.iterdir())
+        except (FileNotFoundError, NotADirectoryError):
+            return removed
+        now = time.time()
+        for entry in entries:
+            name = entry.name
+            if not (name.startswith(".") and ".tmp" in name):
+                continue
+            with contextlib.suppress(OSError):
+                if entry.is_file() and now - entry.stat().st_mtime >= min_age:
+                    entry.unlink()
+                    removed.append(name)
+        return sorted(removed)
 
     def clear_stale(self, keep: Iterable[str]) -> list[str]:
         """Remove the parts whose key is not in ``keep`` (another configuration's, an older
