@@ -194,7 +194,7 @@ def _sample_forcing(system: System, omega: FloatArray, forcing_omega: FloatArray
     """F at the N samples t_j = j T_p / N of every orbit, (1, N, n), when all orbits have the same
     period multiple p = Ω/ω: then Ω t_j = 2π p j / N whatever Ω, so one row serves all (instead
     of P·N evaluations of every forcing harmonic). None when the multiples differ."""
-    if omega.size == 0:
+    if omega.size == 0 or system.load is not None:  # a mean by speed differs from orbit to orbit
         return None
     ratio = forcing_omega / omega
     p = float(np.rint(ratio[0]))

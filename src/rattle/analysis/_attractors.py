@@ -463,10 +463,10 @@ class _Search:
         B, K = self.opts.bands, self.opts.starts
         if B == 0 or K == 0:
             return
-        x_eq = np.asarray(self.system.static_equilibrium(), dtype=float)
-        n = x_eq.size
+        n = self.system.n
         for b, j in enumerate(self.band_indices()):
             w = float(self.grid[j])
+            x_eq = np.asarray(self.system.static_equilibrium(w), dtype=float)
             known = self.by_index.get(j, [])
             amp = max([0.5 * s.p2p for s in known], default=0.0)
             amp = max(amp, float(self.system.length_scale()))

@@ -406,13 +406,13 @@ class _Settler:
         return self.unsettled()
 
 
-def static_state(model: Model | Chain | System) -> FloatArray:
+def static_state(model: Model | Chain | System, omega: float | None = None) -> FloatArray:
     """The static equilibrium at rest as a state: (δ_s, 0) for the single equation, (x_s, 0)
-    (2n,) for a chain or System."""
+    (2n,) for a chain or System (under the mean torques at ``omega`` when they depend on it)."""
     if isinstance(model, Model):
         return np.array([model.static_equilibrium(), 0.0])
     system = model.system() if isinstance(model, Chain) else model
-    return np.concatenate((system.static_equilibrium(), np.zeros(system.n)))
+    return np.concatenate((system.static_equilibrium(omega), np.zeros(system.n)))
 
 
 def make_integrator(model: Model | Chain | System) -> ExactIntegrator | SystemIntegrator:
@@ -488,7 +488,7 @@ def steady_state(
         flow: _ModelFlow | _SystemFlow = _ModelFlow(model, integ, omega)  # type: ignore[arg-type]
         names: tuple[str, ...] = ()
     else:
-        x = check_system_state(x0, system.n, "x0") if x0 is not None else static_state(system)
+        x = check_system_state(x0, system.n, "x0") if x0 is not None else static_state(system, omega)
         sinteg = SystemIntegrator(system) if integrator is None else integrator
         if not isinstance(sinteg, SystemIntegrator):
             raise TypeError(f"`integrator` must be a SystemIntegrator for a chain, got {integrator!r}")

@@ -107,6 +107,10 @@ class HarmonicBalance:
             F[:, r] += system.cos[h - 1]
             F[:, H + r] += system.sin[h - 1]
         self.forcing = F.reshape(-1)  # flat (n·(2H+1),); analyses may rescale it (homotopy)
+        # A speed-dependent mean load (drag by speed): d(Ω) u joins the a_0 terms of the forcing,
+        # −d'(Ω) u the Ω-derivative of the residual (``_load_at``); the homotopy leaves it alone.
+        self._load = system.load
+        self._a0 = np.arange(n) * S
         # Linear part.
         C = np.asarray(system.damping, dtype=float)
         K = np.asarray(system.stiffness, dtype=float)
@@ -405,7 +409,21 @@ class HarmonicBalance:
         R = self._linear_part(np.asarray(q).reshape(self.n_coordinates, self._S), kw, -(kw**2))
         if self.n_elements:
             R += self._forces(q)
-        return R.reshape(-1) - self.forcing
+        return R.reshape(-1) - self._forcing_at(omega)
+
+    def _forcing_at(self, omega: float) -> FloatArray:
+        """The forcing coefficients at Ω: :attr:`forcing` plus the load's d(Ω) u at the a_0 slots."""
+        if self._load is None:
+            return self.forcing
+        F = self.forcing.copy()
+        F[self._a0] += float(self._load.value(omega)) * self._load.direction
+        return F
+
+    def _load_slope(self, Rw: FloatArray, omega: float) -> FloatArray:
+        """∂R/∂Ω gains −d'(Ω) u at the a_0 slots (in place; returned)."""
+        if self._load is not None:
+            Rw[self._a0] -= self._load.slope(float(omega)) * self._load.direction
+        return Rw
 
     def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """R (n·S,), ∂R/∂q (n·S, n·S) and ∂R/∂Ω (n·S,) in one AFT pass (S = 2H+1)."""
@@ -425,11 +443,11 @@ class HarmonicBalance:
         else:
             Rq = np.zeros((self.size, self.size))
         R = R.reshape(-1)
-        R -= self.forcing
+        R -= self._forcing_at(omega)
         Rq.reshape(-1)[self._lin_index] += self._linear_values(kw, m2)
         Rw = self._linear_part_dw(Q, w).reshape(-1)
         Rw /= self.period
-        return R, Rq, Rw
+        return R, Rq, self._load_slope(Rw, omega)
 
     def _residual_jacobian_compiled(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """:meth:`residual_jacobian` of one coordinate and one element: the samples and spectra by
@@ -444,8 +462,9 @@ class HarmonicBalance:
         _kernels.rfft(self._fg, self._spec)
         c, K, has_K, b, wq = self._kernel_scalars
         X, j1, j2 = self._kernel_tables
-        return _kernels.residual_jacobian(q, omega / self.period, float(self.period), self._spec, N, c, K, has_K, b, wq,
-                                          self.forcing, X, j1, j2)
+        R, Rq, Rw = _kernels.residual_jacobian(q, omega / self.period, float(self.period), self._spec, N, c, K, has_K,
+                                               b, wq, self._forcing_at(omega), X, j1, j2)
+        return R, Rq, self._load_slope(Rw, omega)
 
     # --- Newton steps: full or condensed onto the element deflections ---------------------------
     def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
@@ -510,7 +529,7 @@ class HarmonicBalance:
         fg = self._element_samples(self._synthesize_elements(self.element_series(q)))
         spec = np.fft.rfft(fg, axis=1)
         R += self._element_forces(spec)
-        R = R.reshape(-1) - self.forcing
+        R = R.reshape(-1) - self._forcing_at(omega)
         Je = self._jacobians_from_spectra(spec[m:])  # (m, S, S)
         # Receptance of the elements' deflections to their forces, per harmonic: g_k = A Z_k⁻¹ B.
         g0 = self._A @ K_inv @ self._B  # (m, m)
@@ -570,7 +589,7 @@ class HarmonicBalance:
         """
         system = self.system
         n, H = self.n_coordinates, self.basis.harmonics
-        xc = system.static_equilibrium() if center is None else np.asarray(center, dtype=float).reshape(n)
+        xc = system.static_equilibrium(omega) if center is None else np.asarray(center, dtype=float).reshape(n)
         if stiffness_slope is None:
             stages = system.stages_of(xc)
             slopes = np.array([e.slopes[s] for e, s in zip(system.elements, stages)])

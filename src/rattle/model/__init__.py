@@ -1,6 +1,7 @@
 """Models: elastic laws, excitation and the sub-system equation."""
 
 from ._chain import Chain, Element, Link, Torque
+from ._drag import Drag, SpeedLoad
 from ._engine import base_order, engine_speed, engine_torque, firing_orders, forcing_frequency
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Backlash, Clutch, Linear, Piecewise, Stages
 from ._excitation import Excitation
@@ -13,5 +14,5 @@ __all__ = [
     "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "Stages", "ELASTIC_LAWS",
     "Excitation", "Model", "System", "ReducedElement", "Chain", "Link", "Element", "Torque", "check_analysable_model", "reference_case", "backlash_case",
     "firing_orders", "engine_speed", "forcing_frequency", "base_order", "engine_torque",
-    "SoundPath",
+    "SoundPath", "Drag", "SpeedLoad",
 ]

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from .._limits import MAX_MAGNITUDE
+from ._drag import Drag, drag_load
 from ._elastic import AbstractElastic, _check_real, _check_real_sequence
 from ._system import ReducedElement, System
 
@@ -158,6 +159,9 @@ class Chain:
     #: The engine order of the forcing frequency Ω (set by ``[engine]``, SPEC §6): the crankshaft
     #: speed is rpm = Ω · 60 / (2π · speed_order). None: no engine, results carry no rpm.
     speed_order: float | None = None
+    #: A drag torque tabulated by crankshaft speed (``[drag]``, SPEC §6): the mean torques then
+    #: depend on Ω (:mod:`rattle.model._drag`); needs ``speed_order``.
+    drag: Drag | None = None
     _system: System | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -200,6 +204,8 @@ class Chain:
             if not q > 0:
                 raise ValueError(f"`speed_order` must be > 0 (an engine order), got {q!r}")
             object.__setattr__(self, "speed_order", q)
+        if self.drag is not None:
+            self._check_drag(N)
         self._check_connected()
         if self.free:
             total = sum(t.mean for t in torques)
@@ -215,6 +221,9 @@ class Chain:
         self._check_scales()
         try:
             self._system.static_equilibrium()
+            if self._system.load is not None:  # and under every drag of the table
+                for w in self._system.load.nodes:
+                    self._system.static_equilibrium(float(w))
         except ValueError:
             raise ValueError(
                 "`torques`: the mean torques cannot be balanced by the chain's stiffness: no position "
@@ -222,6 +231,24 @@ class Chain:
                 "clearance element without stiffness there), so the chain would turn without end and "
                 "has no periodic motion; add a stiff link to ground, or balance the mean torques"
             ) from None
+
+    def _check_drag(self, N: int) -> None:
+        drag = self.drag
+        if not isinstance(drag, Drag):
+            raise TypeError(f"`drag` must be a rattle.model.Drag, got {drag!r}")
+        if self.speed_order is None:
+            raise ValueError("`drag` is tabulated over the crankshaft speed, but the chain has no `speed_order` (the "
+                             "engine order of Ω): give an [engine] (or `speed_order`) so that rpm maps to Ω")
+        if not 1 <= drag.inertia <= N:
+            raise ValueError(f"`drag.inertia` must be an inertia number 1 … {N}, got {drag.inertia}")
+        if drag.balance is not None and not 1 <= drag.balance <= N:
+            raise ValueError(f"`drag.balance` must be an inertia number 1 … {N}, got {drag.balance}")
+        if self.free and drag.balance is None:
+            raise ValueError(
+                "`drag.balance` is missing: on a free chain (no link to ground) the drag must be delivered by the "
+                "engine at every speed, or the whole chain slows down and has no periodic motion; give the "
+                "engine's inertia as `balance` (with [engine] this is automatic)"
+            )
 
     # --- structure --------------------------------------------------------------------------
     @property
@@ -324,6 +351,13 @@ class Chain:
             for e in self.elements
         )
         Fh = Th @ P.T
+        load = None
+        if self.drag is not None:  # T_m(Ω) = T_m − D(Ω) e_j + D(Ω) e_b
+            e = np.zeros(N)
+            e[self.drag.inertia - 1] -= 1.0
+            if self.drag.balance is not None:
+                e[self.drag.balance - 1] += 1.0
+            load = drag_load(self.drag, float(self.speed_order), P @ e)  # type: ignore[arg-type]
         return System(
             damping=P @ Ct @ Z,
             stiffness=P @ Kt @ Z,
@@ -334,6 +368,7 @@ class Chain:
             coordinates=names,
             angles=Z,
             free=self.free,
+            load=load,
         )
 
     def system(self) -> System:
@@ -384,6 +419,7 @@ class Chain:
             "elements": [x.to_dict() for x in self.elements],
             "torques": [x.to_dict() for x in self.torques],
             **({"speed_order": self.speed_order} if self.speed_order is not None else {}),
+            **({"drag": self.drag.to_dict()} if self.drag is not None else {}),
         }
 
     def speed_rpm(self, omega: Any) -> Any:

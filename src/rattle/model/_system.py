@@ -25,6 +25,11 @@ the equation is linear:
     x'' + C x' + K_s x = F(t) − Σ_e b_e o_e,       K_s = K + Σ_e k_e b_e a_eᵀ,
 
 and its first-order form z = (x, x') has the stage matrix A_s = [[0, I], [−K_s, −C]].
+
+A speed-dependent mean load (a drag torque tabulated by speed, :mod:`rattle.model._drag`) makes
+the mean forcing a function of the forcing frequency, F_0(Ω) = F_0 + d(Ω) u (``load``): every
+analysis at frequency Ω uses :meth:`System.mean_at` (the forcing, the static equilibrium, the
+exact flow), and the harmonic balance carries d(Ω) and d'(Ω) in its residual.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._typing import FloatArray
+from ._drag import SpeedLoad
 from ._elastic import AbstractElastic
 
 
@@ -68,7 +74,8 @@ class System:
     ``damping`` C and ``stiffness`` K (n, n); ``elements`` the clearance elements; forcing
     ``mean`` F_0 (n,), ``cos`` and ``sin`` (H_f, n): row h−1 holds F_ch and F_sh of harmonic h.
     ``coordinates`` names the coordinates; ``angles`` Z (N, n) maps x to the inertias' angles
-    (relative to the last inertia for a free chain, ``free`` True).
+    (relative to the last inertia for a free chain, ``free`` True); ``load`` an optional
+    Ω-dependent part of the mean forcing (:class:`~rattle.model.SpeedLoad`, a drag by speed).
     """
 
     damping: FloatArray
@@ -80,6 +87,7 @@ class System:
     coordinates: tuple[str, ...]
     angles: FloatArray
     free: bool = False
+    load: SpeedLoad | None = None
     _stiffness_cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # --- sizes --------------------------------------------------------------------------------
@@ -109,10 +117,27 @@ class System:
         return np.array([e.b for e in self.elements], dtype=float).reshape(self.m, self.n).T
 
     # --- the forcing --------------------------------------------------------------------------
-    def forcing(self, t: FloatArray | float, omega: float) -> FloatArray:
-        """F(t) at times ``t``: shape t.shape + (n,)."""
+    def mean_at(self, omega: FloatArray | float) -> FloatArray:
+        """F_0(Ω) = F_0 + d(Ω) u, shape Ω.shape + (n,) (F_0 itself without a ``load``)."""
+        if self.load is None:
+            return np.broadcast_to(self.mean, np.shape(omega) + (self.n,)).copy() if np.ndim(omega) else self.mean.copy()
+        d = np.asarray(self.load.value(omega), dtype=float)
+        return self.mean + d[..., None] * self.load.direction
+
+    def mean_slope(self, omega: float) -> FloatArray:
+        """dF_0/dΩ = d'(Ω) u (n,): zero without a ``load``."""
+        if self.load is None:
+            return np.zeros(self.n)
+        return self.load.slope(float(omega)) * self.load.direction
+
+    def forcing(self, t: FloatArray | float, omega: FloatArray | float) -> FloatArray:
+        """F(t) at times ``t``: shape t.shape + (n,) (``omega`` a number, or an array broadcasting
+        against ``t``)."""
         t = np.asarray(t, dtype=float)
-        out = np.broadcast_to(self.mean, t.shape + (self.n,)).copy()
+        if self.load is None:
+            out = np.broadcast_to(self.mean, t.shape + (self.n,)).copy()
+        else:
+            out = np.broadcast_to(self.mean_at(np.broadcast_to(omega, t.shape)), t.shape + (self.n,)).copy()
         for h in range(1, self.forced_harmonics + 1):
             ph = h * omega * t
             out += np.cos(ph)[..., None] * self.cos[h - 1] + np.sin(ph)[..., None] * self.sin[h - 1]
@@ -163,8 +188,9 @@ class System:
         return out
 
     # --- equilibrium and scales ---------------------------------------------------------------
-    def static_equilibrium(self) -> FloatArray:
-        """x_s solving K x + Σ_e b_e f_e(a_e·x) = F_0.
+    def static_equilibrium(self, omega: float | None = None) -> FloatArray:
+        """x_s solving K x + Σ_e b_e f_e(a_e·x) = F_0 (F_0(Ω) at ``omega`` with a ``load``;
+        without ``omega`` the constant part F_0).
 
         Every stage combination is linear: K_s x = F_0 − Σ b_e o_e. Starting from the
         combination at x = 0 the solution is iterated (non-smooth Newton: solve on the current
@@ -173,11 +199,12 @@ class System:
         other stiffness) and F_0 balances it, the least-squares solution in the middle of the
         gap is taken.
         """
+        F0 = self.mean if omega is None else self.mean_at(float(omega))
         x = np.zeros(self.n)
         seen: set[tuple[int, ...]] = set()
         stages = self.stages_of(x)
         for _ in range(4 * (self.m + 1) + 8):
-            sol = self._solve_on(stages)
+            sol = self._solve_on(stages, F0)
             if sol is not None and self.stages_of(sol) == stages:
                 return sol
             seen.add(stages)
@@ -187,7 +214,7 @@ class System:
             if stages in seen:
                 break
         for combo in itertools.product(*(range(c) for c in self.stage_counts())):
-            sol = self._solve_on(combo)
+            sol = self._solve_on(combo, F0)
             if sol is not None and self._on_stages(sol, combo):
                 return sol
         raise ValueError(
@@ -195,9 +222,9 @@ class System:
             "balanced by any stage of the elastic elements (check the links to ground and the mean torques)"
         )
 
-    def _solve_on(self, stages: tuple[int, ...]) -> FloatArray | None:
+    def _solve_on(self, stages: tuple[int, ...], F0: FloatArray) -> FloatArray | None:
         Ks = self.stage_stiffness(stages)
-        rhs = self.mean - self.stage_offset(stages)
+        rhs = F0 - self.stage_offset(stages)
         try:
             cond = np.linalg.cond(Ks)
         except np.linalg.LinAlgError:
@@ -248,12 +275,16 @@ class System:
     def force_scale(self) -> float:
         """A characteristic force per inertia: max over coordinates of |F_0| + Σ_h |F_h|."""
         amp = np.abs(self.mean) + np.sum(np.hypot(self.cos, self.sin), axis=0)
+        if self.load is not None:
+            amp = amp + self.load.largest * np.abs(self.load.direction)
         return max(float(np.max(amp)), 1e-300)
 
     def length_scale(self) -> float:
         """A characteristic deflection (rad): the static deflection, the breakpoints and the
         quasi-static dynamic amplitude on the softest positive stages, whichever is largest."""
         xs = self.static_equilibrium()
+        if self.load is not None:  # the static deflection under the largest drag of the table
+            xs = max((self.static_equilibrium(float(w)) for w in self.load.nodes), key=lambda x: float(np.max(np.abs(x))))
         bp = max((float(np.max(np.abs(e.breakpoints))) for e in self.elements if e.breakpoints.size), default=0.0)
         softest = tuple(int(np.argmin(np.where(e.slopes > 0, e.slopes, np.inf))) for e in self.elements)
         Ks = self.stage_stiffness(softest)

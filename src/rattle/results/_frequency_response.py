@@ -104,7 +104,10 @@ def linear_frequency_response(model: Model, omega: FloatArray, element: int = 0)
     a = system.elements[element].a
     K_l = system.stiffness + sum(np.outer(e.b, e.a) for e in system.elements)
     n = system.n
-    mean = np.full(omega.shape, float(a @ np.linalg.solve(K_l, system.mean)))
+    if system.load is None:
+        mean = np.full(omega.shape, float(a @ np.linalg.solve(K_l, system.mean)))
+    else:  # the mean torques follow the drag by speed
+        mean = (np.linalg.solve(K_l, system.mean_at(omega.ravel()).T).T @ a).reshape(omega.shape)
     ac2 = np.zeros(omega.shape)
     flat = omega.ravel()
     for h in range(1, system.forced_harmonics + 1):

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as sla
 
 from .._typing import FloatArray, IntArray
 from .._validate import as_float_array, check_omega
@@ -32,6 +33,17 @@ _EPS = float(np.finfo(float).eps)
 _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(12)
 _PANELS_PER_SCALE = 4  # Gauss-Legendre panels per stage time scale (integral measures)
 _EXTREMA_PER_SCALE = 40  # grid points per stage time scale bracketing the extrema
+
+
+def _constant_response(A: FloatArray, g: FloatArray, tau: float) -> FloatArray:
+    """∫_0^τ exp(A(τ−σ)) (0, g) dσ (2n,): the response of s' = A s + (0, g) from s = 0 (a constant
+    forcing of the lower half), from the exponential of the augmented matrix [[A, (0, g)], [0, 0]]
+    (exact also for a singular A)."""
+    n2 = A.shape[0]
+    Ab = np.zeros((n2 + 1, n2 + 1))
+    Ab[:n2, :n2] = A
+    Ab[n2 // 2 : n2, n2] = g
+    return sla.expm(Ab * tau)[:n2, n2]
 
 
 def check_system_state(value: object, n: int, name: str = "z0") -> FloatArray:
@@ -210,10 +222,13 @@ class SystemTrajectory:
             raise ValueError(f"`fixed` must be 'time' or 'phase', got {fixed!r}")
         n2 = 2 * self.system.n
         s = np.zeros(n2)
+        slope = self.system.mean_slope(self.omega)  # dF_0/dΩ of a mean load by speed
         for i in range(self.n_segments):
             sol = self.segments[i].sol
             ta, tb = float(self.t_start[i]), float(self.t_end[i])
             s = sol.transition(tb - ta) @ (s - sol.omega_particular(ta)) + sol.omega_particular(tb)
+            if np.any(slope):
+                s = s + _constant_response(sol.A, slope, tb - ta)
         if fixed == "phase":
             s = s - self._vector_field(self.t1, self.state1) * (self.t1 / self.omega)
             s = s + self.sensitivity @ self._vector_field(self.t0, self.state0) * (self.t0 / self.omega)

@@ -118,7 +118,10 @@ class SystemStages:
         n, m = system.n, system.m
         self.n, self.m = n, m
         self.C = np.asarray(system.damping, dtype=float)
-        self.mean = np.asarray(system.mean, dtype=float).reshape(n)
+        self.mean = np.asarray(system.mean_at(self.omega), dtype=float).reshape(n)
+        # The cached modal forms are those of Ā = [[A, g], [0, 0]], g holding the mean forcing: a
+        # mean that changes with Ω (a drag by speed) makes it part of the cache key.
+        self._cache_tag = None if system.load is None else self.mean.tobytes()
         cos = np.asarray(system.cos, dtype=float).reshape(-1, n)
         sin = np.asarray(system.sin, dtype=float).reshape(-1, n)
         keep = np.any(cos != 0.0, axis=1) | np.any(sin != 0.0, axis=1)
@@ -222,7 +225,8 @@ class StageSolution:
         Abar[: 2 * n, : 2 * n] = A
         Abar[: 2 * n, 2 * n] = g
         self.Abar = Abar
-        cached = flow.modal_cache.get(stages)
+        key = stages if flow._cache_tag is None else (stages, flow._cache_tag)
+        cached = flow.modal_cache.get(key)
         lam = np.linalg.eigvals(A) if cached is None else cached["eigenvalues"]
         self.eigenvalues = lam
         rho = float(np.max(np.abs(lam))) if lam.size else 0.0
@@ -270,7 +274,7 @@ class StageSolution:
             cached = {"eigenvalues": lam, "method": self.method}
             if self.method == "modal":
                 cached.update({k: getattr(self, k) for k in _MODAL_FIELDS})
-            flow.modal_cache[stages] = cached
+            flow.modal_cache[key] = cached
         else:
             for k, v in cached.items():
                 if k != "eigenvalues":
