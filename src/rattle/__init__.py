@@ -61,7 +61,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(
         ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
     ),
-    **dict.fromkeys(["SoundPath"], ".model"),
+    **dict.fromkeys(["SoundPath", "Drag"], ".model"),
     **dict.fromkeys(["SoundPressure", "linear_sound_pressure", "sound_pressure"], ".results"),
 }
 
@@ -76,7 +76,7 @@ __all__ = [
     "__version__",
     # models
     "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "AbstractElastic", "reference_case",
-    "backlash_case", "Chain", "Link", "Element", "Torque", "System",
+    "backlash_case", "Chain", "Link", "Element", "Torque", "System", "Drag",
     # front ends and their results
     "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse",
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
@@ -131,5 +131,5 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .maps import AttractorSearch, ResponseMap, response_map
     from .stability import Hill, Monodromy
     from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit
-    from .model import SoundPath
+    from .model import Drag, SoundPath
     from .results import SoundPressure, linear_sound_pressure, sound_pressure

@@ -59,7 +59,7 @@ def sweep_direction(
     ``report(direction)`` is called after each frequency.
     """
     integ = make_integrator(model)
-    x = static_state(model)
+    x = static_state(model, float(omegas[0]) if len(omegas) else None)
     dim = x.size
     n = len(omegas)
     rows: dict[str, np.ndarray] = {name: np.empty(n) for name in _ROW_SCALARS}

@@ -170,7 +170,7 @@ class RunConfig:
 # --------------------------------------------------------------------------------------------
 # Schema
 # --------------------------------------------------------------------------------------------
-_TOP_KEYS = ("model", "excitation", "analysis", "engine", "paths")
+_TOP_KEYS = ("model", "excitation", "analysis", "engine", "paths", "drag")
 _MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
 _EXCITATION_KEYS = ("mean", "amplitudes", "phases")
 _ANALYSIS_KEYS = ("omega", "harmonics")
@@ -480,6 +480,12 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
     model_t = _model_in_radians(check, model_t)
     if "inertias" in model_t:  # SPEC §5: a chain of inertias
         return _chain_config(check, data, model_t, units)
+    if "drag" in data:
+        raise check.error(
+            "`drag` needs a chain of inertias (SPEC §5–6): the drag torque acts on one inertia, but [model] is the "
+            "single equation (inertia, damping, stiffness); use `[model] inertias` with [[model.links]] and "
+            "[[model.elements]], or put a constant drag into `excitation.mean`"
+        )
     if "engine" in data:
         raise check.error(
             "`engine` needs a chain of inertias (SPEC §5–6): the engine torque acts on one inertia, but [model] "
@@ -769,6 +775,41 @@ def _engine(check: _Checker, data: Mapping[str, Any], n: int, units: str) -> _En
 
 
 # --------------------------------------------------------------------------------------------
+# [drag] (SPEC §6): the drag torque by speed on one inertia
+# --------------------------------------------------------------------------------------------
+_DRAG_KEYS = ("inertia", "speed_rpm", "torque", "balance")
+_EXAMPLES.update({
+    "drag": "[drag] with inertia = 2, speed_rpm = [600, 1500, 3000], torque = [2.0, 2.6, 3.5]",
+    "drag.inertia": "inertia = 2",
+    "drag.speed_rpm": "speed_rpm = [600, 1500, 3000]",
+    "drag.torque": "torque = [2.0, 2.6, 3.5]",
+    "drag.balance": "balance = 1",
+})
+
+
+def _drag(check: _Checker, data: Mapping[str, Any], n: int, engine: _Engine | None, free: bool) -> Any:
+    """The :class:`~rattle.model.Drag` of ``[drag]``: on a free chain the engine's inertia delivers
+    it (``balance``, default the [engine]'s inertia)."""
+    from ..model import Drag
+
+    t = check.table(data, "drag", "drag")
+    check.keys(t, "drag", _DRAG_KEYS, required=("inertia", "speed_rpm", "torque"))
+    for key in ("inertia", "balance"):
+        if key in t:
+            check.integer(t[key], f"drag.{key}")
+            if not 1 <= t[key] <= n:
+                raise check.error(f"`drag.{key}` must be an inertia number 1 … {n} (`model.inertias` has {n}), "
+                                  f"got {t[key]}")
+    for key in ("speed_rpm", "torque"):
+        check.array(t[key], f"drag.{key}")
+    balance = t.get("balance")
+    if balance is None and free and engine is not None:
+        balance = engine.torque.inertia
+    return check.build(Drag, {f: f"drag.{f}" for f in _DRAG_KEYS}, inertia=t["inertia"], speed_rpm=t["speed_rpm"],
+                       torque=t["torque"], balance=balance)
+
+
+# --------------------------------------------------------------------------------------------
 # Chains (SPEC §5)
 # --------------------------------------------------------------------------------------------
 _CHAIN_MODEL = ("inertias", "links", "elements", "speed_order")
@@ -918,8 +959,16 @@ def _chain_config(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
             names["torques"] = "engine.mean_torque` with `excitation.torques"
         analysis_t = {**analysis_t, "omega": [float(forcing_frequency(r, speed_order)) for r in engine.rpm]}
         omega_names = {"omega_min": "engine.speed_rpm[0]", "omega_max": "engine.speed_rpm[1]"}
+    drag = None
+    if "drag" in data:
+        free = not any(0 in x.between for x in (*links, *elements))
+        drag = _drag(check, data, n, engine, free)
+        names["drag"] = "drag"
+        if speed_order is None:
+            raise check.error("`drag` is tabulated over the crankshaft speed (`drag.speed_rpm`), but there is no "
+                              "engine order to map rpm to Ω: give an [engine] (or `model.speed_order`)")
     chain = check.build(Chain, names, inertias=model_t["inertias"], links=tuple(links), elements=tuple(elements),
-                        torques=tuple(torques), speed_order=speed_order)
+                        torques=tuple(torques), speed_order=speed_order, drag=drag)
     analysis = _analysis(check, analysis_t)
     if engine is not None and analysis.harmonics < engine.harmonics:
         raise check.error(
@@ -971,6 +1020,8 @@ def model_to_toml_dict(model: Model, analysis: AnalysisSettings | None = None) -
                                  "excitation": {"torques": d["torques"]}}
         if d.get("speed_order") is not None:  # an [engine]'s base order: results keep their rpm
             out_c["model"]["speed_order"] = d["speed_order"]
+        if d.get("drag") is not None:  # written with its balancing inertia (no [engine] to infer it from)
+            out_c["drag"] = d["drag"]
         if not d["links"]:
             del out_c["model"]["links"]
         if analysis is not None:
