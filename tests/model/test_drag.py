@@ -211,3 +211,19 @@ def test_drag_needs_an_engine_order_and_a_chain() -> None:
               '[excitation]\nmean = 0.0\namplitudes = [0.1]\n' + DRAG)
     with pytest.raises(ConfigError, match="`drag` needs a chain of inertias"):
         _config(single)
+
+
+@pytest.mark.parametrize("command", [["frf"], ["sweep", "--direction", "up"], ["compare"],
+                                     ["map", "--vary", "alpha=0.05,0.1"]])
+def test_cli_refuses_an_unsorted_drag_table_with_exit_2_writing_nothing(tmp_path, command) -> None:
+    from click.testing import CliRunner
+
+    from rattle.cli.main import cli
+
+    case = tmp_path / "case.toml"
+    case.write_text(BASE + "[drag]\ninertia = 2\nspeed_rpm = [900.0, 600.0]\ntorque = [1.0, 2.0]\n", encoding="utf-8")
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, [command[0], str(case), *command[1:], "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "drag.speed_rpm" in result.output + str(getattr(result, "stderr", ""))
+    assert not out.exists()
