@@ -321,6 +321,9 @@ def orbit_command(
                    "(one in the multi-valued region, one where the sweep is not period 1).")
 @click.option("--workers", type=int, default=1, show_default=True, metavar="W",
               help="Processes for the sweep: 2 runs the up and down sweeps at once.")
+@click.option("--measured", "measured", type=click.Path(path_type=Path), default=None, metavar="FILE.csv",
+              help="A measured run-up (CSV: speed_rpm or omega, and acc_p2p and/or spl_db) to overlay and "
+                   "table against the computed curves: measured.csv.")
 @_harmonics_option
 @_omega_min_option
 @_omega_max_option
@@ -328,18 +331,34 @@ def orbit_command(
 @_rpm_max_option
 @_quiet_option
 def compare_command(
-    config: Path, output: Path, points: int, at: str | None, workers: int, harmonics: int | None,
-    omega_min: float | None, omega_max: float | None, rpm_min: float | None, rpm_max: float | None, quiet: bool,
+    config: Path, output: Path, points: int, at: str | None, workers: int, measured: Path | None,
+    harmonics: int | None, omega_min: float | None, omega_max: float | None, rpm_min: float | None,
+    rpm_max: float | None, quiet: bool,
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
-    compare.png, frf.csv, sweep.csv, compare.json in OUTPUT."""
+    compare.png, frf.csv, sweep.csv, compare.json in OUTPUT.
+
+    With --measured FILE.csv the measured points are drawn over the computed curves of the same
+    quantity and tabled against them in measured.csv (HB largest stable, sweep up, sweep down,
+    differences).
+    """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
+    if measured is not None:
+        from ..io._read import check_input_file  # no numpy: refused at once
+
+        try:
+            check_input_file(measured, what="measured data file")
+        except ConfigError as exc:
+            raise ConfigError(f"`--measured`: {exc}") from None
     run_config = _io().load_config(config)
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
     )
     at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
+    measured_run = None if measured is None else _io().read_measured_csv(
+        measured, speed_order=getattr(run_config.model, "speed_order", None),
+        omega_range=(analysis.omega_min, analysis.omega_max), has_paths=bool(run_config.paths))
     t_start = time.perf_counter()
     from ..analysis import compare  # only now: all input has been validated
 
@@ -352,14 +371,34 @@ def compare_command(
     meta = sections("compare", config, run_config, analysis, {
         "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
+        "measured": None if measured is None else str(measured),
     })
-    written = write_set(output, COMPARE_FILES, [
-        ("frf.csv", (result.frf.with_sound(run_config.paths) if run_config.paths else result.frf).to_csv),
-        ("sweep.csv", result.sweep.to_csv),
+    frf = result.frf.with_sound(run_config.paths) if run_config.paths else result.frf
+    steps: list[tuple[str, Any]] = [
+        ("frf.csv", frf.to_csv), ("sweep.csv", result.sweep.to_csv),
         ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
-        ("compare.png", lambda path: save_plot(result, path)),
-    ])
-    echo_written(result.summary(), written, output)
+    ]
+    summary = result.summary()
+    if measured_run is None:
+        steps.append(("compare.png", lambda path: save_plot(result, path)))
+    else:
+        from ..results import compare_measured
+
+        def draw_measured() -> Any:
+            from ..plotting import compare_plot  # matplotlib checked by save_figure first
+
+            return compare_plot(result, measured=beside)
+
+        # Hook: the sweep's sound pressure, once a sweep result can carry it (SweepResult.with_sound);
+        # until then spl_db is compared against the harmonic balance only.
+        sweep = result.sweep
+        if run_config.paths and hasattr(sweep, "with_sound"):
+            sweep = sweep.with_sound(run_config.paths)
+        beside = compare_measured(measured_run, frf, sweep)
+        summary += "\n" + beside.summary()
+        steps += [("compare.png", lambda path: save_figure(draw_measured, path)), ("measured.csv", beside.to_csv)]
+    written = write_set(output, COMPARE_FILES, steps)
+    echo_written(summary, written, output)
 
 
 # --------------------------------------------------------------------------------------------

@@ -36,7 +36,7 @@ logger = logging.getLogger("rattle")
 FRF_FILES = ("frf.csv", "frf.json", "frf.png")
 SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")
 ORBIT_FILES = ("orbit.csv", "orbit.json", "orbit.png")
-COMPARE_FILES = ("frf.csv", "sweep.csv", "compare.json", "compare.png")
+COMPARE_FILES = ("frf.csv", "sweep.csv", "compare.json", "compare.png", "measured.csv")
 #: ``rattle map``: with two or more varied parameters also ``map_<NAME>.png`` for each one after
 #: the first (:func:`rattle.plotting._map.map_plot_names`); ``map.md`` with ``--report``.
 MAP_FILES = ("map.csv", "map.nc", "map.json", "map.png", "map.md")

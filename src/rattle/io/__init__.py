@@ -19,6 +19,7 @@ _LAZY: dict[str, str] = {
                      "rename_keys"], "._config"),
     **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
     **dict.fromkeys(["read_path_csv", "PATH_COLUMNS"], "._paths"),
+    **dict.fromkeys(["read_measured_csv", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS"], "._measured"),
     **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
                     "._metadata"),
@@ -59,6 +60,7 @@ if TYPE_CHECKING:
     )
     from ._csv import format_csv, read_csv, write_csv
     from ._paths import PATH_COLUMNS, read_path_csv
+    from ._measured import MEASURED_SPEED_COLUMNS, MEASURED_VALUE_COLUMNS, read_measured_csv
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
     from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
 
@@ -71,6 +73,8 @@ __all__ = [
     "write_csv", "read_csv", "format_csv",
     # sound path tables ([[paths]], SPEC §6)
     "read_path_csv", "PATH_COLUMNS",
+    # measured run-ups (rattle compare --measured)
+    "read_measured_csv", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS",
     # metadata
     "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
     # atomic writes, output sets, bounded reads

@@ -15,7 +15,12 @@ from ._orbit import window_periods
 from ._sweep import DIRECTION_STYLES, sweep_plot
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..results import Comparison
+    from ..results import Comparison, MeasuredComparison
+
+#: Labels of the measured-data panels (``compare_plot(..., measured=...)``).
+MEASURED_LABELS: dict[str, str] = {
+    "acc_p2p": "δ'' peak-to-peak (rad/s²)", "spl_db": "sound pressure level (dB re 20 µPa)",
+}
 
 
 def _steady_history(
@@ -67,6 +72,7 @@ def compare_plot(
     *,
     samples: int = 256,
     title: str | None = None,
+    measured: "MeasuredComparison | None" = None,
 ) -> tuple[Any, PlotAxes]:
     """Draw the frequency response (stable solid, unstable dashed) with the up (▲) and down (▼)
     sweep points over it, the examined frequencies marked (a), (b), …, and below it one panel
@@ -82,13 +88,19 @@ def compare_plot(
         Samples per forcing period of the time histories.
     title : str, optional
         Figure title (default none: the axes titles say what is shown).
+    measured : MeasuredComparison, optional
+        Measured points (:func:`rattle.results.compare_measured`): below the frequency-response
+        panels, one panel per measured quantity Q (``acc_p2p``, ``spl_db``) with the frequency
+        response of Q (stable solid, unstable dashed), the up (▲) and down (▼) sweep points of Q
+        (when the sweep carries Q) and the measured points (black ●, joined), over engine rpm
+        when the model has an engine.
 
     Returns
     -------
     (figure, PlotAxes)
         Panels ``frf`` (the top axes, the primary) and ``history_a``, ``history_b``, … (one per
         examined frequency, lettered as in the figure); the alias ``histories`` is the list of
-        the history panels. A chain: one frequency-response panel and one row of time
+        the history panels; with ``measured`` also ``measured_Q`` per measured quantity Q. A chain: one frequency-response panel and one row of time
         histories per clearance element NAME (``NAME_frf``, ``NAME_history_a``, …; the primary
         is the first element's ``NAME_frf``); the aliases ``frf`` and ``histories`` are the
         first element's, ``frf_panels`` (list) and ``element_histories`` (element name → list
@@ -103,18 +115,24 @@ def compare_plot(
     names = tuple(getattr(sweep, "element_names", ()) or ())
     m = max(1, len(names))
     n = len(comparison.at)
+    quantities = tuple(measured.measured.quantities) if measured is not None else ()
+    q = len(quantities)
     if fig is None:
-        fig = plt.figure(figsize=(13, (9 if n else 6) if m == 1 else 2.6 + 3.4 * m * (2 if n else 1)),
+        fig = plt.figure(figsize=(13, ((9 if n else 6) if m == 1 else 2.6 + 3.4 * m * (2 if n else 1)) + 3.6 * q),
                          layout="constrained")
     if n:
-        gs = fig.add_gridspec(2 * m, n, height_ratios=(1.5,) * m + (1.0,) * m)
+        gs = fig.add_gridspec(2 * m + q, n, height_ratios=(1.5,) * m + (1.2,) * q + (1.0,) * m)
         frf_axes = [fig.add_subplot(gs[k, :]) for k in range(m)]
-        rows = [[fig.add_subplot(gs[m + k, j]) for j in range(n)] for k in range(m)]
+        measured_axes = [fig.add_subplot(gs[m + k, :]) for k in range(q)]
+        rows = [[fig.add_subplot(gs[m + q + k, j]) for j in range(n)] for k in range(m)]
     else:
-        gs = fig.add_gridspec(m, 1)
+        gs = fig.add_gridspec(m + q, 1)
         frf_axes = [fig.add_subplot(gs[k, 0]) for k in range(m)]
+        measured_axes = [fig.add_subplot(gs[m + k, 0]) for k in range(q)]
         rows = [[] for _ in range(m)]
     ax_frf = frf_axes[0]
+    for quantity, ax_q in zip(quantities, measured_axes):
+        _draw_measured(measured, quantity, ax_q)  # type: ignore[arg-type]
 
     if not names:
         frequency_response_plot(frf, ax=ax_frf, linear=False, title="")
@@ -128,7 +146,7 @@ def compare_plot(
             ax_k.set_ylabel(f"{name}: δ rms (rad)")
     letters = string.ascii_lowercase
     sx = speed_axis(frf)[0]  # crankshaft rpm with an engine
-    for ax_k in frf_axes:
+    for ax_k in [*frf_axes, *measured_axes]:
         for j, w in enumerate(comparison.at):
             ax_k.axvline(w * sx, color="0.35", lw=0.9, ls="-.", zorder=0)
             ax_k.annotate(f"({letters[j % 26]})", (w * sx, 1.0), xycoords=("data", "axes fraction"),
@@ -182,9 +200,11 @@ def compare_plot(
     if title is not None:
         fig.suptitle(title)
     tags = [f"history_{letters[j]}" if j < 26 else f"history_{j}" for j in range(n)]
+    extra = {f"measured_{quantity}": ax_q for quantity, ax_q in zip(quantities, measured_axes)}
     if not names:
-        return fig, PlotAxes({"frf": ax_frf, **dict(zip(tags, rows[0]))}, aliases={"histories": rows[0]})
+        return fig, PlotAxes({"frf": ax_frf, **extra, **dict(zip(tags, rows[0]))}, aliases={"histories": rows[0]})
     panels: dict[str, Any] = {f"{name}_frf": ax_k for name, ax_k in zip(names, frf_axes)}
+    panels.update(extra)
     for name, row in zip(names, rows):
         panels.update({f"{name}_{tag}": ax for tag, ax in zip(tags, row)})
     aliases = {"frf": ax_frf, "histories": rows[0], "frf_panels": frf_axes,
@@ -192,4 +212,30 @@ def compare_plot(
     return fig, PlotAxes(panels, aliases=aliases)
 
 
-__all__ = ["compare_plot"]
+def _draw_measured(measured: "MeasuredComparison", quantity: str, ax: Any) -> None:
+    """One measured-data panel: the frequency response of ``quantity`` (stable solid, unstable
+    dashed), the sweep points of it (when the sweep carries it) and the measured points."""
+    from ._frf import draw_branches, speed_axis
+    from ._sweep import _draw_sweep
+
+    frf, sweep = measured.frf, measured.sweep
+    sx, xlabel = speed_axis(frf)
+    draw_branches(frf, ax, quantity, lw=1.3)
+    y_sweep = sweep.columns().get(quantity)
+    if y_sweep is not None:
+        _draw_sweep(sweep, ax, np.asarray(y_sweep, dtype=float), False, False, legend=False)
+    run = measured.measured
+    ax.plot(run.omega * sx, run.values[quantity], "o-", color="black", mfc="black", ms=4.5, lw=1.0,
+            label=f"measured ({run.source})", zorder=6)
+    names = tuple(getattr(frf, "element_names", ()) or ())
+    label = MEASURED_LABELS.get(quantity, quantity)
+    ax.set_ylabel(f"{names[0]}: {label}" if names and quantity == "acc_p2p" else label)
+    ax.set_xlabel(xlabel)
+    gaps = [c.replace("_", " ") for (qq, c) in measured.missing if qq == quantity]
+    ax.set_title(f"measured {quantity} against the computed" + (f" (no {', '.join(gaps)})" if gaps else ""),
+                 fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best", framealpha=0.9)
+
+
+__all__ = ["compare_plot", "MEASURED_LABELS"]
