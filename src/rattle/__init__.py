@@ -62,6 +62,7 @@ _LAZY: dict[str, str] = {
         ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
     ),
     **dict.fromkeys(["SoundPath", "Drag"], ".model"),
+    **dict.fromkeys(["clutch_damper", "hub_spline", "gear_pair", "loose_gear"], ".model"),
     **dict.fromkeys(["SoundPressure", "linear_sound_pressure", "sound_pressure"], ".results"),
 }
 
@@ -77,6 +78,8 @@ __all__ = [
     # models
     "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "AbstractElastic", "reference_case",
     "backlash_case", "Chain", "Link", "Element", "Torque", "System", "Drag",
+    # sub-system builders (a data sheet → an ordinary chain element or chain)
+    "clutch_damper", "hub_spline", "gear_pair", "loose_gear",
     # front ends and their results
     "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse",
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
@@ -132,4 +135,5 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .stability import Hill, Monodromy
     from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit
     from .model import Drag, SoundPath
+    from .model import clutch_damper, gear_pair, hub_spline, loose_gear
     from .results import SoundPressure, linear_sound_pressure, sound_pressure
