@@ -188,7 +188,7 @@ def read_measured_csv(
             if not lo * (1 - _RANGE_SLACK) <= w <= hi * (1 + _RANGE_SLACK):
                 shown = f"{lo / factor:.6g} … {hi / factor:.6g} {unit}"
                 option = "--rpm-min/--rpm-max" if speed == "speed_rpm" else "--omega-min/--omega-max"
-                raise fail(f"line {lines[i]}, column `{speed}`: {s[i]!r} {unit} lies outside the analysis range "
+                raise fail(f"line {lines[i]}, column `{speed}`: {s[i]:.6g} {unit} lies outside the analysis range "
                            f"{shown}; widen the range ({option} or the configuration) or remove the rows outside it")
     try:
         return MeasuredRun(omega=omega, values={q: cols[q] for q in quantities},
