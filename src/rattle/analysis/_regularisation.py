@@ -1,0 +1,139 @@
+"""The regularisation continued to its limit: one periodic orbit of a discontinuous law at ε → 0.
+
+The harmonic balance of a preload or friction law solves the regularised equation
+(:class:`~rattle.hb.RegularisedBalance`, smooth steps of relative width ε). This module follows
+one solution at a fixed forcing frequency Ω from a comfortable ε_0 down a geometric ladder
+ε_0 > ε_1 > … > ε_min, each solution starting Newton for the next (a homotopy in ε): where
+Newton fails the step in log ε is halved and retried. A narrower step needs more harmonics: after
+each solve the spectrum of δ is checked, and while the harmonics in the top half of the basis
+carry more than ``tail_tol`` of its fluctuation (rms) H is doubled (up to
+``max_harmonics``) and the same ε solved again.
+
+The record (:class:`RegularisationLimit`) holds every rung: ε, H, rms and mean of δ, the
+spectral tail. The change of the rms between the last rungs measures what ε still does to the
+answer; for an error linear in ε (a jump smeared over a width ε) the Richardson value
+rms(ε_k) − ε_k (rms(ε_k) − rms(ε_{k−1}))/(ε_k − ε_{k−1}) estimates the limit — both are reported,
+and the exact event-driven orbit (:mod:`rattle.timeint`) is the check.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..continuation import NewtonOptions, solve_fixed
+from ..errors import ConvergenceError
+from ..hb import RegularisedBalance, resize_harmonics
+
+
+@dataclass(frozen=True, slots=True)
+class RegularisationStep:
+    """One rung of the ladder: ``eps``, ``harmonics`` H, the coefficients ``q`` of δ, its
+    ``mean``, ``rms`` and ``p2p`` (sampled), and ``tail``: the rms of δ's harmonics in the top half
+    of the basis relative to the rms of its fluctuation."""
+
+    eps: float
+    harmonics: int
+    q: FloatArray
+    mean: float
+    rms: float
+    p2p: float
+    tail: float
+
+
+@dataclass(frozen=True, slots=True)
+class RegularisationLimit:
+    """The ladder of one orbit (:func:`regularisation_limit`) at forcing frequency ``omega``."""
+
+    omega: float
+    steps: tuple[RegularisationStep, ...]
+
+    @property
+    def last(self) -> RegularisationStep:
+        return self.steps[-1]
+
+    @property
+    def change(self) -> float:
+        """|rms(ε_last) − rms(ε_previous)| / rms(ε_last): what the last refinement of ε changed."""
+        if len(self.steps) < 2:
+            return math.nan
+        a, b = self.steps[-2].rms, self.steps[-1].rms
+        return abs(b - a) / max(abs(b), 1e-300)
+
+    @property
+    def extrapolated_rms(self) -> float:
+        """Richardson's ε → 0 value of the rms from the last two rungs (error linear in ε)."""
+        if len(self.steps) < 2:
+            return self.last.rms
+        a, b = self.steps[-2], self.steps[-1]
+        return b.rms - b.eps * (b.rms - a.rms) / (b.eps - a.eps)
+
+
+def _measures(pb: RegularisedBalance, q: FloatArray, omega: float) -> tuple[float, float, float, float]:
+    delta, _ = pb.samples(q, omega)
+    H = pb.basis.harmonics
+    power = q[1 : H + 1] ** 2 + q[H + 1 :] ** 2  # 2 × the power of harmonic k of δ
+    total = math.sqrt(float(np.sum(power)))
+    tail = math.sqrt(float(np.sum(power[H // 2 :]))) / total if total > 0 else 0.0
+    return float(np.mean(delta)), float(np.sqrt(np.mean(delta**2))), float(np.ptp(delta)), tail
+
+
+def regularisation_limit(
+    problem: Callable[[float, int], RegularisedBalance],
+    omega: float,
+    q0: FloatArray,
+    *,
+    eps_start: float = 0.1,
+    eps_min: float = 1e-3,
+    ratio: float = 0.5,
+    harmonics: int = 32,
+    max_harmonics: int = 256,
+    tail_tol: float = 1e-6,
+    newton: NewtonOptions | None = None,
+) -> RegularisationLimit:
+    """Follow the periodic orbit started at ``q0`` (coefficients with ``harmonics`` harmonics) at
+    ``omega`` from ε = ``eps_start`` down to ``eps_min`` (module docstring).
+
+    ``problem(eps, H)`` builds the :class:`RegularisedBalance` at relative width ε with H
+    harmonics. Raises :class:`~rattle.errors.ConvergenceError` (with the rungs reached) when the
+    first solve fails, or when a step in log ε shrinks below 1 % of the requested one.
+    """
+    if not (0 < eps_min <= eps_start) or not (0 < ratio < 1):
+        raise ValueError(f"need 0 < eps_min <= eps_start and 0 < ratio < 1, got eps_min={eps_min!r}, "
+                         f"eps_start={eps_start!r}, ratio={ratio!r}")
+    newton = NewtonOptions(max_iterations=30) if newton is None else newton
+    steps: list[RegularisationStep] = []
+    H, eps, q = int(harmonics), float(eps_start), np.asarray(q0, dtype=float)
+    log_step = math.log(ratio)
+    while True:
+        pb = problem(eps, H)
+        res = solve_fixed(pb, resize_harmonics(q, H), omega, newton)
+        if not res.converged:
+            if not steps:
+                raise ConvergenceError(f"the regularised orbit at Ω = {omega:g}, ε = {eps:g} (H = {H}) did not "
+                                       f"converge from the start given: {res.message}")
+            if abs(log_step) < 0.01 * abs(math.log(ratio)):
+                raise ConvergenceError(f"the regularisation ladder at Ω = {omega:g} stalled at ε = "
+                                       f"{steps[-1].eps:g}: Newton fails for any smaller ε (H = {H})")
+            log_step *= 0.5  # back off: a smaller step in log ε from the last good rung
+            eps = steps[-1].eps * math.exp(log_step)
+            continue
+        mean, rms, p2p, tail = _measures(pb, res.q, omega)
+        if tail > tail_tol and 2 * H <= max_harmonics:  # the step is not resolved: more harmonics, same ε
+            H *= 2
+            q = res.q
+            continue
+        q = res.q
+        steps.append(RegularisationStep(eps=eps, harmonics=H, q=q, mean=mean, rms=rms, p2p=p2p, tail=tail))
+        if eps <= eps_min * (1 + 1e-12):
+            break
+        log_step = max(log_step * 1.5, math.log(ratio)) if log_step > math.log(ratio) else math.log(ratio)
+        eps = max(eps * math.exp(log_step), eps_min)
+    return RegularisationLimit(omega=float(omega), steps=tuple(steps))
+
+
+__all__ = ["RegularisationLimit", "RegularisationStep", "regularisation_limit"]
