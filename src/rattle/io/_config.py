@@ -472,6 +472,10 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
 
         rest = config_from_dict({k: v for k, v in data.items() if k != "paths"}, source_name)
         return with_paths(rest, data["paths"], source_name)
+    from ._subsystems import expand_subsystems  # damper, spline, gear pair shapes → the ordinary tables
+
+    if (expanded := expand_subsystems(data, source_name)) is not data:
+        return dataclasses.replace(config_from_dict(expanded, source_name), source=copy.deepcopy(dict(data)))
 
     # Structure of every table first, so that a misspelt key is reported before its values.
     check.keys(data, "", _TOP_KEYS, required=("model",) if "engine" in data else ("model", "excitation"))
