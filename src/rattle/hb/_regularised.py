@@ -23,8 +23,8 @@ of δ (q = [a_0, a_1 … a_H, b_1 … b_H], base frequency ω = Ω/p),
 
 with ℰ (N × (2H+1)) the synthesis at N samples per period, 𝒜 = ℰ⁺ the truncated analysis and
 ∇(ω) the derivative operator (:meth:`FourierBasis.derivative_matrix`; ∂∇/∂ω = ∇(1)). The
-matrices are dense (the Toeplitz structure of the piecewise-linear core does not hold for the
-velocity term): O(N H²) per Jacobian.
+products 𝒜 diag(w) ℰ are assembled from the spectrum of the samples w by the product rule of the
+harmonic balance's core (:func:`~rattle.hb._residual.product_jacobians`, O(N log N + H²)).
 
 Regularisation changes the answer: the orbit of the ε-problem differs from the discontinuous
 one by O(ε) in general (a smooth step of width ε shifts where the jump acts by a fraction of ε
@@ -42,6 +42,7 @@ import numpy as np
 from .._typing import FloatArray
 from ._basis import FourierBasis
 from ._options import HBOptions
+from ._residual import product_jacobians, product_tables
 
 
 @runtime_checkable
@@ -112,18 +113,8 @@ class RegularisedBalance:
             F[H + n * period] -= a * np.sin(ph)
         self.forcing = F
         self.amplitude_scale = abs(float(mean)) + sum(abs(a) for a in amps)
-        # Synthesis ℰ (N, S) and analysis 𝒜 (S, N) at the sample phases θ_j = 2π j / N.
-        theta = 2.0 * np.pi * np.arange(N) / N
-        k = self.basis.k
-        E = np.empty((N, S))
-        E[:, 0] = 1.0
-        E[:, 1 : H + 1] = np.cos(np.outer(theta, k))
-        E[:, H + 1 :] = np.sin(np.outer(theta, k))
-        self._E = E
-        A = E.T * (2.0 / N)
-        A[0] *= 0.5
-        self._A = A
         self._D1 = self.basis.derivative_matrix(1.0)  # ∇(ω) = ω ∇(1)
+        self._tables = product_tables(H, 2)
 
     # --- scales (ContinuationProblem) --------------------------------------------------------
     @property
@@ -160,7 +151,7 @@ class RegularisedBalance:
     def samples(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray]:
         """δ(t_j) and δ'(t_j) at the N samples of the solution period."""
         w = omega / self.period
-        return self._E @ q, self._E @ (w * (self._D1 @ q))
+        return self.basis.synthesize(q), self.basis.synthesize(w * (self._D1 @ q))
 
     def residual(self, q: FloatArray, omega: float) -> FloatArray:
         return self.residual_jacobian(q, omega, jacobian=False)[0]
@@ -171,15 +162,17 @@ class RegularisedBalance:
         w = omega / self.period
         D = w * self._D1
         dq = D @ q
-        delta, vel = self._E @ q, self._E @ dq
+        delta, vel = self.basis.synthesize(np.stack((q, dq)))
         g, g_d, g_v = self.force.regularised(delta, vel, *self.widths)
         lin = D @ (dq + self.c * q)  # (∇² + c∇) q
-        R = lin + self._A @ g - self.forcing
+        R = lin + self.basis.analyze(g) - self.forcing
         if not jacobian:
             return R, None, None
-        J = D @ D + self.c * D + (self._A * g_d) @ self._E + ((self._A * g_v) @ self._E) @ D
+        # 𝒜 diag(w) ℰ from the spectrum of w (the product rule, O(N log N + H²); exact for N ≥ 4H + 1)
+        Jd, Jv = product_jacobians(np.fft.rfft(np.stack((g_d, g_v)), axis=1), self.basis.samples, self._tables)
+        J = D @ D + self.c * D + Jd + Jv @ D
         d1q = self._D1 @ q
-        Rw = (D @ d1q + self._D1 @ dq + self.c * d1q + self._A @ (g_v * (self._E @ d1q))) / self.period
+        Rw = (D @ d1q + self._D1 @ dq + self.c * d1q + self.basis.analyze(g_v * self.basis.synthesize(d1q))) / self.period
         return R, J, Rw
 
     def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:

@@ -65,6 +65,34 @@ def _jacobian_gather_tables(H: int) -> tuple[np.ndarray, np.ndarray]:
     return j1, j2
 
 
+def product_tables(H: int, k: int) -> tuple[FloatArray, np.ndarray, np.ndarray]:
+    """Buffer X (k, 4L+1) and the gather tables of :func:`product_jacobians` for k signals."""
+    j1, j2 = _jacobian_gather_tables(H)
+    size = 4 * (4 * H + 1) + 1
+    shift = (size * np.arange(k))[:, None, None]
+    return np.zeros((k, size)), j1[None] + shift, j2[None] + shift
+
+
+def product_jacobians(spec: np.ndarray, samples: int, tables: tuple[FloatArray, np.ndarray, np.ndarray]) -> FloatArray:
+    """Γ* diag(g) Γ (k, S, S) — the coefficients of g(t) δ(t) as a linear map of δ's — from the
+    rfft spectra (k, ≥ 2H+1) of k signals g sampled at ``samples`` points, with the ``tables`` of
+    :func:`product_tables` (see :func:`_jacobian_gather_tables`)."""
+    X, j1, j2 = tables
+    H = (j1.shape[-1] - 1) // 2
+    S = 2 * H + 1
+    off, L = 2 * H, 4 * H + 1
+    G = spec[:, :S] / samples
+    Gr, Gi = G.real, G.imag
+    X[:, off:L] = Gr
+    X[:, :off] = Gr[:, :0:-1]
+    X[:, L + off : 2 * L] = Gi
+    np.negative(Gi[:, :0:-1], out=X[:, L : L + off])
+    np.negative(X[:, : 2 * L], out=X[:, 2 * L : 4 * L])
+    J = np.take(X, j1)
+    J += np.take(X, j2)
+    return J
+
+
 class HarmonicBalance:
     """The discretised problem R(q, Ω) = 0 for one model, harmonic count and period multiple.
 
@@ -363,30 +391,13 @@ class HarmonicBalance:
         """Buffer X (k, 4L+1) and gather tables for k signals at once (cached per k)."""
         got = self._tables.get(k)
         if got is None:
-            j1, j2 = _jacobian_gather_tables(self.basis.harmonics)
-            size = 4 * (4 * self.basis.harmonics + 1) + 1
-            shift = (size * np.arange(k))[:, None, None]
-            X = np.zeros((k, size))
-            got = self._tables[k] = (X, j1[None] + shift, j2[None] + shift)
+            got = self._tables[k] = product_tables(self.basis.harmonics, k)
         return got
 
     def _jacobians_from_spectra(self, spec: np.ndarray) -> FloatArray:
         """J_e = Γ* diag(g_e) Γ (k, S, S) from the rfft spectra (k, ≥ 2H+1) of k slope signals
         (see :func:`_jacobian_gather_tables`)."""
-        H = self.basis.harmonics
-        S = 2 * H + 1
-        off, L = 2 * H, 4 * H + 1
-        X, j1, j2 = self._product_tables(spec.shape[0])
-        G = spec[:, :S] / self.basis.samples
-        Gr, Gi = G.real, G.imag
-        X[:, off:L] = Gr
-        X[:, :off] = Gr[:, :0:-1]
-        X[:, L + off : 2 * L] = Gi
-        np.negative(Gi[:, :0:-1], out=X[:, L : L + off])
-        np.negative(X[:, : 2 * L], out=X[:, 2 * L : 4 * L])
-        J = np.take(X, j1)
-        J += np.take(X, j2)
-        return J
+        return product_jacobians(spec, self.basis.samples, self._product_tables(spec.shape[0]))
 
     def _assemble(self, Je: FloatArray) -> FloatArray:
         """Σ_e W_e ⊗ J_e (n·S, n·S) from the element blocks J_e (m, S, S)."""
