@@ -172,7 +172,7 @@ def test_sweeps_interpolated_and_differences_hand_checked(tmp_path: Path) -> Non
     line = result.summary().splitlines()
     assert line[0].startswith("measured acc_p2p (2 points, measured): largest difference hb +27.3 % at Ω = 1.2")
     assert "sweep down -10.9 % at Ω = 1.2" in line[0]
-    assert "hb -1 dB at Ω = 1.8" in line[1] and "sweep up: none (the sweep result carries no spl_db)" in line[1]
+    assert "hb -1.00 dB at Ω = 1.8" in line[1] and "sweep up: none (the sweep result carries no spl_db)" in line[1]
     # measured.csv: the same columns and values
     back = read_csv(result.to_csv(tmp_path / "measured.csv"))
     assert list(back) == result.column_names()
@@ -189,6 +189,9 @@ def test_outside_the_sweep_and_without_a_direction_nan() -> None:
     np.testing.assert_allclose(c["acc_p2p_sweep_up"][:1], [11.0], rtol=1e-15)
     assert math.isnan(c["acc_p2p_sweep_up"][1]) and np.all(np.isnan(c["acc_p2p_sweep_down"]))
     assert result.missing == {("acc_p2p", "sweep_down"): "no down sweep"}
+    assert result.summary() == ("measured acc_p2p (2 points, measured): largest difference sweep up +1000.0 % at "
+                                "Ω = 1.25; hb: no stable solution computed at 2 point(s); sweep up: outside the "
+                                "sweep at 1 point(s); sweep down: none (no down sweep)")
 
 
 def test_measured_run_checks_its_arguments() -> None:
@@ -201,3 +204,15 @@ def test_measured_run_checks_its_arguments() -> None:
     with pytest.raises(ValueError, match="no `spl_db` column"):
         compare_measured(MeasuredRun(omega=[1.5], values={"spl_db": [60.0]}),
                          _frf([0, 0], [1.0, 2.0], [True, True], [1.0, 2.0]), _sweep(up=([1.0, 2.0], [1.0, 2.0])))
+
+
+def test_the_example_run_up_reads_against_its_configuration() -> None:
+    from rattle.io import load_config
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    cfg = load_config(examples / "engine_clutch_si.toml")
+    run = read_measured_csv(examples / "engine_clutch_measured.csv", speed_order=cfg.model.speed_order,
+                            omega_range=cfg.analysis.omega)
+    assert len(run) == 41 and run.quantities == ("acc_p2p",)
+    assert run.speed_rpm[0] == 600.0 and run.speed_rpm[-1] == 1400.0
+    np.testing.assert_allclose(run.omega, run.speed_rpm * 2.0 * 2.0 * math.pi / 60.0, rtol=1e-15)  # order 2

@@ -308,7 +308,7 @@ class MeasuredComparison:
         for q in m.quantities:
             parts = []
             for c, (d, i) in self.largest_differences(q).items():
-                text = f"{100.0 * d:+.3g} %" if DIFFERENCE_KIND[q] == "rel" else f"{d:+.3g} dB"
+                text = f"{100.0 * d:+.1f} %" if DIFFERENCE_KIND[q] == "rel" else f"{d:+.2f} dB"
                 parts.append(f"{c.replace('_', ' ')} {text} at {where(i)}")
             for c in COMPUTED:
                 if (q, c) in self.missing:
@@ -316,7 +316,8 @@ class MeasuredComparison:
                     continue
                 gaps = int(np.sum(~np.isfinite(self.computed[(q, c)])))
                 if gaps:
-                    parts.append(f"{c.replace('_', ' ')} missing at {gaps} point(s)")
+                    why = "no stable solution computed" if c == "hb" else "outside the sweep"
+                    parts.append(f"{c.replace('_', ' ')}: {why} at {gaps} point(s)")
             lines.append(f"measured {q} ({len(m)} points, {m.source}): largest difference "
                          + ("; ".join(parts) if parts else "none (no computed value at any measured point)"))
         return "\n".join(lines)
