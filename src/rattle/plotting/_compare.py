@@ -226,7 +226,7 @@ def _draw_measured(measured: "MeasuredComparison", quantity: str, ax: Any) -> No
         _draw_sweep(sweep, ax, np.asarray(y_sweep, dtype=float), False, False, legend=False)
     run = measured.measured
     ax.plot(run.omega * sx, run.values[quantity], "o-", color="black", mfc="black", ms=4.5, lw=1.0,
-            label=f"measured ({run.source})", zorder=6)
+            label="measured" if run.source == "measured" else f"measured ({run.source})", zorder=6)
     names = tuple(getattr(frf, "element_names", ()) or ())
     label = MEASURED_LABELS.get(quantity, quantity)
     ax.set_ylabel(f"{names[0]}: {label}" if names and quantity == "acc_p2p" else label)
