@@ -147,7 +147,7 @@ def _backlash_m(check: _Checker, t: dict[str, Any], where: str) -> dict[str, str
             raise check.error(f"`{where}.backlash` and `{where}.backlash_um` are both given: one backlash in m and "
                               "in µm; keep one of them")
         check.number(t["backlash_um"], f"{where}.backlash_um")
-        t["backlash"] = float(t.pop("backlash_um")) * 1e-6
+        t["backlash"] = float(t.pop("backlash_um")) / 1e6  # correctly rounded: 60 µm → 6e-05 exactly as written
         names["backlash"] = f"{where}.backlash_um"
     return names
 

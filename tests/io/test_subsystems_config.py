@@ -1,0 +1,250 @@
+"""Sub-system shapes of the configuration file (rattle.io._subsystems): each equals its Python
+builder; bad physical input refused naming the key (exit 2 on the command line)."""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+
+import pytest
+from click.testing import CliRunner
+
+from rattle.cli.main import cli
+from rattle.errors import ConfigError
+from rattle.io import config_from_dict, load_config
+from rattle.model import Link, Torque, clutch_damper, gear_pair, hub_spline, loose_gear
+
+DAMPER = """
+[model]
+units = "SI"
+inertias = [0.15, 0.012, 0.02]
+
+[[model.links]]
+between = [1, 2]
+damping = 0.15
+
+[[model.links]]
+between = [3, 0]
+stiffness = 1000.0
+damping = 0.05
+
+[[model.elements]]
+name = "damper"
+type = "damper"
+between = [1, 2]
+drive_stiffness_per_deg = [1.5, 30.0]
+drive_angles_deg = [4.0]
+coast_stiffness = [57.29577951308232, 1145.9155902616465]
+coast_angles_deg = [3.0]
+free_play_deg = 0.5
+
+[[model.elements]]
+name = "spline"
+type = "spline"
+between = [2, 3]
+stiffness = 8000.0
+backlash_deg = 1.0
+
+[[excitation.torques]]
+inertia = 1
+mean = 5.0
+amplitudes = [60.0]
+
+[analysis]
+omega = [50.0, 300.0]
+harmonics = 8
+"""
+
+GEARS = """
+[model]
+units = "SI"
+
+[model.gear_pair]
+base_radii = [0.03, 0.04]
+inertias = [5.0e-3, 6.0e-3]
+mesh_stiffness = 2.0e8
+mesh_damping_ratio = 0.05
+backlash_um = 60.0
+
+[[excitation.torques]]
+inertia = 1
+mean = 20.0
+amplitudes = [25.0]
+
+[[excitation.torques]]
+inertia = 2
+mean = -26.666666666666668
+amplitudes = [4.0]
+
+[analysis]
+omega = [3000.0, 12000.0]
+harmonics = 8
+"""
+
+LOOSE = """
+[model]
+units = "SI"
+
+[model.loose_gear]
+base_radii = [0.03, 0.04]
+inertia = 2.0e-4
+mesh_stiffness = 2.0e8
+mesh_damping_ratio = 0.05
+backlash_um = 100.0
+drag_torque = 0.05
+speed_rpm = [600.0, 3000.0]
+orders = [2.0, 4.0]
+drive_acceleration = [400.0, 100.0]
+drive_phases_deg = [0.0, 90.0]
+
+[analysis]
+harmonics = 8
+"""
+
+
+def _data(text: str) -> dict:
+    return tomllib.loads(text)
+
+
+def test_damper_and_spline_equal_their_builders():
+    cfg = config_from_dict(_data(DAMPER))
+    damper, spline = cfg.model.elements
+    ref = clutch_damper(drive_stiffness=[1.5 * 180 / math.pi, 30.0 * 180 / math.pi],
+                        drive_angles=[math.radians(4.0)], coast_stiffness=[57.29577951308232, 1145.9155902616465],
+                        coast_angles=[math.radians(3.0)], free_play=math.radians(0.5))
+    assert damper.stiffness == pytest.approx(ref.stiffness, rel=1e-15)
+    assert damper.law.breakpoints == pytest.approx(ref.law.breakpoints, rel=1e-15)
+    assert damper.law.slopes == pytest.approx(ref.law.slopes, rel=1e-15)
+    # by hand: stiffest stage 30 N m/deg = 1718.87 N m/rad; breakpoints −3, −0.25, 0.25, 4 deg
+    assert damper.stiffness == pytest.approx(30.0 * 180 / math.pi)
+    assert damper.law.breakpoints == pytest.approx(tuple(math.radians(x) for x in (-3.0, -0.25, 0.25, 4.0)))
+    assert damper.law.slopes == pytest.approx((20 / 30, 1 / 30, 0.0, 1.5 / 30, 1.0))
+    ref_s = hub_spline(backlash=math.radians(1.0), stiffness=8000.0)
+    assert spline.law == ref_s.law and spline.stiffness == 8000.0 and spline.between == (2, 3)
+    # the file as written is kept for provenance; the resolved configuration is ordinary
+    assert cfg.source["model"]["elements"][0]["type"] == "damper"
+    resolved = cfg.to_dict()
+    assert resolved["model"]["elements"][0]["type"] == "piecewise"
+    again = config_from_dict(resolved)
+    assert again.model.elements == cfg.model.elements
+
+
+def test_gear_pair_equals_its_builder_with_gear2_torques_scaled():
+    cfg = config_from_dict(_data(GEARS))
+    ref = gear_pair(base_radii=[0.03, 0.04], inertias=[5e-3, 6e-3], mesh_stiffness=2e8, mesh_damping_ratio=0.05,
+                    backlash=60e-6, torques=[Torque(inertia=1, mean=20.0, amplitudes=[25.0]),
+                                             Torque(inertia=2, mean=-26.666666666666668, amplitudes=[4.0])])
+    chain = cfg.model
+    assert chain.inertias == pytest.approx(ref.chain.inertias, rel=1e-15)
+    assert chain.elements == ref.chain.elements
+    assert chain.links[0].damping == pytest.approx(ref.damping, rel=1e-15)
+    # torque on gear 2 × r1/r2 = 0.75: −20 N m and 3 N m on gear 1's side (hand calculation)
+    t2 = [t for t in chain.torques if t.inertia == 2][0]
+    assert t2.mean == pytest.approx(-20.0, rel=1e-15) and t2.amplitudes == pytest.approx((3.0,))
+    assert chain.elements[0].name == "mesh" and chain.elements[0].law.b == pytest.approx(1e-3)
+    assert chain.elements[0].stiffness == pytest.approx(1.8e5)
+    assert cfg.units == "SI"
+
+
+def test_loose_gear_equals_its_builder_with_an_engine_axis():
+    cfg = config_from_dict(_data(LOOSE))
+    ref = loose_gear(base_radii=[0.03, 0.04], inertia=2e-4, mesh_stiffness=2e8, mesh_damping_ratio=0.05,
+                     backlash=100e-6, drive_acceleration=[400.0, 100.0], drive_phases=[0.0, math.pi / 2],
+                     drag_torque=0.05)
+    chain = cfg.model
+    assert chain.elements == ref.chain.elements and chain.links == ref.chain.links
+    assert not chain.free and chain.speed_order == pytest.approx(2.0)
+    (tq,) = chain.torques
+    # J2 (r1/r2) A: 2e-4 · 0.75 · 400 = 0.06 N m at order 2 (harmonic 1), 0.015 at order 4; drag as mean
+    assert tq.mean == pytest.approx(0.05) and tq.amplitudes == pytest.approx((0.06, 0.015))
+    assert tq.phases == pytest.approx((0.0, math.pi / 2))
+    # speed axis: Ω = 2 · 2π/60 · rpm
+    assert cfg.analysis.omega == pytest.approx((2 * 2 * math.pi / 60 * 600, 2 * 2 * math.pi / 60 * 3000))
+
+
+def _set(data: dict, path: str, value) -> dict:
+    data = copy.deepcopy(data)
+    keys = path.split(".")
+    node = data
+    for k in keys[:-1]:
+        node = node[int(k)] if k.isdigit() else node[k]
+    if value is _DEL:
+        del node[keys[-1]]
+    else:
+        node[keys[-1]] = value
+    return data
+
+
+_DEL = object()
+
+
+@pytest.mark.parametrize("text, path, value, fragments", [
+    (DAMPER, "model.elements.0.drive_angles_deg", [4.0, 3.0],
+     ["`model.elements[0].drive_angles_deg`", "must have one entry fewer"]),
+    (DAMPER, "model.elements.0.drive_stiffness_per_deg", [1.5, 30.0, 60.0],
+     ["`model.elements[0].drive_angles_deg`", "must have one entry fewer"]),
+    (DAMPER, "model.elements.0.drive_stiffness_per_deg", [1.5, -30.0],
+     ["`model.elements[0].drive_stiffness_per_deg[1]`", "must be > 0"]),
+    (DAMPER, "model.elements.0.coast_stiffness", [0.0, 1000.0],
+     ["`model.elements[0].coast_stiffness[0]`", "must be > 0"]),
+    (DAMPER, "model.elements.0.free_play_deg", 7.0,
+     ["`model.elements[0].coast_angles_deg[0]`", "free_play/2"]),
+    (DAMPER, "model.elements.0.stiffness", 100.0, ["`model.elements[0].stiffness` is not a known key"]),
+    (DAMPER, "model.elements.0.coast_stiffness", _DEL, ["`model.elements[0].coast_stiffness` is missing"]),
+    (DAMPER, "model.elements.0.drive_angles", [0.1],
+     ["`model.elements[0].drive_angles` and `model.elements[0].drive_angles_deg` are both given"]),
+    (DAMPER, "model.elements.1.backlash_deg", -1.0, ["`model.elements[1].backlash_deg`", "must be > 0"]),
+    (DAMPER, "model.elements.1.stiffness", 0.0, ["`model.elements[1].stiffness` must be > 0"]),
+    (GEARS, "model.gear_pair.base_radii", [0.03, -0.04], ["`model.gear_pair.base_radii[1]` must be > 0"]),
+    (GEARS, "model.gear_pair.base_radii", [0.03], ["`model.gear_pair.base_radii` must be a pair"]),
+    (GEARS, "model.gear_pair.inertias", [0.0, 6e-3], ["`model.gear_pair.inertias[0]` must be > 0"]),
+    (GEARS, "model.gear_pair.mesh_stiffness", -2e8, ["`model.gear_pair.mesh_stiffness` must be > 0"]),
+    (GEARS, "model.gear_pair.mesh_damping_ratio", 0.0, ["`model.gear_pair.mesh_damping_ratio` must be > 0"]),
+    (GEARS, "model.gear_pair.backlash_um", 0.0, ["`model.gear_pair.backlash_um` must be > 0"]),
+    (GEARS, "model.gear_pair.backlash", 6e-5, ["`model.gear_pair.backlash` and `model.gear_pair.backlash_um`"]),
+    (GEARS, "model.gear_pair.mesh_stifness", 1.0, ["`model.gear_pair.mesh_stifness` is not a known key",
+                                                   "did you mean `mesh_stiffness`"]),
+    (GEARS, "model.units", _DEL, ["needs `model.units` = \"SI\""]),
+    (GEARS, "model.inertias", [1.0, 1.0], ["`model.inertias` cannot be given with [model.gear_pair]"]),
+    (LOOSE, "model.loose_gear.inertia", -2e-4, ["`model.loose_gear.inertia` must be > 0"]),
+    (LOOSE, "model.loose_gear.drag_torque", -0.05, ["`model.loose_gear.drag_torque` must be >= 0"]),
+    (LOOSE, "model.loose_gear.drive_acceleration", [400.0], ["`model.loose_gear.drive_acceleration` must have one"]),
+    (LOOSE, "drag", {"inertia": 1, "speed_rpm": [600.0], "torque": [0.1]}, ["`drag` cannot be given"]),
+])
+def test_bad_physical_input_is_refused_naming_the_key(text, path, value, fragments):
+    with pytest.raises(ConfigError) as info:
+        config_from_dict(_set(_data(text), path, value), source_name="case.toml")
+    message = str(info.value)
+    assert message.startswith("case.toml: ")
+    for fragment in fragments:
+        assert fragment in message, (fragment, message)
+
+
+def test_damper_in_the_single_equation_is_pointed_at_a_chain():
+    data = {"model": {"inertia": 1.0, "damping": 0.05, "stiffness": 1.0,
+                      "elastic": {"type": "damper", "drive_stiffness": [1.0]}},
+            "excitation": {"mean": 0.0, "amplitudes": [0.1]}}
+    with pytest.raises(ConfigError, match=r"`model.elastic.type` = \"damper\" is a sub-system of a chain"):
+        config_from_dict(data)
+
+
+def test_refusal_exits_2_on_the_command_line(tmp_path):
+    path = tmp_path / "gears.toml"
+    path.write_text(GEARS.replace("inertias = [5.0e-3, 6.0e-3]", "inertias = [-5.0e-3, 6.0e-3]"), encoding="utf-8")
+    try:
+        runner = CliRunner(mix_stderr=False)  # type: ignore[call-arg]
+    except TypeError:
+        runner = CliRunner()
+    result = runner.invoke(cli, ["frf", str(path), "-o", str(tmp_path / "out")], catch_exceptions=False)
+    assert result.exit_code == 2
+    assert "`model.gear_pair.inertias[0]` must be > 0" in result.stderr
+    assert not (tmp_path / "out" / "frf.csv").exists()
+
+
+def test_load_config_reads_the_shapes_from_a_file(tmp_path):
+    path = tmp_path / "damper.toml"
+    path.write_text(DAMPER, encoding="utf-8")
+    cfg = load_config(path)
+    assert [e.name for e in cfg.model.elements] == ["damper", "spline"]
+    assert cfg.model.links[1] == Link(between=(3, 0), stiffness=1000.0, damping=0.05)
