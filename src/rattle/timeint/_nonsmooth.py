@@ -1,0 +1,595 @@
+"""Event-driven exact integration of one coordinate with a discontinuous law (preload, friction).
+
+The equation (c = C/I, k = K/I, g relative to K; :mod:`rattle.model._discontinuous`)
+
+    δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) = F_m + Σ_n F_pn cos(n Ω t + φ_n),
+
+f(δ) = s_j δ + e_j on stage j (jumps J_i ≥ 0 at the breakpoints d_i allowed), r(δ) = r_j ≥ 0.
+State x = (δ, δ'), vector field φ(t, x) = (δ', a), a = F − c δ' − k (f + r σ), σ = sgn δ'.
+
+Modes, each linear with constant coefficients, hence solved in closed form by the stage
+solutions of :mod:`._stage_solutions` (the law's stage j with the constant offset e_j + σ r_j):
+
+- *slip* on stage j with σ ∈ {−1, +1} (σ = 0 when r_j = 0): δ'' + c δ' + k s_j δ = F − k (e_j + σ r_j);
+- *stick* at δ_s inside stage j (r_j > 0): δ ≡ δ_s, δ' ≡ 0, the Filippov solution while the
+  force friction must hold stays in its band, |F(t) − k f(δ_s)| ≤ k r_j;
+- *lock* at a breakpoint d_i: δ ≡ d_i, δ' ≡ 0 while k (f(d_i⁻) − r_i) ≤ F(t) ≤ k (f(d_i⁺) + r_{i+1})
+  (Filippov: 0 lies in the convex hull of the four one-sided fields at (d_i, 0)).
+
+Events (located to round-off by Newton's method safeguarded by bisection, on a bracketing grid;
+the δ-crossings by the crossing search of :class:`~rattle.timeint.ExactIntegrator`):
+
+- δ reaches a breakpoint in slip: the next stage; a jump (or a change of friction level) makes the
+  field discontinuous, the crossing is transversal (the surface δ = d_i has normal n = (1, 0),
+  nᵀφ = δ' the same on both sides) and its saltation matrix is
+  S = I + (φ⁺ − φ⁻) nᵀ / (nᵀ φ⁻) = [[1, 0], [(a⁺ − a⁻)/δ', 1]];
+- δ' reaches 0 in slip with friction: with R = F − k f(δ) (the force friction must balance),
+  stick if |R| ≤ k r_j, with saltation [[1, 0], [0, 0]] (entry into the sliding surface δ' = 0,
+  whose own flow is [[1, 0], [0, 0]]: δ-perturbations stay, δ'-perturbations are removed); else
+  reversal σ → sgn R, transversal through δ' = 0 (n = (0, 1)), S = [[1, 0], [0, a⁺/a⁻]];
+- stick ends when R(t) leaves ±k r_j (a time-dependent surface): the slip field there equals the
+  stick field (a⁺ = 0 at the band's edge), so S = I; the slip starts with σ = sgn R;
+- lock: a jump J_i > 0 with F inside the lock band is approached by a chattering spiral around
+  (d_i, 0) (in the relay limit δ'' ≈ −(kJ/2) sgn(δ − d_i) + …, the velocity at the n-th crossing
+  drops by O(c δ'²/a) only, with friction by a fixed fraction: Zeno). The integrator follows every
+  crossing exactly and snaps into the lock when a crossing's |δ'| ≤ ``lock_velocity`` (the neglected
+  motion stays within |δ'| ≤ that and |δ − d_i| ≤ δ'²/(2|a|)); in the lock all perturbations die
+  (the sensitivity is 0, a super-stable phase) and it ends like a stick (S = I).
+
+Between events the sensitivity is the stage transition matrix exp(A τ), A = [[0, 1], [−k s_j, −c]],
+so ∂x(t1)/∂x(t0) = Π (exp(A τ) and S) is exact, and so are the Floquet multipliers of
+:func:`shoot_nonsmooth_orbit`. Grazing (a tangential touch of a switching surface) is not
+resolved: the map is not differentiable there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray, IntArray
+from .._validate import check_omega, check_state
+from ..errors import ConvergenceError
+from ..model._discontinuous import NonsmoothSystem
+from ..model._elastic import Stages
+from ._integrator import ExactIntegrator, _Segment
+from ._roots import bracketed_newton
+from ._shooting import _newton_shooting
+from ._stage_solutions import StageSolutions
+
+_EPS = float(np.finfo(float).eps)
+_CHUNK = 64
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(16)
+
+SLIP, STICK, LOCK = 0, 1, 2
+_KIND_NAMES = ("slip", "stick", "lock")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NonsmoothOptions:
+    """``samples_per_scale`` grid points per fastest time scale to bracket events (≥ 8);
+    ``max_events`` the budget of one integration (exceeded: ``ConvergenceError``);
+    ``lock_velocity`` the |δ'| (relative to the velocity scale L·ν of the system, L its length
+    scale, ν the larger of Ω and the stiffest stage's natural frequency) below which a crossing of a
+    jump whose lock band holds F snaps into the lock (0: never; the chatter is then followed to
+    ``max_events``)."""
+
+    samples_per_scale: int = 40
+    max_events: int = 200_000
+    lock_velocity: float = 1e-9
+
+    def __post_init__(self) -> None:
+        for name, value, low in (("samples_per_scale", self.samples_per_scale, 8), ("max_events", self.max_events, 1)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+                raise TypeError(f"`{name}` must be an integer, got {value!r}")
+            if value < low:
+                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
+        lv = self.lock_velocity
+        if isinstance(lv, bool) or not isinstance(lv, (int, float)) or not (math.isfinite(lv) and 0.0 <= lv < 1.0):
+            raise ValueError(f"`lock_velocity` must be a number in [0, 1) (relative to the velocity scale), got {lv!r}")
+
+
+class _Search(ExactIntegrator):
+    """The δ-crossing search of :class:`ExactIntegrator` (``_first_exit``), on the mode table."""
+
+    def __init__(self, samples_per_scale: int) -> None:  # no model: only the search is used
+        self.samples_per_scale = samples_per_scale
+
+
+def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: int) -> StageSolutions:
+    """Stage solutions of every mode m = 3 j + σ + 1 (stage j, σ ∈ {−1, 0, 1}): slope s_j and
+    offset e_j + σ r_j; the mode's δ-range is its stage's (``lower``/``upper``)."""
+    st = system.law.stages
+    r = system.law.friction_levels
+    n = len(st.slopes)
+    slopes = np.repeat(st.slopes, 3)
+    offsets = (st.offsets[:, None] + np.array([-1.0, 0.0, 1.0])[None, :] * r[:, None]).ravel()
+    table = SimpleNamespace(
+        elastic=SimpleNamespace(stages=Stages(np.arange(3 * n - 1, dtype=float), slopes, offsets)),
+        excitation=system.excitation, c=system.c, k=system.k)
+    sol = StageSolutions(table, omega, samples_per_scale)  # type: ignore[arg-type]
+    edges = np.concatenate(([-np.inf], st.breakpoints, [np.inf]))
+    sol.lower = np.repeat(edges[:-1], 3)
+    sol.upper = np.repeat(edges[1:], 3)
+    return sol
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
+class NonsmoothTrajectory:
+    """An exact trajectory from ``t0`` to ``t1``: segments i from ``t_start[i]`` to ``t_end[i]``
+    of ``kind[i]`` (0 slip, 1 stick, 2 lock) on ``stage[i]`` with friction sign ``sign[i]``
+    (slip only), start state ``x_start[i]`` and homogeneous part ``homogeneous[i]`` (slip);
+    ``state0``/``state1`` (2,), ``sensitivity`` ∂x(t1)/∂x(t0) (2×2, with the saltation matrices);
+    the switching events ``event_time`` with ``event_kind`` (``crossing``, ``reversal``,
+    ``stick``, ``unstick``, ``lock``, ``unlock``)."""
+
+    system: NonsmoothSystem
+    omega: float
+    t0: float
+    t1: float
+    state0: FloatArray
+    state1: FloatArray
+    sensitivity: FloatArray
+    t_start: FloatArray
+    t_end: FloatArray
+    kind: IntArray
+    stage: IntArray
+    sign: IntArray
+    x_start: FloatArray
+    homogeneous: FloatArray
+    event_time: FloatArray
+    event_kind: tuple[str, ...]
+    solutions: StageSolutions = field(repr=False)
+
+    def _segment_of(self, t: FloatArray) -> IntArray:
+        return np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+
+    def sample(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """δ, δ' and δ'' at times ``t`` in [t0, t1] (arrays of t's shape); δ'' on a stick or lock
+        is 0, at a switching time the value of the segment starting there."""
+        t = np.asarray(t, dtype=float)
+        flat = t.ravel()
+        idx = self._segment_of(flat)
+        d, v, a = np.empty_like(flat), np.zeros_like(flat), np.zeros_like(flat)
+        sol = self.solutions
+        for i in np.unique(idx):
+            sel = idx == i
+            if self.kind[i] == SLIP:
+                m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
+                h0, h1 = self.homogeneous[i]
+                dd, vv, aa = sol.evaluate(m, flat[sel], float(self.t_start[i]), h0, h1, order=2)
+                d[sel], v[sel], a[sel] = dd, vv, aa
+            else:
+                d[sel] = self.x_start[i, 0]
+        return d.reshape(t.shape), v.reshape(t.shape), a.reshape(t.shape)
+
+    def integrate(self, fun, panels_per_scale: int = 4) -> float:  # type: ignore[no-untyped-def]
+        """∫_{t0}^{t1} fun(t, δ, δ', δ'') dt by Gauss–Legendre panels inside every segment (the
+        integrand is smooth there; ``panels_per_scale`` panels per time scale of the mode)."""
+        total = 0.0
+        sol = self.solutions
+        for i in range(len(self.t_start)):
+            ta, tb = float(self.t_start[i]), float(self.t_end[i])
+            if tb <= ta:
+                continue
+            if self.kind[i] == SLIP:
+                m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
+                scale = float(sol.time_scale[m])
+                n = 1 if not math.isfinite(scale) else max(1, math.ceil((tb - ta) * panels_per_scale / scale))
+            else:
+                n = max(1, math.ceil((tb - ta) * panels_per_scale * max(sol.nw.max(initial=0.0), 1e-300) / 6.0))
+                n = min(n, 10_000)
+            edges = np.linspace(ta, tb, n + 1)
+            half = 0.5 * np.diff(edges)
+            tq = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]
+            d, v, a = self.sample(np.clip(tq, ta, tb))
+            if self.kind[i] != SLIP:
+                d = np.full_like(tq, self.x_start[i, 0])
+                v = np.zeros_like(tq)
+                a = np.zeros_like(tq)
+            total += float(np.sum(half[:, None] * _GAUSS_W[None, :] * fun(tq, d, v, a)))
+        return total
+
+    def friction_dissipation(self) -> float:
+        """k ∫ r(δ) |δ'| dt over [t0, t1] (exact: on a slip segment sgn δ' is constant, so
+        ∫ |δ'| dt = |δ(end) − δ(start)|)."""
+        r = self.system.law.friction_levels
+        ends = np.append(self.x_start[1:, 0], self.state1[0])
+        slip = self.kind == SLIP
+        return float(self.system.k * np.sum(r[self.stage[slip]] * np.abs(ends[slip] - self.x_start[slip, 0])))
+
+    def energy(self, state: FloatArray) -> float:
+        """E = δ'²/2 + k V(δ), V = ∫_0^δ f (per unit inertia)."""
+        return float(0.5 * state[1] ** 2 + self.system.k * float(self.system.law.potential(np.array([state[0]]))[0]))
+
+    @property
+    def stick_time(self) -> float:
+        """Total time spent sticking or locked."""
+        held = self.kind != SLIP
+        return float(np.sum(self.t_end[held] - self.t_start[held]))
+
+    def mean_and_rms(self) -> tuple[float, float]:
+        """(1/T)∫δ dt and sqrt((1/T)∫δ² dt) over [t0, t1]."""
+        T = self.t1 - self.t0
+        m = self.integrate(lambda t, d, v, a: d) / T
+        return m, math.sqrt(max(self.integrate(lambda t, d, v, a: d * d) / T, 0.0))
+
+
+class NonsmoothIntegrator:
+    """Event-driven exact integrator of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (module
+    docstring) for a :class:`~rattle.model._discontinuous.NonsmoothSystem`."""
+
+    def __init__(self, system: NonsmoothSystem, options: NonsmoothOptions | None = None) -> None:
+        if not isinstance(system, NonsmoothSystem):
+            raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
+        options = NonsmoothOptions() if options is None else options
+        if not isinstance(options, NonsmoothOptions):
+            raise TypeError(f"`options` must be NonsmoothOptions, got {options!r}")
+        self.system = system
+        self.options = options
+        self._search = _Search(options.samples_per_scale)
+        self._cache: tuple[float, StageSolutions] | None = None
+        st = system.law.stages
+        self._d = st.breakpoints.tolist()
+        self._s = st.slopes.tolist()
+        self._e = st.offsets.tolist()
+        self._J = st.jumps.tolist()
+        self._r = system.law.friction_levels.tolist()
+
+    def solutions(self, omega: float) -> StageSolutions:
+        """The closed-form solutions of every mode at ``omega`` (the last one cached)."""
+        if self._cache is not None and self._cache[0] == omega:
+            return self._cache[1]
+        sol = _mode_solutions(self.system, omega, self.options.samples_per_scale)
+        self._cache = (float(omega), sol)
+        return sol
+
+    def velocity_scale(self, omega: float) -> float:
+        """L ν: the length scale times the larger of Ω and the stiffest stage's natural frequency."""
+        sys = self.system
+        return sys.length_scale() * max(omega, math.sqrt(sys.k * max(self._s)))
+
+    # --- helpers -----------------------------------------------------------------------------
+    def _f(self, j: int, d: float) -> float:
+        return self._s[j] * d + self._e[j]
+
+    def _band(self, i: int) -> tuple[float, float]:
+        """The lock band [L, U] of F at breakpoint i."""
+        k, d = self.system.k, self._d[i]
+        return k * (self._f(i, d) - self._r[i]), k * (self._f(i + 1, d) + self._r[i + 1])
+
+    def _stage_of(self, d: float) -> int:
+        return int(np.searchsorted(self._d, d, side="right"))
+
+    def _classify(self, sol: StageSolutions, t: float, d: float, v: float) -> tuple[int, int, int]:
+        """(kind, stage or breakpoint, σ) of the state (δ, δ') at t."""
+        F = float(sol.forcing(np.asarray(t)))
+        k = self.system.k
+        if v == 0.0:
+            if d in self._d:
+                i = self._d.index(d)
+                lo, hi = self._band(i)
+                if lo <= F <= hi:
+                    return LOCK, i, 0
+                j = i + 1 if F > hi else i
+                return SLIP, j, (0 if self._r[j] == 0.0 else (1 if F > hi else -1))
+            j = self._stage_of(d)
+            R = F - k * self._f(j, d)
+            if self._r[j] > 0.0:
+                if abs(R) <= k * self._r[j]:
+                    return STICK, j, 0
+                return SLIP, j, (1 if R > 0 else -1)
+            return SLIP, j, 0
+        j = self._stage_of(d)
+        if j > 0 and d == self._d[j - 1] and v < 0.0:
+            j -= 1
+        return SLIP, j, (0 if self._r[j] == 0.0 else (1 if v > 0 else -1))
+
+    # --- public ------------------------------------------------------------------------------
+    def propagate(self, x0: FloatArray | tuple[float, float], t0: float, t1: float, omega: float) -> NonsmoothTrajectory:
+        """Integrate exactly from ``x0`` = (δ, δ') at ``t0`` to ``t1`` ≥ t0 at forcing frequency
+        ``omega``: the :class:`NonsmoothTrajectory` with its sensitivity ∂x(t1)/∂x(t0)."""
+        x0 = check_state(x0)
+        omega = check_omega(omega)
+        t0, t1 = float(t0), float(t1)
+        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
+            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        sol = self.solutions(omega)
+        rec: dict[str, list] = {k: [] for k in ("t", "kind", "stage", "sign", "x", "h", "et", "ek")}
+        d, v, M = self._march(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
+        t_start = np.asarray(rec["t"], dtype=float)
+        return NonsmoothTrajectory(
+            system=self.system, omega=omega, t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
+            sensitivity=np.array([[M[0], M[1]], [M[2], M[3]]]), t_start=t_start, t_end=np.append(t_start[1:], t1),
+            kind=np.asarray(rec["kind"], dtype=np.int64), stage=np.asarray(rec["stage"], dtype=np.int64),
+            sign=np.asarray(rec["sign"], dtype=np.int64), x_start=np.asarray(rec["x"], dtype=float).reshape(-1, 2),
+            homogeneous=np.asarray(rec["h"], dtype=float).reshape(-1, 2),
+            event_time=np.asarray(rec["et"], dtype=float), event_kind=tuple(rec["ek"]), solutions=sol)
+
+    # --- the march ---------------------------------------------------------------------------
+    def _march(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
+               rec: dict[str, list]) -> tuple[float, float, tuple[float, float, float, float]]:
+        k, c = self.system.k, self.system.c
+        kind, j, sigma = self._classify(sol, t0, d, v)
+        if kind != SLIP:
+            v = 0.0
+        t = t0
+        m11, m12, m21, m22 = 1.0, 0.0, 0.0, 1.0
+        v_lock = self.options.lock_velocity * self.velocity_scale(omega)
+        n_events = 0
+        while True:
+            if kind == SLIP:
+                mode = 3 * j + sigma + 1
+                seg = _Segment(sol, mode, t, d, v)
+                self._record(rec, t, SLIP, j, sigma, d, v, (seg.h0, seg.h1))
+                tau_end = t1 - t
+                tau_v = self._first_stop(sol, seg, sigma, tau_end) if sigma != 0 else None
+                tau_c, j_new, d_c, v_c = self._search._first_exit(seg, tau_end if tau_v is None else tau_v)
+                tau = tau_c if j_new >= 0 else (tau_end if tau_v is None else tau_v)
+                f11, f12, f21, f22 = sol.transition_scalar(mode, tau)
+                m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
+                                      f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
+                if j_new < 0 and tau_v is None:
+                    d_e, v_e, _ = seg.state(tau)
+                    return d_e, v_e, (m11, m12, m21, m22)
+                t = t + tau
+                F = float(sol.forcing(np.asarray(t)))
+                if j_new >= 0:  # δ reaches breakpoint i
+                    up = j_new > mode
+                    i = j if up else j - 1
+                    jn = j + 1 if up else j - 1
+                    d = self._d[i]
+                    v = v_c
+                    sn = 0 if self._r[jn] == 0.0 else (1 if up else -1)
+                    lo, hi = self._band(i)
+                    if lo < F < hi and abs(v) <= v_lock and (self._J[i] > 0.0 or self._r[i] + self._r[jn] > 0.0):
+                        kind, j, v = LOCK, i, 0.0
+                        m11, m12, m21, m22 = (0.0, 0.0, 0.0, 0.0) if self._J[i] > 0.0 else (m11, m12, 0.0, 0.0)
+                        self._event(rec, t, "lock")
+                    else:
+                        a_m = F - c * v - k * (self._f(j, d) + self._r[j] * sigma)
+                        a_p = F - c * v - k * (self._f(jn, d) + self._r[jn] * sn)
+                        q = (a_p - a_m) / v if v != 0.0 else 0.0
+                        m21, m22 = m21 + q * m11, m22 + q * m12
+                        j, sigma = jn, sn
+                        self._event(rec, t, "crossing")
+                else:  # δ' = 0 inside stage j with friction
+                    d, _, _ = seg.state(tau)
+                    v = 0.0
+                    R = F - k * self._f(j, d)
+                    if abs(R) <= k * self._r[j]:
+                        kind = STICK
+                        m21, m22 = 0.0, 0.0
+                        self._event(rec, t, "stick")
+                    else:
+                        sn = 1 if R > 0.0 else -1
+                        a_m, a_p = R - k * self._r[j] * sigma, R - k * self._r[j] * sn
+                        if a_m != 0.0:
+                            m21, m22 = m21 * (a_p / a_m), m22 * (a_p / a_m)
+                        sigma = sn
+                        self._event(rec, t, "reversal")
+            else:
+                self._record(rec, t, kind, j, 0, d, 0.0, (0.0, 0.0))
+                if kind == STICK:
+                    fd = k * self._f(j, d)
+                    lo, hi = fd - k * self._r[j], fd + k * self._r[j]
+                else:
+                    lo, hi = self._band(j)
+                t_exit, up = self._band_exit(sol, t, t1, lo, hi)
+                if t_exit is None:
+                    return d, 0.0, (m11, m12, m21, m22)
+                t = t_exit
+                if kind == STICK:
+                    sigma = 1 if up else -1
+                    self._event(rec, t, "unstick")
+                else:
+                    j = j + 1 if up else j
+                    sigma = 0 if self._r[j] == 0.0 else (1 if up else -1)
+                    self._event(rec, t, "unlock")
+                kind, v = SLIP, 0.0
+            n_events += 1
+            if n_events > self.options.max_events:
+                raise ConvergenceError(
+                    f"more than `max_events` = {self.options.max_events} switching events between t0 = {t0!r} "
+                    f"and t1 = {t1!r} (a chattering approach to a lock?): raise `max_events` or `lock_velocity`, "
+                    "or shorten the interval")
+
+    @staticmethod
+    def _record(rec: dict[str, list], t: float, kind: int, j: int, sigma: int, d: float, v: float,
+                h: tuple[float, float]) -> None:
+        if rec["t"] and rec["t"][-1] == t:  # a zero-length segment (two events at one time)
+            for key in ("t", "kind", "stage", "sign", "x", "h"):
+                rec[key].pop()
+        rec["t"].append(t)
+        rec["kind"].append(kind)
+        rec["stage"].append(j)
+        rec["sign"].append(sigma)
+        rec["x"].append((d, v))
+        rec["h"].append(h)
+
+    @staticmethod
+    def _event(rec: dict[str, list], t: float, name: str) -> None:
+        rec["et"].append(t)
+        rec["ek"].append(name)
+
+    # --- event searches ----------------------------------------------------------------------
+    def _first_stop(self, sol: StageSolutions, seg: _Segment, sigma: int, tau_end: float) -> float | None:
+        """First local time in (0, tau_end] where σ δ' reaches 0 (None: it does not)."""
+        m = seg.j
+        step = float(sol.grid_step[m])
+        if not math.isfinite(step):
+            step = max(tau_end, 1e-300) / self.options.samples_per_scale
+        c, ks, ke = sol.c, float(sol.ks[m]), float(sol.ke[m])
+
+        def vel(tau: float) -> tuple[float, float]:
+            _, vv, aa = seg.state(tau)
+            return vv, aa
+
+        tol_t = 4.0 * _EPS * max(tau_end, step) + 1e-300
+        tau_a = 0.0
+        first = True
+        while tau_a < tau_end:
+            n = max(1, min(_CHUNK, math.ceil((tau_end - tau_a) / step)))
+            taus = tau_a + step * np.arange(n + 1)
+            if taus[-1] >= tau_end or n < _CHUNK:
+                taus[-1] = tau_end
+            d, v = seg.scan(taus)
+            sv = sigma * v
+            if first and sv[1] <= 0.0 and abs(v[0]) <= seg.v_floor:
+                # starting from rest and stopping again within the first cell: find a point moving
+                fine = np.linspace(0.0, taus[1], 65)[1:]
+                _, vf = seg.scan(fine)
+                moving = np.flatnonzero(sigma * vf > seg.v_floor)
+                if moving.size == 0:
+                    return float(fine[0])  # below resolution: stops at once
+                i0 = int(moving[0])
+                back = np.flatnonzero(sigma * vf[i0:] <= 0.0)
+                if back.size:
+                    ib = i0 + int(back[0])
+                    return bracketed_newton(vel, float(fine[ib - 1]), float(fine[ib]), float(vf[ib - 1]),
+                                            float(vf[ib]), tol_t, seg.v_floor)
+            start = 1
+            hits = np.flatnonzero(sv[start:] <= 0.0)
+            i_hit = start + int(hits[0]) if hits.size else None
+            # a tangential return of σδ' towards 0 inside a cell: σδ'' from − to + (a minimum)
+            acc = sol.forcing(seg.ts + taus) - c * v - ks * d - ke
+            sa = sigma * acc
+            mins = np.flatnonzero((sa[:-1] < 0.0) & (sa[1:] >= 0.0) & (sv[:-1] > 0.0) & (sv[1:] > 0.0))
+            for i in mins.tolist():
+                if i_hit is not None and i >= i_hit - 1:
+                    break
+
+                def accel(tau: float) -> tuple[float, float]:
+                    dd, vv, aa = seg.state(tau)
+                    jerk = float(sol.forcing(np.asarray(seg.ts + tau), 1)) - c * aa - ks * vv
+                    return aa, jerk
+
+                tau_m = bracketed_newton(accel, float(taus[i]), float(taus[i + 1]), float(acc[i]), float(acc[i + 1]),
+                                         tol_t)
+                v_m = seg.state(tau_m)[1]
+                if sigma * v_m <= 0.0:
+                    return bracketed_newton(vel, float(taus[i]), tau_m, float(v[i]), v_m, tol_t, seg.v_floor)
+            if i_hit is not None:
+                a_, b_ = float(taus[i_hit - 1]), float(taus[i_hit])
+                va = float(v[i_hit - 1])
+                if sigma * va <= 0.0:  # the segment start (v = 0 to round-off)
+                    va = sigma * 1e-300
+                return bracketed_newton(vel, a_, b_, va, float(v[i_hit]), tol_t, seg.v_floor)
+            tau_a = float(taus[-1])
+            first = False
+        return None
+
+    def _band_exit(self, sol: StageSolutions, t0: float, t1: float, lo: float, hi: float) -> tuple[float | None, bool]:
+        """First time in (t0, t1] where F(t) leaves [lo, hi]: (time, True if above); (None, _)
+        when it stays. Extrema of F inside a grid cell are refined (a brief excursion is found)."""
+        if sol.nw.size == 0:
+            F = sol.mean
+            return (None, False) if lo <= F <= hi else (t0, F > hi)
+        step = 2.0 * math.pi / float(np.max(sol.nw)) / self.options.samples_per_scale
+        tol = 4.0 * _EPS * max(abs(t1), 1.0)
+
+        def g_up(t: float) -> tuple[float, float]:
+            return float(sol.forcing(np.asarray(t))) - hi, float(sol.forcing(np.asarray(t), 1))
+
+        def g_dn(t: float) -> tuple[float, float]:
+            return lo - float(sol.forcing(np.asarray(t))), -float(sol.forcing(np.asarray(t), 1))
+
+        def dF(t: float) -> tuple[float, float]:
+            return float(sol.forcing(np.asarray(t), 1)), float(sol.forcing(np.asarray(t), 2))
+
+        ta = t0
+        while ta < t1:
+            n = max(1, min(_CHUNK, math.ceil((t1 - ta) / step)))
+            ts = ta + step * np.arange(n + 1)
+            if ts[-1] >= t1 or n < _CHUNK:
+                ts[-1] = t1
+            F = sol.forcing(ts)
+            F1 = sol.forcing(ts, 1)
+            for i in range(n):
+                cand: list[tuple[float, float, bool]] = []  # (bracket start, end, up)
+                a_, b_ = float(ts[i]), float(ts[i + 1])
+                if F[i + 1] > hi:
+                    cand.append((a_, b_, True))
+                elif F[i + 1] < lo:
+                    cand.append((a_, b_, False))
+                elif (F1[i] > 0.0) != (F1[i + 1] > 0.0) and F1[i] != 0.0:
+                    te = bracketed_newton(dF, a_, b_, float(F1[i]), float(F1[i + 1]), tol)
+                    Fe = float(sol.forcing(np.asarray(te)))
+                    if Fe > hi:
+                        cand.append((a_, te, True))
+                    elif Fe < lo:
+                        cand.append((a_, te, False))
+                if cand:
+                    a_, b_, up = cand[0]
+                    g = g_up if up else g_dn
+                    ga, gb = g(a_)[0], g(b_)[0]
+                    if ga >= 0.0:  # inside the band by construction at the bracket's start
+                        ga = -1e-300
+                    return bracketed_newton(g, a_, b_, ga, gb, tol), up
+            ta = float(ts[-1])
+        return None, False
+
+
+# ---------------------------------------------------------------------------------------------
+# Periodic orbits
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class NonsmoothOrbit:
+    """A periodic orbit of the discontinuous equation found by Newton shooting on the exact period
+    map: ``state0`` (δ, δ') at t = 0, ``omega``, ``period`` p (T = p 2π/Ω), ``monodromy`` M (with
+    the saltation matrices), ``multipliers`` (eigenvalues of M, largest modulus first),
+    ``converged``, ``iterations``, ``residual`` (scaled ‖φ(x0) − x0‖∞), ``trajectory`` over one
+    period, ``mean`` and ``rms`` of δ."""
+
+    state0: FloatArray
+    omega: float
+    period: int
+    monodromy: FloatArray
+    multipliers: ComplexArray
+    converged: bool
+    iterations: int
+    residual: float
+    trajectory: NonsmoothTrajectory
+    mean: float
+    rms: float
+
+    @property
+    def stable(self) -> bool:
+        """True when every Floquet multiplier lies inside the unit circle."""
+        return bool(np.all(np.abs(self.multipliers) < 1.0))
+
+
+def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray | tuple[float, float], *,
+                          period: int = 1, tol: float = 1e-12, max_iterations: int = 50,
+                          integrator: NonsmoothIntegrator | None = None) -> NonsmoothOrbit:
+    """Periodic orbit of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) by Newton shooting: r(x0) =
+    φ(x0; 0 → T) − x0 = 0 with the Jacobian M − I, M the exact monodromy (stage transition and
+    saltation matrices). The residual is scaled by (L, L ν) (:meth:`NonsmoothIntegrator.velocity_scale`).
+    A failed solve is returned with ``converged`` False."""
+    if not isinstance(system, NonsmoothSystem):
+        raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
+    omega = check_omega(omega)
+    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
+        raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
+    if not (isinstance(tol, (int, float)) and tol > 0.0):
+        raise ValueError(f"`tol` must be a positive number, got {tol!r}")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 0:
+        raise ValueError(f"`max_iterations` must be an integer >= 0, got {max_iterations!r}")
+    integ = NonsmoothIntegrator(system) if integrator is None else integrator
+    if integ.system != system:
+        raise ValueError("`integrator` was built for a different system than `system`")
+    L = system.length_scale()
+    scale = np.array([L, integ.velocity_scale(omega)])
+    shot = _newton_shooting(integ, omega, check_state(x0), int(period), float(tol), int(max_iterations), scale)  # type: ignore[arg-type]
+    traj: NonsmoothTrajectory = shot.trajectory  # type: ignore[assignment]
+    mean, rms = traj.mean_and_rms()
+    return NonsmoothOrbit(state0=shot.x, omega=omega, period=int(period), monodromy=traj.sensitivity,
+                          multipliers=shot.multipliers(), converged=shot.residual <= tol, iterations=shot.iterations,
+                          residual=shot.residual, trajectory=traj, mean=mean, rms=rms)
+
+
+__all__ = ["NonsmoothOptions", "NonsmoothIntegrator", "NonsmoothTrajectory", "NonsmoothOrbit",
+           "shoot_nonsmooth_orbit"]
