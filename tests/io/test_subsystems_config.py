@@ -194,6 +194,7 @@ _DEL = object()
     (DAMPER, "model.elements.0.coast_stiffness", _DEL, ["`model.elements[0].coast_stiffness` is missing"]),
     (DAMPER, "model.elements.0.drive_angles", [0.1],
      ["`model.elements[0].drive_angles` and `model.elements[0].drive_angles_deg` are both given"]),
+    (DAMPER, "model.elements.0.type", "dampr", ["`model.elements[0].type` must be one of", 'did you mean "damper"']),
     (DAMPER, "model.elements.1.backlash_deg", -1.0, ["`model.elements[1].backlash_deg`", "must be > 0"]),
     (DAMPER, "model.elements.1.stiffness", 0.0, ["`model.elements[1].stiffness` must be > 0"]),
     (GEARS, "model.gear_pair.base_radii", [0.03, -0.04], ["`model.gear_pair.base_radii[1]` must be > 0"]),

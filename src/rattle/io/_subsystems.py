@@ -38,6 +38,7 @@ import warnings
 from collections.abc import Mapping
 from typing import Any
 
+from ..model import ELASTIC_LAWS
 from ..model._builders import clutch_damper, gear_pair, hub_spline, loose_gear
 from ._config import _Checker, _in_radians, _show, rename_keys
 
@@ -282,6 +283,17 @@ def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>") -> M
     if "loose_gear" in model_t:
         return _loose_gear(check, dict(data), model_t)
     elements = model_t.get("elements")
+    for k, t in enumerate(elements if isinstance(elements, list) else []):
+        kind = t.get("type") if isinstance(t, Mapping) else None
+        if isinstance(kind, str) and kind not in ELASTIC_LAWS and kind not in SUBSYSTEM_TYPES:
+            from ._config import _did_you_mean
+
+            types = [*ELASTIC_LAWS, *SUBSYSTEM_TYPES]
+            hint = _did_you_mean(kind, types).replace("`", '"')
+            raise check.error(
+                f"`model.elements[{k}].type` must be one of {', '.join(_show(x) for x in types)}, got {_show(kind)}; "
+                f"{hint}use one of these names (\"damper\" and \"spline\" take a data sheet's values)"
+            )
     if isinstance(elements, list) and any(isinstance(t, Mapping) and t.get("type") in SUBSYSTEM_TYPES
                                           for t in elements):
         new = []
