@@ -249,3 +249,21 @@ def test_load_config_reads_the_shapes_from_a_file(tmp_path):
     cfg = load_config(path)
     assert [e.name for e in cfg.model.elements] == ["damper", "spline"]
     assert cfg.model.links[1] == Link(between=(3, 0), stiffness=1000.0, damping=0.05)
+
+
+def test_gear_pair_engine_and_drag_on_gear2_are_scaled():
+    data = _data(GEARS)
+    del data["excitation"], data["analysis"]
+    data["engine"] = {"inertia": 2, "speed_rpm": [1000.0, 5000.0], "orders": [25.0], "amplitudes": [8.0],
+                      "mean_torque": 4.0}
+    data["excitation"] = {"torques": [{"inertia": 1, "mean": -3.0}]}  # 4 N m on gear 2 = 3 N m on gear 1's side
+    cfg = config_from_dict(data)
+    (engine,) = [t for t in cfg.model.torques if t.inertia == 2]
+    assert engine.mean == pytest.approx(3.0) and engine.amplitudes == pytest.approx((6.0,))
+    data = _data(GEARS)
+    del data["analysis"]
+    data["engine"] = {"inertia": 1, "speed_rpm": [1000.0, 5000.0], "orders": [25.0], "amplitudes": [25.0]}
+    data["excitation"] = {"torques": [{"inertia": 1, "mean": 0.0}]}
+    data["drag"] = {"inertia": 2, "speed_rpm": [1000.0, 5000.0], "torque": [20.0, 40.0]}  # N m of gear 2
+    cfg = config_from_dict(data)
+    assert cfg.model.drag.torque == pytest.approx((15.0, 30.0)) and cfg.model.drag.balance == 1
