@@ -72,7 +72,7 @@ def _stage_side(side: str, stiffness: object, angles: object, half_play: float) 
     return k, a
 
 
-def damper_law(*, drive_stiffness: Sequence[float], drive_angles: Sequence[float], coast_stiffness: Sequence[float],
+def _damper_law(*, drive_stiffness: Sequence[float], drive_angles: Sequence[float], coast_stiffness: Sequence[float],
                coast_angles: Sequence[float], free_play: float = 0.0) -> tuple[float, Piecewise]:
     """The stiffness K_e and the law f of a multi-stage damper (:func:`clutch_damper`)."""
     p = _check_real("free_play", free_play)
@@ -133,7 +133,7 @@ def clutch_damper(*, drive_stiffness: Sequence[float], drive_angles: Sequence[fl
     -------
     Element
     """
-    K, law = damper_law(drive_stiffness=drive_stiffness, drive_angles=drive_angles,
+    K, law = _damper_law(drive_stiffness=drive_stiffness, drive_angles=drive_angles,
                         coast_stiffness=coast_stiffness, coast_angles=coast_angles, free_play=free_play)
     return Element(name=name, between=between, stiffness=K, law=law)
 
