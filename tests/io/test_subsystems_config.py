@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import copy
 import math
-import tomllib
 
 import pytest
+import tomllib
 from click.testing import CliRunner
 
 from rattle.cli.main import cli
@@ -140,7 +140,7 @@ def test_gear_pair_equals_its_builder_with_gear2_torques_scaled():
     assert chain.elements == ref.chain.elements
     assert chain.links[0].damping == pytest.approx(ref.damping, rel=1e-15)
     # torque on gear 2 × r1/r2 = 0.75: −20 N m and 3 N m on gear 1's side (hand calculation)
-    t2 = [t for t in chain.torques if t.inertia == 2][0]
+    t2 = next(t for t in chain.torques if t.inertia == 2)
     assert t2.mean == pytest.approx(-20.0, rel=1e-15) and t2.amplitudes == pytest.approx((3.0,))
     assert chain.elements[0].name == "mesh" and chain.elements[0].law.b == pytest.approx(1e-3)
     assert chain.elements[0].stiffness == pytest.approx(1.8e5)

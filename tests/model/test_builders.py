@@ -3,6 +3,7 @@ computation in the physical coordinates (gear angles, line of action)."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -12,7 +13,16 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 import rattle
-from rattle.model import Backlash, Link, Piecewise, Torque, clutch_damper, gear_pair, hub_spline, loose_gear
+from rattle.model import (
+    Backlash,
+    Link,
+    Piecewise,
+    Torque,
+    clutch_damper,
+    gear_pair,
+    hub_spline,
+    loose_gear,
+)
 from rattle.timeint import SystemIntegrator
 
 
@@ -69,18 +79,18 @@ def test_damper_without_free_play():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    (dict(drive_angles=[0.05]), r"`drive_angles` must have one entry fewer than `drive_stiffness`"),
-    (dict(drive_angles=[0.15, 0.05]), r"`drive_angles` must be strictly increasing"),
-    (dict(drive_stiffness=[10.0, -1.0, 1000.0]), r"`drive_stiffness\[1\]` must be > 0"),
-    (dict(coast_stiffness=[0.0, 200.0]), r"`coast_stiffness\[0\]` must be > 0"),
-    (dict(coast_angles=[-0.03]), r"`coast_angles\[0\]` must be > 0"),
-    (dict(free_play=0.08), r"`coast_angles\[0\]` must be > free_play/2"),
-    (dict(free_play=-0.01), r"`free_play` must be >= 0"),
-    (dict(coast_stiffness=[]), r"`coast_stiffness` must hold at least one"),
+    ({"drive_angles": [0.05]}, r"`drive_angles` must have one entry fewer than `drive_stiffness`"),
+    ({"drive_angles": [0.15, 0.05]}, r"`drive_angles` must be strictly increasing"),
+    ({"drive_stiffness": [10.0, -1.0, 1000.0]}, r"`drive_stiffness\[1\]` must be > 0"),
+    ({"coast_stiffness": [0.0, 200.0]}, r"`coast_stiffness\[0\]` must be > 0"),
+    ({"coast_angles": [-0.03]}, r"`coast_angles\[0\]` must be > 0"),
+    ({"free_play": 0.08}, r"`coast_angles\[0\]` must be > free_play/2"),
+    ({"free_play": -0.01}, r"`free_play` must be >= 0"),
+    ({"coast_stiffness": []}, r"`coast_stiffness` must hold at least one"),
 ])
 def test_damper_refusals(kwargs, match):
-    base = dict(drive_stiffness=[10.0, 100.0, 1000.0], drive_angles=[0.05, 0.15], coast_stiffness=[20.0, 200.0],
-                coast_angles=[0.03])
+    base = {"drive_stiffness": [10.0, 100.0, 1000.0], "drive_angles": [0.05, 0.15], "coast_stiffness": [20.0, 200.0],
+                "coast_angles": [0.03]}
     with pytest.raises(ValueError, match=match):
         clutch_damper(**{**base, **kwargs})
 
@@ -250,7 +260,7 @@ def test_loose_gear_equals_imposed_motion():
     z = np.array([delta0, 0.0])
     lost = False
     ts = np.linspace(0.0, t_end, 41)
-    for t0, t in zip(ts[:-1], ts[1:]):
+    for t0, t in itertools.pairwise(ts):
         z, _ = integ.advance(z, t0, t, omega, sensitivity=False)
         a1, _ = th1(t)
         delta = R1 / R2 * a1 - sol.sol(t)[0]
@@ -268,7 +278,7 @@ def test_gear_builders_refuse_bad_input():
         gear_pair(base_radii=[R1, R2], inertias=[0.0, J2], mesh_stiffness=KM, mesh_damping_ratio=ZETA,
                   backlash=BLOS)
     with pytest.raises(ValueError, match="`mesh_stiffness` must be > 0"):
-        _pair_kw = dict(base_radii=[R1, R2], inertias=[J1, J2], mesh_damping_ratio=ZETA, backlash=BLOS)
+        _pair_kw = {"base_radii": [R1, R2], "inertias": [J1, J2], "mesh_damping_ratio": ZETA, "backlash": BLOS}
         gear_pair(mesh_stiffness=0.0, **_pair_kw)
     with pytest.raises(ValueError, match="`links\\[0\\].between` must be"):
         _pair(links=[Link(between=(1, 2), stiffness=1.0)])

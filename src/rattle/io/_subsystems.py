@@ -192,7 +192,7 @@ def _gear_pair(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]
                   backlash=t["backlash"], name=name if isinstance(name, str) else "mesh")
     element = {"name": name, "between": [1, 2], "stiffness": pair.stiffness, "type": "backlash", "b": pair.half_gap}
     out = dict(data)
-    out["model"] = {**({"units": model_t["units"]}), "inertias": list(pair.chain.inertias),
+    out["model"] = {"units": model_t["units"], "inertias": list(pair.chain.inertias),
                     "links": [{"between": [1, 2], "damping": pair.damping}], "elements": [element]}
     # torques on gear 2 are given in N m of gear 2's shaft: on gear 1's side × r1/r2
     r = pair.ratio

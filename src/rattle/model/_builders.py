@@ -32,7 +32,7 @@ import numpy as np
 from ._chain import Chain, Element, Link, Torque
 from ._elastic import Backlash, Piecewise, _check_real, _check_real_sequence
 
-__all__ = ["clutch_damper", "hub_spline", "gear_pair", "loose_gear", "GearPair", "LooseGear"]
+__all__ = ["GearPair", "LooseGear", "clutch_damper", "gear_pair", "hub_spline", "loose_gear"]
 
 
 def _positive(name: str, value: object) -> float:
