@@ -32,8 +32,10 @@ the δ-crossings by the crossing search of :class:`~rattle.timeint.ExactIntegrat
 - lock: a jump J_i > 0 with F inside the lock band is approached by a chattering spiral around
   (d_i, 0) (in the relay limit δ'' ≈ −(kJ/2) sgn(δ − d_i) + …, the velocity at the n-th crossing
   drops by O(c δ'²/a) only, with friction by a fixed fraction: Zeno). The integrator follows every
-  crossing exactly and snaps into the lock when a crossing's |δ'| ≤ ``lock_velocity`` (the neglected
-  motion stays within |δ'| ≤ that and |δ − d_i| ≤ δ'²/(2|a|)); in the lock all perturbations die
+  crossing exactly and snaps into the lock when the next excursion beyond the jump, δ'²/(2|a⁺|)
+  (a⁺ the deceleration on the side entered), is below ``lock_excursion`` · L — by default a few
+  hundred ulps of the length scale L, where the excursions drown in round-off anyway (the neglected
+  motion stays within that excursion and |δ'| ≤ sqrt(2 |a⁺| lock_excursion L)); in the lock all perturbations die
   (the sensitivity is 0, a super-stable phase) and it ends like a stick (S = I).
 
 Between events the sensitivity is the stage transition matrix exp(A τ), A = [[0, 1], [−k s_j, −c]],
@@ -72,14 +74,15 @@ _KIND_NAMES = ("slip", "stick", "lock")
 class NonsmoothOptions:
     """``samples_per_scale`` grid points per fastest time scale to bracket events (≥ 8);
     ``max_events`` the budget of one integration (exceeded: ``ConvergenceError``);
-    ``lock_velocity`` the |δ'| (relative to the velocity scale L·ν of the system, L its length
-    scale, ν the larger of Ω and the stiffest stage's natural frequency) below which a crossing of a
-    jump whose lock band holds F snaps into the lock (0: never; the chatter is then followed to
-    ``max_events``)."""
+    ``lock_excursion`` the excursion beyond a jump (relative to the system's length scale L)
+    below which a crossing of a jump whose lock band holds F snaps into the lock: the chatter
+    around a lock is followed crossing by crossing until its excursions δ'²/(2|a|) reach this
+    (default 1e-13, a few hundred ulps: round-off level); 0 never snaps (the chatter is then
+    followed to ``max_events``)."""
 
     samples_per_scale: int = 40
     max_events: int = 200_000
-    lock_velocity: float = 1e-9
+    lock_excursion: float = 1e-13
 
     def __post_init__(self) -> None:
         for name, value, low in (("samples_per_scale", self.samples_per_scale, 8), ("max_events", self.max_events, 1)):
@@ -87,9 +90,9 @@ class NonsmoothOptions:
                 raise TypeError(f"`{name}` must be an integer, got {value!r}")
             if value < low:
                 raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-        lv = self.lock_velocity
+        lv = self.lock_excursion
         if isinstance(lv, bool) or not isinstance(lv, (int, float)) or not (math.isfinite(lv) and 0.0 <= lv < 1.0):
-            raise ValueError(f"`lock_velocity` must be a number in [0, 1) (relative to the velocity scale), got {lv!r}")
+            raise ValueError(f"`lock_excursion` must be a number in [0, 1) (relative to the length scale), got {lv!r}")
 
 
 class _Search(ExactIntegrator):
@@ -175,21 +178,16 @@ class NonsmoothTrajectory:
             ta, tb = float(self.t_start[i]), float(self.t_end[i])
             if tb <= ta:
                 continue
+            # a stick or lock: δ, δ', δ'' constant, the forcing's period sets the panels of fun(t, …)
+            n = max(1, math.ceil((tb - ta) * panels_per_scale * float(sol.nw.max(initial=0.0)) / (2.0 * math.pi)))
             if self.kind[i] == SLIP:
                 m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
                 scale = float(sol.time_scale[m])
                 n = 1 if not math.isfinite(scale) else max(1, math.ceil((tb - ta) * panels_per_scale / scale))
-            else:
-                n = max(1, math.ceil((tb - ta) * panels_per_scale * max(sol.nw.max(initial=0.0), 1e-300) / 6.0))
-                n = min(n, 10_000)
             edges = np.linspace(ta, tb, n + 1)
             half = 0.5 * np.diff(edges)
             tq = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]
             d, v, a = self.sample(np.clip(tq, ta, tb))
-            if self.kind[i] != SLIP:
-                d = np.full_like(tq, self.x_start[i, 0])
-                v = np.zeros_like(tq)
-                a = np.zeros_like(tq)
             total += float(np.sum(half[:, None] * _GAUSS_W[None, :] * fun(tq, d, v, a)))
         return total
 
@@ -318,7 +316,11 @@ class NonsmoothIntegrator:
             v = 0.0
         t = t0
         m11, m12, m21, m22 = 1.0, 0.0, 0.0, 1.0
-        v_lock = self.options.lock_velocity * self.velocity_scale(omega)
+        if kind == STICK or (kind == LOCK and self._J[j] == 0.0):
+            m22 = 0.0  # a small initial δ' dies within O(δ') time: the stick's projection
+        elif kind == LOCK:
+            m11 = m22 = 0.0  # near a locking jump every perturbation spirals into the lock
+        x_lock = self.options.lock_excursion * self.system.length_scale()
         n_events = 0
         while True:
             if kind == SLIP:
@@ -329,6 +331,7 @@ class NonsmoothIntegrator:
                 tau_v = self._first_stop(sol, seg, sigma, tau_end) if sigma != 0 else None
                 tau_c, j_new, d_c, v_c = self._search._first_exit(seg, tau_end if tau_v is None else tau_v)
                 tau = tau_c if j_new >= 0 else (tau_end if tau_v is None else tau_v)
+                m_before = (m11, m12, m21, m22)
                 f11, f12, f21, f22 = sol.transition_scalar(mode, tau)
                 m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
                                       f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
@@ -342,10 +345,34 @@ class NonsmoothIntegrator:
                     i = j if up else j - 1
                     jn = j + 1 if up else j - 1
                     d = self._d[i]
+                    if self._J[i] > 0.0 or self._r[i] != self._r[i + 1]:
+                        # The field jumps here: an error dτ of the crossing time becomes an error
+                        # (a⁺ − a⁻) dτ of δ'. The search stops at |δ − d_i| ≤ its round-off floor;
+                        # polish τ by Newton steps on δ(τ) − d_i to the last bit.
+                        tau_p = tau_c
+                        for _ in range(3):
+                            dd, vv, _ = seg.state(tau_p)
+                            if vv == 0.0:
+                                break
+                            dt = (dd - d) / vv
+                            tau_p -= dt
+                            if abs(dt) <= 2.0 * _EPS * abs(tau_p):
+                                break
+                        if 0.0 < tau_p <= tau and abs(tau_p - tau_c) <= 1e-6 * max(tau_c, 1e-300) + 1e-12:
+                            t = t - tau + tau_p
+                            tau = tau_p
+                            _, v_c, _ = seg.state(tau)
+                            F = float(sol.forcing(np.asarray(t)))
+                            m11, m12, m21, m22 = m_before
+                            f11, f12, f21, f22 = sol.transition_scalar(mode, tau)
+                            m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
+                                                  f21 * m11 + f22 * m21, f21 * m12 + f22 * m22)
                     v = v_c
                     sn = 0 if self._r[jn] == 0.0 else (1 if up else -1)
                     lo, hi = self._band(i)
-                    if lo < F < hi and abs(v) <= v_lock and (self._J[i] > 0.0 or self._r[i] + self._r[jn] > 0.0):
+                    a_in = F - c * v - k * (self._f(jn, d) + self._r[jn] * sn)  # on the side entered
+                    if (lo < F < hi and a_in * v < 0.0 and v * v <= 2.0 * abs(a_in) * x_lock
+                            and (self._J[i] > 0.0 or self._r[i] + self._r[jn] > 0.0)):
                         kind, j, v = LOCK, i, 0.0
                         m11, m12, m21, m22 = (0.0, 0.0, 0.0, 0.0) if self._J[i] > 0.0 else (m11, m12, 0.0, 0.0)
                         self._event(rec, t, "lock")
@@ -394,7 +421,7 @@ class NonsmoothIntegrator:
             if n_events > self.options.max_events:
                 raise ConvergenceError(
                     f"more than `max_events` = {self.options.max_events} switching events between t0 = {t0!r} "
-                    f"and t1 = {t1!r} (a chattering approach to a lock?): raise `max_events` or `lock_velocity`, "
+                    f"and t1 = {t1!r} (a chattering approach to a lock?): raise `max_events` or `lock_excursion`, "
                     "or shorten the interval")
 
     @staticmethod
@@ -528,7 +555,15 @@ class NonsmoothIntegrator:
                     ga, gb = g(a_)[0], g(b_)[0]
                     if ga >= 0.0:  # inside the band by construction at the bracket's start
                         ga = -1e-300
-                    return bracketed_newton(g, a_, b_, ga, gb, tol), up
+                    te = bracketed_newton(g, a_, b_, ga, gb, tol)
+                    # The slip must start with F on or beyond the band's edge (else round-off makes
+                    # it stop and stick again at once): step up to the first such float.
+                    for _ in range(64):
+                        ge, dge = g(te)
+                        if ge >= 0.0 or te >= b_:
+                            break
+                        te = min(b_, max(float(np.nextafter(te, math.inf)), te - 2.0 * ge / dge if dge > 0 else te))
+                    return te, up
             ta = float(ts[-1])
         return None, False
 

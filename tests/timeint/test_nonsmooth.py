@@ -1,0 +1,356 @@
+"""Event-driven exact integration of one coordinate with preload jumps and Coulomb friction.
+
+References: an independent mode-by-mode DOP853 integration (scipy ``solve_ivp``, rtol 1e-12,
+terminal events on the switching surfaces, the stick's exit by ``brentq``); the exact integrator
+of the continuous laws (T_p = r = 0); closed-form stick and lock exit times; central differences
+of the flow (saltation-based monodromy); the energy balance with the exact friction work.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from rattle.errors import ConvergenceError
+from rattle.model import Clutch, Excitation, Linear, Model, Piecewise, reference_case
+from rattle.model._discontinuous import Friction, NonsmoothLaw, NonsmoothSystem, PiecewiseJump, Preload
+from rattle.timeint import ExactIntegrator
+from rattle.timeint._nonsmooth import NonsmoothIntegrator, NonsmoothOptions, shoot_nonsmooth_orbit
+
+
+# ---------------------------------------------------------------------------------------------
+# Independent reference
+# ---------------------------------------------------------------------------------------------
+def _reference(system: NonsmoothSystem, x0, t1: float, omega: float):
+    """Mode by mode with DOP853 (rtol 1e-12, atol 1e-14) and terminal events; returns the final
+    state and the solver's (t, δ, δ') samples."""
+    st, r = system.law.stages, system.law.friction_levels
+    bp, s, e = st.breakpoints, st.slopes, st.offsets
+    k, c = system.k, system.c
+
+    def F(t):
+        return system.excitation(t, omega)
+
+    t, (d, v) = 0.0, x0
+    j = int(np.searchsorted(bp, d, side="right"))
+    sg = 0 if r[j] == 0 else int(np.sign(v))
+    stick = False
+    ts, xs = [], []
+    while True:
+        if stick:
+            fd = k * (s[j] * d + e[j])
+            lo, hi = fd - k * r[j], fd + k * r[j]
+            grid = np.linspace(t, t1, max(2, int((t1 - t) * 400)))
+            out = np.flatnonzero((F(grid[1:]) > hi) | (F(grid[1:]) < lo))
+            if not out.size:
+                return np.array([d, 0.0]), np.concatenate(ts), np.hstack(xs)
+            i = out[0]
+            up = F(grid[i + 1]) > hi
+            t = brentq(lambda q: (F(q) - hi) if up else (lo - F(q)), grid[i], grid[i + 1], xtol=1e-15, rtol=1e-15)
+            v, sg, stick = 0.0, (1 if up else -1), False
+            continue
+        jj, ss = j, sg
+
+        def rhs(tt, x):
+            return [x[1], F(tt) - c * x[1] - k * (s[jj] * x[0] + e[jj] + r[jj] * ss)]
+
+        events = []
+        for bound, direction, comp in ((jj - 1, -1, 0), (jj, 1, 0)):
+            if 0 <= bound < len(bp):
+                ev = (lambda b: lambda tt, x: x[0] - bp[b])(bound)
+                ev.terminal, ev.direction = True, direction
+                events.append((ev, "up" if direction > 0 else "down"))
+        if ss != 0:
+            ev = lambda tt, x: x[1]  # noqa: E731
+            ev.terminal, ev.direction = True, -ss
+            events.append((ev, "stop"))
+        sol = solve_ivp(rhs, (t, t1), [d, v], method="DOP853", rtol=1e-12, atol=1e-14,
+                        events=[ev for ev, _ in events], dense_output=True)
+        ts.append(sol.t)
+        xs.append(sol.y)
+        if sol.status == 0:
+            return sol.y[:, -1], np.concatenate(ts), np.hstack(xs)
+        t, n = min((te[0], n) for n, te in enumerate(sol.t_events) if len(te))
+        d, v = sol.sol(t)
+        what = events[n][1]
+        if what == "stop":
+            v = 0.0
+            R = F(t) - k * (s[jj] * d + e[jj])
+            if abs(R) <= k * r[jj]:
+                stick = True
+            else:
+                sg = 1 if R > 0 else -1
+        else:
+            d = bp[jj] if what == "up" else bp[jj - 1]
+            j = jj + 1 if what == "up" else jj - 1
+            sg = 0 if r[j] == 0 else (1 if v > 0 else -1)
+
+
+def _system(elastic, friction=None, c=0.05, mean=0.05, amps=(0.03,), phases=None) -> NonsmoothSystem:
+    return NonsmoothSystem(damping=c, stiffness=1.0, law=NonsmoothLaw(elastic=elastic, friction=friction),
+                           excitation=Excitation(mean=mean, amplitudes=amps, phases=phases))
+
+
+def _random_cases(n: int):
+    rng = np.random.default_rng(11)
+    out = []
+    for i in range(n):
+        tp = rng.uniform(0.005, 0.03)
+        b = [0.0, 0.1][i % 2]
+        fr = None if i % 3 == 0 else Friction(levels=tuple(rng.uniform(0.0, 0.015, 3 if b else 2)))
+        sysx = _system(Preload(preload=tp, clearance=b, slope=rng.uniform(0.5, 1.5)), fr, c=rng.uniform(0.02, 0.1),
+                       mean=rng.uniform(-0.03, 0.05), amps=(rng.uniform(0.02, 0.08), rng.uniform(0.0, 0.02)),
+                       phases=(rng.uniform(0, 6), rng.uniform(0, 6)))
+        out.append((sysx, (rng.uniform(-0.15, 0.15), rng.uniform(-0.05, 0.05)), rng.uniform(0.4, 1.6)))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Trajectories
+# ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("case", range(6))
+def test_random_cases_match_solve_ivp(case: int) -> None:
+    sysx, x0, w = _random_cases(6)[case]
+    traj = NonsmoothIntegrator(sysx).propagate(x0, 0.0, 30.0, w)
+    x_ref, t_ref, y_ref = _reference(sysx, x0, 30.0, w)
+    d, v, _ = traj.sample(t_ref)
+    # DOP853 at rtol 1e-12 with event location: its own error is ~1e-11 over 30 s
+    assert np.max(np.abs(d - y_ref[0])) < 1e-8
+    assert np.max(np.abs(v - y_ref[1])) < 1e-8
+    assert np.max(np.abs(traj.state1 - x_ref)) < 1e-8
+    assert len(traj.event_time) > 0  # switching happened
+
+
+def test_stick_phases_match_solve_ivp() -> None:
+    # Friction on the reference clutch at low frequency: the orbit sticks and reverses.
+    sysx = NonsmoothSystem.from_model(reference_case(), friction=Friction(levels=(0.005, 0.02, 0.005)))
+    traj = NonsmoothIntegrator(sysx).propagate((0.1, 0.05), 0.0, 40.0, 0.4)
+    assert {"stick", "unstick", "reversal", "crossing"} <= set(traj.event_kind)
+    x_ref, t_ref, y_ref = _reference(sysx, (0.1, 0.05), 40.0, 0.4)
+    d, v, _ = traj.sample(t_ref)
+    assert np.max(np.abs(d - y_ref[0])) < 1e-8 and np.max(np.abs(v - y_ref[1])) < 1e-8
+
+
+@pytest.mark.parametrize("omega", [0.5, 1.3])
+def test_zero_preload_and_friction_recover_the_exact_integrator(omega: float) -> None:
+    m = reference_case()
+    ref = ExactIntegrator(m).propagate((0.1, 0.05), 0.0, 50.0, omega)
+    for sysx in (NonsmoothSystem.from_model(m), NonsmoothSystem.from_model(m, friction=Friction(levels=0.0))):
+        traj = NonsmoothIntegrator(sysx).propagate((0.1, 0.05), 0.0, 50.0, omega)
+        assert np.array_equal(traj.state1, ref.state1)  # the same stage solutions and crossings
+        np.testing.assert_allclose(traj.sensitivity, ref.sensitivity, rtol=0, atol=1e-13)
+    # Preload(T_p = 0) is the linear law; T_p → 0 converges linearly to it
+    lin = Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=Linear(), excitation=m.excitation)
+    ref = ExactIntegrator(lin).propagate((0.1, 0.05), 0.0, 50.0, omega)
+    zero = NonsmoothIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=0.0)))
+    assert np.max(np.abs(zero.propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) < 1e-14
+    errs = [np.max(np.abs(NonsmoothIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=tp)))
+                          .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for tp in (1e-6, 1e-7)]
+    assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
+
+
+def test_stuck_mass_stays_exactly_stuck_inside_the_band() -> None:
+    # linear law, friction r = 0.1 > |F − k δ0| = |0.02 cos Ωt + 0.01 − 0.02| for all t
+    sysx = _system(Linear(), Friction(levels=0.1), mean=0.01, amps=(0.02,))
+    traj = NonsmoothIntegrator(sysx).propagate((0.02, 0.0), 0.0, 100.0, 0.7)
+    assert traj.state1[0] == 0.02 and traj.state1[1] == 0.0
+    assert traj.event_kind == () and traj.stick_time == 100.0
+    d, v, a = traj.sample(np.linspace(0.0, 100.0, 501))
+    assert np.all(d == 0.02) and np.all(v == 0.0) and np.all(a == 0.0)
+    np.testing.assert_array_equal(traj.sensitivity, [[1.0, 0.0], [0.0, 0.0]])
+
+
+def test_stick_ends_when_the_force_leaves_the_band() -> None:
+    # F = 0.2 cos Ωt, δ0 = 0.15, r = 0.1: stuck at t = 0 (R = 0.05), slip starts when
+    # 0.2 cos Ωt − 0.15 = −0.1 → cos Ωt = 1/4, downwards
+    w = 0.9
+    sysx = _system(Linear(), Friction(levels=0.1), mean=0.0, amps=(0.2,))
+    traj = NonsmoothIntegrator(sysx).propagate((0.15, 0.0), 0.0, 6.0, w)
+    assert traj.event_kind[0] == "unstick"
+    t_exit = math.acos(0.25) / w
+    assert abs(traj.event_time[0] - t_exit) < 1e-14 * 10
+    assert traj.sign[1] == -1 and traj.kind[0] == 1 and traj.kind[1] == 0
+
+
+def test_preload_lock_and_release() -> None:
+    # f = δ + 0.1 sgn δ, F = −0.2 sin Ωt: locked at (0, 0) while |F| ≤ 0.1, released downwards
+    # (F < −0.1) at Ω t = π/6 exactly.
+    w = 0.8
+    sysx = _system(Preload(preload=0.1), None, mean=0.0, amps=(0.2,), phases=(math.pi / 2,))
+    traj = NonsmoothIntegrator(sysx).propagate((0.0, 0.0), 0.0, 3.0, w)
+    assert traj.kind[0] == 2 and traj.event_kind[0] == "unlock"
+    assert abs(traj.event_time[0] - math.pi / 6 / w) < 1e-14
+    assert traj.stage[1] == 0  # below the jump
+    d, v, _ = traj.sample(np.linspace(0.0, math.pi / 6 / w, 50))
+    assert np.all(d == 0.0) and np.all(v == 0.0)
+
+
+def test_chattering_approach_to_the_lock_with_friction_is_zeno_and_snaps() -> None:
+    # |F| ≤ 0.03 < k T_p = 0.1: the spiral around (0, 0) loses a fixed fraction per crossing
+    # (friction), accumulates in finite time and ends in the lock; afterwards δ ≡ 0.
+    sysx = _system(Preload(preload=0.1), Friction(levels=0.01), mean=0.0, amps=(0.03,))
+    traj = NonsmoothIntegrator(sysx).propagate((0.05, 0.0), 0.0, 60.0, 0.8)
+    assert "lock" in traj.event_kind and traj.event_kind[-1] == "lock"
+    # |δ'| at the successive crossings of δ = 0 falls by a nearly fixed factor (Zeno), down to the
+    # round-off level of the excursions δ'²/(2|a|) ~ 1e-13 L, where the lock is entered
+    v = np.abs(traj.x_start[traj.x_start[:, 1] != 0.0, 1])
+    assert np.all(v[1:] < v[:-1]) and v.size > 20
+    assert v[-1] < 2e-7
+    assert np.array_equal(traj.state1, [0.0, 0.0])
+    np.testing.assert_array_equal(traj.sensitivity, np.zeros((2, 2)))  # all perturbations die
+
+
+def test_chatter_without_snap_runs_out_of_budget() -> None:
+    sysx = _system(Preload(preload=0.1), None, mean=0.0, amps=(0.03,))
+    integ = NonsmoothIntegrator(sysx, NonsmoothOptions(lock_excursion=0.0, max_events=50))
+    with pytest.raises(ConvergenceError, match="max_events"):
+        integ.propagate((0.05, 0.0), 0.0, 200.0, 0.8)
+
+
+# ---------------------------------------------------------------------------------------------
+# Sensitivity, shooting, energy
+# ---------------------------------------------------------------------------------------------
+def _fd_sensitivity(integ, x0, T, w, h=1e-6):
+    out = np.empty((2, 2))
+    for i in range(2):
+        e = np.zeros(2)
+        e[i] = h
+        out[:, i] = (integ.propagate(x0 + e, 0.0, T, w).state1 - integ.propagate(x0 - e, 0.0, T, w).state1) / (2 * h)
+    return out
+
+
+@pytest.mark.parametrize("case", ["jump", "jump_clearance_friction", "stage_friction", "stick"])
+def test_monodromy_matches_finite_differences(case: str) -> None:
+    m = reference_case()
+    sysx, x0, w = {
+        "jump": (NonsmoothSystem.from_model(m, elastic=Preload(preload=0.02)), (0.13, 0.05), 0.8),
+        "jump_clearance_friction": (NonsmoothSystem.from_model(m, elastic=Preload(preload=0.02, clearance=0.1),
+                                                               friction=Friction(levels=0.005)), (0.13, 0.05), 0.8),
+        "stage_friction": (NonsmoothSystem.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))),
+                           (0.1, 0.05), 1.5),
+        "stick": (NonsmoothSystem.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))), (0.1, 0.05), 0.4),
+    }[case]
+    integ = NonsmoothIntegrator(sysx)
+    T = 2 * math.pi / w * (2 if case == "stick" else 1)
+    traj = integ.propagate(np.array(x0), 0.0, T, w)
+    kinds = set(traj.event_kind)
+    assert {"crossing"} <= kinds and (case != "stick" or "stick" in kinds)
+    fd = _fd_sensitivity(integ, np.array(x0), T, w)
+    # h = 1e-6: truncation ~1e-10, round-off of the flow (~1e-15) / h ~ 1e-9
+    np.testing.assert_allclose(traj.sensitivity, fd, rtol=0, atol=2e-8 * max(1.0, np.abs(fd).max()))
+    # the saltation matrices matter: without them the product of the stage matrices differs
+    if case != "stick":
+        assert np.abs(traj.sensitivity - fd).max() < 1e-3 * np.abs(fd).max()
+
+
+def test_shooting_stick_slip_orbit_has_a_zero_multiplier() -> None:
+    sysx = NonsmoothSystem.from_model(reference_case(), friction=Friction(levels=0.01))
+    orbit = shoot_nonsmooth_orbit(sysx, 0.4, (0.1, 0.05))
+    assert orbit.converged and orbit.stable
+    assert "stick" in orbit.trajectory.event_kind
+    # stick removes velocity perturbations: rank-1 monodromy, one multiplier exactly 0
+    assert abs(np.linalg.det(orbit.monodromy)) < 1e-15
+    assert np.abs(orbit.multipliers[1]) < 1e-14
+    fd = _fd_sensitivity(NonsmoothIntegrator(sysx), orbit.state0, 2 * math.pi / 0.4, 0.4)
+    np.testing.assert_allclose(orbit.monodromy, fd, atol=1e-8)
+    np.testing.assert_allclose(np.abs(orbit.multipliers[0]), np.abs(np.linalg.eigvals(fd)).max(), atol=1e-8)
+
+
+def test_shooting_preload_orbit_is_periodic_with_exact_multipliers() -> None:
+    sysx = NonsmoothSystem.from_model(reference_case(), elastic=Preload(preload=0.02))
+    orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
+    assert orbit.converged
+    T = 2 * math.pi / 0.8
+    again = NonsmoothIntegrator(sysx).propagate(orbit.state0, 0.0, T, 0.8)
+    assert np.max(np.abs(again.state1 - orbit.state0)) < 1e-12
+    # det M = exp(−c T) · Π (a⁺/a⁻ of the v-reversals) = exp(−cT) here (no friction): a saltation
+    # matrix of a δ-jump crossing has determinant 1
+    assert abs(np.linalg.det(orbit.monodromy) - math.exp(-0.05 * T)) < 1e-12
+    fd = _fd_sensitivity(NonsmoothIntegrator(sysx), orbit.state0, T, 0.8)
+    np.testing.assert_allclose(orbit.monodromy, fd, atol=1e-8)
+
+
+def test_energy_balance_with_friction_work() -> None:
+    # E(t1) − E(t0) = ∫ F δ' dt − c ∫ δ'² dt − k ∫ r(δ) |δ'| dt, E = δ'²/2 + k V(δ): the friction
+    # work from the segments' displacements (exact), the rest by Gauss–Legendre quadrature.
+    sysx = _system(Preload(preload=0.02, clearance=0.1), Friction(levels=(0.02, 0.03, 0.02)), mean=0.02,
+                   amps=(0.06, 0.01))
+    w = 0.3
+    traj = NonsmoothIntegrator(sysx).propagate((0.12, -0.03), 0.0, 40.0, w)
+    assert {"stick", "crossing", "reversal"} <= set(traj.event_kind)
+    power_in = traj.integrate(lambda t, d, v, a: sysx.excitation(t, w) * v)
+    viscous = sysx.c * traj.integrate(lambda t, d, v, a: v * v)
+    friction = traj.friction_dissipation()
+    dE = traj.energy(traj.state1) - traj.energy(traj.state0)
+    assert friction > 0.0
+    assert abs(dE - (power_in - viscous - friction)) < 1e-12 * max(power_in, 1.0)
+    # over a periodic orbit: friction work = input − viscous work, and = k ∫ r |δ'| dt by quadrature
+    orbit = shoot_nonsmooth_orbit(sysx, w, traj.state1)
+    assert orbit.converged
+    o = orbit.trajectory
+    W_f = o.friction_dissipation()
+    W_in = o.integrate(lambda t, d, v, a: sysx.excitation(t, w) * v)
+    W_c = sysx.c * o.integrate(lambda t, d, v, a: v * v)
+    assert abs(W_f - (W_in - W_c)) < 1e-12
+    W_q = o.integrate(lambda t, d, v, a: sysx.law.friction_level(d) * np.abs(v))
+    assert abs(W_f - W_q) < 1e-12
+
+
+# ---------------------------------------------------------------------------------------------
+# Laws
+# ---------------------------------------------------------------------------------------------
+def test_preload_is_the_clutch_limit() -> None:
+    # the clutch α δ (|δ| ≤ b), δ − (1 − α) b sgn δ outside, with α b = T_p fixed and b → 0
+    tp = 0.05
+    x = np.array([-0.3, -0.01, 0.01, 0.3])
+    pre = Preload(preload=tp).force(x)
+    np.testing.assert_allclose(pre, x + tp * np.sign(x), rtol=0, atol=1e-15)
+    for b in (1e-3, 1e-5):
+        alpha = tp / b
+        clutch = PiecewiseJump(breakpoints=(-b, b), slopes=(1.0, alpha, 1.0), jumps=(0.0, 0.0)).force(x)
+        assert np.max(np.abs(clutch - pre)) <= 1.01 * b  # (α − 1) b = T_p − b
+    np.testing.assert_allclose(Preload(preload=0.1, clearance=0.2, slope=2.0).force(np.array([-0.3, 0.1, 0.3])),
+                               [-0.3, 0.0, 0.3])
+    law = NonsmoothLaw(elastic=Clutch(alpha=0.25, b=0.17), friction=Friction(levels=(0.0, 0.02, 0.0)))
+    np.testing.assert_array_equal(law.friction_levels, [0.0, 0.02, 0.0])
+    assert law.stages.jumps.tolist() == [0.0, 0.0]
+
+
+def test_regularised_law_tends_to_the_discontinuous_one() -> None:
+    law = NonsmoothLaw(elastic=Preload(preload=0.05, clearance=0.1), friction=Friction(levels=(0.01, 0.02, 0.01)))
+    d = np.array([-0.3, -0.05, 0.05, 0.25])
+    v = np.array([0.2, -0.1, 0.3, -0.4])
+    g, gd, gv = law.regularised(d, v, 1e-6, 1e-6)
+    exact = law.force(d) + law.friction_level(d) * np.sign(v)
+    np.testing.assert_allclose(g, exact, atol=1e-12)
+    # partials against central differences at a finite width
+    h = 1e-7
+    g1 = law.regularised(d + h, v, 0.05, 0.05)[0]
+    g0 = law.regularised(d - h, v, 0.05, 0.05)[0]
+    np.testing.assert_allclose(law.regularised(d, v, 0.05, 0.05)[1], (g1 - g0) / (2 * h), atol=1e-7)
+    g1 = law.regularised(d, v + h, 0.05, 0.05)[0]
+    g0 = law.regularised(d, v - h, 0.05, 0.05)[0]
+    np.testing.assert_allclose(law.regularised(d, v, 0.05, 0.05)[2], (g1 - g0) / (2 * h), atol=1e-7)
+
+
+def test_invalid_laws_are_refused() -> None:
+    with pytest.raises(ValueError, match="`preload`"):
+        Preload(preload=-0.1)
+    with pytest.raises(ValueError, match="`clearance`"):
+        Preload(preload=0.1, clearance=-1.0)
+    with pytest.raises(ValueError, match="`jumps\\[0\\]`"):
+        PiecewiseJump(breakpoints=(0.0,), slopes=(1.0, 1.0), jumps=(-0.1,))
+    with pytest.raises(ValueError, match="`jumps`"):
+        PiecewiseJump(breakpoints=(0.0,), slopes=(1.0, 1.0), jumps=(0.1, 0.2))
+    with pytest.raises(ValueError, match="`levels\\[1\\]`"):
+        Friction(levels=(0.1, -0.1))
+    with pytest.raises(ValueError, match="one per stage"):
+        NonsmoothLaw(elastic=Piecewise(breakpoints=(-0.1, 0.1), slopes=(1.0, 0.2, 1.0)), friction=Friction(levels=(0.1, 0.2)))
+    with pytest.raises(TypeError, match="`law`"):
+        NonsmoothSystem(damping=0.1, stiffness=1.0, law=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,)))
+    with pytest.raises(ValueError, match="`lock_excursion`"):
+        NonsmoothOptions(lock_excursion=-1.0)
