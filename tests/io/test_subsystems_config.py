@@ -206,6 +206,7 @@ _DEL = object()
     (GEARS, "model.gear_pair.backlash", 6e-5, ["`model.gear_pair.backlash` and `model.gear_pair.backlash_um`"]),
     (GEARS, "model.gear_pair.mesh_stifness", 1.0, ["`model.gear_pair.mesh_stifness` is not a known key",
                                                    "did you mean `mesh_stiffness`"]),
+    (GEARS, "model.gear_pair.name", 3, ["`model.gear_pair.name` must be an identifier"]),
     (GEARS, "model.units", _DEL, ["needs `model.units` = \"SI\""]),
     (GEARS, "model.inertias", [1.0, 1.0], ["`model.inertias` cannot be given with [model.gear_pair]"]),
     (LOOSE, "model.loose_gear.inertia", -2e-4, ["`model.loose_gear.inertia` must be > 0"]),

@@ -153,6 +153,15 @@ def _backlash_m(check: _Checker, t: dict[str, Any], where: str) -> dict[str, str
     return names
 
 
+def _name(check: _Checker, t: Mapping[str, Any], where: str) -> str:
+    """The mesh element's name (default ``"mesh"``): an identifier, it names the output columns."""
+    name = t.get("name", "mesh")
+    if not isinstance(name, str) or not name.isidentifier():
+        raise check.error(f"`{where}.name` must be an identifier (letters, digits, underscore; it names the output "
+                          f"columns NAME_rms …), got {_show(name)}; write e.g. name = \"mesh\"")
+    return name
+
+
 def _scale(value: Any, factor: float) -> Any:
     """A number or list of numbers × ``factor``; anything else unchanged (the reader refuses it by name)."""
     def num(v: Any) -> bool:
@@ -185,11 +194,11 @@ def _gear_pair(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]
         check.array(t[key], f"{where}.{key}")
     for key in ("mesh_stiffness", "mesh_damping_ratio", "backlash"):
         check.number(t[key], f"{where}.{key}")
-    name = t.get("name", "mesh")
+    name = _name(check, t, where)
     names = {**{k: f"{where}.{k}" for k in _GEAR_KEYS}, **names}
     pair = _build(check, gear_pair, names, base_radii=t["base_radii"], inertias=t["inertias"],
                   mesh_stiffness=t["mesh_stiffness"], mesh_damping_ratio=t["mesh_damping_ratio"],
-                  backlash=t["backlash"], name=name if isinstance(name, str) else "mesh")
+                  backlash=t["backlash"], name=name)
     element = {"name": name, "between": [1, 2], "stiffness": pair.stiffness, "type": "backlash", "b": pair.half_gap}
     out = dict(data)
     out["model"] = {"units": model_t["units"], "inertias": list(pair.chain.inertias),
@@ -242,13 +251,13 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
     if len(t["drive_acceleration"]) != len(t["orders"]):
         raise check.error(f"`{where}.drive_acceleration` must have one entry per order of `{where}.orders` "
                           f"({len(t['orders'])}), got {len(t['drive_acceleration'])}")
-    name = t.get("name", "mesh")
+    name = _name(check, t, where)
     names = {**{k: f"{where}.{k}" for k in _LOOSE_KEYS}, **names}
     gear = _build(check, loose_gear, names, base_radii=t["base_radii"], inertia=t["inertia"],
                   mesh_stiffness=t["mesh_stiffness"], mesh_damping_ratio=t["mesh_damping_ratio"],
                   backlash=t["backlash"], drive_acceleration=t["drive_acceleration"],
                   drive_phases=t.get("drive_phases"), drag_torque=t["drag_torque"],
-                  name=name if isinstance(name, str) else "mesh")
+                  name=name)
     tq = gear.chain.torques[0]
     out = dict(data)
     out["model"] = {"units": "SI", "inertias": list(gear.chain.inertias),
