@@ -246,6 +246,8 @@ def sweep_command(
                             workers=workers, callback=bar)
     finally:
         bar.close()
+    if run_config.paths:  # SPEC §6: the sound pressure level of every row's simulated motion
+        result = result.with_sound(run_config.paths)
     meta = sections("sweep", config, run_config, analysis, {
         "direction": direction, "points": points, "workers": workers,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,

@@ -56,7 +56,8 @@ from ..model import check_analysable_model
 from ..model._paths import SoundPath, check_source, parse_source
 
 __all__ = ["SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "P_REF",
-           "UNCOVERED_WARNING"]
+           "UNCOVERED_WARNING", "motion_sound_pressure", "coefficient_sound_pressure", "record_harmonics",
+           "record_samples"]
 
 #: Reference sound pressure of the sound pressure level (Pa): 20 µPa.
 P_REF = 20e-6
@@ -316,5 +317,92 @@ def linear_sound_pressure(model: Any, omega: FloatArray, paths: SoundPath | Sequ
     K = max(model.system().forced_harmonics, 1)
     result = _pressure(model, paths_t, _linear_harmonics(model, omega, K), omega, np.ones(omega.size, dtype=int),
                        omega, a_weighting, None)
+    _warn_uncovered(result)
+    return result
+
+
+# ---------------------------------------------------------------------------------------------
+# Recorded motions (time-domain sweeps) and bare harmonic-balance solutions (response maps)
+# ---------------------------------------------------------------------------------------------
+#: A recorded motion is sampled at no fewer than this many points per forcing period …
+RECORD_SAMPLES_PER_PERIOD = 512
+#: … and at no fewer than this many times the highest harmonic a path table reaches.
+RECORD_OVERSAMPLING = 16
+#: Most samples of one recorded window (a power of two; harmonics above half of it fold back).
+MAX_RECORD_SAMPLES = 2**18
+
+
+def record_samples(omega: float, window: int, paths: Sequence[SoundPath]) -> int:
+    """Samples N of a recorded window of ``window`` forcing periods at Ω = ``omega``: the least
+    power of two ≥ max(512 · window, 16 · (K + 1)), K = the highest harmonic of ω = Ω/window
+    that a path table reaches (f_max · 2π/ω), at most :data:`MAX_RECORD_SAMPLES`."""
+    f_max = max(p.frequency_range[1] for p in paths)
+    k_cover = int(min(f_max * 2.0 * np.pi * window / omega, MAX_RECORD_SAMPLES))
+    need = max(RECORD_SAMPLES_PER_PERIOD * int(window), RECORD_OVERSAMPLING * (k_cover + 1))
+    return int(min(2 ** int(np.ceil(np.log2(need))), MAX_RECORD_SAMPLES))
+
+
+def record_harmonics(trajectory: Any, omega: float, window: int, samples: int) -> ComplexArray:
+    """Acceleration harmonics X''_k, k = 1 … N/2 − 1, (n, N/2 − 1), of the coordinates of a
+    recorded motion: ``trajectory`` (an exact :class:`~rattle.timeint.Trajectory` or
+    :class:`~rattle.timeint.SystemTrajectory` from t = 0) over its first ``window`` forcing periods
+    T_w = window · 2π/Ω, base frequency ω = Ω/window, by the discrete Fourier transform of N =
+    ``samples`` exact samples t_j = j T_w / N (rectangular window):
+
+        X''_k = (2/N) Σ_j x''(t_j) e^{−2πi kj/N}      (x'' = Re Σ_k X''_k e^{ikωt}).
+
+    For a periodic motion of period ``window`` this is its Fourier series up to aliasing: x'' is
+    continuous and its slope jumps at the crossings, so |X''_k| falls as k⁻² and the folded
+    content at harmonic k ≪ N is of relative order (k/N)². For a non-periodic motion it is the
+    spectrum of the record's periodic extension: the forcing's harmonics fall on the bins
+    k = h · window, the rest leaks into neighbouring bins — an estimate."""
+    t = np.arange(samples) * (window * 2.0 * np.pi / omega / samples)
+    acc = np.asarray(trajectory.derivatives(t, 2)[2], dtype=float).reshape(samples, -1)
+    spectrum = np.fft.rfft(acc, axis=0)[1 : samples // 2] * (2.0 / samples)
+    return spectrum.T
+
+
+def motion_sound_pressure(model: Any, trajectory: Any, omega: float, window: int,
+                          paths: SoundPath | Sequence[SoundPath], *, a_weighting: bool | Sequence[bool] = False,
+                          warn: bool = True) -> Any:
+    """Sound pressure at the receiver of a simulated motion (one row; module docstring, eq. 1).
+
+    ``trajectory``: the exact motion at forcing frequency ``omega`` from t = 0 over at least
+    ``window`` forcing periods — a steady state's orbit (``window`` its period p, base frequency
+    ω = Ω/p) or, for a non-periodic motion, its record (``window`` the record's forcing periods,
+    the spectrum an estimate: :func:`record_harmonics`). The source accelerations' harmonics
+    k ω (k up to N/2 − 1, N = :func:`record_samples`) go through the paths harmonic by harmonic:
+    P_k = Σ_j H_j(f_k) A_{s(j),k}, p_rms = sqrt(Σ_k |P_k|²/2) — the rms over the window of the
+    time-domain pressure p(t) = Re Σ_k P_k e^{ikωt} (Parseval). The result's ``period`` is
+    ``window``. ``a_weighting`` a sequence of flags gives a list, one SoundPressure per flag
+    (the harmonics computed once)."""
+    paths_t = _check_paths(paths, model)
+    window = int(window)
+    Xdd = record_harmonics(trajectory, float(omega), window, record_samples(float(omega), window, paths_t))[None]
+    flags = [a_weighting] if isinstance(a_weighting, bool) else list(a_weighting)
+    w = np.array([float(omega) / window])
+    out = [_pressure(model, paths_t, Xdd, w, np.array([window]), np.array([float(omega)]), bool(f), None)
+           for f in flags]
+    if warn:
+        _warn_uncovered(out[0])
+    return out[0] if isinstance(a_weighting, bool) else out
+
+
+def coefficient_sound_pressure(model: Any, q: FloatArray, omega: FloatArray, period: Any,
+                               paths: SoundPath | Sequence[SoundPath], *, a_weighting: bool = False) -> SoundPressure:
+    """Sound pressure of P harmonic-balance solutions given by their coefficients ``q``
+    ((P, n·(2H+1)), coordinate-major blocks [a_0, a_1 … a_H, b_1 … b_H] of base frequency
+    ω = Ω/period), at forcing frequencies ``omega`` (P,) with periods ``period`` (P,): as
+    :func:`sound_pressure` for a frequency response (X''_k = −(kω)² (a_k − i b_k)), without
+    the linear reference."""
+    paths_t = _check_paths(paths, model)
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    period = np.broadcast_to(np.asarray(period, dtype=int), omega.shape).copy()
+    n = model.system().n
+    Q = np.asarray(q, dtype=float).reshape(omega.size, n, -1)
+    H = (Q.shape[2] - 1) // 2
+    w = omega / period
+    Xdd = -((w[:, None, None] * np.arange(1, H + 1)) ** 2) * (Q[:, :, 1 : H + 1] - 1j * Q[:, :, H + 1 :])
+    result = _pressure(model, paths_t, Xdd, w, period, omega, a_weighting, None)
     _warn_uncovered(result)
     return result

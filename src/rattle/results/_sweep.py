@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -16,6 +18,9 @@ from ..model import Model
 #: Per-element columns of a chain's ``sweep.csv``: ``NAME_`` + each of these (the measures of
 #: element NAME's deflection, as the SPEC columns are of the first element's).
 SWEEP_ELEMENT_COLUMNS: tuple[str, ...] = ("mean", "rms", "rms_ac", "p2p", "acc_p2p")
+
+#: ``SteadyStateOptions.record_periods`` when a result's settings do not say (its default).
+_RECORD_PERIODS = 50
 
 #: Sweep directions, in the order ``both`` runs them.
 SWEEP_DIRECTIONS: tuple[str, ...] = ("up", "down")
@@ -64,6 +69,9 @@ class SweepResult:
     ``NAME_p2p``, ``NAME_acc_p2p`` of every element NAME (:data:`SWEEP_ELEMENT_COLUMNS`),
     written after the SPEC columns; the states are z = (x, x') of its n coordinates ((P, 2n)),
     the multipliers (P, 2n).
+
+    ``extra_columns``: columns written last, e.g. the sound pressure levels of
+    :meth:`with_sound` (``spl_db``, ``spl_dba``, ``spl_linear_db``).
     """
 
     model: Model
@@ -87,6 +95,7 @@ class SweepResult:
     settings: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
     element_columns: dict[str, np.ndarray] = field(default_factory=dict)
+    extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -115,7 +124,8 @@ class SweepResult:
         rows = np.flatnonzero(self.direction == direction)
         values = {name: getattr(self, name)[rows] for name in _ROW_FIELDS}
         return SweepResult(model=self.model, settings=self.settings, timings=self.timings,
-                           element_columns={k: v[rows] for k, v in self.element_columns.items()}, **values)
+                           element_columns={k: v[rows] for k, v in self.element_columns.items()},
+                           extra_columns={k: v[rows] for k, v in self.extra_columns.items()}, **values)
 
     def __repr__(self) -> str:
         parts = []
@@ -135,10 +145,11 @@ class SweepResult:
 
     def columns(self) -> dict[str, np.ndarray]:
         """The SPEC columns in order, as a dict of arrays; for a chain followed by the
-        per-element columns (``NAME_mean`` … ``NAME_acc_p2p``), then ``speed_rpm`` with an engine."""
+        per-element columns (``NAME_mean`` … ``NAME_acc_p2p``), then ``speed_rpm`` with an engine,
+        then the extra columns (``spl_db``, ``spl_dba``, ``spl_linear_db`` of :meth:`with_sound`)."""
         rpm = self.speed_rpm
         return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, **self.element_columns,
-                **({} if rpm is None else {"speed_rpm": rpm})}
+                **({} if rpm is None else {"speed_rpm": rpm}), **self.extra_columns}
 
     @property
     def speed_rpm(self) -> FloatArray | None:
@@ -245,6 +256,53 @@ class SweepResult:
                 for j in self.jumps()
             ],
         }
+
+    def records(self) -> Iterator[tuple[Any, int]]:
+        """The recorded motion of every row, again: (exact trajectory from t = 0, window in forcing
+        periods) — the orbit from ``state0`` over its ``period`` forcing periods, or for a
+        non-periodic row (period 0) the record of ``record_periods`` forcing periods the sweep
+        measured (``settings["steady_state"]``). The integrator is deterministic, so these are the
+        trajectories the sweep's measures were taken on."""
+        from ..timeint import ExactIntegrator, SystemIntegrator
+
+        integ: Any = ExactIntegrator(self.model) if isinstance(self.model, Model) else SystemIntegrator(
+            self.model.system())
+        record = int(self.settings.get("steady_state", {}).get("record_periods", _RECORD_PERIODS))
+        for w, p, x in zip(self.omega, self.period, self.state0):
+            window = int(p) if p > 0 else record
+            yield integ.propagate(x, 0.0, window * 2.0 * np.pi / float(w), float(w)), window
+
+    def with_sound(self, paths: Any) -> "SweepResult":
+        """A copy with the sound pressure at the receiver of every row's simulated motion through
+        ``paths`` (:class:`rattle.model.SoundPath` objects; :func:`rattle.results.motion_sound_pressure`
+        on :meth:`records`): ``spl_db`` (dB re 20 µPa), ``spl_dba`` (A-weighted, dB(A)) and
+        ``spl_linear_db`` (the linear system at the same Ω, :func:`rattle.results.linear_sound_pressure`),
+        as :meth:`FrequencyResponse.with_sound <rattle.results.FrequencyResponse.with_sound>` does.
+        A periodic row's level is that of its orbit's Fourier series; a non-periodic row's is an
+        estimate from its record (rectangular window). One warning names the row with the largest
+        share of a source's content outside a path table, when any exceeds
+        :data:`~rattle.results._sound.UNCOVERED_WARNING`."""
+        from ._sound import _check_paths, _warn_uncovered, linear_sound_pressure, motion_sound_pressure
+
+        paths_t = _check_paths(paths, self.model)
+        P = len(self)
+        spl, dba = np.full(P, np.nan), np.full(P, np.nan)
+        worst = None
+        for i, (traj, window) in enumerate(self.records()):
+            plain, weighted = motion_sound_pressure(self.model, traj, float(self.omega[i]), window, paths_t,
+                                                    a_weighting=(False, True), warn=False)
+            spl[i], dba[i] = plain.spl_db[0], weighted.spl_db[0]
+            if worst is None or np.max(plain.uncovered) > np.max(worst.uncovered):
+                worst = plain
+        linear = np.full(P, np.nan)
+        if P:
+            with warnings.catch_warnings():  # the linear reference's harmonics lie within the sweep's
+                warnings.simplefilter("ignore")
+                linear = linear_sound_pressure(self.model, self.omega, paths_t).spl_db
+        if worst is not None:
+            _warn_uncovered(worst)
+        return replace(self, extra_columns={**self.extra_columns, "spl_db": spl, "spl_dba": dba,
+                                            "spl_linear_db": linear})
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
