@@ -88,8 +88,9 @@ def sweep_plot(
     if quantity not in _QUANTITIES:
         raise ValueError(f"`quantity` must be one of {sorted(_QUANTITIES)}, got {quantity!r}")
     names = tuple(getattr(sweep, "element_names", ()) or ())
+    sound = ax is None and "spl_db" in (getattr(sweep, "extra_columns", {}) or {})  # [[paths]]: an SPL panel below
     if names and ax is None:  # a chain: one panel per element, sharing Ω
-        fig, axes = plt.subplots(len(names), 1, figsize=(8, 1.5 + 3.0 * len(names)), sharex=True,
+        fig, axes = plt.subplots(len(names) + sound, 1, figsize=(8, 1.5 + 3.0 * (len(names) + sound)), sharex=True,
                                  layout="constrained", squeeze=False)
         for k, (name, ax_k) in enumerate(zip(names, axes[:, 0])):
             first = title if title is not None else "Time-domain frequency sweep (steady state at each Ω)"
@@ -97,17 +98,42 @@ def sweep_plot(
                         annotate, lines, legend=k == 0)
             ax_k.set_ylabel(f"{name}: {_QUANTITIES[quantity]}")
             ax_k.set_title(f"{first} — element {name}" if k == 0 else f"element {name}", fontsize=10)
-            if k < len(names) - 1:
+            if k < len(names) - 1 or sound:
                 ax_k.set_xlabel("")
+        if sound:
+            _draw_sound_panel(sweep, axes[-1, 0], annotate, lines)
+            return fig, PlotAxes([*zip(names, axes[:-1, 0]), ("spl_db", axes[-1, 0])])
         return fig, PlotAxes(zip(names, axes[:, 0]))
-    if ax is None:
+    if ax is None and sound:
+        fig, (ax, ax_spl) = plt.subplots(2, 1, figsize=(8, 7.6), sharex=True, layout="constrained")
+    elif ax is None:
         fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
     else:
         fig = ax.figure
     _draw_sweep(sweep, ax, np.asarray(getattr(sweep, quantity), dtype=float), annotate, lines, legend=True)
     ax.set_ylabel(_QUANTITIES[quantity])
     ax.set_title(title if title is not None else "Time-domain frequency sweep (steady state at each Ω)")
+    if sound:
+        ax.set_xlabel("")
+        _draw_sound_panel(sweep, ax_spl, annotate, lines)
+        return fig, PlotAxes([("response", ax), ("spl_db", ax_spl)])
     return fig, PlotAxes.single(ax)
+
+
+def _draw_sound_panel(sweep: "SweepResult", ax: Any, annotate: bool, lines: bool) -> None:
+    """The sound pressure level ``spl_db`` at the receiver of every row's simulated motion
+    (``sweep.with_sound(paths)``) per direction, the linear system's level in grey."""
+    from ._frf import speed_axis
+
+    _draw_sweep(sweep, ax, np.asarray(sweep.extra_columns["spl_db"], dtype=float), annotate, lines, legend=False)
+    linear = sweep.extra_columns.get("spl_linear_db")
+    if linear is not None:  # the linear system at each row's Ω, in Ω order (one curve)
+        order = np.argsort(sweep.omega, kind="stable")
+        ax.plot(np.asarray(sweep.omega)[order] * speed_axis(sweep)[0], np.asarray(linear)[order], color="0.55",
+                lw=1.0, label="linear system (f = δ)", zorder=1)
+        ax.legend(fontsize=8, loc="best", framealpha=0.9)
+    ax.set_ylabel("sound pressure level (dB re 20 µPa)")
+    ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)
 
 
 def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:
