@@ -464,7 +464,7 @@ def map_command(
     try:
         result = response_map(run_config.model, params, omega=analysis.omega, omega_points=omega_points,
                               harmonics=analysis.harmonics, workers=workers, scheduler=scheduler, store=output,
-                              progress=bar, tables=tables)
+                              progress=bar, tables=tables, paths=run_config.paths)
     finally:
         bar.close()
     from ..maps import map_report

@@ -13,12 +13,15 @@ give the same bits). It
 4. searches the attractors the branches do not explain and continues each new one as a branch
    (:mod:`rattle.analysis._attractors`);
 5. summarises each grid frequency per SPEC §7 (:func:`summarise`) and the combination's
-   intervals and special points.
+   intervals and special points;
+6. with sound paths (``task["paths"]``), the largest sound pressure level over the stable
+   periodic solutions at each grid frequency (:func:`sound_levels`).
 """
 
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -29,6 +32,7 @@ from ..analysis._grid import solutions_on_grid
 from ..analysis._settings import RunSettings
 from ..errors import RattleError
 from ..results import FrequencyResponse
+from ..results._sound import UNCOVERED_WARNING, coefficient_sound_pressure
 from ._result import INTERVAL_KINDS, CellResult, grid_runs
 
 
@@ -73,6 +77,33 @@ def summarise(census: Census, grid: np.ndarray) -> dict[str, Any]:
     }
 
 
+def sound_levels(model: Any, census: Census, grid: np.ndarray, paths: tuple[Any, ...]) -> tuple[np.ndarray, str]:
+    """``spl_max_stable_db`` on the grid: per grid frequency the largest sound pressure level at
+    the receiver (:func:`rattle.results._sound.coefficient_sound_pressure`, the paper's eq. 1 on
+    each solution's own harmonics k Ω/period) over the stable periodic solutions of every branch
+    there, NaN where there is none; and a note (empty, or the largest share of a source's
+    mean-square acceleration outside a path table, when above UNCOVERED_WARNING: the level is then
+    a lower bound). Attractors seen only by simulation (non-periodic, or periodic beyond the
+    branch budget) have no harmonic-balance series and do not count."""
+    spl = np.full(grid.size, np.nan)
+    stable = [s for s in census.solutions if s.stable]
+    uncovered = 0.0
+    for size in sorted({s.q.size for s in stable}):  # one batch per harmonic count
+        group = [s for s in stable if s.q.size == size]
+        with warnings.catch_warnings():  # reported once, in the cell's message
+            warnings.simplefilter("ignore")
+            sp = coefficient_sound_pressure(model, np.array([s.q for s in group]), np.array([s.omega for s in group]),
+                                            np.array([s.period for s in group]), paths)
+        uncovered = max(uncovered, float(np.max(sp.uncovered, initial=0.0)))
+        for s, level in zip(group, sp.spl_db):
+            if not (level <= spl[s.index]):  # NaN compares False: the first one wins
+                spl[s.index] = level
+    note = "" if uncovered <= UNCOVERED_WARNING else (
+        f"sound: up to {100 * uncovered:.3g} % of a source's mean-square acceleration lies outside a path table "
+        "(transmitted as zero), so spl_max_stable_db is a lower bound there; extend the path tables")
+    return spl, note
+
+
 def _special_points(parts: list[FrequencyResponse]) -> list[dict[str, Any]]:
     out = []
     for frf in parts:
@@ -85,7 +116,8 @@ def _special_points(parts: list[FrequencyResponse]) -> list[dict[str, Any]]:
 def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     """One combination (``task``: ``model`` — built from its configuration tables with the varied
     values set —, ``values`` by NAME, ``omega`` (lo, hi), ``omega_points``, ``run`` the RunSettings,
-    ``max_period``, ``search`` the AttractorSearch) → :meth:`CellResult.to_dict`.
+    ``max_period``, ``search`` the AttractorSearch, optionally ``paths`` the sound paths) →
+    :meth:`CellResult.to_dict`.
 
     A combination whose frequency response fails numerically is not an error of the map: its
     cell says ``failed`` (or ``partial``) with the reason, and the map goes on."""
@@ -96,13 +128,14 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     search: AttractorSearch = task["search"]
     values = dict(task["values"])
     model = task["model"]
+    paths = tuple(task.get("paths") or ())
     timings: dict[str, float] = {}
     status, message = "ok", ""
     try:
         frf = _frequency_response(model, (lo, hi), run, subharmonics=True, max_period=int(task["max_period"]),
                                   throw=False)
     except RattleError as exc:  # nothing computed: the cell says why
-        return _failed(values, grid, f"{type(exc).__name__}: {exc}", time.perf_counter() - t0)
+        return _failed(values, grid, f"{type(exc).__name__}: {exc}", time.perf_counter() - t0, bool(paths))
     if not frf.status.success:
         status, message = "partial", frf.message
     t1 = time.perf_counter()
@@ -119,6 +152,9 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
             f"attractor search: the branch budget ({search.max_branches}) was spent and "
             f"{census.counts['not_continued']} attractors found beyond it were not continued as branches (those seen "
             "by simulation still count where they were seen); raise AttractorSearch(max_branches=…)")) if x)
+    if paths:
+        summary["spl_max_stable_db"], note = sound_levels(model, census, grid, paths)
+        message = "; ".join(x for x in (message, note) if x)
     timings["total"] = time.perf_counter() - t0
     intervals = summary.pop("intervals")
     cell = CellResult(
@@ -132,16 +168,17 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     return cell.to_dict()
 
 
-def _failed(values: dict[str, float], grid: np.ndarray, message: str, seconds: float) -> dict[str, Any]:
+def _failed(values: dict[str, float], grid: np.ndarray, message: str, seconds: float,
+            sound: bool = False) -> dict[str, Any]:
     N = grid.size
     cell = CellResult(
         values=values, omega=grid, n_solutions=np.zeros(N, dtype=int), n_stable=np.zeros(N, dtype=int),
         rms_max_stable=np.full(N, np.nan), rms_ac_max_stable=np.full(N, np.nan),
         regime_max_stable=np.full(N, "", dtype=object), periods_stable=np.full(N, "", dtype=object),
         rattle=np.zeros(N, dtype=bool), intervals={k: [] for k in INTERVAL_KINDS}, status="failed",
-        message=message, timings={"total": seconds},
+        message=message, timings={"total": seconds}, spl_max_stable_db=np.full(N, np.nan) if sound else None,
     )
     return cell.to_dict()
 
 
-__all__ = ["compute_cell", "summarise"]
+__all__ = ["compute_cell", "summarise", "sound_levels"]

@@ -38,14 +38,29 @@ DEFAULT_OMEGA_POINTS = 146
 ProgressCallback = Callable[[int, int, int], None]
 
 
-def _source_of(model: Any) -> tuple[Any, Any]:
-    """The model and the analysis settings of a Model/Chain, a Case or a RunConfig (None: none)."""
+def _source_of(model: Any) -> tuple[Any, Any, tuple[Any, ...]]:
+    """The model, the analysis settings and the sound paths of a Model/Chain, a Case or a
+    RunConfig (None, (): none)."""
     from ..io import RunConfig
 
     config = model if isinstance(model, RunConfig) else getattr(model, "config", None)
     if config is not None:  # a Case (load_case) or a RunConfig: the resolved file
-        return config.model, config.analysis
-    return model, None
+        return config.model, config.analysis, tuple(getattr(config, "paths", ()) or ())
+    return model, None, ()
+
+
+def _paths_fingerprint(paths: tuple[Any, ...]) -> list[dict[str, Any]]:
+    """What a combination's sound levels depend on in its paths: each path's source and the
+    SHA-256 of its table (frequencies, magnitudes, phases as float64 bytes) — a changed row
+    changes the store's key."""
+    import hashlib
+
+    out = []
+    for p in paths:
+        table = np.concatenate([np.asarray(a, dtype="<f8") for a in (p.frequency_hz, p.magnitude, p.phase_deg)])
+        out.append({"source": p.source, "rows": int(np.asarray(p.frequency_hz).size),
+                    "table_sha256": hashlib.sha256(table.tobytes()).hexdigest()})
+    return out
 
 
 def _tables_of(model: Any, lo: float, hi: float, harmonics: int) -> dict[str, Any]:
@@ -83,6 +98,7 @@ def response_map(
     store: str | os.PathLike[str] | Any = None,
     progress: ProgressCallback | None = None,
     tables: Mapping[str, Any] | None = None,
+    paths: Sequence[Any] | None = None,
 ) -> ResponseMap:
     """Response map of ``model`` over the varied parameters and the forcing frequency.
 
@@ -123,6 +139,10 @@ def response_map(
         Called once with the combinations read back, then after each finished combination.
     tables : dict, optional
         The configuration tables to vary (a parsed TOML file); default from ``model``.
+    paths : sequence of SoundPath, optional
+        Sound paths (SPEC §6): every cell then also has ``spl_max_stable_db``, the largest sound
+        pressure level over the stable periodic solutions at each grid frequency. Default: a
+        Case's or RunConfig's ``[[paths]]``, else none; ``()`` for none.
 
     Returns
     -------
@@ -133,7 +153,8 @@ def response_map(
     from ._vary import apply, build_all, combinations, parameters
 
     t_start = time.perf_counter()
-    model, analysis = _source_of(model)
+    model, analysis, config_paths = _source_of(model)
+    paths_t: tuple[Any, ...] = config_paths if paths is None else tuple(paths)
     if omega is None:
         omega = analysis.omega if analysis is not None else (0.1, 3.0)
     lo, hi = check_range(omega, "omega")
@@ -154,6 +175,11 @@ def response_map(
     models = build_all(base, params)  # every combination's model, validated before any work
     orders = {getattr(m, "speed_order", None) for m in models}
     speed_order = orders.pop() if len(orders) == 1 else None  # rpm only when one order holds for all
+    if paths_t:  # every source must exist in every combination's model
+        from ..results._sound import _check_paths
+
+        for m in models:
+            _check_paths(paths_t, m)
 
     settings = {**run.record(), "omega": [lo, hi], "omega_points": omega_points, "max_period": max_period,
                 "search": asdict(search)}
@@ -165,10 +191,14 @@ def response_map(
         values = {name: setting[p.key] for name, p in zip(names, params)}
         cell_tables = apply(base, setting)
         task = {"model": models[flat], "values": values, "omega": (lo, hi), "omega_points": omega_points,
-                "run": run, "max_period": max_period, "search": search}
+                "run": run, "max_period": max_period, "search": search, "paths": paths_t}
         tasks.append((flat, task))
-        # the store's identity of a combination: everything its result depends on
-        keys.append(MapStore.key({"tables": cell_tables, "values": values, "settings": settings, "version": version}))
+        # the store's identity of a combination: everything its result depends on (the paths'
+        # tables only when there are paths: a map without keeps the keys it always had)
+        fingerprint = {"tables": cell_tables, "values": values, "settings": settings, "version": version}
+        if paths_t:
+            fingerprint["paths"] = _paths_fingerprint(paths_t)
+        keys.append(MapStore.key(fingerprint))
 
     the_store = None
     if store is not None:
@@ -209,7 +239,7 @@ def response_map(
         settings={**settings, "engine": engine_used, "workers": workers_used, "version": version},
         timings={"wall": wall, "combinations": float(np.nansum(computed)) if computed else 0.0,
                  "computed": len(computed), "resumed": resumed},
-        config=base, speed_order=speed_order,
+        config=base, speed_order=speed_order, paths=paths_t,
     )
 
 

@@ -15,6 +15,13 @@ response and the attractor search found there, evaluated on the map's Ω grid:
 ``rattle``              some attractor found at Ω crosses a breakpoint (impacts)
 ======================  =====================================================================
 
+With sound paths (``[[paths]]``, SPEC §6) a cell also has the extension column
+
+======================  =====================================================================
+``spl_max_stable_db``   largest sound pressure level at the receiver (dB re 20 µPa) over the
+                        stable periodic solutions found at Ω, any branch and period (NaN if none)
+======================  =====================================================================
+
 A cell result is exactly JSON-serialisable (:meth:`CellResult.to_dict` / :meth:`from_dict`
 round-trip every float bit for bit): that is how a finished combination is stored and read
 back when a map resumes.
@@ -39,6 +46,8 @@ GRID_COLUMNS: tuple[str, ...] = (
 )
 #: ``map.csv`` columns after the varied parameters' names.
 MAP_COLUMNS: tuple[str, ...] = ("omega", *GRID_COLUMNS)
+#: The extension column of a map with sound paths (written after the SPEC §7 columns).
+SOUND_COLUMN = "spl_max_stable_db"
 #: The interval kinds of a cell's design summary.
 INTERVAL_KINDS: tuple[str, ...] = ("impact", "rattle_free", "subharmonic", "nonperiodic")
 
@@ -58,6 +67,11 @@ def grid_runs(mask: np.ndarray, grid: np.ndarray) -> list[list[float]]:
         else:
             j += 1
     return out
+
+
+def _spl(cell: "CellResult", size: int) -> np.ndarray:
+    """A cell's ``spl_max_stable_db``, NaN throughout when it has none (a failed combination)."""
+    return np.full(size, np.nan) if cell.spl_max_stable_db is None else np.asarray(cell.spl_max_stable_db, dtype=float)
 
 
 def _float(x: Any) -> float | None:
@@ -99,6 +113,9 @@ class CellResult:
         Seconds per stage (``frequency_response``, ``grid``, ``search``, ``total``).
     resumed : bool
         Read back from a finished earlier run instead of computed.
+    spl_max_stable_db : ndarray of float (N,), or None
+        With sound paths: the largest sound pressure level (dB re 20 µPa) over the stable
+        periodic solutions at Ω (NaN where none); None for a map without paths.
     """
 
     values: dict[str, float]
@@ -118,13 +135,18 @@ class CellResult:
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)
     resumed: bool = False
+    spl_max_stable_db: np.ndarray | None = None
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The per-frequency columns (``omega`` and :data:`GRID_COLUMNS`)."""
-        return {"omega": self.omega, **{k: getattr(self, k) for k in GRID_COLUMNS}}
+        """The per-frequency columns (``omega`` and :data:`GRID_COLUMNS`, then
+        ``spl_max_stable_db`` with sound paths)."""
+        sound = {} if self.spl_max_stable_db is None else {SOUND_COLUMN: self.spl_max_stable_db}
+        return {"omega": self.omega, **{k: getattr(self, k) for k in GRID_COLUMNS}, **sound}
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (floats exact: ``json`` writes ``repr``; NaN as null)."""
+        sound = {} if self.spl_max_stable_db is None else {
+            SOUND_COLUMN: [_float(x) for x in self.spl_max_stable_db]}
         return {
             "values": dict(self.values),
             "omega": [float(x) for x in self.omega],
@@ -142,12 +164,14 @@ class CellResult:
             "status": self.status,
             "message": self.message,
             "timings": self.timings,
+            **sound,
         }
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], *, resumed: bool = False) -> "CellResult":
         """The inverse of :meth:`to_dict` (``resumed`` marks a result read back from disk)."""
         nan = float("nan")
+        spl = data.get(SOUND_COLUMN)
         return cls(
             values={str(k): float(v) for k, v in data["values"].items()},
             omega=np.asarray(data["omega"], dtype=float),
@@ -166,6 +190,7 @@ class CellResult:
             message=str(data.get("message", "")),
             timings={k: float(v) for k, v in data.get("timings", {}).items()},
             resumed=resumed,
+            spl_max_stable_db=None if spl is None else np.asarray([nan if x is None else x for x in spl], dtype=float),
         )
 
     def to_json(self) -> str:
@@ -188,7 +213,9 @@ class ResponseMap:
     (C order: the last parameter varies fastest), on the Ω grid ``omega``.
 
     ``dataset`` is the same content as an :class:`xarray.Dataset` with one dimension per varied
-    parameter (named by its NAME) and ``omega``.
+    parameter (named by its NAME) and ``omega``. ``paths``: the sound paths
+    (:class:`rattle.model.SoundPath`) the map was computed with, if any (column
+    ``spl_max_stable_db``).
     """
 
     parameters: tuple[Parameter, ...]
@@ -198,6 +225,13 @@ class ResponseMap:
     timings: dict[str, float] = field(default_factory=dict)
     config: dict[str, Any] = field(default_factory=dict)
     speed_order: float | None = None
+    paths: tuple[Any, ...] = ()
+
+    @property
+    def has_sound(self) -> bool:
+        """Whether the map was computed with sound paths (``paths``): then ``map.csv`` and the
+        dataset carry ``spl_max_stable_db``."""
+        return bool(self.paths)
 
     @property
     def speed_rpm(self) -> np.ndarray | None:
@@ -242,6 +276,8 @@ class ResponseMap:
             if col in ("regime_max_stable", "periods_stable"):
                 stack = stack.astype(str)
             data[col] = (dims, stack.reshape(shape))
+        if self.has_sound:
+            data[SOUND_COLUMN] = (dims, np.stack([_spl(c, self.omega.size) for c in self.cells]).reshape(shape))
         data["status"] = (self.names, np.asarray([c.status for c in self.cells], dtype=str).reshape(self.shape))
         data["seconds"] = (self.names, np.asarray([c.timings.get("total", np.nan) for c in self.cells],
                                                   dtype=float).reshape(self.shape))
@@ -258,7 +294,8 @@ class ResponseMap:
 
     def rows(self) -> list[dict[str, Any]]:
         """``map.csv`` rows: per (combination, frequency) the varied values by NAME, then
-        :data:`MAP_COLUMNS` (and ``speed_rpm`` last when the model has an engine). A combination whose frequency response failed (status
+        :data:`MAP_COLUMNS` (then ``speed_rpm`` when the model has an engine, then
+        ``spl_max_stable_db`` with sound paths). A combination whose frequency response failed (status
         ``failed``) knows nothing: its grid columns are None (empty in the CSV), never a
         ``rattle`` = false it did not establish."""
         out = []
@@ -270,14 +307,17 @@ class ResponseMap:
                 row = {**values, "omega": cols["omega"][j], **{k: (cols[k][j] if known else None) for k in GRID_COLUMNS}}
                 if rpm is not None:
                     row["speed_rpm"] = float(rpm[j])
+                if self.has_sound:
+                    row[SOUND_COLUMN] = float(_spl(c, self.omega.size)[j]) if known else None
                 out.append(row)
         return out
 
     @property
     def column_names(self) -> list[str]:
         """``map.csv`` header: the varied NAMEs, then :data:`MAP_COLUMNS`, then ``speed_rpm`` when
-        the model has an engine."""
-        return [*self.names, *MAP_COLUMNS, *(["speed_rpm"] if self.speed_order is not None else [])]
+        the model has an engine, then ``spl_max_stable_db`` with sound paths."""
+        return [*self.names, *MAP_COLUMNS, *(["speed_rpm"] if self.speed_order is not None else []),
+                *([SOUND_COLUMN] if self.has_sound else [])]
 
     def columns(self) -> dict[str, list[Any]]:
         """``map.csv`` as columns of plain Python values (None where empty: NaN rms, and every
@@ -327,4 +367,5 @@ class ResponseMap:
                 for (_, v), c in zip(self.combinations(), self.cells)]
 
 
-__all__ = ["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS", "grid_runs"]
+__all__ = ["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS", "grid_runs",
+           "SOUND_COLUMN"]
