@@ -66,6 +66,7 @@ PUBLIC_API = {
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
     "SystemIntegrator",
     "sound_pressure", "linear_sound_pressure", "SoundPressure", "SoundPath",
+    "Drag", "clutch_damper", "hub_spline", "gear_pair", "loose_gear",
     "Status", "RattleError", "ConfigError", "ConvergenceError",
 }
 
