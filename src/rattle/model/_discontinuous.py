@@ -422,5 +422,4 @@ class NonsmoothSystem:
         return self.k * g, self.k * gd, self.k * gv
 
 
-__all__ = ["JumpStages", "AbstractJumpLaw", "PiecewiseJump", "Preload", "Friction", "NonsmoothLaw",
-           "NonsmoothSystem"]
+__all__ = ["AbstractJumpLaw", "Friction", "JumpStages", "NonsmoothLaw", "NonsmoothSystem", "PiecewiseJump", "Preload"]

@@ -329,7 +329,7 @@ class NonsmoothIntegrator:
                 self._record(rec, t, SLIP, j, sigma, d, v, (seg.h0, seg.h1))
                 tau_end = t1 - t
                 tau_v = self._first_stop(sol, seg, sigma, tau_end) if sigma != 0 else None
-                tau_c, j_new, d_c, v_c = self._search._first_exit(seg, tau_end if tau_v is None else tau_v)
+                tau_c, j_new, _, v_c = self._search._first_exit(seg, tau_end if tau_v is None else tau_v)
                 tau = tau_c if j_new >= 0 else (tau_end if tau_v is None else tau_v)
                 m_before = (m11, m12, m21, m22)
                 f11, f12, f21, f22 = sol.transition_scalar(mode, tau)
@@ -490,7 +490,7 @@ class NonsmoothIntegrator:
                     break
 
                 def accel(tau: float) -> tuple[float, float]:
-                    dd, vv, aa = seg.state(tau)
+                    _, vv, aa = seg.state(tau)
                     jerk = float(sol.forcing(np.asarray(seg.ts + tau), 1)) - c * aa - ks * vv
                     return aa, jerk
 
@@ -626,5 +626,5 @@ def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray 
                           residual=shot.residual, trajectory=traj, mean=mean, rms=rms)
 
 
-__all__ = ["NonsmoothOptions", "NonsmoothIntegrator", "NonsmoothTrajectory", "NonsmoothOrbit",
+__all__ = ["NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory",
            "shoot_nonsmooth_orbit"]
