@@ -382,3 +382,71 @@ def test_invalid_laws_are_refused() -> None:
         NonsmoothSystem(damping=0.1, stiffness=1.0, law=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,)))
     with pytest.raises(ValueError, match="`lock_excursion`"):
         NonsmoothOptions(lock_excursion=-1.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# Filippov consistency on random cases with sticks and locks
+# ---------------------------------------------------------------------------------------------
+def _check_filippov(traj, sysx, omega: float) -> None:
+    st, r, k = sysx.law.stages, sysx.law.friction_levels, sysx.k
+    edges = np.concatenate(([-np.inf], st.breakpoints, [np.inf]))
+    tol = 1e-12
+    for i in range(len(traj.t_start)):
+        ta, tb = traj.t_start[i], traj.t_end[i]
+        if tb <= ta:
+            continue
+        t = ta + (tb - ta) * np.linspace(0.02, 0.98, 25)
+        d, v, _ = traj.sample(t)
+        F = sysx.excitation(t, omega)
+        j = int(traj.stage[i])
+        if traj.kind[i] == 0:  # slip: inside its stage, moving in the direction its friction assumes
+            assert np.all(d >= edges[j] - tol) and np.all(d <= edges[j + 1] + tol)
+            if r[j] > 0:
+                assert traj.sign[i] != 0 and np.all(traj.sign[i] * v >= -tol)
+        elif traj.kind[i] == 1:  # stick: friction holds the torque
+            R = F - k * (st.slopes[j] * d + st.offsets[j])
+            assert np.all(np.abs(R) <= k * r[j] + tol)
+        else:  # lock at breakpoint j: F within the band of the four one-sided fields
+            dj = st.breakpoints[j]
+            lo = k * (st.slopes[j] * dj + st.offsets[j] - r[j])
+            hi = k * (st.slopes[j + 1] * dj + st.offsets[j + 1] + r[j + 1])
+            assert np.all((F >= lo - tol) & (F <= hi + tol)) and np.all(d == dj)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_trajectories_are_filippov_consistent(seed: int) -> None:
+    # forcing amplitudes of the order of the preload: slips, sticks, Zeno locks and releases
+    # (seeds 6 and 7 lock) — every segment is checked against its mode's conditions
+    rng = np.random.default_rng(100 + seed)
+    b = [0.0, 0.05][seed % 2]
+    tp = rng.uniform(0.05, 0.3)
+    sysx = _system(Preload(preload=tp, clearance=b), Friction(levels=tuple(rng.uniform(0.0, 0.4 * tp, 3 if b else 2))),
+                   c=rng.uniform(0.02, 0.1), mean=rng.uniform(-0.3, 0.3) * tp, amps=(rng.uniform(0.6, 1.8) * tp,),
+                   phases=(rng.uniform(0, 6),))
+    w = rng.uniform(0.3, 1.5)
+    traj = NonsmoothIntegrator(sysx).propagate((rng.uniform(-0.2, 0.2), rng.uniform(-0.1, 0.1)), 0.0, 40.0, w)
+    _check_filippov(traj, sysx, w)
+    assert len(traj.event_time) > 2
+    if seed >= 6:
+        assert "lock" in traj.event_kind
+
+
+def test_orbit_with_a_lock_phase_is_superstable() -> None:
+    # preload 0.1 with friction 0.02, F = 0.02 + 0.15 cos 0.3t: the chatter after each release
+    # accumulates (Zeno) into the lock; the lock erases every perturbation
+    w = 0.3
+    sysx = _system(Preload(preload=0.1), Friction(levels=0.02), mean=0.02, amps=(0.15,))
+    integ = NonsmoothIntegrator(sysx)
+    x = np.array([0.1, 0.0])
+    for _ in range(5):
+        x = integ.propagate(x, 0.0, 2 * math.pi / w, w).state1
+    orbit = shoot_nonsmooth_orbit(sysx, w, x, integrator=integ)
+    tr = orbit.trajectory
+    assert orbit.converged and {"lock", "unlock"} <= set(tr.event_kind)
+    np.testing.assert_array_equal(orbit.multipliers, [0.0, 0.0])
+    fd = _fd_sensitivity(integ, orbit.state0, 2 * math.pi / w, w)
+    np.testing.assert_array_equal(fd, np.zeros((2, 2)))
+    # released where F leaves the band [k (−T_p − r), k (T_p + r)] = [−0.12, 0.12]
+    t_un = tr.event_time[list(tr.event_kind).index("unlock")]
+    assert abs(abs(float(sysx.excitation(t_un, w))) - 0.12) < 1e-15
+    _check_filippov(tr, sysx, w)
