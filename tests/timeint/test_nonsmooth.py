@@ -176,6 +176,11 @@ def test_zero_preload_and_friction_recover_the_exact_integrator(omega: float) ->
     errs = [np.max(np.abs(NonsmoothIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=tp)))
                           .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for tp in (1e-6, 1e-7)]
     assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
+    # r → 0 likewise on the clutch (the reversals' saltations vanish with r)
+    ref = ExactIntegrator(m).propagate((0.1, 0.05), 0.0, 50.0, omega)
+    errs = [np.max(np.abs(NonsmoothIntegrator(NonsmoothSystem.from_model(m, friction=Friction(levels=r)))
+                          .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for r in (1e-6, 1e-7)]
+    assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
 
 
 def test_stuck_mass_stays_exactly_stuck_inside_the_band() -> None:

@@ -98,8 +98,11 @@ class NonsmoothOptions:
 class _Search(ExactIntegrator):
     """The δ-crossing search of :class:`ExactIntegrator` (``_first_exit``), on the mode table."""
 
-    def __init__(self, samples_per_scale: int) -> None:  # no model: only the search is used
+    def __init__(self, samples_per_scale: int, max_events: int) -> None:  # no model: only the search is used
+        self.model = None
         self.samples_per_scale = samples_per_scale
+        self.max_segments = max_events
+        self._cache = None
 
 
 def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: int) -> StageSolutions:
@@ -228,7 +231,7 @@ class NonsmoothIntegrator:
             raise TypeError(f"`options` must be NonsmoothOptions, got {options!r}")
         self.system = system
         self.options = options
-        self._search = _Search(options.samples_per_scale)
+        self._search = _Search(options.samples_per_scale, options.max_events)
         self._cache: tuple[float, StageSolutions] | None = None
         st = system.law.stages
         self._d = st.breakpoints.tolist()
