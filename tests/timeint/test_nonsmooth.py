@@ -455,3 +455,26 @@ def test_orbit_with_a_lock_phase_is_superstable() -> None:
     t_un = tr.event_time[list(tr.event_kind).index("unlock")]
     assert abs(abs(float(sysx.excitation(t_un, w))) - 0.12) < 1e-15
     _check_filippov(tr, sysx, w)
+
+
+def test_stiff_first_stage_clutch_tends_to_the_preload_orbit() -> None:
+    # the clutch characteristic with first-stage slope α over ±b, (α − 1) b = T_p (outer stages
+    # s δ ± T_p exactly), integrated by the continuous exact integrator: as b → 0 its periodic
+    # orbit tends to the preload's, the error falling like b² (the multipliers agree)
+    from rattle.timeint import shoot_periodic_orbit
+
+    tp, w = 0.05, 1.2
+    exc = Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,))
+    sysx = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=tp)), excitation=exc)
+    ref = shoot_nonsmooth_orbit(sysx, w, (0.3, 0.0))
+    ref = shoot_nonsmooth_orbit(sysx, w, ref.state0)
+    assert ref.converged
+    errs = []
+    for b in (1e-2, 1e-3):
+        law = Piecewise(breakpoints=(-b, b), slopes=(1.0, tp / b + 1.0, 1.0))
+        m = Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=law, excitation=exc)
+        orbit = shoot_periodic_orbit(m, w, ref.state0)
+        assert orbit.converged
+        errs.append(abs(orbit.rms - ref.rms) / ref.rms)
+        np.testing.assert_allclose(np.abs(orbit.multipliers), np.abs(ref.multipliers), atol=10 * b**2)
+    assert errs[0] < 1e-5 and 50.0 < errs[0] / errs[1] < 200.0

@@ -361,7 +361,8 @@ class NonsmoothIntegrator:
                             tau_p -= dt
                             if abs(dt) <= 2.0 * _EPS * abs(tau_p):
                                 break
-                        if 0.0 < tau_p <= tau and abs(tau_p - tau_c) <= 1e-6 * max(tau_c, 1e-300) + 1e-12:
+                        tau_max = tau_end if tau_v is None else tau_v
+                        if 0.0 < tau_p <= tau_max and abs(tau_p - tau_c) <= 1e-6 * max(tau_c, 1e-300) + 1e-12:
                             t = t - tau + tau_p
                             tau = tau_p
                             _, v_c, _ = seg.state(tau)
