@@ -6,6 +6,8 @@ from __future__ import annotations
 import copy
 import math
 
+import numpy as np
+
 import pytest
 import tomllib
 from click.testing import CliRunner
@@ -212,7 +214,7 @@ _DEL = object()
     (LOOSE, "model.loose_gear.inertia", -2e-4, ["`model.loose_gear.inertia` must be > 0"]),
     (LOOSE, "model.loose_gear.drag_torque", -0.05, ["`model.loose_gear.drag_torque` must be >= 0"]),
     (LOOSE, "model.loose_gear.drive_acceleration", [400.0], ["`model.loose_gear.drive_acceleration` must have one"]),
-    (LOOSE, "drag", {"inertia": 1, "speed_rpm": [600.0], "torque": [0.1]}, ["`drag` cannot be given"]),
+    (LOOSE, "drag", {"inertia": 1, "speed_rpm": [600.0], "torque": [0.1]}, ["`drag.inertia` is not a key"]),
 ])
 def test_bad_physical_input_is_refused_naming_the_key(text, path, value, fragments):
     with pytest.raises(ConfigError) as info:
@@ -268,3 +270,23 @@ def test_gear_pair_engine_and_drag_on_gear2_are_scaled():
     data["drag"] = {"inertia": 2, "speed_rpm": [1000.0, 5000.0], "torque": [20.0, 40.0]}  # N m of gear 2
     cfg = config_from_dict(data)
     assert cfg.model.drag.torque == pytest.approx((15.0, 30.0)) and cfg.model.drag.balance == 1
+
+
+def test_loose_gear_drag_by_speed_enters_its_relative_coordinate_with_a_plus_sign():
+    """δ = (r1/r2) θ1 − θ2: the loose gear's drag holds it back, i.e. + D(rpm) on δ — the same
+    mean as a constant drag_torque of D(rpm) at every speed."""
+    from rattle.io import config_from_dict
+
+    table = _data(LOOSE.replace("drag_torque = 0.05\n", ""))
+    table["drag"] = {"speed_rpm": [600.0, 3000.0], "torque": [0.02, 0.08]}
+    chain = config_from_dict(table).model
+    assert chain.drag.inertia == 0 and chain.drag.balance == 1
+    for rpm in (600.0, 1200.0, 2500.0):
+        D = 0.02 + 0.06 * (rpm - 600.0) / 2400.0
+        const = config_from_dict(_data(LOOSE.replace("drag_torque = 0.05", f"drag_torque = {D!r}"))).model
+        w = rpm * chain.speed_order * 2.0 * np.pi / 60.0
+        assert chain.system().mean_at(w) == pytest.approx(const.system().mean, rel=1e-12)
+    both = _data(LOOSE)
+    both["drag"] = {"speed_rpm": [600.0], "torque": [0.02]}
+    with pytest.raises(ConfigError, match="`model.loose_gear.drag_torque` and \\[drag\\] are both given"):
+        config_from_dict(both)

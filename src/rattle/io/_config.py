@@ -801,7 +801,8 @@ def _drag(check: _Checker, data: Mapping[str, Any], n: int, engine: _Engine | No
     for key in ("inertia", "balance"):
         if key in t:
             check.integer(t[key], f"drag.{key}")
-            if not 1 <= t[key] <= n:
+            low = 0 if key == "inertia" and "balance" in t else 1  # 0: ground, with a balance
+            if not low <= t[key] <= n:
                 raise check.error(f"`drag.{key}` must be an inertia number 1 … {n} (`model.inertias` has {n}), "
                                   f"got {t[key]}")
     for key in ("speed_rpm", "torque"):

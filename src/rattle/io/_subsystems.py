@@ -230,14 +230,25 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
     if model_t.get("units") != "SI":
         raise check.error(f"[model.loose_gear] needs `model.units` = \"SI\" (got {_show(model_t.get('units'))}): its "
                           "radii are in m, its speeds in rpm; add units = \"SI\" to [model]")
-    for key in ("engine", "excitation", "drag"):
+    for key in ("engine", "excitation"):
         if key in data:
             raise check.error(
                 f"`{key}` cannot be given with [model.loose_gear]: the loose gear's excitation is the driving gear's "
                 "motion (`model.loose_gear.speed_rpm`, `orders`, `drive_acceleration`) and its drag the constant "
-                f"`drag_torque` (in its relative coordinate a drag enters with the opposite sign); remove [{key}]"
+                f"`drag_torque` or a [drag] table by speed; remove [{key}]"
             )
     t = dict(check.table(model_t, "loose_gear", where))
+    drag_t = None
+    if "drag" in data:  # the loose gear's drag by speed: in δ = (r1/r2) θ1 − θ2 it enters as + D(rpm)
+        drag_t = check.table(data, "drag", "drag")
+        extra = [k for k in drag_t if k not in ("speed_rpm", "torque")]
+        if extra:
+            raise check.error(f"`drag.{extra[0]}` is not a key of a loose gear's [drag]: it acts on the loose gear "
+                              "(the model's only inertia) and the driving gear delivers it; give speed_rpm and torque")
+        if "drag_torque" in t:
+            raise check.error(f"`{where}.drag_torque` and [drag] are both given: give the loose gear's drag once "
+                              "(a constant `drag_torque`, or [drag] by speed)")
+        t["drag_torque"] = 0.0
     names = _backlash_m(check, t, where)
     t = _in_radians(check, t, where, _LOOSE_KEYS, angles=("drive_phases",))
     _keys(check, t, where, _LOOSE_KEYS, ("base_radii", "inertia", "mesh_stiffness", "mesh_damping_ratio",
@@ -267,6 +278,8 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
     # the base excitation J2 (r1/r2) θ1''(t) and the drag, as an engine torque by order on the loose gear
     out["engine"] = {"inertia": 1, "speed_rpm": t["speed_rpm"], "orders": t["orders"], "mean_torque": tq.mean,
                      "amplitudes": list(tq.amplitudes), "phases": list(tq.phases or ())}
+    if drag_t is not None:  # + D on δ, the reaction on the driving gear (ground of the relative coordinate)
+        out["drag"] = {"inertia": 0, "balance": 1, **{k: drag_t[k] for k in ("speed_rpm", "torque") if k in drag_t}}
     return out
 
 

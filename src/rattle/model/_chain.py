@@ -239,8 +239,8 @@ class Chain:
         if self.speed_order is None:
             raise ValueError("`drag` is tabulated over the crankshaft speed, but the chain has no `speed_order` (the "
                              "engine order of Ω): give an [engine] (or `speed_order`) so that rpm maps to Ω")
-        if not 1 <= drag.inertia <= N:
-            raise ValueError(f"`drag.inertia` must be an inertia number 1 … {N}, got {drag.inertia}")
+        if not 0 <= drag.inertia <= N:
+            raise ValueError(f"`drag.inertia` must be an inertia number 1 … {N} (or 0: ground), got {drag.inertia}")
         if drag.balance is not None and not 1 <= drag.balance <= N:
             raise ValueError(f"`drag.balance` must be an inertia number 1 … {N}, got {drag.balance}")
         if self.free and drag.balance is None:
@@ -354,7 +354,8 @@ class Chain:
         load = None
         if self.drag is not None:  # T_m(Ω) = T_m − D(Ω) e_j + D(Ω) e_b
             e = np.zeros(N)
-            e[self.drag.inertia - 1] -= 1.0
+            if self.drag.inertia:  # 0: the ground takes the drag
+                e[self.drag.inertia - 1] -= 1.0
             if self.drag.balance is not None:
                 e[self.drag.balance - 1] += 1.0
             load = drag_load(self.drag, float(self.speed_order), P @ e)  # type: ignore[arg-type]

@@ -39,6 +39,8 @@ _RAD_PER_S_PER_RPM = 2.0 * math.pi / 60.0
 def _inertia_number(name: str, value: object) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"`{name}` must be an integer inertia number, got {value!r}")
+    if value < 0:
+        raise ValueError(f"`{name}` must be an inertia number >= 1 (or 0: ground), got {value!r}")
     return int(value)
 
 
@@ -47,7 +49,9 @@ class Drag:
     """Drag torque ``torque`` (N m, ≥ 0) at crankshaft speeds ``speed_rpm`` (strictly increasing,
     > 0) on inertia ``inertia``, opposing the mean motion; linear interpolation, constant outside.
     ``balance``: the inertia whose mean torque delivers the drag at every speed (required on a
-    free chain: the engine's inertia)."""
+    free chain: the engine's inertia). ``inertia = 0`` (ground, with a ``balance``) is a drag
+    whose reaction the ground takes: + D on ``balance`` only — the form a drag takes in a
+    relative coordinate (a loose gear's δ = (r1/r2) θ1 − θ2, :func:`~rattle.model.loose_gear`)."""
 
     inertia: int
     speed_rpm: tuple[float, ...]
@@ -56,8 +60,14 @@ class Drag:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia", _inertia_number("inertia", self.inertia))
+        if self.inertia == 0 and self.balance is None:
+            raise ValueError("`inertia` = 0 (ground) needs a `balance`: the inertia on which the drag acts through "
+                             "its reaction; give the inertia the drag acts on, or a balance")
         if self.balance is not None:
             object.__setattr__(self, "balance", _inertia_number("balance", self.balance))
+            if self.balance == 0:
+                raise ValueError("`balance` must be an inertia number >= 1, got 0: ground takes a drag's reaction "
+                                 "when `balance` is left out")
             if self.balance == self.inertia:
                 raise ValueError(f"`balance` must be another inertia than the drag's `inertia` ({self.inertia}): the "
                                  "drag and the torque that delivers it on the same inertia cancel")
