@@ -478,3 +478,29 @@ def test_stiff_first_stage_clutch_tends_to_the_preload_orbit() -> None:
         errs.append(abs(orbit.rms - ref.rms) / ref.rms)
         np.testing.assert_allclose(np.abs(orbit.multipliers), np.abs(ref.multipliers), atol=10 * b**2)
     assert errs[0] < 1e-5 and 50.0 < errs[0] / errs[1] < 200.0
+
+
+@pytest.mark.parametrize("omega", [0.5, 1.3])
+def test_orbit_measures_match_the_exact_integrator_without_jumps(omega: float) -> None:
+    from rattle.timeint import shoot_periodic_orbit
+
+    m = reference_case()
+    orbit = shoot_nonsmooth_orbit(NonsmoothSystem.from_model(m), omega, (0.1, 0.05))
+    ref = shoot_periodic_orbit(m, omega, orbit.state0)
+    d_lo, d_hi, a_lo, a_hi = orbit.trajectory.extremes()
+    got = np.array([orbit.mean, orbit.rms, d_lo, d_hi, a_lo, a_hi])
+    want = np.array([ref.mean, ref.rms, ref.delta_min, ref.delta_max, ref.acc_min, ref.acc_max])
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-14)
+    assert orbit.regime == ref.regime
+
+
+def test_extremes_include_the_one_sided_accelerations_at_a_jump() -> None:
+    sysx = NonsmoothSystem.from_model(reference_case(), elastic=Preload(preload=0.02), friction=Friction(levels=0.01))
+    orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
+    tr = orbit.trajectory
+    d_lo, d_hi, a_lo, a_hi = tr.extremes()
+    _, _, a = tr.sample(np.linspace(0.0, tr.t1, 20001))
+    d, _, _ = tr.sample(np.linspace(0.0, tr.t1, 20001))
+    assert d_lo <= d.min() and d_hi >= d.max() and d_hi - d.max() < 1e-6 and d.min() - d_lo < 1e-6
+    assert a_lo <= a.min() and a_hi >= a.max()
+    assert orbit.regime == "single_sided" and tr.crossed_breakpoints.tolist() == [0.0]

@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from itertools import pairwise
 from types import SimpleNamespace
 
 import numpy as np
@@ -217,6 +218,59 @@ class NonsmoothTrajectory:
         T = self.t1 - self.t0
         m = self.integrate(lambda t, d, v, a: d) / T
         return m, math.sqrt(max(self.integrate(lambda t, d, v, a: d * d) / T, 0.0))
+
+    def extremes(self, samples_per_scale: int = 16) -> tuple[float, float, float, float]:
+        """(δ_min, δ_max, δ''_min, δ''_max) over [t0, t1]. δ'' jumps at the switchings: both
+        one-sided values count. Inside a slip segment the extrema are the roots of δ' and of the
+        jerk F' − c δ'' − k s_j δ', bracketed on a grid and refined by Newton's method."""
+        sol = self.solutions
+        c = sol.c
+        d_lo, d_hi, a_lo, a_hi = math.inf, -math.inf, math.inf, -math.inf
+        for i in range(len(self.t_start)):
+            ta, tb = float(self.t_start[i]), float(self.t_end[i])
+            if self.kind[i] != SLIP:
+                d0 = float(self.x_start[i, 0])
+                d_lo, d_hi, a_lo, a_hi = min(d_lo, d0), max(d_hi, d0), min(a_lo, 0.0), max(a_hi, 0.0)
+                continue
+            m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
+            h0, h1 = (float(x) for x in self.homogeneous[i])
+            scale = float(sol.time_scale[m])
+            n = 2 if not math.isfinite(scale) else max(2, math.ceil((tb - ta) * samples_per_scale / scale) + 1)
+            t = np.linspace(ta, tb, n)
+            d, v, a, jk = sol.evaluate(m, t, ta, h0, h1, order=3)
+            ks = float(sol.ks[m])
+
+            def at(x: float, m: int = m, ta: float = ta, h0: float = h0, h1: float = h1) -> list[float]:
+                return [float(y[0]) for y in sol.evaluate(m, np.array([x]), ta, h0, h1, order=3)]
+
+            def vel(x: float) -> tuple[float, float]:
+                y = at(x)
+                return y[1], y[2]
+
+            def jerk(x: float, ks: float = ks) -> tuple[float, float]:
+                y = at(x)
+                return y[3], float(sol.forcing(np.array([x]), 2)[0]) - c * y[3] - ks * y[2]
+
+            vals_d, vals_a = [float(d[0]), float(d[-1])], [float(a[0]), float(a[-1])]
+            tol = 4.0 * _EPS * max(abs(tb), 1.0)
+            for q in np.flatnonzero((v[:-1] > 0.0) != (v[1:] > 0.0)).tolist():
+                tq = bracketed_newton(vel, float(t[q]), float(t[q + 1]), float(v[q]), float(v[q + 1]), tol)
+                vals_d.append(at(tq)[0])
+            for q in np.flatnonzero((jk[:-1] > 0.0) != (jk[1:] > 0.0)).tolist():
+                tq = bracketed_newton(jerk, float(t[q]), float(t[q + 1]), float(jk[q]), float(jk[q + 1]), tol)
+                vals_a.append(at(tq)[2])
+            d_lo, d_hi = min(d_lo, *vals_d), max(d_hi, *vals_d)
+            a_lo, a_hi = min(a_lo, *vals_a), max(a_hi, *vals_a)
+        return d_lo, d_hi, a_lo, a_hi
+
+    @property
+    def crossed_breakpoints(self) -> FloatArray:
+        """The breakpoints the trajectory crossed or locked on (sorted, unique)."""
+        bp = self.system.law.stages.breakpoints
+        st, kd = self.stage.tolist(), self.kind.tolist()
+        hit = [float(bp[min(a, b)]) for a, b in pairwise(st) if a != b]
+        hit += [float(bp[j]) for j, k in zip(st, kd) if k == LOCK]
+        return np.unique(np.asarray(hit, dtype=float))
 
 
 class NonsmoothIntegrator:
@@ -599,6 +653,17 @@ class NonsmoothOrbit:
     def stable(self) -> bool:
         """True when every Floquet multiplier lies inside the unit circle."""
         return bool(np.all(np.abs(self.multipliers) < 1.0))
+
+    @property
+    def regime(self) -> str:
+        """``no_impact``, ``single_sided`` or ``double_sided`` from the breakpoints crossed or
+        locked on (a jump at δ = 0 is on neither side: crossing only it is ``single_sided``)."""
+        crossed = self.trajectory.crossed_breakpoints
+        if crossed.size == 0:
+            return "no_impact"
+        if np.all(crossed >= 0.0) or np.all(crossed <= 0.0):
+            return "single_sided"
+        return "double_sided"
 
 
 def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray | tuple[float, float], *,
