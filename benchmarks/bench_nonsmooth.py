@@ -58,10 +58,7 @@ def main() -> None:
               f"{np.array2string(np.abs(orbit.multipliers), precision=4)}, stick/lock time = {tr.stick_time:.3f}, "
               f"events {events}, shooting {t_shoot * 1e3:.1f} ms ({orbit.iterations} Newton steps)")
 
-        N, H = 256, 32
-        d, _, _ = tr.sample(np.arange(N) * T / N)
-        c = np.fft.rfft(d) / N
-        q0 = np.concatenate(([c[0].real], 2 * c[1 : H + 1].real, -2 * c[1 : H + 1].imag))
+        q0 = tr.fourier(32)
 
         def problem(eps: float, harmonics: int, sysx: NonsmoothSystem = sysx) -> RegularisedBalance:
             return RegularisedBalance(C, sysx, FM, (FP,), (PHASE,), regularisation=eps, length_scale=0.3,

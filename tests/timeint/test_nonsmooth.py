@@ -504,3 +504,19 @@ def test_extremes_include_the_one_sided_accelerations_at_a_jump() -> None:
     assert d_lo <= d.min() and d_hi >= d.max() and d_hi - d.max() < 1e-6 and d.min() - d_lo < 1e-6
     assert a_lo <= a.min() and a_hi >= a.max()
     assert orbit.regime == "single_sided" and tr.crossed_breakpoints.tolist() == [0.0]
+
+
+def test_fourier_coefficients_of_an_orbit() -> None:
+    # against a 2^16-point FFT of the exact samples (aliasing of the k⁻³ tail below 1e-15) and
+    # Parseval: the rms of the series tends to the orbit's rms (tail beyond H = 64 ~ 1e-9)
+    sysx = NonsmoothSystem.from_model(reference_case(), elastic=Preload(preload=0.02), friction=Friction(levels=0.01))
+    orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
+    tr = orbit.trajectory
+    H = 64
+    q = tr.fourier(H)
+    N = 2**16
+    d = tr.sample(np.arange(N) * tr.t1 / N)[0]
+    c = np.fft.rfft(d) / N
+    np.testing.assert_allclose(q, np.concatenate(([c[0].real], 2 * c[1 : H + 1].real, -2 * c[1 : H + 1].imag)),
+                               rtol=0, atol=1e-14)
+    assert abs(math.sqrt(q[0] ** 2 + 0.5 * np.sum(q[1:] ** 2)) - orbit.rms) < 1e-8 * orbit.rms

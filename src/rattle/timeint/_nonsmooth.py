@@ -195,6 +195,41 @@ class NonsmoothTrajectory:
             total += float(np.sum(half[:, None] * _GAUSS_W[None, :] * fun(tq, d, v, a)))
         return total
 
+    def fourier(self, harmonics: int) -> FloatArray:
+        """The real Fourier series of δ over [t0, t1] as one period, ω = 2π/(t1 − t0):
+        q = [a_0, a_1 … a_H, b_1 … b_H] with δ(t) = a_0 + Σ a_k cos kωt + b_k sin kωt — the
+        harmonic balance's unknowns, e.g. to start it on this orbit. The integrals are taken by
+        Gauss–Legendre panels inside the segments, at least 2 panels per period of harmonic H, so
+        the coefficients are exact to round-off (no aliasing of the kinks of δ')."""
+        if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) or harmonics < 0:
+            raise ValueError(f"`harmonics` must be an integer >= 0, got {harmonics!r}")
+        T = self.t1 - self.t0
+        w = 2.0 * math.pi / T
+        k = np.arange(1, harmonics + 1)
+        acc = np.zeros(2 * harmonics + 1)
+        sol = self.solutions
+        for i in range(len(self.t_start)):
+            ta, tb = float(self.t_start[i]), float(self.t_end[i])
+            if tb <= ta:
+                continue
+            n = math.ceil((tb - ta) * max(2 * harmonics, 4) / T)
+            if self.kind[i] == SLIP:
+                scale = float(sol.time_scale[3 * int(self.stage[i]) + int(self.sign[i]) + 1])
+                if math.isfinite(scale):
+                    n = max(n, math.ceil((tb - ta) * 4 / scale))
+            edges = np.linspace(ta, tb, max(n, 1) + 1)
+            half = 0.5 * np.diff(edges)
+            tq = ((0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]).ravel()
+            wq = (half[:, None] * _GAUSS_W[None, :]).ravel()
+            d = self.sample(np.clip(tq, ta, tb))[0] * wq
+            th = np.outer(k * w, tq)
+            acc[0] += d.sum()
+            acc[1 : harmonics + 1] += np.cos(th) @ d
+            acc[harmonics + 1 :] += np.sin(th) @ d
+        acc[0] /= T
+        acc[1:] *= 2.0 / T
+        return acc
+
     def friction_dissipation(self) -> float:
         """k ∫ r(δ) |δ'| dt over [t0, t1] (exact: on a slip segment sgn δ' is constant, so
         ∫ |δ'| dt = |δ(end) − δ(start)|)."""
