@@ -267,6 +267,7 @@ class NonsmoothLaw:
     friction: Friction | None = None
     _data: JumpStages = field(init=False, repr=False, compare=False)
     _levels: FloatArray = field(init=False, repr=False, compare=False)
+    _cont: JumpStages = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         el = self.elastic
@@ -286,6 +287,9 @@ class NonsmoothLaw:
         levels.setflags(write=False)
         object.__setattr__(self, "_data", data)
         object.__setattr__(self, "_levels", levels)
+        # f without its jumps (f_c(0) = 0), for the regularised law
+        object.__setattr__(self, "_cont", _jump_stages(tuple(data.breakpoints.tolist()), tuple(data.slopes.tolist()),
+                                                       (0.0,) * len(data.breakpoints)))
 
     @property
     def stages(self) -> JumpStages:
@@ -336,7 +340,7 @@ class NonsmoothLaw:
         st = self._data
         d = np.asarray(delta, dtype=float)
         v = np.asarray(velocity, dtype=float)
-        cont = _jump_stages(tuple(st.breakpoints.tolist()), tuple(st.slopes.tolist()), (0.0,) * len(st.breakpoints))
+        cont = self._cont
         j = np.searchsorted(cont.breakpoints, d, side="right")
         g = cont.slopes[j] * d + cont.offsets[j]
         g_d = cont.slopes[j].astype(float)
