@@ -10,7 +10,7 @@ from ._comparison import Comparison
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, compare_measured
 from ._orbit import OrbitSolution, PeriodicOrbit
-from ._sound import SoundPressure, a_weighting_db, linear_sound_pressure, sound_pressure
+from ._sound import SoundPressure, a_weighting_db, linear_sound_pressure, motion_sound_pressure, sound_pressure
 from ._steady import SteadyState
 from ._sweep import SweepResult
 
@@ -18,6 +18,6 @@ __all__ = [
     "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
     "SweepResult", "SteadyState", "PeriodicOrbit", "OrbitSolution", "Comparison",
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
-    "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db",
+    "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
 ]
