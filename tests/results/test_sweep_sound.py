@@ -210,3 +210,17 @@ def test_plot_gets_an_spl_panel_in_rpm_with_an_engine(tmp_path, sweep, config):
     x = axes["spl_db"].lines[0].get_xdata()
     np.testing.assert_allclose(x, s.speed_rpm, rtol=1e-12)
     plt.close(fig)
+
+
+def test_a_non_periodic_row_is_measured_over_its_record(config, sweep):
+    """A row of period 0 is taken over the record of ``record_periods`` forcing periods from its
+    state (here a periodic motion dressed as period 0 with a record of 3): the level of the
+    orbit again, through SweepResult.records' period-0 branch."""
+    import dataclasses
+
+    dressed = dataclasses.replace(sweep, period=np.zeros(2, dtype=np.int64),
+                                  settings={**sweep.settings, "steady_state": {"record_periods": 3}})
+    windows = [w for _, w in dressed.records()]
+    assert windows == [3, 3]
+    loud = sweep.with_sound(config.paths).extra_columns["spl_db"]
+    np.testing.assert_allclose(dressed.with_sound(config.paths).extra_columns["spl_db"], loud, atol=1e-6, rtol=0)
