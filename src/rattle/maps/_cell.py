@@ -155,6 +155,7 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     if paths:
         summary["spl_max_stable_db"], note = sound_levels(model, census, grid, paths)
         message = "; ".join(x for x in (message, note) if x)
+        timings["sound"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
     intervals = summary.pop("intervals")
     cell = CellResult(
