@@ -85,12 +85,10 @@ def test_measured_spl_against_the_harmonic_balance(tmp_path: Path) -> None:
     assert np.all(np.isfinite(hb))
     np.testing.assert_allclose(m["spl_db_hb"], hb, rtol=1e-12)
     np.testing.assert_allclose(m["spl_db_diff_hb"], hb - np.array([70.0, 71.0, 72.0]), rtol=1e-12)
-    s = read_csv(tmp_path / "out" / "sweep.csv")
-    if "spl_db" in s:  # once a sweep carries its sound pressure, it is compared too
-        assert np.all(np.isfinite(m["spl_db_sweep_up"]))
-    else:               # until then: against the harmonic balance only, and the summary says so
-        assert np.all(np.isnan(m["spl_db_sweep_up"])) and np.all(np.isnan(m["spl_db_diff_sweep_down"]))
-        assert "sweep up: none (the sweep result carries no spl_db)" in result.stdout
+    # the sweeps carry their sound pressure (SweepResult.with_sound): compared too, in dB
+    assert np.all(np.isfinite(m["spl_db_sweep_up"])) and np.all(np.isfinite(m["spl_db_sweep_down"]))
+    np.testing.assert_allclose(m["spl_db_diff_sweep_up"], m["spl_db_sweep_up"] - np.array([70.0, 71.0, 72.0]),
+                               rtol=1e-12)
     assert np.all(np.isfinite(m["acc_p2p_sweep_up"]))
 
 

@@ -44,15 +44,12 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import datetime as _dt
-import difflib
 import json
 import math
 import os
 import re
 import sys
-import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -62,6 +59,9 @@ from .. import _limits
 from ..errors import ConfigError
 from ..model import AbstractElastic, ELASTIC_LAWS, Excitation, Model, check_analysable_model
 from ..model._elastic import _check_real
+from ._checks import (
+    _EXAMPLES, _Checker, _did_you_mean, _example, _in_radians, _join, _kind, _show, rename_keys,
+)
 from ._read import read_bounded
 
 if sys.version_info >= (3, 11):
@@ -175,32 +175,6 @@ _MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
 _EXCITATION_KEYS = ("mean", "amplitudes", "phases")
 _ANALYSIS_KEYS = ("omega", "harmonics")
 
-# Example lines for "add e.g. ..." hints: the SPEC §2 example file.
-_EXAMPLES = {
-    "model": "[model] with inertia = 1.0, damping = 0.05, stiffness = 1.0",
-    "model.inertia": "inertia = 1.0",
-    "model.damping": "damping = 0.05",
-    "model.stiffness": "stiffness = 1.0",
-    "model.elastic": '[model.elastic] with type = "clutch", alpha = 0.25, b = 0.174533',
-    "model.elastic.type": 'type = "clutch"',
-    "model.elastic.alpha": "alpha = 0.25",
-    "model.elastic.b": "b = 0.174533",
-    "model.elastic.breakpoints": "breakpoints = [-0.3, -0.1, 0.05, 0.2]",
-    "model.elastic.slopes": "slopes = [1.0, 0.3, 0.05, 0.3, 1.0]",
-    "excitation": "[excitation] with mean = 0.05, amplitudes = [0.03]",
-    "excitation.mean": "mean = 0.05",
-    "excitation.amplitudes": "amplitudes = [0.03]",
-    "excitation.phases": "phases = [0.0]",
-    "analysis": "[analysis] with omega = [0.1, 3.0], harmonics = 32",
-    "analysis.omega": "omega = [0.1, 3.0]",
-    "analysis.harmonics": "harmonics = 32",
-}
-
-
-def _example(key: str) -> str:
-    return _EXAMPLES.get(key, f"{key.rsplit('.', 1)[-1]} = ...")
-
-
 def _law_params(law: type[AbstractElastic]) -> dict[str, tuple[str, bool]]:
     """Constructor parameters of an elastic law: name -> (kind "number"/"array", required)."""
     params = {}
@@ -211,193 +185,6 @@ def _law_params(law: type[AbstractElastic]) -> dict[str, tuple[str, bool]]:
         required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
         params[f.name] = (kind, required)
     return params
-
-
-# --------------------------------------------------------------------------------------------
-# Message helpers
-# --------------------------------------------------------------------------------------------
-def _show(value: Any) -> str:
-    """A value as it would be written in TOML."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, float):
-        return repr(value)
-    if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_show(v) for v in value) + "]"
-    return str(value)
-
-
-def _kind(value: Any) -> str:
-    """The TOML type name of a value, with its article."""
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, (int, np.integer)):
-        return "an integer"
-    if isinstance(value, (float, np.floating)):
-        return "a float"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, Mapping):
-        return "a table"
-    if isinstance(value, (list, tuple)):
-        return "an array"
-    if isinstance(value, (_dt.datetime, _dt.date, _dt.time)):
-        return "a date/time"
-    return f"a {type(value).__name__}"
-
-
-def _join(names: Sequence[str]) -> str:
-    return ", ".join(names) if names else "(none)"
-
-
-def _did_you_mean(word: str, choices: Sequence[str]) -> str:
-    lowered = {c.lower(): c for c in choices}
-    match = difflib.get_close_matches(word.lower(), list(lowered), n=1, cutoff=0.6)
-    return f"did you mean `{lowered[match[0]]}`? " if match else ""
-
-
-_BACKTICKED = re.compile(r"`([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)`")
-
-
-def rename_keys(message: str, names: Mapping[str, str]) -> str:
-    """Replace backticked field names in ``message`` by the names the user wrote.
-
-    ```inertia``` becomes ```model.inertia```, ```slopes[2]``` becomes
-    ```model.elastic.slopes[2]```: the dataclasses name their fields, the configuration
-    file and the command line name keys and options.
-
-    Parameters
-    ----------
-    message : str
-        An error message from a dataclass ``__post_init__``.
-    names : mapping of str to str
-        Field name -> user-facing key or option.
-
-    Returns
-    -------
-    str
-        The message with every known backticked name replaced.
-    """
-
-    def repl(m: re.Match[str]) -> str:
-        name, index = m.group(1), m.group(2)
-        return f"`{names[name]}{index}`" if name in names else m.group(0)
-
-    return _BACKTICKED.sub(repl, message)
-
-
-class _Checker:
-    """Validation of one configuration, with its source name for the messages."""
-
-    def __init__(self, source_name: str) -> None:
-        self.source_name = source_name
-        #: full rad key -> the ``_deg`` key the user wrote (``model.elastic.b`` -> ``model.elastic.b_deg``)
-        self.degree_keys: dict[str, str] = {}
-
-    def error(self, message: str) -> ConfigError:
-        for rad, deg in self.degree_keys.items():  # name the key the user wrote
-            message = message.replace(f"`{rad}`", f"`{deg}` (converted to rad)").replace(f"`{rad}[", f"`{deg}[")
-        return ConfigError(f"{self.source_name}: {message}")
-
-    # --- structure ---------------------------------------------------------------------------
-    def table(self, parent: Mapping[str, Any], key: str, full: str) -> Mapping[str, Any]:
-        value = parent[key]
-        if not isinstance(value, Mapping):
-            raise self.error(
-                f"`{full}` must be a table, got {_show(value)} ({_kind(value)}); "
-                f"write it as a section, e.g. {_example(full)}"
-            )
-        return value
-
-    def keys(
-        self,
-        table: Mapping[str, Any],
-        where: str,
-        allowed: Sequence[str],
-        required: Sequence[str],
-    ) -> None:
-        """Refuse unknown keys, then missing required ones."""
-        prefix = f"{where}." if where else ""
-        place = f"[{where}]" if where else "the top level"
-        for key in table:
-            if key not in allowed:
-                raise self.error(
-                    f"`{prefix}{key}` is not a known key: {place} allows only "
-                    f"{_join(allowed)}; {_did_you_mean(str(key), allowed)}"
-                    "remove it or correct its spelling"
-                )
-        for key in required:
-            if key not in table:
-                raise self.error(
-                    f"`{prefix}{key}` is missing: {place} requires {_join(required)}; "
-                    f"add e.g. {_example(prefix + key)}"
-                )
-
-    # --- TOML value types ----------------------------------------------------------------------
-    def number(self, value: Any, key: str) -> None:
-        """Check that ``value`` is a TOML number (not a boolean, string, array or table)."""
-        example = _example(key.split("[")[0])
-        if isinstance(value, bool):
-            fix = "booleans are not numbers; write a number"
-        elif isinstance(value, (int, np.integer)):
-            return  # the range is the dataclasses' rule
-        elif isinstance(value, (float, np.floating)):
-            if math.isfinite(value):
-                return
-            # TOML has nan/inf literals; no physical quantity or setting may take them.
-            raise self.error(
-                f"`{key}` must be a finite number, got {_show(float(value))} (TOML's "
-                f"{'not-a-number' if math.isnan(value) else 'infinity'} literal); "
-                f"write a finite value, e.g. {example}"
-            )
-        elif isinstance(value, str):
-            fix = "remove the quotes"
-        elif isinstance(value, (list, tuple)):
-            fix = "give a single number, not an array"
-        else:
-            fix = "give a number"
-        raise self.error(f"`{key}` must be a number, got {_show(value)} ({_kind(value)}); {fix}, e.g. {example}")
-
-    def array(self, value: Any, key: str) -> None:
-        """Check that ``value`` is a TOML array of numbers."""
-        if not isinstance(value, (list, tuple)):
-            raise self.error(
-                f"`{key}` must be an array of numbers, got {_show(value)} ({_kind(value)}); "
-                f"write it in brackets, e.g. {_example(key)}"
-            )
-        for i, item in enumerate(value):
-            self.number(item, f"{key}[{i}]")
-
-    def integer(self, value: Any, key: str) -> None:
-        """Check that ``value`` is a TOML integer."""
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise self.error(
-                f"`{key}` must be an integer, got {_show(value)} ({_kind(value)}); "
-                f"write a whole number without quotes or decimal point, e.g. {_example(key)}"
-            )
-
-    # --- construction --------------------------------------------------------------------------
-    def build(self, factory: Callable[..., _T], names: Mapping[str, str], /, **kwargs: Any) -> _T:
-        """Call ``factory(**kwargs)``; re-raise its ValueError/TypeError with the full key names."""
-        try:
-            # Warnings of the dataclasses (a clearance that looks like degrees) name their field:
-            # re-issue them with the full key, as the errors below.
-            with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always")
-                result = factory(**kwargs)
-            for w in caught:
-                warnings.warn(f"{self.source_name}: {rename_keys(str(w.message), names)}", w.category, stacklevel=3)
-            return result
-        except (ValueError, TypeError) as exc:
-            message = str(exc)
-            renamed = rename_keys(message, names)
-            if renamed == message:  # no field named: say which table it came from
-                renamed = f"`{next(iter(names.values())).rsplit('.', 1)[0]}`: {message}"
-            raise self.error(renamed) from exc
 
 
 # --------------------------------------------------------------------------------------------
@@ -645,9 +432,6 @@ def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
 #: ``[model] units``: the numbers are taken as given either way (the numerics are scale-aware);
 #: ``"SI"`` declares kg m², N m/rad, N m s/rad, N m and rad, and is required by ``[engine]``.
 UNITS = ("dimensionless", "SI")
-#: Keys holding angles (rad) that may be given in degrees as ``KEY_deg``: in ``[model.elastic]``
-#: and every ``[[model.elements]]``.
-ANGLE_KEYS = ("b", "breakpoints")
 
 
 def _units(check: _Checker, model_t: Mapping[str, Any]) -> str:
@@ -662,37 +446,6 @@ def _units(check: _Checker, model_t: Mapping[str, Any]) -> str:
             "(dimensionless)"
         )
     return value
-
-
-def _in_radians(check: _Checker, table: Mapping[str, Any], where: str, known: Sequence[str],
-                angles: Sequence[str] = ANGLE_KEYS) -> dict[str, Any]:
-    """``table`` with every ``KEY_deg`` (``KEY`` one of ``angles``, in degrees) replaced by ``KEY`` in rad."""
-    out = dict(table)
-    for key in table:
-        if not (isinstance(key, str) and key.endswith("_deg")):
-            continue
-        twin = key[: -len("_deg")]
-        if twin not in angles:
-            why = (f"`{twin}` is not an angle" if twin in known else f"`{where}.{twin}` is not a known key")
-            raise check.error(
-                f"`{where}.{key}` is not a known key: {why}, so it has no value in degrees (the `_deg` keys here "
-                f"are {_join([a + '_deg' for a in angles])}); remove it or correct its spelling"
-            )
-        if twin in table:
-            raise check.error(
-                f"`{where}.{twin}` and `{where}.{key}` are both given: one angle in rad and in degrees; "
-                f"keep one of them"
-            )
-        value = table[key]
-        if isinstance(value, (list, tuple)):
-            check.array(value, f"{where}.{key}")
-            out[twin] = [math.radians(float(v)) for v in value]
-        else:
-            check.number(value, f"{where}.{key}")
-            out[twin] = math.radians(float(value))
-        del out[key]
-        check.degree_keys[f"{where}.{twin}"] = f"{where}.{key}"
-    return out
 
 
 def _model_in_radians(check: _Checker, model_t: Mapping[str, Any]) -> dict[str, Any]:
