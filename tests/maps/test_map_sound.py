@@ -4,6 +4,7 @@ the paths' tables, and the command line."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -123,3 +124,22 @@ def test_cli_map_writes_the_column(tmp_path, sound_map):
     rows = np.genfromtxt(out / "map.csv", delimiter=",", names=True, dtype=None, encoding="utf-8")
     # the CLI's search differs from the fixture's, not the stable period-1 solutions found here
     np.testing.assert_allclose(rows["spl_max_stable_db"], sound_map.cells[0].spl_max_stable_db, atol=1e-9, rtol=0)
+
+
+def test_heat_map_of_the_level(sound_map, config):
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = sound_map.plot(quantity="spl")
+    mesh = axes["map"].collections[0]
+    np.testing.assert_array_equal(np.asarray(mesh.get_array()).ravel(), sound_map.cells[0].spl_max_stable_db)
+    assert "sound pressure level" in axes["colorbar"].get_ylabel()
+    plt.close(fig)
+    plain = dataclasses.replace(sound_map, paths=())
+    with pytest.raises(ValueError, match="quantity"):
+        plain.plot(quantity="spl")
+    with pytest.raises(ValueError, match="quantity"):
+        sound_map.plot(quantity="loudness")

@@ -24,7 +24,7 @@ from ._axes import PlotAxes, unwrap
 #: not import the maps layer above it.
 ResponseMap = Any
 
-__all__ = ["plot_map", "map_plot_names", "NO_SOLUTION_COLOR", "RATTLE_HATCH", "RATTLE_COLOR"]
+__all__ = ["plot_map", "map_plot_names", "NO_SOLUTION_COLOR", "RATTLE_HATCH", "RATTLE_COLOR", "MAP_QUANTITIES"]
 
 #: Colour of the cells with no stable period-1 solution (``rms_max_stable`` NaN).
 NO_SOLUTION_COLOR = "0.78"
@@ -98,10 +98,25 @@ def map_plot_names(response_map: ResponseMap) -> list[tuple[str, str]]:
     return out
 
 
+#: What a map's colour can show: quantity → (cell field, colour-bar label, legend text of an empty cell).
+MAP_QUANTITIES: dict[str, tuple[str, str, str]] = {
+    "rms": ("rms_max_stable", "largest stable period-1 rms of δ (rad)", "no stable period-1 solution"),
+    "spl": ("spl_max_stable_db", "largest stable sound pressure level (dB re 20 µPa)", "no stable periodic solution"),
+}
+
+
+def _values(cell: Any, field: str, size: int) -> np.ndarray:
+    """A cell's colour values (NaN throughout where it has none: a failed combination)."""
+    v = getattr(cell, field, None)
+    return np.full(size, np.nan) if v is None else np.asarray(v, dtype=float)
+
+
 def plot_map(
     response_map: ResponseMap, parameter: str | None = None, ax: Any = None, *, title: str | None = None,
+    quantity: str = "rms",
 ) -> tuple[Any, PlotAxes]:
-    """Heat map of the largest stable rms over Ω (x) and one varied parameter (y).
+    """Heat map of the largest stable rms (or sound pressure level) over Ω (x) and one varied
+    parameter (y).
 
     Parameters
     ----------
@@ -114,6 +129,9 @@ def plot_map(
         Axes to draw into (one varied parameter only; default: a new figure).
     title : str, optional
         Figure title.
+    quantity : {"rms", "spl"}, default "rms"
+        The colour: ``rms_max_stable``, or ``spl_max_stable_db`` (a map computed with sound
+        paths: the largest level over the stable periodic solutions, dB re 20 µPa).
 
     Returns
     -------
@@ -127,6 +145,8 @@ def plot_map(
     frequency (viridis, one scale over all panels). Grey: no stable period-1 solution there (the
     motion is sub-harmonic or non-periodic, ``periods_stable`` says which). Hatched: ``rattle``
     true (some attractor found impacts). Black outline: the boundary of the rattle-free cells.
+    With ``quantity="spl"`` the colour is ``spl_max_stable_db`` (dB) and grey means no stable
+    periodic solution of any period.
     """
     import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
@@ -134,6 +154,13 @@ def plot_map(
     from matplotlib.patches import Patch, Rectangle
     from matplotlib.lines import Line2D
 
+    if quantity not in MAP_QUANTITIES:
+        raise ValueError(f"`quantity` must be one of {', '.join(map(repr, MAP_QUANTITIES))}, got {quantity!r}")
+    if quantity == "spl" and not getattr(response_map, "has_sound", False):
+        raise ValueError("`quantity` \"spl\" needs a map computed with sound paths (response_map(..., paths=...), "
+                         "or [[paths]] in the configuration); this one has none")
+    field, bar_label, empty_label = MAP_QUANTITIES[quantity]
+    N = np.asarray(response_map.omega).size
     names = [p.name for p in response_map.parameters]
     if not names:
         raise ValueError("`response_map` varies no parameter; there is nothing to draw")
@@ -151,7 +178,7 @@ def plot_map(
     omega = np.asarray(response_map.omega if rpm is None else rpm, dtype=float)
     xe, ye = _edges(omega), _edges(yvalues)
 
-    rms_all = np.concatenate([np.asarray(c.rms_max_stable, float) for c in response_map.cells]) \
+    rms_all = np.concatenate([_values(c, field, N) for c in response_map.cells]) \
         if response_map.cells else np.array([np.nan])
     finite = rms_all[np.isfinite(rms_all)]
     vmin, vmax = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
@@ -178,7 +205,7 @@ def plot_map(
 
     mesh = None
     for a, (panel_title, cells) in zip(axes_list, shown):
-        rms = np.array([np.asarray(response_map.cells[k].rms_max_stable, float) for k in cells])
+        rms = np.array([_values(response_map.cells[k], field, N) for k in cells])
         rattle = np.array([np.asarray(response_map.cells[k].rattle, bool) for k in cells])
         mesh = a.pcolormesh(xe, ye, np.ma.masked_invalid(rms), cmap=cmap, norm=norm, shading="flat")
         for i in range(rattle.shape[0]):  # hatched runs of impacting cells, row by row
@@ -206,12 +233,12 @@ def plot_map(
         a.set_ylabel(_label(response_map, parameter))
     if mesh is not None:
         cbar = fig.colorbar(mesh, ax=axes_list, shrink=0.9)
-        cbar.set_label("largest stable period-1 rms of δ (rad)")
+        cbar.set_label(bar_label)
         cax = cbar.ax
     handles = [
         Patch(facecolor="none", edgecolor=RATTLE_COLOR, hatch=RATTLE_HATCH, label="impacts (rattle)"),
         Line2D([], [], color="black", linewidth=1.6, label="rattle-free boundary"),
-        Patch(facecolor=NO_SOLUTION_COLOR, edgecolor="0.5", label="no stable period-1 solution"),
+        Patch(facecolor=NO_SOLUTION_COLOR, edgecolor="0.5", label=empty_label),
     ]
     if ax is None:
         fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=8, frameon=False)
@@ -219,7 +246,8 @@ def plot_map(
         axes_list[0].legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.85)
     heading = title
     if heading is None and ax is None:
-        heading = "response map: largest stable rms, impacts hatched, rattle-free outlined"
+        heading = (f"response map: {'largest stable rms' if quantity == 'rms' else 'largest stable sound pressure level'}"
+                   ", impacts hatched, rattle-free outlined")
         if len(panels) > len(shown):
             heading += f" (first {len(shown)} of {len(panels)} panels)"
     if heading:
