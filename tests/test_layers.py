@@ -4,7 +4,9 @@
 - ``rattle.results`` holds data: it imports neither ``io``, ``plotting`` nor ``analysis`` when
   loaded (its ``.to_csv()``/``.plot()`` delegates import them inside the method, when called);
 - ``rattle.plotting`` draws results and knows nothing of the front ends, the demo or the CLI;
-- the command line imports the demo and the numerics only inside a command (a quick front door).
+- the command line imports the demo and the numerics only inside a command (a quick front door);
+- ``rattle.files`` (atomic writes, CSV, bounded reads, metadata) imports nothing of rattle but
+  ``errors``: every layer may write through it.
 """
 
 from __future__ import annotations
@@ -72,6 +74,10 @@ def test_imports_point_one_way(path: Path) -> None:
     if _in(me, "rattle.plotting"):
         bad = [m for m, _ in imports if any(_in(m, p) for p in ("rattle.analysis", "rattle.demo", "rattle.cli"))]
         assert not bad, f"{me} imports {bad}"
+    if _in(me, "rattle.files"):  # the file primitives: below every layer that writes
+        bad = [m for m, _ in imports if _in(m, "rattle") and not any(_in(m, p) for p in ("rattle.files", "rattle.errors",
+                                                                                        "rattle._release"))]
+        assert not bad, f"{me} imports {bad}: rattle.files knows no model, result or configuration"
     if _in(me, "rattle.cli"):
         heavy = [m for m, top in imports if top and any(_in(m, p) for p in ("rattle.demo", "rattle.analysis"))]
         assert not heavy, f"{me} imports {heavy} when loaded; import them inside the command"

@@ -259,7 +259,7 @@ def test_a_signal_during_the_move_waits_until_the_set_is_in_place(tmp_path: Path
     the KeyboardInterrupt is raised."""
     import signal
 
-    from rattle.io import _atomic
+    from rattle.files import _atomic
 
     out = tmp_path / "out"
     _old_set(out)

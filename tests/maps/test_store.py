@@ -80,7 +80,7 @@ def test_the_write_is_atomic(tmp_path, monkeypatch) -> None:
     monkeypatch.setattr(os, "replace", real_replace)
     assert store.load(key) == {"v": 1}  # the old part, whole
     assert [p.name for p in store.parts.iterdir()] == [f"{key}.json"]  # the temporary file removed
-    assert store_module.atomic_write_text.__module__ == "rattle.io._atomic"
+    assert store_module.atomic_write_text.__module__ == "rattle.files._atomic"
 
 
 @pytest.mark.parametrize("damage", ["truncated", "empty", "not json", "other key", "not a dict", "binary"])

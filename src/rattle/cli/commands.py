@@ -346,7 +346,7 @@ def compare_command(
     """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
     if measured is not None:
-        from ..io._read import check_input_file  # no numpy: refused at once
+        from ..files._read import check_input_file  # no numpy: refused at once
 
         try:
             check_input_file(measured, what="measured data file")

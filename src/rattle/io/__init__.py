@@ -1,6 +1,8 @@
-"""Input and output: the configuration file, CSV tables, run metadata and atomic writes.
+"""Input and output: the configuration file, sound-path and measured tables — and, under their
+public names, the file primitives of :mod:`rattle.files` (CSV tables, run metadata, atomic writes).
 
-The numerical core never touches files; everything that reads or writes lives here.
+The numerical core never touches files; everything that reads or writes lives here or in
+:mod:`rattle.files`.
 """
 
 from __future__ import annotations
@@ -9,20 +11,20 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 #: Public name → the module that defines it. Imported on first use (PEP 562): the command line
-#: reaches ``rattle.io._read`` and ``._atomic`` without numpy, which ``._config`` (the model)
+#: reaches ``rattle.files._read`` and ``._atomic`` without numpy, which ``._config`` (the model)
 #: and ``._csv``/``._metadata`` need.
 _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
-                     "recover_staging"], "._atomic"),
+                     "recover_staging"], "..files._atomic"),
     **dict.fromkeys(["DEFAULT_HARMONICS", "DEFAULT_OMEGA", "AnalysisSettings", "RunConfig", "check_harmonics",
                      "config_from_dict", "dumps_toml", "load_config", "model_to_toml_dict",
                      "rename_keys"], "._config"),
-    **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
+    **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "..files._csv"),
     **dict.fromkeys(["read_path_csv", "PATH_COLUMNS"], "._paths"),
     **dict.fromkeys(["read_measured_csv", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS"], "._measured"),
-    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
+    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "..files._read"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
-                    "._metadata"),
+                    "..files._metadata"),
 }
 
 
@@ -51,18 +53,18 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:
-    from ._atomic import (
+    from ..files._atomic import (
         STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging,
     )
     from ._config import (
         DEFAULT_HARMONICS, DEFAULT_OMEGA, AnalysisSettings, RunConfig, check_harmonics, config_from_dict, dumps_toml,
         load_config, model_to_toml_dict, rename_keys,
     )
-    from ._csv import format_csv, read_csv, write_csv
+    from ..files._csv import format_csv, read_csv, write_csv
     from ._paths import PATH_COLUMNS, read_path_csv
     from ._measured import MEASURED_SPEED_COLUMNS, MEASURED_VALUE_COLUMNS, read_measured_csv
-    from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
-    from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
+    from ..files._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
+    from ..files._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
 
 __all__ = [
     # configuration

@@ -62,7 +62,7 @@ from ..model._elastic import _check_real
 from ._checks import (
     _EXAMPLES, _Checker, _did_you_mean, _example, _in_radians, _join, _kind, _show, rename_keys,
 )
-from ._read import read_bounded
+from ..files._read import read_bounded
 
 if sys.version_info >= (3, 11):
     import tomllib

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ._read import read_bounded
+from ..files._read import read_bounded
 
 __all__ = ["PATH_COLUMNS", "PATHS_KEYS", "MAX_PATH_BYTES", "read_path_csv", "paths_from_config", "with_paths"]
 

@@ -337,7 +337,7 @@ class ResponseMap:
         """Write ``map.csv`` (SPEC §7) to ``path`` atomically; returns the path."""
         from pathlib import Path
 
-        from ..io._csv import write_csv
+        from ..files._csv import write_csv
 
         write_csv(path, self.columns(), self.column_names)
         return Path(path)
@@ -347,7 +347,7 @@ class ResponseMap:
         dependency), atomically; returns the path."""
         from pathlib import Path
 
-        from ..io._atomic import atomic_path
+        from ..files._atomic import atomic_path
 
         with atomic_path(path) as tmp:
             self.dataset.to_netcdf(tmp, engine="scipy")

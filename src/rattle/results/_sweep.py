@@ -307,7 +307,7 @@ class SweepResult:
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
         """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
-        from ..io._csv import write_csv
+        from ..files._csv import write_csv
 
         cols = self.columns()
         write_csv(path, cols, list(cols))

@@ -1,0 +1,46 @@
+"""Files: the primitives every layer writes and reads with — atomic writes and output sets, CSV
+tables, bounded reads of input files, run metadata. They know nothing of rattle's models, results
+or configuration (they import only :mod:`rattle.errors`), so the results' ``.to_csv()``, the maps'
+store and the command line use them without reaching the configuration reader
+(:mod:`rattle.io`, which re-exports them under their public names).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: Public name → the module that defines it, imported on first use (PEP 562): the command line
+#: reaches ``._read`` and ``._atomic`` without numpy, which ``._csv`` and ``._metadata`` need.
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
+                     "recover_staging"], "._atomic"),
+    **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
+    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
+    **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
+                    "._metadata"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'rattle.files' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+if TYPE_CHECKING:
+    from ._atomic import (
+        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging,
+    )
+    from ._csv import format_csv, read_csv, write_csv
+    from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
+    from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
+
+__all__ = sorted(_LAZY)
