@@ -2,6 +2,7 @@
 
 from ._builders import GearPair, LooseGear, clutch_damper, gear_pair, hub_spline, loose_gear
 from ._chain import Chain, Element, Link, Torque
+from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw, NonsmoothSystem, PiecewiseJump, Preload
 from ._drag import Drag, SpeedLoad
 from ._engine import base_order, engine_speed, engine_torque, firing_orders, forcing_frequency
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Backlash, Clutch, Linear, Piecewise, Stages
@@ -16,5 +17,6 @@ __all__ = [
     "Excitation", "Model", "System", "ReducedElement", "Chain", "Link", "Element", "Torque", "check_analysable_model", "reference_case", "backlash_case",
     "firing_orders", "engine_speed", "forcing_frequency", "base_order", "engine_torque",
     "SoundPath", "Drag", "SpeedLoad",
+    "AbstractJumpLaw", "Preload", "PiecewiseJump", "Friction", "NonsmoothLaw", "NonsmoothSystem",
     "clutch_damper", "hub_spline", "gear_pair", "loose_gear", "GearPair", "LooseGear",
 ]

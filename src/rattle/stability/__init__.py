@@ -9,6 +9,7 @@ from ._floquet import (
 from ._hill import hill_exponents, hill_multipliers
 from ._methods import STABILITY_METHODS, AbstractStabilityMethod, Hill, Monodromy, floquet_monitor, stability_method
 from ._monitor import FloquetMonitor, hb_system
+from ._regularised import regularised_monodromy, regularised_multipliers
 
 __all__ = [
     "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
@@ -17,4 +18,5 @@ __all__ = [
     "hill_exponents", "hill_multipliers", "FloquetMonitor", "hb_system",
     "AbstractStabilityMethod", "Monodromy", "Hill", "STABILITY_METHODS", "stability_method", "floquet_monitor",
     "is_stable", "classify_loss", "torus_ratio", "critical_distance", "UNIT_CIRCLE_TOL", "COMPLEX_TOL",
+    "regularised_monodromy", "regularised_multipliers",
 ]

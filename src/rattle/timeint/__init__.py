@@ -15,11 +15,15 @@ from ._shooting import ShootingOrbit, shoot_periodic_orbit
 from ._shooting_problem import ShootingProblem
 from ._system_shooting import SystemOrbit, shoot_system_orbit
 
+from ._nonsmooth import (
+    NonsmoothIntegrator, NonsmoothOptions, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit,
+)
 __all__ = [
     "ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
     "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem",
     "integrate_general", "GeneralSolution",
     "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
+    "NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
 ]
 
 #: Names that moved out of ``rattle.timeint`` (the steady state is an analysis, its result a

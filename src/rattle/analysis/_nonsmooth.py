@@ -1,0 +1,153 @@
+"""Frequency response of a discontinuous law (preload, friction): regularised HB, checked exactly.
+
+For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.NonsmoothSystem`):
+
+1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedBalance`, smooth steps of
+   relative width ε, H harmonics) is continued over Ω by pseudo-arclength
+   (:class:`~rattle.continuation.ContinuationStepper`): folds are followed as on the smooth laws;
+2. every continuation point is checked against the exact flow: Newton shooting on the
+   event-driven integrator (:func:`~rattle.timeint.shoot_nonsmooth_orbit`: crossings, sticking and
+   locking exact, the monodromy with saltation matrices) started from the HB orbit's state at
+   t = 0. The exact orbit gives the rms and the multipliers that are reported as the answer; the
+   HB's own values (rms, and the multipliers of the regularised orbit,
+   :func:`~rattle.stability.regularised_multipliers`) are kept beside them, so the regularisation's
+   effect is measured at every point (``rms_error``);
+3. a shooting that does not converge, or converges to an orbit whose state at t = 0 is farther than
+   ``match`` (relative to the orbit's size) from the HB one, is flagged ``matched = False``: there the
+   HB point has no exact counterpart nearby (usually near a fold or a grazing, where the exact
+   orbit has moved away or Newton stalls) and only the HB values stand.
+
+Cost: one continuation of 2H + 1 unknowns plus one exact shooting (a few ms) per point.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray
+from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
+from ..errors import RattleError, Status
+from ..hb import HBOptions, RegularisedBalance
+from ..model import NonsmoothSystem
+from ..stability import regularised_multipliers
+from ..timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
+from ._regularisation import regularisation_limit
+
+
+@dataclass(frozen=True, slots=True)
+class NonsmoothResponse:
+    """Rows of a continued branch (arrays of length P) and how the run ended.
+
+    ``omega``; ``rms_hb`` of the regularised HB orbit; ``rms`` of the exact orbit (nan where not
+    ``matched``); ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact multipliers
+    ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of the
+    regularised orbit; ``stick_time`` per period of the exact orbit; ``matched``; ``status``,
+    ``message``; ``regularisation`` ε and ``harmonics`` H of the HB."""
+
+    omega: FloatArray
+    rms_hb: FloatArray
+    rms: FloatArray
+    rms_error: FloatArray
+    stable: np.ndarray
+    multipliers: ComplexArray
+    multipliers_hb: ComplexArray
+    stick_time: FloatArray
+    matched: np.ndarray
+    status: Status
+    message: str
+    regularisation: float
+    harmonics: int
+
+    def __len__(self) -> int:
+        return int(self.omega.size)
+
+
+def _rms(q: FloatArray, H: int) -> float:
+    return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
+
+
+def nonsmooth_response(
+    system: NonsmoothSystem,
+    omega: tuple[float, float],
+    *,
+    harmonics: int = 128,
+    regularisation: float = 0.01,
+    match: float = 0.05,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+) -> NonsmoothResponse:
+    """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring).
+
+    ``harmonics`` H and ``regularisation`` ε of the HB; ``match`` the largest distance of the exact
+    orbit's state at t = 0 from the HB's, relative to the orbit's peak-to-peak (state scaled by Ω
+    for the velocity), for the two to count as one orbit.
+    """
+    if not isinstance(system, NonsmoothSystem):
+        raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
+    lo, hi = (float(w) for w in omega)
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+        raise ValueError(f"`omega` must be (min, max) with 0 < min < max, got {omega!r}")
+    if not (match > 0):
+        raise ValueError(f"`match` must be > 0, got {match!r}")
+    exc = system.excitation
+    L = system.length_scale()
+    wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
+    def make(eps: float, H: int) -> RegularisedBalance:
+        return RegularisedBalance(system.c, system, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
+                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
+
+    problem = make(regularisation, harmonics)
+    # the start: solved where the steps are wide (ε = 0.1), then narrowed to ε by homotopy
+    start = regularisation_limit(make, lo, np.zeros(problem.size), eps_start=max(0.1, regularisation),
+                                 eps_min=regularisation, harmonics=harmonics, max_harmonics=harmonics,
+                                 tail_tol=math.inf).last.q
+    stepper = ContinuationStepper(problem, start, lo, (lo, hi),
+                                  options=continuation or ContinuationOptions(),
+                                  newton=newton or NewtonOptions())
+    points = stepper.run()
+    integ = NonsmoothIntegrator(system)
+    rows: dict[str, list] = {k: [] for k in ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched")}
+    for pt in points:
+        w, q = float(pt.omega), pt.q
+        rms_hb = _rms(q, harmonics)
+        mu_hb = regularised_multipliers(problem, q, w)
+        d0, v0 = (float(a[0]) for a in problem.samples(q, w))
+        size = max(float(np.ptp(problem.basis.synthesize(q))), 1e-12 * L)
+        orbit = None
+        try:
+            orbit = shoot_nonsmooth_orbit(system, w, (d0, v0), integrator=integ, max_iterations=30)
+        except (RattleError, ValueError, ArithmeticError):  # e.g. the event budget of a chattering orbit
+            orbit = None
+        ok = orbit is not None and orbit.converged
+        if ok:
+            dist = math.hypot((orbit.state0[0] - d0) / size, (orbit.state0[1] - v0) / (size * w))
+            ok = dist <= match
+        rows["omega"].append(w)
+        rows["rms_hb"].append(rms_hb)
+        rows["mult_hb"].append(mu_hb)
+        rows["matched"].append(ok)
+        if ok:
+            rows["rms"].append(orbit.rms)
+            rows["mult"].append(np.asarray(orbit.multipliers, dtype=complex)[:2])
+            rows["stable"].append(bool(orbit.stable))
+            rows["stick"].append(float(orbit.trajectory.stick_time))
+        else:
+            rows["rms"].append(math.nan)
+            rows["mult"].append(mu_hb)
+            rows["stable"].append(bool(np.all(np.abs(mu_hb) < 1.0)))
+            rows["stick"].append(math.nan)
+    rms = np.array(rows["rms"])
+    rms_hb = np.array(rows["rms_hb"])
+    return NonsmoothResponse(
+        omega=np.array(rows["omega"]), rms_hb=rms_hb, rms=rms, rms_error=rms_hb / rms - 1.0,
+        stable=np.array(rows["stable"], dtype=bool), multipliers=np.array(rows["mult"]).reshape(-1, 2),
+        multipliers_hb=np.array(rows["mult_hb"]).reshape(-1, 2), stick_time=np.array(rows["stick"]),
+        matched=np.array(rows["matched"], dtype=bool), status=stepper.status or Status.SUCCESS,
+        message=stepper.message, regularisation=float(regularisation), harmonics=int(harmonics),
+    )
+
+
+__all__ = ["NonsmoothResponse", "nonsmooth_response"]

@@ -1,0 +1,59 @@
+"""Frequency response of preload and friction laws: the regularised HB continued over Ω, every point
+checked by exact event-driven shooting (issue 11)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rattle.analysis._nonsmooth import nonsmooth_response
+from rattle.continuation import solve_fixed
+from rattle.hb import HBOptions, RegularisedBalance
+from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.stability import regularised_multipliers
+from rattle.timeint import shoot_nonsmooth_orbit
+
+
+def _system(tp: float, r: float) -> NonsmoothSystem:
+    law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r) if r else None)
+    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+                           excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
+
+
+@pytest.mark.parametrize("tp, r, omega, bound", [
+    (0.05, 0.02, (0.75, 0.85), 3e-4),  # preload and friction, slipping all the time: measured 8.8e-5
+    (0.2, 0.0, (1.15, 1.25), 1e-5),    # preload alone, two transversal crossings: measured 2.9e-6
+])
+def test_branch_matches_the_exact_orbits(tp: float, r: float, omega: tuple[float, float], bound: float) -> None:
+    res = nonsmooth_response(_system(tp, r), omega, harmonics=64, regularisation=0.01)
+    assert res.status.success and len(res) >= 10
+    assert res.omega[0] == omega[0] and res.omega[-1] == pytest.approx(omega[1])
+    assert res.matched.all()
+    assert np.max(np.abs(res.rms_error)) <= bound
+    # the regularised orbit's multipliers are those of the exact one (saltations included)
+    assert np.max(np.abs(np.abs(res.multipliers_hb) - np.abs(res.multipliers))) <= 1e-3
+    assert res.stable.all() == bool(np.all(np.abs(res.multipliers) < 1))
+    # a row is the exact orbit shot independently from the HB state
+    i = len(res) // 2
+    exact = shoot_nonsmooth_orbit(_system(tp, r), float(res.omega[i]), (0.0, 0.0))
+    if exact.converged and abs(exact.rms - res.rms[i]) < 1e-3 * exact.rms:  # the same orbit reached from rest
+        assert res.rms[i] == pytest.approx(exact.rms, rel=1e-9)
+
+
+def test_regularised_multipliers_converge_to_the_exact_with_a_stick_phase() -> None:
+    """A friction orbit with sticking has an exact zero multiplier (the stick forgets the velocity);
+    the regularised orbit's smallest multiplier tends to it as ε falls, the largest to the exact one."""
+    system = _system(0.2, 0.05)
+    w = 0.6
+    exact = shoot_nonsmooth_orbit(system, w, (0.05, 0.0))
+    assert exact.converged and exact.trajectory.stick_time > 0.5
+    lo = []
+    for eps in (0.03, 0.01):
+        pb = RegularisedBalance(system.c, system, 0.01, (0.3,), (0.3,), regularisation=eps,
+                                length_scale=system.length_scale(), frequency_scale=1.0, options=HBOptions(harmonics=128))
+        coef = exact.trajectory.fourier(128)
+        sol = solve_fixed(pb, coef, w)
+        assert sol.converged
+        mu = np.abs(regularised_multipliers(pb, sol.q, w))
+        lo.append(mu[1])
+    assert lo[1] < lo[0] < 0.05 and abs(exact.multipliers[1]) < 1e-12
