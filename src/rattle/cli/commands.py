@@ -376,8 +376,9 @@ def compare_command(
         "measured": None if measured is None else str(measured),
     })
     frf = result.frf.with_sound(run_config.paths) if run_config.paths else result.frf
+    sweep = result.sweep.with_sound(run_config.paths) if run_config.paths else result.sweep
     steps: list[tuple[str, Any]] = [
-        ("frf.csv", frf.to_csv), ("sweep.csv", result.sweep.to_csv),
+        ("frf.csv", frf.to_csv), ("sweep.csv", sweep.to_csv),
         ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
     ]
     summary = result.summary()
@@ -391,12 +392,7 @@ def compare_command(
 
             return compare_plot(result, measured=beside)
 
-        # Hook: the sweep's sound pressure, once a sweep result can carry it (SweepResult.with_sound);
-        # until then spl_db is compared against the harmonic balance only.
-        sweep = result.sweep
-        if run_config.paths and hasattr(sweep, "with_sound"):
-            sweep = sweep.with_sound(run_config.paths)
-        beside = compare_measured(measured_run, frf, sweep)
+        beside = compare_measured(measured_run, frf, sweep)  # the sweeps with their sound pressure (paths)
         summary += "\n" + beside.summary()
         steps += [("compare.png", lambda path: save_figure(draw_measured, path)), ("measured.csv", beside.to_csv)]
     written = write_set(output, COMPARE_FILES, steps)

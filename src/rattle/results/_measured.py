@@ -192,8 +192,8 @@ def _frf_column(frf: FrequencyResponse, quantity: str) -> FloatArray:
 def _sweep_column(part: SweepResult, quantity: str) -> FloatArray | None:
     """The sweep's values of ``quantity``, or None when its result has no such column.
 
-    Hook for the sweep's sound pressure: ``spl_db`` is taken from ``SweepResult.columns()``
-    as soon as a sweep result carries it; until then the sweep has no sound pressure to compare."""
+    ``spl_db`` is taken from ``SweepResult.columns()``: a sweep with its sound pressure
+    (:meth:`SweepResult.with_sound`) carries it, a sweep of a model without paths does not."""
     if quantity == "acc_p2p":
         return np.asarray(part.acc_p2p, dtype=float)
     col = part.columns().get(quantity)
