@@ -85,7 +85,9 @@ def test_measured_spl_against_the_harmonic_balance(tmp_path: Path) -> None:
     assert np.all(np.isfinite(hb))
     np.testing.assert_allclose(m["spl_db_hb"], hb, rtol=1e-12)
     np.testing.assert_allclose(m["spl_db_diff_hb"], hb - np.array([70.0, 71.0, 72.0]), rtol=1e-12)
-    # the sweeps carry their sound pressure (SweepResult.with_sound): compared too, in dB
+    # the sweeps carry their sound pressure (SweepResult.with_sound): written in sweep.csv, compared too, in dB
+    s = read_csv(tmp_path / "out" / "sweep.csv")
+    assert {"spl_db", "spl_dba", "spl_linear_db"} <= set(s) and np.all(np.isfinite(s["spl_db"]))
     assert np.all(np.isfinite(m["spl_db_sweep_up"])) and np.all(np.isfinite(m["spl_db_sweep_down"]))
     np.testing.assert_allclose(m["spl_db_diff_sweep_up"], m["spl_db_sweep_up"] - np.array([70.0, 71.0, 72.0]),
                                rtol=1e-12)
