@@ -70,6 +70,18 @@ def check_omega(value: object, name: str = "omega") -> float:
     return w
 
 
+def check_shooting(period: object, tol: object, max_iterations: object) -> tuple[int, float, int]:
+    """The arguments every Newton shooting takes: ``period`` an integer >= 1 (forcing periods),
+    ``tol`` a number > 0, ``max_iterations`` an integer >= 0."""
+    if isinstance(period, bool) or not isinstance(period, Integral) or period < 1:
+        raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
+    if isinstance(tol, bool) or not (isinstance(tol, (int, float)) and tol > 0.0):
+        raise ValueError(f"`tol` must be a positive number, got {tol!r}")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, Integral) or max_iterations < 0:
+        raise ValueError(f"`max_iterations` must be an integer >= 0, got {max_iterations!r}")
+    return int(period), float(tol), int(max_iterations)
+
+
 def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
     """A frequency range (min, max) in rad/s: two finite numbers, 0 < min < max."""
     if isinstance(omega, (str, bytes)) or not hasattr(omega, "__iter__") or hasattr(omega, "items"):
@@ -167,5 +179,5 @@ def numerical_failures(func: _F) -> _F:
     return wrapper  # type: ignore[return-value]
 
 
-__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_range", "check_state", "as_float_array", "check_int", "check_bool", "check_choice",
+__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_shooting", "check_range", "check_state", "as_float_array", "check_int", "check_bool", "check_choice",
            "check_instance"]

@@ -174,17 +174,21 @@ def _scale(value: Any, factor: float) -> Any:
     return value
 
 
+def _whole_model(check: _Checker, model_t: Mapping[str, Any], key: str, whole: str, units: str) -> None:
+    """A shape that is the whole model: [model] holds only ``units`` = "SI" and the shape's table."""
+    others = [k for k in model_t if k not in ("units", key)]
+    if others:
+        raise check.error(f"`model.{others[0]}` cannot be given with [model.{key}]: {whole}; [model] then holds only "
+                          f"units and {key}")
+    if model_t.get("units") != "SI":
+        raise check.error(f"[model.{key}] needs `model.units` = \"SI\" (got {_show(model_t.get('units'))}): {units}; "
+                          "add units = \"SI\" to [model]")
+
+
 def _gear_pair(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]) -> dict[str, Any]:
     where = "model.gear_pair"
-    others = [k for k in model_t if k not in ("units", "gear_pair")]
-    if others:
-        raise check.error(
-            f"`model.{others[0]}` cannot be given with [model.gear_pair]: the gear pair is the whole chain (its two "
-            "gears are inertias 1 and 2); [model] then holds only units and gear_pair"
-        )
-    if model_t.get("units") != "SI":
-        raise check.error(f"[model.gear_pair] needs `model.units` = \"SI\" (got {_show(model_t.get('units'))}): its "
-                          "radii are in m, its mesh stiffness in N/m; add units = \"SI\" to [model]")
+    _whole_model(check, model_t, "gear_pair", "the gear pair is the whole chain (its two gears are inertias 1 and 2)",
+                 "its radii are in m, its mesh stiffness in N/m")
     t = check.table(model_t, "gear_pair", where)
     t = dict(t)
     names = _backlash_m(check, t, where)
@@ -221,15 +225,8 @@ def _gear_pair(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]
 
 def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]) -> dict[str, Any]:
     where = "model.loose_gear"
-    others = [k for k in model_t if k not in ("units", "loose_gear")]
-    if others:
-        raise check.error(
-            f"`model.{others[0]}` cannot be given with [model.loose_gear]: the loose gear is the whole model (one "
-            "inertia in the relative coordinate); [model] then holds only units and loose_gear"
-        )
-    if model_t.get("units") != "SI":
-        raise check.error(f"[model.loose_gear] needs `model.units` = \"SI\" (got {_show(model_t.get('units'))}): its "
-                          "radii are in m, its speeds in rpm; add units = \"SI\" to [model]")
+    _whole_model(check, model_t, "loose_gear", "the loose gear is the whole model (one inertia in the relative "
+                 "coordinate)", "its radii are in m, its speeds in rpm")
     for key in ("engine", "excitation"):
         if key in data:
             raise check.error(

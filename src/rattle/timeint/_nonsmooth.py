@@ -54,7 +54,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray, IntArray
-from .._validate import check_omega, check_state
+from .._validate import check_omega, check_shooting, check_state
 from ..errors import ConvergenceError
 from ..model._discontinuous import NonsmoothSystem
 from ..model._elastic import Stages
@@ -711,12 +711,7 @@ def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray 
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
     omega = check_omega(omega)
-    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
-        raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
-    if not (isinstance(tol, (int, float)) and tol > 0.0):
-        raise ValueError(f"`tol` must be a positive number, got {tol!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 0:
-        raise ValueError(f"`max_iterations` must be an integer >= 0, got {max_iterations!r}")
+    check_shooting(period, tol, max_iterations)
     integ = NonsmoothIntegrator(system) if integrator is None else integrator
     if integ.system != system:
         raise ValueError("`integrator` was built for a different system than `system`")

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
-from .._validate import check_omega
+from .._validate import check_omega, check_shooting
 from ..model import Model
 from ._exact import ExactIntegrator, Trajectory
 
@@ -122,12 +122,7 @@ def shoot_periodic_orbit(
     if not isinstance(model, Model):
         raise TypeError(f"`model` must be a rattle Model, got {model!r}")
     omega = check_omega(omega)
-    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
-        raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
-    if not (isinstance(tol, (int, float)) and tol > 0.0):
-        raise ValueError(f"`tol` must be a positive number, got {tol!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 0:
-        raise ValueError(f"`max_iterations` must be an integer >= 0, got {max_iterations!r}")
+    check_shooting(period, tol, max_iterations)
     integ = ExactIntegrator(model) if integrator is None else integrator
     if integ.model is not model and integ.model != model:
         raise ValueError("`integrator` was built for a different model than `model`")

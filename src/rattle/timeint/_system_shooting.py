@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
-from .._validate import check_omega
+from .._validate import check_omega, check_shooting
 from ..model import System
 from ._flow import (
     SystemIntegrator,
@@ -117,12 +117,7 @@ def shoot_system_orbit(
         raise TypeError(f"`system` must be a rattle.model.System, got {system!r}")
     omega = check_omega(omega)
     z = check_system_state(z0, system.n)
-    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
-        raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
-    if isinstance(tol, bool) or not (isinstance(tol, (int, float)) and tol > 0.0):
-        raise ValueError(f"`tol` must be a positive number, got {tol!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 0:
-        raise ValueError(f"`max_iterations` must be an integer >= 0, got {max_iterations!r}")
+    check_shooting(period, tol, max_iterations)
     integ = SystemIntegrator(system) if integrator is None else integrator
     if not isinstance(integ, SystemIntegrator):
         raise TypeError(f"`integrator` must be a SystemIntegrator or None, got {integrator!r}")
