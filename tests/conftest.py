@@ -25,8 +25,15 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
 import matplotlib
 import numpy as np
 import pytest
+from hypothesis import settings as _hypothesis_settings
 
 matplotlib.use("Agg")
+
+# Property tests draw the same examples on every run (a CI run must not fail on a draw a local
+# run never made); run with HYPOTHESIS_PROFILE=explore to draw new ones (and record failures).
+_hypothesis_settings.register_profile("ci", derandomize=True, deadline=None)
+_hypothesis_settings.register_profile("explore", deadline=None)
+_hypothesis_settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 # The command-line tests' shared helpers (tests/cli/_cli_helpers.py) are importable from every
 # test module, as tests/_cases.py is (pytest puts this folder on sys.path for its conftest).

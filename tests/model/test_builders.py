@@ -86,6 +86,7 @@ def test_damper_without_free_play():
     ({"coast_angles": [-0.03]}, r"`coast_angles\[0\]` must be > 0"),
     ({"free_play": 0.08}, r"`coast_angles\[0\]` must be > free_play/2"),
     ({"free_play": -0.01}, r"`free_play` must be >= 0"),
+    ({"free_play": 5e-324}, r"`free_play` must be 0 \(none\) or at least 1e-12 rad"),
     ({"coast_stiffness": []}, r"`coast_stiffness` must hold at least one"),
 ])
 def test_damper_refusals(kwargs, match):
@@ -102,7 +103,7 @@ _gap = st.floats(min_value=1e-3, max_value=0.1)
 @settings(max_examples=60, deadline=None)
 @given(kd=st.lists(_stage, min_size=1, max_size=4), kc=st.lists(_stage, min_size=1, max_size=4),
        gd=st.lists(_gap, min_size=3, max_size=3), gc=st.lists(_gap, min_size=3, max_size=3),
-       play=st.floats(min_value=0.0, max_value=0.05))
+       play=st.one_of(st.just(0.0), st.floats(min_value=1e-12, max_value=0.05)))
 def test_damper_law_invariants(kd, kc, gd, gc, play):
     """Any data sheet gives a continuous law with f(0) = 0, the torque of the stages by hand, and
     zero torque inside the free play."""

@@ -35,6 +35,10 @@ from ._elastic import Backlash, Piecewise, _check_real, _check_real_sequence
 __all__ = ["GearPair", "LooseGear", "clutch_damper", "gear_pair", "hub_spline", "loose_gear"]
 
 
+#: The smallest non-zero free play of a damper (rad): 1e-12 rad (6e-11 degrees) is no free play.
+MIN_FREE_PLAY = 1e-12
+
+
 def _positive(name: str, value: object) -> float:
     x = _check_real(name, value)
     if not x > 0:
@@ -78,6 +82,10 @@ def _damper_law(*, drive_stiffness: Sequence[float], drive_angles: Sequence[floa
     p = _check_real("free_play", free_play)
     if p < 0:
         raise ValueError(f"`free_play` must be >= 0 (the total free play around zero), got {p!r}")
+    if 0 < p < MIN_FREE_PLAY:
+        raise ValueError(f"`free_play` must be 0 (none) or at least {MIN_FREE_PLAY:g} rad, got {p!r}: a free play "
+                         "that small is no free play (its two stage ends would be closer than the crossings of a "
+                         "motion can be told apart); give 0")
     kd, ad = _stage_side("drive", drive_stiffness, drive_angles, p / 2)
     kc, ac = _stage_side("coast", coast_stiffness, coast_angles, p / 2)
     K = max(*kd, *kc)
