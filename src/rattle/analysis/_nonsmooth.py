@@ -45,7 +45,11 @@ class NonsmoothResponse:
     ``matched``); ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact multipliers
     ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of the
     regularised orbit; ``stick_time`` per period of the exact orbit; ``matched``; ``status``,
-    ``message``; ``regularisation`` ε and ``harmonics`` H of the HB."""
+    ``message``; ``regularisation`` ε and ``harmonics`` H of the HB.
+
+    The regularisation continued to its limit at ``limit`` matched points (row indices
+    ``limit_index``): ``limit_eps`` the smallest ε reached, ``limit_rms`` the HB rms there,
+    ``limit_richardson`` the Richardson ε → 0 value, each against the exact rms of the row."""
 
     omega: FloatArray
     rms_hb: FloatArray
@@ -60,6 +64,20 @@ class NonsmoothResponse:
     message: str
     regularisation: float
     harmonics: int
+    limit_index: np.ndarray
+    limit_eps: FloatArray
+    limit_rms: FloatArray
+    limit_richardson: FloatArray
+
+    @property
+    def limit_error(self) -> FloatArray:
+        """limit_rms / rms − 1 at the ladder's rows."""
+        return self.limit_rms / self.rms[self.limit_index] - 1.0
+
+    @property
+    def richardson_error(self) -> FloatArray:
+        """limit_richardson / rms − 1 at the ladder's rows."""
+        return self.limit_richardson / self.rms[self.limit_index] - 1.0
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -76,6 +94,9 @@ def nonsmooth_response(
     harmonics: int = 128,
     regularisation: float = 0.01,
     match: float = 0.05,
+    limit: int = 0,
+    limit_eps: float = 1e-3,
+    limit_harmonics: int = 256,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
 ) -> NonsmoothResponse:
@@ -83,7 +104,10 @@ def nonsmooth_response(
 
     ``harmonics`` H and ``regularisation`` ε of the HB; ``match`` the largest distance of the exact
     orbit's state at t = 0 from the HB's, relative to the orbit's peak-to-peak (state scaled by Ω
-    for the velocity), for the two to count as one orbit.
+    for the velocity), for the two to count as one orbit. ``limit`` > 0: at that many matched rows,
+    evenly spread, the regularisation is continued from ε down to ``limit_eps`` (harmonics raised up
+    to ``limit_harmonics``; :func:`~rattle.analysis._regularisation.regularisation_limit`) and its
+    last and Richardson rms are kept beside the exact one.
     """
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
@@ -141,12 +165,31 @@ def nonsmooth_response(
             rows["stick"].append(math.nan)
     rms = np.array(rows["rms"])
     rms_hb = np.array(rows["rms_hb"])
+    matched = np.array(rows["matched"], dtype=bool)
+    candidates = np.flatnonzero(matched)
+    pick = candidates[np.unique(np.linspace(0, candidates.size - 1, min(int(limit), candidates.size)).round().astype(int))] \
+        if limit > 0 and candidates.size else np.zeros(0, dtype=int)
+    lim_eps, lim_rms, lim_rich = [], [], []
+    for i in pick:
+        try:
+            lad = regularisation_limit(make, float(points[i].omega), points[i].q, eps_start=regularisation,
+                                       eps_min=min(limit_eps, regularisation), harmonics=harmonics,
+                                       max_harmonics=max(limit_harmonics, harmonics))
+            lim_eps.append(lad.last.eps)
+            lim_rms.append(lad.last.rms)
+            lim_rich.append(lad.extrapolated_rms)
+        except RattleError:  # the ladder stalled: the row keeps its ε
+            lim_eps.append(math.nan)
+            lim_rms.append(math.nan)
+            lim_rich.append(math.nan)
     return NonsmoothResponse(
         omega=np.array(rows["omega"]), rms_hb=rms_hb, rms=rms, rms_error=rms_hb / rms - 1.0,
         stable=np.array(rows["stable"], dtype=bool), multipliers=np.array(rows["mult"]).reshape(-1, 2),
         multipliers_hb=np.array(rows["mult_hb"]).reshape(-1, 2), stick_time=np.array(rows["stick"]),
-        matched=np.array(rows["matched"], dtype=bool), status=stepper.status or Status.SUCCESS,
+        matched=matched, status=stepper.status or Status.SUCCESS,
         message=stepper.message, regularisation=float(regularisation), harmonics=int(harmonics),
+        limit_index=np.asarray(pick, dtype=int), limit_eps=np.array(lim_eps), limit_rms=np.array(lim_rms),
+        limit_richardson=np.array(lim_rich),
     )
 
 
