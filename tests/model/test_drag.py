@@ -227,3 +227,49 @@ def test_cli_refuses_an_unsorted_drag_table_with_exit_2_writing_nothing(tmp_path
     assert result.exit_code == 2, result.output
     assert "drag.speed_rpm" in result.output + str(getattr(result, "stderr", ""))
     assert not out.exists()
+
+
+def _random_drag_chain(seed: int, free: bool) -> Chain:
+    """A random three-inertia chain with two clearance elements and a three-point drag table on
+    inertia 3; free chains get the drag delivered by inertia 1 (the engine), grounded ones hold it."""
+    rng = np.random.default_rng(seed)
+    inertias = tuple(rng.uniform(0.5, 1.5, 3))
+    links = [Link(between=(1, 2), damping=rng.uniform(0.03, 0.06)), Link(between=(2, 3), damping=rng.uniform(0.03, 0.06))]
+    if not free:
+        links.append(Link(between=(1, 0), stiffness=rng.uniform(0.2, 0.4), damping=rng.uniform(0.02, 0.04)))
+    elements = (Element(name="e1", between=(1, 2), stiffness=rng.uniform(1.0, 2.0),
+                        law=rattle.Clutch(alpha=rng.uniform(0.2, 0.4), b=rng.uniform(0.1, 0.2))),
+                Element(name="e2", between=(2, 3), stiffness=rng.uniform(1.0, 2.0), law=rattle.Backlash(b=rng.uniform(0.05, 0.1))))
+    d = rng.uniform(0.02, 0.05, 3).cumsum()
+    drag = Drag(inertia=3, speed_rpm=(10.0, 20.0, 30.0), torque=tuple(d), balance=1 if free else None)
+    torques = (Torque(inertia=1, amplitudes=(rng.uniform(0.03, 0.06),)),)
+    return Chain(inertias=inertias, links=tuple(links), elements=elements, torques=torques,
+                 speed_order=60.0 / (2.0 * math.pi * 20.0), drag=drag)  # rpm = 20 Ω: the table spans Ω 0.5 … 1.5
+
+
+@pytest.mark.parametrize("seed, free", [(1, True), (2, False), (3, True)])
+def test_random_chains_with_drag_agree_with_exact_shooting(seed: int, free: bool) -> None:
+    """Random three-inertia chains whose drag changes along the branch: every 4th stable point of the
+    continuation is an orbit of the exact flow with the drag of its Ω (Newton shooting from the HB
+    state: same orbit, element rms within the H = 24 truncation — measured 8.0e-6, 4.9e-7, 1.2e-5
+    relative on seeds 1, 2, 3 — and the same stability)."""
+    from rattle.timeint import shoot_system_orbit
+
+    chain = _random_drag_chain(seed, free)
+    system = chain.system()
+    assert system.load is not None and np.any(system.load.direction)
+    frf = rattle.frequency_response(chain, omega=(0.6, 1.4), harmonics=24, confirm_tori=False)
+    n, S = system.n, 2 * 24 + 1
+    checked = 0
+    for i in np.flatnonzero(frf.stable)[::4][:8]:
+        w = float(frf.omega[i])
+        Q = frf.coefficients[i].reshape(n, S)
+        z0 = np.concatenate((Q[:, 0] + Q[:, 1:25].sum(axis=1), (Q[:, 25:] * np.arange(1, 25)).sum(axis=1) * w))
+        orbit = shoot_system_orbit(system, w, z0)
+        assert orbit.converged
+        assert np.max(np.abs(orbit.state0 - z0)) <= 1e-2 * chain.length_scale()
+        for name in chain.element_names:
+            assert frf.element(name)["rms"][i] == pytest.approx(orbit.measures.element(name)["rms"], rel=1e-4), (name, w)
+        assert orbit.stable
+        checked += 1
+    assert checked >= 4
