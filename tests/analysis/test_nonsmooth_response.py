@@ -70,3 +70,36 @@ def test_the_regularisation_continued_to_its_limit_at_chosen_rows() -> None:
     before = np.abs(res.rms_error[res.limit_index])
     assert np.all(np.abs(res.limit_error) < 0.7 * before)
     assert np.all(np.abs(res.richardson_error) < np.abs(res.limit_error))
+
+
+def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None:
+    from rattle.files import read_csv
+    from rattle.results import NONSMOOTH_COLUMNS
+
+    system = _system(0.05, 0.02)
+    res = nonsmooth_response(system, (0.75, 0.85), harmonics=64, regularisation=0.01)
+    i = len(res) // 2
+    exact = shoot_nonsmooth_orbit(system, float(res.omega[i]), (0.0, 0.0))
+    d_lo, d_hi, a_lo, a_hi = exact.trajectory.extremes()
+    if abs(exact.rms - res.rms[i]) < 1e-6 * exact.rms:  # the same orbit from rest: its measures
+        assert res.mean[i] == pytest.approx(exact.mean, rel=1e-9)
+        assert res.p2p[i] == pytest.approx(d_hi - d_lo, rel=1e-9) and res.acc_p2p[i] == pytest.approx(a_hi - a_lo, rel=1e-9)
+        assert res.regime[i] == exact.regime
+    assert np.allclose(res.rms_ac**2 + res.mean**2, res.rms**2, rtol=1e-12)
+    assert set(res.regime) <= {"no_impact", "single_sided", "double_sided"}
+    assert not any(res.bifurcation)  # stable throughout
+    path = res.to_csv(tmp_path / "frf.csv")
+    cols = read_csv(path)
+    assert list(cols) == list(NONSMOOTH_COLUMNS) and len(cols["omega"]) == len(res)
+    np.testing.assert_allclose(cols["rms"], res.rms, rtol=1e-15)
+
+
+def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
+    """The preload-only branch near Ω = 0.31 … 0.36 loses and regains stability several times: every
+    change between matched rows carries a label, and only those."""
+    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), harmonics=64, regularisation=0.01)
+    m = np.flatnonzero(res.matched)
+    changes = {int(j) for i, j in zip(m, m[1:]) if res.stable[i] != res.stable[j]}
+    labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
+    assert changes and labelled == changes
+    assert set(res.bifurcation[list(labelled)]) <= {"fold", "period_doubling", "neimark_sacker"}

@@ -24,64 +24,17 @@ Cost: one continuation of 2H + 1 unknowns plus one exact shooting (a few ms) per
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-
 import numpy as np
 
-from .._typing import ComplexArray, FloatArray
+from .._typing import FloatArray
 from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
 from ..model import NonsmoothSystem
+from ..results import NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
 from ._regularisation import regularisation_limit
-
-
-@dataclass(frozen=True, slots=True)
-class NonsmoothResponse:
-    """Rows of a continued branch (arrays of length P) and how the run ended.
-
-    ``omega``; ``rms_hb`` of the regularised HB orbit; ``rms`` of the exact orbit (nan where not
-    ``matched``); ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact multipliers
-    ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of the
-    regularised orbit; ``stick_time`` per period of the exact orbit; ``matched``; ``status``,
-    ``message``; ``regularisation`` ε and ``harmonics`` H of the HB.
-
-    The regularisation continued to its limit at ``limit`` matched points (row indices
-    ``limit_index``): ``limit_eps`` the smallest ε reached, ``limit_rms`` the HB rms there,
-    ``limit_richardson`` the Richardson ε → 0 value, each against the exact rms of the row."""
-
-    omega: FloatArray
-    rms_hb: FloatArray
-    rms: FloatArray
-    rms_error: FloatArray
-    stable: np.ndarray
-    multipliers: ComplexArray
-    multipliers_hb: ComplexArray
-    stick_time: FloatArray
-    matched: np.ndarray
-    status: Status
-    message: str
-    regularisation: float
-    harmonics: int
-    limit_index: np.ndarray
-    limit_eps: FloatArray
-    limit_rms: FloatArray
-    limit_richardson: FloatArray
-
-    @property
-    def limit_error(self) -> FloatArray:
-        """limit_rms / rms − 1 at the ladder's rows."""
-        return self.limit_rms / self.rms[self.limit_index] - 1.0
-
-    @property
-    def richardson_error(self) -> FloatArray:
-        """limit_richardson / rms − 1 at the ladder's rows."""
-        return self.limit_richardson / self.rms[self.limit_index] - 1.0
-
-    def __len__(self) -> int:
-        return int(self.omega.size)
 
 
 def _rms(q: FloatArray, H: int) -> float:
@@ -134,7 +87,8 @@ def nonsmooth_response(
                                   newton=newton or NewtonOptions())
     points = stepper.run()
     integ = NonsmoothIntegrator(system)
-    rows: dict[str, list] = {k: [] for k in ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched")}
+    rows: dict[str, list] = {k: [] for k in ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched",
+                                             "mean", "p2p", "acc_p2p", "regime")}
     for pt in points:
         w, q = float(pt.omega), pt.q
         rms_hb = _rms(q, harmonics)
@@ -156,15 +110,21 @@ def nonsmooth_response(
         rows["mult_hb"].append(mu_hb)
         rows["matched"].append(ok)
         if ok:
+            d_lo, d_hi, a_lo, a_hi = orbit.trajectory.extremes()
             rows["rms"].append(orbit.rms)
+            rows["mean"].append(orbit.mean)
+            rows["p2p"].append(d_hi - d_lo)
+            rows["acc_p2p"].append(a_hi - a_lo)
+            rows["regime"].append(orbit.regime)
             rows["mult"].append(np.asarray(orbit.multipliers, dtype=complex)[:2])
             rows["stable"].append(bool(orbit.stable))
             rows["stick"].append(float(orbit.trajectory.stick_time))
         else:
-            rows["rms"].append(math.nan)
+            for key in ("rms", "mean", "p2p", "acc_p2p", "stick"):
+                rows[key].append(math.nan)
+            rows["regime"].append("")
             rows["mult"].append(mu_hb)
             rows["stable"].append(bool(np.all(np.abs(mu_hb) < 1.0)))
-            rows["stick"].append(math.nan)
     rms = np.array(rows["rms"])
     rms_hb = np.array(rows["rms_hb"])
     matched = np.array(rows["matched"], dtype=bool)
@@ -184,8 +144,11 @@ def nonsmooth_response(
             lim_eps.append(math.nan)
             lim_rms.append(math.nan)
             lim_rich.append(math.nan)
+    mean = np.array(rows["mean"])
     return NonsmoothResponse(
-        omega=np.array(rows["omega"]), rms_hb=rms_hb, rms=rms, rms_error=rms_hb / rms - 1.0,
+        omega=np.array(rows["omega"]), rms_hb=rms_hb, mean=mean, rms=rms,
+        rms_ac=np.sqrt(np.maximum(rms**2 - mean**2, 0.0)), p2p=np.array(rows["p2p"]),
+        acc_p2p=np.array(rows["acc_p2p"]), regime=np.array(rows["regime"], dtype=object),
         stable=np.array(rows["stable"], dtype=bool), multipliers=np.array(rows["mult"]).reshape(-1, 2),
         multipliers_hb=np.array(rows["mult_hb"]).reshape(-1, 2), stick_time=np.array(rows["stick"]),
         matched=matched, status=stepper.status or Status.SUCCESS,

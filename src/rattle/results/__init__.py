@@ -9,6 +9,7 @@ from ._columns import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 from ._comparison import Comparison
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, compare_measured
+from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothResponse
 from ._orbit import OrbitSolution, PeriodicOrbit
 from ._sound import SoundPressure, a_weighting_db, linear_sound_pressure, motion_sound_pressure, sound_pressure
 from ._steady import SteadyState
@@ -20,4 +21,5 @@ __all__ = [
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
+    "NonsmoothResponse", "NONSMOOTH_COLUMNS",
 ]

@@ -1,0 +1,117 @@
+"""The frequency response of a discontinuous law (preload, friction): rows of a continued branch.
+
+Each row is a point of the regularised harmonic balance (:mod:`rattle.analysis._nonsmooth`) and,
+where exact Newton shooting on the event-driven flow found the same orbit (``matched``), that exact
+orbit: its SPEC §1 measures, its Floquet multipliers (saltation matrices, a zero multiplier per
+stick phase), its stick time. The HB's own rms and multipliers stand beside them, so that the
+regularisation's effect is read row by row (``rms_error``). Where a row is not matched, the exact
+columns are empty (nan) and ``stable`` is the regularised orbit's.
+
+``bifurcation`` labels a row whose stability differs from the previous matched row's, from the
+multiplier that crossed (:func:`rattle.stability.classify_loss`: through +1 a fold, through −1 a
+period doubling, a complex pair a Neimark–Sacker point): the change lies between the two rows
+(not located).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray
+from ..errors import Status
+from ..stability import classify_loss
+
+#: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
+NONSMOOTH_COLUMNS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
+                     "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs")
+
+
+@dataclass(frozen=True, slots=True)
+class NonsmoothResponse:
+    """Rows of a continued branch (arrays of length P) and how the run ended.
+
+    ``omega``; ``rms_hb`` of the regularised HB orbit; from the exact orbit (nan where not
+    ``matched``): ``mean``, ``rms``, ``rms_ac``, ``p2p`` and ``acc_p2p`` of δ and δ'', ``regime``,
+    ``stick_time`` per period; ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact
+    multipliers ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of
+    the regularised orbit; ``status``, ``message``; ``regularisation`` ε and ``harmonics`` H.
+
+    The regularisation continued to its limit at the rows ``limit_index``: ``limit_eps`` the
+    smallest ε reached, ``limit_rms`` the HB rms there, ``limit_richardson`` the Richardson ε → 0
+    value (:attr:`limit_error`, :attr:`richardson_error` against the exact rms of the row)."""
+
+    omega: FloatArray
+    rms_hb: FloatArray
+    mean: FloatArray
+    rms: FloatArray
+    rms_ac: FloatArray
+    p2p: FloatArray
+    acc_p2p: FloatArray
+    regime: np.ndarray
+    stable: np.ndarray
+    multipliers: ComplexArray
+    multipliers_hb: ComplexArray
+    stick_time: FloatArray
+    matched: np.ndarray
+    status: Status
+    message: str
+    regularisation: float
+    harmonics: int
+    limit_index: np.ndarray
+    limit_eps: FloatArray
+    limit_rms: FloatArray
+    limit_richardson: FloatArray
+
+    def __len__(self) -> int:
+        return int(self.omega.size)
+
+    @property
+    def rms_error(self) -> FloatArray:
+        """rms_hb / rms − 1: the regularisation's (and truncation's) effect on the rms, row by row."""
+        return self.rms_hb / self.rms - 1.0
+
+    @property
+    def limit_error(self) -> FloatArray:
+        """limit_rms / rms − 1 at the ladder's rows."""
+        return self.limit_rms / self.rms[self.limit_index] - 1.0
+
+    @property
+    def richardson_error(self) -> FloatArray:
+        """limit_richardson / rms − 1 at the ladder's rows."""
+        return self.limit_richardson / self.rms[self.limit_index] - 1.0
+
+    @property
+    def bifurcation(self) -> np.ndarray:
+        """The kind of stability change at each row against the previous matched row ("" none)."""
+        out = np.full(len(self), "", dtype=object)
+        prev = None
+        for i in np.flatnonzero(self.matched):
+            if prev is not None and bool(self.stable[i]) != bool(self.stable[prev]):
+                out[i] = classify_loss(self.multipliers[prev], self.multipliers[i])
+            prev = i
+        return out
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The rows as columns :data:`NONSMOOTH_COLUMNS`."""
+        mu, mu_hb = np.abs(self.multipliers), np.abs(self.multipliers_hb)
+        return {
+            "omega": self.omega, "mean": self.mean, "rms": self.rms, "rms_ac": self.rms_ac, "p2p": self.p2p,
+            "acc_p2p": self.acc_p2p, "regime": self.regime, "stable": self.stable, "bifurcation": self.bifurcation,
+            "rms_hb": self.rms_hb, "rms_error": self.rms_error, "matched": self.matched,
+            "stick_time": self.stick_time, "mu1_abs": mu[:, 0], "mu2_abs": mu[:, 1], "mu1_hb_abs": mu_hb[:, 0],
+            "mu2_hb_abs": mu_hb[:, 1],
+        }
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write :meth:`columns` to ``path`` atomically."""
+        from ..files._csv import write_csv
+
+        cols = self.columns()
+        write_csv(path, cols, list(NONSMOOTH_COLUMNS))
+        return Path(path)
+
+
+__all__ = ["NONSMOOTH_COLUMNS", "NonsmoothResponse"]
