@@ -7,8 +7,9 @@ store and the command line use them without reaching the configuration reader
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_exports
 
 #: Public name → the module that defines it, imported on first use (PEP 562): the command line
 #: reaches ``._read`` and ``._atomic`` without numpy, which ``._csv`` and ``._metadata`` need.
@@ -22,19 +23,6 @@ _LAZY: dict[str, str] = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'rattle.files' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module, __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
-
-
 if TYPE_CHECKING:
     from ._atomic import (
         STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging,
@@ -43,4 +31,10 @@ if TYPE_CHECKING:
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
     from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
 
-__all__ = sorted(_LAZY)
+__all__ = [
+    "MAX_CONFIG_BYTES", "OutputSet", "STAGING_PREFIX", "atomic_path", "atomic_write_bytes", "atomic_write_text",
+    "check_input_file", "environment", "format_csv", "metadata_document", "rattle_version", "read_bounded",
+    "read_csv", "recover_staging", "to_jsonable", "write_csv", "write_metadata",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)

@@ -7,8 +7,9 @@ The numerical core never touches files; everything that reads or writes lives he
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_exports
 
 #: Public name → the module that defines it. Imported on first use (PEP 562): the command line
 #: reaches ``rattle.files._read`` and ``._atomic`` without numpy, which ``._config`` (the model)
@@ -31,25 +32,6 @@ _LAZY: dict[str, str] = {
 #: Names that moved out of ``rattle.io``: the column lists are the results' own (SPEC §3 columns
 #: of the result attributes). Still served here, with a DeprecationWarning.
 _MOVED: dict[str, str] = dict.fromkeys(["FRF_COLUMNS", "ORBIT_COLUMNS", "SWEEP_COLUMNS"], "rattle.results")
-
-
-def __getattr__(name: str) -> Any:
-    if name in _MOVED:
-        import warnings
-
-        warnings.warn(f"`rattle.io.{name}` is deprecated; import it from {_MOVED[name]}", DeprecationWarning,
-                      stacklevel=2)
-        return getattr(importlib.import_module(_MOVED[name]), name)
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'rattle.io' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module, __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
 
 
 if TYPE_CHECKING:
@@ -83,3 +65,5 @@ __all__ = [
     "atomic_write_text", "atomic_write_bytes", "atomic_path", "OutputSet", "recover_staging", "STAGING_PREFIX",
     "read_bounded", "check_input_file", "MAX_CONFIG_BYTES",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__, _MOVED)

@@ -11,8 +11,9 @@ arguments (:mod:`rattle.maps._vary`) without importing the numerics.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_exports
 
 _LAZY: dict[str, str] = {
     "AttractorSearch": "..analysis._attractors",
@@ -26,21 +27,10 @@ __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "Respo
            "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS"]
 
 
-def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'rattle.maps' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module, __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
-
-
 if TYPE_CHECKING:
     from ..analysis._attractors import AttractorSearch
     from ._map import DEFAULT_OMEGA_POINTS, response_map
     from ._report import map_report
     from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap
+
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)
