@@ -42,8 +42,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from .._typing import FloatArray, IntArray
-from ._elastic import AbstractElastic, _check_real, _check_real_sequence
+from .._typing import FloatArray
+from ._elastic import AbstractElastic, StageLaw, _check_real, _check_real_sequence
 from ._excitation import Excitation
 from ._model import Model
 
@@ -99,29 +99,15 @@ def _check_law_data(d: tuple[float, ...], s: tuple[float, ...], J: tuple[float, 
                              f"the motion from the breakpoint and has no unique solution there), got {v!r}")
 
 
-class AbstractJumpLaw:
-    """Base of the laws with jumps: vectorised f, ∂f/∂δ (away from the jumps) and the stage data."""
+class AbstractJumpLaw(StageLaw):
+    """Base of the laws with jumps: vectorised f, ∂f/∂δ (away from the jumps; :class:`StageLaw`)
+    and the stage data."""
 
     name: ClassVar[str] = "abstract_jump"
 
     @property
     def stages(self) -> JumpStages:  # pragma: no cover - overridden
         raise NotImplementedError
-
-    def stage(self, delta: FloatArray | float) -> IntArray:
-        """Index j of the stage holding δ (d_j ≤ δ < d_{j+1})."""
-        return np.searchsorted(self.stages.breakpoints, delta, side="right")
-
-    def force(self, delta: FloatArray | float) -> FloatArray:
-        """f(δ) = s_j δ + e_j (the right limit at a jump)."""
-        st = self.stages
-        j = np.searchsorted(st.breakpoints, delta, side="right")
-        return st.slopes[j] * delta + st.offsets[j]
-
-    def stiffness(self, delta: FloatArray | float) -> FloatArray:
-        """∂f/∂δ = s_j (the jumps are not included)."""
-        st = self.stages
-        return st.slopes[np.searchsorted(st.breakpoints, delta, side="right")]
 
     def to_dict(self) -> dict[str, object]:  # pragma: no cover - overridden
         raise NotImplementedError

@@ -12,7 +12,7 @@ with offsets e_j fixed by continuity at the breakpoints and by f(0) = 0.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -63,7 +63,32 @@ def _stages(breakpoints: tuple[float, ...], slopes: tuple[float, ...]) -> Stages
     return Stages(d, s, e)
 
 
-class AbstractElastic:
+class StageLaw:
+    """A law f(δ) = s_j δ + e_j on stages d_j ≤ δ < d_{j+1}, read from its ``stages`` (breakpoints,
+    slopes, offsets): the continuous laws here and the laws with jumps of
+    :mod:`rattle.model._discontinuous` (where f is the right limit at a jump)."""
+
+    @property
+    def stages(self) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def stage(self, delta: FloatArray | float) -> IntArray:
+        """Index j of the stage holding δ (d_j ≤ δ < d_{j+1}); same shape as ``delta``."""
+        return np.searchsorted(self.stages.breakpoints, delta, side="right")
+
+    def force(self, delta: FloatArray | float) -> FloatArray:
+        """f(δ) = s_j δ + e_j, elementwise (the right limit at a breakpoint)."""
+        st = self.stages
+        j = np.searchsorted(st.breakpoints, delta, side="right")
+        return st.slopes[j] * delta + st.offsets[j]
+
+    def stiffness(self, delta: FloatArray | float) -> FloatArray:
+        """∂f/∂δ = s_j, elementwise (right derivative at a breakpoint; a jump not included)."""
+        st = self.stages
+        return st.slopes[np.searchsorted(st.breakpoints, delta, side="right")]
+
+
+class AbstractElastic(StageLaw):
     """Base class of the elastic laws: pure data, vectorised ``force`` and ``stiffness``."""
 
     name: ClassVar[str] = "abstract"
@@ -76,21 +101,6 @@ class AbstractElastic:
     def stages(self) -> Stages:
         """Breakpoints, slopes and offsets of the law as read-only arrays."""
         return self._stage_data
-
-    def stage(self, delta: FloatArray | float) -> IntArray:
-        """Index j of the stage holding δ (d_j ≤ δ < d_{j+1}); same shape as ``delta``."""
-        return np.searchsorted(self._stage_data.breakpoints, delta, side="right")
-
-    def force(self, delta: FloatArray | float) -> FloatArray:
-        """f(δ) = s_j δ + e_j, elementwise."""
-        st = self._stage_data
-        j = np.searchsorted(st.breakpoints, delta, side="right")
-        return st.slopes[j] * delta + st.offsets[j]
-
-    def stiffness(self, delta: FloatArray | float) -> FloatArray:
-        """∂f/∂δ = s_j, elementwise (right derivative at a breakpoint)."""
-        st = self._stage_data
-        return st.slopes[np.searchsorted(st.breakpoints, delta, side="right")]
 
     def force_and_stiffness(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
         """f(δ) and ∂f/∂δ with one stage look-up."""
