@@ -103,3 +103,15 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
     assert changes and labelled == changes
     assert set(res.bifurcation[list(labelled)]) <= {"fold", "period_doubling", "neimark_sacker"}
+
+
+def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
+    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), harmonics=64, regularisation=0.01)
+    fig, ax = res.plot()
+    assert set(ax) == {"rms", "stick"}
+    exact = [ln for ln in ax["rms"].get_lines() if ln.get_label() == "exact orbit, stable"][0]
+    np.testing.assert_allclose(exact.get_ydata(), np.where(res.matched & res.stable, res.rms, np.nan))
+    stick = ax["stick"].get_lines()[0].get_ydata()
+    assert np.nanmax(stick) > 0.05  # this branch sticks
+    fig.savefig(tmp_path / "frf.png")
+    assert (tmp_path / "frf.png").read_bytes()[:4] == b"\x89PNG"

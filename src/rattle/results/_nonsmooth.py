@@ -105,6 +105,13 @@ class NonsmoothResponse:
             "mu2_hb_abs": mu_hb[:, 1],
         }
 
+    def plot(self) -> tuple:
+        """The exact and HB rms vs Ω with the stability changes, and the stick fraction; returns
+        (figure, PlotAxes). See :func:`rattle.plotting.nonsmooth_response_plot`."""
+        from ..plotting import nonsmooth_response_plot
+
+        return nonsmooth_response_plot(self)
+
     def to_csv(self, path: str | Path) -> Path:
         """Write :meth:`columns` to ``path`` atomically."""
         from ..files._csv import write_csv
