@@ -70,6 +70,20 @@ def check_omega(value: object, name: str = "omega") -> float:
     return w
 
 
+def check_vector(value: object, name: str) -> Any:
+    """A read-only copy of ``value`` as a one-dimensional array of finite floats (a table column)."""
+    import numpy as np
+
+    arr = np.array(as_float_array(value, name, "a sequence of numbers"), dtype=float)
+    if arr.ndim != 1:
+        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}")
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise ValueError(f"`{name}` must hold finite numbers, got {arr[bad[0]]!r} at row {int(bad[0])}")
+    arr.setflags(write=False)
+    return arr
+
+
 def check_shooting(period: object, tol: object, max_iterations: object) -> tuple[int, float, int]:
     """The arguments every Newton shooting takes: ``period`` an integer >= 1 (forcing periods),
     ``tol`` a number > 0, ``max_iterations`` an integer >= 0."""
@@ -179,5 +193,5 @@ def numerical_failures(func: _F) -> _F:
     return wrapper  # type: ignore[return-value]
 
 
-__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_shooting", "check_range", "check_state", "as_float_array", "check_int", "check_bool", "check_choice",
+__all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_shooting", "check_vector", "check_range", "check_state", "as_float_array", "check_int", "check_bool", "check_choice",
            "check_instance"]

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .._validate import check_vector
 
 __all__ = ["SoundPath", "parse_source", "check_source"]
 
@@ -40,20 +41,6 @@ def parse_source(source: str, name: str = "source") -> tuple[str, int | str]:
         raise ValueError(f"`{name}` {source!r} must be \"inertia:N\" with N a whole inertia number (from 1), "
                          "e.g. \"inertia:2\"")
     return "element", source
-
-
-def _vector(name: str, value: object) -> FloatArray:
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"`{name}` must be a sequence of numbers, got {value!r}") from None
-    if arr.ndim != 1:
-        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}")
-    bad = np.flatnonzero(~np.isfinite(arr))
-    if bad.size:
-        raise ValueError(f"`{name}` must hold finite numbers, got {arr[bad[0]]!r} at row {int(bad[0])}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
@@ -92,9 +79,9 @@ class SoundPath:
         parse_source(self.source)
         if not isinstance(self.name, str):
             raise TypeError(f"`name` must be a string, got {self.name!r}")
-        f = _vector("frequency_hz", self.frequency_hz)
-        mag = _vector("magnitude", self.magnitude)
-        ph = _vector("phase_deg", self.phase_deg)
+        f = check_vector(self.frequency_hz, "frequency_hz")
+        mag = check_vector(self.magnitude, "magnitude")
+        ph = check_vector(self.phase_deg, "phase_deg")
         if f.size == 0:
             raise ValueError("`frequency_hz` must hold at least one frequency, got none")
         if f.size > MAX_PATH_ROWS:

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .._validate import check_vector
 from ._frequency_response import FrequencyResponse
 from ._sweep import SweepResult
 
@@ -54,19 +55,6 @@ DIFFERENCE_KIND: dict[str, str] = {"acc_p2p": "rel", "spl_db": "diff"}
 _END_SLACK = 1e-9
 #: Measured points evaluated at once against the segments (bounds the (points × segments) work array).
 _CHUNK = 512
-
-
-def _as_vector(name: str, value: Any) -> FloatArray:
-    try:
-        a = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"`{name}` must be a sequence of numbers, got {type(value).__name__}") from None
-    if a.ndim != 1:
-        raise ValueError(f"`{name}` must be one-dimensional, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must hold finite numbers, got {a[~np.isfinite(a)][0]!r}")
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -94,7 +82,7 @@ class MeasuredRun:
     lines: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
-        omega = _as_vector("omega", self.omega)
+        omega = check_vector(self.omega, "omega")
         if omega.size == 0:
             raise ValueError("`omega` must hold at least one measured point, got none")
         if np.any(omega <= 0):
@@ -111,7 +99,7 @@ class MeasuredRun:
         for q in MEASURED_QUANTITIES:  # file order
             if q not in self.values:
                 continue
-            v = _as_vector(f"values[{q!r}]", self.values[q])
+            v = check_vector(self.values[q], f"values[{q!r}]")
             if v.size != omega.size:
                 raise ValueError(f"`values[{q!r}]` must have one value per point ({omega.size}), got {v.size}")
             if q == "acc_p2p" and np.any(v <= 0):
@@ -122,7 +110,7 @@ class MeasuredRun:
             raise ValueError(f"`values` may hold only {', '.join(MEASURED_QUANTITIES)}, got {unknown[0]!r}")
         object.__setattr__(self, "values", values)
         if self.speed_rpm is not None:
-            rpm = _as_vector("speed_rpm", self.speed_rpm)
+            rpm = check_vector(self.speed_rpm, "speed_rpm")
             if rpm.size != omega.size:
                 raise ValueError(f"`speed_rpm` must have one value per point ({omega.size}), got {rpm.size}")
             object.__setattr__(self, "speed_rpm", rpm)
