@@ -53,14 +53,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from .._typing import ComplexArray, FloatArray, IntArray
+from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_shooting, check_state
 from ..errors import ConvergenceError
 from ..model._discontinuous import NonsmoothSystem
 from ..model._elastic import Stages
 from ._integrator import ExactIntegrator, _Segment
 from ._roots import bracketed_newton
-from ._shooting import _newton_shooting
+from ._shooting import ShotOrbit, _newton_shooting
 from ._stage_solutions import StageSolutions
 
 _EPS = float(np.finfo(float).eps)
@@ -665,29 +665,16 @@ class NonsmoothIntegrator:
 # Periodic orbits
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class NonsmoothOrbit:
+class NonsmoothOrbit(ShotOrbit):
     """A periodic orbit of the discontinuous equation found by Newton shooting on the exact period
     map: ``state0`` (δ, δ') at t = 0, ``omega``, ``period`` p (T = p 2π/Ω), ``monodromy`` M (with
     the saltation matrices), ``multipliers`` (eigenvalues of M, largest modulus first),
     ``converged``, ``iterations``, ``residual`` (scaled ‖φ(x0) − x0‖∞), ``trajectory`` over one
     period, ``mean`` and ``rms`` of δ."""
 
-    state0: FloatArray
-    omega: float
-    period: int
-    monodromy: FloatArray
-    multipliers: ComplexArray
-    converged: bool
-    iterations: int
-    residual: float
     trajectory: NonsmoothTrajectory
     mean: float
     rms: float
-
-    @property
-    def stable(self) -> bool:
-        """True when every Floquet multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.multipliers) < 1.0))
 
     @property
     def regime(self) -> str:

@@ -25,7 +25,30 @@ _MAX_HALVINGS = 12
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class ShootingOrbit:
+class ShotOrbit:
+    """What every Newton shooting on an exact flow returns (:class:`ShootingOrbit`,
+    :class:`~rattle.timeint.SystemOrbit`, :class:`~rattle.timeint.NonsmoothOrbit` add their
+    trajectory and measures): ``state0`` at t = 0, ``omega``, ``period`` p (T = p·2π/Ω),
+    ``monodromy`` M = ∂x(T)/∂x(0), its ``multipliers`` (largest modulus first), ``converged``,
+    ``iterations`` (Newton steps) and ``residual`` (the scaled ‖φ(x0) − x0‖∞)."""
+
+    state0: FloatArray
+    omega: float
+    period: int
+    monodromy: FloatArray
+    multipliers: ComplexArray
+    converged: bool
+    iterations: int
+    residual: float
+
+    @property
+    def stable(self) -> bool:
+        """True when every Floquet multiplier lies inside the unit circle."""
+        return bool(np.all(np.abs(self.multipliers) < 1.0))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
+class ShootingOrbit(ShotOrbit):
     """A periodic orbit found by shooting, with its exact stability and response measures.
 
     ``state0`` (δ, δ') at t = 0 (rad, rad/s); ``omega`` the forcing frequency (rad/s); ``period``
@@ -38,14 +61,6 @@ class ShootingOrbit:
     ``delta_min``, ``delta_max``, ``p2p``, ``acc_min``, ``acc_max``, ``acc_p2p``.
     """
 
-    state0: FloatArray
-    omega: float
-    period: int
-    monodromy: FloatArray
-    multipliers: ComplexArray
-    converged: bool
-    iterations: int
-    residual: float
     trajectory: Trajectory
     mean: float
     rms: float
@@ -57,11 +72,6 @@ class ShootingOrbit:
     acc_max: float
     acc_p2p: float
     evaluations: int = 0
-
-    @property
-    def stable(self) -> bool:
-        """True when every Floquet multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.multipliers) < 1.0))
 
     @property
     def regime(self) -> str:

@@ -24,12 +24,13 @@ from ._flow import (
     SystemTrajectory,
     check_system_state,
 )
+from ._shooting import ShotOrbit
 
 _MAX_HALVINGS = 12
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class SystemOrbit:
+class SystemOrbit(ShotOrbit):
     """A periodic orbit of a System found by shooting, with its exact stability and measures.
 
     ``state0`` z = (x, x') at t = 0 (2n,); ``omega`` (rad/s); ``period`` p (T = p·2π/Ω);
@@ -40,22 +41,9 @@ class SystemOrbit:
     peak-to-peak values of δ and δ'' over one orbit period (exact to round-off).
     """
 
-    state0: FloatArray
-    omega: float
-    period: int
-    monodromy: FloatArray
-    multipliers: ComplexArray
-    converged: bool
-    iterations: int
-    residual: float
     evaluations: int
     trajectory: SystemTrajectory
     measures: SystemMeasures
-
-    @property
-    def stable(self) -> bool:
-        """True when every Floquet multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.multipliers) < 1.0))
 
     def crossed(self, element: int | str) -> FloatArray:
         """The breakpoints the orbit crosses for one element (index or name), sorted, unique."""
