@@ -71,6 +71,16 @@ SLIP, STICK, LOCK = 0, 1, 2
 _KIND_NAMES = ("slip", "stick", "lock")
 
 
+def _chunk(start: float, end: float, step: float) -> FloatArray:
+    """The grid points of the next at most ``_CHUNK`` cells of width ``step`` from ``start``, the
+    last one placed exactly on ``end`` when the chunk reaches it."""
+    n = max(1, min(_CHUNK, math.ceil((end - start) / step)))
+    pts = start + step * np.arange(n + 1)
+    if pts[-1] >= end or n < _CHUNK:
+        pts[-1] = end
+    return pts
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class NonsmoothOptions:
     """``samples_per_scale`` grid points per fastest time scale to bracket events (≥ 8);
@@ -552,10 +562,7 @@ class NonsmoothIntegrator:
         tau_a = 0.0
         first = True
         while tau_a < tau_end:
-            n = max(1, min(_CHUNK, math.ceil((tau_end - tau_a) / step)))
-            taus = tau_a + step * np.arange(n + 1)
-            if taus[-1] >= tau_end or n < _CHUNK:
-                taus[-1] = tau_end
+            taus = _chunk(tau_a, tau_end, step)
             d, v = seg.scan(taus)
             sv = sigma * v
             if first and sv[1] <= 0.0 and abs(v[0]) <= seg.v_floor:
@@ -622,10 +629,8 @@ class NonsmoothIntegrator:
 
         ta = t0
         while ta < t1:
-            n = max(1, min(_CHUNK, math.ceil((t1 - ta) / step)))
-            ts = ta + step * np.arange(n + 1)
-            if ts[-1] >= t1 or n < _CHUNK:
-                ts[-1] = t1
+            ts = _chunk(ta, t1, step)
+            n = ts.size - 1
             F = sol.forcing(ts)
             F1 = sol.forcing(ts, 1)
             for i in range(n):
