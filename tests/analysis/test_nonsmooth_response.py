@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rattle.analysis._nonsmooth import nonsmooth_response
+from rattle.analysis import NonsmoothOptions, nonsmooth_response
 from rattle.continuation import solve_fixed
 from rattle.hb import HBOptions, RegularisedBalance
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
@@ -25,7 +25,7 @@ def _system(tp: float, r: float) -> NonsmoothSystem:
     (0.2, 0.0, (1.15, 1.25), 1e-5),    # preload alone, two transversal crossings: measured 2.9e-6
 ])
 def test_branch_matches_the_exact_orbits(tp: float, r: float, omega: tuple[float, float], bound: float) -> None:
-    res = nonsmooth_response(_system(tp, r), omega, harmonics=64, regularisation=0.01)
+    res = nonsmooth_response(_system(tp, r), omega, NonsmoothOptions(harmonics=64, regularisation=0.01))
     assert res.status.success and len(res) >= 10
     assert res.omega[0] == omega[0] and res.omega[-1] == pytest.approx(omega[1])
     assert res.matched.all()
@@ -63,8 +63,8 @@ def test_the_regularisation_continued_to_its_limit_at_chosen_rows() -> None:
     """limit = 2: at two matched rows the ladder narrows ε from 0.05 to 0.0125; the error against the
     exact orbit falls (measured 2.1e-4 → 7.5e-5 and 4.3e-5 → 2.3e-5: the friction's reversals at δ' = 0
     converge like ε) and the Richardson value is closer still (1.8e-5, 1.4e-5)."""
-    res = nonsmooth_response(_system(0.05, 0.02), (0.75, 0.85), harmonics=64, regularisation=0.05, limit=2,
-                             limit_eps=0.0125, limit_harmonics=128)
+    res = nonsmooth_response(_system(0.05, 0.02), (0.75, 0.85), NonsmoothOptions(harmonics=64, regularisation=0.05, limit=2,
+                                                              limit_eps=0.0125, limit_harmonics=128))
     assert res.limit_index.size == 2 and res.matched[res.limit_index].all()
     assert np.all(res.limit_eps == pytest.approx(0.0125))
     before = np.abs(res.rms_error[res.limit_index])
@@ -77,7 +77,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
     from rattle.results import NONSMOOTH_COLUMNS
 
     system = _system(0.05, 0.02)
-    res = nonsmooth_response(system, (0.75, 0.85), harmonics=64, regularisation=0.01)
+    res = nonsmooth_response(system, (0.75, 0.85), NonsmoothOptions(harmonics=64, regularisation=0.01))
     i = len(res) // 2
     exact = shoot_nonsmooth_orbit(system, float(res.omega[i]), (0.0, 0.0))
     d_lo, d_hi, a_lo, a_hi = exact.trajectory.extremes()
@@ -97,7 +97,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
 def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     """The preload-only branch near Ω = 0.31 … 0.36 loses and regains stability several times: every
     change between matched rows carries a label, and only those."""
-    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), harmonics=64, regularisation=0.01)
+    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), NonsmoothOptions(harmonics=64, regularisation=0.01))
     m = np.flatnonzero(res.matched)
     changes = {int(j) for i, j in zip(m, m[1:]) if res.stable[i] != res.stable[j]}
     labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
@@ -106,7 +106,7 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
 
 
 def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
-    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), harmonics=64, regularisation=0.01)
+    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), NonsmoothOptions(harmonics=64, regularisation=0.01))
     fig, ax = res.plot()
     assert set(ax) == {"rms", "stick"}
     exact = [ln for ln in ax["rms"].get_lines() if ln.get_label() == "exact orbit, stable"][0]
@@ -115,3 +115,20 @@ def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -
     assert np.nanmax(stick) > 0.05  # this branch sticks
     fig.savefig(tmp_path / "frf.png")
     assert (tmp_path / "frf.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"harmonics": 0}, "`harmonics`"), ({"regularisation": 0.0}, "`regularisation`"),
+    ({"regularisation": 1.5}, "`regularisation`"), ({"match": -1.0}, "`match`"), ({"limit": -1}, "`limit`"),
+    ({"limit_eps": float("nan")}, "`limit_eps`"), ({"harmonics": 10**6}, "`harmonics`"),
+])
+def test_options_refuse_bad_settings_naming_them(kwargs: dict, message: str) -> None:
+    with pytest.raises((ValueError, TypeError), match=message):
+        NonsmoothOptions(**kwargs)
+
+
+def test_front_end_refuses_a_bad_range_and_options() -> None:
+    with pytest.raises(ValueError, match="`omega`"):
+        nonsmooth_response(_system(0.05, 0.0), (0.5, 0.4))
+    with pytest.raises(TypeError, match="`options`"):
+        nonsmooth_response(_system(0.05, 0.0), (0.4, 0.5), {"harmonics": 8})  # type: ignore[arg-type]

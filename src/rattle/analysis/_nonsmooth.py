@@ -26,7 +26,10 @@ from __future__ import annotations
 import math
 import numpy as np
 
+from dataclasses import dataclass
+
 from .._typing import FloatArray
+from .._validate import check_int, check_positive, check_range
 from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
@@ -41,35 +44,56 @@ def _rms(q: FloatArray, H: int) -> float:
     return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NonsmoothOptions:
+    """Settings of :func:`nonsmooth_response`.
+
+    ``harmonics`` H and ``regularisation`` ε of the HB (relative widths of the smooth steps);
+    ``match``: the largest departure of the exact orbit's δ(t) from the HB's, relative to the HB
+    orbit's peak-to-peak, for the two to count as one orbit. ``limit`` > 0: at that many matched
+    rows, evenly spread, the regularisation is continued from ε down to ``limit_eps`` (harmonics
+    raised up to ``limit_harmonics``; :func:`~rattle.analysis._regularisation.regularisation_limit`)
+    and its last and Richardson rms are kept beside the exact one.
+    """
+
+    harmonics: int = 128
+    regularisation: float = 0.01
+    match: float = 0.1
+    limit: int = 0
+    limit_eps: float = 1e-3
+    limit_harmonics: int = 256
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "harmonics", check_int("harmonics", self.harmonics, 1))
+        HBOptions(harmonics=self.harmonics)  # its bounds
+        for name in ("regularisation", "match", "limit_eps"):
+            object.__setattr__(self, name, check_positive(getattr(self, name), name))
+        if self.regularisation >= 1.0:
+            raise ValueError(f"`regularisation` (relative width ε of the smooth steps) must be < 1, "
+                             f"got {self.regularisation!r}; use 0.01")
+        object.__setattr__(self, "limit", check_int("limit", self.limit, 0))
+        object.__setattr__(self, "limit_harmonics", check_int("limit_harmonics", self.limit_harmonics, 1))
+        HBOptions(harmonics=self.limit_harmonics)
+
+
 def nonsmooth_response(
     system: NonsmoothSystem,
     omega: tuple[float, float],
+    options: NonsmoothOptions | None = None,
     *,
-    harmonics: int = 128,
-    regularisation: float = 0.01,
-    match: float = 0.1,
-    limit: int = 0,
-    limit_eps: float = 1e-3,
-    limit_harmonics: int = 256,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
 ) -> NonsmoothResponse:
-    """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring).
-
-    ``harmonics`` H and ``regularisation`` ε of the HB; ``match`` the largest departure of the exact
-    orbit's δ(t) from the HB's, relative to the HB orbit's peak-to-peak, for the two to count as one
-    orbit (a regularised stick creeps: a few per cent). ``limit`` > 0: at that many matched rows,
-    evenly spread, the regularisation is continued from ε down to ``limit_eps`` (harmonics raised up
-    to ``limit_harmonics``; :func:`~rattle.analysis._regularisation.regularisation_limit`) and its
-    last and Richardson rms are kept beside the exact one.
-    """
+    """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring), with
+    the settings ``options`` (:class:`NonsmoothOptions`)."""
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
-    lo, hi = (float(w) for w in omega)
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
-        raise ValueError(f"`omega` must be (min, max) with 0 < min < max, got {omega!r}")
-    if not (match > 0):
-        raise ValueError(f"`match` must be > 0, got {match!r}")
+    lo, hi = check_range(omega)
+    opts = NonsmoothOptions() if options is None else options
+    if not isinstance(opts, NonsmoothOptions):
+        raise TypeError(f"`options` must be a NonsmoothOptions, got {opts!r}")
+    harmonics, regularisation, match = opts.harmonics, opts.regularisation, opts.match
+    limit, limit_eps, limit_harmonics = opts.limit, opts.limit_eps, opts.limit_harmonics
     exc = system.excitation
     L = system.length_scale()
     wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
@@ -158,4 +182,4 @@ def nonsmooth_response(
     )
 
 
-__all__ = ["NonsmoothResponse", "nonsmooth_response"]
+__all__ = ["NonsmoothOptions", "NonsmoothResponse", "nonsmooth_response"]
