@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rattle.analysis import NonsmoothOptions, nonsmooth_response
+from rattle.analysis import RegularisationOptions, nonsmooth_response
 from rattle.continuation import solve_fixed
 from rattle.hb import HBOptions, RegularisedBalance
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
@@ -25,7 +25,7 @@ def _system(tp: float, r: float) -> NonsmoothSystem:
     (0.2, 0.0, (1.15, 1.25), 1e-5),    # preload alone, two transversal crossings: measured 2.9e-6
 ])
 def test_branch_matches_the_exact_orbits(tp: float, r: float, omega: tuple[float, float], bound: float) -> None:
-    res = nonsmooth_response(_system(tp, r), omega, NonsmoothOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(_system(tp, r), omega, RegularisationOptions(harmonics=64, regularisation=0.01))
     assert res.status.success and len(res) >= 10
     assert res.omega[0] == omega[0] and res.omega[-1] == pytest.approx(omega[1])
     assert res.matched.all()
@@ -63,7 +63,7 @@ def test_the_regularisation_continued_to_its_limit_at_chosen_rows() -> None:
     """limit = 2: at two matched rows the ladder narrows ε from 0.05 to 0.0125; the error against the
     exact orbit falls (measured 2.1e-4 → 7.5e-5 and 4.3e-5 → 2.3e-5: the friction's reversals at δ' = 0
     converge like ε) and the Richardson value is closer still (1.8e-5, 1.4e-5)."""
-    res = nonsmooth_response(_system(0.05, 0.02), (0.75, 0.85), NonsmoothOptions(harmonics=64, regularisation=0.05, limit=2,
+    res = nonsmooth_response(_system(0.05, 0.02), (0.75, 0.85), RegularisationOptions(harmonics=64, regularisation=0.05, limit=2,
                                                               limit_eps=0.0125, limit_harmonics=128))
     assert res.limit_index.size == 2 and res.matched[res.limit_index].all()
     assert np.all(res.limit_eps == pytest.approx(0.0125))
@@ -77,7 +77,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
     from rattle.results import NONSMOOTH_COLUMNS
 
     system = _system(0.05, 0.02)
-    res = nonsmooth_response(system, (0.75, 0.85), NonsmoothOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(system, (0.75, 0.85), RegularisationOptions(harmonics=64, regularisation=0.01))
     i = len(res) // 2
     exact = shoot_nonsmooth_orbit(system, float(res.omega[i]), (0.0, 0.0))
     d_lo, d_hi, a_lo, a_hi = exact.trajectory.extremes()
@@ -97,7 +97,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
 def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     """The preload-only branch near Ω = 0.31 … 0.36 loses and regains stability several times: every
     change between matched rows carries a label, and only those."""
-    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), NonsmoothOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), RegularisationOptions(harmonics=64, regularisation=0.01))
     m = np.flatnonzero(res.matched)
     changes = {int(j) for i, j in zip(m, m[1:]) if res.stable[i] != res.stable[j]}
     labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
@@ -106,7 +106,7 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
 
 
 def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
-    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), NonsmoothOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), RegularisationOptions(harmonics=64, regularisation=0.01))
     fig, ax = res.plot()
     assert set(ax) == {"rms", "stick"}
     exact = [ln for ln in ax["rms"].get_lines() if ln.get_label() == "exact orbit, stable"][0]
@@ -124,7 +124,7 @@ def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -
 ])
 def test_options_refuse_bad_settings_naming_them(kwargs: dict, message: str) -> None:
     with pytest.raises((ValueError, TypeError), match=message):
-        NonsmoothOptions(**kwargs)
+        RegularisationOptions(**kwargs)
 
 
 def test_front_end_refuses_a_bad_range_and_options() -> None:

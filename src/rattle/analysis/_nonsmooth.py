@@ -45,7 +45,7 @@ def _rms(q: FloatArray, H: int) -> float:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class NonsmoothOptions:
+class RegularisationOptions:
     """Settings of :func:`nonsmooth_response`.
 
     ``harmonics`` H and ``regularisation`` ε of the HB (relative widths of the smooth steps);
@@ -79,19 +79,19 @@ class NonsmoothOptions:
 def nonsmooth_response(
     system: NonsmoothSystem,
     omega: tuple[float, float],
-    options: NonsmoothOptions | None = None,
+    options: RegularisationOptions | None = None,
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
 ) -> NonsmoothResponse:
     """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring), with
-    the settings ``options`` (:class:`NonsmoothOptions`)."""
+    the settings ``options`` (:class:`RegularisationOptions`)."""
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
     lo, hi = check_range(omega)
-    opts = NonsmoothOptions() if options is None else options
-    if not isinstance(opts, NonsmoothOptions):
-        raise TypeError(f"`options` must be a NonsmoothOptions, got {opts!r}")
+    opts = RegularisationOptions() if options is None else options
+    if not isinstance(opts, RegularisationOptions):
+        raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
     harmonics, regularisation, match = opts.harmonics, opts.regularisation, opts.match
     limit, limit_eps, limit_harmonics = opts.limit, opts.limit_eps, opts.limit_harmonics
     exc = system.excitation
@@ -182,4 +182,4 @@ def nonsmooth_response(
     )
 
 
-__all__ = ["NonsmoothOptions", "NonsmoothResponse", "nonsmooth_response"]
+__all__ = ["RegularisationOptions", "NonsmoothResponse", "nonsmooth_response"]
