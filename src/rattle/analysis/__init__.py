@@ -4,6 +4,7 @@ from ._case import Case, load_case
 from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
 from ._nonsmooth import RegularisationOptions, nonsmooth_response
+from ._nonsmooth_orbit import nonsmooth_orbit
 from ._harmonics import adaptive_frequency_response, truncation_error
 from ._orbit import periodic_orbit
 from ._regimes import confirm_with_sweep, label_regions
@@ -13,5 +14,6 @@ from ._time_sweep import time_sweep
 __all__ = [
     "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare",
     "steady_state", "SteadyStateOptions", "nonsmooth_response", "RegularisationOptions",
+    "nonsmooth_orbit",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
 ]

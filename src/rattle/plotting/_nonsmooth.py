@@ -1,9 +1,16 @@
-"""Plot of the frequency response of a discontinuous law (preload, friction).
+"""Plots of a discontinuous law (preload, friction): the frequency response and one orbit.
 
-Top panel: the rms of δ of the exact orbits (solid where stable, dashed where unstable, points the
-exact shooting did not match left out) and the regularised harmonic balance's rms (thin grey),
-with the labelled changes of stability; bottom panel: the fraction of the period the exact orbit
-sticks (or locks), where the friction holds the clutch.
+:func:`nonsmooth_response_plot`. Top panel: the rms of δ of the exact orbits (solid where stable,
+dashed where unstable, points the exact shooting did not match left out) and the regularised
+harmonic balance's rms (thin grey), with the labelled changes of stability, and the Ω-ranges where
+the exact orbit sticks or locks for part of the period shaded; bottom panel: the fraction of the
+period the exact orbit sticks (or locks), where the friction holds the clutch, filled in the same
+colour.
+
+:func:`nonsmooth_orbit_plot`. One period of one orbit: δ(t) exact with the HB's δ(t) dashed and the
+breakpoints (where the law jumps or its friction changes) as horizontal lines; δ'(t); the phase
+portrait (δ, δ'). Every stick phase (friction holds, δ' ≡ 0) is shaded in :data:`STICK_COLOUR`,
+every lock phase (held at a jump of the preload) in :data:`LOCK_COLOUR`, one span per phase.
 """
 
 from __future__ import annotations
@@ -15,9 +22,27 @@ import numpy as np
 from ._axes import PlotAxes
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..results import NonsmoothResponse
+    from ..results import NonsmoothOrbitResult, NonsmoothResponse
 
 _MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D"}
+
+#: Shading of the stick phases (friction holds the clutch) and of the lock phases (held at a jump).
+STICK_COLOUR = "tab:green"
+LOCK_COLOUR = "tab:orange"
+_SHADE_ALPHA = 0.25
+
+
+def _held_runs(omega: np.ndarray, held: np.ndarray) -> list[tuple[float, float]]:
+    """The Ω-ranges (min, max) of the consecutive runs of rows where ``held`` is true."""
+    runs: list[tuple[float, float]] = []
+    idx = np.flatnonzero(held)
+    if idx.size == 0:
+        return runs
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    for part in np.split(idx, breaks + 1):
+        w = omega[part]
+        runs.append((float(np.min(w)), float(np.max(w))))
+    return runs
 
 
 def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]:
@@ -38,11 +63,16 @@ def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]
         sel = labels == kind
         if np.any(sel):
             ax.plot(w[sel], response.rms[sel], marker, color="tab:red", ms=5, ls="none", label=kind.replace("_", " "))
+    held = matched & (np.nan_to_num(response.stick_time) > 0.0)
+    for i, (a, b) in enumerate(_held_runs(w, held)):
+        ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="exact orbit sticks or locks" if i == 0 else None)
     ax.set_ylabel("δ rms (rad)")
     ax.legend(fontsize="small")
     ax.grid(alpha=0.3)
     T = 2.0 * np.pi / w
-    ax_s.plot(w, np.where(matched, response.stick_time / T, np.nan), "-", color="tab:green", lw=1.2)
+    frac = np.where(matched, response.stick_time / T, np.nan)
+    ax_s.plot(w, frac, "-", color=STICK_COLOUR, lw=1.2)
+    ax_s.fill_between(w, 0.0, frac, where=np.isfinite(frac), color=STICK_COLOUR, alpha=_SHADE_ALPHA, lw=0)
     ax_s.set_ylim(-0.02, 1.02)
     ax_s.set_ylabel("stick / period")
     ax_s.set_xlabel("Ω (rad/s)")
@@ -51,4 +81,64 @@ def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]
     return fig, PlotAxes({"rms": ax, "stick": ax_s})
 
 
-__all__ = ["nonsmooth_response_plot"]
+def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tuple[Any, PlotAxes]:
+    """Draw one period of ``result`` (module docstring) at ``points`` times plus every event;
+    returns (figure, PlotAxes with panels ``delta`` (the primary), ``velocity`` and ``phase``).
+    In ``delta`` and ``velocity`` each stick or lock phase is one shaded span (``ax.patches``)."""
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(11, 6))
+    grid = fig.add_gridspec(2, 2, width_ratios=(3, 2))
+    ax_d = fig.add_subplot(grid[0, 0])
+    ax_v = fig.add_subplot(grid[1, 0], sharex=ax_d)
+    ax_p = fig.add_subplot(grid[:, 1])
+    T = result.period
+    t = result.sample_times(points)
+    d_hb, v_hb = result.sample_hb(t), result.sample_hb(t, derivative=1)
+    hb_label = f"regularised HB (ε = {result.regularisation:g}, H = {result.harmonics})"
+    if result.orbit is not None:
+        d, v, _ = result.sample(t)
+        ax_d.plot(t, d, "-", color="tab:blue", lw=1.4, label="exact orbit")
+        ax_v.plot(t, v, "-", color="tab:blue", lw=1.4)
+        ax_p.plot(d, v, "-", color="tab:blue", lw=1.4, label="exact orbit")
+    ax_d.plot(t, d_hb, "--", color="0.35", lw=1.0, label=hb_label)
+    ax_v.plot(t, v_hb, "--", color="0.35", lw=1.0)
+    ax_p.plot(d_hb, v_hb, "--", color="0.35", lw=1.0, label=hb_label)
+    seen: set[str] = set()
+    for ta, tb, kind in result.stick_intervals:
+        colour = STICK_COLOUR if kind == "stick" else LOCK_COLOUR
+        label = None if kind in seen else ("stick (friction holds)" if kind == "stick" else "lock (held at a jump)")
+        seen.add(kind)
+        ax_d.axvspan(ta, tb, color=colour, alpha=_SHADE_ALPHA, lw=0, label=label)
+        ax_v.axvspan(ta, tb, color=colour, alpha=_SHADE_ALPHA, lw=0)
+        held = float(result.sample(np.array([0.5 * (ta + tb)]))[0][0])
+        ax_p.plot([held], [0.0], "o", color=colour, ms=7, label=label)
+    law = result.system.law
+    bp = law.stages.breakpoints
+    jumps, levels = law.stages.jumps, law.friction_levels
+    for i, b in enumerate(bp.tolist()):
+        what = "jump" if jumps[i] > 0 else ("friction changes" if levels[i] != levels[i + 1] else "breakpoint")
+        ax_d.axhline(b, color="0.2", ls=":", lw=0.9, label=f"{what} at δ = {b:g}")
+        ax_p.axvline(b, color="0.2", ls=":", lw=0.9)
+    ax_d.set_ylabel("δ (rad)")
+    ax_v.set_ylabel("δ' (rad/s)")
+    ax_v.set_xlabel("t (s)")
+    ax_d.set_xlim(0.0, T)
+    ax_p.set_xlabel("δ (rad)")
+    ax_p.set_ylabel("δ' (rad/s)")
+    title = f"Ω = {result.omega:.6g} rad/s"
+    if result.orbit is not None:
+        title += (f": rms {result.rms:.4g} rad (HB {result.rms_error:+.1e}), "
+                  f"{'stable' if result.stable else 'unstable'}, held {result.stick_time:.3g} of {T:.3g} s")
+    else:
+        title += ": no exact orbit (HB only)"
+    fig.suptitle(title, fontsize="medium")
+    for a in (ax_d, ax_v, ax_p):
+        a.grid(alpha=0.3)
+    ax_d.legend(fontsize="small", loc="upper right")
+    ax_p.legend(fontsize="small", loc="upper right")
+    fig.tight_layout()
+    return fig, PlotAxes({"delta": ax_d, "velocity": ax_v, "phase": ax_p})
+
+
+__all__ = ["LOCK_COLOUR", "STICK_COLOUR", "nonsmooth_orbit_plot", "nonsmooth_response_plot"]

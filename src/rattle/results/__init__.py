@@ -10,6 +10,7 @@ from ._comparison import Comparison
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, compare_measured
 from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothResponse
+from ._nonsmooth_orbit import NONSMOOTH_ORBIT_COLUMNS, NonsmoothOrbitResult
 from ._orbit import OrbitSolution, PeriodicOrbit
 from ._sound import SoundPressure, a_weighting_db, linear_sound_pressure, motion_sound_pressure, sound_pressure
 from ._steady import SteadyState
@@ -22,4 +23,5 @@ __all__ = [
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
     "NonsmoothResponse", "NONSMOOTH_COLUMNS",
+    "NonsmoothOrbitResult", "NONSMOOTH_ORBIT_COLUMNS",
 ]

@@ -1,0 +1,169 @@
+"""One periodic orbit of a discontinuous law (preload, friction) at one forcing frequency.
+
+For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.NonsmoothSystem`) at Ω:
+
+1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedBalance`, smooth steps of
+   relative width ε, H harmonics) is solved at Ω from rest where the steps are wide (ε = 0.1) and
+   narrowed to the requested ε by the homotopy of
+   :func:`~rattle.analysis._regularisation.regularisation_limit` — the start of
+   :func:`~rattle.analysis.nonsmooth_response`, at one Ω;
+2. the exact orbit: Newton shooting on the event-driven flow
+   (:func:`~rattle.timeint.shoot_nonsmooth_orbit`: crossings, sticking and locking exact, the
+   monodromy with saltation matrices) from the HB orbit's state (δ, δ') at t = 0, or from ``x0``
+   when given. When that fails (no convergence, or the integrator gives up), the exact flow is run
+   for 100 periods from the same state and the shooting restarted from where it arrived (the
+   orbit the motion settles on, if it is stable);
+3. when the ladder of step 1 fails (Newton stalls while ε narrows), the exact orbit is found by
+   settling from ``x0`` or from rest, and the HB is solved at ε from the exact orbit's spectrum
+   (:meth:`~rattle.timeint.NonsmoothTrajectory.fourier`).
+
+The result (:class:`~rattle.results.NonsmoothOrbitResult`) keeps both orbits: the exact one is the
+answer (rms, multipliers, stick and lock phases), the HB series is its regularised approximation.
+
+Cost: one ladder of HB solves (2H + 1 unknowns) and one shooting of a few ms (plus 100 periods of
+the exact flow when settling).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from .._typing import FloatArray
+from .._validate import check_omega, check_state
+from ..errors import ConvergenceError, RattleError
+from ..hb import HBOptions, RegularisedBalance
+from ..model import NonsmoothSystem
+from ..results import NonsmoothOrbitResult
+from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
+from ._nonsmooth import RegularisationOptions
+from ._regularisation import regularisation_limit
+
+#: Periods of the exact flow run from the HB state before shooting again when the direct shooting fails.
+SETTLE_PERIODS = 100
+
+
+def _balance_factory(system: NonsmoothSystem) -> Callable[[float, int], RegularisedBalance]:
+    """``make(ε, H)``: the regularised HB of ``system`` (the scales of :func:`nonsmooth_response`)."""
+    exc = system.excitation
+    L = system.length_scale()
+    wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
+
+    def make(eps: float, H: int) -> RegularisedBalance:
+        return RegularisedBalance(system.c, system, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
+                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
+
+    return make
+
+
+def _hb_orbit(make: Callable[[float, int], RegularisedBalance], omega: float, q0: FloatArray, eps_start: float,
+              opts: RegularisationOptions) -> tuple[FloatArray, FloatArray]:
+    """The HB coefficients at ``omega`` (the ladder from ``eps_start`` down to ``opts.regularisation``
+    started at ``q0``) and the HB orbit's state (δ, δ') at t = 0; raises ConvergenceError."""
+    problem = make(opts.regularisation, opts.harmonics)
+    q = regularisation_limit(make, omega, q0, eps_start=eps_start, eps_min=opts.regularisation,
+                             harmonics=opts.harmonics, max_harmonics=opts.harmonics, tail_tol=math.inf).last.q
+    d0, v0 = (float(a[0]) for a in problem.samples(q, omega))
+    return q, np.array([d0, v0])
+
+
+def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
+           integ: NonsmoothIntegrator) -> tuple[NonsmoothOrbit | None, str]:
+    """The exact orbit from ``x0``, or (None, why)."""
+    try:
+        orbit = shoot_nonsmooth_orbit(system, omega, x0, integrator=integ, max_iterations=30)
+    except (RattleError, ValueError, ArithmeticError) as exc:  # e.g. the event budget of a chattering orbit
+        return None, f"{type(exc).__name__}: {exc}"
+    if not orbit.converged:
+        return None, f"Newton shooting stopped after {orbit.iterations} steps at residual {orbit.residual:.3g}"
+    return orbit, ""
+
+
+def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
+                      integ: NonsmoothIntegrator) -> tuple[NonsmoothOrbit | None, str]:
+    """The exact flow run for :data:`SETTLE_PERIODS` periods from ``x0``, then shot; or (None, why)."""
+    try:
+        settled = integ.propagate(x0, 0.0, SETTLE_PERIODS * 2.0 * math.pi / omega, omega).state1
+    except (RattleError, ValueError, ArithmeticError) as exc:
+        return None, f"{type(exc).__name__}: {exc}"
+    return _shoot(system, omega, settled, integ)
+
+
+def nonsmooth_orbit(
+    system: NonsmoothSystem,
+    omega: float,
+    options: RegularisationOptions | None = None,
+    *,
+    x0: FloatArray | tuple[float, float] | None = None,
+) -> NonsmoothOrbitResult:
+    """The periodic orbit at forcing frequency ``omega`` (module docstring), with the HB settings
+    ``options`` (:class:`RegularisationOptions`: ``harmonics``, ``regularisation`` and ``match``;
+    the ladder settings are not used here). ``x0`` = (δ, δ') at t = 0 starts the exact shooting
+    instead of the HB orbit's state.
+
+    When the HB ladder from rest fails, the exact orbit is sought by settling from ``x0`` (or from
+    rest) and the HB is then solved from the exact orbit's spectrum (``hb_start`` ``"exact"``).
+    A failed exact shooting is reported in the result (``orbit`` None, ``message``); a failed HB
+    leaves nan coefficients. Raises :class:`~rattle.errors.ConvergenceError` when neither is found.
+    """
+    if not isinstance(system, NonsmoothSystem):
+        raise TypeError(f"`system` must be a NonsmoothSystem (rattle.model), got {system!r}")
+    omega = check_omega(omega)
+    opts = RegularisationOptions() if options is None else options
+    if not isinstance(opts, RegularisationOptions):
+        raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
+    start_x = None if x0 is None else check_state(x0)
+    H, eps = opts.harmonics, opts.regularisation
+    make = _balance_factory(system)
+    integ = NonsmoothIntegrator(system)
+    notes: list[str] = []
+    q: FloatArray | None = None
+    hb_state = np.full(2, math.nan)
+    hb_start = ""
+    try:  # the start of nonsmooth_response: wide steps (ε = 0.1) from rest, narrowed to ε
+        q, hb_state = _hb_orbit(make, omega, np.zeros(2 * H + 1), max(0.1, eps), opts)
+        hb_start = "rest"
+    except ConvergenceError as exc:
+        notes.append(f"the regularised HB from rest failed ({exc})")
+    first = start_x if start_x is not None else (hb_state if q is not None else None)
+    first_name = "`x0`" if start_x is not None else "the HB state"
+    orbit, start, why = None, "", ""
+    if first is not None:
+        orbit, why = _shoot(system, omega, first, integ)
+        start = "x0" if start_x is not None else "hb"
+    if orbit is None:
+        origin = first if first is not None else np.zeros(2)
+        orbit, why_settled = _settle_and_shoot(system, omega, origin, integ)
+        where = first_name if first is not None else "rest"
+        if orbit is not None:
+            start = "settled"
+            if first is not None:
+                notes.append(f"shooting from {first_name} failed ({why})")
+            notes.append(f"settled for {SETTLE_PERIODS} periods from {where}, then shooting converged")
+        else:
+            start = ""
+            if first is not None:
+                notes.append(f"shooting from {first_name} failed ({why})")
+            notes.append(f"shooting after settling for {SETTLE_PERIODS} periods from {where} failed ({why_settled})")
+    if q is None and orbit is not None:  # the HB started on the exact orbit's spectrum, at ε directly
+        try:
+            q, hb_state = _hb_orbit(make, omega, orbit.trajectory.fourier(H), eps, opts)
+            hb_start = "exact"
+            notes.append("the HB was solved from the exact orbit's spectrum")
+        except ConvergenceError as exc:
+            notes.append(f"the HB from the exact orbit's spectrum failed too ({exc})")
+    if q is None and orbit is None:
+        raise ConvergenceError(f"no periodic orbit at `omega` = {omega:g}: " + "; ".join(notes)
+                               + "; try another `regularisation` or `harmonics`, or give `x0`")
+    if orbit is None:
+        notes.insert(0, f"no exact orbit at Ω = {omega:g}")
+    coefficients = np.asarray(q, dtype=float) if q is not None else np.full(2 * H + 1, math.nan)
+    return NonsmoothOrbitResult(system=system, omega=omega, orbit=orbit, message="; ".join(notes), start=start,
+                                coefficients=coefficients, regularisation=float(eps), harmonics=int(H),
+                                hb_state=hb_state, hb_start=hb_start, match=float(opts.match),
+                                settle_periods=SETTLE_PERIODS)
+
+
+__all__ = ["NonsmoothOrbitResult", "nonsmooth_orbit"]
