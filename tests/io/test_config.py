@@ -258,7 +258,7 @@ BROKEN: list[tuple[str, str, list[str]]] = [
     ("negative damping", edit("damping = 0.05", "damping = -0.05"), ["`model.damping` must be >= 0, got -0.05"]),
     # --- elastic types and their parameters
     ("unknown elastic type", edit('type = "clutch"', 'type = "spring"'),
-     ['`model.elastic.type` must be one of "linear", "backlash", "clutch", "piecewise", got "spring" (a string)']),
+     ['`model.elastic.type` must be one of "linear", "backlash", "clutch", "piecewise", "preload", got "spring" (a string)']),
     ("elastic type wrong case", edit('type = "clutch"', 'type = "Clutch"'), ['got "Clutch"', 'did you mean "clutch"?']),
     ("elastic type not a string", edit('type = "clutch"', "type = 3"), ["`model.elastic.type` must be one of", "got 3 (an integer)"]),
     ("clutch alpha = 1", edit("alpha = 0.25", "alpha = 1.0"),

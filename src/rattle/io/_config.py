@@ -49,6 +49,7 @@ import math
 import os
 import re
 import sys
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -57,10 +58,11 @@ import numpy as np
 
 from .. import _limits
 from ..errors import ConfigError
-from ..model import AbstractElastic, ELASTIC_LAWS, Excitation, Model, check_analysable_model
+from ..model import AbstractElastic, ELASTIC_LAWS, Excitation, Model, Piecewise, check_analysable_model
+from ..model._discontinuous import Friction, NonsmoothSystem, Preload
 from ..model._elastic import _check_real
 from ._checks import (
-    _EXAMPLES, _Checker, _did_you_mean, _example, _in_radians, _join, _kind, _show, rename_keys,
+    ANGLE_KEYS, _EXAMPLES, _Checker, _did_you_mean, _example, _in_radians, _join, _kind, _show, rename_keys,
 )
 from ..files._read import read_bounded
 
@@ -72,13 +74,17 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 __all__ = [
     "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "AnalysisSettings", "RunConfig",
     "load_config", "config_from_dict", "model_to_toml_dict", "dumps_toml", "rename_keys", "check_harmonics",
-    "check_analysis",
+    "check_analysis", "DEFAULT_REGULARISATION", "DEFAULT_NONSMOOTH_HARMONICS",
 ]
 
 #: Default forcing-frequency range ``analysis.omega`` (rad/s): the SPEC §2 example.
 DEFAULT_OMEGA: tuple[float, float] = (0.1, 3.0)
 #: Default number of harmonics ``analysis.harmonics``: the SPEC §2 example.
 DEFAULT_HARMONICS: int = 32
+#: Defaults for a discontinuous law (a preload or friction: ``rattle.analysis.nonsmooth_response``):
+#: ``analysis.regularisation`` ε and ``analysis.harmonics`` (those of ``RegularisationOptions``).
+DEFAULT_REGULARISATION: float = 0.01
+DEFAULT_NONSMOOTH_HARMONICS: int = 128
 
 _T = TypeVar("_T")
 
@@ -96,11 +102,15 @@ class AnalysisSettings:
         Forcing-frequency range Ω (rad/s), 0 < ``omega_min`` < ``omega_max``.
     harmonics : int
         Harmonics kept in the harmonic balance, >= 1.
+    regularisation : float or None
+        Relative width ε of the smooth steps that replace a discontinuous law's jumps and
+        friction in the harmonic balance, 0 < ε < 1; None (the default) for a continuous law.
     """
 
     omega_min: float = DEFAULT_OMEGA[0]
     omega_max: float = DEFAULT_OMEGA[1]
     harmonics: int = DEFAULT_HARMONICS
+    regularisation: float | None = None
 
     def __post_init__(self) -> None:
         omega_min = _check_real("omega_min", self.omega_min)
@@ -118,6 +128,15 @@ class AnalysisSettings:
             )
         # The same rule (and upper bound, from memory and time) as the library's `harmonics`.
         harmonics = _limits.check_harmonics(self.harmonics, "harmonics")
+        if self.regularisation is not None:
+            eps = _check_real("regularisation", self.regularisation)
+            if not 0.0 < eps < 1.0:
+                raise ValueError(
+                    f"`regularisation` (relative width ε of the smooth steps replacing the jumps and the friction) "
+                    f"must satisfy 0 < ε < 1, got {eps!r}; use e.g. 0.01 (smaller is closer to the exact law and "
+                    "needs more harmonics)"
+                )
+            object.__setattr__(self, "regularisation", eps)
         object.__setattr__(self, "omega_min", omega_min)
         object.__setattr__(self, "omega_max", omega_max)
         object.__setattr__(self, "harmonics", int(harmonics))
@@ -128,8 +147,12 @@ class AnalysisSettings:
         return (self.omega_min, self.omega_max)
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``[analysis]`` table: ``{"omega": [min, max], "harmonics": h}``."""
-        return {"omega": [self.omega_min, self.omega_max], "harmonics": self.harmonics}
+        """The ``[analysis]`` table: ``{"omega": [min, max], "harmonics": h}`` (and ``"regularisation"``
+        for a discontinuous law)."""
+        out: dict[str, Any] = {"omega": [self.omega_min, self.omega_max], "harmonics": self.harmonics}
+        if self.regularisation is not None:
+            out["regularisation"] = self.regularisation
+        return out
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -138,8 +161,11 @@ class RunConfig:
 
     Attributes
     ----------
-    model : Model
-        The ``[model]`` and ``[excitation]`` tables.
+    model : Model, Chain or NonsmoothSystem
+        The ``[model]`` and ``[excitation]`` tables: a :class:`~rattle.model.NonsmoothSystem` when
+        ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or a ``friction`` level > 0; only
+        ``rattle frf`` and :func:`rattle.analysis.nonsmooth_response` solve it), else a Model or a
+        Chain.
     analysis : AnalysisSettings
         The ``[analysis]`` table, defaults filled in.
     source : dict
@@ -157,11 +183,30 @@ class RunConfig:
     #: ``[model] units`` (SPEC §6): ``"dimensionless"`` or ``"SI"``; the model holds the numbers as given
     #: (angles converted to rad) either way.
     units: str = "dimensionless"
+    #: For a discontinuous law: the Model of the same inertia, damping, stiffness and excitation
+    #: with the law's continuous part (f without its jumps and friction), whose stages set the
+    #: frequency bounds (:mod:`rattle._limits`); None otherwise.
+    continuous_model: Model | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def discontinuous(self) -> bool:
+        """True when :attr:`model` is a :class:`~rattle.model.NonsmoothSystem` (a jump or friction)."""
+        return isinstance(self.model, NonsmoothSystem)
+
+    @property
+    def bounds_model(self) -> Any:
+        """The model whose stages set the frequency bounds: :attr:`continuous_model` for a
+        discontinuous law, :attr:`model` otherwise."""
+        return self.continuous_model if self.discontinuous else self.model
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved configuration (defaults filled in) as a TOML-shaped dict (angles in rad, an
-        ``[engine]`` resolved into its torque and ``[model] speed_order``)."""
-        out = model_to_toml_dict(self.model, self.analysis)
+        ``[engine]`` resolved into its torque and ``[model] speed_order``; a discontinuous law with
+        its preload and friction as written: relative to K, or in N m with ``units = "SI"``)."""
+        if self.discontinuous:
+            out = _nonsmooth_to_toml_dict(self.model, self.continuous_model, self.analysis, self.units)
+        else:
+            out = model_to_toml_dict(self.model, self.analysis)
         if self.units != "dimensionless":
             out["model"] = {"units": self.units, **out["model"]}
         return out
@@ -173,9 +218,21 @@ class RunConfig:
 _TOP_KEYS = ("model", "excitation", "analysis", "engine", "paths", "drag")
 _MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
 _EXCITATION_KEYS = ("mean", "amplitudes", "phases")
-_ANALYSIS_KEYS = ("omega", "harmonics")
+_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation")
+#: Keys of ``[model.elastic]`` besides the continuous laws' parameters: ``friction`` (any type) and
+#: the parameters of type = "preload" (the discontinuous laws, :mod:`rattle.model._discontinuous`).
+_MODEL_ELASTIC_KEYS = ("friction", "preload", "clearance", "slope")
+#: Every ``[model.elastic] type``: the continuous laws and the preload (a torque jump).
+_LAWS: dict[str, type] = {**ELASTIC_LAWS, "preload": Preload}
+_EXAMPLES.update({
+    "model.elastic.preload": "preload = 0.05",
+    "model.elastic.clearance": "clearance = 0.0",
+    "model.elastic.slope": "slope = 1.0",
+    "model.elastic.friction": "friction = 0.02",
+    "analysis.regularisation": "regularisation = 0.01",
+})
 
-def _law_params(law: type[AbstractElastic]) -> dict[str, tuple[str, bool]]:
+def _law_params(law: type) -> dict[str, tuple[str, bool]]:
     """Constructor parameters of an elastic law: name -> (kind "number"/"array", required)."""
     params = {}
     for f in dataclasses.fields(law):  # type: ignore[arg-type]
@@ -258,6 +315,12 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         from ._paths import with_paths
 
         rest = config_from_dict({k: v for k, v in data.items() if k != "paths"}, source_name)
+        if rest.discontinuous:
+            raise check.error(
+                "`paths` (sound paths) is not supported with a discontinuous law (`model.elastic.preload` or "
+                "`model.elastic.friction`) yet: the sound pressure is computed from the smooth laws' responses; "
+                "remove [[paths]] (rattle frf gives the law's response without it)"
+            )
         return with_paths(rest, data["paths"], source_name)
     from ._subsystems import expand_subsystems  # damper, spline, gear pair shapes → the ordinary tables
 
@@ -288,7 +351,7 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         check.keys(data, "", _TOP_KEYS, required=("model", "excitation"))
     check.keys(model_t, "model", _MODEL_KEYS, required=_MODEL_KEYS)
     elastic_t = check.table(model_t, "elastic", "model.elastic")
-    law, law_params = _elastic_structure(check, elastic_t)
+    law, law_params = _elastic_structure(check, {k: v for k, v in elastic_t.items() if k != "friction"})
     excitation_t = check.table(data, "excitation", "excitation")
     check.keys(excitation_t, "excitation", _EXCITATION_KEYS, required=("mean", "amplitudes"))
     analysis_t: Mapping[str, Any] = {}
@@ -302,6 +365,9 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
     for key, (kind, _) in law_params.items():
         if key in elastic_t:
             (check.array if kind == "array" else check.number)(elastic_t[key], f"model.elastic.{key}")
+    if "friction" in elastic_t:
+        friction_t = elastic_t["friction"]
+        (check.array if isinstance(friction_t, (list, tuple)) else check.number)(friction_t, "model.elastic.friction")
     check.number(excitation_t["mean"], "excitation.mean")
     check.array(excitation_t["amplitudes"], "excitation.amplitudes")
     if "phases" in excitation_t:
@@ -319,16 +385,95 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
     model = check.build(
         Model, {k: f"model.{k}" for k in (*_MODEL_KEYS, "excitation")},
         inertia=model_t["inertia"], damping=model_t["damping"], stiffness=model_t["stiffness"],
-        elastic=elastic, excitation=excitation,
+        elastic=_continuous_part(check, elastic), excitation=excitation,
     )
-    analysis = _analysis(check, analysis_t)
+    system = _nonsmooth_system(check, model, elastic, elastic_t.get("friction"), units)
+    analysis = _analysis(check, analysis_t, discontinuous=system is not None)
     check_harmonics(model, analysis.harmonics)
     try:
         check_analysis(model, analysis)
     except ConfigError as exc:
         raise check.error(str(exc)) from None
+    if system is not None:
+        return RunConfig(model=system, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name,
+                         units=units, continuous_model=model)
     return RunConfig(model=model, analysis=analysis, source=copy.deepcopy(dict(data)), source_name=source_name,
                      units=units)
+
+
+# --------------------------------------------------------------------------------------------
+# Discontinuous laws: a preload (torque jump) and friction in [model.elastic]
+# --------------------------------------------------------------------------------------------
+def _continuous_part(check: _Checker, elastic: Any) -> AbstractElastic:
+    """The continuous law of ``elastic``: itself, or for a :class:`Preload` the piecewise-linear law
+    of its stages without the jumps (slope s, and 0 inside a clearance b), which carries c, k and
+    the stiffest stage into :class:`Model` (the frequency bounds, the scales)."""
+    if not isinstance(elastic, Preload):
+        return elastic
+    st = elastic.stages
+    if elastic.clearance > 0:  # the warning of a clearance in degrees by mistake, named as written
+        check.build(_limits.warn_clearance, {"clearance": "model.elastic.clearance"}, b=elastic.clearance,
+                    name="clearance", stacklevel=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return Piecewise(breakpoints=tuple(st.breakpoints.tolist()), slopes=tuple(st.slopes.tolist()))
+
+
+def _stage_names(elastic: Any) -> str:
+    """The stages of a law in words, for the message on a per-stage friction list."""
+    d = [float(x) for x in elastic.stages.breakpoints]
+    if not d:
+        return "δ"
+    return ", ".join([f"δ < {d[0]:.6g}", *[f"{a:.6g} < δ < {b:.6g}" for a, b in zip(d, d[1:])], f"δ > {d[-1]:.6g}"])
+
+
+def _nonsmooth_system(check: _Checker, model: Model, elastic: Any, friction_t: Any,
+                      units: str) -> NonsmoothSystem | None:
+    """The :class:`NonsmoothSystem` of a law with a jump (``preload`` > 0) or ``friction`` (a level
+    > 0); None for a continuous law. Preload and friction are torques relative to K (the torque
+    jump is K T_p, the friction torque K r); with ``units = "SI"`` they are given in N m and
+    divided here by ``model.stiffness`` K."""
+    friction = None
+    if friction_t is not None:
+        friction = check.build(Friction, {"levels": "model.elastic.friction"}, levels=friction_t)
+        n = len(elastic.stages.slopes)
+        if len(friction.levels) not in (1, n):
+            raise check.error(
+                f"`model.elastic.friction` must hold one level (every stage) or one per stage of the law: type = "
+                f"{json.dumps(elastic.name if isinstance(elastic, Preload) else elastic.to_dict()['type'])} has "
+                f"{n} stage{'' if n == 1 else 's'} ({_stage_names(elastic)}), got {len(friction.levels)} levels "
+                f"{_show(list(friction.levels))}; give {n} levels or a single number"
+            )
+    if not isinstance(elastic, Preload) and (friction is None or not any(friction.levels)):
+        return None
+    if isinstance(elastic, Preload) and elastic.preload == 0.0 and (friction is None or not any(friction.levels)):
+        return None  # no jump, no friction: the continuous law (slope s, clearance b) of `model`
+    if units == "SI":  # torques in N m → relative to K
+        K = model.stiffness
+        if isinstance(elastic, Preload):
+            elastic = Preload(preload=elastic.preload / K, clearance=elastic.clearance, slope=elastic.slope)
+        if friction is not None:
+            friction = Friction(levels=tuple(r / K for r in friction.levels))
+    return check.build(NonsmoothSystem.from_model, {"model": "model", "elastic": "model.elastic",
+                                                   "friction": "model.elastic.friction"},
+                       model=model, elastic=elastic, friction=friction)
+
+
+def _nonsmooth_to_toml_dict(system: NonsmoothSystem, model: Model | None, analysis: AnalysisSettings,
+                            units: str) -> dict[str, Any]:
+    """The tables of a discontinuous configuration (round trip through :func:`config_from_dict`):
+    the preload and friction as written (× K back to N m with ``units = "SI"``)."""
+    assert model is not None
+    scale = model.stiffness if units == "SI" else 1.0
+    law = system.law
+    elastic = dict(law.elastic.to_dict())
+    if isinstance(law.elastic, Preload):
+        elastic["preload"] = law.elastic.preload * scale
+    if law.friction is not None:
+        elastic["friction"] = [r * scale for r in law.friction.levels]
+    out = model_to_toml_dict(model, analysis)
+    out["model"]["elastic"] = elastic
+    return out
 
 
 def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonics") -> None:
@@ -368,25 +513,25 @@ def _elastic_structure(
     check: _Checker, table: Mapping[str, Any]
 ) -> tuple[type[AbstractElastic], dict[str, tuple[str, bool]]]:
     """Resolve ``model.elastic.type`` through ELASTIC_LAWS and check the keys against its parameters."""
-    allowed_types = list(ELASTIC_LAWS)
+    allowed_types = list(_LAWS)
     if "type" not in table:
         raise check.error(
             f"`model.elastic.type` is missing: [model.elastic] needs type = one of "
             f"{_join([json.dumps(t) for t in allowed_types])}; add e.g. {_example('model.elastic.type')}"
         )
     name = table["type"]
-    if not isinstance(name, str) or name not in ELASTIC_LAWS:
+    if not isinstance(name, str) or name not in _LAWS:
         hint = _did_you_mean(name, allowed_types).replace("`", '"') if isinstance(name, str) else ""
         raise check.error(
             f"`model.elastic.type` must be one of {_join([json.dumps(t) for t in allowed_types])}, "
             f"got {_show(name)} ({_kind(name)}); {hint}use one of these names"
         )
-    law = ELASTIC_LAWS[name]
+    law = _LAWS[name]
     params = _law_params(law)
     for key in table:
         if key == "type" or key in params:
             continue
-        users = [t for t, other in ELASTIC_LAWS.items() if key in _law_params(other)]
+        users = [t for t, other in _LAWS.items() if key in _law_params(other)]
         if users:
             raise check.error(
                 f"`model.elastic.{key}` does not belong to type = {json.dumps(name)}, whose "
@@ -409,7 +554,21 @@ def _elastic_structure(
     return law, params
 
 
-def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
+def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = False) -> AnalysisSettings:
+    """``[analysis]``; for a discontinuous law also ``regularisation`` (refused otherwise), and the
+    harmonics default :data:`DEFAULT_NONSMOOTH_HARMONICS`."""
+    regularisation = None
+    if "regularisation" in table:
+        if not discontinuous:
+            raise check.error(
+                f"`analysis.regularisation` = {_show(table['regularisation'])} applies only to a discontinuous law "
+                "(`model.elastic.preload` > 0 or a `model.elastic.friction` level > 0), whose jumps the harmonic "
+                "balance smooths; this law is continuous and solved without it: remove `analysis.regularisation`"
+            )
+        regularisation = table["regularisation"]
+        check.number(regularisation, "analysis.regularisation")
+    elif discontinuous:
+        regularisation = DEFAULT_REGULARISATION
     omega = table.get("omega", list(DEFAULT_OMEGA))
     check.array(omega, "analysis.omega")
     if len(omega) != 2:
@@ -417,12 +576,13 @@ def _analysis(check: _Checker, table: Mapping[str, Any]) -> AnalysisSettings:
             f"`analysis.omega` must be a list of two numbers [min, max] (rad/s), got {_show(omega)} "
             f"({len(omega)} number{'' if len(omega) == 1 else 's'}); write e.g. {_example('analysis.omega')}"
         )
-    harmonics = table.get("harmonics", DEFAULT_HARMONICS)
+    harmonics = table.get("harmonics", DEFAULT_NONSMOOTH_HARMONICS if discontinuous else DEFAULT_HARMONICS)
     check.integer(harmonics, "analysis.harmonics")
     return check.build(
         AnalysisSettings,
-        {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics"},
-        omega_min=omega[0], omega_max=omega[1], harmonics=harmonics,
+        {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics",
+         "regularisation": "analysis.regularisation"},
+        omega_min=omega[0], omega_max=omega[1], harmonics=harmonics, regularisation=regularisation,
     )
 
 
@@ -452,8 +612,9 @@ def _model_in_radians(check: _Checker, model_t: Mapping[str, Any]) -> dict[str, 
     """``[model]`` without ``units``, its angles in rad (``[model.elastic]``, ``[[model.elements]]``)."""
     out = {k: v for k, v in model_t.items() if k != "units"}
     laws = sorted({p for law in ELASTIC_LAWS.values() for p in _law_params(law)} | {"type"})
-    if isinstance(out.get("elastic"), Mapping):
-        out["elastic"] = _in_radians(check, out["elastic"], "model.elastic", laws)
+    if isinstance(out.get("elastic"), Mapping):  # also the preload's clearance (clearance_deg)
+        out["elastic"] = _in_radians(check, out["elastic"], "model.elastic", [*laws, *_MODEL_ELASTIC_KEYS],
+                                     angles=(*ANGLE_KEYS, "clearance"))
     elements = out.get("elements")
     if isinstance(elements, (list, tuple)) and all(isinstance(t, Mapping) for t in elements):
         out["elements"] = [_in_radians(check, t, f"model.elements[{k}]", [*_MODEL_ELEMENTS_KEYS, *laws])

@@ -280,6 +280,34 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
     return out
 
 
+#: Keys that make a law discontinuous (:mod:`rattle.model._discontinuous`): [model.elastic] only.
+_DISCONTINUOUS_KEYS = ("friction", "preload")
+
+
+def _refuse_discontinuous_in_chain(check: _Checker, model_t: Mapping[str, Any]) -> None:
+    """A preload or friction on a chain's element (or a gear pair, loose gear, damper or spline
+    shape) is refused: the event-driven integrator and the regularised harmonic balance of the
+    discontinuous laws treat the single equation only."""
+    where: list[tuple[str, Mapping[str, Any]]] = []
+    elements = model_t.get("elements")
+    if isinstance(elements, list):
+        where += [(f"model.elements[{k}]", t) for k, t in enumerate(elements) if isinstance(t, Mapping)]
+    for shape in ("gear_pair", "loose_gear"):
+        if isinstance(model_t.get(shape), Mapping):
+            where.append((f"model.{shape}", model_t[shape]))
+    for name, t in where:
+        key = next((f"{name}.{k}" for k in _DISCONTINUOUS_KEYS if k in t), None)
+        if key is None and t.get("type") == "preload":
+            key = f"{name}.type"
+        if key is not None:
+            raise check.error(
+                f"`{key}`: discontinuous laws (a preload or friction) are solved for the single equation only "
+                "([model] inertia, damping, stiffness with [model.elastic] type = \"preload\" or a `friction` "
+                "key); a chain's elements, a gear pair, a loose gear, a damper and a spline take the continuous "
+                "laws: remove it, or model the clutch alone as the single equation"
+            )
+
+
 def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>") -> Mapping[str, Any]:
     """``data`` with every sub-system shape rewritten into ordinary tables; ``data`` itself (the same
     object) when it has none. Raises ConfigError naming the key the user wrote."""
@@ -287,6 +315,7 @@ def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>") -> M
     if not isinstance(model_t, Mapping):
         return data
     check = _Checker(source_name)
+    _refuse_discontinuous_in_chain(check, model_t)
     elastic = model_t.get("elastic")
     if isinstance(elastic, Mapping) and elastic.get("type") in SUBSYSTEM_TYPES:
         raise check.error(
