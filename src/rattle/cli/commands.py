@@ -22,8 +22,8 @@ from .checks import (
 )
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
-    map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections,
-    set_verbose, warning, write_frf, write_set,
+    map_csv_writer, map_json_writer, map_summary, metadata_writer, nonsmooth_metadata, nonsmooth_summary, one_line,
+    save_figure, save_plot, sections, set_verbose, warning, write_frf, write_set,
 )
 
 if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
@@ -31,7 +31,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
     from ..model import Model
 
 __all__ = [
-    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf",
+    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_frf",
     "frf_command", "sweep_command", "orbit_command", "compare_command", "map_command", "demo_command",
 ]
 
@@ -169,6 +169,58 @@ def run_frf(
     echo_written(result.summary(), written, output)
 
 
+def _law_keys(run_config: Any) -> str:
+    """The keys that make the configuration's law discontinuous, as the user wrote them."""
+    law = run_config.model.law
+    keys = [f"`model.elastic.{k}`" for k, on in (("preload", bool(law.stages.jumps.any())),
+                                                  ("friction", bool(law.friction_levels.any()))) if on]
+    return " and ".join(keys) or "`model.elastic`"
+
+
+def refuse_discontinuous(run_config: Any, command: str) -> None:
+    """Exit 2 (nothing written) when ``rattle COMMAND`` cannot solve the configuration's law yet."""
+    if run_config.discontinuous:
+        raise ConfigError(
+            f"{_law_keys(run_config)}: a discontinuous law (a torque jump or friction) is not supported by "
+            f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance checked by exact "
+            "shooting)"
+        )
+
+
+def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path, sections: dict[str, Any]) -> None:
+    """``rattle frf`` on a discontinuous law: :func:`rattle.analysis.nonsmooth_response` with the
+    file's ``[analysis]`` (harmonics, regularisation), written as one set frf.csv, frf.json, frf.png.
+
+    Raises
+    ------
+    ConvergenceError
+        When the continuation did not cover the range (status not a success): the rows computed
+        are written first, and the error names the files (exit status 1, as the smooth frf).
+    """
+    t_start = time.perf_counter()
+    from ..analysis import RegularisationOptions, nonsmooth_response  # only now: all input has been validated
+
+    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation)
+    logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised harmonic "
+                "balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
+                analysis.omega_max, options.harmonics, options.regularisation)
+    result = nonsmooth_response(run_config.model, analysis.omega, options)
+    timings = {"nonsmooth_response": time.perf_counter() - t_start}
+    meta = nonsmooth_metadata(result, run_config.model, options, timings)
+    written = write_set(output, FRF_FILES, [
+        ("frf.csv", result.to_csv),
+        ("frf.json", metadata_writer(meta, sections, t_start)),
+        ("frf.png", lambda path: save_plot(result, path)),
+    ])
+    echo_written(nonsmooth_summary(result, options), written, output)
+    if not result.status.success:
+        raise ConvergenceError(
+            f"frequency response incomplete: {result.message or result.status.message}; the points computed "
+            f"before the failure were written to {', '.join(str(output / name) for name in written)}",
+            partial=result,
+        )
+
+
 @click.command("frf", short_help="Frequency response of the model in a configuration file.")
 @common_options
 @click.argument("config", type=click.Path(path_type=Path))
@@ -192,12 +244,19 @@ def frf_command(
     """
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
+    if run_config.discontinuous and subharmonics:
+        raise ConfigError(f"`--subharmonics` is not supported for a discontinuous law ({_law_keys(run_config)}) "
+                          "yet: only its period-1 branch is followed; leave --subharmonics out")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
-        run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
+        run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
+        omega_max=w_max,
     )
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None}
+    if run_config.discontinuous:
+        run_nonsmooth_frf(run_config, analysis, output, sections("frf", config, run_config, analysis, options))
+        return
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
             subharmonics=subharmonics, paths=run_config.paths)
 
@@ -235,6 +294,7 @@ def sweep_command(
         raise ConfigError("`--direction` is required: give --direction up, down or both")
     precheck(config, output, points=points, workers=workers)
     run_config = _io().load_config(config)
+    refuse_discontinuous(run_config, "sweep")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(run_config.analysis, run_config.model, labels=labels, omega_min=w_min, omega_max=w_max)
     t_start = time.perf_counter()
@@ -288,6 +348,7 @@ def orbit_command(
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
+    refuse_discontinuous(run_config, "orbit")
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
@@ -353,6 +414,7 @@ def compare_command(
         except ConfigError as exc:
             raise ConfigError(f"`--measured`: {exc}") from None
     run_config = _io().load_config(config)
+    refuse_discontinuous(run_config, "compare")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
@@ -444,6 +506,7 @@ def map_command(
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
     run_config = _io().load_config(config)
+    refuse_discontinuous(run_config, "map")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max

@@ -25,7 +25,7 @@ __all__ = [
     "FRF_FILES", "SWEEP_FILES", "ORBIT_FILES", "COMPARE_FILES", "Writer", "ProgressBar", "write_set", "save_figure",
     "save_plot", "frf_steps", "write_frf", "metadata_writer", "sections", "echo_written", "error", "warning",
     "one_line", "set_verbose", "reset_verbose", "logger", "MAP_FILES", "MapProgress", "map_csv_writer",
-    "map_json_writer", "map_summary",
+    "map_json_writer", "map_summary", "nonsmooth_metadata", "nonsmooth_summary",
 ]
 
 logger = logging.getLogger("rattle")
@@ -227,6 +227,76 @@ def write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: floa
     """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output`` as one set (``names``: the
     command's whole set, see :func:`write_set`); return the names written."""
     return write_set(output, names, frf_steps(result, sections, t_start))
+
+
+# --------------------------------------------------------------------------------------------
+# rattle frf on a discontinuous law (preload, friction)
+# --------------------------------------------------------------------------------------------
+def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str, float]) -> dict[str, Any]:
+    """The ``frf.json`` sections of a :class:`rattle.results.NonsmoothResponse`: the settings of the
+    regularised harmonic balance (``options``, a ``RegularisationOptions``), the equation solved,
+    status and message, the rows (all, matched by exact shooting, sticking), the largest and median
+    \|rms_error\| over the matched rows, the stability changes and ``timings``."""
+    import numpy as np
+
+    matched = np.asarray(result.matched, dtype=bool)
+    err = np.abs(np.asarray(result.rms_error, dtype=float)[matched])
+    err = err[np.isfinite(err)]
+    stick = np.asarray(result.stick_time, dtype=float)
+    labels = result.bifurcation
+    return {
+        "settings": {
+            "method": "regularised harmonic balance continued over Ω, every point checked by exact event-driven "
+                      "shooting (rattle.analysis.nonsmooth_response)",
+            "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
+            "limit": options.limit,
+        },
+        "system": {"damping": system.damping, "stiffness": system.stiffness, "law": system.law.to_dict(),
+                   "excitation": system.excitation.to_dict()},
+        "status": result.status.name.lower(),
+        "message": result.message or result.status.message,
+        "points": len(result),
+        "matched": int(np.count_nonzero(matched)),
+        "sticking": int(np.count_nonzero(matched & (np.nan_to_num(stick) > 0))),
+        "unstable": int(np.count_nonzero(~np.asarray(result.stable, dtype=bool))),
+        "rms_error_max": float(np.max(err)) if err.size else None,
+        "rms_error_median": float(np.median(err)) if err.size else None,
+        "bifurcations": [{"kind": str(labels[i]), "index": int(i), "omega": float(result.omega[i])}
+                         for i in range(len(result)) if labels[i]],
+        "timings": dict(timings),
+    }
+
+
+def nonsmooth_summary(result: Any, options: Any) -> str:
+    """What ``rattle frf`` prints for a discontinuous law."""
+    import numpy as np
+
+    n = len(result)
+    matched = np.asarray(result.matched, dtype=bool)
+    lines = [
+        f"{n} points over Ω = {np.min(result.omega):.4g} … {np.max(result.omega):.4g} (regularised harmonic balance, "
+        f"H = {options.harmonics}, ε = {options.regularisation:g}); {int(np.count_nonzero(matched))} matched by exact "
+        f"shooting, {int(np.count_nonzero(~np.asarray(result.stable, dtype=bool)))} unstable"
+        if n else "no points",
+        f"status: {result.status.name.lower()} — {result.message or result.status.message}",
+    ]
+    err = np.abs(np.asarray(result.rms_error, dtype=float)[matched])
+    err = err[np.isfinite(err)]
+    if err.size:
+        lines.append(f"rms of the HB against the exact orbit: median error {np.median(err):.2g}, largest "
+                     f"{np.max(err):.2g} (at Ω = {result.omega[matched][np.nanargmax(np.abs(result.rms_error[matched]))]:.5g})")
+        stick = np.nan_to_num(np.asarray(result.stick_time, dtype=float)[matched])
+        if np.any(stick > 0):
+            period = 2.0 * np.pi / np.asarray(result.omega, dtype=float)[matched]
+            lines.append(f"sticks at {int(np.count_nonzero(stick > 0))} of the matched points (at most "
+                         f"{np.max(stick / period):.0%} of the period)")
+        i = int(np.nanargmax(np.where(matched, result.rms, np.nan)))
+        lines.append(f"largest exact rms {result.rms[i]:.5g} rad at Ω = {result.omega[i]:.5g} ({result.regime[i]})")
+    labels = result.bifurcation
+    changes = [f"{labels[i]} before Ω = {result.omega[i]:.5g}" for i in range(n) if labels[i]]
+    if changes:
+        lines.append("stability changes (between rows): " + ", ".join(changes))
+    return "\n".join(lines)
 
 
 # --------------------------------------------------------------------------------------------
