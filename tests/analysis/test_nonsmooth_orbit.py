@@ -1,0 +1,270 @@
+"""One orbit of a preload / friction law: the exact orbit started from the regularised HB, its stick
+and lock phases, its table and its plot (issue 11: "the plots show stick phases")."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rattle.analysis import RegularisationOptions, nonsmooth_orbit
+from rattle.errors import Status
+from rattle.files import read_csv
+from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.results import NONSMOOTH_ORBIT_COLUMNS, NonsmoothOrbitResult, NonsmoothResponse
+from rattle.timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
+
+OPTS = RegularisationOptions(harmonics=64, regularisation=0.01)
+
+
+def _system(tp: float, r: float, fp: float = 0.3) -> NonsmoothSystem:
+    law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r) if r else None)
+    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+                           excitation=Excitation(mean=0.01, amplitudes=(fp,), phases=(0.3,)))
+
+
+def _span(patch) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+    """The t- (or Ω-) range of an ``axvspan``: a Rectangle (matplotlib ≥ 3.9) or a Polygon."""
+    if hasattr(patch, "get_width"):
+        return patch.get_x(), patch.get_x() + patch.get_width()
+    xy = np.asarray(patch.get_xy())
+    return float(xy[:, 0].min()), float(xy[:, 0].max())
+
+
+@pytest.fixture(scope="module")
+def sticking() -> NonsmoothOrbitResult:
+    """T_p = 0.2, r = 0.05, Ω = 0.6: three stick phases, 1.97 s of the 10.5 s period."""
+    return nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+
+
+@pytest.fixture(scope="module")
+def locking() -> NonsmoothOrbitResult:
+    """T_p = 0.25, r = 0.02, Ω = 0.3: two stick phases and a lock at the jump δ = 0."""
+    return nonsmooth_orbit(_system(0.25, 0.02), 0.3, OPTS)
+
+
+def test_the_stick_phases_are_the_trajectory_s(sticking: NonsmoothOrbitResult) -> None:
+    res = sticking
+    assert res.converged and res.start == "hb" and res.hb_start == "rest" and res.message == ""
+    tr = res.orbit.trajectory
+    spans = res.stick_intervals
+    assert len(spans) == 3 and {k for *_, k in spans} == {"stick"}
+    assert sum(b - a for a, b, _ in spans) == pytest.approx(tr.stick_time, rel=1e-13, abs=0)
+    assert tr.stick_time == pytest.approx(1.97, abs=0.01)
+    # every span runs from a "stick" event to an "unstick" event (merged, maximal)
+    events = dict(zip(tr.event_time.tolist(), tr.event_kind))
+    for a, b, _ in spans:
+        assert events[a] == "stick" and events[b] == "unstick"
+        t = np.linspace(a, b, 41)
+        d, v, acc = res.sample(t)  # at t = b the slip that starts there: δ' = 0 to round-off
+        assert np.max(np.abs(v)) <= 1e-12 and np.all(v[:-1] == 0.0) and np.all(acc[:-1] == 0.0)
+        assert np.ptp(d[:-1]) == 0.0 and abs(d[-1] - d[0]) <= 1e-15
+        # the friction holds: |F(t) − k f(δ_s)| ≤ k r over the span
+        F = 0.01 + 0.3 * np.cos(0.6 * t + 0.3)
+        assert np.max(np.abs(F - (d + 0.2 * np.sign(d)))) <= 0.05 * (1 + 1e-9)
+    # outside the spans it slips: δ' vanishes only at isolated points
+    t = np.linspace(0.0, res.period, 2001)
+    held = np.zeros(t.size, dtype=bool)
+    for a, b, _ in spans:
+        held |= (t >= a) & (t <= b)
+    assert np.count_nonzero(np.abs(res.sample(t)[1][~held]) <= 1e-12) <= 2
+    # a stick phase forgets the velocity: one exact zero multiplier
+    assert abs(res.multipliers[1]) < 1e-12 and res.stable and res.regime == "single_sided"
+
+
+def test_rms_is_an_independent_shooting_s_and_the_hb_is_kept(sticking: NonsmoothOrbitResult) -> None:
+    res = sticking
+    exact = shoot_nonsmooth_orbit(_system(0.2, 0.05), 0.6, (0.05, 0.0))  # from elsewhere
+    assert exact.converged
+    assert res.rms == pytest.approx(exact.rms, rel=1e-9)
+    assert res.mean == pytest.approx(exact.mean, rel=1e-9)
+    np.testing.assert_allclose(np.abs(res.multipliers), np.abs(exact.multipliers), atol=1e-9)
+    # δ_HB: the series itself (rms by the sampled mean square, exact for N > 2H), its state at t = 0
+    t = np.arange(1024) * res.period / 1024
+    assert res.rms_hb == pytest.approx(math.sqrt(np.mean(res.sample_hb(t) ** 2)), rel=1e-12)
+    assert res.sample_hb(0.0) == pytest.approx(res.hb_state[0], rel=1e-12)
+    assert res.sample_hb(0.0, derivative=1) == pytest.approx(res.hb_state[1], rel=1e-9)
+    assert res.rms_error == pytest.approx(res.rms_hb / res.rms - 1.0, rel=1e-15)
+    # the stick creeps under regularisation: ε = 0.01 is off by about 10 % (docs/nonsmooth.md: 9.3e-2)
+    assert 0.03 < abs(res.rms_error) < 0.2 and res.matched and res.hb_distance < 0.1
+    assert res.regularisation == 0.01 and res.harmonics == 64 and res.coefficients.size == 129
+    # started from the orbit's own state, the shooting stays there
+    again = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, x0=res.orbit.state0)
+    assert again.start == "x0" and again.rms == pytest.approx(res.rms, rel=1e-12)
+
+
+def test_csv_holds_one_period_with_every_event_and_the_modes(sticking: NonsmoothOrbitResult, tmp_path) -> None:
+    res = sticking
+    path = res.to_csv(tmp_path / "orbit.csv")
+    cols = read_csv(path)
+    assert list(cols) == list(NONSMOOTH_ORBIT_COLUMNS) == ["t", "delta", "velocity", "acceleration", "mode", "delta_hb"]
+    t = cols["t"]
+    tr = res.orbit.trajectory
+    assert t[0] == 0.0 and t[-1] == pytest.approx(res.period, rel=1e-15) and np.all(np.diff(t) > 0)
+    assert t.size >= 513 + tr.event_time.size - 1
+    assert set(tr.event_time.tolist()) <= set(t.tolist())
+    d, v, a = tr.sample(t)
+    np.testing.assert_array_equal(cols["delta"], d)
+    np.testing.assert_array_equal(cols["velocity"], v)
+    np.testing.assert_array_equal(cols["acceleration"], a)
+    np.testing.assert_array_equal(cols["delta_hb"], res.sample_hb(t))
+    # the mode of each row from the merged spans (a span owns its start, not its end)
+    expect = np.full(t.size, "slip", dtype=object)
+    for lo, hi, kind in res.stick_intervals:
+        expect[(t >= lo) & (t < hi)] = kind
+    assert list(cols["mode"]) == list(expect)
+    assert set(cols["mode"]) == {"slip", "stick"}
+    assert np.all(cols["velocity"][cols["mode"] == "stick"] == 0.0)
+    assert (tmp_path / "orbit.csv").read_text().startswith("t,delta,velocity,acceleration,mode,delta_hb\n")
+
+
+def test_plot_shades_every_stick_phase_and_saves(sticking: NonsmoothOrbitResult, tmp_path) -> None:
+    fig, ax = sticking.plot()
+    assert list(ax) == ["delta", "velocity", "phase"]
+    n = len(sticking.stick_intervals)
+    assert len(ax["delta"].patches) == n == len(ax["velocity"].patches) == 3
+    spans = sorted(_span(p) for p in ax["delta"].patches)
+    np.testing.assert_allclose(spans, [(a, b) for a, b, _ in sticking.stick_intervals], rtol=1e-14)
+    labels = [ln.get_label() for ln in ax["delta"].get_lines()]
+    assert labels[:2] == ["exact orbit", "regularised HB (ε = 0.01, H = 64)"] and "jump at δ = 0" in labels
+    hb = ax["delta"].get_lines()[1]
+    assert hb.get_linestyle() == "--"
+    legend = [t.get_text() for t in ax["delta"].get_legend().get_texts()]
+    assert "stick (friction holds)" in legend
+    fig.savefig(tmp_path / "orbit.png")
+    assert (tmp_path / "orbit.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_lock_at_the_jump_is_shaded_in_its_own_colour(locking: NonsmoothOrbitResult) -> None:
+    from matplotlib.colors import to_rgb
+
+    from rattle.plotting._nonsmooth import LOCK_COLOUR, STICK_COLOUR
+
+    res = locking
+    kinds = [k for *_, k in res.stick_intervals]
+    assert kinds.count("lock") == 1 and kinds.count("stick") == 2
+    assert sum(b - a for a, b, _ in res.stick_intervals) == pytest.approx(res.stick_time, rel=1e-13)
+    (a, b, _), = [s for s in res.stick_intervals if s[2] == "lock"]
+    d, v, _ = res.sample(np.linspace(a, b, 21)[:-1])  # [a, b): at b the slip starts
+    assert np.all(d == 0.0) and np.all(v == 0.0)  # held at the jump δ = 0
+    # in the lock band: |F| ≤ k (T_p + r)
+    F = 0.01 + 0.3 * np.cos(0.3 * np.linspace(a, b, 21) + 0.3)
+    assert np.max(np.abs(F)) <= 0.27 * (1 + 1e-12)
+    assert np.max(np.abs(res.multipliers)) < 1e-12  # a lock forgets everything: super-stable
+    fig, ax = res.plot()
+    colours = [to_rgb(p.get_facecolor()[:3]) for p in ax["delta"].patches]
+    assert len(colours) == 3
+    assert colours.count(to_rgb(LOCK_COLOUR)) == 1 and colours.count(to_rgb(STICK_COLOUR)) == 2
+    legend = [t.get_text() for t in ax["delta"].get_legend().get_texts()]
+    assert "lock (held at a jump)" in legend and "stick (friction holds)" in legend
+
+
+def test_a_failed_shooting_is_retried_after_settling(sticking: NonsmoothOrbitResult, monkeypatch) -> None:
+    """The first shooting (from the HB state) is made to fail: the flow settles for 100 periods
+    and the shooting from there finds the same stable orbit."""
+    import rattle.analysis._nonsmooth_orbit as mod
+
+    calls: list[np.ndarray] = []
+    real = mod.shoot_nonsmooth_orbit
+
+    def flaky(system, omega, x0, **kw):  # type: ignore[no-untyped-def]
+        calls.append(np.asarray(x0, dtype=float))
+        if len(calls) == 1:
+            raise mod.ConvergenceError("made to fail")
+        return real(system, omega, x0, **kw)
+
+    monkeypatch.setattr(mod, "shoot_nonsmooth_orbit", flaky)
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    assert len(calls) == 2 and np.array_equal(calls[0], res.hb_state)
+    x100 = NonsmoothIntegrator(_system(0.2, 0.05)).propagate(res.hb_state, 0.0, 100 * res.period, 0.6).state1
+    np.testing.assert_array_equal(calls[1], x100)
+    assert res.start == "settled" and "made to fail" in res.message and "settled for 100 periods" in res.message
+    assert res.rms == pytest.approx(sticking.rms, rel=1e-9) and res.hb_start == "rest"
+
+
+def test_a_failed_hb_ladder_is_replaced_by_settling_and_the_exact_spectrum(sticking: NonsmoothOrbitResult,
+                                                                          monkeypatch) -> None:
+    """The ladder from rest is made to fail: the exact orbit comes from rest by settling, and the
+    HB is solved at ε from its spectrum — the same HB orbit as the ladder's."""
+    import rattle.analysis._nonsmooth_orbit as mod
+
+    real = mod.regularisation_limit
+    starts: list[float] = []
+
+    def flaky(make, omega, q0, **kw):  # type: ignore[no-untyped-def]
+        starts.append(kw["eps_start"])
+        if len(starts) == 1:
+            raise mod.ConvergenceError("ladder made to fail")
+        return real(make, omega, q0, **kw)
+
+    monkeypatch.setattr(mod, "regularisation_limit", flaky)
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    assert starts == [0.1, 0.01]
+    assert res.start == "settled" and res.hb_start == "exact" and "ladder made to fail" in res.message
+    assert res.rms == pytest.approx(sticking.rms, rel=1e-9)
+    assert res.rms_hb == pytest.approx(sticking.rms_hb, rel=1e-6) and res.matched
+
+    def fails(make, omega, q0, **kw):  # type: ignore[no-untyped-def]
+        raise mod.ConvergenceError("no HB")
+
+    monkeypatch.setattr(mod, "regularisation_limit", fails)
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)  # the exact orbit alone: HB columns nan
+    assert res.converged and res.hb_start == "" and np.all(np.isnan(res.coefficients))
+    assert math.isnan(res.rms_hb) and math.isnan(res.hb_distance) and not res.matched
+    cols = res.columns(64)
+    assert np.all(np.isnan(cols["delta_hb"])) and np.all(np.isfinite(cols["delta"]))
+    monkeypatch.setattr(mod, "shoot_nonsmooth_orbit", lambda *a, **k: (_ for _ in ()).throw(mod.ConvergenceError("x")))
+    with pytest.raises(mod.ConvergenceError, match="`omega`"):
+        nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+
+
+def test_without_an_exact_orbit_the_hb_stands_alone(monkeypatch, tmp_path) -> None:
+    import rattle.analysis._nonsmooth_orbit as mod
+
+    monkeypatch.setattr(mod, "shoot_nonsmooth_orbit", lambda *a, **k: (_ for _ in ()).throw(mod.ConvergenceError("x")))
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    assert not res.converged and res.orbit is None and res.start == "" and "no exact orbit" in res.message
+    assert math.isnan(res.rms) and math.isnan(res.stick_time) and res.stable is None and res.regime == ""
+    assert res.stick_intervals == [] and np.all(np.isnan(res.multipliers)) and res.rms_hb > 0
+    cols = read_csv(res.to_csv(tmp_path / "orbit.csv"))
+    assert np.all(np.isnan(cols["delta"])) and set(cols["mode"]) == {""} and np.all(np.isfinite(cols["delta_hb"]))
+    fig, ax = res.plot()
+    assert len(ax["delta"].patches) == 0 and [ln.get_label() for ln in ax["delta"].get_lines()][0].startswith("regularised HB")
+
+
+def test_the_branch_plot_shades_where_the_exact_orbit_sticks() -> None:
+    """A hand-made response: rows 1–2 and 4 stick (two runs), row 3 slips, row 5 is not matched."""
+    w = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0])
+    nan = np.full(6, np.nan)
+    stick = np.array([0.0, 1.0, 2.0, 0.0, 0.5, np.nan])
+    matched = np.array([True, True, True, True, True, False])
+    mu = np.tile([0.5 + 0j, 0.0 + 0j], (6, 1))
+    res = NonsmoothResponse(
+        omega=w, rms_hb=np.linspace(0.1, 0.2, 6), mean=np.zeros(6), rms=np.linspace(0.1, 0.2, 6), rms_ac=nan,
+        p2p=nan, acc_p2p=nan, regime=np.full(6, "single_sided", dtype=object), stable=np.ones(6, dtype=bool),
+        multipliers=mu, multipliers_hb=mu, stick_time=stick, matched=matched, status=Status.SUCCESS, message="",
+        regularisation=0.01, harmonics=64, limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0),
+        limit_rms=np.zeros(0), limit_richardson=np.zeros(0))
+    fig, ax = res.plot()
+    spans = sorted(_span(p) for p in ax["rms"].patches)
+    np.testing.assert_allclose(spans, [(0.6, 0.7), (0.9, 0.9)])
+    np.testing.assert_allclose(ax["stick"].get_lines()[0].get_ydata(), np.where(matched, stick / (2 * np.pi / w), np.nan))
+    assert len(ax["stick"].collections) == 1  # the stick fraction filled
+
+
+@pytest.mark.parametrize("args, kwargs, error, message", [
+    ((0.0,), {}, ValueError, "`omega`"), ((-0.6,), {}, ValueError, "`omega`"), ((math.nan,), {}, ValueError, "`omega`"),
+    (("0.6",), {}, TypeError, "`omega`"), ((0.6, {"harmonics": 8}), {}, TypeError, "`options`"),
+    ((0.6,), {"x0": (0.0,)}, ValueError, "`x0`"),
+])
+def test_bad_arguments_are_refused_by_name(args: tuple, kwargs: dict, error: type, message: str) -> None:
+    with pytest.raises(error, match=message):
+        nonsmooth_orbit(_system(0.2, 0.05), *args, **kwargs)
+
+
+def test_a_system_that_is_not_nonsmooth_is_refused() -> None:
+    with pytest.raises(TypeError, match="`system`"):
+        nonsmooth_orbit("clutch", 0.6)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="`system`"):
+        nonsmooth_orbit(_system(0.2, 0.05).law, 0.6)  # type: ignore[arg-type]
