@@ -236,7 +236,7 @@ def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str
     """The ``frf.json`` sections of a :class:`rattle.results.NonsmoothResponse`: the settings of the
     regularised harmonic balance (``options``, a ``RegularisationOptions``), the equation solved,
     status and message, the rows (all, matched by exact shooting, sticking), the largest and median
-    \|rms_error\| over the matched rows, the stability changes and ``timings``."""
+    |rms_error| over the matched rows, the stability changes and ``timings``."""
     import numpy as np
 
     matched = np.asarray(result.matched, dtype=bool)

@@ -1,0 +1,154 @@
+"""``rattle`` on a discontinuous law (preload, friction): ``rattle frf`` writes the non-smooth
+response as one set; the commands that cannot solve such a law refuse it (exit 2, nothing written)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from _cli_helpers import PNG, assert_bad_input, invoke, write_config
+from rattle.io import load_config, read_csv
+from rattle.results._nonsmooth import NONSMOOTH_COLUMNS
+
+#: T_p = 0.05 with friction r = 0.02 on every stage, c = 0.05, F = 0.01 + 0.3 cos(Ω t + 0.3): above
+#: the primary resonance every orbit crosses the jump twice per period and slips (no stick).
+PRELOAD = """\
+[model]
+inertia = 1.0
+damping = 0.05
+stiffness = 1.0
+
+[model.elastic]
+type = "preload"
+preload = 0.05
+friction = 0.02
+
+[excitation]
+mean = 0.01
+amplitudes = [0.3]
+phases = [0.3]
+
+[analysis]
+omega = [1.2, 1.25]
+harmonics = 32
+"""
+
+
+@pytest.fixture(scope="module")
+def frf_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("nonsmooth")
+    config = write_config(folder, PRELOAD)
+    result = invoke(["frf", str(config), "-o", "out"], folder)
+    return folder, config, result
+
+
+def test_frf_writes_the_three_files_as_one_set(frf_run):
+    folder, _config, result = frf_run
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    out = folder / "out"
+    assert sorted(p.name for p in out.iterdir()) == ["frf.csv", "frf.json", "frf.png"]
+    assert (out / "frf.png").read_bytes()[:8] == PNG
+    header = (out / "frf.csv").read_text().splitlines()[0]
+    assert header == ",".join(NONSMOOTH_COLUMNS)
+    assert "matched by exact shooting" in result.stdout and "wrote frf.csv, frf.json, frf.png" in result.stdout
+
+
+def test_frf_json_holds_the_settings_and_the_measured_error(frf_run):
+    folder, config, _result = frf_run
+    meta = json.loads((folder / "out" / "frf.json").read_text())
+    table = read_csv(folder / "out" / "frf.csv")
+    matched = np.asarray(table["matched"], dtype=bool)
+    err = np.abs(np.asarray(table["rms_error"], dtype=float)[matched])
+    assert meta["command"] == "frf" and meta["status"] == "success" and meta["version"]
+    assert meta["settings"]["harmonics"] == 32 and meta["settings"]["regularisation"] == 0.01
+    assert meta["analysis"] == {"omega": [1.2, 1.25], "harmonics": 32, "regularisation": 0.01}
+    assert meta["points"] == len(table["omega"]) and meta["matched"] == int(matched.sum()) > 0
+    assert meta["rms_error_max"] == pytest.approx(float(np.max(err)), rel=1e-12)
+    assert meta["system"]["law"]["friction"] == {"levels": [0.02]}
+    assert meta["config"]["model"]["elastic"]["preload"] == 0.05
+    assert meta["timings"]["cli_wall_time"] > 0 and "nonsmooth_response" in meta["timings"]
+    assert meta["bifurcations"] == []
+
+
+def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
+    """The csv's rms is that of the exact orbit: Newton shooting of the event-driven flow from rest
+    at the middle row's Ω lands on it to 1e-9."""
+    from rattle.timeint import shoot_nonsmooth_orbit
+
+    folder, config, _result = frf_run
+    table = read_csv(folder / "out" / "frf.csv")
+    i = len(table["omega"]) // 2
+    assert bool(table["matched"][i])
+    system = load_config(config).model
+    orbit = shoot_nonsmooth_orbit(system, float(table["omega"][i]), (0.0, 0.0))
+    assert orbit.converged
+    assert abs(orbit.rms - float(table["rms"][i])) <= 1e-9
+    assert abs(orbit.mean - float(table["mean"][i])) <= 1e-9
+    # and the HB's rms beside it differs from it by the rms_error of the row
+    assert float(table["rms_hb"][i]) / orbit.rms - 1.0 == pytest.approx(float(table["rms_error"][i]), abs=1e-9)
+    assert math.isfinite(float(table["mu1_abs"][i])) and float(table["stick_time"][i]) == 0.0
+
+
+@pytest.mark.parametrize("args", [["sweep", "--direction", "up"], ["compare"], ["map", "--vary", "damping=0.04,0.05"],
+                                  ["orbit", "--omega", "1.2"]])
+def test_commands_that_cannot_solve_the_law_refuse_it_and_write_nothing(tmp_path, args):
+    config = write_config(tmp_path, PRELOAD)
+    result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
+    if args[0] == "orbit" and result.exit_code == 0:  # rattle orbit solves these laws (nonsmooth_orbit)
+        return
+    assert_bad_input(result, "`model.elastic.preload` and `model.elastic.friction`",
+                     f"not supported by `rattle {args[0]}` yet", "use `rattle frf`")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_bad_friction_list_and_subharmonics_are_refused_with_nothing_written(tmp_path):
+    config = write_config(tmp_path, PRELOAD.replace("friction = 0.02", "friction = [0.02, 0.0, 0.02]"))
+    result = invoke(["frf", str(config), "-o", "out"], tmp_path)
+    assert_bad_input(result, "`model.elastic.friction` must hold one level", 'type = "preload" has 2 stages',
+                     "got 3 levels")
+    assert not (tmp_path / "out").exists()
+    config = write_config(tmp_path, PRELOAD)
+    result = invoke(["frf", str(config), "--subharmonics", "-o", "out"], tmp_path)
+    assert_bad_input(result, "`--subharmonics`", "discontinuous law")
+    assert not (tmp_path / "out").exists()
+    config = write_config(tmp_path, PRELOAD.replace("preload = 0.05\nfriction = 0.02", "preload = 0.0")
+                          .replace("harmonics = 32", "harmonics = 32\nregularisation = 0.01"))
+    result = invoke(["frf", str(config), "-o", "out"], tmp_path)
+    assert_bad_input(result, "`analysis.regularisation` = 0.01 applies only to a discontinuous law")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_chain_with_friction_is_refused_by_frf(tmp_path):
+    text = """\
+[model]
+inertias = [2.0, 2.0]
+[[model.links]]
+between = [1, 2]
+damping = 0.1
+[[model.elements]]
+between = [1, 2]
+stiffness = 1.0
+type = "clutch"
+alpha = 0.25
+b = 0.174533
+friction = 0.01
+[[excitation.torques]]
+inertia = 1
+mean = 0.05
+amplitudes = [0.06]
+"""
+    result = invoke(["frf", str(write_config(tmp_path, text)), "-o", "out"], tmp_path)
+    assert_bad_input(result, "`model.elements[0].friction`", "solved for the single equation only")
+    assert not (tmp_path / "out").exists()
+
+
+def test_omega_options_override_the_range_of_a_discontinuous_law(tmp_path):
+    config = write_config(tmp_path, PRELOAD)
+    result = invoke(["frf", str(config), "--omega-min", "1e-9", "-o", "out"], tmp_path)
+    assert_bad_input(result, "`--omega-min`")
+    result = invoke(["frf", str(config), "--rpm-min", "800", "-o", "out"], tmp_path)
+    assert_bad_input(result, "`--rpm-min` needs a model with an engine")
+    assert not (tmp_path / "out").exists()
