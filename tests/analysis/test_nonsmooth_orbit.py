@@ -90,6 +90,12 @@ def test_rms_is_an_independent_shooting_s_and_the_hb_is_kept(sticking: Nonsmooth
     assert 0.03 < abs(res.rms_error) < 0.2 and res.matched and res.hb_distance < 0.1
     assert res.regularisation == 0.01 and res.harmonics == 64 and res.coefficients.size == 129
     # started from the orbit's own state, the shooting stays there
+    summary = res.summary()
+    assert summary["rms"] == res.rms and summary["mu2_abs"] < 1e-12 and summary["stable"] is True
+    assert summary["phases"] == [[a, b, k] for a, b, k in res.stick_intervals] and summary["start"] == "hb"
+    import json
+
+    assert json.loads(json.dumps(summary))["regime"] == "single_sided"
     again = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, x0=res.orbit.state0)
     assert again.start == "x0" and again.rms == pytest.approx(res.rms, rel=1e-12)
 

@@ -211,6 +211,21 @@ class NonsmoothOrbitResult:
             mode = np.full(t.size, "", dtype=object)
         return {"t": t, "delta": d, "velocity": v, "acceleration": a, "mode": mode, "delta_hb": self.sample_hb(t)}
 
+    def summary(self) -> dict[str, Any]:
+        """The scalars of the orbit as plain Python values (JSON-ready; nan stays nan, None for
+        ``stable`` without an exact orbit): omega, period, rms, mean, rms_hb, rms_error,
+        hb_distance, matched, stable, mu1_abs, mu2_abs, stick_time, regime, start, hb_start,
+        regularisation, harmonics, message, and ``phases``: [[t_start, t_end, kind], …]."""
+        mu = np.abs(self.multipliers)
+        return {
+            "omega": self.omega, "period": self.period, "rms": self.rms, "mean": self.mean, "rms_hb": self.rms_hb,
+            "rms_error": self.rms_error, "hb_distance": self.hb_distance, "matched": self.matched,
+            "stable": self.stable, "mu1_abs": float(mu[0]), "mu2_abs": float(mu[1]), "stick_time": self.stick_time,
+            "regime": self.regime, "start": self.start, "hb_start": self.hb_start,
+            "regularisation": self.regularisation, "harmonics": self.harmonics, "message": self.message,
+            "phases": [[a, b, k] for a, b, k in self.stick_intervals],
+        }
+
     def to_csv(self, path: str | Path, points: int = 512) -> Path:
         """Write :meth:`columns` to ``path`` atomically; returns the path."""
         from ..files._csv import write_csv
