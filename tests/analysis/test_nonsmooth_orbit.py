@@ -12,7 +12,11 @@ from rattle.analysis import RegularisationOptions, nonsmooth_orbit
 from rattle.errors import Status
 from rattle.files import read_csv
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
-from rattle.results import NONSMOOTH_ORBIT_COLUMNS, NonsmoothOrbitResult, NonsmoothResponse
+from rattle.results import (
+    NONSMOOTH_ORBIT_COLUMNS,
+    NonsmoothOrbitResult,
+    NonsmoothResponse,
+)
 from rattle.timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
 
 OPTS = RegularisationOptions(harmonics=64, regularisation=0.01)
@@ -158,7 +162,7 @@ def test_a_lock_at_the_jump_is_shaded_in_its_own_colour(locking: NonsmoothOrbitR
     F = 0.01 + 0.3 * np.cos(0.3 * np.linspace(a, b, 21) + 0.3)
     assert np.max(np.abs(F)) <= 0.27 * (1 + 1e-12)
     assert np.max(np.abs(res.multipliers)) < 1e-12  # a lock forgets everything: super-stable
-    fig, ax = res.plot()
+    _fig, ax = res.plot()
     colours = [to_rgb(p.get_facecolor()[:3]) for p in ax["delta"].patches]
     assert len(colours) == 3
     assert colours.count(to_rgb(LOCK_COLOUR)) == 1 and colours.count(to_rgb(STICK_COLOUR)) == 2
@@ -235,8 +239,9 @@ def test_without_an_exact_orbit_the_hb_stands_alone(monkeypatch, tmp_path) -> No
     assert res.stick_intervals == [] and np.all(np.isnan(res.multipliers)) and res.rms_hb > 0
     cols = read_csv(res.to_csv(tmp_path / "orbit.csv"))
     assert np.all(np.isnan(cols["delta"])) and set(cols["mode"]) == {""} and np.all(np.isfinite(cols["delta_hb"]))
-    fig, ax = res.plot()
-    assert len(ax["delta"].patches) == 0 and [ln.get_label() for ln in ax["delta"].get_lines()][0].startswith("regularised HB")
+    _fig, ax = res.plot()
+    assert len(ax["delta"].patches) == 0
+    assert ax["delta"].get_lines()[0].get_label().startswith("regularised HB")
 
 
 def test_the_branch_plot_shades_where_the_exact_orbit_sticks() -> None:
@@ -252,7 +257,7 @@ def test_the_branch_plot_shades_where_the_exact_orbit_sticks() -> None:
         multipliers=mu, multipliers_hb=mu, stick_time=stick, matched=matched, status=Status.SUCCESS, message="",
         regularisation=0.01, harmonics=64, limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0),
         limit_rms=np.zeros(0), limit_richardson=np.zeros(0))
-    fig, ax = res.plot()
+    _fig, ax = res.plot()
     spans = sorted(_span(p) for p in ax["rms"].patches)
     np.testing.assert_allclose(spans, [(0.6, 0.7), (0.9, 0.9)])
     np.testing.assert_allclose(ax["stick"].get_lines()[0].get_ydata(), np.where(matched, stick / (2 * np.pi / w), np.nan))
@@ -274,3 +279,11 @@ def test_a_system_that_is_not_nonsmooth_is_refused() -> None:
         nonsmooth_orbit("clutch", 0.6)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="`system`"):
         nonsmooth_orbit(_system(0.2, 0.05).law, 0.6)  # type: ignore[arg-type]
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():  # type: ignore[no-untyped-def]
+    yield
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
