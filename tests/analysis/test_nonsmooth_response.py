@@ -25,7 +25,7 @@ def _system(tp: float, r: float) -> NonsmoothSystem:
     (0.2, 0.0, (1.15, 1.25), 1e-5),    # preload alone, two transversal crossings: measured 2.9e-6
 ])
 def test_branch_matches_the_exact_orbits(tp: float, r: float, omega: tuple[float, float], bound: float) -> None:
-    res = nonsmooth_response(_system(tp, r), omega, RegularisationOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(_system(tp, r), omega, RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
     assert res.status.success and len(res) >= 10
     assert res.omega[0] == omega[0] and res.omega[-1] == pytest.approx(omega[1])
     assert res.matched.all()
@@ -64,7 +64,7 @@ def test_the_regularisation_continued_to_its_limit_at_chosen_rows() -> None:
     exact orbit falls (measured 2.1e-4 → 7.5e-5 and 4.3e-5 → 2.3e-5: the friction's reversals at δ' = 0
     converge like ε) and the Richardson value is closer still (1.8e-5, 1.4e-5)."""
     res = nonsmooth_response(_system(0.05, 0.02), (0.75, 0.85), RegularisationOptions(harmonics=64, regularisation=0.05, limit=2,
-                                                              limit_eps=0.0125, limit_harmonics=128))
+                                                              limit_eps=0.0125, limit_harmonics=128, refine=None))
     assert res.limit_index.size == 2 and res.matched[res.limit_index].all()
     assert np.all(res.limit_eps == pytest.approx(0.0125))
     before = np.abs(res.rms_error[res.limit_index])
@@ -77,7 +77,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
     from rattle.results import NONSMOOTH_COLUMNS
 
     system = _system(0.05, 0.02)
-    res = nonsmooth_response(system, (0.75, 0.85), RegularisationOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(system, (0.75, 0.85), RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
     i = len(res) // 2
     exact = shoot_nonsmooth_orbit(system, float(res.omega[i]), (0.0, 0.0))
     d_lo, d_hi, a_lo, a_hi = exact.trajectory.extremes()
@@ -97,7 +97,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
 def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     """The preload-only branch near Ω = 0.31 … 0.36 loses and regains stability several times: every
     change between matched rows carries a label, and only those."""
-    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), RegularisationOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
     m = np.flatnonzero(res.matched)
     changes = {int(j) for i, j in zip(m, m[1:]) if res.stable[i] != res.stable[j]}
     labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
@@ -106,7 +106,7 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
 
 
 def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
-    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), RegularisationOptions(harmonics=64, regularisation=0.01))
+    res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
     fig, ax = res.plot()
     assert set(ax) == {"rms", "stick"}
     exact = [ln for ln in ax["rms"].get_lines() if ln.get_label() == "exact orbit, stable"][0]
@@ -132,3 +132,20 @@ def test_front_end_refuses_a_bad_range_and_options() -> None:
         nonsmooth_response(_system(0.05, 0.0), (0.5, 0.4))
     with pytest.raises(TypeError, match="`options`"):
         nonsmooth_response(_system(0.05, 0.0), (0.4, 0.5), {"harmonics": 8})  # type: ignore[arg-type]
+
+
+def test_rows_the_hb_misses_are_refined_towards_the_limit() -> None:
+    """refine = 1.5e-4: every matched row whose HB rms misses the exact by more than that at ε = 0.05
+    gets the ladder (here to ε = 0.0125), and only those; there the HB's error at its limit
+    (hb_error) is smaller than at ε, and the columns carry it."""
+    res = nonsmooth_response(_system(0.05, 0.02), (0.75, 0.8), RegularisationOptions(
+        harmonics=64, regularisation=0.05, limit_eps=0.0125, limit_harmonics=64, refine=1.5e-4))
+    m = np.flatnonzero(res.matched)
+    off = m[np.abs(res.rms_error[m]) > 1.5e-4]
+    assert off.size and set(res.limit_index.tolist()) == set(off.tolist())
+    assert np.all(np.abs(res.hb_error[off]) < np.abs(res.rms_error[off]))
+    rest = np.setdiff1d(m, off)
+    np.testing.assert_array_equal(res.hb_error[rest], res.rms_error[rest])
+    cols = res.columns()
+    assert np.isnan(cols["eps_limit"][rest]).all() and np.all(cols["eps_limit"][off] == pytest.approx(0.0125))
+    np.testing.assert_allclose(cols["rms_error_limit"][off], res.hb_error[off], rtol=1e-12)

@@ -26,7 +26,8 @@ from ..stability import classify_loss
 
 #: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
 NONSMOOTH_COLUMNS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
-                     "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs")
+                     "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs", "eps_limit", "rms_hb_limit",
+                     "rms_error_limit")
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,9 +40,12 @@ class NonsmoothResponse:
     multipliers ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of
     the regularised orbit; ``status``, ``message``; ``regularisation`` ε and ``harmonics`` H.
 
-    The regularisation continued to its limit at the rows ``limit_index``: ``limit_eps`` the
+    The regularisation continued to its limit at the rows ``limit_index`` (evenly spread ones and
+    those whose HB missed the exact rms by more than the ``refine`` tolerance): ``limit_eps`` the
     smallest ε reached, ``limit_rms`` the HB rms there, ``limit_richardson`` the Richardson ε → 0
-    value (:attr:`limit_error`, :attr:`richardson_error` against the exact rms of the row)."""
+    value (:attr:`limit_error`, :attr:`richardson_error` against the exact rms of the row). As
+    columns (nan at the other rows): ``eps_limit``, ``rms_hb_limit``, ``rms_error_limit``;
+    :attr:`hb_error` is the HB's error at its smallest ε on every row."""
 
     omega: FloatArray
     rms_hb: FloatArray
@@ -83,6 +87,20 @@ class NonsmoothResponse:
         """limit_richardson / rms − 1 at the ladder's rows."""
         return self.limit_richardson / self.rms[self.limit_index] - 1.0
 
+    def _per_row(self, values: FloatArray) -> FloatArray:
+        out = np.full(len(self), np.nan)
+        out[self.limit_index] = values
+        return out
+
+    @property
+    def hb_error(self) -> FloatArray:
+        """The HB's relative rms error against the exact orbit at the smallest ε it reached on each
+        row: the limit's where the regularisation was continued (and did not stall), else
+        :attr:`rms_error` (nan where not matched)."""
+        lim = self._per_row(self.limit_rms)
+        best = np.where(np.isfinite(lim), lim, self.rms_hb)
+        return best / self.rms - 1.0
+
     @property
     def bifurcation(self) -> np.ndarray:
         """The kind of stability change at each row against the previous matched row ("" none)."""
@@ -102,7 +120,8 @@ class NonsmoothResponse:
             "acc_p2p": self.acc_p2p, "regime": self.regime, "stable": self.stable, "bifurcation": self.bifurcation,
             "rms_hb": self.rms_hb, "rms_error": self.rms_error, "matched": self.matched,
             "stick_time": self.stick_time, "mu1_abs": mu[:, 0], "mu2_abs": mu[:, 1], "mu1_hb_abs": mu_hb[:, 0],
-            "mu2_hb_abs": mu_hb[:, 1],
+            "mu2_hb_abs": mu_hb[:, 1], "eps_limit": self._per_row(self.limit_eps),
+            "rms_hb_limit": self._per_row(self.limit_rms), "rms_error_limit": self._per_row(self.limit_rms) / self.rms - 1.0,
         }
 
     def plot(self) -> tuple:
