@@ -17,7 +17,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 @pytest.mark.parametrize("name", sorted(p.name for p in EXAMPLES.glob("*.toml")))
 def test_example_configurations_parse(name):
     cfg = load_config(EXAMPLES / name)
-    assert cfg.analysis.harmonics >= cfg.model.system().forced_harmonics
+    assert cfg.analysis.harmonics >= cfg.bounds_model.system().forced_harmonics  # a discontinuous law: its continuous part
 
 
 def test_reference_example_is_the_reference_case():
@@ -52,6 +52,8 @@ def test_example_states_every_special_point_it_has(name):
     """Every special point of the period-1 branch at the example's own settings is stated in its
     header (kind and Ω to 5 decimals), and every stated one is found: none missing, none extra."""
     cfg = load_config(EXAMPLES / name)
+    if cfg.discontinuous:  # stated between rows, not located: test_discontinuous_examples_as_stated
+        pytest.skip("a discontinuous law (preload or friction): see test_discontinuous_examples_as_stated")
     if "none (the continuation stops first)" in (EXAMPLES / name).read_text():  # a model HB cannot resolve, said so
         stop = re.search(r"rattle frf stops at ([0-9.]+) rpm", (EXAMPLES / name).read_text())
         with pytest.raises(rattle.ConvergenceError, match="frequency response incomplete") as info:
@@ -77,3 +79,39 @@ def test_loose_gear_example_rattles_below_the_drag_criterion_only():
     assert acc[1500.0] > 300 and acc[1560.0] > 100 and acc[1590.0] > 20
     assert acc[1600.0] < 1.0 and acc[1610.0] < 1.0 and acc[1700.0] < 1.0
     assert np.max(sweep.p2p) < 2 * 1.25e-3  # never across the gap to the coast flank
+
+
+def _stated_changes(path: Path) -> list[tuple[str, float, float]]:
+    """The stability changes a discontinuous example states between rows: 'fold 0.6246' or
+    'period_doubling 0.541-0.547' → (kind, low, high)."""
+    text = path.read_text()
+    head = text[text.index("# Stability changes") :]
+    head = head[: head.index("\n[")]
+    return [(kind, float(a), float(b or a)) for kind, a, b in
+            re.findall(r"(fold|period_doubling|neimark_sacker) ([0-9.]+)(?:-([0-9.]+))?", head)]
+
+
+@pytest.mark.parametrize(("name", "omega", "stick"), [
+    ("torque_converter_preload.toml", (0.58, 0.63), 0.0),
+    ("clutch_friction.toml", (0.3, 0.34), 0.1),
+    ("clutch_friction.toml", (0.7, 0.76), 0.0),
+])
+def test_discontinuous_examples_as_stated(name, omega, stick):
+    """The stability changes an example with a preload or friction states lie where it says (on a
+    part of its range, at its own harmonics and regularisation), and it sticks where it says."""
+    from rattle.analysis import RegularisationOptions, nonsmooth_response
+
+    cfg = load_config(EXAMPLES / name)
+    assert cfg.discontinuous
+    result = nonsmooth_response(cfg.model, omega, RegularisationOptions(harmonics=cfg.analysis.harmonics,
+                                                                        regularisation=cfg.analysis.regularisation))
+    assert result.status.success and np.mean(result.matched) > 0.95  # a few rows at a fold may not match
+    labels = result.bifurcation
+    found = sorted((str(labels[i]), float(result.omega[i])) for i in range(len(result)) if labels[i])
+    stated = sorted((k, lo, hi) for k, lo, hi in _stated_changes(EXAMPLES / name) if omega[0] < lo and hi < omega[1])
+    assert [k for k, _ in found] == [k for k, _, _ in stated], (found, stated)
+    for (_, w), (_, lo, hi) in zip(sorted(found, key=lambda x: x[1]), sorted(stated, key=lambda x: x[1])):
+        assert lo - 2e-3 <= w <= hi + 2e-3, (w, lo, hi)
+    fraction = np.nan_to_num(result.stick_time) * result.omega / (2.0 * np.pi)
+    assert np.max(fraction) == pytest.approx(stick, abs=0.01)  # "up to 10 % of the period at Omega = 0.3"
+    assert np.max(np.abs(result.rms_error[result.matched])) < 0.05
