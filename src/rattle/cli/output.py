@@ -249,7 +249,8 @@ def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str
             "method": "regularised harmonic balance continued over Ω, every point checked by exact event-driven "
                       "shooting (rattle.analysis.nonsmooth_response)",
             "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
-            "limit": options.limit,
+            "limit": options.limit, "refine": getattr(options, "refine", None), "limit_eps": options.limit_eps,
+            "limit_harmonics": options.limit_harmonics,
         },
         "system": {"damping": system.damping, "stiffness": system.stiffness, "law": system.law.to_dict(),
                    "excitation": system.excitation.to_dict()},
@@ -261,10 +262,23 @@ def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str
         "unstable": int(np.count_nonzero(~np.asarray(result.stable, dtype=bool))),
         "rms_error_max": float(np.max(err)) if err.size else None,
         "rms_error_median": float(np.median(err)) if err.size else None,
+        "refined": int(np.size(result.limit_index)),
+        "hb_error_max": _largest(getattr(result, "hb_error", None), matched),
         "bifurcations": [{"kind": str(labels[i]), "index": int(i), "omega": float(result.omega[i])}
                          for i in range(len(result)) if labels[i]],
         "timings": dict(timings),
     }
+
+
+def _largest(values: Any, rows: Any) -> float | None:
+    """max |values| over ``rows`` (finite ones), None when there is none."""
+    import numpy as np
+
+    if values is None:
+        return None
+    v = np.abs(np.asarray(values, dtype=float)[rows])
+    v = v[np.isfinite(v)]
+    return float(np.max(v)) if v.size else None
 
 
 def nonsmooth_summary(result: Any, options: Any) -> str:
@@ -285,6 +299,11 @@ def nonsmooth_summary(result: Any, options: Any) -> str:
     if err.size:
         lines.append(f"rms of the HB against the exact orbit: median error {np.median(err):.2g}, largest "
                      f"{np.max(err):.2g} (at Ω = {result.omega[matched][np.nanargmax(np.abs(result.rms_error[matched]))]:.5g})")
+        refined = int(np.size(result.limit_index))
+        best = _largest(getattr(result, "hb_error", None), matched)
+        if refined and best is not None:
+            lines.append(f"regularisation continued towards its limit at {refined} row(s) (those off by more than "
+                         f"{options.refine:g} and any asked for): largest error at the smallest ε {best:.2g}")
         stick = np.nan_to_num(np.asarray(result.stick_time, dtype=float)[matched])
         if np.any(stick > 0):
             period = 2.0 * np.pi / np.asarray(result.omega, dtype=float)[matched]
