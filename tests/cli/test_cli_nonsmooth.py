@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -92,13 +93,10 @@ def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
     assert math.isfinite(float(table["mu1_abs"][i])) and float(table["stick_time"][i]) == 0.0
 
 
-@pytest.mark.parametrize("args", [["sweep", "--direction", "up"], ["compare"], ["map", "--vary", "damping=0.04,0.05"],
-                                  ["orbit", "--omega", "1.2"]])
+@pytest.mark.parametrize("args", [["sweep", "--direction", "up"], ["compare"], ["map", "--vary", "damping=0.04,0.05"]])
 def test_commands_that_cannot_solve_the_law_refuse_it_and_write_nothing(tmp_path, args):
     config = write_config(tmp_path, PRELOAD)
     result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
-    if args[0] == "orbit" and result.exit_code == 0:  # rattle orbit solves these laws (nonsmooth_orbit)
-        return
     assert_bad_input(result, "`model.elastic.preload` and `model.elastic.friction`",
                      f"not supported by `rattle {args[0]}` yet", "use `rattle frf`")
     assert not (tmp_path / "out").exists()
@@ -151,4 +149,43 @@ def test_omega_options_override_the_range_of_a_discontinuous_law(tmp_path):
     assert_bad_input(result, "`--omega-min`")
     result = invoke(["frf", str(config), "--rpm-min", "800", "-o", "out"], tmp_path)
     assert_bad_input(result, "`--rpm-min` needs a model with an engine")
+    assert not (tmp_path / "out").exists()
+
+
+def test_orbit_writes_the_exact_orbit_with_its_stick_phase(tmp_path):
+    """The reference clutch with friction 0.02 on the main stage sticks once per period at Ω = 0.35;
+    orbit.csv holds the exact orbit (its rms over the period is the json's) with the mode column."""
+    from rattle.results import NONSMOOTH_ORBIT_COLUMNS
+
+    text = (Path(__file__).resolve().parents[2] / "examples" / "clutch_friction.toml").read_text()
+    config = write_config(tmp_path, text.replace("harmonics = 64", "harmonics = 32"))
+    result = invoke(["orbit", str(config), "--omega", "0.35", "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    out = tmp_path / "out"
+    assert sorted(p.name for p in out.iterdir()) == ["orbit.csv", "orbit.json", "orbit.png"]
+    assert (out / "orbit.png").read_bytes()[:8] == PNG
+    assert (out / "orbit.csv").read_text().splitlines()[0] == ",".join(NONSMOOTH_ORBIT_COLUMNS)
+    table = read_csv(out / "orbit.csv")
+    meta = json.loads((out / "orbit.json").read_text())
+    assert meta["status"] == "converged" and meta["command"] == "orbit" and meta["settings"]["harmonics"] == 32
+    orbit = meta["orbit"]
+    assert orbit["matched"] and orbit["stable"] and orbit["period"] == pytest.approx(2 * math.pi / 0.35, rel=1e-15)
+    modes = list(table["mode"])
+    assert "stick" in modes and "slip" in modes
+    # the stick phase: δ' = 0 and δ constant over the rows the csv marks "stick"
+    t, d, v = (np.asarray(table[k], dtype=float) for k in ("t", "delta", "velocity"))
+    held = np.array([m == "stick" for m in modes])
+    assert np.max(np.abs(v[held])) == 0.0 and np.ptp(d[held]) == 0.0
+    (a, b, kind), = orbit["phases"]
+    assert kind == "stick" and b - a == pytest.approx(orbit["stick_time"], rel=1e-12)
+    assert "sticks or locks 1 time(s) per period" in result.stdout
+
+
+def test_orbit_of_a_discontinuous_law_refuses_period_and_range_options(tmp_path):
+    config = write_config(tmp_path, PRELOAD)
+    assert_bad_input(invoke(["orbit", str(config), "--omega", "1.2", "--period", "2", "-o", "out"], tmp_path),
+                     "`--period` 2", "only the period-1 orbit")
+    assert_bad_input(invoke(["orbit", str(config), "--omega", "1.2", "--omega-min", "1.0", "-o", "out"], tmp_path),
+                     "`--omega-min` is not used for a discontinuous law")
+    assert_bad_input(invoke(["orbit", str(config), "--omega", "1e-9", "-o", "out"], tmp_path), "`--omega`")
     assert not (tmp_path / "out").exists()

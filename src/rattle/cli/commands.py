@@ -31,7 +31,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
     from ..model import Model
 
 __all__ = [
-    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_frf",
+    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_frf", "run_nonsmooth_orbit",
     "frf_command", "sweep_command", "orbit_command", "compare_command", "map_command", "demo_command",
 ]
 
@@ -348,7 +348,9 @@ def orbit_command(
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
-    refuse_discontinuous(run_config, "orbit")
+    if run_config.discontinuous:
+        run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max)
+        return
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
@@ -371,6 +373,68 @@ def orbit_command(
         ("orbit.png", lambda path: save_plot(result, path)),
     ])
     echo_written(result.summary(), written, output)
+
+
+def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
+                        harmonics: int | None, omega_min: float | None, omega_max: float | None) -> None:
+    """``rattle orbit`` on a discontinuous law: :func:`rattle.analysis.nonsmooth_orbit` (the regularised
+    HB orbit at Ω and the exact orbit shot from it, with its stick and lock phases), written as one
+    set orbit.csv, orbit.json, orbit.png.
+
+    Only the period-1 orbit; ``--omega-min``/``--omega-max`` (a search range of the smooth laws) are
+    refused. Raises ConvergenceError (exit 1) after writing the set when the exact shooting failed.
+    """
+    law = _law_keys(run_config)
+    if period != 1:
+        raise ConfigError(f"`--period` {period}: only the period-1 orbit of a discontinuous law ({law}) is computed "
+                          "yet; leave --period out")
+    for option, value in (("--omega-min", omega_min), ("--omega-max", omega_max)):
+        if value is not None:
+            raise ConfigError(f"`{option}` is not used for a discontinuous law ({law}): its orbit is computed at "
+                              "--omega alone, without following a branch; leave it out")
+    analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
+    check_omega(omega, model=run_config.bounds_model)
+    t_start = time.perf_counter()
+    from ..analysis import RegularisationOptions, nonsmooth_orbit  # only now: all input has been validated
+
+    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation)
+    logger.info("computing the orbit of a discontinuous law at Ω = %g: regularised harmonic balance (H = %d, ε = %g) "
+                "and exact shooting", omega, options.harmonics, options.regularisation)
+    result = nonsmooth_orbit(run_config.model, omega, options)
+    timings = {"nonsmooth_orbit": time.perf_counter() - t_start}
+    ok = result.orbit is not None and bool(result.converged)
+    meta = {
+        "settings": {"method": "exact event-driven shooting started from the regularised harmonic balance "
+                               "(rattle.analysis.nonsmooth_orbit)", "harmonics": options.harmonics,
+                     "regularisation": options.regularisation, "match": options.match},
+        "status": "converged" if ok else "failed",
+        "message": result.message or ("" if ok else "the exact shooting did not converge"),
+        "orbit": result.summary(),
+        "timings": timings,
+    }
+    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, "harmonics": harmonics})
+    written = write_set(output, ORBIT_FILES, [
+        ("orbit.csv", result.to_csv),
+        ("orbit.json", metadata_writer(meta, sections_, t_start)),
+        ("orbit.png", lambda path: save_plot(result, path)),
+    ])
+    lines = [f"orbit at Ω = {omega:.6g} (period {result.period:.6g} s): "
+             + (f"exact rms {result.rms:.6g} rad, mean {result.mean:.6g} rad, {result.regime}, "
+                f"{'stable' if result.stable else 'unstable'} (|μ| = {abs(result.multipliers[0]):.3g}, "
+                f"{abs(result.multipliers[1]):.3g})" if ok else "no exact orbit")]
+    if ok:
+        held = sum(b - a for a, b, _ in result.stick_intervals)
+        lines.append(f"regularised HB (H = {options.harmonics}, ε = {options.regularisation:g}): rms {result.rms_hb:.6g} "
+                     f"(error {result.rms_error:.2g}); {'matched' if result.matched else 'NOT matched'}")
+        if result.stick_intervals:
+            lines.append(f"sticks or locks {len(result.stick_intervals)} time(s) per period, {held:.4g} s "
+                         f"({held / result.period:.0%} of the period)")
+    if result.message:
+        lines.append(result.message)
+    echo_written("\n".join(lines), written, output)
+    if not ok:
+        raise ConvergenceError(f"the exact orbit at `--omega` {omega:g} was not found ({result.message}); the "
+                               f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
 
 
 @click.command("compare", short_help="Frequency response and time-domain sweep together.")
