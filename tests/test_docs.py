@@ -269,10 +269,10 @@ def test_command_examples_parse():
 # Outputs
 # --------------------------------------------------------------------------------------------
 def test_every_output_column_is_documented():
-    from rattle.results import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
+    from rattle.results import FRF_COLUMNS, NONSMOOTH_COLUMNS, NONSMOOTH_ORBIT_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 
     text = _text("outputs.md")
-    for columns in (FRF_COLUMNS, SWEEP_COLUMNS, ORBIT_COLUMNS):
+    for columns in (FRF_COLUMNS, SWEEP_COLUMNS, ORBIT_COLUMNS, NONSMOOTH_COLUMNS, NONSMOOTH_ORBIT_COLUMNS):
         assert f"`{','.join(columns)}`" in text, f"the header {','.join(columns)} is not in docs/outputs.md"
         for column in columns:
             assert f"`{column}`" in text, f"column `{column}` is not in docs/outputs.md"
