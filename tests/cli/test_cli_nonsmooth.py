@@ -58,7 +58,7 @@ def test_frf_writes_the_three_files_as_one_set(frf_run):
 
 
 def test_frf_json_holds_the_settings_and_the_measured_error(frf_run):
-    folder, config, _result = frf_run
+    folder, _config, _result = frf_run
     meta = json.loads((folder / "out" / "frf.json").read_text())
     table = read_csv(folder / "out" / "frf.csv")
     matched = np.asarray(table["matched"], dtype=bool)
@@ -173,7 +173,7 @@ def test_orbit_writes_the_exact_orbit_with_its_stick_phase(tmp_path):
     modes = list(table["mode"])
     assert "stick" in modes and "slip" in modes
     # the stick phase: δ' = 0 and δ constant over the rows the csv marks "stick"
-    t, d, v = (np.asarray(table[k], dtype=float) for k in ("t", "delta", "velocity"))
+    d, v = (np.asarray(table[k], dtype=float) for k in ("delta", "velocity"))
     held = np.array([m == "stick" for m in modes])
     assert np.max(np.abs(v[held])) == 0.0 and np.ptp(d[held]) == 0.0
     (a, b, kind), = orbit["phases"]
@@ -189,3 +189,25 @@ def test_orbit_of_a_discontinuous_law_refuses_period_and_range_options(tmp_path)
                      "`--omega-min` is not used for a discontinuous law")
     assert_bad_input(invoke(["orbit", str(config), "--omega", "1e-9", "-o", "out"], tmp_path), "`--omega`")
     assert not (tmp_path / "out").exists()
+
+
+def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkeypatch):
+    """As the smooth frf: the rows computed are written as the set, then exit status 1 naming them."""
+    import dataclasses
+
+    import rattle.analysis
+    from rattle.errors import Status
+
+    real = rattle.analysis.nonsmooth_response
+
+    def stopped(*args, **kwargs):
+        return dataclasses.replace(real(*args, **kwargs), status=Status.MAX_STEPS, message="")
+
+    monkeypatch.setattr(rattle.analysis, "nonsmooth_response", stopped)
+    config = write_config(tmp_path, PRELOAD.replace("omega = [1.2, 1.25]", "omega = [1.2, 1.21]"))
+    result = invoke(["frf", str(config), "-o", "out"], tmp_path)
+    assert result.exit_code == 1, (result.stdout, result.stderr)
+    assert "frequency response incomplete: the maximum number of continuation steps" in result.stderr
+    assert "were written to" in result.stderr and "frf.csv" in result.stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["frf.csv", "frf.json", "frf.png"]
+    assert json.loads((tmp_path / "out" / "frf.json").read_text())["status"] == "max_steps"

@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import itertools
 import json
 import math
 import os
@@ -424,7 +425,7 @@ def _stage_names(elastic: Any) -> str:
     d = [float(x) for x in elastic.stages.breakpoints]
     if not d:
         return "δ"
-    return ", ".join([f"δ < {d[0]:.6g}", *[f"{a:.6g} < δ < {b:.6g}" for a, b in zip(d, d[1:])], f"δ > {d[-1]:.6g}"])
+    return ", ".join([f"δ < {d[0]:.6g}", *[f"{a:.6g} < δ < {b:.6g}" for a, b in itertools.pairwise(d)], f"δ > {d[-1]:.6g}"])
 
 
 def _nonsmooth_system(check: _Checker, model: Model, elastic: Any, friction_t: Any,
