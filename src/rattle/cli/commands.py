@@ -183,7 +183,7 @@ def refuse_discontinuous(run_config: Any, command: str) -> None:
         raise ConfigError(
             f"{_law_keys(run_config)}: a discontinuous law (a torque jump or friction) is not supported by "
             f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance checked by exact "
-            "shooting)"
+            "shooting) or `rattle orbit`"
         )
 
 
