@@ -31,9 +31,10 @@ ladder (0.5–2 s) per refined row.
 from __future__ import annotations
 
 import math
-import numpy as np
-
+from collections.abc import Callable
 from dataclasses import dataclass
+
+import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_int, check_positive, check_range
@@ -49,6 +50,20 @@ from ._regularisation import regularisation_limit
 
 def _rms(q: FloatArray, H: int) -> float:
     return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
+
+
+def balance_factory(system: NonsmoothSystem) -> Callable[[float, int], RegularisedBalance]:
+    """``make(ε, H)``: the regularised HB of ``system`` at relative width ε with H harmonics, on
+    the scales every front end uses (the law's length scale L, ω_n = √(k s_max))."""
+    exc = system.excitation
+    L = system.length_scale()
+    wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
+
+    def make(eps: float, H: int) -> RegularisedBalance:
+        return RegularisedBalance(system.c, system, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
+                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
+
+    return make
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -105,13 +120,8 @@ def nonsmooth_response(
         raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
     harmonics, regularisation, match = opts.harmonics, opts.regularisation, opts.match
     limit, limit_eps, limit_harmonics, refine = opts.limit, opts.limit_eps, opts.limit_harmonics, opts.refine
-    exc = system.excitation
+    make = balance_factory(system)
     L = system.length_scale()
-    wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
-    def make(eps: float, H: int) -> RegularisedBalance:
-        return RegularisedBalance(system.c, system, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
-                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
-
     problem = make(regularisation, harmonics)
     # the start: solved where the steps are wide (ε = 0.1), then narrowed to ε by homotopy
     start = regularisation_limit(make, lo, np.zeros(problem.size), eps_start=max(0.1, regularisation),
@@ -196,4 +206,4 @@ def nonsmooth_response(
     )
 
 
-__all__ = ["RegularisationOptions", "NonsmoothResponse", "nonsmooth_response"]
+__all__ = ["NonsmoothResponse", "RegularisationOptions", "nonsmooth_response"]

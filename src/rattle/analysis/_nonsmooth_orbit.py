@@ -34,28 +34,15 @@ import numpy as np
 from .._typing import FloatArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError, RattleError
-from ..hb import HBOptions, RegularisedBalance
+from ..hb import RegularisedBalance
 from ..model import NonsmoothSystem
 from ..results import NonsmoothOrbitResult
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
-from ._nonsmooth import RegularisationOptions
+from ._nonsmooth import RegularisationOptions, balance_factory
 from ._regularisation import regularisation_limit
 
 #: Periods of the exact flow run from the HB state before shooting again when the direct shooting fails.
 SETTLE_PERIODS = 100
-
-
-def _balance_factory(system: NonsmoothSystem) -> Callable[[float, int], RegularisedBalance]:
-    """``make(ε, H)``: the regularised HB of ``system`` (the scales of :func:`nonsmooth_response`)."""
-    exc = system.excitation
-    L = system.length_scale()
-    wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
-
-    def make(eps: float, H: int) -> RegularisedBalance:
-        return RegularisedBalance(system.c, system, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
-                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
-
-    return make
 
 
 def _hb_orbit(make: Callable[[float, int], RegularisedBalance], omega: float, q0: FloatArray, eps_start: float,
@@ -116,7 +103,7 @@ def nonsmooth_orbit(
         raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
     start_x = None if x0 is None else check_state(x0)
     H, eps = opts.harmonics, opts.regularisation
-    make = _balance_factory(system)
+    make = balance_factory(system)
     integ = NonsmoothIntegrator(system)
     notes: list[str] = []
     q: FloatArray | None = None
