@@ -65,7 +65,8 @@ def test_frf_json_holds_the_settings_and_the_measured_error(frf_run):
     err = np.abs(np.asarray(table["rms_error"], dtype=float)[matched])
     assert meta["command"] == "frf" and meta["status"] == "success" and meta["version"]
     assert meta["settings"]["harmonics"] == 32 and meta["settings"]["regularisation"] == 0.01
-    assert meta["analysis"] == {"omega": [1.2, 1.25], "harmonics": 32, "regularisation": 0.01}
+    assert meta["analysis"] == {"omega": [1.2, 1.25], "harmonics": 32, "regularisation": 0.01, "refine": 0.005}
+    assert meta["settings"]["refine"] == 0.005
     assert meta["points"] == len(table["omega"]) and meta["matched"] == int(matched.sum()) > 0
     assert meta["rms_error_max"] == pytest.approx(float(np.max(err)), rel=1e-12)
     assert meta["system"]["law"]["friction"] == {"levels": [0.02]}

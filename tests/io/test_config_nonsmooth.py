@@ -89,9 +89,10 @@ def test_analysis_defaults_of_a_discontinuous_law_are_the_front_end_defaults():
     cfg = config_from_dict(_base({"type": "preload", "preload": 0.05}))
     assert cfg.analysis.harmonics == RegularisationOptions().harmonics == 128
     assert cfg.analysis.regularisation == RegularisationOptions().regularisation == 0.01
+    assert cfg.analysis.refine == RegularisationOptions().refine == 0.005
     cfg = config_from_dict(_base({"type": "preload", "preload": 0.05}, harmonics=48, regularisation=0.003))
     assert (cfg.analysis.harmonics, cfg.analysis.regularisation) == (48, 0.003)
-    assert cfg.analysis.to_dict() == {"omega": [0.8, 1.6], "harmonics": 48, "regularisation": 0.003}
+    assert cfg.analysis.to_dict() == {"omega": [0.8, 1.6], "harmonics": 48, "regularisation": 0.003, "refine": 0.005}
     assert config_from_dict(cfg.to_dict()).analysis == cfg.analysis
     # a continuous law keeps its defaults and has no regularisation
     smooth = config_from_dict(_base({"type": "linear"}))
@@ -185,3 +186,19 @@ def test_sound_paths_with_a_discontinuous_law_are_refused():
     data = _base({"type": "preload", "preload": 0.05})
     data["paths"] = [{"name": "p", "source": "acceleration", "table": "x.csv"}]
     _refused(copy.deepcopy(data), "`paths`", "discontinuous law", "remove [[paths]]")
+
+
+def test_refine_key_reaches_the_settings_and_is_refused_on_a_continuous_law() -> None:
+    base = {"model": {"inertia": 1.0, "damping": 0.05, "stiffness": 1.0,
+                      "elastic": {"type": "preload", "preload": 0.05, "friction": 0.02}},
+            "excitation": {"mean": 0.01, "amplitudes": [0.3]}}
+    assert config_from_dict(base).analysis.refine == 0.005
+    cfg = config_from_dict({**base, "analysis": {"refine": 0}})
+    assert cfg.analysis.refine == 0.0 and cfg.to_dict()["analysis"]["refine"] == 0.0
+    with pytest.raises(ConfigError, match="`analysis.refine`"):
+        config_from_dict({**base, "analysis": {"refine": 1.5}})
+    with pytest.raises(ConfigError, match="`analysis.refine`"):
+        config_from_dict({**base, "analysis": {"refine": "yes"}})
+    smooth = {**base, "model": {**base["model"], "elastic": {"type": "linear"}}}
+    with pytest.raises(ConfigError, match="`analysis.refine`.*continuous"):
+        config_from_dict({**smooth, "analysis": {"refine": 0.01}})

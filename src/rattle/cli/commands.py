@@ -200,7 +200,8 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
     t_start = time.perf_counter()
     from ..analysis import RegularisationOptions, nonsmooth_response  # only now: all input has been validated
 
-    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation)
+    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
+                                    refine=analysis.refine or None)
     logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised harmonic "
                 "balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
                 analysis.omega_max, options.harmonics, options.regularisation)
@@ -397,7 +398,8 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
     t_start = time.perf_counter()
     from ..analysis import RegularisationOptions, nonsmooth_orbit  # only now: all input has been validated
 
-    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation)
+    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
+                                    refine=analysis.refine or None)
     logger.info("computing the orbit of a discontinuous law at Ω = %g: regularised harmonic balance (H = %d, ε = %g) "
                 "and exact shooting", omega, options.harmonics, options.regularisation)
     result = nonsmooth_orbit(run_config.model, omega, options)

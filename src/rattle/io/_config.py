@@ -85,6 +85,9 @@ DEFAULT_HARMONICS: int = 32
 #: Defaults for a discontinuous law (a preload or friction: ``rattle.analysis.nonsmooth_response``):
 #: ``analysis.regularisation`` ε and ``analysis.harmonics`` (those of ``RegularisationOptions``).
 DEFAULT_REGULARISATION: float = 0.01
+#: ``analysis.refine``: the HB rms error (relative, against the exact orbit) above which a row's
+#: regularisation is continued to its limit; 0 turns the refinement off.
+DEFAULT_REFINE: float = 0.005
 DEFAULT_NONSMOOTH_HARMONICS: int = 128
 
 _T = TypeVar("_T")
@@ -106,12 +109,16 @@ class AnalysisSettings:
     regularisation : float or None
         Relative width ε of the smooth steps that replace a discontinuous law's jumps and
         friction in the harmonic balance, 0 < ε < 1; None (the default) for a continuous law.
+    refine : float or None
+        For a discontinuous law: the relative HB rms error against the exact orbit above which a
+        row's regularisation is continued to its limit (0: never); None for a continuous law.
     """
 
     omega_min: float = DEFAULT_OMEGA[0]
     omega_max: float = DEFAULT_OMEGA[1]
     harmonics: int = DEFAULT_HARMONICS
     regularisation: float | None = None
+    refine: float | None = None
 
     def __post_init__(self) -> None:
         omega_min = _check_real("omega_min", self.omega_min)
@@ -138,6 +145,14 @@ class AnalysisSettings:
                     "needs more harmonics)"
                 )
             object.__setattr__(self, "regularisation", eps)
+        if self.refine is not None:
+            tol = _check_real("refine", self.refine)
+            if not 0.0 <= tol < 1.0:
+                raise ValueError(
+                    f"`refine` (the relative HB rms error above which a row's regularisation is continued to its "
+                    f"limit) must satisfy 0 <= refine < 1, got {tol!r}; use 0.005 (0.5 %), or 0 to turn it off"
+                )
+            object.__setattr__(self, "refine", tol)
         object.__setattr__(self, "omega_min", omega_min)
         object.__setattr__(self, "omega_max", omega_max)
         object.__setattr__(self, "harmonics", int(harmonics))
@@ -153,6 +168,8 @@ class AnalysisSettings:
         out: dict[str, Any] = {"omega": [self.omega_min, self.omega_max], "harmonics": self.harmonics}
         if self.regularisation is not None:
             out["regularisation"] = self.regularisation
+        if self.refine is not None:
+            out["refine"] = self.refine
         return out
 
 
@@ -219,7 +236,7 @@ class RunConfig:
 _TOP_KEYS = ("model", "excitation", "analysis", "engine", "paths", "drag")
 _MODEL_KEYS = ("inertia", "damping", "stiffness", "elastic")
 _EXCITATION_KEYS = ("mean", "amplitudes", "phases")
-_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation")
+_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine")
 #: Keys of ``[model.elastic]`` besides the continuous laws' parameters: ``friction`` (any type) and
 #: the parameters of type = "preload" (the discontinuous laws, :mod:`rattle.model._discontinuous`).
 _MODEL_ELASTIC_KEYS = ("friction", "preload", "clearance", "slope")
@@ -231,6 +248,7 @@ _EXAMPLES.update({
     "model.elastic.slope": "slope = 1.0",
     "model.elastic.friction": "friction = 0.02",
     "analysis.regularisation": "regularisation = 0.01",
+    "analysis.refine": "refine = 0.005",
 })
 
 def _law_params(law: type) -> dict[str, tuple[str, bool]]:
@@ -570,6 +588,16 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         check.number(regularisation, "analysis.regularisation")
     elif discontinuous:
         regularisation = DEFAULT_REGULARISATION
+    refine = DEFAULT_REFINE if discontinuous else None
+    if "refine" in table:
+        if not discontinuous:
+            raise check.error(
+                f"`analysis.refine` = {_show(table['refine'])} applies only to a discontinuous law "
+                "(`model.elastic.preload` > 0 or a `model.elastic.friction` level > 0), whose regularised harmonic "
+                "balance it refines; this law is continuous: remove `analysis.refine`"
+            )
+        refine = table["refine"]
+        check.number(refine, "analysis.refine")
     omega = table.get("omega", list(DEFAULT_OMEGA))
     check.array(omega, "analysis.omega")
     if len(omega) != 2:
@@ -582,8 +610,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
     return check.build(
         AnalysisSettings,
         {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics",
-         "regularisation": "analysis.regularisation"},
-        omega_min=omega[0], omega_max=omega[1], harmonics=harmonics, regularisation=regularisation,
+         "regularisation": "analysis.regularisation", "refine": "analysis.refine"},
+        omega_min=omega[0], omega_max=omega[1], harmonics=harmonics, regularisation=regularisation, refine=refine,
     )
 
 
