@@ -13,9 +13,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..io import AnalysisSettings, RunConfig, load_config
-from ..model import Model
+from ..model import Model, NonsmoothSystem
 from ._compare import compare
 from ._frequency_response import frequency_response
+from ._nonsmooth import RegularisationOptions, nonsmooth_response
+from ._nonsmooth_orbit import nonsmooth_orbit
 from ._orbit import periodic_orbit
 from ._time_sweep import time_sweep
 
@@ -28,8 +30,26 @@ class Case:
     config: RunConfig
 
     @property
-    def model(self) -> Model:
+    def model(self) -> Model | NonsmoothSystem:
+        """The model: a :class:`~rattle.model.Model` (or chain), or a
+        :class:`~rattle.model.NonsmoothSystem` when the law has a preload or friction."""
         return self.config.model
+
+    @property
+    def discontinuous(self) -> bool:
+        """True when the law has a jump or friction (the front ends of :mod:`._nonsmooth`)."""
+        return isinstance(self.config.model, NonsmoothSystem)
+
+    def regularisation_options(self) -> RegularisationOptions:
+        """The file's ``harmonics``, ``regularisation`` and ``refine`` for a discontinuous law."""
+        a = self.analysis
+        return RegularisationOptions(harmonics=a.harmonics, regularisation=a.regularisation,
+                                     refine=a.refine or None)
+
+    def _continuous_only(self, what: str) -> None:
+        if self.discontinuous:
+            raise TypeError(f"`{what}` is not available for a discontinuous law (preload or friction) yet: "
+                            "use `frequency_response()` or `periodic_orbit(omega)`")
 
     @property
     def analysis(self) -> AnalysisSettings:
@@ -43,20 +63,33 @@ class Case:
         """:func:`rattle.frequency_response` of this case over the file's ``analysis.omega`` with
         its ``analysis.harmonics`` — what ``rattle frf CONFIG`` computes. Keyword ``options``
         (``subharmonics=True``, ``omega=…``, ``hb=HBOptions(…)``, ``newton=…``, …) are passed on
-        and override the file; an unknown keyword raises TypeError."""
+        and override the file; an unknown keyword raises TypeError.
+
+        For a discontinuous law: :func:`rattle.analysis.nonsmooth_response` over the file's range
+        with :meth:`regularisation_options` (keywords ``omega``, ``options``, ``continuation``,
+        ``newton`` override)."""
+        if self.discontinuous:
+            kw: dict[str, Any] = {"omega": self.analysis.omega, "options": self.regularisation_options(), **options}
+            return nonsmooth_response(self.model, **kw)  # type: ignore[arg-type]
         return frequency_response(self.model, **self._with_analysis(options, "omega"))
 
     def periodic_orbit(self, omega: float, **options: Any) -> Any:
         """:func:`rattle.periodic_orbit` at ``omega`` with the file's harmonics, the primary branch
-        followed over ``analysis.omega`` (as ``rattle orbit CONFIG --omega W``)."""
+        followed over ``analysis.omega`` (as ``rattle orbit CONFIG --omega W``); for a
+        discontinuous law :func:`rattle.analysis.nonsmooth_orbit` with :meth:`regularisation_options`."""
+        if self.discontinuous:
+            kw: dict[str, Any] = {"options": self.regularisation_options(), **options}
+            return nonsmooth_orbit(self.model, omega, **kw)  # type: ignore[arg-type]
         return periodic_orbit(self.model, omega, **self._with_analysis(options, "search_range"))
 
     def compare(self, **options: Any) -> Any:
         """:func:`rattle.compare` over the file's range with its harmonics (as ``rattle compare``)."""
+        self._continuous_only("compare")
         return compare(self.model, **self._with_analysis(options, "omega"))
 
     def time_sweep(self, **options: Any) -> Any:
         """:func:`rattle.time_sweep` over the file's range (as ``rattle sweep``)."""
+        self._continuous_only("time_sweep")
         kw = {"omega": self.analysis.omega, **options}
         return time_sweep(self.model, **kw)
 

@@ -127,10 +127,21 @@ class Model:
     # --- I/O delegates --------------------------------------------------------------------
     @classmethod
     def from_toml(cls, path: str | Path) -> Model:
-        """Read the ``[model]`` and ``[excitation]`` tables of a SPEC §2 TOML file."""
-        from ..io import load_config
+        """Read the ``[model]`` and ``[excitation]`` tables of a SPEC §2 TOML file.
 
-        return load_config(path).model
+        A file whose law has a preload or friction describes a
+        :class:`~rattle.model.NonsmoothSystem`, not a Model: ConfigError, pointing to
+        ``rattle.load_case(path).model``."""
+        from ..errors import ConfigError
+        from ..io import load_config
+        from ._discontinuous import NonsmoothSystem
+
+        model = load_config(path).model
+        if isinstance(model, NonsmoothSystem):
+            raise ConfigError(f"{path}: the law has a preload or friction (`model.elastic.preload`/`friction`), "
+                              f"which makes a NonsmoothSystem, not a Model: read it with "
+                              f"`rattle.load_case({str(path)!r}).model`")
+        return model
 
     def to_dict(self) -> dict[str, object]:
         return {

@@ -1,0 +1,53 @@
+"""A case file with a preload or friction from Python: load_case dispatches to the front ends of the
+discontinuous laws with the file's settings, and Model.from_toml refuses it clearly."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rattle
+from rattle.errors import ConfigError
+from rattle.model import NonsmoothSystem
+from rattle.results import NonsmoothOrbitResult, NonsmoothResponse
+
+CASE = """
+[model]
+inertia = 1.0
+damping = 0.05
+stiffness = 1.0
+[model.elastic]
+type = "preload"
+preload = 0.05
+friction = 0.02
+[excitation]
+mean = 0.01
+amplitudes = [0.3]
+phases = [0.3]
+[analysis]
+omega = [1.2, 1.23]
+harmonics = 32
+regularisation = 0.02
+refine = 0
+"""
+
+
+def test_load_case_runs_the_discontinuous_front_ends_on_the_file_settings(tmp_path) -> None:
+    path = tmp_path / "case.toml"
+    path.write_text(CASE)
+    case = rattle.load_case(path)
+    assert case.discontinuous and isinstance(case.model, NonsmoothSystem)
+    opts = case.regularisation_options()
+    assert (opts.harmonics, opts.regularisation, opts.refine) == (32, 0.02, None)
+    frf = case.frequency_response()
+    assert isinstance(frf, NonsmoothResponse) and frf.harmonics == 32 and frf.regularisation == 0.02
+    assert frf.omega[0] == 1.2 and frf.omega[-1] == pytest.approx(1.23) and frf.limit_index.size == 0
+    orbit = case.periodic_orbit(1.21)
+    assert isinstance(orbit, NonsmoothOrbitResult) and orbit.converged
+    i = int(np.argmin(np.abs(frf.omega - 1.21)))
+    assert orbit.rms == pytest.approx(frf.rms[i], rel=0.05)  # the same branch, a row nearby
+    for name in ("compare", "time_sweep"):
+        with pytest.raises(TypeError, match=f"`{name}`"):
+            getattr(case, name)()
+    with pytest.raises(ConfigError, match="load_case"):
+        rattle.Model.from_toml(path)
