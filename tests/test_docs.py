@@ -123,21 +123,24 @@ def test_readme_keeps_the_two_set_up_commands():
 # Configuration keys
 # --------------------------------------------------------------------------------------------
 def _config_keys() -> list[str]:
-    """Every key the loader accepts, dotted, from its allowed-key sets and the elastic laws."""
+    """Every key the loader accepts, dotted, from its allowed-key sets (the model tables' in
+    rattle.model._tables, [analysis]'s in rattle.io._config) and the elastic laws."""
     from rattle.io import _config
-    from rattle.model import ELASTIC_LAWS
+    from rattle.model import ELASTIC_LAWS, _tables
 
     keys: list[str] = []
-    for name, value in vars(_config).items():
-        m = re.fullmatch(r"_([A-Z_]+)_KEYS", name)
-        if not m or not isinstance(value, (tuple, list, set, frozenset, dict)):
-            continue
-        prefix = "" if m.group(1) == "TOP" else m.group(1).lower().replace("_", ".") + "."
-        keys += [prefix + str(k) for k in value]
-    assert "model" in keys and "excitation" in keys, f"no allowed-key sets found in rattle.io._config: {keys}"
+    for module in (_tables, _config):
+        for name, value in vars(module).items():
+            m = re.fullmatch(r"_([A-Z_]+)_KEYS", name)
+            if not m or not isinstance(value, (tuple, list, set, frozenset, dict)):
+                continue
+            prefix = "" if m.group(1) == "TOP" else m.group(1).lower().replace("_", ".") + "."
+            keys += [prefix + str(k) for k in value]
+    assert "model" in keys and "excitation" in keys, f"no allowed-key sets found in rattle.model._tables: {keys}"
+    assert "analysis.omega" in keys, f"no [analysis] keys found in rattle.io._config: {keys}"
     keys.append("model.elastic.type")
     for law in ELASTIC_LAWS.values():
-        keys += [f"model.elastic.{p}" for p in _config._law_params(law)]
+        keys += [f"model.elastic.{p}" for p in _tables._law_params(law)]
     return sorted(set(keys))
 
 

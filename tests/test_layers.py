@@ -6,7 +6,10 @@
 - ``rattle.plotting`` draws results and knows nothing of the front ends, the demo or the CLI;
 - the command line imports the demo and the numerics only inside a command (a quick front door);
 - ``rattle.files`` (atomic writes, CSV, bounded reads, metadata) imports nothing of rattle but
-  ``errors``: every layer may write through it.
+  ``errors``: every layer may write through it;
+- ``rattle.model`` is the ground floor of the numerics: it imports nothing above it, not even
+  inside a method (``Model.from_toml`` reads its tables with ``rattle.model._tables`` and the
+  bounded read of ``rattle.files``, never through ``rattle.io``).
 """
 
 from __future__ import annotations
@@ -78,9 +81,24 @@ def test_imports_point_one_way(path: Path) -> None:
         bad = [m for m, _ in imports if _in(m, "rattle") and not any(_in(m, p) for p in ("rattle.files", "rattle.errors",
                                                                                         "rattle._release", "rattle._lazy"))]
         assert not bad, f"{me} imports {bad}: rattle.files knows no model, result or configuration"
+    if _in(me, "rattle.model"):  # the ground floor: its own modules and the helpers below it only
+        below = ("rattle.model", "rattle.errors", "rattle._limits", "rattle._typing", "rattle._validate", "rattle.files")
+        bad = [m for m, _ in imports if _in(m, "rattle") and m != "rattle" and not any(_in(m, p) for p in below)]
+        assert not bad, f"{me} imports {bad}: the model knows no configuration reader, analysis, result or front end"
     if _in(me, "rattle.cli"):
         heavy = [m for m, top in imports if top and any(_in(m, p) for p in ("rattle.demo", "rattle.analysis"))]
         assert not heavy, f"{me} imports {heavy} when loaded; import them inside the command"
+
+
+def test_the_model_rule_catches_an_import_of_io_inside_a_method(tmp_path: Path, monkeypatch) -> None:
+    """The rule above sees an import made inside a method (the arrow ``Model.from_toml`` once drew)."""
+    fake = tmp_path / "rattle" / "model" / "_reader.py"
+    fake.parent.mkdir(parents=True)
+    fake.write_text("class M:\n    def from_toml(cls, path):\n        from ..io import load_config\n\n"
+                    "        return load_config(path).model\n", encoding="utf-8")
+    monkeypatch.setitem(globals(), "SRC", tmp_path / "rattle")
+    with pytest.raises(AssertionError, match=r"rattle\.model\._reader imports \['rattle\.io', 'rattle\.io\.load_config'\]"):
+        test_imports_point_one_way(fake)
 
 
 def test_moved_column_lists_still_answer_from_io_with_a_warning() -> None:

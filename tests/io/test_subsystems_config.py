@@ -1,4 +1,4 @@
-"""Sub-system shapes of the configuration file (rattle.io._subsystems): each equals its Python
+"""Sub-system shapes of the configuration file (rattle.model._table_shapes): each equals its Python
 builder; bad physical input refused naming the key (exit 2 on the command line)."""
 
 from __future__ import annotations

@@ -9,10 +9,17 @@ from __future__ import annotations
 
 import os
 import stat
+import sys
+from typing import Any
 
 from ..errors import ConfigError
 
-__all__ = ["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"]
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+__all__ = ["MAX_CONFIG_BYTES", "read_bounded", "check_input_file", "read_toml"]
 
 #: Largest configuration file read (bytes). A case file is a few hundred bytes; 1 MiB leaves
 #: room for long comments and generated files while keeping a mistaken path harmless.
@@ -89,3 +96,34 @@ def read_bounded(path: str | os.PathLike[str], limit: int = MAX_CONFIG_BYTES, wh
             "give the path of a .toml case file"
         )
     return data
+
+
+def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The tables of the TOML configuration file ``path`` (as ``tomllib`` parses them), read with
+    :func:`read_bounded`: a regular file of at most :data:`MAX_CONFIG_BYTES`, UTF-8 text.
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be read or is not TOML; the message names the file and says the fix.
+    """
+    name = os.fspath(path)
+    try:
+        # a regular file of at most MAX_CONFIG_BYTES, checked before reading (not /dev/zero, not a FIFO)
+        return tomllib.loads(read_bounded(path).decode("utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(
+            f"configuration file {name!r} does not exist; check the path "
+            f"(relative paths start at {os.getcwd()!r})"
+        ) from None
+    except IsADirectoryError:
+        raise ConfigError(f"configuration file {name!r} is a directory; give the path of a .toml file") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"configuration file {name!r} is not UTF-8 text ({exc.reason} at byte {exc.start}); "
+            "save it with UTF-8 encoding"
+        ) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{name} is not valid TOML: {exc}; correct the syntax there") from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read configuration file {name!r}: {exc.strerror or exc}") from None

@@ -16,7 +16,7 @@ Each builder states its physics and returns the objects every analysis already s
   (:class:`LooseGear`).
 
 Angles are in rad, stiffnesses in N m/rad (N/m for a mesh), lengths in m: the configuration
-reader (:mod:`rattle.io._subsystems`) converts degrees and micrometres before calling these.
+reader (:mod:`._table_shapes`) converts degrees and micrometres before calling these.
 Every refusal is a ``ValueError``/``TypeError`` naming the argument in backticks.
 """
 

@@ -16,6 +16,7 @@ A two-inertia free chain with one element is exactly the single equation of SPEC
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -408,10 +409,11 @@ class Chain:
     @classmethod
     def from_toml(cls, path: str | Path) -> Any:
         """Read a SPEC §5 TOML file (``[model] inertias``, ``[[model.links]]``, ``[[model.elements]]``,
-        ``[[excitation.torques]]``)."""
-        from ..io import load_config
+        ``[[excitation.torques]]``), as :func:`rattle.io.load_config` reads them."""
+        from ..files._read import read_toml
+        from ._tables import model_tables
 
-        return load_config(path).model
+        return model_tables(read_toml(path), os.fspath(path)).model
 
     def to_dict(self) -> dict[str, object]:
         return {

@@ -9,7 +9,7 @@ h = q / q_0. Each order is written as a fraction with a denominator of at most
 fires at order 3/2) accepted only when it matches the order given to :data:`ORDER_RTOL`
 relative; q_0 is the gcd of the fractions.
 
-No I/O here: the configuration reader (:mod:`rattle.io`) calls :func:`engine_torque`.
+No I/O here: the reader of the model tables (:mod:`._tables`) calls :func:`engine_torque`.
 """
 
 from __future__ import annotations

@@ -9,6 +9,7 @@ unit-slope stage and f the elastic law (see ``_elastic``).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -131,12 +132,16 @@ class Model:
 
         A file whose law has a preload or friction describes a
         :class:`~rattle.model.NonsmoothSystem`, not a Model: ConfigError, pointing to
-        ``rattle.load_case(path).model``."""
-        from ..errors import ConfigError
-        from ..io import load_config
-        from ._discontinuous import NonsmoothSystem
+        ``rattle.load_case(path).model``.
 
-        model = load_config(path).model
+        The model tables are read as :func:`rattle.io.load_config` reads them (the same rules and
+        messages); ``[analysis]`` and ``[[paths]]`` are the run's and left alone."""
+        from ..errors import ConfigError
+        from ..files._read import read_toml
+        from ._discontinuous import NonsmoothSystem
+        from ._tables import model_tables
+
+        model = model_tables(read_toml(path), os.fspath(path)).model
         if isinstance(model, NonsmoothSystem):
             raise ConfigError(f"{path}: the law has a preload or friction (`model.elastic.preload`/`friction`), "
                               f"which makes a NonsmoothSystem, not a Model: read it with "

@@ -38,9 +38,9 @@ import warnings
 from collections.abc import Mapping
 from typing import Any
 
-from ..model import ELASTIC_LAWS
-from ..model._builders import clutch_damper, gear_pair, hub_spline, loose_gear
-from ._checks import _Checker, _in_radians, _show, rename_keys
+from ._builders import clutch_damper, gear_pair, hub_spline, loose_gear
+from ._elastic import ELASTIC_LAWS
+from ._table_checks import _Checker, _in_radians, _show, rename_keys
 
 __all__ = ["SUBSYSTEM_TYPES", "expand_subsystems"]
 
@@ -81,7 +81,7 @@ def _keys(check: _Checker, table: Mapping[str, Any], where: str, allowed: tuple[
           required: tuple[str, ...], what: str, kind: str) -> None:
     for key in table:
         if key not in allowed:
-            from ._checks import _did_you_mean
+            from ._table_checks import _did_you_mean
 
             raise check.error(
                 f"`{where}.{key}` is not a known key: {what} allows only {', '.join(allowed)} (angles also as "
@@ -334,7 +334,7 @@ def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>") -> M
     for k, t in enumerate(elements if isinstance(elements, list) else []):
         kind = t.get("type") if isinstance(t, Mapping) else None
         if isinstance(kind, str) and kind not in ELASTIC_LAWS and kind not in SUBSYSTEM_TYPES:
-            from ._checks import _did_you_mean
+            from ._table_checks import _did_you_mean
 
             types = [*ELASTIC_LAWS, *SUBSYSTEM_TYPES]
             hint = _did_you_mean(kind, types).replace("`", '"')

@@ -3,9 +3,10 @@
 :class:`_Checker` validates the structure and the TOML types of one configuration (unknown and
 missing keys with the nearest known key, numbers, arrays, integers, sub-tables) and re-raises the
 model dataclasses' errors with the key the user wrote (:func:`rename_keys`); :func:`_in_radians`
-turns the ``KEY_deg`` keys into radians once, remembering what the user wrote. The readers of
-:mod:`._config` (SPEC §2, §5, §6) and :mod:`._subsystems` (data-sheet shapes) share it; it knows no
-table of its own except the hint lines ``_EXAMPLES`` they extend.
+turns the ``KEY_deg`` keys into radians once, remembering what the user wrote. The readers of the
+model tables (:mod:`._tables`, SPEC §2, §5, §6), of the data-sheet shapes (:mod:`._table_shapes`)
+and of the ``[analysis]`` table (:mod:`rattle.io`) share it; it knows no table of its own except
+the hint lines ``_EXAMPLES`` they extend.
 """
 
 from __future__ import annotations
@@ -45,9 +46,6 @@ _EXAMPLES = {
     "excitation.mean": "mean = 0.05",
     "excitation.amplitudes": "amplitudes = [0.03]",
     "excitation.phases": "phases = [0.0]",
-    "analysis": "[analysis] with omega = [0.1, 3.0], harmonics = 32",
-    "analysis.omega": "omega = [0.1, 3.0]",
-    "analysis.harmonics": "harmonics = 32",
 }
 
 
