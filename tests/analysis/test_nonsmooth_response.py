@@ -103,6 +103,11 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
     assert changes and labelled == changes
     assert set(res.bifurcation[list(labelled)]) <= {"fold", "period_doubling", "neimark_sacker"}
+    # the HB orbit's own stability (saltation matrices along one period from its state) is the exact
+    # orbit's at every matched row here (measured 472 of 472; the smooth monodromy of the regularised
+    # equation agrees at 84 %: it misjudges the slow crossings of the jump)
+    hb_stable = np.all(np.abs(res.multipliers_hb[m]) < 1.0, axis=1)
+    assert np.mean(hb_stable == res.stable[m]) >= 0.99
 
 
 def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
@@ -125,6 +130,8 @@ def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -
 def test_options_refuse_bad_settings_naming_them(kwargs: dict, message: str) -> None:
     with pytest.raises((ValueError, TypeError), match=message):
         RegularisationOptions(**kwargs)
+    with pytest.raises(ValueError, match="`stability`"):
+        RegularisationOptions(stability="hill")
 
 
 def test_front_end_refuses_a_bad_range_and_options() -> None:

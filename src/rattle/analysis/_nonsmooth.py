@@ -9,9 +9,10 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    event-driven integrator (:func:`~rattle.timeint.shoot_nonsmooth_orbit`: crossings, sticking and
    locking exact, the monodromy with saltation matrices) started from the HB orbit's state at
    t = 0. The exact orbit gives the rms and the multipliers that are reported as the answer; the
-   HB's own values (rms, and the multipliers of the regularised orbit,
-   :func:`~rattle.stability.regularised_multipliers`) are kept beside them, so the regularisation's
-   effect is measured at every point (``rms_error``);
+   HB's own values (rms, and the HB orbit's multipliers: the non-smooth monodromy, with saltation
+   matrices, of one period of the exact flow from the HB state, or on request the smooth one of
+   the regularised equation, :func:`~rattle.stability.regularised_multipliers`) are kept beside
+   them, so the regularisation's effect is measured at every point (``rms_error``);
 3. a shooting that does not converge, or converges to an orbit whose δ(t) departs from the HB
    orbit's by more than ``match`` of its peak-to-peak anywhere on the period (64 samples), is
    flagged ``matched = False``: there the HB point has no exact counterpart nearby (usually near a
@@ -52,6 +53,24 @@ def _rms(q: FloatArray, H: int) -> float:
     return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
 
 
+def _hb_multipliers(problem: RegularisedBalance, integ: NonsmoothIntegrator, q: FloatArray, omega: float,
+                    state: tuple[float, float], method: str) -> np.ndarray:
+    """The Floquet multipliers of the HB orbit (2,), largest modulus first: ``"saltation"`` the
+    non-smooth monodromy (stage matrices and saltation matrices at every switching) of one period
+    of the exact flow from the HB orbit's state at t = 0; ``"regularised"`` the smooth monodromy of
+    the regularised equation along the HB orbit (:func:`~rattle.stability.regularised_multipliers`).
+    The first falls back to the second when the flow cannot be followed (the event budget)."""
+    if method == "saltation":
+        try:
+            M = integ.propagate(np.asarray(state, dtype=float), 0.0, 2.0 * math.pi / omega, omega).sensitivity
+            mu = np.linalg.eigvals(M).astype(complex)
+            if np.all(np.isfinite(mu)):
+                return mu[np.argsort(-np.abs(mu), kind="stable")]
+        except (RattleError, ValueError, ArithmeticError):
+            pass
+    return regularised_multipliers(problem, q, omega)
+
+
 def balance_factory(system: NonsmoothSystem) -> Callable[[float, int], RegularisedBalance]:
     """``make(ε, H)``: the regularised HB of ``system`` at relative width ε with H harmonics, on
     the scales every front end uses (the law's length scale L, ω_n = √(k s_max))."""
@@ -77,6 +96,11 @@ class RegularisationOptions:
     :func:`~rattle.analysis._regularisation.regularisation_limit`) at ``limit`` matched rows evenly
     spread, and at every matched row whose HB rms differs from the exact one by more than
     ``refine`` (relative; None: none); its last and Richardson rms are kept beside the exact one.
+    ``stability``: how the HB orbit's own multipliers are found: ``"saltation"`` (default) the
+    non-smooth monodromy of one period of the exact flow from the HB orbit's state, saltation
+    matrices included; ``"regularised"`` the smooth monodromy of the regularised equation along
+    the HB orbit (near a slow crossing of a jump the smoothing misjudges it: measured in
+    docs/nonsmooth.md).
     """
 
     harmonics: int = 128
@@ -86,6 +110,7 @@ class RegularisationOptions:
     limit_eps: float = 1e-3
     limit_harmonics: int = 256
     refine: float | None = 0.005
+    stability: str = "saltation"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "harmonics", check_int("harmonics", self.harmonics, 1))
@@ -100,6 +125,8 @@ class RegularisationOptions:
         HBOptions(harmonics=self.limit_harmonics)
         if self.refine is not None:
             object.__setattr__(self, "refine", check_positive(self.refine, "refine"))
+        if self.stability not in ("saltation", "regularised"):
+            raise ValueError(f"`stability` must be 'saltation' or 'regularised', got {self.stability!r}")
 
 
 def nonsmooth_response(
@@ -137,8 +164,8 @@ def nonsmooth_response(
     for pt in points:
         w, q = float(pt.omega), pt.q
         rms_hb = _rms(q, harmonics)
-        mu_hb = regularised_multipliers(problem, q, w)
         d0, v0 = (float(a[0]) for a in problem.samples(q, w))
+        mu_hb = _hb_multipliers(problem, integ, q, w, (d0, v0), opts.stability)
         size = max(float(np.ptp(problem.basis.synthesize(q))), 1e-12 * L)
         orbit = None
         try:

@@ -38,7 +38,8 @@ class NonsmoothResponse:
     ``matched``): ``mean``, ``rms``, ``rms_ac``, ``p2p`` and ``acc_p2p`` of δ and δ'', ``regime``,
     ``stick_time`` per period; ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact
     multipliers ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of
-    the regularised orbit; ``status``, ``message``; ``regularisation`` ε and ``harmonics`` H.
+    the HB orbit (by default the non-smooth monodromy of one period of the exact flow from its
+    state, saltations included; :class:`~rattle.analysis.RegularisationOptions` ``stability``); ``status``, ``message``; ``regularisation`` ε and ``harmonics`` H.
 
     The regularisation continued to its limit at the rows ``limit_index`` (evenly spread ones and
     those whose HB missed the exact rms by more than the ``refine`` tolerance): ``limit_eps`` the
