@@ -138,15 +138,14 @@ class Model:
         messages); ``[analysis]`` and ``[[paths]]`` are the run's and left alone."""
         from ..errors import ConfigError
         from ..files._read import read_toml
-        from ._discontinuous import NonsmoothSystem
         from ._tables import model_tables
 
-        model = model_tables(read_toml(path), os.fspath(path)).model
-        if isinstance(model, NonsmoothSystem):
+        tables = model_tables(read_toml(path), os.fspath(path))
+        if tables.discontinuous:
             raise ConfigError(f"{path}: the law has a preload or friction (`model.elastic.preload`/`friction`), "
                               f"which makes a NonsmoothSystem, not a Model: read it with "
                               f"`rattle.load_case({str(path)!r}).model`")
-        return model
+        return tables.model
 
     def to_dict(self) -> dict[str, object]:
         return {
