@@ -109,7 +109,7 @@ def test_spec_example_parses_to_the_reference_case(tmp_path: Path) -> None:
     assert config.source_name == str(tmp_path / "case.toml")
 
 
-def test_model_from_toml_delegates_to_load_config(tmp_path: Path) -> None:
+def test_model_from_toml_reads_the_model_of_load_config(tmp_path: Path) -> None:
     path = write(tmp_path, SPEC_EXAMPLE)
     assert Model.from_toml(path) == load_config(path).model
     assert Model.from_toml(str(path)) == load_config(path).model
