@@ -256,7 +256,7 @@ def test_the_branch_plot_shades_where_the_exact_orbit_sticks() -> None:
         p2p=nan, acc_p2p=nan, regime=np.full(6, "single_sided", dtype=object), stable=np.ones(6, dtype=bool),
         multipliers=mu, multipliers_hb=mu, stick_time=stick, matched=matched, status=Status.SUCCESS, message="",
         regularisation=0.01, harmonics=64, limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0),
-        limit_rms=np.zeros(0), limit_richardson=np.zeros(0))
+        limit_rms=np.zeros(0), limit_richardson=np.zeros(0), limit_linear=np.zeros(0, dtype=bool))
     _fig, ax = res.plot()
     spans = sorted(_span(p) for p in ax["rms"].patches)
     np.testing.assert_allclose(spans, [(0.6, 0.7), (0.9, 0.9)])

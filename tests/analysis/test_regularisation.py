@@ -48,3 +48,23 @@ def test_ladder_reports_a_failed_start() -> None:
                              newton=NewtonOptions(max_iterations=1))
     with pytest.raises(ValueError, match="eps_min"):
         regularisation_limit(_make, 0.8, np.zeros(33), eps_start=0.01, eps_min=0.1)
+
+
+def test_richardson_is_trusted_only_where_the_last_rungs_are_linear_in_eps() -> None:
+    from rattle.analysis._regularisation import RegularisationLimit, RegularisationStep
+
+    def ladder(rms: list[float], eps: list[float]) -> RegularisationLimit:
+        return RegularisationLimit(omega=1.0, steps=tuple(
+            RegularisationStep(eps=e, harmonics=32, q=np.zeros(65), mean=0.0, rms=r, p2p=0.0, tail=0.0)
+            for r, e in zip(rms, eps)))
+
+    eps = [0.01, 0.005, 0.0025]
+    lin = ladder([1.0 + 3.0 * e for e in eps], eps)  # rms = 1 + 3 ε: linear, the limit 1
+    assert lin.linear and lin.extrapolated_rms == pytest.approx(1.0, rel=1e-12)
+    quad = ladder([1.0 + 300.0 * e * e for e in eps], eps)  # quadratic: the slopes halve
+    assert not quad.linear
+    flat = ladder([1.0, 1.0 + 1e-12, 1.0 + 2e-12], eps)  # converged: nothing left to extrapolate
+    assert flat.linear
+    assert not ladder([1.0, 1.01], eps[:2]).linear  # two rungs do not show a line
+    turn = ladder([1.0, 1.01, 1.0], eps)  # the change reverses
+    assert not turn.linear

@@ -206,7 +206,7 @@ def nonsmooth_response(
     if refine is not None and candidates.size:  # and every row whose HB misses the exact rms by more than `refine`
         off = candidates[np.abs(rms_hb[candidates] / rms[candidates] - 1.0) > refine]
         pick = np.union1d(pick, off).astype(int)
-    lim_eps, lim_rms, lim_rich = [], [], []
+    lim_eps, lim_rms, lim_rich, lim_lin = [], [], [], []
     for i in pick:
         try:
             lad = regularisation_limit(make, float(points[i].omega), points[i].q, eps_start=regularisation,
@@ -215,10 +215,12 @@ def nonsmooth_response(
             lim_eps.append(lad.last.eps)
             lim_rms.append(lad.last.rms)
             lim_rich.append(lad.extrapolated_rms)
+            lim_lin.append(lad.linear)
         except RattleError:  # the ladder stalled: the row keeps its ε
             lim_eps.append(math.nan)
             lim_rms.append(math.nan)
             lim_rich.append(math.nan)
+            lim_lin.append(False)
     mean = np.array(rows["mean"])
     return NonsmoothResponse(
         omega=np.array(rows["omega"]), rms_hb=rms_hb, mean=mean, rms=rms,
@@ -229,7 +231,7 @@ def nonsmooth_response(
         matched=matched, status=stepper.status or Status.SUCCESS,
         message=stepper.message, regularisation=float(regularisation), harmonics=int(harmonics),
         limit_index=np.asarray(pick, dtype=int), limit_eps=np.array(lim_eps), limit_rms=np.array(lim_rms),
-        limit_richardson=np.array(lim_rich),
+        limit_richardson=np.array(lim_rich), limit_linear=np.array(lim_lin, dtype=bool),
     )
 
 

@@ -65,6 +65,19 @@ class RegularisationLimit:
         return abs(b - a) / max(abs(b), 1e-300)
 
     @property
+    def linear(self) -> bool:
+        """True when the last three rungs lie on one straight line in ε to within 30 % of its slope
+        (or the rms no longer moves, 1e-9): the regime in which Richardson's value holds."""
+        if len(self.steps) < 3:
+            return False
+        a, b, c = self.steps[-3:]
+        s1 = (b.rms - a.rms) / (b.eps - a.eps)
+        s2 = (c.rms - b.rms) / (c.eps - b.eps)
+        if max(abs(b.rms - a.rms), abs(c.rms - b.rms)) <= 1e-9 * abs(c.rms):
+            return True
+        return s1 != 0.0 and 0.7 <= s2 / s1 <= 1.3
+
+    @property
     def extrapolated_rms(self) -> float:
         """Richardson's ε → 0 value of the rms from the last two rungs (error linear in ε)."""
         if len(self.steps) < 2:

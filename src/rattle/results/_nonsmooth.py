@@ -27,7 +27,7 @@ from ..stability import classify_loss
 #: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
 NONSMOOTH_COLUMNS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
                      "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs", "eps_limit", "rms_hb_limit",
-                     "rms_error_limit")
+                     "rms_hb_extrapolated", "rms_error_limit")
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,9 +44,11 @@ class NonsmoothResponse:
     The regularisation continued to its limit at the rows ``limit_index`` (evenly spread ones and
     those whose HB missed the exact rms by more than the ``refine`` tolerance): ``limit_eps`` the
     smallest ε reached, ``limit_rms`` the HB rms there, ``limit_richardson`` the Richardson ε → 0
-    value (:attr:`limit_error`, :attr:`richardson_error` against the exact rms of the row). As
-    columns (nan at the other rows): ``eps_limit``, ``rms_hb_limit``, ``rms_error_limit``;
-    :attr:`hb_error` is the HB's error at its smallest ε on every row."""
+    value (:attr:`limit_error`, :attr:`richardson_error` against the exact rms of the row) and
+    ``limit_linear`` whether the ladder's last rungs lie on a line in ε (Richardson's value then
+    holds). As columns (nan at the other rows): ``eps_limit``, ``rms_hb_limit``,
+    ``rms_hb_extrapolated`` (Richardson's value where linear) and ``rms_error_limit``;
+    :attr:`hb_error` is the error of the HB's ε → 0 estimate on every row."""
 
     omega: FloatArray
     rms_hb: FloatArray
@@ -69,6 +71,7 @@ class NonsmoothResponse:
     limit_eps: FloatArray
     limit_rms: FloatArray
     limit_richardson: FloatArray
+    limit_linear: np.ndarray
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -94,13 +97,19 @@ class NonsmoothResponse:
         return out
 
     @property
-    def hb_error(self) -> FloatArray:
-        """The HB's relative rms error against the exact orbit at the smallest ε it reached on each
-        row: the limit's where the regularisation was continued (and did not stall), else
-        :attr:`rms_error` (nan where not matched)."""
+    def rms_hb_estimate(self) -> FloatArray:
+        """The HB's ε → 0 estimate of the rms on each row: where the regularisation was continued
+        to its limit, Richardson's value if the last rungs are linear in ε, else the rms at the
+        smallest ε; elsewhere the rms at ε (``rms_hb``)."""
+        ext = self._per_row(np.where(self.limit_linear, self.limit_richardson, np.nan))
         lim = self._per_row(self.limit_rms)
-        best = np.where(np.isfinite(lim), lim, self.rms_hb)
-        return best / self.rms - 1.0
+        return np.where(np.isfinite(ext), ext, np.where(np.isfinite(lim), lim, self.rms_hb))
+
+    @property
+    def hb_error(self) -> FloatArray:
+        """The relative error of :attr:`rms_hb_estimate` against the exact rms (nan where not
+        matched)."""
+        return self.rms_hb_estimate / self.rms - 1.0
 
     @property
     def bifurcation(self) -> np.ndarray:
@@ -122,7 +131,9 @@ class NonsmoothResponse:
             "rms_hb": self.rms_hb, "rms_error": self.rms_error, "matched": self.matched,
             "stick_time": self.stick_time, "mu1_abs": mu[:, 0], "mu2_abs": mu[:, 1], "mu1_hb_abs": mu_hb[:, 0],
             "mu2_hb_abs": mu_hb[:, 1], "eps_limit": self._per_row(self.limit_eps),
-            "rms_hb_limit": self._per_row(self.limit_rms), "rms_error_limit": self._per_row(self.limit_rms) / self.rms - 1.0,
+            "rms_hb_limit": self._per_row(self.limit_rms),
+            "rms_hb_extrapolated": self._per_row(np.where(self.limit_linear, self.limit_richardson, np.nan)),
+            "rms_error_limit": np.where(np.isnan(self._per_row(self.limit_rms)), np.nan, self.hb_error),
         }
 
     def plot(self) -> tuple:
