@@ -1,6 +1,8 @@
 """Benchmark: whole branches of preload and friction laws, the regularised HB against the exact orbit.
 
-Run:  OMP_NUM_THREADS=1 python benchmarks/bench_nonsmooth_branches.py [H] [EPS] [LAWS, e.g. 0,2]
+Run:  OMP_NUM_THREADS=1 python benchmarks/bench_nonsmooth_branches.py [H] [EPS] [LAWS, e.g. 0,2] [DEEP_EPS]
+
+(DEEP_EPS, e.g. 1e-4: the rows still off and not yet linear in ε go on down to it with H up to 512.)
 
 For three laws (c = 0.05, k = 1, F_m = 0.01, F_p = 0.3 at phase 0.3; Ω = 0.3 … 2):
 ``nonsmooth_response`` with H harmonics (default 128) and ε (default 0.01), refine = 0.5 %
@@ -26,6 +28,7 @@ from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Pr
 LAWS = [(0.05, 0.0), (0.05, 0.02), (0.2, 0.05)]
 if len(sys.argv) > 3:  # a subset, e.g. "0" for the first law only
     LAWS = [LAWS[int(i)] for i in sys.argv[3].split(",")]
+DEEP = float(sys.argv[4]) if len(sys.argv) > 4 else None
 
 
 def main() -> None:
@@ -36,7 +39,8 @@ def main() -> None:
         sysx = NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
                                excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
         t0 = time.perf_counter()
-        res = nonsmooth_response(sysx, (0.3, 2.0), RegularisationOptions(harmonics=H, regularisation=eps, refine=0.005))
+        res = nonsmooth_response(sysx, (0.3, 2.0), RegularisationOptions(harmonics=H, regularisation=eps, refine=0.005,
+                                                                          deep_eps=DEEP))
         wall = time.perf_counter() - t0
         m = np.flatnonzero(res.matched)
         e = np.abs(res.rms_error[m])

@@ -156,3 +156,27 @@ def test_rows_the_hb_misses_are_refined_towards_the_limit() -> None:
     cols = res.columns()
     assert np.isnan(cols["eps_limit"][rest]).all() and np.all(cols["eps_limit"][off] == pytest.approx(0.0125))
     np.testing.assert_allclose(cols["rms_error_limit"][off], res.hb_error[off], rtol=1e-12)
+
+
+def test_a_deeper_ladder_continues_the_rungs_it_was_given() -> None:
+    """_deeper goes on from the last rung of a ladder (0.05 → 0.025) down to deep_eps (0.0125) with
+    up to deep_harmonics: one ladder, ε strictly falling, its first rungs those given, and the error
+    against the exact orbit smaller at the end (the friction's reversals converge like ε)."""
+    from rattle.analysis._nonsmooth import _deeper, balance_factory
+    from rattle.analysis._regularisation import regularisation_limit
+
+    system = _system(0.05, 0.02)
+    make = balance_factory(system)
+    exact = shoot_nonsmooth_orbit(system, 0.8, (0.0, 0.0))
+    assert exact.converged
+    lad = regularisation_limit(make, 0.8, exact.trajectory.fourier(32), eps_start=0.05, eps_min=0.025,
+                               harmonics=32, max_harmonics=32)
+    deep = _deeper(make, lad, RegularisationOptions(deep_eps=0.0125, deep_harmonics=64))
+    eps = [s.eps for s in deep.steps]
+    assert deep.steps[: len(lad.steps)] == lad.steps and eps[-1] == pytest.approx(0.0125)
+    assert all(a > b for a, b in zip(eps, eps[1:]))
+    assert abs(deep.last.rms / exact.rms - 1) < abs(lad.last.rms / exact.rms - 1)
+    with pytest.raises(ValueError, match="`deep_eps`"):
+        RegularisationOptions(deep_eps=0.0)
+    with pytest.raises(ValueError, match="`deep_harmonics`"):
+        RegularisationOptions(deep_harmonics=10**6)

@@ -46,7 +46,7 @@ from ..model import NonsmoothSystem
 from ..results import NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
-from ._regularisation import regularisation_limit
+from ._regularisation import RegularisationLimit, regularisation_limit
 
 
 def _rms(q: FloatArray, H: int) -> float:
@@ -69,6 +69,19 @@ def _hb_multipliers(problem: RegularisedBalance, integ: NonsmoothIntegrator, q: 
         except (RattleError, ValueError, ArithmeticError):
             pass
     return regularised_multipliers(problem, q, omega)
+
+
+def _deeper(make: Callable[[float, int], RegularisedBalance], lad: RegularisationLimit,
+            opts: RegularisationOptions) -> RegularisationLimit:
+    """``lad`` continued from its last rung down to ``opts.deep_eps`` with up to
+    ``opts.deep_harmonics`` harmonics; ``lad`` itself when that stalls."""
+    last = lad.last
+    try:
+        more = regularisation_limit(make, lad.omega, last.q, eps_start=last.eps, eps_min=float(opts.deep_eps),
+                                    harmonics=last.harmonics, max_harmonics=max(opts.deep_harmonics, last.harmonics))
+    except RattleError:
+        return lad
+    return RegularisationLimit(omega=lad.omega, steps=lad.steps + more.steps[1:])
 
 
 def balance_factory(system: NonsmoothSystem) -> Callable[[float, int], RegularisedBalance]:
@@ -96,6 +109,10 @@ class RegularisationOptions:
     :func:`~rattle.analysis._regularisation.regularisation_limit`) at ``limit`` matched rows evenly
     spread, and at every matched row whose HB rms differs from the exact one by more than
     ``refine`` (relative; None: none); its last and Richardson rms are kept beside the exact one.
+    Where such a row is still off by more than ``refine`` at ``limit_eps`` and the ladder's last
+    rungs are not yet linear in ε (Richardson's value not yet to be trusted), the ladder goes on
+    down to ``deep_eps`` (e.g. 1e-4) with up to ``deep_harmonics`` harmonics; None (default): it
+    stops at ``limit_eps``. That costs 20–45 s a row at H = 512 (measured in docs/nonsmooth.md).
     ``stability``: how the HB orbit's own multipliers are found: ``"saltation"`` (default) the
     non-smooth monodromy of one period of the exact flow from the HB orbit's state, saltation
     matrices included; ``"regularised"`` the smooth monodromy of the regularised equation along
@@ -110,21 +127,27 @@ class RegularisationOptions:
     limit_eps: float = 1e-3
     limit_harmonics: int = 256
     refine: float | None = 0.005
+    deep_eps: float | None = None
+    deep_harmonics: int = 512
     stability: str = "saltation"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "harmonics", check_int("harmonics", self.harmonics, 1))
-        HBOptions(harmonics=self.harmonics)  # its bounds
+        for name in ("harmonics", "limit_harmonics", "deep_harmonics"):
+            object.__setattr__(self, name, check_int(name, getattr(self, name), 1))
+            try:
+                HBOptions(harmonics=getattr(self, name))  # its bounds
+            except ValueError as exc:
+                raise ValueError(str(exc).replace("`harmonics`", f"`{name}`", 1)) from None
         for name in ("regularisation", "match", "limit_eps"):
             object.__setattr__(self, name, check_positive(getattr(self, name), name))
         if self.regularisation >= 1.0:
             raise ValueError(f"`regularisation` (relative width ε of the smooth steps) must be < 1, "
                              f"got {self.regularisation!r}; use 0.01")
         object.__setattr__(self, "limit", check_int("limit", self.limit, 0))
-        object.__setattr__(self, "limit_harmonics", check_int("limit_harmonics", self.limit_harmonics, 1))
-        HBOptions(harmonics=self.limit_harmonics)
         if self.refine is not None:
             object.__setattr__(self, "refine", check_positive(self.refine, "refine"))
+        if self.deep_eps is not None:
+            object.__setattr__(self, "deep_eps", check_positive(self.deep_eps, "deep_eps"))
         if self.stability not in ("saltation", "regularised"):
             raise ValueError(f"`stability` must be 'saltation' or 'regularised', got {self.stability!r}")
 
@@ -212,6 +235,9 @@ def nonsmooth_response(
             lad = regularisation_limit(make, float(points[i].omega), points[i].q, eps_start=regularisation,
                                        eps_min=min(limit_eps, regularisation), harmonics=harmonics,
                                        max_harmonics=max(limit_harmonics, harmonics))
+            if refine is not None and opts.deep_eps is not None and matched[i] and not lad.linear \
+                    and abs(lad.last.rms / rms[i] - 1.0) > refine and opts.deep_eps < lad.last.eps:
+                lad = _deeper(make, lad, opts)  # not yet in the linear range and still off: narrower, more harmonics
             lim_eps.append(lad.last.eps)
             lim_rms.append(lad.last.rms)
             lim_rich.append(lad.extrapolated_rms)
