@@ -24,8 +24,11 @@ from typing import Any
 import numpy as np
 
 from .._limits import MAX_MAGNITUDE
+from .._typing import FloatArray
+from ._discontinuous import Friction, NonsmoothLaw
 from ._drag import Drag, drag_load
 from ._elastic import AbstractElastic, _check_real, _check_real_sequence
+from ._friction_system import FrictionSystem
 from ._system import ReducedElement, System
 
 #: Relative tolerance of the mean-torque balance of a free chain.
@@ -88,12 +91,18 @@ class Link:
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Element:
     """A clearance element ``name`` on δ = θ_i − θ_j (``between`` = (i, j)) with the stiffness
-    ``stiffness`` K_e of its unit-slope stage and the piecewise-linear ``law`` f_e."""
+    ``stiffness`` K_e of its unit-slope stage and the piecewise-linear ``law`` f_e; optionally
+    Coulomb ``friction`` r_e (relative to K_e: a hysteresis torque K_e r_e opposing δ', one level
+    for every stage or one per stage of the law, :class:`~rattle.model.Friction`).
+
+    A chain with friction on any element is solved by :func:`rattle.analysis.nonsmooth_response`
+    on :meth:`Chain.friction_system`; the smooth analyses refuse it."""
 
     name: str
     between: tuple[int, int]
     stiffness: float
     law: AbstractElastic
+    friction: Friction | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -108,9 +117,26 @@ class Element:
             raise TypeError(f"`law` must be an elastic law (Linear, Backlash, Clutch, Piecewise), got {self.law!r}")
         object.__setattr__(self, "stiffness", k)
         object.__setattr__(self, "between", _pair("between", self.between))
+        if self.friction is not None:
+            if not isinstance(self.friction, Friction):
+                raise TypeError(f"`friction` must be a rattle.model.Friction (or None), got {self.friction!r}")
+            self.friction.per_stage(len(self.law.stages.slopes))  # one level or one per stage
+
+    @property
+    def has_friction(self) -> bool:
+        """A friction level > 0 on some stage."""
+        return self.friction is not None and any(self.friction.levels)
+
+    def friction_levels(self) -> FloatArray:
+        """r_e on every stage of the law (zeros without friction)."""
+        n = len(self.law.stages.slopes)
+        return np.zeros(n) if self.friction is None else self.friction.per_stage(n)
 
     def to_dict(self) -> dict[str, object]:
-        return {"name": self.name, "between": list(self.between), "stiffness": self.stiffness, **self.law.to_dict()}
+        out = {"name": self.name, "between": list(self.between), "stiffness": self.stiffness, **self.law.to_dict()}
+        if self.friction is not None:
+            out["friction"] = list(self.friction.levels)
+        return out
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -374,12 +400,34 @@ class Chain:
         )
 
     def system(self) -> System:
-        """The equations of motion in the coordinates the numerics use (:class:`System`)."""
+        """The equations of motion in the coordinates the numerics use (:class:`System`).
+
+        Refused (ValueError) for a chain with friction: the smooth analyses would drop it; such a
+        chain is solved on :meth:`friction_system`."""
         assert self._system is not None
+        if self.has_friction:
+            names = ", ".join(e.name for e in self.elements if e.has_friction)
+            raise ValueError(
+                f"the chain has Coulomb friction on element(s) {names}: the smooth analyses (frf, sweep, "
+                "compare, map, orbit) do not hold a torque that jumps at zero relative speed; solve it with "
+                "rattle.analysis.nonsmooth_response(chain.friction_system(), ...)"
+            )
         return self._system
 
+    @property
+    def has_friction(self) -> bool:
+        """Some element carries Coulomb friction (a level > 0)."""
+        return any(e.has_friction for e in self.elements)
+
+    def friction_system(self) -> FrictionSystem:
+        """The equations of motion with every element's friction (:class:`FrictionSystem`)."""
+        assert self._system is not None
+        laws = tuple(NonsmoothLaw(elastic=e.law, friction=e.friction) for e in self.elements)
+        return FrictionSystem(system=self._system, laws=laws, speed_order=self.speed_order)
+
     def _check_scales(self) -> None:
-        sysm = self.system()
+        sysm = self._system
+        assert sysm is not None
         for what, value in (("damping", np.abs(sysm.damping).max()), ("stiffness", np.abs(sysm.stiffness).max()),
                             ("element stiffness", max(np.abs(e.b).max() for e in sysm.elements))):
             if value and not (1.0 / MAX_MAGNITUDE <= value <= MAX_MAGNITUDE):
@@ -395,15 +443,18 @@ class Chain:
         return any(link.damping > 0 for link in self.links)
 
     def length_scale(self) -> float:
-        return self.system().length_scale()
+        assert self._system is not None
+        return self._system.length_scale()
 
     def force_scale(self) -> float:
-        return self.system().force_scale()
+        assert self._system is not None
+        return self._system.force_scale()
 
     @property
     def natural_frequency(self) -> float:
         """The highest natural frequency (rad/s), every element on its stiffest stage."""
-        return self.system().stiffest_frequency()
+        assert self._system is not None
+        return self._system.stiffest_frequency()
 
     # --- I/O delegates -----------------------------------------------------------------------
     @classmethod
