@@ -1,0 +1,305 @@
+"""Harmonic balance of a chain with Coulomb friction on its elements, by regularisation.
+
+The chain's equations with friction (:class:`~rattle.model.FrictionSystem`), n coordinates and
+m clearance elements,
+
+    x'' + C x' + K x + Σ_e b_e g_e(δ_e, δ_e') = F(t),   δ_e = a_e · x,
+    g_e(δ, δ') = f_e(δ) + r_e(δ) sgn(δ'),
+
+have a force that jumps where a relative velocity δ_e' changes sign. As for the single equation
+(:mod:`rattle.hb._regularised`) the harmonic balance solves the regularised equations, every
+sign replaced by a smooth step (:meth:`~rattle.model.NonsmoothLaw.regularised`, g_ε,e relative
+to the element stiffness, which b_e carries):
+
+    sgn(δ') → tanh(δ' / ε_v),   steps of r_e at breakpoints → H_ε(δ − d_i) of width ε_δ,
+    ε_δ = ε L,   ε_v = ε L ω_n,
+
+L the system's length scale with friction (:meth:`FrictionSystem.length_scale`) and ω_n its
+highest natural frequency (:meth:`FrictionSystem.frequency_scale`); both are fixed (the law
+does not depend on Ω), so ε is the only knob.
+
+The unknowns are those of :class:`~rattle.hb.HarmonicBalance`: q = vec(Q), Q (n, 2H+1)
+coordinate-major, row i the real series [a_0, a_1 … a_H, b_1 … b_H] of x_i at base frequency
+ω = Ω/p. With ℰ (N × (2H+1)) the synthesis at N samples per period, 𝒜 = ℰ⁺ the truncated
+analysis and ∇(ω) = ω ∇(1) the derivative operator, the residual is
+
+    R_i(q, Ω) = ∇² q_i + Σ_j C_ij ∇ q_j + Σ_j K_ij q_j
+                + Σ_e b_e,i 𝒜 g_ε,e(ℰ (a_e·Q), ℰ ∇ (a_e·Q)) − F_i(Ω),
+
+F_i the forcing coefficients (mean F_0 plus a speed-dependent load d(Ω) u at a_0, harmonic h of Ω
+at harmonic h·p of ω). Its Jacobians, by AFT with a velocity-dependent force:
+
+    ∂R/∂q = I ⊗ ∇² + C ⊗ ∇ + K ⊗ I + Σ_e (b_e a_eᵀ) ⊗ [𝒜 diag(∂g_e/∂δ) ℰ + 𝒜 diag(∂g_e/∂δ') ℰ ∇],
+    ∂R/∂Ω = (1/p) [2ω ∇(1)² Q + C ∇(1) Q + Σ_e b_e 𝒜 diag(∂g_e/∂δ') ℰ ∇(1) (a_e·Q)] − d'(Ω) u,
+
+the products 𝒜 diag(w) ℰ assembled from the spectra of the samples w by the harmonic balance's
+product rule (:func:`~rattle.hb._residual.product_jacobians`, exact for N ≥ 4H + 1), one pair
+per element; ∂R/∂q is dense, (n·S)² with S = 2H + 1.
+
+The ε-problem's orbit differs from the discontinuous one by O(ε) in general (sticking becomes
+creeping at a speed ~ε_v); it is solved along a decreasing sequence of ε and checked against the
+exact event-driven orbit, for which :meth:`RegularisedSystemBalance.state_at_zero` gives the
+start (x(0), x'(0)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from .._typing import FloatArray
+from ..model import FrictionSystem
+from ._basis import FourierBasis, resize_harmonics
+from ._options import HBOptions
+from ._residual import product_jacobians, product_tables
+
+_gesv = scipy.linalg.lapack.dgesv
+
+
+class RegularisedSystemBalance:
+    """R(q, Ω) = 0 of the regularised chain with friction (module docstring), a
+    :class:`~rattle.continuation.ContinuationProblem` in Ω.
+
+    Parameters
+    ----------
+    fsys
+        The chain's equations with friction (:class:`~rattle.model.FrictionSystem`).
+    regularisation
+        ε > 0, the relative width of the smooth steps (ε_δ = ε L, ε_v = ε L ω_n).
+    options
+        The harmonics and samples (:class:`HBOptions`).
+    period
+        p: the solution's period is p forcing periods.
+    """
+
+    def __init__(self, fsys: FrictionSystem, *, regularisation: float, options: HBOptions | None = None,
+                 period: int = 1) -> None:
+        if not isinstance(fsys, FrictionSystem):
+            raise TypeError(f"`fsys` must be a rattle.model.FrictionSystem (Chain.friction_system() or "
+                            f"FrictionSystem.from_system), got {fsys!r}")
+        eps = _check_regularisation(regularisation)
+        if options is None:
+            options = HBOptions()
+        elif not isinstance(options, HBOptions):
+            raise TypeError(f"`options` must be a rattle.hb.HBOptions or None, got {options!r}")
+        if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
+            raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
+        period = int(period)
+        system = fsys.system
+        n_forced = system.forced_harmonics
+        H = options.harmonics
+        if H < n_forced * period:
+            raise ValueError(
+                f"`harmonics` must be >= {n_forced * period} to hold the excitation's harmonic {n_forced} at "
+                f"period {period} (harmonic {n_forced}×{period} of the base frequency), got {H}"
+            )
+        L, wn = float(fsys.length_scale()), float(fsys.frequency_scale())
+        if not (np.isfinite(L) and L > 0 and np.isfinite(wn) and wn > 0):
+            raise ValueError(f"`fsys` must have a finite length scale > 0 and natural frequency > 0, got "
+                             f"L = {L!r}, ω_n = {wn!r}")
+        self.fsys = fsys
+        self.system = system
+        self.options = options
+        self.period = period
+        self.eps = eps
+        self._L, self._wn = L, wn
+        self.basis = FourierBasis(H, options.n_samples)
+        S = 2 * H + 1
+        n, m = system.n, system.m
+        self.n_coordinates, self.n_elements = n, m
+        self._S = S
+        # Forcing coefficients (as HarmonicBalance): F_0 at a_0, harmonic h of Ω at harmonic h·p.
+        F = np.zeros((n, S))
+        F[:, 0] = system.mean
+        for h in range(1, n_forced + 1):
+            r = h * period
+            F[:, r] += system.cos[h - 1]
+            F[:, H + r] += system.sin[h - 1]
+        self.forcing = F.reshape(-1)
+        self._load = system.load
+        self._a0 = np.arange(n) * S
+        self._force_scale = float(system.force_scale())
+        self._C = np.asarray(system.damping, dtype=float)
+        self._K = np.asarray(system.stiffness, dtype=float)
+        self._A = system.element_rows.reshape(m, n)
+        self._B = system.element_columns.reshape(n, m)
+        W = np.einsum("ie,ej->eij", self._B, self._A)
+        self._W_entries = [(int(e), int(i), int(j), float(W[e, i, j])) for e, i, j in zip(*np.nonzero(W))]
+        self._laws = fsys.laws
+        self._tables = product_tables(H, 2 * m)
+        # The linear part's Jacobian I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I = ω² L2 + ω L1 + L0.
+        D1 = self.basis.derivative_matrix(1.0)
+        I_S = np.eye(S)
+        self._L2 = np.kron(np.eye(n), D1 @ D1)
+        self._L1 = np.kron(self._C, D1)
+        self._L0 = np.kron(self._K, I_S)
+
+    # --- scales (ContinuationProblem) --------------------------------------------------------
+    @property
+    def size(self) -> int:
+        """n·(2H+1) real unknowns."""
+        return self.n_coordinates * self._S
+
+    @property
+    def length_scale(self) -> float:
+        """L (rad): :meth:`FrictionSystem.length_scale`."""
+        return self._L
+
+    @property
+    def parameter_scale(self) -> float:
+        """ω_n (rad/s): :meth:`FrictionSystem.frequency_scale`."""
+        return self._wn
+
+    @property
+    def force_scale(self) -> float:
+        """The forcing's size per inertia (:meth:`System.force_scale`)."""
+        return self._force_scale
+
+    @property
+    def regularisation(self) -> float:
+        """ε."""
+        return self.eps
+
+    @property
+    def widths(self) -> tuple[float, float]:
+        """(ε_δ, ε_v): the widths of the smooth steps in δ (rad) and δ' (rad/s)."""
+        return self.eps * self._L, self.eps * self._L * self._wn
+
+    def with_regularisation(self, regularisation: float) -> RegularisedSystemBalance:
+        """The same problem with another ε (shares the matrices)."""
+        eps = _check_regularisation(regularisation)
+        out = object.__new__(RegularisedSystemBalance)
+        out.__dict__.update(self.__dict__)
+        out.eps = eps
+        return out
+
+    def base_frequency(self, omega: float) -> float:
+        """ω = Ω / p."""
+        return omega / self.period
+
+    # --- views ---------------------------------------------------------------------------------
+    def coordinate_series(self, q: FloatArray) -> FloatArray:
+        """Q (n, 2H+1): row i is the real series of coordinate x_i (a view of ``q``)."""
+        return np.asarray(q).reshape(self.n_coordinates, self._S)
+
+    def element_series(self, q: FloatArray) -> FloatArray:
+        """The deflection series of every element, A Q, shape (m, 2H+1)."""
+        return self._A @ self.coordinate_series(q)
+
+    def element_samples(self, q: FloatArray) -> FloatArray:
+        """δ_e(t_j) at the N sample times of the base period, shape (m, N)."""
+        return self.basis.synthesize(self.element_series(q))
+
+    def element_rms(self, q: FloatArray) -> FloatArray:
+        """rms of every element's deflection over the period, √(a_0² + ½ Σ_h (a_h² + b_h²)), (m,)."""
+        E = self.element_series(q)
+        return np.sqrt(E[:, 0] ** 2 + 0.5 * np.sum(E[:, 1:] ** 2, axis=1))
+
+    def state_at_zero(self, q: FloatArray, omega: float) -> FloatArray:
+        """z(0) = (x(0), x'(0)) (2n,) of the orbit q at forcing frequency Ω: x(0) = a_0 + Σ a_h,
+        x'(0) = Σ_h h ω b_h (ω = Ω/p); the start of the exact integration."""
+        Q = self.coordinate_series(q)
+        H = self.basis.harmonics
+        w = self.base_frequency(omega)
+        x0 = Q[:, 0] + Q[:, 1 : H + 1].sum(axis=1)
+        v0 = Q[:, H + 1 :] @ (self.basis.k * w)
+        return np.concatenate((x0, v0))
+
+    def resize(self, q: FloatArray, harmonics: int, factor: int = 1) -> FloatArray:
+        """:func:`~rattle.hb.resize_harmonics` of every coordinate's series of ``q`` (flat in, flat out)."""
+        return resize_harmonics(self.coordinate_series(q), harmonics, factor).reshape(-1)
+
+    # --- residual ------------------------------------------------------------------------------
+    def _forcing_at(self, omega: float) -> FloatArray:
+        """The forcing coefficients at Ω: :attr:`forcing` plus the load's d(Ω) u at the a_0 slots."""
+        if self._load is None:
+            return self.forcing
+        F = self.forcing.copy()
+        F[self._a0] += float(self._load.value(omega)) * self._load.direction
+        return F
+
+    def _derivative(self, X: FloatArray, w: float) -> FloatArray:
+        """∇(ω) applied to every row of the series X (r, S)."""
+        H = self.basis.harmonics
+        kw = self.basis.k * w
+        out = np.empty_like(X)
+        out[:, 0] = 0.0
+        np.multiply(kw, X[:, H + 1 :], out=out[:, 1 : H + 1])
+        np.multiply(-kw, X[:, 1 : H + 1], out=out[:, H + 1 :])
+        return out
+
+    def _element_forces(self, q: FloatArray, omega: float) -> tuple[FloatArray, ...]:
+        """Q, ∇Q, and the samples g_ε,e, ∂g/∂δ, ∂g/∂δ' (each (m, N)) along the orbit q."""
+        Q = self.coordinate_series(np.asarray(q, dtype=float))
+        w = self.base_frequency(omega)
+        dQ = self._derivative(Q, w)
+        m, N = self.n_elements, self.basis.samples
+        samples = self.basis.synthesize(np.concatenate((self._A @ Q, self._A @ dQ)))  # (2m, N)
+        g, gd, gv = np.empty((m, N)), np.empty((m, N)), np.empty((m, N))
+        ed, ev = self.widths
+        for e, law in enumerate(self._laws):
+            g[e], gd[e], gv[e] = law.regularised(samples[e], samples[m + e], ed, ev)
+        return Q, dQ, g, gd, gv
+
+    def samples(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray]:
+        """δ_e(t_j) and δ_e'(t_j) (m, N) at the N samples of the solution period."""
+        Q = self.coordinate_series(np.asarray(q, dtype=float))
+        dQ = self._derivative(Q, self.base_frequency(omega))
+        return self.basis.synthesize(self._A @ Q), self.basis.synthesize(self._A @ dQ)
+
+    def _linear(self, Q: FloatArray, dQ: FloatArray, w: float) -> FloatArray:
+        """(∇² + C ∇ + K) Q, shape (n, S)."""
+        return self._derivative(dQ, w) + self._C @ dQ + self._K @ Q
+
+    def residual(self, q: FloatArray, omega: float) -> FloatArray:
+        """R(q, Ω), shape (n·(2H+1),)."""
+        Q, dQ, g, _, _ = self._element_forces(q, omega)
+        R = self._linear(Q, dQ, self.base_frequency(omega)) + self._B @ self.basis.analyze(g)
+        return R.reshape(-1) - self._forcing_at(omega)
+
+    def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """R (n·S,), ∂R/∂q (n·S, n·S) and ∂R/∂Ω (n·S,) in one AFT pass (module docstring)."""
+        w = self.base_frequency(omega)
+        Q, dQ, g, gd, gv = self._element_forces(q, omega)
+        n, m, S, H = self.n_coordinates, self.n_elements, self._S, self.basis.harmonics
+        N = self.basis.samples
+        spec = np.fft.rfft(np.concatenate((g, gd, gv)), axis=1)  # (3m, N/2+1)
+        P = self.basis.from_complex(spec[:m, : H + 1] / N)  # 𝒜 g, (m, S)
+        R = (self._linear(Q, dQ, w) + self._B @ P).reshape(-1) - self._forcing_at(omega)
+        # Element blocks J_e = 𝒜 diag(∂g/∂δ) ℰ + 𝒜 diag(∂g/∂δ') ℰ ∇(ω).
+        Jp = product_jacobians(spec[m:], N, self._tables)  # (2m, S, S)
+        Jd, Jv = Jp[:m], Jp[m:]
+        kw = self.basis.k * w
+        Jd[:, :, H + 1 :] += Jv[:, :, 1 : H + 1] * kw  # (Jv ∇)[:, H+k] = kω Jv[:, k]
+        Jd[:, :, 1 : H + 1] -= Jv[:, :, H + 1 :] * kw  # (Jv ∇)[:, k] = −kω Jv[:, H+k]
+        J = (w * w) * self._L2 + w * self._L1 + self._L0
+        J4 = J.reshape(n, S, n, S)
+        for e, i, j, wij in self._W_entries:
+            J4[i, :, j, :] += wij * Jd[e]
+        # ∂R/∂Ω = (1/p) ∂R/∂ω.
+        D1Q = self._derivative(Q, 1.0)
+        vel1 = self.basis.synthesize(self._A @ D1Q)  # ℰ ∇(1) (a_e·Q), (m, N)
+        Rw = self._derivative(D1Q, 2.0 * w) + self._C @ D1Q + self._B @ self.basis.analyze(gv * vel1)
+        Rw = Rw.reshape(-1) / self.period
+        if self._load is not None:
+            Rw[self._a0] -= self._load.slope(float(omega)) * self._load.direction
+        return R, J, Rw
+
+    def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
+        """R(q, Ω) and the Newton increment dq = −(∂R/∂q)⁻¹ R (None when ∂R/∂q is singular)."""
+        R, J, _ = self.residual_jacobian(q, omega)
+        _, _, dq, info = _gesv(J, -R)
+        if info != 0 or not np.all(np.isfinite(dq)):
+            return R, None
+        return R, dq
+
+
+def _check_regularisation(value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(value) and value > 0):
+        raise ValueError(f"`regularisation` (ε, the relative width of the smooth steps) must be a finite number "
+                         f"> 0, got {value!r}; try 0.05 and decrease it along a sequence")
+    return float(value)
+
+
+__all__ = ["RegularisedSystemBalance"]
