@@ -127,12 +127,13 @@ class RegularisedSystemBalance:
         self._W_entries = [(int(e), int(i), int(j), float(W[e, i, j])) for e, i, j in zip(*np.nonzero(W))]
         self._laws = fsys.laws
         self._tables = product_tables(H, 2 * m)
-        # The linear part's Jacobian I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I = ω² L2 + ω L1 + L0.
+        # The linear part's Jacobian I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I = ω² L2 + ω L1 + L0, kept as its
+        # non-zero entries (flat positions and the values of L2, L1, L0 there).
         D1 = self.basis.derivative_matrix(1.0)
-        I_S = np.eye(S)
-        self._L2 = np.kron(np.eye(n), D1 @ D1)
-        self._L1 = np.kron(self._C, D1)
-        self._L0 = np.kron(self._K, I_S)
+        L2, L1, L0 = np.kron(np.eye(n), D1 @ D1), np.kron(self._C, D1), np.kron(self._K, np.eye(S))
+        pos = np.flatnonzero((L2 != 0) | (L1 != 0) | (L0 != 0))
+        self._lin_pos = pos
+        self._lin_vals = np.stack([M.reshape(-1)[pos] for M in (L2, L1, L0)])
 
     # --- scales (ContinuationProblem) --------------------------------------------------------
     @property
@@ -209,6 +210,25 @@ class RegularisedSystemBalance:
         """:func:`~rattle.hb.resize_harmonics` of every coordinate's series of ``q`` (flat in, flat out)."""
         return resize_harmonics(self.coordinate_series(q), harmonics, factor).reshape(-1)
 
+    def linear_solution(self, omega: float) -> FloatArray:
+        """A start for Newton: the steady state of the system linearised about its static
+        equilibrium x_s at Ω, friction left out (every element on the stage holding a_e·x_s,
+        K_s = K + Σ_e s_e b_e a_eᵀ): X_h = (K_s − (hω)² I + i hω C)⁻¹ F_h, mean x_s."""
+        system = self.system
+        n, H, S = self.n_coordinates, self.basis.harmonics, self._S
+        xs = system.static_equilibrium(omega)
+        Ks = system.stage_stiffness(system.stages_of(xs))
+        hw = self.basis.k * self.base_frequency(omega)
+        F = self.forcing.reshape(n, S)
+        Fc = F[:, 1 : H + 1] - 1j * F[:, H + 1 :]  # (n, H)
+        Z = Ks[None] - (hw**2)[:, None, None] * np.eye(n) + 1j * hw[:, None, None] * self._C[None]
+        X = np.linalg.solve(Z, Fc.T[:, :, None])[:, :, 0].T
+        Q = np.zeros((n, S))
+        Q[:, 0] = xs
+        Q[:, 1 : H + 1] = X.real
+        Q[:, H + 1 :] = -X.imag
+        return Q.reshape(-1)
+
     # --- residual ------------------------------------------------------------------------------
     def _forcing_at(self, omega: float) -> FloatArray:
         """The forcing coefficients at Ω: :attr:`forcing` plus the load's d(Ω) u at the a_0 slots."""
@@ -272,7 +292,8 @@ class RegularisedSystemBalance:
         kw = self.basis.k * w
         Jd[:, :, H + 1 :] += Jv[:, :, 1 : H + 1] * kw  # (Jv ∇)[:, H+k] = kω Jv[:, k]
         Jd[:, :, 1 : H + 1] -= Jv[:, :, H + 1 :] * kw  # (Jv ∇)[:, k] = −kω Jv[:, H+k]
-        J = (w * w) * self._L2 + w * self._L1 + self._L0
+        J = np.zeros((n * S, n * S))
+        J.reshape(-1)[self._lin_pos] = np.array([w * w, w, 1.0]) @ self._lin_vals
         J4 = J.reshape(n, S, n, S)
         for e, i, j, wij in self._W_entries:
             J4[i, :, j, :] += wij * Jd[e]
