@@ -20,9 +20,27 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rattle.continuation import solve_fixed
-from rattle.hb import HarmonicBalance, HBOptions, RegularisedBalance, RegularisedSystemBalance
-from rattle.model import (Backlash, Chain, Clutch, Drag, Element, Excitation, Friction, FrictionSystem, Linear, Link,
-                          NonsmoothLaw, NonsmoothSystem, Torque)
+from rattle.hb import (
+    HarmonicBalance,
+    HBOptions,
+    RegularisedBalance,
+    RegularisedSystemBalance,
+)
+from rattle.model import (
+    Backlash,
+    Chain,
+    Clutch,
+    Drag,
+    Element,
+    Excitation,
+    Friction,
+    FrictionSystem,
+    Linear,
+    Link,
+    NonsmoothLaw,
+    NonsmoothSystem,
+    Torque,
+)
 from rattle.model._system import single_equation_system
 
 CLUTCH_R = (0.01, 0.03, 0.01)
@@ -35,7 +53,7 @@ def _chain(kind: str, friction: bool = True, damping: float = 0.05) -> Chain:
         return Friction(levels=r) if friction else None
 
     c = damping
-    clutch = dict(name="clutch", stiffness=1.0, law=Clutch(alpha=0.2, b=0.1), friction=fr(*CLUTCH_R))
+    clutch = {"name": "clutch", "stiffness": 1.0, "law": Clutch(alpha=0.2, b=0.1), "friction": fr(*CLUTCH_R)}
     if kind == "g2":
         return Chain(inertias=(1.0, 0.5),
                      links=(Link(between=(1, 0), damping=0.04), Link(between=(1, 2), stiffness=2.0, damping=0.03)),
@@ -229,7 +247,7 @@ def test_solution_is_the_steady_state_of_the_regularised_equations() -> None:
     pb = RegularisedSystemBalance(fs, regularisation=0.01, options=HBOptions(harmonics=64))
     w = 0.3 * pb.parameter_scale
     q = _ladder(pb, w)
-    d, v = pb.samples(q, w)
+    _, v = pb.samples(q, w)
     ev = pb.widths[1]
     assert np.mean(np.abs(v[0]) < 2 * ev) < 0.3 and np.mean(np.abs(v[1]) < 2 * ev) > 0.5  # friction matters
     rhs, jac = _regularised_rhs(fs, pb.widths, w)
