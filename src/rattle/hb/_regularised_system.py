@@ -127,13 +127,36 @@ class RegularisedSystemBalance:
         self._W_entries = [(int(e), int(i), int(j), float(W[e, i, j])) for e, i, j in zip(*np.nonzero(W))]
         self._laws = fsys.laws
         self._tables = product_tables(H, 2 * m)
-        # The linear part's Jacobian I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I = ω² L2 + ω L1 + L0, kept as its
-        # non-zero entries (flat positions and the values of L2, L1, L0 there).
-        D1 = self.basis.derivative_matrix(1.0)
-        L2, L1, L0 = np.kron(np.eye(n), D1 @ D1), np.kron(self._C, D1), np.kron(self._K, np.eye(S))
-        pos = np.flatnonzero((L2 != 0) | (L1 != 0) | (L0 != 0))
-        self._lin_pos = pos
-        self._lin_vals = np.stack([M.reshape(-1)[pos] for M in (L2, L1, L0)])
+        self._lin_pos, self._lin_vals = self._linear_pattern()
+
+    def _linear_pattern(self) -> tuple[np.ndarray, FloatArray]:
+        """The linear part's Jacobian I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I = ω² L2 + ω L1 + L0 by its
+        non-zero entries: flat positions in the (n·S, n·S) matrix and the values (3, ·) of L2, L1,
+        L0 there (∇(1): a_k → −k on row b_k, b_k → k on row a_k)."""
+        n, S, H = self.n_coordinates, self._S, self.basis.harmonics
+        nS = n * S
+        k = np.arange(1, H + 1, dtype=float)
+        a, b = np.arange(1, H + 1), np.arange(H + 1, S)
+        pos, vals = [], []
+
+        def put(rows: np.ndarray, cols: np.ndarray, *v: float | FloatArray) -> None:
+            pos.append(rows * nS + cols)
+            vals.append(np.stack([np.broadcast_to(np.asarray(x, dtype=float), rows.shape) for x in v]))
+
+        for i in range(n):  # I ⊗ ∇(1)²: −k² on the harmonic rows
+            put(i * S + a, i * S + a, -(k**2), 0.0, 0.0)
+            put(i * S + b, i * S + b, -(k**2), 0.0, 0.0)
+        for i, j in zip(*np.nonzero(self._C)):  # C ⊗ ∇(1)
+            put(i * S + a, j * S + b, 0.0, self._C[i, j] * k, 0.0)
+            put(i * S + b, j * S + a, 0.0, -self._C[i, j] * k, 0.0)
+        r = np.arange(S)
+        for i, j in zip(*np.nonzero(self._K)):  # K ⊗ I
+            put(i * S + r, j * S + r, 0.0, 0.0, self._K[i, j])
+        flat = np.concatenate(pos)
+        unique, inverse = np.unique(flat, return_inverse=True)
+        V = np.concatenate(vals, axis=1)
+        out = np.stack([np.bincount(inverse, weights=v, minlength=unique.size) for v in V])
+        return unique, out
 
     # --- scales (ContinuationProblem) --------------------------------------------------------
     @property
