@@ -15,6 +15,7 @@ from ._shooting import ShootingOrbit, shoot_periodic_orbit
 from ._shooting_problem import ShootingProblem
 from ._system_shooting import SystemOrbit, shoot_system_orbit
 
+from ._friction_chain import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ._nonsmooth import (
     NonsmoothIntegrator, NonsmoothOptions, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit,
 )
@@ -24,6 +25,7 @@ __all__ = [
     "integrate_general", "GeneralSolution",
     "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
     "NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
+    "FrictionIntegrator", "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit",
 ]
 
 #: Names that moved out of ``rattle.timeint`` (the steady state is an analysis, its result a

@@ -1,0 +1,632 @@
+"""Event-driven exact integration of a chain with Coulomb friction on its elements (Filippov).
+
+The equations (:class:`~rattle.model.FrictionSystem`; x ∈ ℝⁿ, m elements, δ_e = a_e·x)
+
+    x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn(δ_e')] = F(t),
+
+f_e continuous piecewise linear (slope k_ej, offset o_ej on stage j), r_e(δ) = r_ej ≥ 0 on stage j.
+
+**Modes.** Every element with friction either *slips* with a sign σ_e = sgn δ_e' ∈ {−1, +1} or
+*sticks* (e ∈ S): δ_e' ≡ 0, its friction torque λ_e whatever holds it, |λ_e| ≤ r_ej (the
+Filippov solution: 0 in the convex hull of the one-sided fields). With A_S (rows a_e) and B_S
+(columns b_e) of the stuck elements and
+
+    y = F(t) − C x' − K_s x − Σ_e b_e o_ej − Σ_{e slips} b_e σ_e r_ej     (K_s the stage stiffness),
+
+the stuck torques are λ = (A_S B_S)⁻¹ A_S y (from A_S x'' = 0) and the motion is
+
+    x'' = P_S y,   P_S = I − B_S (A_S B_S)⁻¹ A_S,
+
+linear with constant coefficients on every stage combination: the system with C, K, b_e and F
+premultiplied by P_S and the slip friction folded into the offsets (o_ej + σ_e r_ej). Each mode is
+therefore solved in closed form by the exact stage solutions of :mod:`._stage_flow` (block-modal
+matrix exponentials, harmonic particular solutions), unchanged. (A_S B_S is invertible: for a
+chain, a_e·M⁻¹a_e K_e > 0, and a set of stuck elements is independent unless they close a loop.)
+
+**Events**, located to round-off (a grid of ``samples_per_scale`` points per fastest time scale
+brackets them, Brent's method refines them):
+
+- δ_e reaches a breakpoint (slipping e): the next stage (the crossing search of
+  :func:`~._events.first_exit`); the friction level may change there;
+- δ_e' reaches 0 (slipping e with friction somewhere on its law; a minimum of σ_e δ_e' inside a
+  grid cell is refined too, so that a touch is not missed): the new mode is chosen by the
+  active-set rule below with e a candidate to stick;
+- λ_e reaches ±r_ej (stuck e): e slips with σ_e = sgn λ_e.
+
+*Active set.* Candidates C (the stuck elements and the one whose velocity vanished): compute λ on C;
+while some |λ_e| > r_ej, release the worst one with σ_e = sgn λ_e (then e accelerates the way
+sgn λ_e says: e_e'' = (a_e·b_e)(λ_e − σ_e r_ej)) and recompute. Elements at zero velocity at the
+start are candidates too.
+
+**Saltation.** Across a switching surface h(z) = 0 (normal n = ∇h) from the field φ⁻ to φ⁺,
+
+    S = I + (φ⁺ − φ⁻) nᵀ / (nᵀ φ⁻),
+
+with h = a_e·x − d (breakpoint; nᵀφ⁻ = δ_e'), h = a_e·x' (velocity zero; nᵀφ⁻ = δ_e''⁻). On entry
+into a stick φ⁺ is the sliding field, nᵀφ⁺ = 0, and nᵀ S = 0: the δ_e'-perturbation is removed.
+At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. Between events the
+sensitivity is the mode's exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the
+Floquet multipliers of :func:`shoot_friction_orbit`. Not resolved: a tangential touch of a
+switching surface (grazing: the map is not differentiable there) and stuck sets closing a loop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .._typing import ComplexArray, FloatArray
+from .._validate import check_omega, check_shooting
+from ..errors import ConvergenceError
+from ..model import FrictionSystem, System
+from ..model._system import ReducedElement
+from ._events import first_exit
+from ._flow import check_system_state
+from ._nonsmooth import NonsmoothOptions
+from ._shooting import ShotOrbit
+from ._stage_flow import Segment, StageSolution, SystemStages
+
+_EPS = float(np.finfo(float).eps)
+_CHUNK = 64
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(16)
+
+#: Event kinds of a :class:`FrictionTrajectory`.
+CROSSING, STICK, REVERSAL, RELEASE = 0, 1, 2, 3
+EVENT_NAMES = ("crossing", "stick", "reversal", "release")
+
+_Key = tuple[tuple[bool, ...], tuple[int, ...]]  # (stuck per element, σ per element: 0 stuck / frictionless)
+
+
+def _brent(fun, a: float, b: float, fa: float, fb: float) -> float:  # type: ignore[no-untyped-def]
+    """The root of ``fun`` in [a, b] (fa, fb of opposite signs or one zero) to round-off."""
+    fa, fb = fun(a), fun(b)  # the scalar evaluation: grid samples may differ from it in round-off
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    if (fa > 0.0) == (fb > 0.0):  # a sign change within round-off: the end nearer zero
+        return a if abs(fa) < abs(fb) else b
+    return float(brentq(fun, a, b, xtol=4.0 * _EPS * max(abs(b), 1e-300), rtol=4.0 * _EPS, maxiter=200))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FrictionTrajectory:
+    """The exact motion from ``t0`` to ``t1``: ``state0``, ``state1`` (2n,) and the sensitivity
+    ∂z(t1)/∂z(t0) (stage transitions and saltation matrices); per segment its start time
+    ``t_start`` (and ``t_end``), the element ``stages`` (k, m), the ``stuck`` flags (k, m) and
+    the exact :class:`~._stage_flow.Segment`; the events (``event_times``, ``event_elements``,
+    ``event_kinds`` indexing :data:`EVENT_NAMES`, ``event_values``: the breakpoint crossed)."""
+
+    system: FrictionSystem
+    omega: float
+    t0: float
+    t1: float
+    state0: FloatArray
+    state1: FloatArray
+    sensitivity: FloatArray
+    t_start: FloatArray
+    t_end: FloatArray
+    stages: np.ndarray
+    stuck: np.ndarray
+    segments: tuple[Segment, ...]
+    event_times: FloatArray
+    event_elements: np.ndarray
+    event_kinds: np.ndarray
+    event_values: FloatArray
+
+    def segment_index(self, t: FloatArray | float) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        return np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+
+    def sample(self, t: FloatArray | float) -> tuple[FloatArray, FloatArray]:
+        """z = (x, x') and z' = (x', x'') at times ``t``: shapes t.shape + (2n,) each."""
+        t = np.asarray(t, dtype=float)
+        flat = t.reshape(-1)
+        idx = self.segment_index(flat)
+        n2 = self.state0.size
+        z = np.empty((flat.size, n2))
+        zd = np.empty((flat.size, n2))
+        for i in np.unique(idx):
+            sel = idx == i
+            zi, zdi = self.segments[i].state(flat[sel] - self.t_start[i])
+            z[sel], zd[sel] = zi, zdi
+        return z.reshape(t.shape + (n2,)), zd.reshape(t.shape + (n2,))
+
+    def element_samples(self, t: FloatArray | float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """δ, δ' and δ'' of every element at times ``t``: shapes t.shape + (m,)."""
+        z, zd = self.sample(t)
+        A = self.system.system.element_rows
+        n = self.system.n
+        return z[..., :n] @ A.T, z[..., n:] @ A.T, zd[..., n:] @ A.T
+
+    def integrate(self, fun, panels_per_scale: int = 4) -> FloatArray:  # type: ignore[no-untyped-def]
+        """∫_{t0}^{t1} fun(z) dt for ``fun`` mapping states (N, 2n) to values (N, …): 16-point
+        Gauss–Legendre on panels of a quarter of each segment's fastest time scale (the solution
+        is analytic on a segment: exact to round-off)."""
+        total = None
+        for i, seg in enumerate(self.segments):
+            ta, tb = float(self.t_start[i]), float(self.t_end[i])
+            if tb <= ta:
+                continue
+            npan = max(1, math.ceil((tb - ta) / (seg.sol.time_scale / panels_per_scale)))
+            edges = np.linspace(0.0, tb - ta, npan + 1)
+            half = 0.5 * np.diff(edges)
+            taus = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]
+            w = (half[:, None] * _GAUSS_W[None, :]).reshape(-1)
+            z, _ = seg.state(taus.reshape(-1))
+            val = np.tensordot(w, np.asarray(fun(z)), axes=(0, 0))
+            total = val if total is None else total + val
+        return np.zeros(0) if total is None else total
+
+    def element_mean_and_rms(self) -> tuple[FloatArray, FloatArray]:
+        """The time mean and rms of every element's deflection over [t0, t1] (m,) each."""
+        A = self.system.system.element_rows
+        n = self.system.n
+        T = self.t1 - self.t0
+        s = self.integrate(lambda z: np.concatenate((z[:, :n] @ A.T, (z[:, :n] @ A.T) ** 2), axis=1)) / T
+        m = A.shape[0]
+        return s[:m], np.sqrt(np.maximum(s[m:], 0.0))
+
+    def stick_time(self) -> FloatArray:
+        """Time every element spends stuck, (m,)."""
+        dur = self.t_end - self.t_start
+        return (self.stuck * dur[:, None]).sum(axis=0)
+
+    def stick_intervals(self, element: int) -> list[tuple[float, float]]:
+        """The [start, end] time intervals where ``element`` sticks (merged)."""
+        out: list[tuple[float, float]] = []
+        for a, b, s in zip(self.t_start, self.t_end, self.stuck[:, element]):
+            if not s or b <= a:
+                continue
+            if out and abs(out[-1][1] - a) <= 1e-12 * max(1.0, abs(a)):
+                out[-1] = (out[-1][0], float(b))
+            else:
+                out.append((float(a), float(b)))
+        return out
+
+    def crossed_breakpoints(self, element: int) -> FloatArray:
+        """The breakpoints ``element`` crossed."""
+        sel = (self.event_kinds == CROSSING) & (self.event_elements == element)
+        return np.unique(self.event_values[sel])
+
+
+class FrictionIntegrator:
+    """Exact event-driven integrator of a :class:`~rattle.model.FrictionSystem` (module
+    docstring); ``options`` the event grid and budget (:class:`~rattle.timeint.NonsmoothOptions`:
+    ``samples_per_scale``, ``max_events``)."""
+
+    def __init__(self, system: FrictionSystem, options: NonsmoothOptions | None = None) -> None:
+        if not isinstance(system, FrictionSystem):
+            raise TypeError(f"`system` must be a rattle.model.FrictionSystem, got {system!r}")
+        if options is not None and not isinstance(options, NonsmoothOptions):
+            raise TypeError(f"`options` must be a NonsmoothOptions, got {options!r}")
+        self.fsys = system
+        self.options = NonsmoothOptions() if options is None else options
+        base = system.system
+        self.base = base
+        self.n, self.m = base.n, base.m
+        self.A = base.element_rows.reshape(self.m, self.n)
+        self.B = base.element_columns.reshape(self.n, self.m)
+        self.levels = [np.asarray(system.friction_levels(e), dtype=float) for e in range(self.m)]
+        self.has_friction = [bool(np.any(r > 0)) for r in self.levels]
+        self._modal: dict = {}
+        self._omega: float | None = None
+        self._flows: dict = {}
+        self._vscale: dict = {}
+        self._vscale_now = 1.0
+
+    # --- modes ----------------------------------------------------------------------------------
+    def _mode_system(self, key: _Key, omega: float) -> System:
+        stuck, sigma = key
+        base = self.base
+        S = [e for e in range(self.m) if stuck[e]]
+        P = np.eye(self.n)
+        if S:
+            AS, BS = self.A[S], self.B[:, S]
+            P = P - BS @ np.linalg.solve(AS @ BS, AS)
+        elements = []
+        for e, el in enumerate(base.elements):
+            law = el.law
+            if sigma[e]:
+                st = el.law.stages
+                law = SimpleNamespace(stages=SimpleNamespace(breakpoints=st.breakpoints, slopes=st.slopes,
+                                                             offsets=st.offsets + sigma[e] * self.levels[e]))
+            elements.append(ReducedElement(el.name, el.a, P @ el.b, law))  # type: ignore[arg-type]
+        return System(damping=P @ base.damping, stiffness=P @ base.stiffness, elements=tuple(elements),
+                      mean=P @ base.mean_at(omega), cos=base.cos @ P.T, sin=base.sin @ P.T,
+                      coordinates=base.coordinates, angles=base.angles, free=base.free, load=None)
+
+    def _flow(self, key: _Key, omega: float) -> SystemStages:
+        if self._omega != omega:
+            self._omega, self._flows = omega, {}
+        flow = self._flows.get(key)
+        if flow is None:
+            cache = self._modal.setdefault(key, {}) if self.base.load is None else None
+            flow = SystemStages(self._mode_system(key, omega), omega, self.options.samples_per_scale, modal_cache=cache)
+            self._flows[key] = flow
+        return flow
+
+    def _base_step(self, omega: float) -> float:
+        """The event grid's step: the fastest time scale of the forcing (its highest harmonic) and
+        of the free chain (its highest natural frequency), over ``samples_per_scale`` — a stuck
+        mode's own time scale can be far longer than that of the torque that must hold it."""
+        key = ("step", float(omega))
+        step = self._vscale.get(key)
+        if step is None:
+            fast = max(float(omega) * max(self.base.forced_harmonics, 1), self.fsys.frequency_scale())
+            step = self._vscale[key] = 2.0 * math.pi / fast / self.options.samples_per_scale
+        return step
+
+    def velocity_scale(self, omega: float) -> float:
+        """L max(Ω, ω_n): the velocity scale of the event tolerances and the shooting residual."""
+        return self.fsys.length_scale() * max(float(omega), self.fsys.frequency_scale())
+
+    def _free_acceleration(self, key: _Key, stages: tuple[int, ...], t: FloatArray | float, z: FloatArray,
+                           omega: float) -> FloatArray:
+        """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,) (z: t.shape + (2n,))."""
+        n = self.n
+        base = self.base
+        x, v = z[..., :n], z[..., n:]
+        const = base.stage_offset(stages).copy()
+        for e in range(self.m):
+            if key[1][e]:
+                const += key[1][e] * self.levels[e][stages[e]] * self.B[:, e]
+        return base.forcing(t, omega) - v @ base.damping.T - x @ base.stage_stiffness(stages).T - const
+
+    def _lambdas(self, S: list[int], y: FloatArray) -> FloatArray:
+        """λ = (A_S B_S)⁻¹ A_S y for y (..., n): shape (..., |S|)."""
+        AS, BS = self.A[S], self.B[:, S]
+        return y @ np.linalg.solve(AS @ BS, AS).T
+
+    def _settle(self, t: float, z: FloatArray, stages: tuple[int, ...], candidates: list[int],
+                sigma: list[int], omega: float) -> _Key:
+        """The active-set choice of the stuck set among ``candidates`` (module docstring)."""
+        S = sorted(set(candidates))
+        sigma = list(sigma)
+        for e in S:
+            sigma[e] = 0
+        while S:
+            key = (tuple(e in S for e in range(self.m)), tuple(sigma))
+            lam = self._lambdas(S, self._free_acceleration(key, stages, t, z, omega))
+            worst, e_w, l_w = 0.0, -1, 0.0
+            for e, lam_e in zip(S, lam.tolist()):
+                r = float(self.levels[e][stages[e]])
+                excess = abs(lam_e) - r
+                if excess > 1e-12 * max(r, abs(lam_e), 1e-300) and excess > worst:
+                    worst, e_w, l_w = excess, e, lam_e
+            if e_w < 0:
+                break
+            S.remove(e_w)
+            sigma[e_w] = 1 if l_w > 0 else -1
+        return tuple(e in S for e in range(self.m)), tuple(sigma)
+
+    def _initial_key(self, t: float, z: FloatArray, stages: tuple[int, ...], omega: float) -> _Key:
+        n = self.n
+        dv = self.A @ z[n:]
+        tol = 64.0 * _EPS * self.velocity_scale(omega)
+        sigma = [0] * self.m
+        cands = []
+        for e in range(self.m):
+            if not self.has_friction[e]:
+                continue
+            if abs(dv[e]) <= tol:
+                cands.append(e)
+            else:
+                sigma[e] = 1 if dv[e] > 0 else -1
+        return self._settle(t, z, stages, cands, sigma, omega)
+
+    def _field(self, key: _Key, stages: tuple[int, ...], t: float, z: FloatArray, omega: float) -> FloatArray:
+        """φ = (x', x'') of the mode ``key`` at (t, z), (2n,)."""
+        n = self.n
+        y = self._free_acceleration(key, stages, t, z, omega)
+        S = [e for e in range(self.m) if key[0][e]]
+        if S:
+            y = y - self.B[:, S] @ self._lambdas(S, y)
+        return np.concatenate((z[n:], y))
+
+    # --- integration ----------------------------------------------------------------------------
+    def propagate(self, z0: FloatArray, t0: float, t1: float, omega: float) -> FrictionTrajectory:
+        """Integrate exactly from ``z0`` = (x, x') at ``t0`` to ``t1`` ≥ t0 at forcing frequency
+        ``omega``: the :class:`FrictionTrajectory` with its segments, events, final state and
+        sensitivity ∂z(t1)/∂z(t0)."""
+        z = check_system_state(z0, self.n)
+        omega = check_omega(omega)
+        self._vscale_now = self.velocity_scale(omega)
+        t0, t1 = float(t0), float(t1)
+        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
+            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        rec: dict[str, list] = {k: [] for k in ("ts", "st", "sk", "seg", "et", "ee", "ek", "ev")}
+        z1, M = self._march(z, t0, t1, omega, rec)
+        ts = np.asarray(rec["ts"], dtype=float)
+        return FrictionTrajectory(
+            system=self.fsys, omega=omega, t0=t0, t1=t1, state0=z, state1=z1, sensitivity=M, t_start=ts,
+            t_end=np.append(ts[1:], t1), stages=np.asarray(rec["st"], dtype=np.int64).reshape(-1, self.m),
+            stuck=np.asarray(rec["sk"], dtype=bool).reshape(-1, self.m), segments=tuple(rec["seg"]),
+            event_times=np.asarray(rec["et"], dtype=float), event_elements=np.asarray(rec["ee"], dtype=np.int64),
+            event_kinds=np.asarray(rec["ek"], dtype=np.int64), event_values=np.asarray(rec["ev"], dtype=float),
+        )
+
+    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float) -> tuple[FloatArray, FloatArray]:
+        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path)."""
+        self._vscale_now = self.velocity_scale(omega)
+        return self._march(np.asarray(z0, dtype=float).copy(), float(t0), float(t1), float(omega), None)
+
+    def _march(self, z: FloatArray, t0: float, t1: float, omega: float,
+               rec: dict[str, list] | None) -> tuple[FloatArray, FloatArray]:
+        n, m = self.n, self.m
+        stages = self._flow(((False,) * m, (0,) * m), omega).stages_at(t0, z)
+        key = self._initial_key(t0, z, stages, omega)
+        t = t0
+        M = np.eye(2 * n)
+        events = 0
+        idle = 0
+        while True:
+            flow = self._flow(key, omega)
+            sol = flow.solution(stages)
+            remaining = t1 - t
+            tau_lim = min(remaining, sol.max_segment)
+            seg = sol.segment(t, z, tau_lim)
+            stuck = key[0]
+            lo, hi = sol.lo.copy(), sol.hi.copy()
+            for e in range(m):
+                if stuck[e]:
+                    lo[e], hi[e] = -np.inf, np.inf
+            if np.any(np.isfinite(lo)) or np.any(np.isfinite(hi)):
+                tau_b, e_b, direction = first_exit(seg, lo, hi, tau_lim, sol.grid_step, flow.samples_per_scale)
+            else:
+                tau_b, e_b, direction = tau_lim, -1, 0
+            tau_f, e_f, kind_f, sign_f = self._friction_event(seg, sol, key, stages, tau_b, omega)
+            if e_f >= 0 and tau_f <= tau_b:
+                tau, e_ev, kind = tau_f, e_f, kind_f
+            elif e_b >= 0:
+                tau, e_ev, kind = tau_b, e_b, CROSSING
+            else:
+                tau, e_ev, kind = tau_b, -1, -1
+            if rec is not None and (tau > 0.0 or not rec["ts"]):
+                rec["ts"].append(t)
+                rec["st"].append(stages)
+                rec["sk"].append(stuck)
+                rec["seg"].append(seg)
+            if tau > 0.0:
+                M = sol.transition(tau) @ M
+                zc = seg.end_state(tau)
+                idle = 0
+            else:
+                zc = z.copy()
+                idle += 1
+                if idle > 4 * m + 8:
+                    raise ConvergenceError(
+                        f"the motion switches modes without advancing in time at t = {t!r} (stages {stages}, "
+                        f"stuck {stuck}): an element at rest whose friction neither holds nor releases it "
+                        "consistently (stuck elements closing a loop?); perturb the state `z0` slightly"
+                    )
+            t = t + tau
+            if e_ev < 0:
+                if tau_lim >= remaining:
+                    return zc, M
+                z = zc
+                continue
+            events += 1
+            if events > self.options.max_events:
+                raise ConvergenceError(
+                    f"more than `max_events` = {self.options.max_events} events between t0 = {t0!r} and t1 = {t1!r} "
+                    "(stick–slip chatter?): raise NonsmoothOptions(max_events=...) or shorten the interval"
+                )
+            a = self.A[e_ev]
+            phi_minus = self._field(key, stages, t, zc, omega)
+            value = math.nan
+            if kind == CROSSING:
+                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
+                zc[:n] += a * ((bound - float(a @ zc[:n])) / float(a @ a))
+                value = bound
+                stages = stages[:e_ev] + (stages[e_ev] + direction,) + stages[e_ev + 1:]
+                cands = [e for e in range(m) if stuck[e]]
+                new_key = self._settle(t, zc, stages, cands, list(key[1]), omega)
+                normal = np.concatenate((a, np.zeros(n)))
+            elif kind == STICK:
+                zc[n:] -= a * (float(a @ zc[n:]) / float(a @ a))
+                cands = [e for e in range(m) if stuck[e]] + [e_ev]
+                new_key = self._settle(t, zc, stages, cands, list(key[1]), omega)
+                if not new_key[0][e_ev]:
+                    kind = REVERSAL
+                normal = np.concatenate((np.zeros(n), a))
+            else:  # RELEASE: the fields agree at the band's edge
+                sigma = list(key[1])
+                sigma[e_ev] = sign_f
+                cands = [e for e in range(m) if stuck[e] and e != e_ev]
+                new_key = self._settle(t, zc, stages, cands, sigma, omega)
+                normal = None
+            if normal is not None:
+                phi_plus = self._field(new_key, stages, t, zc, omega)
+                denom = float(normal @ phi_minus)
+                if denom != 0.0 and math.isfinite(denom):
+                    M = (np.eye(2 * n) + np.outer(phi_plus - phi_minus, normal) / denom) @ M
+            if rec is not None:
+                rec["et"].append(t)
+                rec["ee"].append(e_ev)
+                rec["ek"].append(kind)
+                rec["ev"].append(value)
+            key, z = new_key, zc
+
+    def _friction_event(self, seg: Segment, sol: StageSolution, key: _Key, stages: tuple[int, ...],
+                        tau_end: float, omega: float) -> tuple[float, int, int, int]:
+        """The first friction event in (0, ``tau_end``]: (τ, element, kind, sign) — a velocity zero
+        of a slipping element with friction (kind STICK, refined to a stick or a reversal by the
+        caller) or a stuck element's torque reaching ±r (RELEASE, sign of λ); element −1 if none."""
+        n, m = self.n, self.m
+        stuck, sigma = key
+        slip = [e for e in range(m) if self.has_friction[e] and not stuck[e] and sigma[e]]
+        S = [e for e in range(m) if stuck[e]]
+        if tau_end <= 0.0 or not (slip or S):
+            return tau_end, -1, -1, 0
+        step = min(sol.grid_step, self._base_step(omega))
+        r_S = np.array([self.levels[e][stages[e]] for e in S])
+        if S:
+            AS, BS = self.A[S], self.B[:, S]
+            Lmat = np.linalg.solve(AS @ BS, AS)
+            base = self.base
+            const = base.stage_offset(stages).copy()
+            for e in range(m):
+                if sigma[e]:
+                    const += sigma[e] * self.levels[e][stages[e]] * self.B[:, e]
+            Ks = base.stage_stiffness(stages)
+
+            def lam_at(taus: FloatArray, z: FloatArray) -> FloatArray:
+                y = base.forcing(seg.ts + taus, omega) - z[:, n:] @ base.damping.T - z[:, :n] @ Ks.T - const
+                return y @ Lmat.T
+        sl = np.array(slip, dtype=np.intp)
+        sg = np.array([sigma[e] for e in slip], dtype=float)
+        tau_a = 0.0
+        while tau_a < tau_end:
+            k = max(1, min(_CHUNK, math.ceil((tau_end - tau_a) / step)))
+            taus = tau_a + step * np.arange(k + 1)
+            if k < _CHUNK or taus[-1] >= tau_end:
+                taus[-1] = tau_end
+            z, zd = seg.state(taus)
+            best = (math.inf, -1, -1, 0)
+            if slip:
+                sv = (z[:, n:] @ self.A[sl].T) * sg  # σ δ' (k+1, |slip|)
+                sa = (zd[:, n:] @ self.A[sl].T) * sg  # σ δ''
+                for j, e in enumerate(slip):
+                    hit = self._velocity_zero(seg, e, sg[j], taus, sv[:, j], sa[:, j])
+                    if hit is not None and hit < best[0]:
+                        best = (hit, e, STICK, 0)
+            if S:
+                lam = lam_at(taus, z)  # (k+1, |S|)
+                over = np.abs(lam[1:]) > r_S
+                for j, e in enumerate(S):
+                    if not over[:, j].any():
+                        continue
+                    i = int(over[:, j].argmax()) + 1
+                    s = 1.0 if lam[i, j] > 0 else -1.0
+                    if taus[i - 1] >= best[0]:
+                        continue
+
+                    def g(tau: float, j: int = j, s: float = s) -> float:
+                        zz = seg.end_state(tau)[None]
+                        return float(lam_at(np.array([tau]), zz)[0, j]) - s * r_S[j]
+
+                    ga = float(lam[i - 1, j]) - s * r_S[j]
+                    gb = float(lam[i, j]) - s * r_S[j]
+                    if ga * gb > 0:  # at the start already beyond (round-off): release at once
+                        hit = float(taus[i - 1])
+                    else:
+                        hit = _brent(g, float(taus[i - 1]), float(taus[i]), ga, gb)
+                    if hit < best[0]:
+                        best = (hit, e, RELEASE, int(s))
+            if best[1] >= 0:
+                return best[0], best[1], best[2], best[3]
+            tau_a = float(taus[-1])
+        return tau_end, -1, -1, 0
+
+    def _velocity_zero(self, seg: Segment, e: int, s: float, taus: FloatArray, sv: FloatArray,
+                       sa: FloatArray) -> float | None:
+        """The first τ in (taus[0], taus[-1]] where σ δ_e' reaches 0 (``sv`` its samples, ``sa``
+        those of σ δ_e''), a minimum inside a cell refined; None if none."""
+        a = self.A[e]
+        n = self.n
+
+        def vel(tau: float) -> float:
+            return s * float(a @ seg.end_state(tau)[n:])
+
+        def acc(tau: float) -> float:
+            return s * seg.element_point(tau, e)[2]
+
+        floor = 64.0 * _EPS * max(float(np.max(np.abs(sv))), self._vscale_now)
+        for i in range(1, taus.size):
+            lo_v, hi_v = float(sv[i - 1]), float(sv[i])
+            if hi_v <= 0.0:
+                if lo_v > 0.0:
+                    return _brent(vel, float(taus[i - 1]), float(taus[i]), lo_v, hi_v)
+                if i == 1 and lo_v <= floor:  # starts at rest: accept only a real excursion
+                    if hi_v < -floor:
+                        return float(taus[0])
+                    continue
+                return float(taus[i - 1])
+            if sa[i - 1] < 0.0 < sa[i]:  # a minimum of σ δ' inside the cell
+                try:
+                    tm = _brent(acc, float(taus[i - 1]), float(taus[i]), float(sa[i - 1]), float(sa[i]))
+                except ValueError:
+                    continue
+                vm = vel(tm)
+                if vm < -floor and lo_v > 0.0:  # a real excursion (a touch at round-off level is not one)
+                    return _brent(vel, float(taus[i - 1]), tm, lo_v, vm)
+        return None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FrictionOrbit(ShotOrbit):
+    """A periodic orbit of a chain with friction by Newton shooting on the exact period map:
+    ``state0`` z(0) (2n,), ``monodromy`` (with saltation matrices), ``multipliers``,
+    ``trajectory`` over one period, every element's ``mean`` and ``rms`` (m,) and
+    ``stick_fraction`` (m,: the fraction of the period it sticks)."""
+
+    trajectory: FrictionTrajectory
+    mean: FloatArray
+    rms: FloatArray
+    stick_fraction: FloatArray
+
+
+def _multipliers(M: FloatArray) -> ComplexArray:
+    mu = np.linalg.eigvals(M).astype(complex)
+    return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+
+def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *, period: int = 1,
+                         tol: float = 1e-12, max_iterations: int = 50,
+                         integrator: FrictionIntegrator | None = None) -> FrictionOrbit:
+    """Periodic orbit of the chain with friction by Newton shooting: r(z0) = φ(z0; 0 → T) − z0 = 0
+    with the Jacobian M − I (M the exact monodromy with saltation matrices), steps halved until
+    the scaled residual decreases. Scales: L for positions, L max(Ω, ω_n) for velocities. A
+    failed solve is returned with ``converged`` False."""
+    if not isinstance(system, FrictionSystem):
+        raise TypeError(f"`system` must be a FrictionSystem, got {system!r}")
+    omega = check_omega(omega)
+    check_shooting(period, tol, max_iterations)
+    integ = FrictionIntegrator(system) if integrator is None else integrator
+    if integ.fsys is not system:
+        raise ValueError("`integrator` was built for a different system than `system`")
+    z = check_system_state(z0, system.n).copy()
+    n = system.n
+    scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
+    T = period * 2.0 * math.pi / omega
+    eye = np.eye(2 * n)
+    z1, M = integ.advance(z, 0.0, T, omega)
+    r = z1 - z
+    res = float(np.max(np.abs(r / scale)))
+    it = 0
+    while res > tol and it < max_iterations:
+        it += 1
+        J = M - eye
+        try:
+            dz = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        step = 1.0
+        for _ in range(31):
+            z_try = z + step * dz
+            try:
+                z1_try, M_try = integ.advance(z_try, 0.0, T, omega)
+            except ConvergenceError:
+                step *= 0.5
+                continue
+            r_try = z1_try - z_try
+            res_try = float(np.max(np.abs(r_try / scale)))
+            if res_try < res:
+                break
+            step *= 0.5
+        else:
+            break
+        z, M, r, res = z_try, M_try, r_try, res_try
+    traj = integ.propagate(z, 0.0, T, omega)
+    mean, rms = traj.element_mean_and_rms()
+    return FrictionOrbit(state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
+                         multipliers=_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,
+                         residual=res, trajectory=traj, mean=mean, rms=rms, stick_fraction=traj.stick_time() / T)
+
+
+__all__ = ["FrictionIntegrator", "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit", "EVENT_NAMES"]
