@@ -42,8 +42,8 @@ from .._validate import check_int, check_positive, check_range
 from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
-from ..model import NonsmoothSystem
-from ..results import NonsmoothResponse
+from ..model import FrictionSystem, NonsmoothSystem
+from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
 from ._regularisation import RegularisationLimit, regularisation_limit
@@ -153,17 +153,24 @@ class RegularisationOptions:
 
 
 def nonsmooth_response(
-    system: NonsmoothSystem,
+    system: NonsmoothSystem | FrictionSystem,
     omega: tuple[float, float],
     options: RegularisationOptions | None = None,
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
-) -> NonsmoothResponse:
+) -> NonsmoothResponse | FrictionResponse:
     """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring), with
-    the settings ``options`` (:class:`RegularisationOptions`)."""
+    the settings ``options`` (:class:`RegularisationOptions`). A chain with friction
+    (:class:`~rattle.model.FrictionSystem`) goes to
+    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`)."""
+    if isinstance(system, FrictionSystem):
+        from ._friction_response import friction_response
+
+        return friction_response(system, omega, options, continuation=continuation, newton=newton)
     if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+                        f"friction, Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = RegularisationOptions() if options is None else options
     if not isinstance(opts, RegularisationOptions):

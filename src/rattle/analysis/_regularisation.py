@@ -27,14 +27,17 @@ import numpy as np
 from .._typing import FloatArray
 from ..continuation import NewtonOptions, solve_fixed
 from ..errors import ConvergenceError
-from ..hb import RegularisedBalance, resize_harmonics
+from ..hb import RegularisedBalance, RegularisedSystemBalance, resize_harmonics
 
 
 @dataclass(frozen=True, slots=True)
 class RegularisationStep:
     """One rung of the ladder: ``eps``, ``harmonics`` H, the coefficients ``q`` of δ, its
     ``mean``, ``rms`` and ``p2p`` (sampled), and ``tail``: the rms of δ's harmonics in the top half
-    of the basis relative to the rms of its fluctuation."""
+    of the basis relative to the rms of its fluctuation. For a chain
+    (:class:`~rattle.hb.RegularisedSystemBalance`) ``element_rms`` (m,) holds every element's rms,
+    ``mean``, ``rms`` and ``p2p`` are those of the element with the largest rms and ``tail`` the
+    largest over the elements; None for the single equation."""
 
     eps: float
     harmonics: int
@@ -43,6 +46,7 @@ class RegularisationStep:
     rms: float
     p2p: float
     tail: float
+    element_rms: FloatArray | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,11 +75,10 @@ class RegularisationLimit:
         if len(self.steps) < 3:
             return False
         a, b, c = self.steps[-3:]
-        s1 = (b.rms - a.rms) / (b.eps - a.eps)
-        s2 = (c.rms - b.rms) / (c.eps - b.eps)
-        if max(abs(b.rms - a.rms), abs(c.rms - b.rms)) <= 1e-9 * abs(c.rms):
-            return True
-        return s1 != 0.0 and 0.7 <= s2 / s1 <= 1.3
+        if c.element_rms is not None and a.element_rms is not None and b.element_rms is not None:
+            return all(_linear(a.eps, b.eps, c.eps, x, y, z)
+                       for x, y, z in zip(a.element_rms.tolist(), b.element_rms.tolist(), c.element_rms.tolist()))
+        return _linear(a.eps, b.eps, c.eps, a.rms, b.rms, c.rms)
 
     @property
     def extrapolated_rms(self) -> float:
@@ -84,6 +87,41 @@ class RegularisationLimit:
             return self.last.rms
         a, b = self.steps[-2], self.steps[-1]
         return b.rms - b.eps * (b.rms - a.rms) / (b.eps - a.eps)
+
+    @property
+    def extrapolated_element_rms(self) -> FloatArray:
+        """Richardson's ε → 0 value of every element's rms (a chain's ladder; (m,))."""
+        b = self.last
+        if b.element_rms is None:
+            raise ValueError("`extrapolated_element_rms` needs a chain's ladder (RegularisedSystemBalance)")
+        if len(self.steps) < 2:
+            return b.element_rms.copy()
+        a = self.steps[-2]
+        assert a.element_rms is not None
+        return b.element_rms - b.eps * (b.element_rms - a.element_rms) / (b.eps - a.eps)
+
+
+def _linear(ea: float, eb: float, ec: float, a: float, b: float, c: float) -> bool:
+    """(ε, rms) at three rungs on one line to within 30 % of its slope, or not moving (1e-9)."""
+    s1 = (b - a) / (eb - ea)
+    s2 = (c - b) / (ec - eb)
+    if max(abs(b - a), abs(c - b)) <= 1e-9 * abs(c):
+        return True
+    return s1 != 0.0 and 0.7 <= s2 / s1 <= 1.3
+
+
+def _chain_measures(pb: RegularisedSystemBalance, q: FloatArray) -> tuple[float, float, float, float, FloatArray]:
+    """A chain's: mean, rms, p2p of the element with the largest rms, the largest tail, every rms."""
+    E = pb.element_series(q)
+    H = pb.basis.harmonics
+    power = E[:, 1 : H + 1] ** 2 + E[:, H + 1 :] ** 2
+    total = np.sqrt(np.sum(power, axis=1))
+    top = np.sqrt(np.sum(power[:, H // 2 :], axis=1))
+    tail = float(np.max(np.where(total > 0, top / np.where(total > 0, total, 1.0), 0.0)))
+    rms = pb.element_rms(q)
+    i = int(np.argmax(rms))
+    delta = pb.basis.synthesize(E[i])
+    return float(E[i, 0]), float(rms[i]), float(np.ptp(delta)), tail, rms
 
 
 def _measures(pb: RegularisedBalance, q: FloatArray, omega: float) -> tuple[float, float, float, float]:
@@ -96,7 +134,7 @@ def _measures(pb: RegularisedBalance, q: FloatArray, omega: float) -> tuple[floa
 
 
 def regularisation_limit(
-    problem: Callable[[float, int], RegularisedBalance],
+    problem: Callable[[float, int], RegularisedBalance | RegularisedSystemBalance],
     omega: float,
     q0: FloatArray,
     *,
@@ -112,8 +150,10 @@ def regularisation_limit(
     ``omega`` from ε = ``eps_start`` down to ``eps_min`` (module docstring).
 
     ``problem(eps, H)`` builds the :class:`RegularisedBalance` at relative width ε with H
-    harmonics. Raises :class:`~rattle.errors.ConvergenceError` (with the rungs reached) when the
-    first solve fails, or when a step in log ε shrinks below 1 % of the requested one.
+    harmonics, or a chain's :class:`~rattle.hb.RegularisedSystemBalance` (``q0`` then its flat
+    coordinate series; the spectral tail and the rms are then every element's, linearity and
+    Richardson's value per element). Raises :class:`~rattle.errors.ConvergenceError` (with the
+    rungs reached) when the first solve fails, or when a step in log ε shrinks below 1 % of the requested one.
     """
     if not (0 < eps_min <= eps_start) or not (0 < ratio < 1):
         raise ValueError(f"need 0 < eps_min <= eps_start and 0 < ratio < 1, got eps_min={eps_min!r}, "
@@ -124,7 +164,10 @@ def regularisation_limit(
     log_step = math.log(ratio)
     while True:
         pb = problem(eps, H)
-        res = solve_fixed(pb, resize_harmonics(q, H), omega, newton)
+        chain = isinstance(pb, RegularisedSystemBalance)
+        start = resize_harmonics(np.reshape(q, (pb.n_coordinates, -1)), H).reshape(-1) if chain \
+            else resize_harmonics(q, H)
+        res = solve_fixed(pb, start, omega, newton)
         if not res.converged:
             if not steps:
                 raise ConvergenceError(f"the regularised orbit at Ω = {omega:g}, ε = {eps:g} (H = {H}) did not "
@@ -135,13 +178,18 @@ def regularisation_limit(
             log_step *= 0.5  # back off: a smaller step in log ε from the last good rung
             eps = steps[-1].eps * math.exp(log_step)
             continue
-        mean, rms, p2p, tail = _measures(pb, res.q, omega)
+        el_rms = None
+        if chain:
+            mean, rms, p2p, tail, el_rms = _chain_measures(pb, res.q)
+        else:
+            mean, rms, p2p, tail = _measures(pb, res.q, omega)
         if tail > tail_tol and 2 * H <= max_harmonics:  # the step is not resolved: more harmonics, same ε
             H *= 2
             q = res.q
             continue
         q = res.q
-        steps.append(RegularisationStep(eps=eps, harmonics=H, q=q, mean=mean, rms=rms, p2p=p2p, tail=tail))
+        steps.append(RegularisationStep(eps=eps, harmonics=H, q=q, mean=mean, rms=rms, p2p=p2p, tail=tail,
+                                            element_rms=el_rms))
         if eps <= eps_min * (1 + 1e-12):
             break
         log_step = max(log_step * 1.5, math.log(ratio)) if log_step > math.log(ratio) else math.log(ratio)

@@ -8,6 +8,7 @@ own figures (Figures 4–7) are :mod:`rattle.demo`'s, drawn with the pieces here
 from ._axes import PlotAxes
 from ._compare import compare_plot
 from ._frf import frequency_response_plot
+from ._friction import friction_response_plot
 from ._map import plot_map
 from ._nonsmooth import nonsmooth_orbit_plot, nonsmooth_response_plot
 from ._orbit import orbit_plot
@@ -15,5 +16,5 @@ from ._sweep import sweep_plot
 
 __all__ = [
     "frequency_response_plot", "sweep_plot", "orbit_plot", "compare_plot", "plot_map", "PlotAxes",
-    "nonsmooth_response_plot", "nonsmooth_orbit_plot",
+    "nonsmooth_response_plot", "nonsmooth_orbit_plot", "friction_response_plot",
 ]

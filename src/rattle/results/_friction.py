@@ -1,0 +1,276 @@
+"""The frequency response of a chain with Coulomb friction: rows of a continued branch.
+
+Each row is a point of the chain's regularised harmonic balance
+(:mod:`rattle.analysis._friction_response`) and, where exact Newton shooting on the event-driven
+flow found the same orbit (``matched``), that exact orbit: every element's rms, mean and stick
+fraction, the 2n Floquet multipliers (saltation matrices; a stuck element contributes zero
+multipliers). The HB's own rms (per element) and multipliers (the non-smooth monodromy of one
+period of the exact flow from the HB state) stand beside them, so that the regularisation's
+effect is read row by row: ``rms_error`` = the largest relative HB error over the elements.
+Where a row is not matched the exact columns are nan and ``stable`` is the HB orbit's.
+
+``bifurcation`` labels a row whose stability differs from the previous matched row's by the
+multiplier that crossed (:func:`rattle.stability.classify_loss`): fold (+1), period doubling
+(−1) or Neimark–Sacker (a complex pair); the change lies between the two rows (not located).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray
+from ..errors import Status
+from ..stability import classify_loss
+
+#: The per-element columns of :meth:`FrictionResponse.columns`, NAME_ prefixed, in this order.
+FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated")
+#: The columns closing each row.
+FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation",
+                         "eps_limit", "match_distance")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FrictionResponse:
+    """Rows of a continued branch of a chain with friction (P rows, m elements, n coordinates).
+
+    ``omega`` (P,); ``rpm`` (P,) the crankshaft speed, None without an engine order;
+    ``element_names`` (m); from the exact orbit (nan where not ``matched``): ``rms``, ``mean`` and
+    ``stick_fraction`` (P, m: the fraction of the period each element sticks); ``rms_hb`` (P, m)
+    of the regularised HB orbit; ``match_distance`` (P,) the largest departure of an exact δ_e(t)
+    from the HB's relative to the HB δ_e's peak-to-peak (nan where the shooting failed);
+    ``multipliers`` (P, 2n) the exact orbit's (the HB's where not matched), ``multipliers_hb``
+    (P, 2n) the HB orbit's, largest modulus first; ``stable``, ``stable_hb`` every multiplier
+    inside the unit circle; ``status``, ``message`` of the continuation; ``regularisation`` ε and
+    ``harmonics`` H.
+
+    The regularisation continued to its limit at the rows ``limit_index``: ``limit_eps`` the
+    smallest ε reached (nan: the ladder stalled), ``limit_harmonics`` H there, ``limit_rms`` (k, m)
+    the HB rms there, ``limit_richardson`` (k, m) Richardson's ε → 0 value, ``limit_linear``
+    whether the last three rungs lie on a line in ε for every element (Richardson's value then
+    holds)."""
+
+    omega: FloatArray
+    rpm: FloatArray | None
+    element_names: tuple[str, ...]
+    rms: FloatArray
+    rms_hb: FloatArray
+    mean: FloatArray
+    stick_fraction: FloatArray
+    matched: np.ndarray
+    match_distance: FloatArray
+    stable: np.ndarray
+    stable_hb: np.ndarray
+    multipliers: ComplexArray
+    multipliers_hb: ComplexArray
+    status: Status
+    message: str
+    regularisation: float
+    harmonics: int
+    limit_index: np.ndarray
+    limit_eps: FloatArray
+    limit_harmonics: np.ndarray
+    limit_rms: FloatArray
+    limit_richardson: FloatArray
+    limit_linear: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.omega.size)
+
+    # --- derived columns ----------------------------------------------------------------------
+    @property
+    def element_rms_error(self) -> FloatArray:
+        """rms_hb / rms − 1 per row and element (P, m); nan where not matched."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.rms_hb / self.rms - 1.0
+
+    @property
+    def rms_error(self) -> FloatArray:
+        """Per row the element error of largest magnitude (signed), rms_hb / rms − 1; nan where not
+        matched."""
+        err = self.element_rms_error
+        out = np.full(len(self), np.nan)
+        ok = np.all(np.isfinite(err), axis=1)
+        if np.any(ok):
+            j = np.argmax(np.abs(err[ok]), axis=1)
+            out[ok] = err[ok][np.arange(j.size), j]
+        return out
+
+    @property
+    def mu_abs(self) -> FloatArray:
+        """max |μ| of the exact orbit (the HB's where not matched)."""
+        return np.abs(self.multipliers).max(axis=1) if self.multipliers.size else np.full(len(self), np.nan)
+
+    @property
+    def mu_hb_abs(self) -> FloatArray:
+        """max |μ| of the HB orbit."""
+        return np.abs(self.multipliers_hb).max(axis=1) if self.multipliers_hb.size else np.full(len(self), np.nan)
+
+    @property
+    def stability_agrees(self) -> np.ndarray:
+        """Per matched row: the exact and the HB orbit's stability agree (False elsewhere)."""
+        return self.matched & (self.stable == self.stable_hb)
+
+    def _per_row(self, values: np.ndarray) -> np.ndarray:
+        out = np.full((len(self),) + values.shape[1:], np.nan)
+        out[self.limit_index] = values
+        return out
+
+    @property
+    def rms_hb_limit(self) -> FloatArray:
+        """(P, m): the HB rms at the smallest ε of the ladder (nan at the rows without one)."""
+        return self._per_row(self.limit_rms.reshape(-1, len(self.element_names)))
+
+    @property
+    def rms_hb_extrapolated(self) -> FloatArray:
+        """(P, m): Richardson's ε → 0 value where the ladder's last rungs are linear, else nan."""
+        rich = np.where(self.limit_linear[:, None], self.limit_richardson.reshape(-1, len(self.element_names)), np.nan)
+        return self._per_row(rich)
+
+    @property
+    def rms_hb_estimate(self) -> FloatArray:
+        """(P, m): the HB's ε → 0 estimate: Richardson's value where it holds, else the rms at the
+        ladder's smallest ε, else ``rms_hb``."""
+        ext, lim = self.rms_hb_extrapolated, self.rms_hb_limit
+        return np.where(np.isfinite(ext), ext, np.where(np.isfinite(lim), lim, self.rms_hb))
+
+    @property
+    def hb_error(self) -> FloatArray:
+        """(P,): the largest relative error over the elements of :attr:`rms_hb_estimate`."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.max(np.abs(self.rms_hb_estimate / self.rms - 1.0), axis=1)
+
+    @property
+    def bifurcation(self) -> np.ndarray:
+        """The kind of stability change at each row against the previous matched row ("" none)."""
+        out = np.full(len(self), "", dtype=object)
+        prev = None
+        for i in np.flatnonzero(self.matched):
+            if prev is not None and bool(self.stable[i]) != bool(self.stable[prev]):
+                out[i] = classify_loss(self.multipliers[prev], self.multipliers[i])
+            prev = i
+        return out
+
+    # --- output -------------------------------------------------------------------------------
+    def column_names(self) -> list[str]:
+        """omega, rpm (with an engine order), NAME_ + :data:`FRICTION_ELEMENT_COLUMNS` per element,
+        then :data:`FRICTION_TAIL_COLUMNS`."""
+        head = ["omega"] + ([] if self.rpm is None else ["rpm"])
+        per = [f"{name}_{c}" for name in self.element_names for c in FRICTION_ELEMENT_COLUMNS]
+        return head + per + list(FRICTION_TAIL_COLUMNS)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The rows as columns, in the order of :meth:`column_names`."""
+        cols: dict[str, np.ndarray] = {"omega": self.omega}
+        if self.rpm is not None:
+            cols["rpm"] = self.rpm
+        err = self.element_rms_error
+        lim, ext = self.rms_hb_limit, self.rms_hb_extrapolated
+        for e, name in enumerate(self.element_names):
+            cols[f"{name}_rms"] = self.rms[:, e]
+            cols[f"{name}_rms_hb"] = self.rms_hb[:, e]
+            cols[f"{name}_mean"] = self.mean[:, e]
+            cols[f"{name}_stick"] = self.stick_fraction[:, e]
+            cols[f"{name}_rms_error"] = err[:, e]
+            cols[f"{name}_rms_hb_limit"] = lim[:, e]
+            cols[f"{name}_rms_hb_extrapolated"] = ext[:, e]
+        cols.update(matched=self.matched, stable=self.stable, stable_hb=self.stable_hb, mu_abs=self.mu_abs,
+                    mu_hb_abs=self.mu_hb_abs, rms_error=self.rms_error, bifurcation=self.bifurcation,
+                    eps_limit=self._per_row(self.limit_eps), match_distance=self.match_distance)
+        return cols
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write :meth:`columns` to ``path`` atomically."""
+        from ..files._csv import write_csv
+
+        write_csv(path, self.columns(), self.column_names())
+        return Path(path)
+
+    def metadata(self) -> dict[str, Any]:
+        """A JSON-able summary of the run: settings, counts and the measured HB error."""
+        matched = int(np.sum(self.matched))
+        err = np.abs(self.rms_error[self.matched])
+
+        def num(x: float) -> float | None:
+            return float(x) if math.isfinite(x) else None
+
+        return {
+            "method": "regularised harmonic balance, checked by exact event-driven shooting (Filippov sticking, "
+                      "saltation monodromy)",
+            "regularisation": self.regularisation, "harmonics": self.harmonics,
+            "elements": list(self.element_names), "rows": len(self), "matched": matched,
+            "within_0_5_percent": int(np.sum(err <= 0.005)),
+            "max_rms_error": num(float(np.max(err))) if err.size else None,
+            "median_rms_error": num(float(np.median(err))) if err.size else None,
+            "stability_agrees": int(np.sum(self.stability_agrees)),
+            "unstable_rows": int(np.sum(~self.stable)),
+            "sticking_rows": int(np.sum(np.nan_to_num(self.stick_fraction).max(axis=1) > 0)) if len(self) else 0,
+            "refined_rows": int(self.limit_index.size),
+            "refined_max_error": num(float(np.nanmax(self.hb_error[self.limit_index])))
+            if self.limit_index.size and np.any(np.isfinite(self.hb_error[self.limit_index])) else None,
+            "status": self.status.name,
+            "message": self.message,
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """:meth:`metadata` plus the columns as lists (nan → None): JSON-able."""
+        def clean(v: Any) -> Any:
+            if isinstance(v, (bool, np.bool_)):
+                return bool(v)
+            if isinstance(v, (float, np.floating)):
+                return float(v) if math.isfinite(float(v)) else None
+            if isinstance(v, (int, np.integer)):
+                return int(v)
+            return str(v)
+
+        cols = self.columns()
+        return {"metadata": self.metadata(),
+                "columns": {k: [clean(v) for v in np.asarray(cols[k]).tolist()] for k in self.column_names()}}
+
+    def summary(self) -> str:
+        """A few lines: the branch, how many rows the exact orbit confirmed, the HB's error."""
+        md = self.metadata()
+        P = len(self)
+        lines = [f"chain with friction, elements {', '.join(self.element_names)}: {P} rows, "
+                 f"Ω = {self.omega.min():.5g} … {self.omega.max():.5g} rad/s" if P else "no rows"]
+        if self.rpm is not None and P:
+            lines.append(f"engine speed {self.rpm.min():.5g} … {self.rpm.max():.5g} rpm")
+        lines.append(f"regularised HB ε = {self.regularisation:g}, H = {self.harmonics}; exact orbit matched on "
+                     f"{md['matched']} of {P} rows")
+        if md["matched"]:
+            lines.append(f"HB rms vs exact (largest over the elements): within 0.5 % on {md['within_0_5_percent']} "
+                         f"of {md['matched']} matched rows, max {100 * (md['max_rms_error'] or 0):.3g} %, median "
+                         f"{100 * (md['median_rms_error'] or 0):.3g} %")
+            lines.append(f"stability (exact vs HB monodromy) agrees on {md['stability_agrees']} of {md['matched']}")
+        if self.limit_index.size:
+            txt = "n/a" if md["refined_max_error"] is None else f"{100 * md['refined_max_error']:.3g} %"
+            lines.append(f"regularisation continued towards ε → 0 on {self.limit_index.size} rows "
+                         f"(smallest ε {np.nanmin(self.limit_eps) if np.any(np.isfinite(self.limit_eps)) else math.nan:g}):"
+                         f" largest error of the HB's ε → 0 estimate {txt}")
+        for e, name in enumerate(self.element_names):
+            st = np.nan_to_num(self.stick_fraction[:, e])
+            if np.any(st > 0):
+                w = self.omega[st > 0]
+                lines.append(f"{name} sticks on {int(np.sum(st > 0))} rows (Ω {w.min():.4g} … {w.max():.4g}, "
+                             f"up to {st.max():.0%} of the period)")
+        labels = self.bifurcation
+        for i in np.flatnonzero(labels != ""):
+            lines.append(f"{labels[i].replace('_', ' ')} near Ω = {self.omega[i]:.5g}")
+        if not self.status.success:
+            lines.append(f"continuation: {self.message}")
+        return "\n".join(lines)
+
+    def plot(self) -> tuple:
+        """rms vs Ω per element (exact solid, HB dashed, unstable marked, stick ranges shaded) and
+        the stick fractions; returns (figure, PlotAxes). See
+        :func:`rattle.plotting.friction_response_plot`."""
+        from ..plotting import friction_response_plot
+
+        return friction_response_plot(self)
+
+
+__all__ = ["FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS", "FrictionResponse"]
