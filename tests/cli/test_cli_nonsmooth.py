@@ -120,30 +120,6 @@ def test_a_bad_friction_list_and_subharmonics_are_refused_with_nothing_written(t
     assert not (tmp_path / "out").exists()
 
 
-def test_a_chain_with_friction_is_refused_by_frf(tmp_path):
-    text = """\
-[model]
-inertias = [2.0, 2.0]
-[[model.links]]
-between = [1, 2]
-damping = 0.1
-[[model.elements]]
-between = [1, 2]
-stiffness = 1.0
-type = "clutch"
-alpha = 0.25
-b = 0.174533
-friction = 0.01
-[[excitation.torques]]
-inertia = 1
-mean = 0.05
-amplitudes = [0.06]
-"""
-    result = invoke(["frf", str(write_config(tmp_path, text)), "-o", "out"], tmp_path)
-    assert_bad_input(result, "`model.elements[0].friction`", "solved for the single equation only")
-    assert not (tmp_path / "out").exists()
-
-
 def test_omega_options_override_the_range_of_a_discontinuous_law(tmp_path):
     config = write_config(tmp_path, PRELOAD)
     result = invoke(["frf", str(config), "--omega-min", "1e-9", "-o", "out"], tmp_path)

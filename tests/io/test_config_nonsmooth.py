@@ -163,23 +163,17 @@ def _chain() -> dict:
     }
 
 
-def test_discontinuous_laws_on_a_chain_are_refused_naming_the_key():
-    data = _chain()
-    data["model"]["elements"][0]["friction"] = 0.02
-    _refused(data, "`model.elements[0].friction`", "solved for the single equation only")
+def test_a_preload_on_a_chain_and_friction_on_a_gear_mesh_are_refused_naming_the_key():
+    # friction on [[model.elements]] is accepted (tests/io/test_config_chain_friction.py)
     data = _chain()
     data["model"]["elements"][0] = {"name": "tc", "between": [1, 2], "stiffness": 1.0, "type": "preload",
                                     "preload": 0.05}
     _refused(data, "`model.elements[0].preload`", "solved for the single equation only")
-    data = _chain()
-    data["model"]["elements"][0] = {"between": [1, 2], "type": "damper", "drive_stiffness": [86.0, 1720.0],
-                                    "drive_angles_deg": [4.0], "friction": [0.0, 1.0]}
-    _refused(data, "`model.elements[0].friction`", "single equation only")
     data = {"model": {"units": "SI", "gear_pair": {"base_radii": [0.03, 0.05], "inertias": [1e-3, 3e-3],
                                                    "mesh_stiffness": 2e8, "mesh_damping_ratio": 0.05,
                                                    "backlash_um": 60.0, "friction": 0.1}},
             "excitation": {"torques": [{"inertia": 1, "mean": 1.0, "amplitudes": [0.5]}]}}
-    _refused(data, "`model.gear_pair.friction`", "single equation only")
+    _refused(data, "`model.gear_pair.friction`", "a gear mesh takes no preload or Coulomb friction")
 
 
 def test_sound_paths_with_a_discontinuous_law_are_refused():

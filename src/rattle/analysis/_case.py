@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..io import AnalysisSettings, RunConfig, load_config
-from ..model import Model, NonsmoothSystem
+from ..model import FrictionSystem, Model, NonsmoothSystem
 from ._compare import compare
 from ._frequency_response import frequency_response
 from ._nonsmooth import RegularisationOptions, nonsmooth_response
@@ -30,15 +30,17 @@ class Case:
     config: RunConfig
 
     @property
-    def model(self) -> Model | NonsmoothSystem:
-        """The model: a :class:`~rattle.model.Model` (or chain), or a
-        :class:`~rattle.model.NonsmoothSystem` when the law has a preload or friction."""
+    def model(self) -> Model | NonsmoothSystem | FrictionSystem:
+        """The model: a :class:`~rattle.model.Model` (or chain), a
+        :class:`~rattle.model.NonsmoothSystem` when the law has a preload or friction, or a
+        :class:`~rattle.model.FrictionSystem` for a chain with friction on its elements."""
         return self.config.model
 
     @property
     def discontinuous(self) -> bool:
-        """True when the law has a jump or friction (the front ends of :mod:`._nonsmooth`)."""
-        return isinstance(self.config.model, NonsmoothSystem)
+        """True when the law has a jump or friction, or the chain friction on an element (the front
+        ends of :mod:`._nonsmooth`)."""
+        return isinstance(self.config.model, (NonsmoothSystem, FrictionSystem))
 
     def regularisation_options(self) -> RegularisationOptions:
         """The file's ``harmonics``, ``regularisation`` and ``refine`` for a discontinuous law."""
@@ -48,8 +50,9 @@ class Case:
 
     def _continuous_only(self, what: str) -> None:
         if self.discontinuous:
+            also = "" if isinstance(self.model, FrictionSystem) else " or `periodic_orbit(omega)`"
             raise TypeError(f"`{what}` is not available for a discontinuous law (preload or friction) yet: "
-                            "use `frequency_response()` or `periodic_orbit(omega)`")
+                            f"use `frequency_response()`{also}")
 
     @property
     def analysis(self) -> AnalysisSettings:
@@ -65,8 +68,9 @@ class Case:
         (``subharmonics=True``, ``omega=…``, ``hb=HBOptions(…)``, ``newton=…``, …) are passed on
         and override the file; an unknown keyword raises TypeError.
 
-        For a discontinuous law: :func:`rattle.analysis.nonsmooth_response` over the file's range
-        with :meth:`regularisation_options` (keywords ``omega``, ``options``, ``continuation``,
+        For a discontinuous law, or a chain with friction on its elements:
+        :func:`rattle.analysis.nonsmooth_response` over the file's range with
+        :meth:`regularisation_options` (keywords ``omega``, ``options``, ``continuation``,
         ``newton`` override)."""
         if self.discontinuous:
             kw: dict[str, Any] = {"omega": self.analysis.omega, "options": self.regularisation_options(), **options}
@@ -76,7 +80,11 @@ class Case:
     def periodic_orbit(self, omega: float, **options: Any) -> Any:
         """:func:`rattle.periodic_orbit` at ``omega`` with the file's harmonics, the primary branch
         followed over ``analysis.omega`` (as ``rattle orbit CONFIG --omega W``); for a
-        discontinuous law :func:`rattle.analysis.nonsmooth_orbit` with :meth:`regularisation_options`."""
+        discontinuous law :func:`rattle.analysis.nonsmooth_orbit` with :meth:`regularisation_options`;
+        not available for a chain with friction yet (TypeError)."""
+        if isinstance(self.model, FrictionSystem):
+            raise TypeError("`periodic_orbit` is not available for a chain with friction on its elements yet: use "
+                            "`frequency_response()` (rattle.analysis.nonsmooth_response on the FrictionSystem)")
         if self.discontinuous:
             kw: dict[str, Any] = {"options": self.regularisation_options(), **options}
             return nonsmooth_orbit(self.model, omega, **kw)  # type: ignore[arg-type]

@@ -48,13 +48,31 @@ from ..model import Model, check_analysable_model
 from ..model._discontinuous import NonsmoothSystem, Preload
 from ..model._elastic import _check_real
 from ..model._engine import forcing_frequency
-from ..model._table_checks import _EXAMPLES, _Checker, _example, _kind, _show, rename_keys
+from ..model._friction_system import FrictionSystem
+from ..model._table_checks import (
+    _EXAMPLES,
+    _Checker,
+    _example,
+    _kind,
+    _show,
+    rename_keys,
+)
 from ..model._tables import model_tables
 
 __all__ = [
-    "DEFAULT_OMEGA", "DEFAULT_HARMONICS", "AnalysisSettings", "RunConfig",
-    "load_config", "config_from_dict", "model_to_toml_dict", "dumps_toml", "rename_keys", "check_harmonics",
-    "check_analysis", "DEFAULT_REGULARISATION", "DEFAULT_NONSMOOTH_HARMONICS",
+    "DEFAULT_HARMONICS",
+    "DEFAULT_NONSMOOTH_HARMONICS",
+    "DEFAULT_OMEGA",
+    "DEFAULT_REGULARISATION",
+    "AnalysisSettings",
+    "RunConfig",
+    "check_analysis",
+    "check_harmonics",
+    "config_from_dict",
+    "dumps_toml",
+    "load_config",
+    "model_to_toml_dict",
+    "rename_keys",
 ]
 
 
@@ -159,10 +177,12 @@ class RunConfig:
 
     Attributes
     ----------
-    model : Model, Chain or NonsmoothSystem
+    model : Model, Chain, NonsmoothSystem or FrictionSystem
         The ``[model]`` and ``[excitation]`` tables: a :class:`~rattle.model.NonsmoothSystem` when
         ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or a ``friction`` level > 0; only
-        ``rattle frf`` and :func:`rattle.analysis.nonsmooth_response` solve it), else a Model or a
+        ``rattle frf``, ``rattle orbit`` and :func:`rattle.analysis.nonsmooth_response` solve it), a
+        :class:`~rattle.model.FrictionSystem` for a chain with a ``friction`` level > 0 on some
+        ``[[model.elements]]`` (only ``rattle frf`` and ``nonsmooth_response``), else a Model or a
         Chain.
     analysis : AnalysisSettings
         The ``[analysis]`` table, defaults filled in.
@@ -183,13 +203,21 @@ class RunConfig:
     units: str = "dimensionless"
     #: For a discontinuous law: the Model of the same inertia, damping, stiffness and excitation
     #: with the law's continuous part (f without its jumps and friction), whose stages set the
-    #: frequency bounds (:mod:`rattle._limits`); None otherwise.
-    continuous_model: Model | None = field(default=None, compare=False, repr=False)
+    #: frequency bounds (:mod:`rattle._limits`); for a chain with friction the same chain without
+    #: its friction; None otherwise.
+    continuous_model: Any = field(default=None, compare=False, repr=False)
 
     @property
     def discontinuous(self) -> bool:
-        """True when :attr:`model` is a :class:`~rattle.model.NonsmoothSystem` (a jump or friction)."""
-        return isinstance(self.model, NonsmoothSystem)
+        """True when :attr:`model` is a :class:`~rattle.model.NonsmoothSystem` (a jump or friction)
+        or a :class:`~rattle.model.FrictionSystem` (a chain with friction on its elements)."""
+        return isinstance(self.model, (NonsmoothSystem, FrictionSystem))
+
+    @property
+    def chain_friction(self) -> bool:
+        """True when :attr:`model` is a :class:`~rattle.model.FrictionSystem`: a chain with Coulomb
+        friction on some ``[[model.elements]]`` (only ``rattle frf`` solves it)."""
+        return isinstance(self.model, FrictionSystem)
 
     @property
     def bounds_model(self) -> Any:
@@ -201,7 +229,9 @@ class RunConfig:
         """The resolved configuration (defaults filled in) as a TOML-shaped dict (angles in rad, an
         ``[engine]`` resolved into its torque and ``[model] speed_order``; a discontinuous law with
         its preload and friction as written: relative to K, or in N m with ``units = "SI"``)."""
-        if self.discontinuous:
+        if isinstance(self.model, FrictionSystem):
+            out = _friction_chain_to_toml_dict(self.model, self.continuous_model, self.analysis, self.units)
+        elif self.discontinuous:
             out = _nonsmooth_to_toml_dict(self.model, self.continuous_model, self.analysis, self.units)
         else:
             out = model_to_toml_dict(self.model, self.analysis)
@@ -276,9 +306,9 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         rest = config_from_dict({k: v for k, v in data.items() if k != "paths"}, source_name)
         if rest.discontinuous:
             raise check.error(
-                "`paths` (sound paths) is not supported with a discontinuous law (`model.elastic.preload` or "
-                "`model.elastic.friction`) yet: the sound pressure is computed from the smooth laws' responses; "
-                "remove [[paths]] (rattle frf gives the law's response without it)"
+                "`paths` (sound paths) is not supported with a discontinuous law (`model.elastic.preload`, "
+                "`model.elastic.friction` or a `model.elements[k].friction`) yet: the sound pressure is computed "
+                "from the smooth laws' responses; remove [[paths]] (rattle frf gives the law's response without it)"
             )
         return with_paths(rest, data["paths"], source_name)
 
@@ -342,6 +372,19 @@ def _nonsmooth_to_toml_dict(system: NonsmoothSystem, model: Model | None, analys
     return out
 
 
+def _friction_chain_to_toml_dict(system: FrictionSystem, chain: Any, analysis: AnalysisSettings,
+                                 units: str) -> dict[str, Any]:
+    """The tables of a chain with friction (round trip through :func:`config_from_dict`): the
+    chain without its friction, each element's ``friction`` as written (relative to its stiffness
+    K_e, or × K_e back to N m with ``units = "SI"``)."""
+    out = model_to_toml_dict(chain, analysis)
+    for e, (law, element) in enumerate(zip(system.laws, chain.elements)):
+        if law.friction is not None and any(law.friction.levels):
+            scale = element.stiffness if units == "SI" else 1.0
+            out["model"]["elements"][e]["friction"] = [r * scale for r in law.friction.levels]
+    return out
+
+
 def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonics") -> None:
     """The harmonic balance must hold every excitation harmonic: ``harmonics`` >= their count."""
     if hasattr(model, "excitation"):
@@ -383,8 +426,9 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.regularisation` = {_show(table['regularisation'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0 or a `model.elastic.friction` level > 0), whose jumps the harmonic "
-                "balance smooths; this law is continuous and solved without it: remove `analysis.regularisation`"
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0), "
+                "whose jumps the harmonic balance smooths; this law is continuous and solved without it: remove "
+                "`analysis.regularisation`"
             )
         regularisation = table["regularisation"]
         check.number(regularisation, "analysis.regularisation")
@@ -395,8 +439,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.refine` = {_show(table['refine'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0 or a `model.elastic.friction` level > 0), whose regularised harmonic "
-                "balance it refines; this law is continuous: remove `analysis.refine`"
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0), "
+                "whose regularised harmonic balance it refines; this law is continuous: remove `analysis.refine`"
             )
         refine = table["refine"]
         check.number(refine, "analysis.refine")

@@ -8,7 +8,9 @@ handed on as the SPEC §5 tables the reader already knows::
     type = "damper"                    drive_stiffness, coast_stiffness   N m/rad (or *_per_deg: N m/deg)
     between = [1, 2]                   drive_angles, coast_angles         rad (or *_deg), one fewer than stages
                                        free_play                          rad (or free_play_deg), optional
-        → stiffness = the stiffest stage, type = "piecewise", breakpoints, slopes
+                                       friction                           optional, passed on (per stage of
+                                                                          the law built: coast … drive)
+        → stiffness = the stiffest stage, type = "piecewise", breakpoints, slopes (and friction)
 
     [[model.elements]]                 type = "spline": a clutch hub spline
     type = "spline"                    stiffness                          N m/rad when engaged
@@ -48,8 +50,8 @@ __all__ = ["SUBSYSTEM_TYPES", "expand_subsystems"]
 SUBSYSTEM_TYPES = ("damper", "spline")
 
 _DAMPER_KEYS = ("name", "between", "type", "drive_stiffness", "drive_angles", "coast_stiffness", "coast_angles",
-                "free_play")
-_SPLINE_KEYS = ("name", "between", "type", "stiffness", "backlash")
+                "free_play", "friction")
+_SPLINE_KEYS = ("name", "between", "type", "stiffness", "backlash", "friction")
 _GEAR_KEYS = ("name", "base_radii", "inertias", "mesh_stiffness", "mesh_damping_ratio", "backlash")
 _LOOSE_KEYS = ("name", "base_radii", "inertia", "mesh_stiffness", "mesh_damping_ratio", "backlash", "drag_torque",
                "speed_rpm", "orders", "drive_acceleration", "drive_phases")
@@ -126,7 +128,9 @@ def _damper(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]
                      drive_angles=t.get("drive_angles", []), coast_stiffness=t["coast_stiffness"],
                      coast_angles=t.get("coast_angles", []), free_play=t.get("free_play", 0.0))
     out = {k: t[k] for k in ("name", "between") if k in t}
-    return {**out, "stiffness": element.stiffness, **element.law.to_dict()}
+    # friction (checked by the chain reader, per stage of the law built here) passes through
+    return {**out, "stiffness": element.stiffness, **element.law.to_dict(),
+            **({"friction": t["friction"]} if "friction" in t else {})}
 
 
 def _spline(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]:
@@ -137,7 +141,8 @@ def _spline(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]
     element = _build(check, hub_spline, {k: f"{where}.{k}" for k in _SPLINE_KEYS}, backlash=t["backlash"],
                      stiffness=t["stiffness"])
     out = {k: t[k] for k in ("name", "between") if k in t}
-    return {**out, "stiffness": element.stiffness, **element.law.to_dict()}
+    return {**out, "stiffness": element.stiffness, **element.law.to_dict(),
+            **({"friction": t["friction"]} if "friction" in t else {})}
 
 
 def _backlash_m(check: _Checker, t: dict[str, Any], where: str) -> dict[str, str]:
@@ -280,31 +285,34 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
     return out
 
 
-#: Keys that make a law discontinuous (:mod:`rattle.model._discontinuous`): [model.elastic] only.
-_DISCONTINUOUS_KEYS = ("friction", "preload")
-
-
 def _refuse_discontinuous_in_chain(check: _Checker, model_t: Mapping[str, Any]) -> None:
-    """A preload or friction on a chain's element (or a gear pair, loose gear, damper or spline
-    shape) is refused: the event-driven integrator and the regularised harmonic balance of the
-    discontinuous laws treat the single equation only."""
-    where: list[tuple[str, Mapping[str, Any]]] = []
+    """A preload on a chain's element (``preload`` or type = "preload"), and a preload or friction on
+    a gear pair or loose gear, is refused: in a chain only Coulomb friction on the elements
+    (``[[model.elements]] friction``, also on the damper and spline shapes) is solved; a torque
+    jump is solved for the single equation only."""
     elements = model_t.get("elements")
-    if isinstance(elements, list):
-        where += [(f"model.elements[{k}]", t) for k, t in enumerate(elements) if isinstance(t, Mapping)]
-    for shape in ("gear_pair", "loose_gear"):
-        if isinstance(model_t.get(shape), Mapping):
-            where.append((f"model.{shape}", model_t[shape]))
-    for name, t in where:
-        key = next((f"{name}.{k}" for k in _DISCONTINUOUS_KEYS if k in t), None)
-        if key is None and t.get("type") == "preload":
-            key = f"{name}.type"
+    for k, t in enumerate(elements if isinstance(elements, list) else []):
+        if not isinstance(t, Mapping):
+            continue
+        name = f"model.elements[{k}]"
+        key = f"{name}.preload" if "preload" in t else f"{name}.type" if t.get("type") == "preload" else None
         if key is not None:
             raise check.error(
-                f"`{key}`: discontinuous laws (a preload or friction) are solved for the single equation only "
-                "([model] inertia, damping, stiffness with [model.elastic] type = \"preload\" or a `friction` "
-                "key); a chain's elements, a gear pair, a loose gear, a damper and a spline take the continuous "
-                "laws: remove it, or model the clutch alone as the single equation"
+                f"`{key}`: a preload (a torque jump at δ = 0) is solved for the single equation only ([model] "
+                "inertia, damping, stiffness with [model.elastic] type = \"preload\"); a chain's elements take the "
+                "continuous laws, with Coulomb friction per stage (`friction`) as the only discontinuity: remove "
+                "it, or model the clutch alone as the single equation"
+            )
+    for shape in ("gear_pair", "loose_gear"):
+        t = model_t.get(shape)
+        if not isinstance(t, Mapping):
+            continue
+        key = next((f"model.{shape}.{k}" for k in ("friction", "preload") if k in t), None)
+        if key is not None:
+            raise check.error(
+                f"`{key}`: a gear mesh takes no preload or Coulomb friction (the mesh is a backlash law); friction "
+                "is solved on the elements of a chain ([[model.elements]] friction) and a preload for the single "
+                "equation: remove it"
             )
 
 

@@ -20,7 +20,10 @@ to the radian keys (both given: refused); ``[engine]`` (chains in SI only: inert
 speed_rpm, mean_torque, orders, amplitudes, phases) resolved here into an ordinary torque in
 harmonics of the orders' base order (:mod:`._engine`) and ``Chain.speed_order``; ``[drag]``.
 The data-sheet shapes (damper, spline, gear pair, loose gear) are first rewritten into these
-tables (:mod:`._table_shapes`).
+tables (:mod:`._table_shapes`). ``[[model.elements]] friction`` (Coulomb levels, one or one per
+stage of the element's law, relative to its stiffness K_e, or in N m with ``units = "SI"``) makes
+the model the chain's :class:`FrictionSystem`; a preload on an element is refused (solved for the
+single equation only).
 
 The run's own tables, ``[analysis]`` and ``[[paths]]``, are known here by name only: the
 configuration reader (:mod:`rattle.io`) reads them and, from an ``[engine]``'s speed range
@@ -38,6 +41,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import json
+import re
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -51,6 +55,7 @@ from ._drag import Drag
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Piecewise
 from ._engine import engine_torque
 from ._excitation import Excitation
+from ._friction_system import FrictionSystem
 from ._model import Model
 from ._table_checks import (
     _EXAMPLES,
@@ -123,27 +128,30 @@ class ModelTables:
 
     Attributes
     ----------
-    model : Model, Chain or NonsmoothSystem
+    model : Model, Chain, NonsmoothSystem or FrictionSystem
         A :class:`NonsmoothSystem` when ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or
-        a ``friction`` level > 0), else a Model or a Chain.
+        a ``friction`` level > 0); a :class:`FrictionSystem` (``Chain.friction_system()``) for a
+        chain with a ``friction`` level > 0 on some ``[[model.elements]]``; else a Model or a Chain.
     units : str
         ``[model] units``: ``"dimensionless"`` or ``"SI"``.
-    continuous_model : Model or None
+    continuous_model : Model, Chain or None
         For a discontinuous law the Model of the same inertia, damping, stiffness and excitation
-        with the law's continuous part (whose stages set the frequency bounds); None otherwise.
+        with the law's continuous part (whose stages set the frequency bounds); for a chain with
+        friction the same chain without its friction; None otherwise.
     engine : EngineAxis or None
         The ``[engine]`` of a chain, resolved; None without one.
     """
 
     model: Any
     units: str = "dimensionless"
-    continuous_model: Model | None = None
+    continuous_model: Model | Chain | None = None
     engine: EngineAxis | None = None
 
     @property
     def discontinuous(self) -> bool:
-        """True when :attr:`model` is a :class:`NonsmoothSystem` (a jump or friction)."""
-        return isinstance(self.model, NonsmoothSystem)
+        """True when :attr:`model` is a :class:`NonsmoothSystem` (a jump or friction) or a
+        :class:`FrictionSystem` (a chain with friction on its elements)."""
+        return isinstance(self.model, (NonsmoothSystem, FrictionSystem))
 
 
 def model_tables(data: Mapping[str, Any], source_name: str = "<dict>") -> ModelTables:
@@ -263,23 +271,28 @@ def _stage_names(elastic: Any) -> str:
     return ", ".join([f"δ < {d[0]:.6g}", *[f"{a:.6g} < δ < {b:.6g}" for a, b in itertools.pairwise(d)], f"δ > {d[-1]:.6g}"])
 
 
+def _friction(check: _Checker, elastic: Any, friction_t: Any, key: str) -> Friction:
+    """The :class:`Friction` of ``friction_t`` (written at ``key``): levels >= 0, one (every stage)
+    or one per stage of the law ``elastic``."""
+    friction = check.build(Friction, {"levels": key}, levels=friction_t)
+    n = len(elastic.stages.slopes)
+    if len(friction.levels) not in (1, n):
+        raise check.error(
+            f"`{key}` must hold one level (every stage) or one per stage of the law: type = "
+            f"{json.dumps(elastic.name if isinstance(elastic, Preload) else elastic.to_dict()['type'])} has "
+            f"{n} stage{'' if n == 1 else 's'} ({_stage_names(elastic)}), got {len(friction.levels)} levels "
+            f"{_show(list(friction.levels))}; give {n} levels or a single number"
+        )
+    return friction
+
+
 def _nonsmooth_system(check: _Checker, model: Model, elastic: Any, friction_t: Any,
                       units: str) -> NonsmoothSystem | None:
     """The :class:`NonsmoothSystem` of a law with a jump (``preload`` > 0) or ``friction`` (a level
     > 0); None for a continuous law. Preload and friction are torques relative to K (the torque
     jump is K T_p, the friction torque K r); with ``units = "SI"`` they are given in N m and
     divided here by ``model.stiffness`` K."""
-    friction = None
-    if friction_t is not None:
-        friction = check.build(Friction, {"levels": "model.elastic.friction"}, levels=friction_t)
-        n = len(elastic.stages.slopes)
-        if len(friction.levels) not in (1, n):
-            raise check.error(
-                f"`model.elastic.friction` must hold one level (every stage) or one per stage of the law: type = "
-                f"{json.dumps(elastic.name if isinstance(elastic, Preload) else elastic.to_dict()['type'])} has "
-                f"{n} stage{'' if n == 1 else 's'} ({_stage_names(elastic)}), got {len(friction.levels)} levels "
-                f"{_show(list(friction.levels))}; give {n} levels or a single number"
-            )
+    friction = None if friction_t is None else _friction(check, elastic, friction_t, "model.elastic.friction")
     if not isinstance(elastic, Preload) and (friction is None or not any(friction.levels)):
         return None
     if isinstance(elastic, Preload) and elastic.preload == 0.0 and (friction is None or not any(friction.levels)):
@@ -373,7 +386,7 @@ def _model_in_radians(check: _Checker, model_t: Mapping[str, Any]) -> dict[str, 
                                      angles=(*ANGLE_KEYS, "clearance"))
     elements = out.get("elements")
     if isinstance(elements, (list, tuple)) and all(isinstance(t, Mapping) for t in elements):
-        out["elements"] = [_in_radians(check, t, f"model.elements[{k}]", [*_MODEL_ELEMENTS_KEYS, *laws])
+        out["elements"] = [_in_radians(check, t, f"model.elements[{k}]", [*_MODEL_ELEMENTS_KEYS, "friction", *laws])
                            for k, t in enumerate(elements)]
     return out
 
@@ -557,7 +570,7 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
     elements = []
     for k, t in enumerate(_tables(check, model_t, "elements", "model.elements")):
         where = f"model.elements[{k}]"
-        law_t = {key: v for key, v in t.items() if key not in _MODEL_ELEMENTS_KEYS}
+        law_t = {key: v for key, v in t.items() if key not in (*_MODEL_ELEMENTS_KEYS, "friction")}
         for key in ("between", "stiffness"):
             if key not in t:
                 raise check.error(f"`{where}.{key}` is missing: every [[model.elements]] needs between, stiffness "
@@ -567,6 +580,7 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         except ConfigError as exc:
             message = str(exc).split(": ", 1)[1].replace("model.elastic", where)
             message = message.replace("allows only type,", f"allows only {', '.join(_MODEL_ELEMENTS_KEYS)}, type,")
+            message = re.sub(r"(allows only [^;]*);", r"\1 (and friction);", message, count=1)
             raise check.error(message) from None
         name = t.get("name", f"element{k + 1}")
         if not isinstance(name, str):
@@ -576,11 +590,21 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         for key, (kind, _) in law_params.items():
             if key in law_t:
                 (check.array if kind == "array" else check.number)(law_t[key], f"{where}.{key}")
+        if "friction" in t:
+            try:
+                (check.array if isinstance(t["friction"], (list, tuple)) else check.number)(t["friction"],
+                                                                                            f"{where}.friction")
+            except ConfigError as exc:  # the example of the friction key, not of the whole element
+                message = str(exc).split(": ", 1)[1].split(", e.g. ")[0]
+                raise check.error(f"{message}, e.g. friction = 0.02 (every stage) or friction = [0.0, 0.02, 0.0] "
+                                  "(one level per stage of the law)") from None
         elastic = check.build(law, {f: f"{where}.{f}" for f in law_params} or {"type": f"{where}.type"},
                               **{f: law_t[f] for f in law_params if f in law_t})
+        friction = _element_friction(check, elastic, t, where, units)
         elements.append(check.build(Element, {"name": f"{where}.name", "between": f"{where}.between",
-                                              "stiffness": f"{where}.stiffness"},
-                                    name=name, between=t["between"], stiffness=t["stiffness"], law=elastic))
+                                              "stiffness": f"{where}.stiffness", "friction": f"{where}.friction"},
+                                    name=name, between=t["between"], stiffness=t["stiffness"], law=elastic,
+                                    friction=friction))
 
     torques = []
     for k, t in enumerate(_tables(check, excitation_t, "torques", "excitation.torques") if "torques" in excitation_t else []):
@@ -616,4 +640,23 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                               "engine order to map rpm to Ω: give an [engine] (or `model.speed_order`)")
     chain = check.build(Chain, names, inertias=model_t["inertias"], links=tuple(links), elements=tuple(elements),
                         torques=tuple(torques), speed_order=speed_order, drag=drag)
+    if chain.has_friction:  # the equations with every element's friction; the chain without it sets the bounds
+        smooth = dataclasses.replace(chain, elements=tuple(dataclasses.replace(e, friction=None) for e in elements))
+        return ModelTables(model=chain.friction_system(), units=units, continuous_model=smooth, engine=engine)
     return ModelTables(model=chain, units=units, engine=engine)
+
+
+def _element_friction(check: _Checker, elastic: Any, t: Mapping[str, Any], where: str, units: str) -> Friction | None:
+    """``[[model.elements]] friction``: Coulomb levels r_ej >= 0 relative to the element's stiffness
+    K_e (the hysteresis torque is K_e r_ej), one for every stage or one per stage of its law; with
+    ``units = "SI"`` torques in N m, divided here by K_e. None when absent or all zero (a chain
+    without friction is the smooth chain)."""
+    if "friction" not in t:
+        return None
+    friction = _friction(check, elastic, t["friction"], f"{where}.friction")
+    if not any(friction.levels):
+        return None
+    K = float(t["stiffness"])
+    if units == "SI" and K > 0:  # N m → relative to K_e (a stiffness <= 0 is refused by Element)
+        friction = Friction(levels=tuple(r / K for r in friction.levels))
+    return friction

@@ -1,0 +1,165 @@
+"""``[[model.elements]] friction``: Coulomb friction per stage on a chain's elements, read into the
+chain's FrictionSystem (levels relative to the element's stiffness K_e, or N m with units = "SI"),
+with the refusals naming the key, showing the value, stating the rule and the fix."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+
+from rattle.analysis import load_case
+from rattle.errors import ConfigError
+from rattle.io import config_from_dict, dumps_toml
+from rattle.model import Chain, FrictionSystem
+
+
+def _chain(friction=None, **element) -> dict:
+    """Two inertias, the second grounded by a soft link; a clutch (3 stages) between them."""
+    el = {"name": "clutch", "between": [1, 2], "stiffness": 1.0, "type": "clutch", "alpha": 0.25, "b": 0.1,
+          **element}
+    if friction is not None:
+        el["friction"] = friction
+    return {
+        "model": {"inertias": [1.0, 1.0],
+                  "links": [{"between": [2, 0], "stiffness": 0.1, "damping": 0.05},
+                            {"between": [1, 2], "damping": 0.02}],
+                  "elements": [el]},
+        "excitation": {"torques": [{"inertia": 1, "mean": 0.05, "amplitudes": [0.06]}]},
+        "analysis": {"omega": [0.3, 1.5]},
+    }
+
+
+def _refused(data: dict, *fragments: str) -> str:
+    with pytest.raises(ConfigError) as info:
+        config_from_dict(data, source_name="case.toml")
+    message = str(info.value)
+    assert message.startswith("case.toml: ")
+    for fragment in fragments:
+        assert fragment in message, (fragment, message)
+    return message
+
+
+@pytest.mark.parametrize("friction, levels", [(0.02, [0.02, 0.02, 0.02]), ([0.0, 0.03, 0.01], [0.0, 0.03, 0.01]),
+                                              ([0.04], [0.04, 0.04, 0.04])])
+def test_friction_on_an_element_makes_the_chain_a_friction_system(friction, levels):
+    rc = config_from_dict(_chain(friction))
+    assert isinstance(rc.model, FrictionSystem)
+    assert rc.discontinuous and rc.chain_friction
+    np.testing.assert_array_equal(rc.model.friction_levels(0), levels)
+    assert rc.model.element_names == ("clutch",)
+    # the chain without its friction sets the bounds (its smooth system is the FrictionSystem's)
+    assert isinstance(rc.continuous_model, Chain) and not rc.continuous_model.has_friction
+    assert rc.bounds_model is rc.continuous_model
+    assert rc.model.system.n == rc.continuous_model.system().n == 2
+    # the settings of a discontinuous law: the regularised HB's defaults
+    assert (rc.analysis.harmonics, rc.analysis.regularisation, rc.analysis.refine) == (128, 0.01, 0.005)
+
+
+def test_zero_friction_is_the_smooth_chain():
+    rc = config_from_dict(_chain([0.0, 0.0, 0.0]))
+    assert isinstance(rc.model, Chain) and not rc.discontinuous and not rc.chain_friction
+    assert "friction" not in rc.to_dict()["model"]["elements"][0]
+    _refused(_chain(0.0) | {"analysis": {"regularisation": 0.01}}, "`analysis.regularisation` = 0.01 applies only",
+             "`model.elements[k].friction`")
+
+
+def test_si_friction_is_a_torque_divided_by_the_element_stiffness():
+    data = _chain([0.0, 12.5, 4.0], stiffness=500.0)
+    data["model"]["units"] = "SI"
+    rc = config_from_dict(data)
+    np.testing.assert_allclose(rc.model.friction_levels(0), [0.0, 12.5 / 500.0, 4.0 / 500.0], rtol=0, atol=1e-17)
+    # written back as given (N m), and read again into the same levels
+    out = rc.to_dict()
+    assert out["model"]["units"] == "SI"
+    np.testing.assert_allclose(out["model"]["elements"][0]["friction"], [0.0, 12.5, 4.0], rtol=1e-15)
+    again = config_from_dict(out)
+    np.testing.assert_allclose(again.model.friction_levels(0), rc.model.friction_levels(0), rtol=1e-15)
+    assert again.analysis == rc.analysis
+
+
+def test_the_resolved_configuration_round_trips_through_toml():
+    import tomllib
+
+    rc = config_from_dict(_chain([0.0, 0.03, 0.01]))
+    again = config_from_dict(tomllib.loads(dumps_toml(rc.to_dict())))
+    assert isinstance(again.model, FrictionSystem)
+    np.testing.assert_array_equal(again.model.friction_levels(0), [0.0, 0.03, 0.01])
+    assert again.continuous_model.to_dict() == rc.continuous_model.to_dict()
+    assert again.to_dict() == rc.to_dict()
+
+
+def test_a_damper_and_a_spline_take_friction_per_stage_of_their_law():
+    """The damper's law has the stages coast outermost … drive outermost (here c2, c1, k1, k2: no
+    free play, c1 != k1); K_e is its stiffest stage (200 N m/rad), the spline's its stiffness."""
+    data = {
+        "model": {"units": "SI", "inertias": [0.2, 0.05, 1.0],
+                  "links": [{"between": [3, 0], "stiffness": 50.0, "damping": 5.0},
+                            {"between": [1, 2], "damping": 0.5}],
+                  "elements": [{"name": "damper", "between": [1, 2], "type": "damper",
+                                "drive_stiffness": [20.0, 200.0], "drive_angles_deg": [4.0],
+                                "coast_stiffness": [15.0, 150.0], "coast_angles_deg": [3.0],
+                                "friction": [5.0, 1.0, 2.0, 5.0]},
+                               {"name": "hub", "between": [2, 3], "type": "spline", "stiffness": 500.0,
+                                "backlash_deg": 1.0, "friction": 1.0}]},
+        "excitation": {"torques": [{"inertia": 1, "mean": 10.0, "amplitudes": [20.0]}]},
+        "analysis": {"omega": [5.0, 60.0]},
+    }
+    rc = config_from_dict(data)
+    np.testing.assert_allclose(rc.model.friction_levels(0), np.array([5.0, 1.0, 2.0, 5.0]) / 200.0, rtol=1e-15)
+    np.testing.assert_allclose(rc.model.friction_levels(1), [1.0 / 500.0] * 3, rtol=1e-15)
+    np.testing.assert_allclose(rc.model.system.elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
+    bad = copy.deepcopy(data)
+    bad["model"]["elements"][0]["friction"] = [1.0, 2.0]
+    _refused(bad, "`model.elements[0].friction` must hold one level (every stage) or one per stage", "4 stages",
+             "got 2 levels [1.0, 2.0]", "give 4 levels or a single number")
+
+
+@pytest.mark.parametrize("friction, fragments", [
+    ([0.0, -0.02, 0.0], ["`model.elements[0].friction[1]`", "must be >= 0", "-0.02"]),
+    ([0.01, 0.02], ["`model.elements[0].friction` must hold one level (every stage) or one per stage of the law",
+                    'type = "clutch" has 3 stages (δ < -0.1, -0.1 < δ < 0.1, δ > 0.1)', "got 2 levels [0.01, 0.02]",
+                    "give 3 levels or a single number"]),
+    ("0.02", ["`model.elements[0].friction` must be a number", '"0.02"', "e.g. friction = 0.02"]),
+    ([0.0, "a", 0.0], ["`model.elements[0].friction[1]` must be a number", "e.g. friction = 0.02"]),
+    ([], ["`model.elements[0].friction`", "at least one"]),
+    (math.inf, ["`model.elements[0].friction` must be a finite number"]),
+])
+def test_bad_friction_is_refused_naming_the_key(friction, fragments):
+    _refused(_chain(friction), *fragments)
+
+
+def test_a_preload_on_an_element_is_refused_saying_only_friction_is_solved_for_chains():
+    _refused(_chain(preload=0.05), "`model.elements[0].preload`", "solved for the single equation only",
+             "Coulomb friction per stage (`friction`)")
+    data = _chain()
+    data["model"]["elements"][0] = {"name": "tc", "between": [1, 2], "stiffness": 1.0, "type": "preload",
+                                    "preload": 0.05, "friction": 0.01}
+    _refused(data, "`model.elements[0].preload`", "solved for the single equation only")
+    data["model"]["elements"][0].pop("preload")
+    _refused(data, "`model.elements[0].type`", "solved for the single equation only")
+
+
+def test_an_unknown_element_key_names_friction_among_the_allowed_ones():
+    _refused(_chain(0.01, frition=0.01), "`model.elements[0].frition` is not a known key", "(and friction)")
+
+
+def test_sound_paths_with_chain_friction_are_refused():
+    data = _chain(0.01)
+    data["paths"] = [{"name": "p", "source": "acceleration", "table": "x.csv"}]
+    _refused(data, "`paths`", "`model.elements[k].friction`", "remove [[paths]]")
+
+
+def test_load_case_solves_a_chain_with_friction_by_frequency_response_only(tmp_path):
+    path = tmp_path / "case.toml"
+    path.write_text(dumps_toml(config_from_dict(_chain([0.0, 0.03, 0.0])).to_dict()), encoding="utf-8")
+    case = load_case(path)
+    assert case.discontinuous and isinstance(case.model, FrictionSystem)
+    opts = case.regularisation_options()
+    assert (opts.harmonics, opts.regularisation, opts.refine) == (128, 0.01, 0.005)
+    with pytest.raises(TypeError, match="chain with friction"):
+        case.periodic_orbit(1.0)
+    with pytest.raises(TypeError, match="use `frequency_response\\(\\)`$"):
+        case.compare()
