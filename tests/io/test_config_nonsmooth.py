@@ -133,7 +133,7 @@ def _refused(data: dict, *fragments: str) -> None:
      ["`model.elastic.clearance` and `model.elastic.clearance_deg` are both given"]),
     ({"type": "preload"}, {}, ["`model.elastic.preload` is missing"]),
     ({"type": "preload", "preload": "0.05"}, {}, ["`model.elastic.preload` must be a number", '"0.05"']),
-    ({"type": "linear", "friction": -0.01}, {}, ["`model.elastic.friction[0]`", "must be >= 0, got -0.01"]),
+    ({"type": "linear", "friction": -0.01}, {}, ["`model.elastic.friction`", "must be >= 0, got -0.01"]),
     ({"type": "linear", "friction": []}, {}, ["`model.elastic.friction`", "at least one"]),
     ({"type": "linear", "friction": True}, {}, ["`model.elastic.friction` must be a number", "true"]),
     ({"type": "clutch", "alpha": 0.25, "b": 0.1, "preload": 0.05}, {},

@@ -22,8 +22,9 @@ from .checks import (
 )
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
-    map_csv_writer, map_json_writer, map_summary, metadata_writer, nonsmooth_metadata, nonsmooth_summary, one_line,
-    save_figure, save_plot, sections, set_verbose, warning, write_frf, write_set,
+    friction_metadata, friction_summary, map_csv_writer, map_json_writer, map_summary, metadata_writer,
+    nonsmooth_metadata, nonsmooth_summary, one_line, save_figure, save_plot, sections, set_verbose, warning,
+    write_frf, write_set,
 )
 
 if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
@@ -171,6 +172,10 @@ def run_frf(
 
 def _law_keys(run_config: Any) -> str:
     """The keys that make the configuration's law discontinuous, as the user wrote them."""
+    if getattr(run_config, "chain_friction", False):  # a chain with friction on its elements
+        system = run_config.model
+        keys = [f"`model.elements[{e}].friction`" for e in range(system.m) if system.friction_levels(e).any()]
+        return " and ".join(keys) or "`model.elements`"
     law = run_config.model.law
     keys = [f"`model.elastic.{k}`" for k, on in (("preload", bool(law.stages.jumps.any())),
                                                   ("friction", bool(law.friction_levels.any()))) if on]
@@ -179,6 +184,12 @@ def _law_keys(run_config: Any) -> str:
 
 def refuse_discontinuous(run_config: Any, command: str) -> None:
     """Exit 2 (nothing written) when ``rattle COMMAND`` cannot solve the configuration's law yet."""
+    if getattr(run_config, "chain_friction", False):
+        raise ConfigError(
+            f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
+            f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance of the chain checked by "
+            "exact shooting with Filippov sticking), or remove the friction"
+        )
     if run_config.discontinuous:
         raise ConfigError(
             f"{_law_keys(run_config)}: a discontinuous law (a torque jump or friction) is not supported by "
@@ -188,8 +199,10 @@ def refuse_discontinuous(run_config: Any, command: str) -> None:
 
 
 def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path, sections: dict[str, Any]) -> None:
-    """``rattle frf`` on a discontinuous law: :func:`rattle.analysis.nonsmooth_response` with the
-    file's ``[analysis]`` (harmonics, regularisation), written as one set frf.csv, frf.json, frf.png.
+    """``rattle frf`` on a discontinuous law, or a chain with friction on its elements:
+    :func:`rattle.analysis.nonsmooth_response` (a NonsmoothResponse, or a FrictionResponse for the
+    chain) with the file's ``[analysis]`` (harmonics, regularisation, refine), written as one set
+    frf.csv, frf.json, frf.png.
 
     Raises
     ------
@@ -207,13 +220,14 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
                 analysis.omega_max, options.harmonics, options.regularisation)
     result = nonsmooth_response(run_config.model, analysis.omega, options)
     timings = {"nonsmooth_response": time.perf_counter() - t_start}
-    meta = nonsmooth_metadata(result, run_config.model, options, timings)
+    chain = getattr(run_config, "chain_friction", False)  # a FrictionResponse, one column set per element
+    meta = (friction_metadata if chain else nonsmooth_metadata)(result, run_config.model, options, timings)
     written = write_set(output, FRF_FILES, [
         ("frf.csv", result.to_csv),
         ("frf.json", metadata_writer(meta, sections, t_start)),
         ("frf.png", lambda path: save_plot(result, path)),
     ])
-    echo_written(nonsmooth_summary(result, options), written, output)
+    echo_written((friction_summary if chain else nonsmooth_summary)(result, options), written, output)
     if not result.status.success:
         raise ConvergenceError(
             f"frequency response incomplete: {result.message or result.status.message}; the points computed "
@@ -349,6 +363,11 @@ def orbit_command(
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
+    if getattr(run_config, "chain_friction", False):
+        raise ConfigError(
+            f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
+            "`rattle orbit` yet; use `rattle frf` (every row's exact orbit is checked there), or remove the friction"
+        )
     if run_config.discontinuous:
         run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max)
         return

@@ -274,7 +274,12 @@ def _stage_names(elastic: Any) -> str:
 def _friction(check: _Checker, elastic: Any, friction_t: Any, key: str) -> Friction:
     """The :class:`Friction` of ``friction_t`` (written at ``key``): levels >= 0, one (every stage)
     or one per stage of the law ``elastic``."""
-    friction = check.build(Friction, {"levels": key}, levels=friction_t)
+    try:
+        friction = check.build(Friction, {"levels": key}, levels=friction_t)
+    except ConfigError as exc:
+        if isinstance(friction_t, (list, tuple)):
+            raise
+        raise check.error(str(exc).split(": ", 1)[1].replace(f"`{key}[0]`", f"`{key}`")) from None  # as written
     n = len(elastic.stages.slopes)
     if len(friction.levels) not in (1, n):
         raise check.error(
