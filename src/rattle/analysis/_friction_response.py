@@ -8,7 +8,8 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    relative width ε, H harmonics) is continued over Ω by pseudo-arclength
    (:class:`~rattle.continuation.ContinuationStepper`) from a solution at Ω_min found by a
    homotopy in ε from wide steps (ε = 0.1, started from the linearised chain's steady state,
-   :meth:`~rattle.hb.RegularisedSystemBalance.linear_solution`);
+   :meth:`~rattle.hb.RegularisedSystemBalance.linear_solution`, by Newton, and by Newton with
+   step halving where that wanders);
 2. every continuation point is checked against the exact flow: Newton shooting on the
    event-driven integrator (:func:`~rattle.timeint.shoot_friction_orbit`: crossings and sticking
    exact (Filippov), the monodromy with saltation matrices) from the HB orbit's state at t = 0.
@@ -83,17 +84,51 @@ def _hb_multipliers(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> 
     return mu if np.all(np.isfinite(mu)) else None
 
 
+def _damped_newton(pb: RegularisedSystemBalance, q: FloatArray, omega: float, iterations: int = 200) -> FloatArray | None:
+    """Newton with the step halved until the scaled residual ‖R‖∞ / F_s falls (Armijo, factor
+    1 − s/4); the solution, or None. The start's fallback where plain Newton from the linear
+    solution wanders (an impacting backlash)."""
+    Fs = pb.force_scale
+    R, dq = pb.newton_step(q, omega)
+    res = float(np.max(np.abs(R))) / Fs
+    for _ in range(iterations):
+        if res <= 1e-10:
+            return q
+        if dq is None:
+            return None
+        s = 1.0
+        while True:
+            q_try = q + s * dq
+            R_try, dq_try = pb.newton_step(q_try, omega)
+            res_try = float(np.max(np.abs(R_try))) / Fs
+            if np.isfinite(res_try) and res_try < (1.0 - 0.25 * s) * res:
+                break
+            s *= 0.5
+            if s < 1e-4:
+                return None
+        q, dq, res = q_try, dq_try, res_try
+    return q if res <= 1e-10 else None
+
+
 def _start(make: Callable[[float, int], RegularisedSystemBalance], omega: float, eps: float, H: int,
            newton: NewtonOptions | None) -> FloatArray:
-    """The HB orbit at Ω_min and ε: from the linear solution at wide steps, narrowed by homotopy."""
+    """The HB orbit at Ω_min and ε: from the linear solution at wide steps (ε = 0.1, else 0.3;
+    plain Newton, else damped Newton), narrowed by homotopy in ε."""
     last: RattleError | None = None
     for wide in (0.1, 0.3):
         e0 = max(wide, eps)
-        try:
-            return regularisation_limit(make, omega, make(e0, H).linear_solution(omega), eps_start=e0, eps_min=eps,
-                                        harmonics=H, max_harmonics=H, tail_tol=math.inf, newton=newton).last.q
-        except RattleError as exc:
-            last = exc
+        q0 = make(e0, H).linear_solution(omega)
+        for attempt in range(2):
+            try:
+                return regularisation_limit(make, omega, q0, eps_start=e0, eps_min=eps, harmonics=H, max_harmonics=H,
+                                            tail_tol=math.inf, newton=newton).last.q
+            except RattleError as exc:
+                last = exc
+            if attempt == 0:
+                q_damped = _damped_newton(make(e0, H), q0, omega)
+                if q_damped is None:
+                    break
+                q0 = q_damped
     raise ConvergenceError(f"no regularised orbit found at Ω_min = {omega:g} (ε from 0.3 down to {eps:g}, "
                            f"H = {H}): {last}; start `omega` elsewhere or raise `regularisation`")
 
