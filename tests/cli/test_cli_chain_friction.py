@@ -4,9 +4,13 @@ compare, map and orbit refuse it (exit 2, nothing written) and say that frf solv
 
 from __future__ import annotations
 
+import json
+
+import numpy as np
 import pytest
 
-from _cli_helpers import assert_bad_input, invoke, write_config
+from _cli_helpers import PNG, assert_bad_input, invoke, write_config
+from rattle.io import load_config, read_csv
 
 #: Two inertias, the second grounded by a soft link; a clutch (3 stages) with friction on its
 #: first stage (|δ| < b) only; the forcing on inertia 1.
@@ -74,3 +78,89 @@ def test_frf_refuses_subharmonics_and_bad_friction_with_nothing_written(tmp_path
     result = invoke(["frf", str(config), "--omega-max", "1e9", "-o", "out"], tmp_path)
     assert_bad_input(result, "`--omega-max` must be <=")
     assert not (tmp_path / "out").exists()
+
+
+#: The same chain with friction 0.02 on every stage, forced harder, over a narrow range above the
+#: clutch's first resonance: the element slips through every reversal, the HB matches (0.2 s).
+SLIPPING = (CHAIN.replace("friction = [0.0, 0.03, 0.0]", "friction = 0.02")
+            .replace("amplitudes = [0.06]", "amplitudes = [0.2]").replace("omega = [0.9, 0.95]", "omega = [0.8, 0.82]").replace("harmonics = 16", "harmonics = 32"))
+
+
+@pytest.fixture(scope="module")
+def frf_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("chain_friction")
+    config = write_config(folder, SLIPPING)
+    result = invoke(["frf", str(config), "-o", "out"], folder)
+    return folder, config, result
+
+
+def test_frf_writes_the_friction_response_as_one_set(frf_run):
+    from rattle.results._friction import FRICTION_ELEMENT_COLUMNS, FRICTION_TAIL_COLUMNS
+
+    folder, _config, result = frf_run
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    out = folder / "out"
+    assert sorted(p.name for p in out.iterdir()) == ["frf.csv", "frf.json", "frf.png"]
+    assert (out / "frf.png").read_bytes()[:8] == PNG
+    header = (out / "frf.csv").read_text().splitlines()[0].split(",")
+    assert header == ["omega", *[f"clutch_{c}" for c in FRICTION_ELEMENT_COLUMNS], *FRICTION_TAIL_COLUMNS]
+    assert "chain with friction, elements clutch" in result.stdout
+    assert "status: success" in result.stdout and "clutch: largest exact rms" in result.stdout
+    assert result.stdout.rstrip().endswith("wrote frf.csv, frf.json, frf.png to out")
+
+
+def test_frf_json_holds_the_settings_the_elements_and_the_measured_error(frf_run):
+    folder, _config, _result = frf_run
+    meta = json.loads((folder / "out" / "frf.json").read_text())
+    table = read_csv(folder / "out" / "frf.csv")
+    matched = np.asarray(table["matched"], dtype=bool)
+    err = np.abs(np.asarray(table["rms_error"], dtype=float)[matched])
+    assert meta["command"] == "frf" and meta["status"] == "success" and meta["version"]
+    assert meta["analysis"] == {"omega": [0.8, 0.82], "harmonics": 32, "regularisation": 0.01, "refine": 0.005}
+    assert meta["settings"]["harmonics"] == 32 and meta["settings"]["regularisation"] == 0.01
+    assert meta["system"]["coordinates"] == 2
+    assert meta["system"]["elements"] == [{"name": "clutch", "law": {"type": "clutch", "alpha": 0.25, "b": 0.1},
+                                           "friction": [0.02, 0.02, 0.02], "sticking_rows": 0}]
+    assert meta["points"] == len(table["omega"]) and meta["matched"] == int(matched.sum()) == len(table["omega"])
+    assert meta["max_rms_error"] == pytest.approx(float(np.max(err)), rel=1e-12)
+    assert meta["config"]["model"]["elements"][0]["friction"] == 0.02
+    assert meta["timings"]["cli_wall_time"] > 0 and "nonsmooth_response" in meta["timings"]
+
+
+def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
+    """The csv's clutch_rms is the exact orbit's: Newton shooting of the event-driven flow from rest
+    at the first row's Ω lands on it to 1e-9, and the HB's rms differs from it by the row's error."""
+    from rattle.timeint import shoot_friction_orbit
+
+    folder, config, _result = frf_run
+    table = read_csv(folder / "out" / "frf.csv")
+    assert bool(table["matched"][0])
+    orbit = shoot_friction_orbit(load_config(config).model, float(table["omega"][0]), np.zeros(4))
+    assert orbit.converged
+    assert abs(float(orbit.rms[0]) - float(table["clutch_rms"][0])) <= 1e-9
+    assert abs(float(orbit.mean[0]) - float(table["clutch_mean"][0])) <= 1e-9
+    assert float(table["clutch_stick"][0]) == 0.0
+    rel = float(table["clutch_rms_hb"][0]) / float(orbit.rms[0]) - 1.0
+    assert rel == pytest.approx(float(table["clutch_rms_error"][0]), abs=1e-9)
+    assert rel == pytest.approx(float(table["rms_error"][0]), abs=1e-9)  # one element: the row's error
+
+
+def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkeypatch):
+    import dataclasses
+
+    import rattle.analysis
+    from rattle.errors import Status
+
+    real = rattle.analysis.nonsmooth_response
+
+    def stopped(*args, **kwargs):
+        return dataclasses.replace(real(*args, **kwargs), status=Status.MAX_STEPS, message="")
+
+    monkeypatch.setattr(rattle.analysis, "nonsmooth_response", stopped)
+    config = write_config(tmp_path, SLIPPING.replace("omega = [0.8, 0.82]", "omega = [0.8, 0.805]"))
+    result = invoke(["frf", str(config), "-o", "out"], tmp_path)
+    assert result.exit_code == 1, (result.stdout, result.stderr)
+    assert "frequency response incomplete: the maximum number of continuation steps" in result.stderr
+    assert "were written to" in result.stderr and "frf.csv" in result.stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["frf.csv", "frf.json", "frf.png"]
+    assert json.loads((tmp_path / "out" / "frf.json").read_text())["status"] == "max_steps"

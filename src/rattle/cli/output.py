@@ -322,42 +322,29 @@ def nonsmooth_summary(result: Any, options: Any) -> str:
 # --------------------------------------------------------------------------------------------
 # rattle frf on a chain with Coulomb friction on its elements
 # --------------------------------------------------------------------------------------------
-def _friction_errors(result: Any) -> Any:
-    """Per row, the largest relative error of the HB rms against the exact one over the elements
-    (nan where not matched)."""
-    import numpy as np
-
-    rms = np.asarray(result.rms, dtype=float).reshape(len(result.omega), -1)
-    rms_hb = np.asarray(result.rms_hb, dtype=float).reshape(rms.shape)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        err = np.abs(rms_hb / rms - 1.0)
-    err = np.where(np.isfinite(err), err, -np.inf).max(axis=1) if err.size else np.full(len(result.omega), np.nan)
-    err = np.where(np.isfinite(err), err, np.nan)
-    return np.where(np.asarray(result.matched, dtype=bool), err, np.nan)
-
-
 def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str, float]) -> dict[str, Any]:
     """The ``frf.json`` sections of a :class:`rattle.results.FrictionResponse` (a chain with Coulomb
-    friction on its elements): the settings of the regularised harmonic balance, the elements (law
-    and friction level per stage, relative to the element's stiffness), status and message, the rows
-    (all, matched by exact shooting, with some element sticking, unstable), the largest and median
-    relative error of the HB rms against the exact one over the matched rows (the worst element
-    per row), and ``timings``."""
+    friction on its elements): the settings of the regularised harmonic balance (``options``, a
+    ``RegularisationOptions``), the elements (law, friction level per stage relative to the
+    element's stiffness, the matched rows where it sticks), status and message, the rows, and the
+    response's own counts and measured HB error (:meth:`FrictionResponse.metadata`: matched,
+    within_0_5_percent, max_rms_error, median_rms_error, stability_agrees, unstable_rows,
+    sticking_rows, refined_rows, refined_max_error), and ``timings``."""
     import numpy as np
 
+    own = {k: v for k, v in result.metadata().items() if k not in ("method", "regularisation", "harmonics",
+                                                                      "status", "message")}
     matched = np.asarray(result.matched, dtype=bool)
-    err = _friction_errors(result)[matched]
-    err = err[np.isfinite(err)]
-    stick = np.nan_to_num(np.asarray(result.stick_fraction, dtype=float).reshape(len(result.omega), -1))
-    elements = []
-    for e, (name, element) in enumerate(zip(system.element_names, system.system.elements)):
-        elements.append({"name": name, "law": element.law.to_dict(),
-                         "friction": [float(r) for r in system.friction_levels(e)],
-                         "sticking_rows": int(np.count_nonzero(matched & (stick[:, e] > 0)))})
+    stick = np.nan_to_num(np.asarray(result.stick_fraction, dtype=float).reshape(len(result), -1))
+    elements = [{"name": name, "law": element.law.to_dict(),
+                 "friction": [float(r) for r in system.friction_levels(e)],
+                 "sticking_rows": int(np.count_nonzero(matched & (stick[:, e] > 0)))}
+                for e, (name, element) in enumerate(zip(system.element_names, system.system.elements))]
     return {
         "settings": {
             "method": "regularised harmonic balance of the chain continued over Ω, every point checked by exact "
-                      "event-driven shooting with Filippov sticking (rattle.analysis.nonsmooth_response)",
+                      "event-driven shooting with Filippov sticking and saltation monodromy "
+                      "(rattle.analysis.nonsmooth_response)",
             "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
             "limit": options.limit, "refine": getattr(options, "refine", None), "limit_eps": options.limit_eps,
             "limit_harmonics": options.limit_harmonics,
@@ -365,54 +352,26 @@ def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str,
         "system": {"coordinates": int(system.n), "elements": elements},
         "status": result.status.name.lower(),
         "message": result.message or result.status.message,
-        "points": len(result.omega),
-        "matched": int(np.count_nonzero(matched)),
-        "sticking": int(np.count_nonzero(matched & np.any(stick > 0, axis=1))),
-        "unstable": int(np.count_nonzero(~np.asarray(result.stable, dtype=bool))),
-        "rms_error_max": float(np.max(err)) if err.size else None,
-        "rms_error_median": float(np.median(err)) if err.size else None,
-        "refined": int(np.size(result.limit_index)),
+        "points": len(result),
+        **own,
         "timings": dict(timings),
     }
 
 
 def friction_summary(result: Any, options: Any) -> str:
-    """What ``rattle frf`` prints for a chain with friction on its elements."""
+    """What ``rattle frf`` prints for a chain with friction on its elements: the response's summary
+    (:meth:`FrictionResponse.summary`), the continuation's status, and every element's largest
+    exact rms."""
     import numpy as np
 
-    omega = np.asarray(result.omega, dtype=float)
-    n = omega.size
+    lines = [result.summary(), f"status: {result.status.name.lower()} — {result.message or result.status.message}"]
     matched = np.asarray(result.matched, dtype=bool)
-    names = list(result.element_names)
-    lines = [
-        f"{n} points over Ω = {np.min(omega):.4g} … {np.max(omega):.4g} (regularised harmonic balance of the chain, "
-        f"H = {options.harmonics}, ε = {options.regularisation:g}); {int(np.count_nonzero(matched))} matched by "
-        f"exact shooting, {int(np.count_nonzero(~np.asarray(result.stable, dtype=bool)))} unstable"
-        if n else "no points",
-        f"status: {result.status.name.lower()} — {result.message or result.status.message}",
-    ]
-    err = _friction_errors(result)
-    if np.any(np.isfinite(err)):
-        i = int(np.nanargmax(err))
-        lines.append(f"rms of the HB against the exact orbit (worst element per row): median error "
-                     f"{np.nanmedian(err):.2g}, largest {err[i]:.2g} (at Ω = {omega[i]:.5g})")
-        refined = int(np.size(result.limit_index))
-        if refined:
-            lines.append(f"regularisation continued towards its limit at {refined} row(s)")
-        rms = np.asarray(result.rms, dtype=float).reshape(n, -1)
-        stick = np.nan_to_num(np.asarray(result.stick_fraction, dtype=float).reshape(n, -1))
-        for e, name in enumerate(names):
-            col = np.where(matched, rms[:, e], np.nan)
-            if not np.any(np.isfinite(col)):
-                continue
+    rms = np.asarray(result.rms, dtype=float).reshape(len(result), -1)
+    for e, name in enumerate(result.element_names):
+        col = np.where(matched, rms[:, e], np.nan)
+        if np.any(np.isfinite(col)):
             j = int(np.nanargmax(col))
-            held = matched & (stick[:, e] > 0)
-            line = f"{name}: largest exact rms {col[j]:.5g} rad at Ω = {omega[j]:.5g}"
-            if np.any(held):
-                line += (f"; sticks at {int(np.count_nonzero(held))} of the matched points (Ω = "
-                         f"{np.min(omega[held]):.4g} … {np.max(omega[held]):.4g}, at most {np.max(stick[held, e]):.0%} "
-                         "of the period)")
-            lines.append(line)
+            lines.append(f"{name}: largest exact rms {col[j]:.5g} rad at Ω = {result.omega[j]:.5g}")
     return "\n".join(lines)
 
 
