@@ -483,4 +483,4 @@ class Chain:
         return np.asarray(omega, dtype=float) * (60.0 / (2.0 * math.pi * self.speed_order))
 
 
-__all__ = ["Chain", "Link", "Element", "Torque", "BALANCE_RTOL"]
+__all__ = ["BALANCE_RTOL", "Chain", "Element", "Link", "Torque"]
