@@ -44,8 +44,8 @@ class FrictionResponse:
     of the regularised HB orbit; ``match_distance`` (P,) the largest departure of an exact δ_e(t)
     from the HB's relative to the HB δ_e's peak-to-peak (nan where the shooting failed);
     ``multipliers`` (P, 2n) the exact orbit's (the HB's where not matched), ``multipliers_hb``
-    (P, 2n) the HB orbit's, largest modulus first; ``stable``, ``stable_hb`` every multiplier
-    inside the unit circle; ``status``, ``message`` of the continuation; ``regularisation`` ε and
+    (P, 2n) the HB orbit's, largest modulus first (nan where none could be found); ``stable``,
+    ``stable_hb`` every multiplier inside the unit circle (False where none could be found); ``status``, ``message`` of the continuation; ``regularisation`` ε and
     ``harmonics`` H.
 
     The regularisation continued to its limit at the rows ``limit_index``: ``limit_eps`` the
