@@ -27,7 +27,10 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
 
 Cost: one continuation of n(2H + 1) unknowns (a dense Jacobian) plus two exact integrations of
 a period (the shooting, a few ms per Newton step, and the HB orbit's monodromy) per point, and a
-ladder per refined row. Not resolved: grazing (a tangential touch of a breakpoint or of zero
+ladder per refined row. Where an element sticks the whole period the exact orbits form a family
+(its stuck deflection is free within the friction band; a multiplier 1, counted as inside the
+unit circle up to :data:`UNIT_TOL`) while the regularised HB picks one (its creep balance): the
+shooting may end on another member, and the row is then left unmatched. Not resolved: grazing (a tangential touch of a breakpoint or of zero
 relative velocity) and stuck sets closing a loop (the exact integrator's limits); such rows are
 left unmatched.
 """
@@ -52,6 +55,9 @@ from ._regularisation import RegularisationLimit, regularisation_limit
 
 #: Samples per period on which the exact and the HB orbits are compared.
 MATCH_SAMPLES = 64
+#: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
+#: gives a neutral multiplier 1 (a family of orbits, its stuck deflection free within the band).
+UNIT_TOL = 1e-8
 
 
 def friction_balance_factory(system: FrictionSystem) -> Callable[[float, int], RegularisedSystemBalance]:
@@ -203,26 +209,28 @@ def friction_response(
             orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30)
         except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
             orbit = None
+        t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / w / MATCH_SAMPLES)
+        E = problem.element_series(q)
+        d_hb = np.stack([problem.basis.evaluate(E[e], w, t) for e in range(m)], axis=1)  # (64, m)
+        size = np.maximum(np.ptp(problem.basis.synthesize(E), axis=1), 1e-12 * L)
+        traj = None
         if orbit is not None and orbit.converged:  # one orbit: every δ_e(t) within `match` of the HB's
-            t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / w / MATCH_SAMPLES)
-            E = problem.element_series(q)
-            d_hb = np.stack([problem.basis.evaluate(E[e], w, t) for e in range(m)], axis=1)  # (64, m)
-            size = np.maximum(np.ptp(problem.basis.synthesize(E), axis=1), 1e-12 * L)
-            d_ex = orbit.trajectory.element_samples(t)[0]
-            dist_all[i] = float(np.max(np.max(np.abs(d_ex - d_hb), axis=0) / size))
+            traj = orbit.trajectory
+            dist_all[i] = float(np.max(np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size))
             matched[i] = dist_all[i] <= match
         if matched[i]:
-            assert orbit is not None
-            rms[i], mean[i], stick[i] = orbit.rms, orbit.mean, orbit.stick_fraction
-            mult[i] = np.asarray(orbit.multipliers, dtype=complex)
+            assert traj is not None
+            mean[i], rms[i] = traj.element_mean_and_rms()
+            stick[i] = traj.stick_time() / (2.0 * math.pi / w)
+            mult[i] = _multipliers(traj.sensitivity)
             if mu_hb is None:
                 mu_hb = mult[i]
         if mu_hb is not None:
             mult_hb[i] = mu_hb
         if not matched[i]:
             mult[i] = mult_hb[i]
-    stable = np.abs(mult).max(axis=1) < 1.0  # nan (nothing known) → False
-    stable_hb = np.abs(mult_hb).max(axis=1) < 1.0
+    stable = np.abs(mult).max(axis=1) < 1.0 + UNIT_TOL  # nan (nothing known) → False
+    stable_hb = np.abs(mult_hb).max(axis=1) < 1.0 + UNIT_TOL
     with np.errstate(invalid="ignore", divide="ignore"):
         err = np.max(np.abs(rms_hb / rms - 1.0), axis=1)
     candidates = np.flatnonzero(matched)
