@@ -96,13 +96,18 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
 
 def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     """The preload-only branch near Ω = 0.31 … 0.36 loses and regains stability several times: every
-    change between matched rows carries a label, and only those."""
+    change between matched rows carries a stability label; every change of the switching pattern
+    (crossings or held phases per period) without one is labelled a grazing; nothing else is."""
     res = nonsmooth_response(_system(0.05, 0.0), (0.3, 0.4), RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
     m = np.flatnonzero(res.matched)
     changes = {int(j) for i, j in zip(m, m[1:]) if res.stable[i] != res.stable[j]}
+    pattern = {int(j) for i, j in zip(m, m[1:]) if res.stable[i] == res.stable[j]
+               and (res.sticks[i], res.crossings[i]) != (res.sticks[j], res.crossings[j])}
     labelled = {int(i) for i in np.flatnonzero(res.bifurcation != "")}
-    assert changes and labelled == changes
-    assert set(res.bifurcation[list(labelled)]) <= {"fold", "period_doubling", "neimark_sacker"}
+    assert changes and labelled == changes | pattern
+    assert set(res.bifurcation[list(changes)]) <= {"fold", "period_doubling", "neimark_sacker"}
+    assert set(res.bifurcation[list(pattern)]) <= {"grazing", "grazing_sliding"}
+    assert np.all(res.crossings[m] >= 0) and np.all(res.sticks[m] >= 0)
     # the HB orbit's own stability (saltation matrices along one period from its state) is the exact
     # orbit's at every matched row here (measured 472 of 472; the smooth monodromy of the regularised
     # equation agrees at 84 %: it misjudges the slow crossings of the jump)

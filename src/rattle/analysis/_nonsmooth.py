@@ -190,7 +190,7 @@ def nonsmooth_response(
     points = stepper.run()
     integ = NonsmoothIntegrator(system)
     rows: dict[str, list] = {k: [] for k in ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched",
-                                             "mean", "p2p", "acc_p2p", "regime")}
+                                             "mean", "p2p", "acc_p2p", "regime", "sticks", "crossings")}
     for pt in points:
         w, q = float(pt.omega), pt.q
         rms_hb = _rms(q, harmonics)
@@ -221,7 +221,12 @@ def nonsmooth_response(
             rows["mult"].append(np.asarray(orbit.multipliers, dtype=complex)[:2])
             rows["stable"].append(bool(orbit.stable))
             rows["stick"].append(float(orbit.trajectory.stick_time))
+            kinds = orbit.trajectory.event_kind  # the switching pattern: held phases and crossings per period
+            rows["sticks"].append(sum(k in ("stick", "lock") for k in kinds))
+            rows["crossings"].append(sum(k == "crossing" for k in kinds))
         else:
+            rows["sticks"].append(-1)
+            rows["crossings"].append(-1)
             for key in ("rms", "mean", "p2p", "acc_p2p", "stick"):
                 rows[key].append(math.nan)
             rows["regime"].append("")
@@ -261,6 +266,7 @@ def nonsmooth_response(
         acc_p2p=np.array(rows["acc_p2p"]), regime=np.array(rows["regime"], dtype=object),
         stable=np.array(rows["stable"], dtype=bool), multipliers=np.array(rows["mult"]).reshape(-1, 2),
         multipliers_hb=np.array(rows["mult_hb"]).reshape(-1, 2), stick_time=np.array(rows["stick"]),
+        sticks=np.array(rows["sticks"], dtype=np.int64), crossings=np.array(rows["crossings"], dtype=np.int64),
         matched=matched, status=stepper.status or Status.SUCCESS,
         message=stepper.message, regularisation=float(regularisation), harmonics=int(harmonics),
         limit_index=np.asarray(pick, dtype=int), limit_eps=np.array(lim_eps), limit_rms=np.array(lim_rms),

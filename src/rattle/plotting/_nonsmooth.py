@@ -24,7 +24,7 @@ from ._axes import PlotAxes
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import NonsmoothOrbitResult, NonsmoothResponse
 
-_MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D"}
+_MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D", "grazing": "^", "grazing_sliding": "v"}
 
 #: Shading of the stick phases (friction holds the clutch) and of the lock phases (held at a jump).
 STICK_COLOUR = "tab:green"

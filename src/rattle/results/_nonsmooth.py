@@ -27,7 +27,7 @@ from ..stability import classify_loss
 #: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
 NONSMOOTH_COLUMNS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
                      "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs", "eps_limit", "rms_hb_limit",
-                     "rms_hb_extrapolated", "rms_error_limit")
+                     "rms_hb_extrapolated", "rms_error_limit", "sticks", "crossings")
 
 
 @dataclass(frozen=True, slots=True)
@@ -36,7 +36,8 @@ class NonsmoothResponse:
 
     ``omega``; ``rms_hb`` of the regularised HB orbit; from the exact orbit (nan where not
     ``matched``): ``mean``, ``rms``, ``rms_ac``, ``p2p`` and ``acc_p2p`` of δ and δ'', ``regime``,
-    ``stick_time`` per period; ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact
+    ``stick_time`` per period, the switching pattern ``sticks`` (stick and lock phases per period)
+    and ``crossings`` (breakpoint crossings per period; −1 where not matched); ``rms_error`` = rms_hb / rms − 1; ``stable`` from the exact
     multipliers ``multipliers`` (P, 2) (the HB's where not matched); ``multipliers_hb`` (P, 2) of
     the HB orbit (by default the non-smooth monodromy of one period of the exact flow from its
     state, saltations included; :class:`~rattle.analysis.RegularisationOptions` ``stability``); ``status``, ``message``; ``regularisation`` ε and ``harmonics`` H.
@@ -72,6 +73,13 @@ class NonsmoothResponse:
     limit_rms: FloatArray
     limit_richardson: FloatArray
     limit_linear: np.ndarray
+    sticks: np.ndarray | None = None
+    crossings: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("sticks", "crossings"):  # not given: unknown (-1) on every row
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.full(self.omega.size, -1, dtype=np.int64))
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -113,12 +121,22 @@ class NonsmoothResponse:
 
     @property
     def bifurcation(self) -> np.ndarray:
-        """The kind of stability change at each row against the previous matched row ("" none)."""
+        """The bifurcation between each row and the previous matched row ("" none): a change of
+        stability by its kind (:func:`~rattle.stability.classify_loss`: ``fold``,
+        ``period_doubling``, ``neimark_sacker``), else a change of the exact orbit's switching
+        pattern, a discontinuity-induced bifurcation: ``grazing_sliding`` where a stick (or lock)
+        phase appears or vanishes (the number of held phases per period, :attr:`sticks`, changes)
+        and ``grazing`` where a pair of breakpoint crossings does (:attr:`crossings`)."""
         out = np.full(len(self), "", dtype=object)
         prev = None
         for i in np.flatnonzero(self.matched):
-            if prev is not None and bool(self.stable[i]) != bool(self.stable[prev]):
-                out[i] = classify_loss(self.multipliers[prev], self.multipliers[i])
+            if prev is not None:
+                if bool(self.stable[i]) != bool(self.stable[prev]):
+                    out[i] = classify_loss(self.multipliers[prev], self.multipliers[i])
+                elif min(self.sticks[i], self.sticks[prev]) >= 0 and self.sticks[i] != self.sticks[prev]:
+                    out[i] = "grazing_sliding"
+                elif min(self.crossings[i], self.crossings[prev]) >= 0 and self.crossings[i] != self.crossings[prev]:
+                    out[i] = "grazing"
             prev = i
         return out
 
@@ -134,6 +152,7 @@ class NonsmoothResponse:
             "rms_hb_limit": self._per_row(self.limit_rms),
             "rms_hb_extrapolated": self._per_row(np.where(self.limit_linear, self.limit_richardson, np.nan)),
             "rms_error_limit": np.where(np.isnan(self._per_row(self.limit_rms)), np.nan, self.hb_error),
+            "sticks": self.sticks, "crossings": self.crossings,
         }
 
     def plot(self) -> tuple:
