@@ -315,7 +315,8 @@ def nonsmooth_summary(result: Any, options: Any) -> str:
     labels = result.bifurcation
     changes = [f"{labels[i]} before Ω = {result.omega[i]:.5g}" for i in range(n) if labels[i]]
     if changes:
-        lines.append("stability changes (between rows): " + ", ".join(changes))
+        lines.append("bifurcations (between rows; grazing: a crossing or a stick phase appears or vanishes): "
+                     + ", ".join(changes))
     return "\n".join(lines)
 
 
