@@ -164,3 +164,54 @@ def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkey
     assert "were written to" in result.stderr and "frf.csv" in result.stderr
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["frf.csv", "frf.json", "frf.png"]
     assert json.loads((tmp_path / "out" / "frf.json").read_text())["status"] == "max_steps"
+
+
+#: A four-cylinder engine driving a two-stage clutch damper (SI): friction 2 N m on the idle stage
+#: only (K_e = 1720 N m/rad: r = 2/1720), the engine's mean torque taken by a constant drag.
+ENGINE = """\
+[model]
+units = "SI"
+inertias = [0.15, 0.01]
+
+[[model.links]]
+between = [1, 2]
+damping = 0.15
+
+[[model.elements]]
+name = "damper"
+between = [1, 2]
+stiffness = 1720.0
+type = "clutch"
+alpha = 0.05
+b_deg = 4.0
+friction = [0.0, 2.0, 0.0]
+
+[engine]
+inertia = 1
+cylinders = 4
+speed_rpm = [400.0, 1500.0]
+mean_torque = 5.0
+orders = [2.0, 4.0]
+amplitudes = [60.0, 10.0]
+
+[[excitation.torques]]
+inertia = 2
+mean = -5.0
+
+[analysis]
+harmonics = 32
+"""
+
+
+def test_frf_on_an_engine_chain_with_friction_in_si_takes_rpm_options_and_writes_rpm(tmp_path):
+    config = write_config(tmp_path, ENGINE)
+    result = invoke(["frf", str(config), "--rpm-min", "1000", "--rpm-max", "1020", "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    table = read_csv(tmp_path / "out" / "frf.csv")
+    rpm, omega = np.asarray(table["rpm"], dtype=float), np.asarray(table["omega"], dtype=float)
+    assert rpm[0] == pytest.approx(1000.0, rel=1e-12) and rpm[-1] == pytest.approx(1020.0, rel=1e-12)
+    np.testing.assert_allclose(omega, rpm * 2.0 * 2.0 * np.pi / 60.0, rtol=1e-12)  # base order 2
+    meta = json.loads((tmp_path / "out" / "frf.json").read_text())
+    np.testing.assert_allclose(meta["system"]["elements"][0]["friction"], [0.0, 2.0 / 1720.0, 0.0], rtol=1e-15)
+    assert meta["options"] == {"rpm_min": 1000.0, "rpm_max": 1020.0}
+    assert "engine speed 1000 … 1020 rpm" in result.stdout
