@@ -113,8 +113,15 @@ def test_a_damper_and_a_spline_take_friction_per_stage_of_their_law():
     np.testing.assert_allclose(rc.model.system.elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
     bad = copy.deepcopy(data)
     bad["model"]["elements"][0]["friction"] = [1.0, 2.0]
-    _refused(bad, "`model.elements[0].friction` must hold one level (every stage) or one per stage", "4 stages",
+    _refused(bad, "`model.elements[0].friction` must hold one level (every stage) or one per stage of the damper",
+             "4 stages (coast stage 2, coast stage 1, drive stage 1, drive stage 2; from the most negative twist)",
              "got 2 levels [1.0, 2.0]", "give 4 levels or a single number")
+    bad["model"]["elements"][0].update(free_play_deg=0.5, coast_stiffness=[20.0, 150.0])  # c1 = k1, free play
+    _refused(bad, "5 stages (coast stage 2, coast stage 1, free play, drive stage 1, drive stage 2;")
+    del bad["model"]["elements"][0]["free_play_deg"]  # c1 = k1 without free play: one stage across zero
+    _refused(bad, "3 stages (coast stage 2, coast/drive stage 1, drive stage 2;")
+    bad["model"]["elements"][0]["friction"] = [1.0, 2.0, 3.0]
+    np.testing.assert_allclose(config_from_dict(bad).model.friction_levels(0), np.array([1.0, 2.0, 3.0]) / 200.0)
 
 
 @pytest.mark.parametrize("friction, fragments", [

@@ -128,9 +128,32 @@ def _damper(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]
                      drive_angles=t.get("drive_angles", []), coast_stiffness=t["coast_stiffness"],
                      coast_angles=t.get("coast_angles", []), free_play=t.get("free_play", 0.0))
     out = {k: t[k] for k in ("name", "between") if k in t}
-    # friction (checked by the chain reader, per stage of the law built here) passes through
+    if isinstance(t.get("friction"), list):  # one level per stage: counted in the damper's own stages
+        _damper_friction_count(check, t, where, len(element.law.stages.slopes))
+    # friction (its values checked by the chain reader, per stage of the law built here) passes through
     return {**out, "stiffness": element.stiffness, **element.law.to_dict(),
             **({"friction": t["friction"]} if "friction" in t else {})}
+
+
+def _damper_friction_count(check: _Checker, t: Mapping[str, Any], where: str, n: int) -> None:
+    """A damper's ``friction`` list: one level or one per stage of its law, the stages named as the
+    data sheet gives them (coast outermost first, the free play, then drive from zero outwards)."""
+    kc, kd = list(t["coast_stiffness"]), list(t["drive_stiffness"])
+    names = [f"coast stage {j}" for j in range(len(kc), 0, -1)]
+    if float(t.get("free_play", 0.0)) > 0:
+        names.append("free play")
+    drive = [f"drive stage {j}" for j in range(1, len(kd) + 1)]
+    if names[-1] == "coast stage 1" and float(kc[0]) == float(kd[0]):  # one stage across zero
+        names[-1], drive = "coast/drive stage 1", drive[1:]
+    names += drive
+    levels = t["friction"]
+    if len(levels) not in (1, n):
+        stages = ", ".join(names) if len(names) == n else f"{n} stages"
+        raise check.error(
+            f"`{where}.friction` must hold one level (every stage) or one per stage of the damper: it has {n} "
+            f"stage{'' if n == 1 else 's'} ({stages}; from the most negative twist), got {len(levels)} levels "
+            f"{_show(levels)}; give {n} levels or a single number"
+        )
 
 
 def _spline(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]:
