@@ -305,3 +305,13 @@ def test_random_chains_agree_with_the_independent_event_integration(seed):
     exact = FrictionIntegrator(fs).propagate(z0, 0.0, 2 * T, omega)
     ref = _reference(fs, z0, 2 * T, omega)
     assert np.abs(exact.state1 - ref).max() <= 1e-9 * max(np.abs(exact.state1).max(), 1e-3)
+
+
+def test_a_case_file_with_friction_on_an_element_reads_as_that_chain():
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "chain_clutch_friction.toml"
+    ch = Chain.from_toml(path)
+    assert isinstance(ch, Chain) and ch.has_friction
+    fs = ch.friction_system()
+    assert any(np.any(fs.friction_levels(e) > 0) for e in range(fs.m))

@@ -464,7 +464,8 @@ class Chain:
         from ..files._read import read_toml
         from ._tables import model_tables
 
-        return model_tables(read_toml(path), os.fspath(path)).model
+        tables = model_tables(read_toml(path), os.fspath(path))
+        return tables.chain if tables.chain is not None else tables.model
 
     def to_dict(self) -> dict[str, object]:
         return {

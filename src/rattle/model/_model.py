@@ -141,6 +141,8 @@ class Model:
         from ._tables import model_tables
 
         tables = model_tables(read_toml(path), os.fspath(path))
+        if tables.chain is not None:  # a chain with friction on its elements: the Chain itself
+            return tables.chain  # type: ignore[return-value]
         if tables.discontinuous:
             raise ConfigError(f"{path}: the law has a preload or friction (`model.elastic.preload`/`friction`), "
                               f"which makes a NonsmoothSystem, not a Model: read it with "

@@ -140,12 +140,16 @@ class ModelTables:
         friction the same chain without its friction; None otherwise.
     engine : EngineAxis or None
         The ``[engine]`` of a chain, resolved; None without one.
+    chain : Chain or None
+        For a chain with friction, the :class:`Chain` itself (its elements with their friction),
+        which :meth:`Chain.from_toml` returns; None otherwise.
     """
 
     model: Any
     units: str = "dimensionless"
     continuous_model: Model | Chain | None = None
     engine: EngineAxis | None = None
+    chain: Chain | None = None
 
     @property
     def discontinuous(self) -> bool:
@@ -647,7 +651,8 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                         torques=tuple(torques), speed_order=speed_order, drag=drag)
     if chain.has_friction:  # the equations with every element's friction; the chain without it sets the bounds
         smooth = dataclasses.replace(chain, elements=tuple(dataclasses.replace(e, friction=None) for e in elements))
-        return ModelTables(model=chain.friction_system(), units=units, continuous_model=smooth, engine=engine)
+        return ModelTables(model=chain.friction_system(), units=units, continuous_model=smooth, engine=engine,
+                           chain=chain)
     return ModelTables(model=chain, units=units, engine=engine)
 
 
