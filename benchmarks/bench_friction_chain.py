@@ -53,6 +53,7 @@ def main() -> None:
         err = np.abs(r.element_rms_error[m]).max(axis=1)
         est = r.hb_error[m]
         agree = r.stable[m] == r.stable_hb[m]
+        agree_lim = r.stable[m] == r.stable_hb_limit[m]
         sticks = np.nan_to_num(r.stick_fraction).max(axis=1) > 0
         print(f"H = {H}: {len(r)} rows, matched {int(m.sum())} ({m.mean():.1%}), status {r.status.name}, {dt:.1f} s "
               f"({dt / max(len(r), 1) * 1e3:.0f} ms/row)")
@@ -61,6 +62,8 @@ def main() -> None:
         if r.limit_index.size:
             print(f"  refined {r.limit_index.size} rows (ε → {np.nanmin(r.limit_eps):g}); HB ε→0 estimate within 0.5 %: "
                   f"{np.mean(est <= 0.005):.1%} of matched (median {np.nanmedian(est):.2%}, max {np.nanmax(est):.2%})")
+            print(f"  stability with the HB at its limit (refined rows) agrees on {int(agree_lim.sum())}/{int(m.sum())} "
+                  f"({agree_lim.mean():.1%})")
         print(f"  stability agrees on {int(agree.sum())}/{int(m.sum())} matched rows ({agree.mean():.1%}); "
               f"unstable exact rows {int((~r.stable[m]).sum())}; sticking rows {int((sticks & m).sum())} "
               f"(Ω {r.omega[sticks & m].min() / wn:.3g} … {r.omega[sticks & m].max() / wn:.3g} ω_n)"
@@ -71,8 +74,18 @@ def main() -> None:
                   ", ".join(f"{r.omega[i] / wn:.4f} {r.mu_abs[i]:.4f} {r.mu_hb_abs[i]:.4f}" for i in bad[:8]))
         un = np.flatnonzero(~m)
         if un.size:
-            print(f"  unmatched rows at Ω/ω_n: {', '.join(f'{w:.3f}' for w in r.omega[un][:12] / wn)}"
-                  + (" …" if un.size > 12 else ""))
+            departed = np.isfinite(r.match_distance[un])
+            print(f"  unmatched {un.size} rows: {int(departed.sum())} shot to another orbit (δ departs by more than "
+                  f"`match`), {int((~departed).sum())} shooting failed; Ω/ω_n ranges:",
+                  ", ".join(f"{a / wn:.3f}–{b / wn:.3f}" for a, b in _runs(r.omega, ~m)[:12]))
+
+
+def _runs(omega: np.ndarray, sel: np.ndarray) -> list[tuple[float, float]]:
+    idx = np.flatnonzero(sel)
+    if idx.size == 0:
+        return []
+    parts = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    return [(float(omega[p].min()), float(omega[p].max())) for p in parts]
 
 
 if __name__ == "__main__":

@@ -74,6 +74,8 @@ def test_sticking_rows_match_the_exact_orbit_at_the_regularisation_limit(stickin
     assert np.all(r.hb_error <= 0.005)
     # Exact stability (saltation monodromy of the exact orbit) agrees with the HB orbit's.
     np.testing.assert_array_equal(r.stable, r.stable_hb)
+    np.testing.assert_array_equal(r.stable, r.stable_hb_limit)  # and the HB at ε = 1e-3
+    assert r.limit_multipliers is not None and np.all(np.isfinite(r.limit_multipliers))
     assert np.any(~r.stable) and np.any(r.stable)  # a stability change inside the range
     assert set(r.bifurcation[r.bifurcation != ""]) <= {"fold", "period_doubling", "neimark_sacker"}
     assert np.any(r.bifurcation != "")
@@ -138,7 +140,7 @@ def test_columns_csv_and_json(sticking: FrictionResponse, slipping: FrictionResp
     for name in ("clutch", "gear"):
         for col in ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated"):
             assert f"{name}_{col}" in header
-    for col in ("matched", "stable", "stable_hb", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation"):
+    for col in ("matched", "stable", "stable_hb", "stable_hb_limit", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation"):
         assert col in header
     assert "rpm" not in header and len(rows) == len(sticking) + 1
     i = header.index("clutch_rms")

@@ -23,7 +23,10 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    (relative), the regularisation is continued at that row towards its limit (ε down to
    ``limit_eps``, H up to ``limit_harmonics``, and on to ``deep_eps`` if asked;
    :func:`~rattle.analysis._regularisation.regularisation_limit`): the rms at the smallest ε and
-   Richardson's ε → 0 value (where the last three rungs are linear in ε) are kept per element.
+   Richardson's ε → 0 value (where the last three rungs are linear in ε) are kept per element,
+   and the HB orbit's multipliers are found again from the state of the smallest ε (the
+   stability of the HB at its limit: at ε = 0.01 a sticking orbit's state is off by the
+   regularisation, and so is the monodromy of the flow from it).
 
 Cost: one continuation of n(2H + 1) unknowns (a dense Jacobian) plus two exact integrations of
 a period (the shooting, a few ms per Newton step, and the HB orbit's monodromy) per point, and a
@@ -238,7 +241,7 @@ def friction_response(
                                 .round().astype(int))] if opts.limit > 0 and candidates.size else np.zeros(0, int)
     if refine is not None and candidates.size:
         pick = np.union1d(pick, candidates[err[candidates] > refine]).astype(int)
-    lim_eps, lim_H, lim_rms, lim_rich, lim_lin = [], [], [], [], []
+    lim_eps, lim_H, lim_rms, lim_rich, lim_lin, lim_mu = [], [], [], [], [], []
     for i in pick.tolist():
         try:
             lad = _ladder(make, float(points[i].omega), points[i].q, opts,
@@ -249,12 +252,16 @@ def friction_response(
             lim_rms.append(lad.last.element_rms)
             lim_rich.append(lad.extrapolated_element_rms)
             lim_lin.append(lad.linear)
+            w = float(points[i].omega)
+            mu_lim = _hb_multipliers(integ, make(lad.last.eps, lad.last.harmonics).state_at_zero(lad.last.q, w), w)
+            lim_mu.append(np.full(2 * n, np.nan + 0j) if mu_lim is None else mu_lim)
         except RattleError:  # the ladder stalled: the row keeps its ε
             lim_eps.append(math.nan)
             lim_H.append(0)
             lim_rms.append(np.full(m, np.nan))
             lim_rich.append(np.full(m, np.nan))
             lim_lin.append(False)
+            lim_mu.append(np.full(2 * n, np.nan + 0j))
     omegas = np.array([float(p.omega) for p in points])
     rpm = system.speed_rpm(omegas)
     return FrictionResponse(
@@ -266,6 +273,7 @@ def friction_response(
         limit_harmonics=np.array(lim_H, dtype=int), limit_rms=np.array(lim_rms, dtype=float).reshape(-1, m),
         limit_richardson=np.array(lim_rich, dtype=float).reshape(-1, m),
         limit_linear=np.array(lim_lin, dtype=bool),
+        limit_multipliers=np.array(lim_mu, dtype=complex).reshape(-1, 2 * n),
     )
 
 

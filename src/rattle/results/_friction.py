@@ -30,7 +30,7 @@ from ..stability import classify_loss
 #: The per-element columns of :meth:`FrictionResponse.columns`, NAME_ prefixed, in this order.
 FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated")
 #: The columns closing each row.
-FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation",
+FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "stable_hb_limit", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation",
                          "eps_limit", "match_distance")
 
 
@@ -52,7 +52,8 @@ class FrictionResponse:
     smallest ε reached (nan: the ladder stalled), ``limit_harmonics`` H there, ``limit_rms`` (k, m)
     the HB rms there, ``limit_richardson`` (k, m) Richardson's ε → 0 value, ``limit_linear``
     whether the last three rungs lie on a line in ε for every element (Richardson's value then
-    holds)."""
+    holds), ``limit_multipliers`` (k, 2n) the multipliers of the HB orbit at the smallest ε
+    (:attr:`stable_hb_limit`)."""
 
     omega: FloatArray
     rpm: FloatArray | None
@@ -77,6 +78,7 @@ class FrictionResponse:
     limit_rms: FloatArray
     limit_richardson: FloatArray
     limit_linear: np.ndarray
+    limit_multipliers: ComplexArray | None = None
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -111,9 +113,25 @@ class FrictionResponse:
         return np.abs(self.multipliers_hb).max(axis=1) if self.multipliers_hb.size else np.full(len(self), np.nan)
 
     @property
+    def stable_hb_limit(self) -> np.ndarray:
+        """The HB orbit's stability at its limit: at the ladder's rows that of the orbit at the
+        smallest ε, elsewhere :attr:`stable_hb`."""
+        out = self.stable_hb.copy()
+        if self.limit_multipliers is not None and self.limit_index.size:
+            mu = np.abs(self.limit_multipliers).max(axis=1)
+            ok = np.isfinite(mu)
+            out[self.limit_index[ok]] = mu[ok] < 1.0 + 1e-8
+        return out
+
+    @property
     def stability_agrees(self) -> np.ndarray:
         """Per matched row: the exact and the HB orbit's stability agree (False elsewhere)."""
         return self.matched & (self.stable == self.stable_hb)
+
+    @property
+    def stability_agrees_limit(self) -> np.ndarray:
+        """As :attr:`stability_agrees` with the HB at its limit (:attr:`stable_hb_limit`)."""
+        return self.matched & (self.stable == self.stable_hb_limit)
 
     def _per_row(self, values: np.ndarray) -> np.ndarray:
         out = np.full((len(self),) + values.shape[1:], np.nan)
@@ -178,7 +196,8 @@ class FrictionResponse:
             cols[f"{name}_rms_error"] = err[:, e]
             cols[f"{name}_rms_hb_limit"] = lim[:, e]
             cols[f"{name}_rms_hb_extrapolated"] = ext[:, e]
-        cols.update(matched=self.matched, stable=self.stable, stable_hb=self.stable_hb, mu_abs=self.mu_abs,
+        cols.update(matched=self.matched, stable=self.stable, stable_hb=self.stable_hb,
+                    stable_hb_limit=self.stable_hb_limit, mu_abs=self.mu_abs,
                     mu_hb_abs=self.mu_hb_abs, rms_error=self.rms_error, bifurcation=self.bifurcation,
                     eps_limit=self._per_row(self.limit_eps), match_distance=self.match_distance)
         return cols
@@ -207,6 +226,7 @@ class FrictionResponse:
             "max_rms_error": num(float(np.max(err))) if err.size else None,
             "median_rms_error": num(float(np.median(err))) if err.size else None,
             "stability_agrees": int(np.sum(self.stability_agrees)),
+            "stability_agrees_limit": int(np.sum(self.stability_agrees_limit)),
             "unstable_rows": int(np.sum(~self.stable)),
             "sticking_rows": int(np.sum(np.nan_to_num(self.stick_fraction).max(axis=1) > 0)) if len(self) else 0,
             "refined_rows": int(self.limit_index.size),
@@ -245,7 +265,8 @@ class FrictionResponse:
             lines.append(f"HB rms vs exact (largest over the elements): within 0.5 % on {md['within_0_5_percent']} "
                          f"of {md['matched']} matched rows, max {100 * (md['max_rms_error'] or 0):.3g} %, median "
                          f"{100 * (md['median_rms_error'] or 0):.3g} %")
-            lines.append(f"stability (exact vs HB monodromy) agrees on {md['stability_agrees']} of {md['matched']}")
+            lines.append(f"stability (exact vs HB monodromy) agrees on {md['stability_agrees']} of {md['matched']} "
+                         f"({md['stability_agrees_limit']} with the HB at its limit where refined)")
         if self.limit_index.size:
             txt = "n/a" if md["refined_max_error"] is None else f"{100 * md['refined_max_error']:.3g} %"
             lines.append(f"regularisation continued towards ε → 0 on {self.limit_index.size} rows "
