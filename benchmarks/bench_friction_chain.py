@@ -9,7 +9,21 @@ is within 0.5 % of the exact one at ε and after the ε-ladder (rows off by more
 down to ε = 1e-3; Richardson where linear), stability agreement (exact saltation monodromy of the
 exact orbit vs that of one period of exact flow from the HB state), rows that stick, time.
 
-Run:  OMP_NUM_THREADS=1 python benchmarks/bench_friction_chain.py [--harmonics 64 128] [--no-refine]
+Run:  OMP_NUM_THREADS=1 python benchmarks/bench_friction_chain.py [--harmonics 64 128] [--no-refine] [--lo 0.4]
+
+Measured 2026-12-01 (2 cores shared with other jobs, two runs at a time: times are upper bounds):
+
+- full branch 0.2 … 2 ω_n, ``--no-refine``: H = 64: 1499 rows, 1077 matched (71.8 %), HB at ε within
+  0.5 % on 60.3 % of them (median 0.34 %, max 6.3 %), stability agrees on 95.5 %, 1285 s
+  (857 ms/row); H = 128: 1496 rows, 1095 matched (73.2 %), 62.4 % within 0.5 % (median 0.31 %),
+  stability 96.2 %, 1407 s. 1269 rows lie in 0.2 … 0.4 ω_n (the gear rattles; superharmonic
+  resonances, many folds); the clutch sticks part of the period on 396 rows (0.21 … 0.57 ω_n).
+- ``--lo 0.4`` (ladder on): H = 64: 181 rows, 63 matched; within 0.5 % at ε 20.6 % (median
+  1.37 %), after the ladder (ε → 1e-3) 98.4 % (median 0.05 %, max 0.84 %); stability agrees on
+  84.1 % at ε, 90.5 % with the HB at its limit; 233 s. H = 128: 170 rows, 54 matched; 22.2 % →
+  98.1 % (max 1.7 %); stability 85.2 % → 90.7 %; 265 s. Unmatched: 0.575 … 2 ω_n, where the
+  clutch sticks the whole period: those exact orbits form a family (the stuck deflection is free
+  within the friction band), the shooting ends on another member or stalls (M − I singular).
 """
 
 from __future__ import annotations
