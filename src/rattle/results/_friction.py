@@ -30,8 +30,8 @@ from ..stability import classify_loss
 #: The per-element columns of :meth:`FrictionResponse.columns`, NAME_ prefixed, in this order.
 FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated")
 #: The columns closing each row.
-FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "stable_hb_limit", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation",
-                         "eps_limit", "match_distance")
+FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation",
+                         "eps_limit", "match_distance", "stable_hb_limit")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -196,10 +196,10 @@ class FrictionResponse:
             cols[f"{name}_rms_error"] = err[:, e]
             cols[f"{name}_rms_hb_limit"] = lim[:, e]
             cols[f"{name}_rms_hb_extrapolated"] = ext[:, e]
-        cols.update(matched=self.matched, stable=self.stable, stable_hb=self.stable_hb,
-                    stable_hb_limit=self.stable_hb_limit, mu_abs=self.mu_abs,
+        cols.update(matched=self.matched, stable=self.stable, stable_hb=self.stable_hb, mu_abs=self.mu_abs,
                     mu_hb_abs=self.mu_hb_abs, rms_error=self.rms_error, bifurcation=self.bifurcation,
-                    eps_limit=self._per_row(self.limit_eps), match_distance=self.match_distance)
+                    eps_limit=self._per_row(self.limit_eps), match_distance=self.match_distance,
+                    stable_hb_limit=self.stable_hb_limit)
         return cols
 
     def to_csv(self, path: str | Path) -> Path:
