@@ -301,8 +301,9 @@ class FrictionIntegrator:
         return y @ np.linalg.solve(AS @ BS, AS).T
 
     def _settle(self, t: float, z: FloatArray, stages: tuple[int, ...], candidates: list[int],
-                sigma: list[int], omega: float) -> _Key:
-        """The active-set choice of the stuck set among ``candidates`` (module docstring)."""
+                sigma: list[int], omega: float, tol: float = 1e-12) -> _Key:
+        """The active-set choice of the stuck set among ``candidates`` (module docstring); a
+        torque exceeding its band by less than ``tol`` (relative) still holds."""
         S = sorted(set(candidates))
         sigma = list(sigma)
         for e in S:
@@ -314,7 +315,7 @@ class FrictionIntegrator:
             for e, lam_e in zip(S, lam.tolist()):
                 r = float(self.levels[e][stages[e]])
                 excess = abs(lam_e) - r
-                if excess > 1e-12 * max(r, abs(lam_e), 1e-300) and excess > worst:
+                if excess > tol * max(r, abs(lam_e), 1e-300) and excess > worst:
                     worst, e_w, l_w = excess, e, lam_e
             if e_w < 0:
                 break
@@ -448,7 +449,9 @@ class FrictionIntegrator:
             elif kind == STICK:
                 zc[n:] -= a * (float(a @ zc[n:]) / float(a @ a))
                 cands = [e for e in range(m) if stuck[e]] + [e_ev]
-                new_key = self._settle(t, zc, stages, cands, list(key[1]), omega)
+                # a velocity zero again at once (no time passed): the torque sits on its band's edge
+                # (a touch); the round-off that tipped it over must not keep it slipping forever
+                new_key = self._settle(t, zc, stages, cands, list(key[1]), omega, 1e-12 if idle == 0 else 1e-6)
                 if not new_key[0][e_ev]:
                     kind = REVERSAL
                 normal = np.concatenate((np.zeros(n), a))
@@ -560,10 +563,18 @@ class FrictionIntegrator:
             if hi_v <= 0.0:
                 if lo_v > 0.0:
                     return _brent(vel, float(taus[i - 1]), float(taus[i]), lo_v, hi_v)
-                if i == 1 and lo_v <= floor:  # starts at rest: accept only a real excursion
-                    if hi_v < -floor:
-                        return float(taus[0])
-                    continue
+                if i == 1 and lo_v <= floor:  # starts at rest: a positive excursion first?
+                    if hi_v >= -floor:
+                        continue
+                    if sa[0] > 0.0 > sa[1]:  # σ δ' rises, turns, and falls through 0 in the cell
+                        try:
+                            tm = _brent(acc, float(taus[0]), float(taus[1]), float(sa[0]), float(sa[1]))
+                        except ValueError:
+                            tm = float(taus[0])
+                        vm = vel(tm)
+                        if vm > floor:
+                            return _brent(vel, tm, float(taus[1]), vm, hi_v)
+                    return float(taus[0])  # no excursion: the element cannot move this way (a stick)
                 return float(taus[i - 1])
             if sa[i - 1] < 0.0 < sa[i]:  # a minimum of σ δ' inside the cell
                 try:
