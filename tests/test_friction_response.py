@@ -142,10 +142,10 @@ def test_columns_csv_and_json(sticking: FrictionResponse, slipping: FrictionResp
             assert f"{name}_{col}" in header
     for col in ("matched", "stable", "stable_hb", "stable_hb_limit", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation"):
         assert col in header
-    assert "rpm" not in header and len(rows) == len(sticking) + 1
+    assert "speed_rpm" not in header and len(rows) == len(sticking) + 1
     i = header.index("clutch_rms")
     np.testing.assert_allclose([float(x[i]) for x in rows[1:]], sticking.rms[:, 0], rtol=1e-12)
-    assert slipping.column_names()[:2] == ["omega", "rpm"]
+    assert slipping.column_names()[:2] == ["omega", "speed_rpm"]
     doc = json.loads(json.dumps(sticking.to_dict()))
     assert doc["metadata"]["rows"] == len(sticking) and doc["metadata"]["matched"] == len(sticking)
     assert doc["metadata"]["elements"] == ["clutch", "gear"]

@@ -208,7 +208,7 @@ def test_frf_on_an_engine_chain_with_friction_in_si_takes_rpm_options_and_writes
     result = invoke(["frf", str(config), "--rpm-min", "1000", "--rpm-max", "1020", "-o", "out"], tmp_path)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     table = read_csv(tmp_path / "out" / "frf.csv")
-    rpm, omega = np.asarray(table["rpm"], dtype=float), np.asarray(table["omega"], dtype=float)
+    rpm, omega = np.asarray(table["speed_rpm"], dtype=float), np.asarray(table["omega"], dtype=float)
     assert rpm[0] == pytest.approx(1000.0, rel=1e-12) and rpm[-1] == pytest.approx(1020.0, rel=1e-12)
     np.testing.assert_allclose(omega, rpm * 2.0 * 2.0 * np.pi / 60.0, rtol=1e-12)  # base order 2
     meta = json.loads((tmp_path / "out" / "frf.json").read_text())

@@ -175,9 +175,9 @@ class FrictionResponse:
 
     # --- output -------------------------------------------------------------------------------
     def column_names(self) -> list[str]:
-        """omega, rpm (with an engine order), NAME_ + :data:`FRICTION_ELEMENT_COLUMNS` per element,
+        """omega, speed_rpm (with an engine order), NAME_ + :data:`FRICTION_ELEMENT_COLUMNS` per element,
         then :data:`FRICTION_TAIL_COLUMNS`."""
-        head = ["omega"] + ([] if self.rpm is None else ["rpm"])
+        head = ["omega"] + ([] if self.rpm is None else ["speed_rpm"])
         per = [f"{name}_{c}" for name in self.element_names for c in FRICTION_ELEMENT_COLUMNS]
         return head + per + list(FRICTION_TAIL_COLUMNS)
 
@@ -185,7 +185,7 @@ class FrictionResponse:
         """The rows as columns, in the order of :meth:`column_names`."""
         cols: dict[str, np.ndarray] = {"omega": self.omega}
         if self.rpm is not None:
-            cols["rpm"] = self.rpm
+            cols["speed_rpm"] = self.rpm
         err = self.element_rms_error
         lim, ext = self.rms_hb_limit, self.rms_hb_extrapolated
         for e, name in enumerate(self.element_names):
