@@ -69,6 +69,7 @@ from ._flow import check_system_state
 from ._nonsmooth import NonsmoothOptions
 from ._shooting import ShotOrbit
 from ._stage_flow import Segment, StageSolution, SystemStages
+from ._system_shooting import _newton_system
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
@@ -623,35 +624,10 @@ def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *
     n = system.n
     scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
     T = period * 2.0 * math.pi / omega
-    eye = np.eye(2 * n)
-    z1, M = integ.advance(z, 0.0, T, omega)
-    r = z1 - z
-    res = float(np.max(np.abs(r / scale)))
-    it = 0
-    while res > tol and it < max_iterations:
-        it += 1
-        J = M - eye
-        try:
-            dz = np.linalg.solve(J, -r)
-        except np.linalg.LinAlgError:
-            dz = np.linalg.lstsq(J, -r, rcond=None)[0]
-        step = 1.0
-        for _ in range(31):
-            z_try = z + step * dz
-            try:
-                z1_try, M_try = integ.advance(z_try, 0.0, T, omega)
-            except ConvergenceError:
-                step *= 0.5
-                continue
-            r_try = z1_try - z_try
-            res_try = float(np.max(np.abs(r_try / scale)))
-            if res_try < res:
-                break
-            step *= 0.5
-        else:
-            break
-        z, M, r, res = z_try, M_try, r_try, res_try
-    traj = integ.propagate(z, 0.0, T, omega)
+    # Newton on φ(z0) − z0 with M − I (the shooting core shared with the smooth chain's)
+    shot = _newton_system(integ, omega, z, int(period), float(tol), int(max_iterations), scale, max_halvings=30)
+    z, res, it = shot.x, shot.residual, shot.iterations
+    traj: FrictionTrajectory = shot.trajectory  # type: ignore[assignment]
     mean, rms = traj.element_mean_and_rms()
     return FrictionOrbit(state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
                          multipliers=_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,

@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from .._validate import check_omega, check_shooting
+from ..errors import ConvergenceError
 from ..model import System
 from ._flow import (
     SystemIntegrator,
@@ -139,7 +141,7 @@ class _SystemShot:
         return _multipliers(self.trajectory.sensitivity)
 
 
-def _newton_system(integ: SystemIntegrator, omega: float, z0: FloatArray, period: int, tol: float,
+def _newton_system(integ: SystemIntegrator | Any, omega: float, z0: FloatArray, period: int, tol: float,
                    max_iterations: int, scale: FloatArray, max_halvings: int = _MAX_HALVINGS) -> _SystemShot:
     """Newton's method on r(z0) = φ(z0; 0 → p·2π/Ω) − z0 with the exact monodromy, the period
     maps without records (:meth:`SystemIntegrator.advance`), the last iterate's trajectory
@@ -162,7 +164,11 @@ def _newton_system(integ: SystemIntegrator, omega: float, z0: FloatArray, period
         step = 1.0
         for _ in range(max_halvings + 1):
             z_try = z + step * dz
-            z1_try, M_try = integ.advance(z_try, 0.0, T, omega)
+            try:
+                z1_try, M_try = integ.advance(z_try, 0.0, T, omega)
+            except ConvergenceError:  # a trial state the flow cannot follow (an event budget): shorter step
+                step *= 0.5
+                continue
             evaluations += 1
             r_try = z1_try - z_try
             res_try = float(np.max(np.abs(r_try / scale)))
