@@ -315,3 +315,26 @@ def test_a_case_file_with_friction_on_an_element_reads_as_that_chain():
     assert isinstance(ch, Chain) and ch.has_friction
     fs = ch.friction_system()
     assert any(np.any(fs.friction_levels(e) > 0) for e in range(fs.m))
+
+
+def test_a_fully_stuck_element_gives_a_family_of_orbits_held_by_its_deflection():
+    """Friction strong enough to hold the clutch the whole period: every stuck deflection within
+    the band carries a periodic orbit (a multiplier 1). ``hold`` picks the member: converged, the
+    clutch constant at the held value, and two holds give two different orbits."""
+    ch = _chain(levels=((0.3,), None), torque=0.1)
+    fs = ch.friction_system()
+    omega = 1.2
+    orbits = []
+    for d in (0.02, 0.06):
+        o = shoot_friction_orbit(fs, omega, np.zeros(6), hold={0: d})
+        assert o.converged and o.stick_fraction[0] == pytest.approx(1.0)
+        t = np.linspace(0.0, 2 * math.pi / omega, 9)
+        dd, vv, _ = o.trajectory.element_samples(t)
+        assert np.allclose(dd[:, 0], d, rtol=0, atol=1e-12) and np.abs(vv[:, 0]).max() <= 1e-12
+        assert np.min(np.abs(np.abs(o.multipliers) - 1.0)) <= 1e-9  # the family's neutral direction
+        orbits.append(o)
+    assert not np.allclose(orbits[0].state0, orbits[1].state0)
+    # a start in the stick removes a δ_e' perturbation (the entry saltation S = I − b aᵀ/(a·b) on
+    # the velocities: the slip along b that a relative velocity starts is undone at once)
+    b = fs.system.element_columns[:, 0]
+    assert np.allclose(orbits[0].monodromy[:, 3:] @ b, 0.0, atol=1e-12)

@@ -93,6 +93,26 @@ def _hb_multipliers(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> 
     return mu if np.all(np.isfinite(mu)) else None
 
 
+#: An element stuck at least this fraction of one period of the exact flow from the HB state is
+#: held at the HB's mean deflection when the plain shooting finds no matching orbit.
+HOLD_FRACTION = 0.9
+
+
+def _held_elements(integ: FrictionIntegrator, z0: FloatArray, omega: float, E: FloatArray) -> dict[int, float]:
+    """{element: the HB's mean deflection} of the elements that stick at least
+    :data:`HOLD_FRACTION` of one period of the exact flow from the HB state ``z0``. Where an
+    element sticks the whole period the exact periodic orbits form a family (its stuck deflection
+    is free within the friction band; a multiplier 1): the regularised HB picks one member by its
+    creep balance, and the exact orbit checked against it is the member with the same stuck
+    deflection (:func:`~rattle.timeint.shoot_friction_orbit` ``hold``)."""
+    T = 2.0 * math.pi / omega
+    try:
+        frac = integ.propagate(z0, 0.0, T, omega).stick_time() / T
+    except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return {}
+    return {int(e): float(E[e][0]) for e in np.flatnonzero(frac >= HOLD_FRACTION)}
+
+
 def _damped_newton(pb: RegularisedSystemBalance, q: FloatArray, omega: float, iterations: int = 200) -> FloatArray | None:
     """Newton with the step halved until the scaled residual ‖R‖∞ / F_s falls (Armijo, factor
     1 − s/4); the solution, or None. The start's fallback where plain Newton from the linear
@@ -221,6 +241,19 @@ def friction_response(
             traj = orbit.trajectory
             dist_all[i] = float(np.max(np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size))
             matched[i] = dist_all[i] <= match
+        if not matched[i]:  # an element stuck (nearly) the whole period: a family of exact orbits
+            held = _held_elements(integ, z0, w, E)
+            if held:
+                try:
+                    orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30, hold=held)
+                except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+                    orbit = None
+                if orbit is not None and orbit.converged and all(orbit.stick_fraction[e] >= 1.0 - 1e-9 for e in held):
+                    free = [e for e in range(m) if e not in held]
+                    traj = orbit.trajectory
+                    gap = np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size
+                    dist_all[i] = float(np.max(gap[free])) if free else 0.0
+                    matched[i] = dist_all[i] <= match
         if matched[i]:
             assert traj is not None
             mean[i], rms[i] = traj.element_mean_and_rms()

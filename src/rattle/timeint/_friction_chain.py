@@ -382,6 +382,11 @@ class FrictionIntegrator:
         key = self._initial_key(t0, z, stages, omega)
         t = t0
         M = np.eye(2 * n)
+        S = [e for e in range(m) if key[0][e]]
+        if S:  # a start in a stick: a perturbation of δ_e' slips and sticks again at once, which
+            # removes it (the entry saltation, whichever its sign): δx' → P_S δx'
+            AS, BS = self.A[S], self.B[:, S]
+            M[n:, n:] -= BS @ np.linalg.solve(AS @ BS, AS)
         events = 0
         idle = 0
         while True:
@@ -606,13 +611,63 @@ def _multipliers(M: FloatArray) -> ComplexArray:
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
+def _newton_held(integ: FrictionIntegrator, omega: float, z: FloatArray, T: float, hold: dict[int, float],
+                 scale: FloatArray, tol: float, max_iterations: int) -> tuple[FloatArray, float, int]:
+    """Gauss–Newton on [φ(z0) − z0; a_e·x0 − d_e (e held)] = 0 with the Jacobian [[M − I]; [a_e, 0]]
+    (least squares: M − I is singular along the family of orbits the holds pick one of)."""
+    n = integ.n
+    rows = np.zeros((len(hold), 2 * n))
+    target = np.zeros(len(hold))
+    for k, (e, d) in enumerate(hold.items()):
+        rows[k, :n] = integ.A[e]
+        target[k] = d
+    L = float(scale[0])
+
+    def residual(zz: FloatArray) -> tuple[FloatArray, FloatArray] | None:
+        try:
+            z1, M = integ.advance(zz, 0.0, T, omega)
+        except ConvergenceError:
+            return None
+        return np.concatenate(((z1 - zz) / scale, (rows @ zz - target) / L)), M
+
+    out = residual(z)
+    if out is None:
+        return z, math.inf, 0
+    r, M = out
+    res = float(np.max(np.abs(r)))
+    it = 0
+    while res > tol and it < max_iterations:
+        it += 1
+        J = np.vstack(((M - np.eye(2 * n)) / scale[:, None], rows / L))
+        dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        step = 1.0
+        for _ in range(31):
+            out = residual(z + step * dz)
+            if out is not None and float(np.max(np.abs(out[0]))) < res:
+                break
+            step *= 0.5
+        else:
+            break
+        z = z + step * dz
+        r, M = out  # type: ignore[misc]
+        res = float(np.max(np.abs(r)))
+    return z, res, it
+
+
 def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *, period: int = 1,
                          tol: float = 1e-12, max_iterations: int = 50,
-                         integrator: FrictionIntegrator | None = None) -> FrictionOrbit:
+                         integrator: FrictionIntegrator | None = None,
+                         hold: dict[int, float] | None = None) -> FrictionOrbit:
     """Periodic orbit of the chain with friction by Newton shooting: r(z0) = φ(z0; 0 → T) − z0 = 0
     with the Jacobian M − I (M the exact monodromy with saltation matrices), steps halved until
     the scaled residual decreases. Scales: L for positions, L max(Ω, ω_n) for velocities. A
-    failed solve is returned with ``converged`` False."""
+    failed solve is returned with ``converged`` False.
+
+    ``hold`` {element: deflection}: elements that stick the whole period. Their orbits form a
+    family (the stuck deflection is free within the friction band; a multiplier 1, M − I
+    singular); the one whose held deflection is the given one is found, by Gauss–Newton on the
+    shooting equations with a_e·x0 = d_e added. The start is moved onto the holds: δ_e = d_e and
+    δ_e' = 0."""
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a FrictionSystem, got {system!r}")
     omega = check_omega(omega)
@@ -624,10 +679,20 @@ def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *
     n = system.n
     scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
     T = period * 2.0 * math.pi / omega
-    # Newton on φ(z0) − z0 with M − I (the shooting core shared with the smooth chain's)
-    shot = _newton_system(integ, omega, z, int(period), float(tol), int(max_iterations), scale, max_halvings=30)
-    z, res, it = shot.x, shot.residual, shot.iterations
-    traj: FrictionTrajectory = shot.trajectory  # type: ignore[assignment]
+    if hold:
+        held = {int(e): float(d) for e, d in hold.items()}
+        for e, d in held.items():
+            if not 0 <= e < system.m:
+                raise ValueError(f"`hold` names element {e}; the system has elements 0 … {system.m - 1}")
+            a = integ.A[e]
+            z[:n] += a * ((d - float(a @ z[:n])) / float(a @ a))
+            z[n:] -= a * (float(a @ z[n:]) / float(a @ a))
+        z, res, it = _newton_held(integ, omega, z, T, held, scale, float(tol), int(max_iterations))
+        traj: FrictionTrajectory = integ.propagate(z, 0.0, T, omega)
+    else:  # Newton on φ(z0) − z0 with M − I (the shooting core shared with the smooth chain's)
+        shot = _newton_system(integ, omega, z, int(period), float(tol), int(max_iterations), scale, max_halvings=30)
+        z, res, it = shot.x, shot.residual, shot.iterations
+        traj = shot.trajectory  # type: ignore[assignment]
     mean, rms = traj.element_mean_and_rms()
     return FrictionOrbit(state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
                          multipliers=_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,
