@@ -187,3 +187,23 @@ def test_bad_arguments_are_refused() -> None:
         friction_response(fs, (1.28, 1.3), RegularisationOptions(harmonics=32), continuation=0.1)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="`harmonics`"):
         RegularisationOptions(harmonics=0)
+
+
+def test_bifurcation_labels_follow_stability_and_switching_pattern(sticking: FrictionResponse) -> None:
+    """Every change of stability between matched rows carries its kind; every change of an
+    element's stick phases or crossings without one is a grazing label; nothing else is labelled."""
+    r = sticking
+    m = np.flatnonzero(r.matched)
+    assert r.pattern is not None and np.all(r.pattern[m] >= 0)
+    k = len(r.element_names)
+    want: dict[int, set[str]] = {}
+    for i, j in zip(m, m[1:]):
+        if r.stable[i] != r.stable[j]:
+            want[int(j)] = {"fold", "period_doubling", "neimark_sacker"}
+        elif np.any(r.pattern[i, :k] != r.pattern[j, :k]):
+            want[int(j)] = {"grazing_sliding"}
+        elif np.any(r.pattern[i, k:] != r.pattern[j, k:]):
+            want[int(j)] = {"grazing"}
+    labels = r.bifurcation
+    assert {int(i) for i in np.flatnonzero(labels != "")} == set(want)
+    assert all(labels[i] in kinds for i, kinds in want.items())

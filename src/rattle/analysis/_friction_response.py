@@ -53,6 +53,7 @@ from ..hb import HBOptions, RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionResponse
 from ..timeint import FrictionIntegrator, shoot_friction_orbit
+from ..timeint._friction_chain import CROSSING, STICK
 from ._nonsmooth import RegularisationOptions
 from ._regularisation import RegularisationLimit, regularisation_limit
 
@@ -223,6 +224,7 @@ def friction_response(
     rms, mean, stick = (np.full((P, m), np.nan) for _ in range(3))
     mult, mult_hb = np.full((P, 2 * n), np.nan + 0j), np.full((P, 2 * n), np.nan + 0j)
     matched, dist_all = np.zeros(P, dtype=bool), np.full(P, np.nan)
+    pattern = np.full((P, 2 * m), -1, dtype=np.int64)
     for i, pt in enumerate(points):
         w, q = float(pt.omega), pt.q
         rms_hb[i] = problem.element_rms(q)
@@ -258,6 +260,10 @@ def friction_response(
             assert traj is not None
             mean[i], rms[i] = traj.element_mean_and_rms()
             stick[i] = traj.stick_time() / (2.0 * math.pi / w)
+            for e in range(m):  # the switching pattern: stick phases and breakpoint crossings per period
+                mine = traj.event_elements == e
+                pattern[i, e] = int(np.sum(mine & (traj.event_kinds == STICK)))
+                pattern[i, m + e] = int(np.sum(mine & (traj.event_kinds == CROSSING)))
             mult[i] = _multipliers(traj.sensitivity)
             if mu_hb is None:
                 mu_hb = mult[i]
@@ -306,7 +312,7 @@ def friction_response(
         limit_harmonics=np.array(lim_H, dtype=int), limit_rms=np.array(lim_rms, dtype=float).reshape(-1, m),
         limit_richardson=np.array(lim_rich, dtype=float).reshape(-1, m),
         limit_linear=np.array(lim_lin, dtype=bool),
-        limit_multipliers=np.array(lim_mu, dtype=complex).reshape(-1, 2 * n),
+        limit_multipliers=np.array(lim_mu, dtype=complex).reshape(-1, 2 * n), pattern=pattern,
     )
 
 

@@ -53,7 +53,8 @@ class FrictionResponse:
     the HB rms there, ``limit_richardson`` (k, m) Richardson's ε → 0 value, ``limit_linear``
     whether the last three rungs lie on a line in ε for every element (Richardson's value then
     holds), ``limit_multipliers`` (k, 2n) the multipliers of the HB orbit at the smallest ε
-    (:attr:`stable_hb_limit`)."""
+    (:attr:`stable_hb_limit`). ``pattern`` (P, 2m): the exact orbit's stick phases (columns 0 … m−1)
+    and breakpoint crossings (m … 2m−1) per period of every element, −1 where not matched."""
 
     omega: FloatArray
     rpm: FloatArray | None
@@ -79,6 +80,7 @@ class FrictionResponse:
     limit_richardson: FloatArray
     limit_linear: np.ndarray
     limit_multipliers: ComplexArray | None = None
+    pattern: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -164,12 +166,24 @@ class FrictionResponse:
 
     @property
     def bifurcation(self) -> np.ndarray:
-        """The kind of stability change at each row against the previous matched row ("" none)."""
+        """The bifurcation between each row and the previous matched row ("" none): a change of
+        stability by its kind (``fold``, ``period_doubling``, ``neimark_sacker``), else a change of
+        the exact orbit's switching pattern (:attr:`pattern`), a discontinuity-induced bifurcation:
+        ``grazing_sliding`` where an element's stick phase appears or vanishes, ``grazing`` where a
+        pair of its breakpoint crossings does."""
         out = np.full(len(self), "", dtype=object)
+        pat = self.pattern
+        m = len(self.element_names)
         prev = None
         for i in np.flatnonzero(self.matched):
-            if prev is not None and bool(self.stable[i]) != bool(self.stable[prev]):
-                out[i] = classify_loss(self.multipliers[prev], self.multipliers[i])
+            if prev is not None:
+                if bool(self.stable[i]) != bool(self.stable[prev]):
+                    out[i] = classify_loss(self.multipliers[prev], self.multipliers[i])
+                elif pat is not None and min(pat[i].min(), pat[prev].min()) >= 0:
+                    if np.any(pat[i, :m] != pat[prev, :m]):
+                        out[i] = "grazing_sliding"
+                    elif np.any(pat[i, m:] != pat[prev, m:]):
+                        out[i] = "grazing"
             prev = i
         return out
 
