@@ -35,7 +35,8 @@ def test_the_example_as_stated_on_its_period_doubling_range():
                                                                         refine=cfg.analysis.refine or None))
     assert result.status.success and np.all(result.matched)
     labels = result.bifurcation
-    found = sorted((str(labels[i]), float(result.omega[i])) for i in range(len(result)) if labels[i])
+    found = sorted((str(labels[i]), float(result.omega[i])) for i in range(len(result))
+                   if labels[i] in ("fold", "period_doubling", "neimark_sacker"))  # not the grazings
     stated = sorted((k, lo, hi) for k, lo, hi in _stated_changes(EXAMPLES / NAME) if omega[0] < lo and hi < omega[1])
     assert [k for k, _ in found] == [k for k, _, _ in stated] == ["period_doubling"] * 4, (found, stated)
     for (_, w), (_, lo, hi) in zip(sorted(found, key=lambda x: x[1]), sorted(stated, key=lambda x: x[1])):
