@@ -54,8 +54,11 @@ from ..model import FrictionSystem
 from ..results import FrictionResponse
 from ..timeint import FrictionIntegrator, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, STICK
-from ._nonsmooth import RegularisationOptions
-from ._regularisation import RegularisationLimit, regularisation_limit
+from ._regularisation import (
+    RegularisationLimit,
+    RegularisationOptions,
+    regularisation_limit,
+)
 
 #: Samples per period on which the exact and the HB orbits are compared.
 MATCH_SAMPLES = 64

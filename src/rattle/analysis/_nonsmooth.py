@@ -33,12 +33,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
 from .._typing import FloatArray
-from .._validate import check_int, check_positive, check_range
+from .._validate import check_range
 from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
@@ -46,7 +45,11 @@ from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
-from ._regularisation import RegularisationLimit, regularisation_limit
+from ._regularisation import (
+    RegularisationLimit,
+    RegularisationOptions,
+    regularisation_limit,
+)
 
 
 def _rms(q: FloatArray, H: int) -> float:
@@ -96,60 +99,6 @@ def balance_factory(system: NonsmoothSystem) -> Callable[[float, int], Regularis
                                   length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
 
     return make
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class RegularisationOptions:
-    """Settings of :func:`nonsmooth_response`.
-
-    ``harmonics`` H and ``regularisation`` ε of the HB (relative widths of the smooth steps);
-    ``match``: the largest departure of the exact orbit's δ(t) from the HB's, relative to the HB
-    orbit's peak-to-peak, for the two to count as one orbit. The regularisation is continued from
-    ε down to ``limit_eps`` (harmonics raised up to ``limit_harmonics``;
-    :func:`~rattle.analysis._regularisation.regularisation_limit`) at ``limit`` matched rows evenly
-    spread, and at every matched row whose HB rms differs from the exact one by more than
-    ``refine`` (relative; None: none); its last and Richardson rms are kept beside the exact one.
-    Where such a row is still off by more than ``refine`` at ``limit_eps`` and the ladder's last
-    rungs are not yet linear in ε (Richardson's value not yet to be trusted), the ladder goes on
-    down to ``deep_eps`` (e.g. 1e-4) with up to ``deep_harmonics`` harmonics; None (default): it
-    stops at ``limit_eps``. That costs 20–45 s a row at H = 512 (measured in docs/nonsmooth.md).
-    ``stability``: how the HB orbit's own multipliers are found: ``"saltation"`` (default) the
-    non-smooth monodromy of one period of the exact flow from the HB orbit's state, saltation
-    matrices included; ``"regularised"`` the smooth monodromy of the regularised equation along
-    the HB orbit (near a slow crossing of a jump the smoothing misjudges it: measured in
-    docs/nonsmooth.md).
-    """
-
-    harmonics: int = 128
-    regularisation: float = 0.01
-    match: float = 0.1
-    limit: int = 0
-    limit_eps: float = 1e-3
-    limit_harmonics: int = 256
-    refine: float | None = 0.005
-    deep_eps: float | None = None
-    deep_harmonics: int = 512
-    stability: str = "saltation"
-
-    def __post_init__(self) -> None:
-        for name in ("harmonics", "limit_harmonics", "deep_harmonics"):
-            object.__setattr__(self, name, check_int(name, getattr(self, name), 1))
-            try:
-                HBOptions(harmonics=getattr(self, name))  # its bounds
-            except ValueError as exc:
-                raise ValueError(str(exc).replace("`harmonics`", f"`{name}`", 1)) from None
-        for name in ("regularisation", "match", "limit_eps"):
-            object.__setattr__(self, name, check_positive(getattr(self, name), name))
-        if self.regularisation >= 1.0:
-            raise ValueError(f"`regularisation` (relative width ε of the smooth steps) must be < 1, "
-                             f"got {self.regularisation!r}; use 0.01")
-        object.__setattr__(self, "limit", check_int("limit", self.limit, 0))
-        if self.refine is not None:
-            object.__setattr__(self, "refine", check_positive(self.refine, "refine"))
-        if self.deep_eps is not None:
-            object.__setattr__(self, "deep_eps", check_positive(self.deep_eps, "deep_eps"))
-        if self.stability not in ("saltation", "regularised"):
-            raise ValueError(f"`stability` must be 'saltation' or 'regularised', got {self.stability!r}")
 
 
 def nonsmooth_response(
