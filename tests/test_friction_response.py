@@ -207,3 +207,13 @@ def test_bifurcation_labels_follow_stability_and_switching_pattern(sticking: Fri
     labels = r.bifurcation
     assert {int(i) for i in np.flatnonzero(labels != "")} == set(want)
     assert all(labels[i] in kinds for i, kinds in want.items())
+
+
+def test_a_start_where_newton_fails_from_the_linear_solution_uses_the_exact_orbit() -> None:
+    """At Ω_min = 1.52232 neither plain nor damped Newton converges from the linearised chain's
+    solution (ε = 0.1 and 0.3); the start then takes the spectrum of the exact orbit (simulated
+    and shot) and narrows ε from there: the branch starts, and its first row matches."""
+    fs = _chain(STICK, 0.1).friction_system()
+    res = friction_response(fs, (1.52232, 1.53), RegularisationOptions(harmonics=64, refine=None))
+    assert len(res) >= 2 and res.omega[0] == pytest.approx(1.52232) and res.matched[0]
+    assert np.abs(res.element_rms_error[0]).max() < 0.03

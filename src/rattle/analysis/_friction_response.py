@@ -9,7 +9,8 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    (:class:`~rattle.continuation.ContinuationStepper`) from a solution at Ω_min found by a
    homotopy in ε from wide steps (ε = 0.1, started from the linearised chain's steady state,
    :meth:`~rattle.hb.RegularisedSystemBalance.linear_solution`, by Newton, and by Newton with
-   step halving where that wanders);
+   step halving where that wanders; last, from the spectrum of the exact orbit simulated and shot
+   from the linear solution's state);
 2. every continuation point is checked against the exact flow: Newton shooting on the
    event-driven integrator (:func:`~rattle.timeint.shoot_friction_orbit`: crossings and sticking
    exact (Filippov), the monodromy with saltation matrices) from the HB orbit's state at t = 0.
@@ -160,6 +161,32 @@ def _damped_newton(pb: RegularisedSystemBalance, q: FloatArray, omega: float, it
     return q if res <= 1e-10 else None
 
 
+#: Forcing periods simulated from the linear solution before the exact shooting of the start's
+#: fallback (the transient of a lightly damped chain).
+SETTLE_PERIODS = 40
+
+
+def _exact_spectrum(pb: RegularisedSystemBalance, omega: float) -> FloatArray | None:
+    """The start's last fallback: the Fourier series (pb's H) of the exact periodic orbit reached
+    by simulating :data:`SETTLE_PERIODS` periods from the linear solution's state and shooting;
+    None when that fails."""
+    fs: FrictionSystem = pb.fsys
+    integ = FrictionIntegrator(fs)
+    T = 2.0 * math.pi / omega
+    try:
+        z = pb.state_at_zero(pb.linear_solution(omega), omega)
+        for _ in range(SETTLE_PERIODS):
+            z = integ.advance(z, 0.0, T, omega)[0]
+        orbit = shoot_friction_orbit(fs, omega, z, integrator=integ, max_iterations=30)
+    except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None
+    if not orbit.converged:
+        return None
+    N = pb.basis.samples
+    x = orbit.trajectory.sample(np.arange(N) * (T / N))[0][:, : fs.n]
+    return pb.basis.analyze(x.T).reshape(-1)
+
+
 def _start(make: Callable[[float, int], RegularisedSystemBalance], omega: float, eps: float, H: int,
            newton: NewtonOptions | None) -> FloatArray:
     """The HB orbit at Ω_min and ε: from the linear solution at wide steps (ε = 0.1, else 0.3;
@@ -179,6 +206,13 @@ def _start(make: Callable[[float, int], RegularisedSystemBalance], omega: float,
                 if q_damped is None:
                     break
                 q0 = q_damped
+    q_exact = _exact_spectrum(make(max(0.1, eps), H), omega)
+    if q_exact is not None:  # the exact orbit's spectrum as the start, narrowed from wide steps
+        try:
+            return regularisation_limit(make, omega, q_exact, eps_start=max(0.1, eps), eps_min=eps, harmonics=H,
+                                        max_harmonics=H, tail_tol=math.inf, newton=newton).last.q
+        except RattleError as exc:
+            last = exc
     raise ConvergenceError(f"no regularised orbit found at Ω_min = {omega:g} (ε from 0.3 down to {eps:g}, "
                            f"H = {H}): {last}; start `omega` elsewhere or raise `regularisation`")
 
