@@ -9,7 +9,7 @@ is within 0.5 % of the exact one at ε and after the ε-ladder (rows off by more
 down to ε = 1e-3; Richardson where linear), stability agreement (exact saltation monodromy of the
 exact orbit vs that of one period of exact flow from the HB state), rows that stick, time.
 
-Run:  OMP_NUM_THREADS=1 python benchmarks/bench_friction_chain.py [--harmonics 64 128] [--no-refine] [--lo 0.4]
+Run:  OMP_NUM_THREADS=1 python benchmarks/bench_friction_chain.py [--harmonics 64 128] [--no-refine] [--lo 0.4] [--eps 0.001]
 
 Measured 2026-12-01 (2 cores shared with other jobs, two runs at a time: times are upper bounds):
 
@@ -53,12 +53,13 @@ def main() -> None:
     ap.add_argument("--no-refine", action="store_true")
     ap.add_argument("--lo", type=float, default=0.2)
     ap.add_argument("--hi", type=float, default=2.0)
+    ap.add_argument("--eps", type=float, default=0.01)
     args = ap.parse_args()
     fs = chain().friction_system()
     wn = fs.frequency_scale()
-    print(f"chain: 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = 0.01")
+    print(f"chain: 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = {args.eps:g}")
     for H in args.harmonics:
-        opts = RegularisationOptions(harmonics=H, regularisation=0.01, refine=None if args.no_refine else 0.005,
+        opts = RegularisationOptions(harmonics=H, regularisation=args.eps, refine=None if args.no_refine else 0.005,
                                      limit_harmonics=H)
         t0 = time.perf_counter()
         r = friction_response(fs, (args.lo * wn, args.hi * wn), opts)
@@ -71,7 +72,7 @@ def main() -> None:
         sticks = np.nan_to_num(r.stick_fraction).max(axis=1) > 0
         print(f"H = {H}: {len(r)} rows, matched {int(m.sum())} ({m.mean():.1%}), status {r.status.name}, {dt:.1f} s "
               f"({dt / max(len(r), 1) * 1e3:.0f} ms/row)")
-        print(f"  HB at ε = 0.01 within 0.5 %: {np.mean(err <= 0.005):.1%} of matched "
+        print(f"  HB at ε = {args.eps:g} within 0.5 %: {np.mean(err <= 0.005):.1%} of matched "
               f"(median {np.median(err):.2%}, max {np.max(err):.2%})")
         if r.limit_index.size:
             print(f"  refined {r.limit_index.size} rows (ε → {np.nanmin(r.limit_eps):g}); HB ε→0 estimate within 0.5 %: "
