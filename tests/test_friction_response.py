@@ -217,3 +217,13 @@ def test_a_start_where_newton_fails_from_the_linear_solution_uses_the_exact_orbi
     res = friction_response(fs, (1.52232, 1.53), RegularisationOptions(harmonics=64, refine=None))
     assert len(res) >= 2 and res.omega[0] == pytest.approx(1.52232) and res.matched[0]
     assert np.abs(res.element_rms_error[0]).max() < 0.03
+
+
+def test_without_options_a_chain_is_solved_at_its_own_default_regularisation() -> None:
+    """options None: ε = 0.001 (a chain's velocity width is ~10× the single equation's at equal
+    ε); the slipping branch is then within 0.5 % at ε on every row."""
+    from rattle.analysis._friction_response import CHAIN_REGULARISATION
+
+    r = friction_response(_chain(SLIP, 0.2).friction_system(), (1.28, 1.281), continuation=WIDE)
+    assert r.regularisation == CHAIN_REGULARISATION == 0.001
+    assert np.all(r.matched) and np.abs(r.element_rms_error).max() <= 0.005

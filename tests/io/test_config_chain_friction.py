@@ -55,7 +55,7 @@ def test_friction_on_an_element_makes_the_chain_a_friction_system(friction, leve
     assert rc.bounds_model is rc.continuous_model
     assert rc.model.system.n == rc.continuous_model.system().n == 2
     # the settings of a discontinuous law: the regularised HB's defaults
-    assert (rc.analysis.harmonics, rc.analysis.regularisation, rc.analysis.refine) == (128, 0.01, 0.005)
+    assert (rc.analysis.harmonics, rc.analysis.regularisation, rc.analysis.refine) == (128, 0.001, 0.005)
 
 
 def test_zero_friction_is_the_smooth_chain():
@@ -165,7 +165,7 @@ def test_load_case_solves_a_chain_with_friction_by_frequency_response_only(tmp_p
     case = load_case(path)
     assert case.discontinuous and isinstance(case.model, FrictionSystem)
     opts = case.regularisation_options()
-    assert (opts.harmonics, opts.regularisation, opts.refine) == (128, 0.01, 0.005)
+    assert (opts.harmonics, opts.regularisation, opts.refine) == (128, 0.001, 0.005)
     with pytest.raises(TypeError, match="chain with friction"):
         case.periodic_orbit(1.0)
     with pytest.raises(TypeError, match="use `frequency_response\\(\\)`$"):
