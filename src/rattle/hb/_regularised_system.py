@@ -51,7 +51,14 @@ from .._typing import FloatArray
 from ..model import FrictionSystem
 from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions
-from ._residual import product_jacobians, product_tables
+from ._residual import (
+    check_forced_harmonics,
+    forcing_with_load,
+    load_slope,
+    product_jacobians,
+    product_tables,
+    system_forcing,
+)
 
 _gesv = scipy.linalg.lapack.dgesv
 
@@ -86,13 +93,8 @@ class RegularisedSystemBalance:
             raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
         period = int(period)
         system = fsys.system
-        n_forced = system.forced_harmonics
         H = options.harmonics
-        if H < n_forced * period:
-            raise ValueError(
-                f"`harmonics` must be >= {n_forced * period} to hold the excitation's harmonic {n_forced} at "
-                f"period {period} (harmonic {n_forced}×{period} of the base frequency), got {H}"
-            )
+        check_forced_harmonics(system, H, period)
         L, wn = float(fsys.length_scale()), float(fsys.frequency_scale())
         if not (np.isfinite(L) and L > 0 and np.isfinite(wn) and wn > 0):
             raise ValueError(f"`fsys` must have a finite length scale > 0 and natural frequency > 0, got "
@@ -108,14 +110,7 @@ class RegularisedSystemBalance:
         n, m = system.n, system.m
         self.n_coordinates, self.n_elements = n, m
         self._S = S
-        # Forcing coefficients (as HarmonicBalance): F_0 at a_0, harmonic h of Ω at harmonic h·p.
-        F = np.zeros((n, S))
-        F[:, 0] = system.mean
-        for h in range(1, n_forced + 1):
-            r = h * period
-            F[:, r] += system.cos[h - 1]
-            F[:, H + r] += system.sin[h - 1]
-        self.forcing = F.reshape(-1)
+        self.forcing = system_forcing(system, H, period)
         self._load = system.load
         self._a0 = np.arange(n) * S
         self._force_scale = float(system.force_scale())
@@ -255,11 +250,7 @@ class RegularisedSystemBalance:
     # --- residual ------------------------------------------------------------------------------
     def _forcing_at(self, omega: float) -> FloatArray:
         """The forcing coefficients at Ω: :attr:`forcing` plus the load's d(Ω) u at the a_0 slots."""
-        if self._load is None:
-            return self.forcing
-        F = self.forcing.copy()
-        F[self._a0] += float(self._load.value(omega)) * self._load.direction
-        return F
+        return forcing_with_load(self.forcing, self._load, self._a0, omega)
 
     def _derivative(self, X: FloatArray, w: float) -> FloatArray:
         """∇(ω) applied to every row of the series X (r, S)."""
@@ -324,10 +315,7 @@ class RegularisedSystemBalance:
         D1Q = self._derivative(Q, 1.0)
         vel1 = self.basis.synthesize(self._A @ D1Q)  # ℰ ∇(1) (a_e·Q), (m, N)
         Rw = self._derivative(D1Q, 2.0 * w) + self._C @ D1Q + self._B @ self.basis.analyze(gv * vel1)
-        Rw = Rw.reshape(-1) / self.period
-        if self._load is not None:
-            Rw[self._a0] -= self._load.slope(float(omega)) * self._load.direction
-        return R, J, Rw
+        return R, J, load_slope(Rw.reshape(-1) / self.period, self._load, self._a0, omega)
 
     def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
         """R(q, Ω) and the Newton increment dq = −(∂R/∂q)⁻¹ R (None when ∂R/∂q is singular)."""

@@ -25,6 +25,8 @@ b = [K/I]); it runs through the same code and gives the same numbers as the scal
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.linalg
 
@@ -32,6 +34,9 @@ from .._typing import FloatArray
 from . import _kernels
 from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions
+
+if TYPE_CHECKING:
+    from ..model import SpeedLoad, System
 
 _gesv = scipy.linalg.lapack.dgesv
 
@@ -93,6 +98,47 @@ def product_jacobians(spec: np.ndarray, samples: int, tables: tuple[FloatArray, 
     return J
 
 
+def check_forced_harmonics(system: System, harmonics: int, period: int) -> None:
+    """Refuse ``harmonics`` too few to hold the excitation's highest harmonic at ``period``."""
+    n_forced = system.forced_harmonics
+    if harmonics < n_forced * period:
+        raise ValueError(
+            f"`harmonics` must be >= {n_forced * period} to hold the excitation's harmonic "
+            f"{n_forced} at period {period} (harmonic {n_forced}×{period} of the base "
+            f"frequency), got {harmonics}"
+        )
+
+
+def system_forcing(system: System, harmonics: int, period: int) -> FloatArray:
+    """The forcing coefficients of ``system``, flat (n·(2H+1),), coordinate-major: F_0 at a_0,
+    harmonic h of Ω (F_ch cos + F_sh sin) at harmonic h·p of the base frequency."""
+    H, S = harmonics, 2 * harmonics + 1
+    F = np.zeros((system.n, S))
+    F[:, 0] = system.mean
+    for h in range(1, system.forced_harmonics + 1):
+        r = h * period
+        F[:, r] += system.cos[h - 1]
+        F[:, H + r] += system.sin[h - 1]
+    return F.reshape(-1)
+
+
+def forcing_with_load(forcing: FloatArray, load: SpeedLoad | None, a0: np.ndarray, omega: float) -> FloatArray:
+    """``forcing`` plus a speed-dependent mean load's d(Ω) u at the a_0 slots ``a0`` (``forcing``
+    itself without a load)."""
+    if load is None:
+        return forcing
+    F = forcing.copy()
+    F[a0] += float(load.value(omega)) * load.direction
+    return F
+
+
+def load_slope(Rw: FloatArray, load: SpeedLoad | None, a0: np.ndarray, omega: float) -> FloatArray:
+    """∂R/∂Ω gains −d'(Ω) u at the a_0 slots (in place; returned)."""
+    if load is not None:
+        Rw[a0] -= load.slope(float(omega)) * load.direction
+    return Rw
+
+
 class HarmonicBalance:
     """The discretised problem R(q, Ω) = 0 for one model, harmonic count and period multiple.
 
@@ -106,13 +152,7 @@ class HarmonicBalance:
         if isinstance(period, bool) or not isinstance(period, int) or period < 1:
             raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
         system = model.system()
-        n_forced = system.forced_harmonics
-        if options.harmonics < n_forced * period:
-            raise ValueError(
-                f"`harmonics` must be >= {n_forced * period} to hold the excitation's harmonic "
-                f"{n_forced} at period {period} (harmonic {n_forced}×{period} of the base "
-                f"frequency), got {options.harmonics}"
-            )
+        check_forced_harmonics(system, options.harmonics, period)
         self.model = model
         self.system = system
         self.options = options
@@ -127,14 +167,7 @@ class HarmonicBalance:
         self._k2 = self.basis.k**2
         self.length_scale = system.length_scale()
         self.force_scale = system.force_scale()
-        # Forcing coefficients: F_0 at a_0, harmonic h of Ω (F_ch cos + F_sh sin) at harmonic h·p.
-        F = np.zeros((n, S))
-        F[:, 0] = system.mean
-        for h in range(1, n_forced + 1):
-            r = h * period
-            F[:, r] += system.cos[h - 1]
-            F[:, H + r] += system.sin[h - 1]
-        self.forcing = F.reshape(-1)  # flat (n·(2H+1),); analyses may rescale it (homotopy)
+        self.forcing = system_forcing(system, H, period)  # flat (n·(2H+1),); analyses may rescale it (homotopy)
         # A speed-dependent mean load (drag by speed): d(Ω) u joins the a_0 terms of the forcing,
         # −d'(Ω) u the Ω-derivative of the residual (``_load_at``); the homotopy leaves it alone.
         self._load = system.load
@@ -424,17 +457,11 @@ class HarmonicBalance:
 
     def _forcing_at(self, omega: float) -> FloatArray:
         """The forcing coefficients at Ω: :attr:`forcing` plus the load's d(Ω) u at the a_0 slots."""
-        if self._load is None:
-            return self.forcing
-        F = self.forcing.copy()
-        F[self._a0] += float(self._load.value(omega)) * self._load.direction
-        return F
+        return forcing_with_load(self.forcing, self._load, self._a0, omega)
 
     def _load_slope(self, Rw: FloatArray, omega: float) -> FloatArray:
         """∂R/∂Ω gains −d'(Ω) u at the a_0 slots (in place; returned)."""
-        if self._load is not None:
-            Rw[self._a0] -= self._load.slope(float(omega)) * self._load.direction
-        return Rw
+        return load_slope(Rw, self._load, self._a0, omega)
 
     def residual_jacobian(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """R (n·S,), ∂R/∂q (n·S, n·S) and ∂R/∂Ω (n·S,) in one AFT pass (S = 2H+1)."""
