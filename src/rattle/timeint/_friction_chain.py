@@ -217,8 +217,8 @@ class FrictionIntegrator:
         self._modal: dict = {}
         self._omega: float | None = None
         self._flows: dict = {}
-        self._vscale: dict = {}
-        self._vscale_now = 1.0
+        self._L = float(system.length_scale())  # fixed scales: the event tolerances and grid read them
+        self._wn = float(system.frequency_scale())
 
     # --- modes ----------------------------------------------------------------------------------
     def _mode_system(self, key: _Key, omega: float) -> System:
@@ -255,12 +255,8 @@ class FrictionIntegrator:
         """The event grid's step: the fastest time scale of the forcing (its highest harmonic) and
         of the free chain (its highest natural frequency), over ``samples_per_scale`` — a stuck
         mode's own time scale can be far longer than that of the torque that must hold it."""
-        key = ("step", float(omega))
-        step = self._vscale.get(key)
-        if step is None:
-            fast = max(float(omega) * max(self.base.forced_harmonics, 1), self.fsys.frequency_scale())
-            step = self._vscale[key] = 2.0 * math.pi / fast / self.options.samples_per_scale
-        return step
+        fast = max(float(omega) * max(self.base.forced_harmonics, 1), self._wn)
+        return 2.0 * math.pi / fast / self.options.samples_per_scale
 
     @staticmethod
     def _solution(flow: SystemStages, key: _Key, stages: tuple[int, ...]) -> StageSolution:
@@ -282,7 +278,7 @@ class FrictionIntegrator:
 
     def velocity_scale(self, omega: float) -> float:
         """L max(Ω, ω_n): the velocity scale of the event tolerances and the shooting residual."""
-        return self.fsys.length_scale() * max(float(omega), self.fsys.frequency_scale())
+        return self._L * max(float(omega), self._wn)
 
     def _free_acceleration(self, key: _Key, stages: tuple[int, ...], t: FloatArray | float, z: FloatArray,
                            omega: float) -> FloatArray:
@@ -355,7 +351,6 @@ class FrictionIntegrator:
         sensitivity ∂z(t1)/∂z(t0)."""
         z = check_system_state(z0, self.n)
         omega = check_omega(omega)
-        self._vscale_now = self.velocity_scale(omega)
         t0, t1 = float(t0), float(t1)
         if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
             raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
@@ -372,7 +367,6 @@ class FrictionIntegrator:
 
     def advance(self, z0: FloatArray, t0: float, t1: float, omega: float) -> tuple[FloatArray, FloatArray]:
         """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path)."""
-        self._vscale_now = self.velocity_scale(omega)
         return self._march(np.asarray(z0, dtype=float).copy(), float(t0), float(t1), float(omega), None)
 
     def _march(self, z: FloatArray, t0: float, t1: float, omega: float,
@@ -493,18 +487,9 @@ class FrictionIntegrator:
         step = min(sol.grid_step, self._base_step(omega))
         r_S = np.array([self.levels[e][stages[e]] for e in S])
         if S:
-            AS, BS = self.A[S], self.B[:, S]
-            Lmat = np.linalg.solve(AS @ BS, AS)
-            base = self.base
-            const = base.stage_offset(stages).copy()
-            for e in range(m):
-                if sigma[e]:
-                    const += sigma[e] * self.levels[e][stages[e]] * self.B[:, e]
-            Ks = base.stage_stiffness(stages)
 
             def lam_at(taus: FloatArray, z: FloatArray) -> FloatArray:
-                y = base.forcing(seg.ts + taus, omega) - z[:, n:] @ base.damping.T - z[:, :n] @ Ks.T - const
-                return y @ Lmat.T
+                return self._lambdas(S, self._free_acceleration(key, stages, seg.ts + taus, z, omega))
         sl = np.array(slip, dtype=np.intp)
         sg = np.array([sigma[e] for e in slip], dtype=float)
         tau_a = 0.0
@@ -563,7 +548,7 @@ class FrictionIntegrator:
         def acc(tau: float) -> float:
             return s * seg.element_point(tau, e)[2]
 
-        floor = 64.0 * _EPS * max(float(np.max(np.abs(sv))), self._vscale_now)
+        floor = 64.0 * _EPS * max(float(np.max(np.abs(sv))), self.velocity_scale(seg.sol.flow.omega))
         for i in range(1, taus.size):
             lo_v, hi_v = float(sv[i - 1]), float(sv[i])
             if hi_v <= 0.0:
