@@ -91,14 +91,22 @@ def _multipliers(M: FloatArray) -> np.ndarray:
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
-def _hb_multipliers(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> np.ndarray | None:
-    """The HB orbit's 2n multipliers, largest modulus first: the non-smooth monodromy (saltation
-    matrices at every switching) of one period of the exact flow from its state ``z0`` at t = 0;
-    None when that flow cannot be followed (the event budget, a loop of stuck elements)."""
+def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
+    """One period of the exact flow from the HB orbit's state ``z0`` at t = 0; None when it cannot
+    be followed (the event budget, a loop of stuck elements)."""
     try:
-        mu = _multipliers(integ.propagate(z0, 0.0, 2.0 * math.pi / omega, omega).sensitivity)
+        return integ.propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
     except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
         return None
+
+
+def _hb_multipliers(flow: FrictionTrajectory | None) -> np.ndarray | None:
+    """The HB orbit's 2n multipliers, largest modulus first: the non-smooth monodromy (saltation
+    matrices at every switching) of one period of the exact flow from its state (:func:`_hb_flow`);
+    None without that flow."""
+    if flow is None:
+        return None
+    mu = _multipliers(flow.sensitivity)
     return mu if np.all(np.isfinite(mu)) else None
 
 
@@ -107,18 +115,16 @@ def _hb_multipliers(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> 
 HOLD_FRACTION = 0.9
 
 
-def _held_elements(integ: FrictionIntegrator, z0: FloatArray, omega: float, E: FloatArray) -> dict[int, float]:
-    """{element: the HB's mean deflection} of the elements that stick at least
-    :data:`HOLD_FRACTION` of one period of the exact flow from the HB state ``z0``. Where an
+def _held_elements(flow: FrictionTrajectory | None, E: FloatArray) -> dict[int, float]:
+    """{element: the HB's mean deflection (row of the element series ``E``)} of the elements that
+    stick at least :data:`HOLD_FRACTION` of the period on ``flow`` (:func:`_hb_flow`). Where an
     element sticks the whole period the exact periodic orbits form a family (its stuck deflection
     is free within the friction band; a multiplier 1): the regularised HB picks one member by its
     creep balance, and the exact orbit checked against it is the member with the same stuck
     deflection (:func:`~rattle.timeint.shoot_friction_orbit` ``hold``)."""
-    T = 2.0 * math.pi / omega
-    try:
-        frac = integ.propagate(z0, 0.0, T, omega).stick_time() / T
-    except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+    if flow is None:
         return {}
+    frac = flow.stick_time() / (flow.t1 - flow.t0)
     return {int(e): float(E[e][0]) for e in np.flatnonzero(frac >= HOLD_FRACTION)}
 
 
@@ -288,7 +294,8 @@ def friction_response(
         w, q = float(pt.omega), pt.q
         rms_hb[i] = problem.element_rms(q)
         z0 = problem.state_at_zero(q, w)
-        mu_hb = _hb_multipliers(integ, z0, w)
+        hb_flow = _hb_flow(integ, z0, w)
+        mu_hb = _hb_multipliers(hb_flow)
         try:
             orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30)
         except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
@@ -303,7 +310,7 @@ def friction_response(
             dist_all[i] = float(np.max(np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size))
             matched[i] = dist_all[i] <= match
         if not matched[i]:  # an element stuck (nearly) the whole period: a family of exact orbits
-            held = _held_elements(integ, z0, w, E)
+            held = _held_elements(hb_flow, E)
             if held:
                 try:
                     orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30, hold=held)
@@ -356,7 +363,7 @@ def friction_response(
             lim_rich.append(lad.extrapolated_element_rms)
             lim_lin.append(lad.linear)
             w = float(points[i].omega)
-            mu_lim = _hb_multipliers(integ, make(lad.last.eps, lad.last.harmonics).state_at_zero(lad.last.q, w), w)
+            mu_lim = _hb_multipliers(_hb_flow(integ, make(lad.last.eps, lad.last.harmonics).state_at_zero(lad.last.q, w), w))
             lim_mu.append(np.full(2 * n, np.nan + 0j) if mu_lim is None else mu_lim)
         except RattleError:  # the ladder stalled: the row keeps its ε
             lim_eps.append(math.nan)
