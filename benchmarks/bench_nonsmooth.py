@@ -26,7 +26,8 @@ from rattle.analysis._regularisation import regularisation_limit
 from rattle.hb import HBOptions
 from rattle.hb._regularised import RegularisedBalance
 from rattle.model import Excitation
-from rattle.model._discontinuous import Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model._discontinuous import Friction, NonsmoothLaw, Preload
+from rattle.model._nonsmooth_system import NonsmoothSystem
 from rattle.timeint._nonsmooth import NonsmoothIntegrator, shoot_nonsmooth_orbit
 
 C, FM, FP, PHASE = 0.05, 0.01, 0.3, 0.3

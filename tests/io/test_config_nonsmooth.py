@@ -12,7 +12,8 @@ import pytest
 from rattle.errors import ConfigError
 from rattle.io import config_from_dict
 from rattle.model import Model
-from rattle.model._discontinuous import NonsmoothSystem, Preload
+from rattle.model._discontinuous import Preload
+from rattle.model._nonsmooth_system import NonsmoothSystem
 
 
 def _base(elastic: dict, **analysis: object) -> dict:

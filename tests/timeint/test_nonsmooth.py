@@ -20,10 +20,10 @@ from rattle.model import Clutch, Excitation, Linear, Model, Piecewise, reference
 from rattle.model._discontinuous import (
     Friction,
     NonsmoothLaw,
-    NonsmoothSystem,
     PiecewiseJump,
     Preload,
 )
+from rattle.model._nonsmooth_system import NonsmoothSystem
 from rattle.timeint import ExactIntegrator
 from rattle.timeint._nonsmooth import (
     NonsmoothIntegrator,

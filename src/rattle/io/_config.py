@@ -46,10 +46,11 @@ from .. import _limits
 from ..errors import ConfigError
 from ..files._read import read_toml
 from ..model import Model, check_analysable_model
-from ..model._discontinuous import NonsmoothSystem, Preload
+from ..model._discontinuous import Preload
 from ..model._elastic import _check_real
 from ..model._engine import forcing_frequency
 from ..model._friction_system import FrictionSystem
+from ..model._nonsmooth_system import NonsmoothSystem
 from ..model._table_checks import (
     _EXAMPLES,
     _Checker,

@@ -1,16 +1,20 @@
-"""Models: elastic laws, excitation and the sub-system equation."""
+"""Models: elastic and discontinuous laws, excitation, the single equation, the chain, and the
+reader of their configuration tables."""
 
+from ._analysable import check_analysable_model
 from ._builders import GearPair, LooseGear, clutch_damper, gear_pair, hub_spline, loose_gear
 from ._chain import Chain, Element, Link, Torque
-from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw, NonsmoothSystem, PiecewiseJump, Preload
+from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw, PiecewiseJump, Preload
 from ._drag import Drag, SpeedLoad
 from ._friction_system import FrictionSystem
 from ._engine import base_order, engine_speed, engine_torque, firing_orders, forcing_frequency
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Backlash, Clutch, Linear, Piecewise, Stages
 from ._excitation import Excitation
-from ._model import Model, check_analysable_model
+from ._model import Model
+from ._nonsmooth_system import NonsmoothSystem
 from ._paths import SoundPath
 from ._system import ReducedElement, System
+from . import _tables  # noqa: F401  (loaded here: registers the reader of Model.from_toml and Chain.from_toml)
 from .library import backlash_case, reference_case
 
 __all__ = [

@@ -16,7 +16,6 @@ A two-inertia free chain with one element is exactly the single equation of SPEC
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ from ._discontinuous import Friction, NonsmoothLaw
 from ._drag import Drag, drag_load
 from ._elastic import AbstractElastic, _check_real, _check_real_sequence
 from ._friction_system import FrictionSystem
+from ._readers import read_tables
 from ._system import ReducedElement, System
 
 #: Relative tolerance of the mean-torque balance of a free chain.
@@ -461,10 +461,7 @@ class Chain:
     def from_toml(cls, path: str | Path) -> Any:
         """Read a SPEC §5 TOML file (``[model] inertias``, ``[[model.links]]``, ``[[model.elements]]``,
         ``[[excitation.torques]]``), as :func:`rattle.io.load_config` reads them."""
-        from ..files._read import read_toml
-        from ._tables import model_tables
-
-        tables = model_tables(read_toml(path), os.fspath(path))
+        tables = read_tables(path)
         return tables.chain if tables.chain is not None else tables.model
 
     def to_dict(self) -> dict[str, object]:

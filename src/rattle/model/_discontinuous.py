@@ -1,6 +1,8 @@
-"""Discontinuous laws: a torque jump (preload) and Coulomb friction (hysteresis), one coordinate.
+"""Discontinuous laws: a torque jump (preload) and Coulomb friction (hysteresis) of one coordinate.
 
-The single equation of SPEC §1 with the law's stiffness scaling (c = C/I, k = K/I),
+The law g of the single equation of SPEC §1 (c = C/I, k = K/I; the equation itself is
+:class:`~rattle.model.NonsmoothSystem`, :mod:`._nonsmooth_system`) and of every element of a chain
+with friction (:mod:`._friction_system`),
 
     δ'' + c δ' + k g(δ, δ') = F(t) = F_m + Σ_n F_pn cos(n Ω t + φ_n),
     g(δ, δ') = f(δ) + r(δ) sgn(δ'),
@@ -32,7 +34,8 @@ Library laws:
   clutch damper whose friction washers act on some stages only).
 - :class:`NonsmoothLaw` — an elastic law (continuous :class:`~rattle.model.AbstractElastic` or one
   of the above) together with its friction: the data the exact integrator reads.
-- :class:`NonsmoothSystem` — the whole equation per unit inertia (c, k, law, excitation).
+
+The laws know no model: this module imports only the continuous laws of :mod:`._elastic`.
 """
 
 from __future__ import annotations
@@ -44,8 +47,6 @@ import numpy as np
 
 from .._typing import FloatArray
 from ._elastic import AbstractElastic, StageLaw, _check_real, _check_real_sequence
-from ._excitation import Excitation
-from ._model import Model
 
 
 @dataclass(frozen=True, slots=True)
@@ -351,65 +352,4 @@ class NonsmoothLaw:
                 "friction": None if self.friction is None else self.friction.to_dict()}
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class NonsmoothSystem:
-    """δ'' + c δ' + k g(δ, δ') = F(t), per unit inertia: ``damping`` c = C/I ≥ 0 (1/s),
-    ``stiffness`` k = K/I > 0 (1/s²), ``law`` g (:class:`NonsmoothLaw`) and ``excitation`` F."""
-
-    damping: float
-    stiffness: float
-    law: NonsmoothLaw
-    excitation: Excitation
-
-    def __post_init__(self) -> None:
-        c = _check_real("damping", self.damping)
-        k = _check_real("stiffness", self.stiffness)
-        if c < 0:
-            raise ValueError(f"`damping` (c = C/I) must be >= 0, got {c!r}")
-        if k <= 0:
-            raise ValueError(f"`stiffness` (k = K/I) must be > 0, got {k!r}")
-        if not isinstance(self.law, NonsmoothLaw):
-            raise TypeError(f"`law` must be a NonsmoothLaw, got {self.law!r}")
-        if not isinstance(self.excitation, Excitation):
-            raise TypeError(f"`excitation` must be an Excitation, got {self.excitation!r}")
-        object.__setattr__(self, "damping", c)
-        object.__setattr__(self, "stiffness", k)
-
-    @classmethod
-    def from_model(cls, model: Model, *, elastic: AbstractElastic | AbstractJumpLaw | None = None,
-                   friction: Friction | None = None) -> NonsmoothSystem:
-        """The model's c, k and excitation with its law (or ``elastic``) and ``friction``."""
-        if not isinstance(model, Model):
-            raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-        law = NonsmoothLaw(elastic=model.elastic if elastic is None else elastic, friction=friction)
-        return cls(damping=model.c, stiffness=model.k, law=law, excitation=model.excitation)
-
-    # The equation's coefficients under the names the exact integrator's stage solutions read.
-    @property
-    def c(self) -> float:
-        return self.damping
-
-    @property
-    def k(self) -> float:
-        return self.stiffness
-
-    def length_scale(self) -> float:
-        """A characteristic angle L (rad): breakpoints, the jumps' and friction's deflections and
-        the quasi-static dynamic amplitude, whichever is largest."""
-        st = self.law.stages
-        s_pos = st.slopes[st.slopes > 0]
-        exc = self.excitation
-        dyn = (abs(exc.mean) + exc.amplitude_scale) / (self.k * float(np.min(s_pos)))
-        bp = float(np.max(np.abs(st.breakpoints))) if st.breakpoints.size else 0.0
-        jump = float(np.sum(st.jumps) + np.max(self.law.friction_levels)) / float(np.min(s_pos))
-        return max(bp, dyn, jump, 1e-300)
-
-    def regularised(self, delta: FloatArray, velocity: FloatArray, width: float,
-                    velocity_width: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """k g_ε and its partials (per unit inertia): the ``RegularisedForce`` of
-        :mod:`rattle.hb._regularised`."""
-        g, gd, gv = self.law.regularised(delta, velocity, width, velocity_width)
-        return self.k * g, self.k * gd, self.k * gv
-
-
-__all__ = ["AbstractJumpLaw", "Friction", "JumpStages", "NonsmoothLaw", "NonsmoothSystem", "PiecewiseJump", "Preload"]
+__all__ = ["AbstractJumpLaw", "Friction", "JumpStages", "NonsmoothLaw", "PiecewiseJump", "Preload"]

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._typing import FloatArray
-from ._discontinuous import NonsmoothLaw
+from ._discontinuous import Friction, NonsmoothLaw
 from ._system import System
 
 
@@ -60,8 +60,6 @@ class FrictionSystem:
     @classmethod
     def from_system(cls, system: System, levels: tuple[object, ...], speed_order: float | None = None) -> FrictionSystem:
         """``system`` with friction ``levels`` per element (None, a number, or one per stage)."""
-        from ._discontinuous import Friction
-
         if len(levels) != system.m:
             raise ValueError(f"`levels` must hold one entry per element ({system.m}), got {len(levels)}")
         laws = tuple(NonsmoothLaw(elastic=el.law, friction=None if r is None else Friction(levels=r))  # type: ignore[arg-type]

@@ -9,16 +9,15 @@ unit-slope stage and f the elastic law (see ``_elastic``).
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from .._limits import check_scales
 from ._elastic import AbstractElastic, _check_real
 from ._excitation import Excitation
+from ._readers import read_tables
 from ._system import System, single_equation_system
 
 
@@ -32,7 +31,7 @@ class Model:
     finite in double precision; see :mod:`rattle._limits`). ``damping`` = 0 is a valid model
     (its motion can be integrated exactly) but the analyses refuse it: an undamped forced system
     has no asymptotically stable periodic orbit (see
-    :func:`check_analysable_model`).
+    :func:`~rattle.model.check_analysable_model`).
     """
 
     inertia: float
@@ -137,10 +136,8 @@ class Model:
         The model tables are read as :func:`rattle.io.load_config` reads them (the same rules and
         messages); ``[analysis]`` and ``[[paths]]`` are the run's and left alone."""
         from ..errors import ConfigError
-        from ..files._read import read_toml
-        from ._tables import model_tables
 
-        tables = model_tables(read_toml(path), os.fspath(path))
+        tables = read_tables(path)
         if tables.chain is not None:  # a chain with friction on its elements: the Chain itself
             return tables.chain  # type: ignore[return-value]
         if tables.discontinuous:
@@ -159,45 +156,4 @@ class Model:
         }
 
 
-def check_analysable_model(model: object, name: str = "model") -> Any:
-    """A model the analyses can treat (:class:`~rattle.model.Model` or
-    :class:`~rattle.model.Chain`): refuse zero damping.
-
-    Zero damping is refused (not handled). An undamped forced piecewise-linear oscillator has
-    an unbounded response at its linear resonances and no asymptotically stable periodic orbit:
-    its Floquet multipliers lie on the unit circle (det M = exp(−c T) = 1), so the stability
-    verdicts, the located special points and the settled periods would all be meaningless, and
-    the linear start solution divides 0 by 0 at resonance. Give a small positive damping
-    instead (ζ = 0.001 … 0.05 is typical of drivetrains). The models themselves accept damping
-    0, so that undamped motions can still be integrated exactly
-    (:class:`~rattle.timeint.ExactIntegrator`). For a chain, a chain with no damping in any
-    link is refused.
-    """
-    from ._chain import Chain
-
-    if isinstance(model, Chain):
-        if not model.has_damping:
-            raise ValueError(
-                f"`{name}.links` must give some damping for an analysis, got none: an undamped forced "
-                "chain has unbounded resonant response and no asymptotically stable periodic orbit "
-                "(Floquet multipliers on the unit circle); give the links a small positive damping"
-            )
-        return model
-    if not isinstance(model, Model):
-        raise TypeError(
-            f"`{name}` must be a rattle Model or Chain (e.g. rattle.reference_case() or Model.from_toml(path)), "
-            f"got {model!r} ({type(model).__name__})"
-        )
-    if model.damping == 0.0:
-        raise ValueError(
-            f"`{name}.damping` must be > 0 for an analysis, got 0.0: an undamped forced system has "
-            "unbounded resonant response and no asymptotically stable periodic orbit (Floquet "
-            "multipliers on the unit circle), so stability and settling verdicts would be meaningless; "
-            "give a small positive damping, e.g. a damping ratio of 0.01 "
-            f"(damping = {0.02 * math.sqrt(model.stiffness * model.inertia):.3g})"
-        )
-    return model
-
-
-
-__all__ = ["Model", "check_analysable_model"]
+__all__ = ["Model"]

@@ -33,7 +33,9 @@ The value rules (positive inertia, increasing breakpoints, 0 <= alpha < 1, …) 
 dataclasses, the single source of truth; this module checks only what they cannot see (the
 table structure, unknown and missing keys, the TOML type of each value) and re-raises their
 errors as :class:`~rattle.errors.ConfigError` with the full key. Every message names the key in
-backticks, shows the value received, states the rule and says the fix. No file is read here.
+backticks, shows the value received, states the rule and says the fix. No file is read here:
+:func:`model_tables` is registered, when this module is loaded, as the reader that
+:meth:`Model.from_toml` and :meth:`Chain.from_toml` call on a file's parsed tables (:mod:`._readers`).
 """
 
 from __future__ import annotations
@@ -50,13 +52,15 @@ from typing import Any
 from .. import _limits
 from ..errors import ConfigError
 from ._chain import Chain, Element, Link, Torque
-from ._discontinuous import Friction, NonsmoothSystem, Preload
+from ._discontinuous import Friction, Preload
 from ._drag import Drag
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Piecewise
 from ._engine import engine_torque
 from ._excitation import Excitation
 from ._friction_system import FrictionSystem
 from ._model import Model
+from ._nonsmooth_system import NonsmoothSystem
+from ._readers import register_reader
 from ._table_checks import (
     _EXAMPLES,
     ANGLE_KEYS,
@@ -670,3 +674,8 @@ def _element_friction(check: _Checker, elastic: Any, t: Mapping[str, Any], where
     if units == "SI" and K > 0:  # N m → relative to K_e (a stiffness <= 0 is refused by Element)
         friction = Friction(levels=tuple(r / K for r in friction.levels))
     return friction
+
+
+# Model.from_toml and Chain.from_toml read their files with this reader (they cannot import it:
+# it builds them).
+register_reader(model_tables)

@@ -56,8 +56,8 @@ import numpy as np
 from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_shooting, check_state
 from ..errors import ConvergenceError
-from ..model._discontinuous import NonsmoothSystem
 from ..model._elastic import Stages
+from ..model._nonsmooth_system import NonsmoothSystem
 from ._integrator import ExactIntegrator, _Segment
 from ._roots import bracketed_newton
 from ._shooting import ShotOrbit, _newton_shooting
@@ -320,7 +320,7 @@ class NonsmoothTrajectory:
 
 class NonsmoothIntegrator:
     """Event-driven exact integrator of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (module
-    docstring) for a :class:`~rattle.model._discontinuous.NonsmoothSystem`."""
+    docstring) for a :class:`~rattle.model._nonsmooth_system.NonsmoothSystem`."""
 
     def __init__(self, system: NonsmoothSystem, options: NonsmoothOptions | None = None) -> None:
         if not isinstance(system, NonsmoothSystem):
