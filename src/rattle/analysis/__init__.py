@@ -3,6 +3,7 @@
 from ._case import Case, load_case
 from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
+from ._friction_orbit import friction_orbit
 from ._friction_response import friction_response
 from ._nonsmooth import RegularisationOptions, nonsmooth_response
 from ._nonsmooth_orbit import nonsmooth_orbit
@@ -15,6 +16,6 @@ from ._time_sweep import time_sweep
 __all__ = [
     "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare",
     "steady_state", "SteadyStateOptions", "nonsmooth_response", "RegularisationOptions",
-    "nonsmooth_orbit", "friction_response",
+    "nonsmooth_orbit", "friction_response", "friction_orbit",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
 ]

@@ -1,0 +1,303 @@
+"""One periodic orbit of a chain with Coulomb friction at one forcing frequency.
+
+For x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t)
+(:class:`~rattle.model.FrictionSystem`, n coordinates, m elements, δ_e = a_e · x) at Ω:
+
+1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedSystemBalance`, smooth steps
+   of relative width ε, H harmonics) at Ω: started from the linearised chain's steady state at
+   wide steps (ε = 0.1, else 0.3) and narrowed to the requested ε by homotopy, with the fallbacks
+   of :func:`~rattle.analysis.friction_response`'s start (damped Newton; the spectrum of the exact
+   orbit reached by simulation);
+2. the exact orbit: Newton shooting on the event-driven flow
+   (:func:`~rattle.timeint.shoot_friction_orbit`: every element's sticking exact, Filippov; the
+   2n multipliers with saltation matrices) from the HB orbit's state (x, x') at t = 0, or from
+   ``x0`` when given. Where an element sticks (nearly) the whole period of the exact flow from
+   the HB state, the exact orbits form a family (its stuck deflection is free within the friction
+   band; M − I singular) and the member held at the HB's mean deflection is shot (``hold``) when
+   the plain shooting does not converge on the HB's orbit. When that fails too, the exact flow is
+   run for :data:`SETTLE_PERIODS` periods and the shooting restarted from where it arrived (the
+   orbit the motion settles on, if it is stable; elements stuck a whole period there held where
+   they stuck);
+3. when the HB of step 1 fails and an exact orbit was found, the HB is solved at ε from the exact
+   orbit's spectrum.
+
+The result (:class:`~rattle.results.FrictionOrbitResult`) keeps both orbits per element: the exact
+one is the answer (rms, mean, stick fraction and phases, multipliers), the HB series its
+regularised approximation, and the HB orbit's own multipliers (the non-smooth monodromy of one
+period of the exact flow from its state) beside the exact ones.
+
+Cost: one HB ladder of n(2H + 1) unknowns (a dense Jacobian), one period of exact flow from the
+HB state and one shooting of a few ms per Newton step (plus 100 periods of exact flow when
+settling).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._typing import FloatArray
+from .._validate import as_float_array, check_omega
+from ..errors import ConvergenceError, RattleError, Status
+from ..model import FrictionSystem
+from ..results import FrictionOrbitResult
+from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
+from ._friction_response import CHAIN_REGULARISATION, _start, friction_balance_factory
+from ._regularisation import RegularisationOptions
+
+#: Periods of the exact flow run before shooting again when the shooting from the start fails.
+SETTLE_PERIODS = 100
+#: Equally spaced samples per period of the result (every event time is added).
+ORBIT_POINTS = 512
+#: An element stuck at least this fraction of one period of the exact flow is held (a family of
+#: orbits; :func:`~rattle.timeint.shoot_friction_orbit` ``hold``).
+HOLD_FRACTION = 0.9
+
+_FAILURES = (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError)
+
+
+def _check_x0(value: object, n: int) -> FloatArray:
+    """``x0``: a finite state (x_1 … x_n, x'_1 … x'_n) of shape (2n,)."""
+    z = as_float_array(value, "x0", f"a state (x, x') of {2 * n} numbers")
+    if z.shape != (2 * n,) or not np.all(np.isfinite(z)):
+        raise ValueError(f"`x0` must be a finite state (x_1 … x_n, x'_1 … x'_n) of shape ({2 * n},) for a chain "
+                         f"of n = {n} coordinates, got {value!r}")
+    return z.copy()
+
+
+def _flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
+    """One period of the exact flow from ``z0`` at t = 0; None when it cannot be followed."""
+    try:
+        return integ.propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
+    except _FAILURES:
+        return None
+
+
+def _stuck_all_period(flow: FrictionTrajectory | None) -> list[int]:
+    """The elements that stick at least :data:`HOLD_FRACTION` of the period on ``flow``."""
+    if flow is None:
+        return []
+    frac = flow.stick_time() / (flow.t1 - flow.t0)
+    return [int(e) for e in np.flatnonzero(frac >= HOLD_FRACTION)]
+
+
+def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: FrictionIntegrator,
+           hold: dict[int, float] | None = None) -> tuple[FrictionOrbit | None, str]:
+    """The exact orbit from ``z0`` (``hold`` the elements held), or (None, why)."""
+    try:
+        orbit = shoot_friction_orbit(system, omega, z0, integrator=integ, max_iterations=30, hold=hold or None)
+    except _FAILURES as exc:  # e.g. the event budget of a chattering orbit, a loop of stuck elements
+        return None, f"{type(exc).__name__}: {exc}"
+    if not orbit.converged:
+        return None, f"Newton shooting stopped after {orbit.iterations} steps at residual {orbit.residual:.3g}"
+    if hold and not all(orbit.stick_fraction[e] >= 1.0 - 1e-9 for e in hold):
+        return None, "an element held at its stuck deflection slipped on the orbit found"
+    return orbit, ""
+
+
+def _settle(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FloatArray | None:
+    """The state after :data:`SETTLE_PERIODS` periods of the exact flow from ``z0``; None when the
+    flow cannot be followed."""
+    T = 2.0 * math.pi / omega
+    z = np.asarray(z0, dtype=float)
+    try:
+        for _ in range(SETTLE_PERIODS):
+            z = integ.advance(z, 0.0, T, omega)[0]
+    except _FAILURES:
+        return None
+    return z if np.all(np.isfinite(z)) else None
+
+
+def _gap(orbit: FrictionOrbit, E: FloatArray, omega: float, basis_eval, free: list[int]) -> float:  # type: ignore[no-untyped-def]
+    """The largest departure of the exact δ_e(t) (``free`` elements) from the HB's (series rows
+    ``E``) on 64 samples, relative to the HB δ_e's peak-to-peak."""
+    t = np.arange(64) * (2.0 * math.pi / omega / 64)
+    d_hb = np.stack([basis_eval(E[e], omega, t) for e in range(E.shape[0])], axis=1)
+    size = np.maximum(np.ptp(d_hb, axis=0), 1e-12 * max(float(np.max(np.abs(d_hb))), 1e-300))
+    gap = np.max(np.abs(orbit.trajectory.element_samples(t)[0] - d_hb), axis=0) / size
+    return float(np.max(gap[free])) if free else 0.0
+
+
+def friction_orbit(
+    system: FrictionSystem,
+    omega: float,
+    options: RegularisationOptions | None = None,
+    *,
+    x0: FloatArray | None = None,
+) -> FrictionOrbitResult:
+    """The periodic orbit of the chain with friction ``system`` at forcing frequency ``omega``
+    (module docstring), with the HB settings ``options``
+    (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε and
+    ``match``; the ladder settings are not used here. None: the defaults with
+    ε = :data:`~rattle.analysis._friction_response.CHAIN_REGULARISATION`). ``x0`` = (x, x') at
+    t = 0 (2n numbers) starts the exact shooting instead of the HB orbit's state.
+
+    A failed exact shooting is reported in the result (``converged`` False, ``message``); a failed
+    HB leaves nan series. Raises :class:`~rattle.errors.ConvergenceError` when neither is found,
+    TypeError/ValueError on bad arguments (``system`` not a FrictionSystem, ``omega`` not finite
+    and > 0, ``options`` not a RegularisationOptions or with too few harmonics for the
+    excitation, ``x0`` not a finite state of shape (2n,))."""
+    if not isinstance(system, FrictionSystem):
+        raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    omega = check_omega(omega)
+    opts = RegularisationOptions(regularisation=CHAIN_REGULARISATION) if options is None else options
+    if not isinstance(opts, RegularisationOptions):
+        raise TypeError(f"`options` must be a RegularisationOptions or None, got {opts!r}")
+    n, m = system.n, system.m
+    start_x = None if x0 is None else _check_x0(x0, n)
+    H, eps = opts.harmonics, opts.regularisation
+    make = friction_balance_factory(system)
+    problem = make(eps, H)  # raises on too few harmonics for the excitation
+    integ = FrictionIntegrator(system)
+    T = 2.0 * math.pi / omega
+    notes: list[str] = []
+
+    # 1. the regularised HB at Ω
+    q: FloatArray | None = None
+    hb_start = ""
+    try:
+        q = _start(make, omega, eps, H, None)
+        hb_start = "linear"
+    except RattleError as exc:
+        notes.append(f"the regularised HB failed ({exc})")
+    E = problem.element_series(q) if q is not None else None
+    z_hb = problem.state_at_zero(q, omega) if q is not None else None
+    hb_flow = _flow(integ, z_hb, omega) if z_hb is not None else None
+
+    # 2. the exact orbit
+    orbit: FrictionOrbit | None = None
+    start, held_set = "", [] if E is None else _stuck_all_period(hb_flow)
+    held: dict[int, float] = {}
+    if start_x is not None:
+        orbit, why = _shoot(system, omega, start_x, integ)
+        start = "x0"
+        if orbit is None:
+            notes.append(f"shooting from `x0` failed ({why})")
+    elif z_hb is not None:
+        if held_set:  # a family of orbits: the member held at the HB's mean deflection first
+            assert E is not None
+            hold = {e: float(E[e][0]) for e in held_set}
+            free = [e for e in range(m) if e not in held_set]
+            orbit, why = _shoot(system, omega, z_hb, integ, hold)
+            if orbit is not None and _gap(orbit, E, omega, problem.basis.evaluate, free) <= opts.match:
+                start, held = "held", hold
+                names = ", ".join(system.element_names[e] for e in held_set)
+                notes.append(f"{names} stuck the whole period, held at the HB's mean deflection")
+            else:
+                notes.append(f"shooting with {', '.join(system.element_names[e] for e in held_set)} held at the "
+                             "HB's mean deflection " + (f"failed ({why})" if orbit is None else "missed the HB orbit"))
+                orbit = None
+        if orbit is None:
+            orbit, why = _shoot(system, omega, z_hb, integ)
+            start = "hb"
+            if orbit is None:
+                notes.append(f"shooting from the HB state failed ({why})")
+    if orbit is None:
+        origin = start_x if start_x is not None else (z_hb if z_hb is not None else None)
+        where = "`x0`" if start_x is not None else ("the HB state" if z_hb is not None else "the linearised chain")
+        if origin is None:
+            origin = problem.state_at_zero(problem.linear_solution(omega), omega)
+        settled = _settle(integ, origin, omega)
+        if settled is None:
+            notes.append(f"the exact flow from {where} could not be followed for {SETTLE_PERIODS} periods")
+        else:
+            orbit, why = _shoot(system, omega, settled, integ)
+            if orbit is None:
+                stuck = _stuck_all_period(_flow(integ, settled, omega))
+                if stuck:
+                    rows = system.system.element_rows.reshape(m, n)
+                    hold = {e: float(rows[e] @ settled[:n]) for e in stuck}
+                    orbit, why = _shoot(system, omega, settled, integ, hold)
+                    if orbit is not None:
+                        held = hold
+            if orbit is not None:
+                start = "settled"
+                notes.append(f"settled for {SETTLE_PERIODS} periods from {where}, then shooting converged")
+            else:
+                start = ""
+                notes.append(f"shooting after settling for {SETTLE_PERIODS} periods from {where} failed ({why})")
+
+    # 3. the HB from the exact orbit's spectrum when the first failed
+    if q is None and orbit is not None:
+        N = problem.basis.samples
+        x = orbit.trajectory.sample(np.arange(N) * (T / N))[0][:, :n]
+        try:
+            q = _start_from(make, problem.basis.analyze(x.T).reshape(-1), omega, eps, H)
+            hb_start = "exact"
+            notes.append("the HB was solved from the exact orbit's spectrum")
+        except RattleError as exc:
+            notes.append(f"the HB from the exact orbit's spectrum failed too ({exc})")
+        if q is not None:
+            E = problem.element_series(q)
+            hb_flow = _flow(integ, problem.state_at_zero(q, omega), omega)
+    if q is None and orbit is None:
+        raise ConvergenceError(f"no periodic orbit at `omega` = {omega:g}: " + "; ".join(notes)
+                               + "; try another `regularisation` or `harmonics`, or give `x0`")
+    if orbit is None:
+        notes.insert(0, f"no exact orbit at Ω = {omega:g}")
+    return _result(system, omega, opts, orbit, q, E, hb_flow, start, hb_start, held, notes)
+
+
+def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> FloatArray:  # type: ignore[no-untyped-def]
+    """The HB at ε from the series ``q0`` (Newton at ε; raises RattleError)."""
+    from ._regularisation import regularisation_limit
+
+    return regularisation_limit(make, omega, q0, eps_start=eps, eps_min=eps, harmonics=H, max_harmonics=H,
+                                tail_tol=math.inf).last.q
+
+
+def _multipliers(M: FloatArray) -> np.ndarray:
+    mu = np.linalg.eigvals(M).astype(complex)
+    return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+
+def _result(system: FrictionSystem, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
+            q: FloatArray | None, E: FloatArray | None, hb_flow: FrictionTrajectory | None, start: str,
+            hb_start: str, held: dict[int, float], notes: list[str]) -> FrictionOrbitResult:
+    """The result's samples and measures (:class:`~rattle.results.FrictionOrbitResult`)."""
+    n, m, H = system.n, system.m, opts.harmonics
+    T = 2.0 * math.pi / omega
+    t = np.linspace(0.0, T, ORBIT_POINTS + 1)
+    nan_m = np.full(m, math.nan)
+    if orbit is not None:
+        tr = orbit.trajectory
+        ev = tr.event_times
+        t = np.unique(np.concatenate((t, ev[(ev >= 0.0) & (ev <= T)])))
+        delta, velocity, _ = tr.element_samples(t)
+        stuck = np.asarray(tr.stuck, dtype=bool)[tr.segment_index(t)]
+        intervals = tuple(tuple(tr.stick_intervals(e)) for e in range(m))
+        rms, mean, frac = orbit.rms.copy(), orbit.mean.copy(), orbit.stick_fraction.copy()
+        mult, state0 = np.asarray(orbit.multipliers, dtype=complex), orbit.state0.copy()
+    else:
+        delta, velocity = np.full((t.size, m), math.nan), np.full((t.size, m), math.nan)
+        stuck = np.zeros((t.size, m), dtype=bool)
+        intervals = tuple(() for _ in range(m))
+        rms, mean, frac = nan_m.copy(), nan_m.copy(), nan_m.copy()
+        mult, state0 = np.full(2 * n, complex(math.nan, math.nan)), np.full(2 * n, math.nan)
+    if E is not None:
+        coeff = np.asarray(E, dtype=float)
+        rms_hb = np.sqrt(coeff[:, 0] ** 2 + 0.5 * np.sum(coeff[:, 1:] ** 2, axis=1))
+    else:
+        coeff, rms_hb = np.full((m, 2 * H + 1), math.nan), nan_m.copy()
+    mult_hb = np.full(2 * n, complex(math.nan, math.nan))
+    if hb_flow is not None and q is not None:
+        mu = _multipliers(hb_flow.sensitivity)
+        if np.all(np.isfinite(mu)):
+            mult_hb = mu
+    k = np.arange(1, H + 1) * omega
+    ph = np.multiply.outer(t, k)
+    delta_hb = coeff[:, 0] + np.cos(ph) @ coeff[:, 1 : H + 1].T + np.sin(ph) @ coeff[:, H + 1 :].T
+    rpm = system.speed_rpm(omega)
+    return FrictionOrbitResult(
+        omega=omega, speed_rpm=None if rpm is None else float(rpm), element_names=system.element_names,  # type: ignore[arg-type]
+        t=t, delta=delta, velocity=velocity, stuck=stuck, stick_intervals=intervals, rms=rms, mean=mean,
+        stick_fraction=frac, multipliers=mult, state0=state0, converged=orbit is not None,
+        status=Status.CONVERGED if orbit is not None else Status.MAX_ITERATIONS, message="; ".join(notes),
+        start=start, coefficients_hb=coeff, delta_hb=delta_hb, rms_hb=rms_hb, multipliers_hb=mult_hb,
+        regularisation=float(opts.regularisation), harmonics=int(H), hb_start=hb_start, match=float(opts.match),
+        held=tuple(system.element_names[e] for e in held), settle_periods=SETTLE_PERIODS,
+    )
+
+
+__all__ = ["FrictionOrbitResult", "friction_orbit"]
