@@ -17,9 +17,12 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    The two are one orbit (``matched``) when the shooting converged and every element's δ_e(t)
    stays within ``match`` × (the HB δ_e's peak-to-peak) of the HB's on 64 samples of the period.
    The exact orbit gives the answer (every element's rms, mean, stick fraction; the 2n
-   multipliers); the HB's own values stand beside them: its rms and its multipliers, those of the
+   multipliers); the HB's own values stand beside them: its rms and its multipliers. Those are,
+   by ``stability`` (:class:`~rattle.analysis.RegularisationOptions`), ``"saltation"``: the
    non-smooth monodromy (saltation matrices) of one period of the exact flow from the HB state
-   (the exact orbit's when that flow cannot be followed);
+   (the exact orbit's when that flow cannot be followed), or ``"regularised"``: the smooth
+   monodromy of the regularised chain linearised along the HB orbit
+   (:func:`~rattle.stability.regularised_system_multipliers`; it reads the HB series only);
 3. where a matched row's HB rms misses the exact one by more than ``refine`` on any element
    (relative), the regularisation is continued at that row towards its limit (ε down to
    ``limit_eps``, H up to ``limit_harmonics``, and on to ``deep_eps`` if asked;
@@ -53,6 +56,7 @@ from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionResponse
+from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, STICK
 from ._regularisation import (
@@ -259,17 +263,14 @@ def friction_response(
     ε = :data:`CHAIN_REGULARISATION`)
     (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε,
     ``match``, ``refine``, ``limit``, ``limit_eps``, ``limit_harmonics``, ``deep_eps``,
-    ``deep_harmonics``; ``stability`` must be ``"saltation"``: the regularised monodromy is the
-    single equation's)."""
+    ``deep_harmonics``, ``stability``: how the HB orbit's own multipliers are found, see the
+    module docstring)."""
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = RegularisationOptions(regularisation=CHAIN_REGULARISATION) if options is None else options
     if not isinstance(opts, RegularisationOptions):
         raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
-    if opts.stability != "saltation":
-        raise ValueError(f"`stability` = {opts.stability!r} is not available for a chain with friction: its HB "
-                         "multipliers are the non-smooth monodromy of the exact flow; use 'saltation'")
     if continuation is not None and not isinstance(continuation, ContinuationOptions):
         raise TypeError(f"`continuation` must be a ContinuationOptions or None, got {continuation!r}")
     if newton is not None and not isinstance(newton, NewtonOptions):
@@ -295,7 +296,8 @@ def friction_response(
         rms_hb[i] = problem.element_rms(q)
         z0 = problem.state_at_zero(q, w)
         hb_flow = _hb_flow(integ, z0, w)
-        mu_hb = _hb_multipliers(hb_flow)
+        mu_hb = _hb_multipliers(hb_flow) if opts.stability == "saltation" \
+            else regularised_system_multipliers(problem, q, w)
         try:
             orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30)
         except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
@@ -363,7 +365,9 @@ def friction_response(
             lim_rich.append(lad.extrapolated_element_rms)
             lim_lin.append(lad.linear)
             w = float(points[i].omega)
-            mu_lim = _hb_multipliers(_hb_flow(integ, make(lad.last.eps, lad.last.harmonics).state_at_zero(lad.last.q, w), w))
+            last = make(lad.last.eps, lad.last.harmonics)
+            mu_lim = _hb_multipliers(_hb_flow(integ, last.state_at_zero(lad.last.q, w), w)) \
+                if opts.stability == "saltation" else regularised_system_multipliers(last, lad.last.q, w)
             lim_mu.append(np.full(2 * n, np.nan + 0j) if mu_lim is None else mu_lim)
         except RattleError:  # the ladder stalled: the row keeps its ε
             lim_eps.append(math.nan)

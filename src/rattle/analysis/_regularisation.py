@@ -220,9 +220,9 @@ class RegularisationOptions:
     stops at ``limit_eps``. That costs 20–45 s a row at H = 512 (measured in docs/nonsmooth.md).
     ``stability``: how the HB orbit's own multipliers are found: ``"saltation"`` (default) the
     non-smooth monodromy of one period of the exact flow from the HB orbit's state, saltation
-    matrices included; ``"regularised"`` the smooth monodromy of the regularised equation along
-    the HB orbit (near a slow crossing of a jump the smoothing misjudges it: measured in
-    docs/nonsmooth.md).
+    matrices included; ``"regularised"`` the smooth monodromy of the regularised equation (or
+    chain) linearised along the HB orbit (near a slow crossing of a jump, or where a stick phase
+    appears, the smoothing misjudges it: measured in docs/nonsmooth.md).
     """
 
     harmonics: int = 128

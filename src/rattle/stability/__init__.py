@@ -9,7 +9,12 @@ from ._floquet import (
 from ._hill import hill_exponents, hill_multipliers
 from ._methods import STABILITY_METHODS, AbstractStabilityMethod, Hill, Monodromy, floquet_monitor, stability_method
 from ._monitor import FloquetMonitor, hb_system
-from ._regularised import regularised_monodromy, regularised_multipliers
+from ._regularised import (
+    regularised_monodromy,
+    regularised_multipliers,
+    regularised_system_monodromy,
+    regularised_system_multipliers,
+)
 
 __all__ = [
     "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
@@ -18,5 +23,5 @@ __all__ = [
     "hill_exponents", "hill_multipliers", "FloquetMonitor", "hb_system",
     "AbstractStabilityMethod", "Monodromy", "Hill", "STABILITY_METHODS", "stability_method", "floquet_monitor",
     "is_stable", "classify_loss", "torus_ratio", "critical_distance", "UNIT_CIRCLE_TOL", "COMPLEX_TOL",
-    "regularised_monodromy", "regularised_multipliers",
+    "regularised_monodromy", "regularised_multipliers", "regularised_system_monodromy", "regularised_system_multipliers",
 ]
