@@ -1,6 +1,7 @@
 """``rattle`` on a chain with Coulomb friction on its elements (``[[model.elements]] friction``):
-``rattle frf`` writes the chain's non-smooth response (a FrictionResponse) as one set; sweep,
-compare, map and orbit refuse it (exit 2, nothing written) and say that frf solves it."""
+``rattle frf`` writes the chain's non-smooth response (a FrictionResponse) as one set, ``rattle
+orbit`` one exact orbit with the regularised HB's beside it (a FrictionOrbitResult); sweep,
+compare and map refuse it (exit 2, nothing written) and say that frf and orbit solve it."""
 
 from __future__ import annotations
 
@@ -47,14 +48,61 @@ harmonics = 16
 """
 
 
-@pytest.mark.parametrize("args", [["sweep", "--direction", "up"], ["compare"], ["map", "--vary", "mean=0.04,0.05"],
-                                  ["orbit", "--omega", "0.9"]])
-def test_commands_other_than_frf_refuse_a_chain_with_friction_and_write_nothing(tmp_path, args):
+@pytest.mark.parametrize("args", [["sweep", "--direction", "up"], ["compare"], ["map", "--vary", "mean=0.04,0.05"]])
+def test_sweep_compare_and_map_refuse_a_chain_with_friction_and_write_nothing(tmp_path, args):
     config = write_config(tmp_path, CHAIN)
     result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
     assert_bad_input(result, "`model.elements[0].friction`", "a chain with Coulomb friction on its elements",
-                     f"not supported by `rattle {args[0]}` yet", "use `rattle frf`")
+                     f"not supported by `rattle {args[0]}` yet", "use `rattle frf`", "or `rattle orbit`")
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("args, fragments", [
+    (["--period", "2"], ["`--period` 2", "only the period-1 orbit of a chain with friction", "leave --period out"]),
+    (["--omega-min", "0.5"], ["`--omega-min` is not used for a chain with friction", "leave it out"]),
+    (["--omega-max", "1.5"], ["`--omega-max` is not used for a chain with friction"]),
+    (["--harmonics", "0"], ["`--harmonics`"]),
+])
+def test_orbit_refuses_options_it_does_not_take_on_a_chain_with_friction(tmp_path, args, fragments):
+    config = write_config(tmp_path, CHAIN)
+    result = invoke(["orbit", str(config), "--omega", "0.9", *args, "-o", "out"], tmp_path)
+    assert_bad_input(result, *fragments)
+    assert not (tmp_path / "out").exists()
+
+
+def test_orbit_writes_the_exact_orbit_of_the_chain_as_one_set(tmp_path):
+    """``rattle orbit`` on the chain: orbit.csv (t, then clutch_delta, clutch_velocity, clutch_stuck,
+    clutch_delta_hb), orbit.json (settings, elements, the orbit's measures) and orbit.png; the csv's
+    clutch_delta is the exact orbit's (its rms is the json's, and that of Newton shooting of the
+    event-driven flow from rest to 1e-9)."""
+    from rattle.results import FRICTION_ORBIT_ELEMENT_COLUMNS
+    from rattle.timeint import shoot_friction_orbit
+
+    config = write_config(tmp_path, CHAIN)
+    result = invoke(["orbit", str(config), "--omega", "0.9", "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    out = tmp_path / "out"
+    assert sorted(p.name for p in out.iterdir()) == ["orbit.csv", "orbit.json", "orbit.png"]
+    assert (out / "orbit.png").read_bytes()[:8] == PNG
+    header = (out / "orbit.csv").read_text().splitlines()[0].split(",")
+    assert header == ["t", *[f"clutch_{c}" for c in FRICTION_ORBIT_ELEMENT_COLUMNS]]
+    meta = json.loads((out / "orbit.json").read_text())
+    assert meta["command"] == "orbit" and meta["status"] == "converged" and meta["options"] == {"omega": 0.9}
+    assert meta["settings"]["harmonics"] == 16 and meta["settings"]["regularisation"] == 0.001
+    assert meta["system"] == {"coordinates": 2, "elements": [
+        {"name": "clutch", "law": {"type": "clutch", "alpha": 0.25, "b": 0.1}, "friction": [0.0, 0.03, 0.0]}]}
+    orbit = meta["orbit"]
+    assert orbit["converged"] and orbit["matched"] and orbit["omega"] == 0.9 and "friction_orbit" in meta["timings"]
+    clutch = orbit["elements"][0]
+    table = read_csv(out / "orbit.csv")
+    t, d = np.asarray(table["t"], dtype=float), np.asarray(table["clutch_delta"], dtype=float)
+    assert t[0] == 0.0 and t[-1] == pytest.approx(2 * np.pi / 0.9, rel=1e-15)
+    assert np.sqrt(np.trapezoid(d**2, t) / t[-1]) == pytest.approx(clutch["rms"], rel=1e-4)
+    exact = shoot_friction_orbit(load_config(config).model, 0.9, np.zeros(4))
+    assert exact.converged and abs(float(exact.rms[0]) - clutch["rms"]) <= 1e-9
+    assert abs(clutch["rms_hb"] / clutch["rms"] - 1.0) <= 0.01  # measured 0.46 % (H = 16)
+    assert "clutch: exact rms" in result.stdout and "HB (H = 16, ε = 0.001)" in result.stdout
+    assert result.stdout.rstrip().endswith("wrote orbit.csv, orbit.json, orbit.png to out")
 
 
 def test_frf_refuses_subharmonics_and_bad_friction_with_nothing_written(tmp_path):

@@ -33,6 +33,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 
 __all__ = [
     "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_frf", "run_nonsmooth_orbit",
+    "run_friction_orbit",
     "frf_command", "sweep_command", "orbit_command", "compare_command", "map_command", "demo_command",
 ]
 
@@ -188,7 +189,7 @@ def refuse_discontinuous(run_config: Any, command: str) -> None:
         raise ConfigError(
             f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
             f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance of the chain checked by "
-            "exact shooting with Filippov sticking), or remove the friction"
+            "exact shooting with Filippov sticking) or `rattle orbit` (one orbit at a frequency), or remove the friction"
         )
     if run_config.discontinuous:
         raise ConfigError(
@@ -359,15 +360,18 @@ def orbit_command(
     selected solution: the stable one closest in rms to the simulated steady state (preferring
     the requested period); orbit.json lists them all. A chain: those of its first clearance
     element, then NAME_delta and NAME_acceleration of every element.
+
+    A discontinuous law, or a chain with friction on its elements: the period-1 orbit at W alone,
+    exact (event-driven shooting, sticking exact) and regularised harmonic balance side by side;
+    orbit.csv holds t and per element NAME_delta, NAME_velocity, NAME_stuck, NAME_delta_hb for the
+    chain. --period other than 1 and --omega-min/--omega-max are refused there.
     """
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
     if getattr(run_config, "chain_friction", False):
-        raise ConfigError(
-            f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
-            "`rattle orbit` yet; use `rattle frf` (every row's exact orbit is checked there), or remove the friction"
-        )
+        run_friction_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max)
+        return
     if run_config.discontinuous:
         run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max)
         return
@@ -404,14 +408,7 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
     Only the period-1 orbit; ``--omega-min``/``--omega-max`` (a search range of the smooth laws) are
     refused. Raises ConvergenceError (exit 1) after writing the set when the exact shooting failed.
     """
-    law = _law_keys(run_config)
-    if period != 1:
-        raise ConfigError(f"`--period` {period}: only the period-1 orbit of a discontinuous law ({law}) is computed "
-                          "yet; leave --period out")
-    for option, value in (("--omega-min", omega_min), ("--omega-max", omega_max)):
-        if value is not None:
-            raise ConfigError(f"`{option}` is not used for a discontinuous law ({law}): its orbit is computed at "
-                              "--omega alone, without following a branch; leave it out")
+    _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
     analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
     check_omega(omega, model=run_config.bounds_model)
     t_start = time.perf_counter()
@@ -454,6 +451,68 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
         lines.append(result.message)
     echo_written("\n".join(lines), written, output)
     if not ok:
+        raise ConvergenceError(f"the exact orbit at `--omega` {omega:g} was not found ({result.message}); the "
+                               f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
+
+
+def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | None, omega_max: float | None) -> None:
+    """Exit 2 on the options the orbit of a discontinuous law (or of a chain with friction) does not
+    take: ``--period`` other than 1, ``--omega-min``/``--omega-max``."""
+    law = _law_keys(run_config)
+    what = ("a chain with friction on its elements" if getattr(run_config, "chain_friction", False)
+            else "a discontinuous law")
+    if period != 1:
+        raise ConfigError(f"`--period` {period}: only the period-1 orbit of {what} ({law}) is computed yet; "
+                          "leave --period out")
+    for option, value in (("--omega-min", omega_min), ("--omega-max", omega_max)):
+        if value is not None:
+            raise ConfigError(f"`{option}` is not used for {what} ({law}): its orbit is computed at --omega alone, "
+                              "without following a branch; leave it out")
+
+
+def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
+                       harmonics: int | None, omega_min: float | None, omega_max: float | None) -> None:
+    """``rattle orbit`` on a chain with Coulomb friction on its elements:
+    :func:`rattle.analysis.friction_orbit` (the chain's regularised HB orbit at Ω and the exact orbit
+    shot from it, every element's stick phases), written as one set orbit.csv, orbit.json,
+    orbit.png.
+
+    Only the period-1 orbit; ``--omega-min``/``--omega-max`` are refused (exit 2). Raises
+    ConvergenceError (exit 1) after writing the set when the exact shooting failed.
+    """
+    _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
+    analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
+    check_omega(omega, model=run_config.bounds_model)
+    t_start = time.perf_counter()
+    from ..analysis import RegularisationOptions, friction_orbit  # only now: all input has been validated
+
+    system = run_config.model
+    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
+                                    refine=analysis.refine or None)
+    logger.info("computing the orbit of a chain with friction at Ω = %g: regularised harmonic balance (H = %d, "
+                "ε = %g) and exact shooting", omega, options.harmonics, options.regularisation)
+    result = friction_orbit(system, omega, options)
+    timings = {"friction_orbit": time.perf_counter() - t_start}
+    elements = [{"name": name, "law": element.law.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}
+                for e, (name, element) in enumerate(zip(system.element_names, system.system.elements))]
+    meta = {
+        "settings": {"method": "exact event-driven shooting of the chain (Filippov sticking, saltation monodromy) "
+                               "started from its regularised harmonic balance (rattle.analysis.friction_orbit)",
+                     "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match},
+        "system": {"coordinates": int(system.n), "elements": elements},
+        "status": "converged" if result.converged else "failed",
+        "message": result.message or ("" if result.converged else "the exact shooting did not converge"),
+        "orbit": result.metadata(),
+        "timings": timings,
+    }
+    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, "harmonics": harmonics})
+    written = write_set(output, ORBIT_FILES, [
+        ("orbit.csv", result.to_csv),
+        ("orbit.json", metadata_writer(meta, sections_, t_start)),
+        ("orbit.png", lambda path: save_plot(result, path)),
+    ])
+    echo_written(result.summary(), written, output)
+    if not result.converged:
         raise ConvergenceError(f"the exact orbit at `--omega` {omega:g} was not found ({result.message}); the "
                                f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
 
