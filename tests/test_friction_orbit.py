@@ -77,6 +77,18 @@ def test_the_hb_rms_is_within_half_a_percent_and_the_orbits_match(result):
     # the HB samples are the series': rms over the period sampled on the uniform part of t
     np.testing.assert_allclose(result.sample_hb(result.t), result.delta_hb, atol=1e-12)
     assert result.stable_hb is True and result.stable is True
+    # the HB orbit's multipliers by the non-smooth monodromy of the flow from its state (default) and
+    # by the regularised chain's monodromy along it: both within 1e-3 of the exact max |μ| here
+    mu = result.mu_abs
+    assert abs(float(np.max(np.abs(result.multipliers_hb))) - mu) <= 1e-3
+
+
+def test_the_hb_multipliers_by_the_regularised_monodromy(system, result):
+    opts = RegularisationOptions(harmonics=32, regularisation=0.001, stability="regularised")
+    r = friction_orbit(system, OMEGA, opts)
+    assert abs(float(r.rms[0]) - float(result.rms[0])) <= 1e-9
+    assert abs(float(np.max(np.abs(r.multipliers_hb))) - result.mu_abs) <= 1e-3
+    assert not np.allclose(r.multipliers_hb, result.multipliers_hb)
 
 
 def test_the_damper_sticks_and_its_stick_phases_are_exact(result):

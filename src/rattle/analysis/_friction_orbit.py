@@ -23,8 +23,10 @@ For x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t)
 
 The result (:class:`~rattle.results.FrictionOrbitResult`) keeps both orbits per element: the exact
 one is the answer (rms, mean, stick fraction and phases, multipliers), the HB series its
-regularised approximation, and the HB orbit's own multipliers (the non-smooth monodromy of one
-period of the exact flow from its state) beside the exact ones.
+regularised approximation, and the HB orbit's own multipliers beside the exact ones: by the
+options' ``stability``, ``"saltation"`` the non-smooth monodromy of one period of the exact flow
+from its state, ``"regularised"`` the smooth monodromy of the regularised chain along the HB orbit
+(:func:`~rattle.stability.regularised_system_multipliers`).
 
 Cost: one HB ladder of n(2H + 1) unknowns (a dense Jacobian), one period of exact flow from the
 HB state and one shooting of a few ms per Newton step (plus 100 periods of exact flow when
@@ -40,8 +42,10 @@ import numpy as np
 from .._typing import FloatArray
 from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError, RattleError, Status
+from ..hb import RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionOrbitResult
+from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ._friction_response import CHAIN_REGULARISATION, _start, friction_balance_factory
 from ._regularisation import RegularisationOptions
@@ -128,8 +132,9 @@ def friction_orbit(
 ) -> FrictionOrbitResult:
     """The periodic orbit of the chain with friction ``system`` at forcing frequency ``omega``
     (module docstring), with the HB settings ``options``
-    (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε and
-    ``match``; the ladder settings are not used here. None: the defaults with
+    (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε,
+    ``match`` and ``stability``, how the HB orbit's own multipliers are found; the ladder settings
+    are not used here. None: the defaults with
     ε = :data:`~rattle.analysis._friction_response.CHAIN_REGULARISATION`). ``x0`` = (x, x') at
     t = 0 (2n numbers) starts the exact shooting instead of the HB orbit's state.
 
@@ -236,7 +241,7 @@ def friction_orbit(
                                + "; try another `regularisation` or `harmonics`, or give `x0`")
     if orbit is None:
         notes.insert(0, f"no exact orbit at Ω = {omega:g}")
-    return _result(system, omega, opts, orbit, q, E, hb_flow, start, hb_start, held, notes)
+    return _result(system, problem, omega, opts, orbit, q, E, hb_flow, start, hb_start, held, notes)
 
 
 def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> FloatArray:  # type: ignore[no-untyped-def]
@@ -252,7 +257,7 @@ def _multipliers(M: FloatArray) -> np.ndarray:
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
-def _result(system: FrictionSystem, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
+def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
             q: FloatArray | None, E: FloatArray | None, hb_flow: FrictionTrajectory | None, start: str,
             hb_start: str, held: dict[int, float], notes: list[str]) -> FrictionOrbitResult:
     """The result's samples and measures (:class:`~rattle.results.FrictionOrbitResult`)."""
@@ -281,10 +286,16 @@ def _result(system: FrictionSystem, omega: float, opts: RegularisationOptions, o
     else:
         coeff, rms_hb = np.full((m, 2 * H + 1), math.nan), nan_m.copy()
     mult_hb = np.full(2 * n, complex(math.nan, math.nan))
-    if hb_flow is not None and q is not None:
+    mu = None
+    if q is not None and opts.stability == "regularised":
+        try:
+            mu = regularised_system_multipliers(problem, q, omega)
+        except _FAILURES:
+            mu = None
+    elif hb_flow is not None and q is not None:
         mu = _multipliers(hb_flow.sensitivity)
-        if np.all(np.isfinite(mu)):
-            mult_hb = mu
+    if mu is not None and np.all(np.isfinite(mu)):
+        mult_hb = mu
     k = np.arange(1, H + 1) * omega
     ph = np.multiply.outer(t, k)
     delta_hb = coeff[:, 0] + np.cos(ph) @ coeff[:, 1 : H + 1].T + np.sin(ph) @ coeff[:, H + 1 :].T

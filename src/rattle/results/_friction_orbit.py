@@ -62,9 +62,9 @@ class FrictionOrbitResult:
 
     Of the regularised HB (ε ``regularisation``, H ``harmonics``; nan where it failed):
     ``coefficients_hb`` (m, 2H+1) every element's series [a_0, a_1 … a_H, b_1 … b_H],
-    ``delta_hb`` (N, m) its samples at ``t``, ``rms_hb`` (m,), ``multipliers_hb`` (2n,) the
-    non-smooth monodromy of one period of the exact flow from the HB state (nan where that flow
-    could not be followed), ``hb_start`` how it was solved (``"linear"``: from the linearised
+    ``delta_hb`` (N, m) its samples at ``t``, ``rms_hb`` (m,), ``multipliers_hb`` (2n,) the HB
+    orbit's (the non-smooth monodromy of one period of the exact flow from the HB state, or the
+    regularised chain's monodromy along it, by the options' ``stability``; nan where not found), ``hb_start`` how it was solved (``"linear"``: from the linearised
     chain, ε narrowed from wide steps; ``"exact"``: from the exact orbit's spectrum, after that
     failed; ``""`` failed). ``match``: the largest :attr:`match_distance` for the two orbits to
     count as one (:attr:`matched`)."""
