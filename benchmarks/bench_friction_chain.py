@@ -10,6 +10,7 @@ down to ε = 1e-3; Richardson where linear), stability agreement (exact saltatio
 exact orbit vs that of one period of exact flow from the HB state), rows that stick, time.
 
 Run:  OMP_NUM_THREADS=1 python benchmarks/bench_friction_chain.py [--harmonics 64 128] [--no-refine] [--lo 0.4] [--eps 0.001]
+      [--stability regularised]
 
 Measured 2026-12-01 (2 cores shared with other jobs, two runs at a time: times are upper bounds):
 
@@ -54,13 +55,16 @@ def main() -> None:
     ap.add_argument("--lo", type=float, default=0.2)
     ap.add_argument("--hi", type=float, default=2.0)
     ap.add_argument("--eps", type=float, default=0.01)
+    ap.add_argument("--stability", choices=("saltation", "regularised"), default="saltation",
+                    help="the HB orbit's own multipliers: the exact flow from its state, or the regularised monodromy")
     args = ap.parse_args()
     fs = chain().friction_system()
     wn = fs.frequency_scale()
-    print(f"chain: 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = {args.eps:g}")
+    print(f"chain: 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = {args.eps:g}, "
+          f"HB stability {args.stability}")
     for H in args.harmonics:
         opts = RegularisationOptions(harmonics=H, regularisation=args.eps, refine=None if args.no_refine else 0.005,
-                                     limit_harmonics=H)
+                                     limit_harmonics=H, stability=args.stability)
         t0 = time.perf_counter()
         r = friction_response(fs, (args.lo * wn, args.hi * wn), opts)
         dt = time.perf_counter() - t0
