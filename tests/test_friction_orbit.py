@@ -204,3 +204,14 @@ def test_rattle_orbit_writes_the_three_files_with_the_documented_columns(tmp_pat
     table = read_csv(out / "orbit.csv")
     assert np.any(np.asarray(table["clutch_stuck"], dtype=bool))
     assert "clutch: exact rms" in res.stdout and "sticks" in res.stdout
+
+
+def test_nonsmooth_orbit_dispatches_a_friction_system(system, result):
+    """``nonsmooth_orbit`` takes the chain too (as ``nonsmooth_response`` does): the same orbit."""
+    from rattle.analysis import nonsmooth_orbit
+
+    r = nonsmooth_orbit(system, OMEGA, OPTIONS)
+    assert type(r) is type(result)
+    np.testing.assert_array_equal(r.rms, result.rms)
+    with pytest.raises(TypeError, match="FrictionSystem"):
+        nonsmooth_orbit("chain", OMEGA)  # type: ignore[arg-type]

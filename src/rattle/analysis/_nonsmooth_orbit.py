@@ -35,8 +35,8 @@ from .._typing import FloatArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError, RattleError
 from ..hb import RegularisedBalance
-from ..model import NonsmoothSystem
-from ..results import NonsmoothOrbitResult
+from ..model import FrictionSystem, NonsmoothSystem
+from ..results import FrictionOrbitResult, NonsmoothOrbitResult
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
 from ._nonsmooth import RegularisationOptions, balance_factory
 from ._regularisation import regularisation_limit
@@ -79,12 +79,12 @@ def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
 
 
 def nonsmooth_orbit(
-    system: NonsmoothSystem,
+    system: NonsmoothSystem | FrictionSystem,
     omega: float,
     options: RegularisationOptions | None = None,
     *,
     x0: FloatArray | tuple[float, float] | None = None,
-) -> NonsmoothOrbitResult:
+) -> NonsmoothOrbitResult | FrictionOrbitResult:
     """The periodic orbit at forcing frequency ``omega`` (module docstring), with the HB settings
     ``options`` (:class:`RegularisationOptions`: ``harmonics``, ``regularisation`` and ``match``;
     the ladder settings are not used here). ``x0`` = (δ, δ') at t = 0 starts the exact shooting
@@ -94,9 +94,18 @@ def nonsmooth_orbit(
     rest) and the HB is then solved from the exact orbit's spectrum (``hb_start`` ``"exact"``).
     A failed exact shooting is reported in the result (``orbit`` None, ``message``); a failed HB
     leaves nan coefficients. Raises :class:`~rattle.errors.ConvergenceError` when neither is found.
+
+    A chain with friction on its elements (:class:`~rattle.model.FrictionSystem`) goes to
+    :func:`~rattle.analysis._friction_orbit.friction_orbit` (a :class:`FrictionOrbitResult`;
+    ``x0`` then the chain's state (x, x'), 2n values).
     """
+    if isinstance(system, FrictionSystem):
+        from ._friction_orbit import friction_orbit
+
+        return friction_orbit(system, omega, options, x0=x0)
     if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem (rattle.model), got {system!r}")
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+                        f"friction on its elements; rattle.model), got {system!r}")
     omega = check_omega(omega)
     opts = RegularisationOptions() if options is None else options
     if not isinstance(opts, RegularisationOptions):

@@ -188,7 +188,8 @@ class RunConfig:
         ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or a ``friction`` level > 0; only
         ``rattle frf``, ``rattle orbit`` and :func:`rattle.analysis.nonsmooth_response` solve it), a
         :class:`~rattle.model.FrictionSystem` for a chain with a ``friction`` level > 0 on some
-        ``[[model.elements]]`` (only ``rattle frf`` and ``nonsmooth_response``), else a Model or a
+        ``[[model.elements]]`` (only ``rattle frf``, ``rattle orbit``, ``nonsmooth_response`` and
+        ``nonsmooth_orbit``), else a Model or a
         Chain.
     analysis : AnalysisSettings
         The ``[analysis]`` table, defaults filled in.
@@ -222,7 +223,7 @@ class RunConfig:
     @property
     def chain_friction(self) -> bool:
         """True when :attr:`model` is a :class:`~rattle.model.FrictionSystem`: a chain with Coulomb
-        friction on some ``[[model.elements]]`` (only ``rattle frf`` solves it)."""
+        friction on some ``[[model.elements]]`` (``rattle frf`` and ``rattle orbit`` solve it)."""
         return isinstance(self.model, FrictionSystem)
 
     @property
