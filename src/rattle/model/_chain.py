@@ -24,9 +24,9 @@ import numpy as np
 
 from .._limits import MAX_MAGNITUDE
 from .._typing import FloatArray
-from ._discontinuous import Friction, NonsmoothLaw
+from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw
 from ._drag import Drag, drag_load
-from ._elastic import AbstractElastic, _check_real, _check_real_sequence
+from ._elastic import AbstractElastic, Piecewise, _check_real, _check_real_sequence
 from ._friction_system import FrictionSystem
 from ._readers import read_tables
 from ._system import ReducedElement, System
@@ -91,17 +91,20 @@ class Link:
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Element:
     """A clearance element ``name`` on δ = θ_i − θ_j (``between`` = (i, j)) with the stiffness
-    ``stiffness`` K_e of its unit-slope stage and the piecewise-linear ``law`` f_e; optionally
-    Coulomb ``friction`` r_e (relative to K_e: a hysteresis torque K_e r_e opposing δ', one level
-    for every stage or one per stage of the law, :class:`~rattle.model.Friction`).
+    ``stiffness`` K_e of its unit-slope stage and the piecewise-linear ``law`` f_e (continuous, or
+    with upward torque jumps: :class:`~rattle.model.Preload`, :class:`~rattle.model.PiecewiseJump`,
+    e.g. a torque-converter clutch); optionally Coulomb ``friction`` r_e (relative to K_e: a
+    hysteresis torque K_e r_e opposing δ', one level for every stage or one per stage of the law,
+    :class:`~rattle.model.Friction`).
 
-    A chain with friction on any element is solved by :func:`rattle.analysis.nonsmooth_response`
-    on :meth:`Chain.friction_system`; the smooth analyses refuse it."""
+    A chain with friction or a torque jump on any element is solved on
+    :meth:`Chain.friction_system` (:func:`rattle.analysis.nonsmooth_response`, the exact flow of
+    :class:`rattle.timeint.FrictionIntegrator`); the smooth analyses refuse it."""
 
     name: str
     between: tuple[int, int]
     stiffness: float
-    law: AbstractElastic
+    law: AbstractElastic | AbstractJumpLaw
     friction: Friction | None = None
 
     def __post_init__(self) -> None:
@@ -113,8 +116,9 @@ class Element:
         k = _check_real("stiffness", self.stiffness)
         if k <= 0:
             raise ValueError(f"`stiffness` of an element must be > 0, got {k!r}")
-        if not isinstance(self.law, AbstractElastic):
-            raise TypeError(f"`law` must be an elastic law (Linear, Backlash, Clutch, Piecewise), got {self.law!r}")
+        if not isinstance(self.law, (AbstractElastic, AbstractJumpLaw)):
+            raise TypeError(f"`law` must be an elastic law (Linear, Backlash, Clutch, Piecewise) or a law with "
+                            f"torque jumps (Preload, PiecewiseJump), got {self.law!r}")
         object.__setattr__(self, "stiffness", k)
         object.__setattr__(self, "between", _pair("between", self.between))
         if self.friction is not None:
@@ -126,6 +130,20 @@ class Element:
     def has_friction(self) -> bool:
         """A friction level > 0 on some stage."""
         return self.friction is not None and any(self.friction.levels)
+
+    @property
+    def has_jumps(self) -> bool:
+        """The law jumps (a torque jump J > 0 at some breakpoint: a preload)."""
+        return isinstance(self.law, AbstractJumpLaw) and bool(np.any(self.law.stages.jumps > 0))
+
+    def continuous_law(self) -> AbstractElastic:
+        """The law without its jumps: the same breakpoints and slopes, continuous, f(0) = 0 (the law
+        itself when it is continuous). The smooth equations of a chain carry it for an element with
+        jumps; the jumps are the :class:`~rattle.model.FrictionSystem`'s (:meth:`Chain.friction_system`)."""
+        if isinstance(self.law, AbstractElastic):
+            return self.law
+        st = self.law.stages
+        return Piecewise(breakpoints=tuple(st.breakpoints.tolist()), slopes=tuple(st.slopes.tolist()))
 
     def friction_levels(self) -> FloatArray:
         """r_e on every stage of the law (zeros without friction)."""
@@ -374,7 +392,7 @@ class Chain:
             names = tuple(f"theta{k + 1}" for k in range(N))
         P = D @ Minv
         elements = tuple(
-            ReducedElement(e.name, self._w(e.between) @ Z, P @ self._w(e.between) * e.stiffness, e.law)
+            ReducedElement(e.name, self._w(e.between) @ Z, P @ self._w(e.between) * e.stiffness, e.continuous_law())
             for e in self.elements
         )
         Fh = Th @ P.T
@@ -402,14 +420,22 @@ class Chain:
     def system(self) -> System:
         """The equations of motion in the coordinates the numerics use (:class:`System`).
 
-        Refused (ValueError) for a chain with friction: the smooth analyses would drop it; such a
-        chain is solved on :meth:`friction_system`."""
+        Refused (ValueError) for a chain with friction or with a torque jump (a preload) on an
+        element: the smooth analyses would drop them; such a chain is solved on
+        :meth:`friction_system`."""
         assert self._system is not None
         if self.has_friction:
             names = ", ".join(e.name for e in self.elements if e.has_friction)
             raise ValueError(
                 f"the chain has Coulomb friction on element(s) {names}: the smooth analyses (frf, sweep, "
                 "compare, map, orbit) do not hold a torque that jumps at zero relative speed; solve it with "
+                "rattle.analysis.nonsmooth_response(chain.friction_system(), ...)"
+            )
+        if self.has_jumps:
+            names = ", ".join(e.name for e in self.elements if e.has_jumps)
+            raise ValueError(
+                f"the chain has a torque jump (preload) in the law of element(s) {names}: the smooth analyses "
+                "(frf, sweep, compare, map, orbit) need a continuous law; solve it with "
                 "rattle.analysis.nonsmooth_response(chain.friction_system(), ...)"
             )
         return self._system
@@ -419,8 +445,22 @@ class Chain:
         """Some element carries Coulomb friction (a level > 0)."""
         return any(e.has_friction for e in self.elements)
 
+    @property
+    def has_jumps(self) -> bool:
+        """Some element's law has a torque jump (a preload: :class:`~rattle.model.Preload`,
+        :class:`~rattle.model.PiecewiseJump` with a jump > 0)."""
+        return any(e.has_jumps for e in self.elements)
+
+    @property
+    def discontinuous(self) -> bool:
+        """Friction or a torque jump on some element: the smooth analyses cannot be used, the chain
+        is solved on :meth:`friction_system`."""
+        return self.has_friction or self.has_jumps
+
     def friction_system(self) -> FrictionSystem:
-        """The equations of motion with every element's friction (:class:`FrictionSystem`)."""
+        """The equations of motion with every element's friction and torque jumps
+        (:class:`FrictionSystem`): its ``system`` holds the continuous part of every law (the law
+        without its jumps), its ``laws`` the whole law (:class:`NonsmoothLaw`: jumps and friction)."""
         assert self._system is not None
         laws = tuple(NonsmoothLaw(elastic=e.law, friction=e.friction) for e in self.elements)
         return FrictionSystem(system=self._system, laws=laws, speed_order=self.speed_order)
