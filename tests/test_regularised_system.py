@@ -148,8 +148,9 @@ def test_without_friction_it_is_the_smooth_harmonic_balance(kind: str) -> None:
         assert np.max(np.abs(hb.system.mean_slope(w))) > 0
 
 
-def test_single_equation_is_the_regularised_balance() -> None:
-    """δ'' + c δ' + k g(δ, δ') = F(t) as an n = 1 system and as the scalar problem: same numbers."""
+def _single_equation_pair() -> tuple[RegularisedSystemBalance, RegularisedBalance]:
+    """δ'' + c δ' + k g(δ, δ') = F(t) as an n = 1 chain problem and as the scalar problem, with the
+    same widths of the smooth steps (H = 24, ε = 0.02 for the chain)."""
     c, k, law, mean, amps, phases = 0.15, 3.0, Clutch(alpha=0.2, b=0.1), 0.15, (0.3, 0.1), (0.4, -1.0)
     fs = FrictionSystem.from_system(single_equation_system(c, k, law, mean, amps, phases), (CLUTCH_R,))
     opts = HBOptions(harmonics=24)
@@ -159,7 +160,13 @@ def test_single_equation_is_the_regularised_balance() -> None:
     L_ns = nsys.length_scale()  # the scalar problem's own scale: ε rescaled to the same widths
     ref = RegularisedBalance(c, nsys, mean, amps, phases, regularisation=0.02 * pb.length_scale / L_ns,
                              length_scale=L_ns, frequency_scale=math.sqrt(k * 1.0), options=opts)
-    assert pb.parameter_scale == pytest.approx(math.sqrt(k))
+    return pb, ref
+
+
+def test_single_equation_is_the_regularised_balance() -> None:
+    """δ'' + c δ' + k g(δ, δ') = F(t) as an n = 1 system and as the scalar problem: same numbers."""
+    pb, ref = _single_equation_pair()
+    assert pb.parameter_scale == pytest.approx(math.sqrt(3.0))
     np.testing.assert_allclose(pb.widths, ref.widths, rtol=1e-14)
     w = 0.6 * pb.parameter_scale
     q = _random_q(pb, w)
@@ -328,15 +335,7 @@ def test_regularised_monodromy_of_one_coordinate_is_the_single_equations() -> No
     equation's closed-form 2 × 2 one (:func:`regularised_monodromy`) on the same series."""
     from rattle.stability import regularised_monodromy, regularised_system_monodromy
 
-    c, k, law, mean, amps, phases = 0.15, 3.0, Clutch(alpha=0.2, b=0.1), 0.15, (0.3, 0.1), (0.4, -1.0)
-    fs = FrictionSystem.from_system(single_equation_system(c, k, law, mean, amps, phases), (CLUTCH_R,))
-    opts = HBOptions(harmonics=24)
-    pb = RegularisedSystemBalance(fs, regularisation=0.02, options=opts)
-    nsys = NonsmoothSystem(damping=c, stiffness=k, law=NonsmoothLaw(elastic=law, friction=Friction(levels=CLUTCH_R)),
-                           excitation=Excitation(mean=mean, amplitudes=amps, phases=phases))
-    L_ns = nsys.length_scale()
-    ref = RegularisedBalance(c, nsys, mean, amps, phases, regularisation=0.02 * pb.length_scale / L_ns,
-                             length_scale=L_ns, frequency_scale=math.sqrt(k * 1.0), options=opts)
+    pb, ref = _single_equation_pair()
     w = 0.6 * pb.parameter_scale
     q = _random_q(pb, w)
     M = regularised_system_monodromy(pb, q, w)
