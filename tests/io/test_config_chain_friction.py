@@ -138,15 +138,58 @@ def test_bad_friction_is_refused_naming_the_key(friction, fragments):
     _refused(_chain(friction), *fragments)
 
 
-def test_a_preload_on_an_element_is_refused_saying_only_friction_is_solved_for_chains():
-    _refused(_chain(preload=0.05), "`model.elements[0].preload`", "solved for the single equation only",
-             "Coulomb friction per stage (`friction`)")
+def _preload_chain(**element) -> dict:
     data = _chain()
-    data["model"]["elements"][0] = {"name": "tc", "between": [1, 2], "stiffness": 1.0, "type": "preload",
-                                    "preload": 0.05, "friction": 0.01}
-    _refused(data, "`model.elements[0].preload`", "solved for the single equation only")
-    data["model"]["elements"][0].pop("preload")
-    _refused(data, "`model.elements[0].type`", "solved for the single equation only")
+    data["model"]["elements"][0] = {"name": "tc", "between": [1, 2], "stiffness": 2.0, "type": "preload",
+                                    "preload": 0.05, **element}
+    return data
+
+
+def test_a_preload_element_makes_the_chain_a_friction_system_with_its_jump():
+    """type = "preload" on an element: the torque jump (relative to K_e), optional clearance (also in
+    degrees) and friction; the chain without jumps and friction (the laws' continuous parts) sets
+    the bounds."""
+    from rattle.model import Preload
+
+    rc = config_from_dict(_preload_chain(friction=0.01, clearance_deg=1.0, slope=0.5))
+    assert isinstance(rc.model, FrictionSystem) and rc.model.has_jumps and rc.chain_friction
+    b = math.radians(1.0)
+    assert rc.model.laws[0].elastic == Preload(preload=0.05, clearance=b, slope=0.5)
+    np.testing.assert_array_equal(rc.model.friction_levels(0), [0.01, 0.01, 0.01])
+    np.testing.assert_array_equal(rc.model.laws[0].stages.jumps, [0.05, 0.05])
+    assert isinstance(rc.continuous_model, Chain) and not rc.continuous_model.discontinuous
+    rc.continuous_model.system()  # the smooth chain exists (the bounds read it)
+    # without friction, the jump alone
+    rc = config_from_dict(_preload_chain())
+    assert isinstance(rc.model, FrictionSystem) and rc.model.has_jumps and not rc.model.has_friction
+    # a zero preload without friction is the continuous chain
+    rc = config_from_dict(_preload_chain(preload=0.0))
+    assert isinstance(rc.model, Chain) and not rc.model.discontinuous
+
+
+def test_a_preload_in_si_is_divided_by_the_element_stiffness():
+    data = _preload_chain(preload=3.0, friction=1.0)
+    data["model"]["units"] = "SI"
+    rc = config_from_dict(data)
+    assert rc.model.laws[0].elastic.preload == pytest.approx(3.0 / 2.0, rel=1e-15)
+    np.testing.assert_allclose(rc.model.friction_levels(0), [0.5, 0.5], rtol=1e-15)
+
+
+@pytest.mark.parametrize("element, fragments", [
+    ({"preload": -0.01}, ["`model.elements[0].preload`", "must be >= 0"]),
+    ({"preload": "0.05"}, ["`model.elements[0].preload` must be a number"]),
+    ({"slope": 0.0}, ["`model.elements[0].slope` must be > 0"]),
+    ({"friction": [0.01, 0.02, 0.03]}, ["`model.elements[0].friction` must hold one level",
+                                        'type = "preload" has 2 stages']),
+    ({"b": 0.1}, ["`model.elements[0].b` does not belong to type = \"preload\"", "preload, clearance, slope"]),
+])
+def test_a_bad_preload_element_is_refused_naming_the_key(element, fragments):
+    _refused(_preload_chain(**element), *fragments)
+
+
+def test_a_preload_key_on_another_law_points_to_the_preload_type():
+    _refused(_chain(preload=0.05), "`model.elements[0].preload` does not belong to type = \"clutch\"",
+             'choose a type that uses it ("preload")')
 
 
 def test_an_unknown_element_key_names_friction_among_the_allowed_ones():

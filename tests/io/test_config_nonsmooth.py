@@ -155,21 +155,8 @@ def test_refusals_name_the_key_show_the_value_and_state_the_rule(elastic, analys
     _refused(_base(elastic, **analysis), *fragments)
 
 
-def _chain() -> dict:
-    return {
-        "model": {"inertias": [2.0, 2.0], "links": [{"between": [1, 2], "damping": 0.1}],
-                  "elements": [{"name": "clutch", "between": [1, 2], "stiffness": 1.0, "type": "clutch",
-                                "alpha": 0.25, "b": 0.1}]},
-        "excitation": {"torques": [{"inertia": 1, "mean": 0.05, "amplitudes": [0.06]}]},
-    }
-
-
-def test_a_preload_on_a_chain_and_friction_on_a_gear_mesh_are_refused_naming_the_key():
-    # friction on [[model.elements]] is accepted (tests/io/test_config_chain_friction.py)
-    data = _chain()
-    data["model"]["elements"][0] = {"name": "tc", "between": [1, 2], "stiffness": 1.0, "type": "preload",
-                                    "preload": 0.05}
-    _refused(data, "`model.elements[0].preload`", "solved for the single equation only")
+def test_friction_on_a_gear_mesh_is_refused_naming_the_key():
+    # friction and type = "preload" on [[model.elements]] are accepted (tests/io/test_config_chain_friction.py)
     data = {"model": {"units": "SI", "gear_pair": {"base_radii": [0.03, 0.05], "inertias": [1e-3, 3e-3],
                                                    "mesh_stiffness": 2e8, "mesh_damping_ratio": 0.05,
                                                    "backlash_um": 60.0, "friction": 0.1}},

@@ -309,23 +309,9 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
 
 
 def _refuse_discontinuous_in_chain(check: _Checker, model_t: Mapping[str, Any]) -> None:
-    """A preload on a chain's element (``preload`` or type = "preload"), and a preload or friction on
-    a gear pair or loose gear, is refused: in a chain only Coulomb friction on the elements
-    (``[[model.elements]] friction``, also on the damper and spline shapes) is solved; a torque
-    jump is solved for the single equation only."""
-    elements = model_t.get("elements")
-    for k, t in enumerate(elements if isinstance(elements, list) else []):
-        if not isinstance(t, Mapping):
-            continue
-        name = f"model.elements[{k}]"
-        key = f"{name}.preload" if "preload" in t else f"{name}.type" if t.get("type") == "preload" else None
-        if key is not None:
-            raise check.error(
-                f"`{key}`: a preload (a torque jump at δ = 0) is solved for the single equation only ([model] "
-                "inertia, damping, stiffness with [model.elastic] type = \"preload\"); a chain's elements take the "
-                "continuous laws, with Coulomb friction per stage (`friction`) as the only discontinuity: remove "
-                "it, or model the clutch alone as the single equation"
-            )
+    """A preload or friction on a gear pair or loose gear is refused: the mesh is a backlash law.
+    (Friction and torque jumps on a chain's ``[[model.elements]]`` are solved, and friction on the
+    damper and spline shapes.)"""
     for shape in ("gear_pair", "loose_gear"):
         t = model_t.get(shape)
         if not isinstance(t, Mapping):
@@ -333,9 +319,9 @@ def _refuse_discontinuous_in_chain(check: _Checker, model_t: Mapping[str, Any]) 
         key = next((f"model.{shape}.{k}" for k in ("friction", "preload") if k in t), None)
         if key is not None:
             raise check.error(
-                f"`{key}`: a gear mesh takes no preload or Coulomb friction (the mesh is a backlash law); friction "
-                "is solved on the elements of a chain ([[model.elements]] friction) and a preload for the single "
-                "equation: remove it"
+                f"`{key}`: a gear mesh takes no preload or Coulomb friction (the mesh is a backlash law); both "
+                "are solved on the elements of a chain ([[model.elements]] friction, type = \"preload\"): remove "
+                "it, or write the mesh as an element"
             )
 
 
@@ -364,10 +350,10 @@ def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>") -> M
     elements = model_t.get("elements")
     for k, t in enumerate(elements if isinstance(elements, list) else []):
         kind = t.get("type") if isinstance(t, Mapping) else None
-        if isinstance(kind, str) and kind not in ELASTIC_LAWS and kind not in SUBSYSTEM_TYPES:
+        if isinstance(kind, str) and kind not in ELASTIC_LAWS and kind != "preload" and kind not in SUBSYSTEM_TYPES:
             from ._table_checks import _did_you_mean
 
-            types = [*ELASTIC_LAWS, *SUBSYSTEM_TYPES]
+            types = [*ELASTIC_LAWS, "preload", *SUBSYSTEM_TYPES]
             hint = _did_you_mean(kind, types).replace("`", '"')
             raise check.error(
                 f"`model.elements[{k}].type` must be one of {', '.join(_show(x) for x in types)}, got {_show(kind)}; "

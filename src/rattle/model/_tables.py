@@ -21,9 +21,9 @@ speed_rpm, mean_torque, orders, amplitudes, phases) resolved here into an ordina
 harmonics of the orders' base order (:mod:`._engine`) and ``Chain.speed_order``; ``[drag]``.
 The data-sheet shapes (damper, spline, gear pair, loose gear) are first rewritten into these
 tables (:mod:`._table_shapes`). ``[[model.elements]] friction`` (Coulomb levels, one or one per
-stage of the element's law, relative to its stiffness K_e, or in N m with ``units = "SI"``) makes
-the model the chain's :class:`FrictionSystem`; a preload on an element is refused (solved for the
-single equation only).
+stage of the element's law, relative to its stiffness K_e, or in N m with ``units = "SI"``) and
+``[[model.elements]] type = "preload"`` (a torque jump, ``preload``, ``clearance``, ``slope``, the
+jump relative to K_e or in N m) make the model the chain's :class:`FrictionSystem`.
 
 The run's own tables, ``[analysis]`` and ``[[paths]]``, are known here by name only: the
 configuration reader (:mod:`rattle.io`) reads them and, from an ``[engine]``'s speed range
@@ -399,7 +399,9 @@ def _model_in_radians(check: _Checker, model_t: Mapping[str, Any]) -> dict[str, 
                                      angles=(*ANGLE_KEYS, "clearance"))
     elements = out.get("elements")
     if isinstance(elements, (list, tuple)) and all(isinstance(t, Mapping) for t in elements):
-        out["elements"] = [_in_radians(check, t, f"model.elements[{k}]", [*_MODEL_ELEMENTS_KEYS, "friction", *laws])
+        out["elements"] = [_in_radians(check, t, f"model.elements[{k}]",
+                                       [*_MODEL_ELEMENTS_KEYS, "friction", *laws, *_MODEL_ELASTIC_KEYS],
+                                       angles=(*ANGLE_KEYS, "clearance"))
                            for k, t in enumerate(elements)]
     return out
 
@@ -613,6 +615,8 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                                   "(one level per stage of the law)") from None
         elastic = check.build(law, {f: f"{where}.{f}" for f in law_params} or {"type": f"{where}.type"},
                               **{f: law_t[f] for f in law_params if f in law_t})
+        if isinstance(elastic, Preload):  # a torque jump: relative to K_e like the slopes (N m with SI)
+            elastic = _element_preload(check, elastic, t, where, units)
         friction = _element_friction(check, elastic, t, where, units)
         elements.append(check.build(Element, {"name": f"{where}.name", "between": f"{where}.between",
                                               "stiffness": f"{where}.stiffness", "friction": f"{where}.friction"},
@@ -653,11 +657,26 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                               "engine order to map rpm to Ω: give an [engine] (or `model.speed_order`)")
     chain = check.build(Chain, names, inertias=model_t["inertias"], links=tuple(links), elements=tuple(elements),
                         torques=tuple(torques), speed_order=speed_order, drag=drag)
-    if chain.has_friction:  # the equations with every element's friction; the chain without it sets the bounds
-        smooth = dataclasses.replace(chain, elements=tuple(dataclasses.replace(e, friction=None) for e in elements))
+    if chain.discontinuous:  # the equations with every element's friction and jumps; the chain without
+        # them (every law's continuous part) sets the bounds
+        smooth = dataclasses.replace(chain, elements=tuple(dataclasses.replace(e, friction=None, law=e.continuous_law())
+                                                           for e in elements))
         return ModelTables(model=chain.friction_system(), units=units, continuous_model=smooth, engine=engine,
                            chain=chain)
     return ModelTables(model=chain, units=units, engine=engine)
+
+
+def _element_preload(check: _Checker, elastic: Preload, t: Mapping[str, Any], where: str, units: str) -> Preload:
+    """``[[model.elements]] type = "preload"``: the torque jump T_p relative to the element's
+    stiffness K_e (the jump is K_e T_p each way), or in N m with ``units = "SI"``, divided here by
+    K_e; a clearance in degrees by mistake is warned about as for the single equation."""
+    if elastic.clearance > 0:
+        check.build(_limits.warn_clearance, {"clearance": f"{where}.clearance"}, b=elastic.clearance,
+                    name="clearance", stacklevel=2)
+    K = float(t["stiffness"])
+    if units == "SI" and K > 0:  # a stiffness <= 0 is refused by Element
+        return Preload(preload=elastic.preload / K, clearance=elastic.clearance, slope=elastic.slope)
+    return elastic
 
 
 def _element_friction(check: _Checker, elastic: Any, t: Mapping[str, Any], where: str, units: str) -> Friction | None:
