@@ -1,10 +1,12 @@
-"""Event-driven exact integration of a chain with Coulomb friction on its elements (Filippov).
+"""Event-driven exact integration of a chain with Coulomb friction and torque jumps on its elements (Filippov).
 
 The equations (:class:`~rattle.model.FrictionSystem`; x ∈ ℝⁿ, m elements, δ_e = a_e·x)
 
     x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn(δ_e')] = F(t),
 
-f_e continuous piecewise linear (slope k_ej, offset o_ej on stage j), r_e(δ) = r_ej ≥ 0 on stage j.
+f_e piecewise linear (slope k_ej, offset o_ej on stage j: the law's own offsets, so upward jumps
+J_ei = f_e(d_i⁺) − f_e(d_i⁻) ≥ 0 at its breakpoints are allowed, a preload), r_e(δ) = r_ej ≥ 0 on
+stage j.
 
 **Modes.** Every element with friction either *slips* with a sign σ_e = sgn δ_e' ∈ {−1, +1} or
 *sticks* (e ∈ S): δ_e' ≡ 0, its friction torque λ_e whatever holds it, |λ_e| ≤ r_ej (the
@@ -31,12 +33,27 @@ brackets them, Brent's method refines them):
 - δ_e' reaches 0 (slipping e with friction somewhere on its law; a minimum of σ_e δ_e' inside a
   grid cell is refined too, so that a touch is not missed): the new mode is chosen by the
   active-set rule below with e a candidate to stick;
-- λ_e reaches ±r_ej (stuck e): e slips with σ_e = sgn λ_e.
+- λ_e reaches ±r_ej (stuck e): e slips with σ_e = sgn λ_e; a locked e's λ_e leaves its band.
 
 *Active set.* Candidates C (the stuck elements and the one whose velocity vanished): compute λ on C;
 while some |λ_e| > r_ej, release the worst one with σ_e = sgn λ_e (then e accelerates the way
 sgn λ_e says: e_e'' = (a_e·b_e)(λ_e − σ_e r_ej)) and recompute. Elements at zero velocity at the
 start are candidates too.
+
+**Locks at a jump.** An element may be held at a breakpoint d_i where its law jumps (J_ei > 0):
+δ_e ≡ d_i, δ_e' ≡ 0, a constraint exactly like a stick (it joins the held set S, its torque is the
+same λ_e), with the asymmetric band λ_e ∈ [−r_ei, J_ei + r_e,i+1] (λ relative to the stage-i value
+f_e(d_i⁻): the element sits on stage i). It ends when λ_e leaves the band: above, e slips up
+(stage i + 1, σ = +1), below, down (stage i, σ = −1); the fields agree there (S = I). It is reached
+by a chatter across the jump (Zeno with friction, an exponential decay without): at a crossing of
+the jump with speed v, when the acceleration on the side entered points back and the next
+excursion v²/(2|δ_e''⁺|) is at most ``lock_excursion`` · L, and the active set keeps e held, the
+element locks. The chatter's relay torque acts along b_e and the held elements' reactions, so its
+limit removes v along w_e = B_S (A_S B_S)⁻¹ ê_e (a_e·w_e = 1, a_k·w_e = 0 for the other held k):
+x' ← x' − w_e (a_e·x'), momentum-conserving. Its saltation, the crossing's with the locked field
+as φ⁺ composed with that removal (the 1/v terms lie along w_e and cancel), is
+S = blockdiag(Π, Π), Π = I − w_e a_eᵀ (0 for one coordinate: the single equation's lock). An
+element at rest within round-off of a jump at the start is a lock candidate, with that saltation.
 
 **Saltation.** Across a switching surface h(z) = 0 (normal n = ∇h) from the field φ⁻ to φ⁺,
 
@@ -44,8 +61,8 @@ start are candidates too.
 
 with h = a_e·x − d (breakpoint; nᵀφ⁻ = δ_e'), h = a_e·x' (velocity zero; nᵀφ⁻ = δ_e''⁻). On entry
 into a stick φ⁺ is the sliding field, nᵀφ⁺ = 0, and nᵀ S = 0: the δ_e'-perturbation is removed.
-At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. Between events the
-sensitivity is the mode's exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the
+At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. A crossing of a jump has φ⁺ ≠ φ⁻ (the
+stages on each side) and S ≠ I. Between events the sensitivity is the mode's exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the
 Floquet multipliers of :func:`shoot_friction_orbit`. Not resolved: a tangential touch of a
 switching surface (grazing: the map is not differentiable there) and stuck sets closing a loop.
 """
@@ -75,9 +92,10 @@ _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(16)
 
-#: Event kinds of a :class:`FrictionTrajectory`.
-CROSSING, STICK, REVERSAL, RELEASE = 0, 1, 2, 3
-EVENT_NAMES = ("crossing", "stick", "reversal", "release")
+#: Event kinds of a :class:`FrictionTrajectory` (``lock``/``unlock``: an element held at a jump of
+#: its law, ``event_values`` the breakpoint).
+CROSSING, STICK, REVERSAL, RELEASE, LOCK, UNLOCK = 0, 1, 2, 3, 4, 5
+EVENT_NAMES = ("crossing", "stick", "reversal", "release", "lock", "unlock")
 
 _Key = tuple[tuple[bool, ...], tuple[int, ...]]  # (stuck per element, σ per element: 0 stuck / frictionless)
 
@@ -98,9 +116,11 @@ def _brent(fun, a: float, b: float, fa: float, fb: float) -> float:  # type: ign
 class FrictionTrajectory:
     """The exact motion from ``t0`` to ``t1``: ``state0``, ``state1`` (2n,) and the sensitivity
     ∂z(t1)/∂z(t0) (stage transitions and saltation matrices); per segment its start time
-    ``t_start`` (and ``t_end``), the element ``stages`` (k, m), the ``stuck`` flags (k, m) and
-    the exact :class:`~._stage_flow.Segment`; the events (``event_times``, ``event_elements``,
-    ``event_kinds`` indexing :data:`EVENT_NAMES`, ``event_values``: the breakpoint crossed)."""
+    ``t_start`` (and ``t_end``), the element ``stages`` (k, m), the ``stuck`` flags (k, m: held
+    by friction or locked at a jump), the ``locked`` flags (k, m: held at a jump of its law, on the
+    stage below it) and the exact :class:`~._stage_flow.Segment`; the events (``event_times``,
+    ``event_elements``, ``event_kinds`` indexing :data:`EVENT_NAMES`, ``event_values``: the
+    breakpoint crossed, locked on or left)."""
 
     system: FrictionSystem
     omega: float
@@ -118,6 +138,7 @@ class FrictionTrajectory:
     event_elements: np.ndarray
     event_kinds: np.ndarray
     event_values: FloatArray
+    locked: np.ndarray | None = None
 
     def segment_index(self, t: FloatArray | float) -> np.ndarray:
         t = np.asarray(t, dtype=float)
@@ -173,9 +194,16 @@ class FrictionTrajectory:
         return s[:m], np.sqrt(np.maximum(s[m:], 0.0))
 
     def stick_time(self) -> FloatArray:
-        """Time every element spends stuck, (m,)."""
+        """Time every element spends stuck or locked, (m,)."""
         dur = self.t_end - self.t_start
         return (self.stuck * dur[:, None]).sum(axis=0)
+
+    def lock_time(self) -> FloatArray:
+        """Time every element spends locked at a jump of its law, (m,) (part of :meth:`stick_time`)."""
+        if self.locked is None:
+            return np.zeros(self.stuck.shape[1])
+        dur = self.t_end - self.t_start
+        return (self.locked * dur[:, None]).sum(axis=0)
 
     def stick_intervals(self, element: int) -> list[tuple[float, float]]:
         """The [start, end] time intervals where ``element`` sticks (merged)."""
@@ -214,6 +242,10 @@ class FrictionIntegrator:
         self.B = base.element_columns.reshape(self.n, self.m)
         self.levels = [np.asarray(system.friction_levels(e), dtype=float) for e in range(self.m)]
         self.has_friction = [bool(np.any(r > 0)) for r in self.levels]
+        # the law's own stages (jumps included): every mode reads these offsets, not the smooth system's
+        self.offsets = [np.asarray(law.stages.offsets, dtype=float) for law in system.laws]
+        self.jumps = [np.asarray(law.stages.jumps, dtype=float) for law in system.laws]
+        self.breakpoints = [np.asarray(law.stages.breakpoints, dtype=float) for law in system.laws]
         self._modal: dict = {}
         self._omega: float | None = None
         self._flows: dict = {}
@@ -231,11 +263,9 @@ class FrictionIntegrator:
             P = P - BS @ np.linalg.solve(AS @ BS, AS)
         elements = []
         for e, el in enumerate(base.elements):
-            law = el.law
-            if sigma[e]:
-                st = el.law.stages
-                law = SimpleNamespace(stages=SimpleNamespace(breakpoints=st.breakpoints, slopes=st.slopes,
-                                                             offsets=st.offsets + sigma[e] * self.levels[e]))
+            st = el.law.stages  # the law's own offsets (its jumps included) and the slip friction
+            law = SimpleNamespace(stages=SimpleNamespace(breakpoints=st.breakpoints, slopes=st.slopes,
+                                                         offsets=self.offsets[e] + sigma[e] * self.levels[e]))
             elements.append(ReducedElement(el.name, el.a, P @ el.b, law))  # type: ignore[arg-type]
         return System(damping=P @ base.damping, stiffness=P @ base.stiffness, elements=tuple(elements),
                       mean=P @ base.mean_at(omega), cos=base.cos @ P.T, sin=base.sin @ P.T,
@@ -282,14 +312,14 @@ class FrictionIntegrator:
 
     def _free_acceleration(self, key: _Key, stages: tuple[int, ...], t: FloatArray | float, z: FloatArray,
                            omega: float) -> FloatArray:
-        """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,) (z: t.shape + (2n,))."""
+        """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,) (z: t.shape + (2n,));
+        o_ej the law's own offsets (jumps included)."""
         n = self.n
         base = self.base
         x, v = z[..., :n], z[..., n:]
-        const = base.stage_offset(stages).copy()
+        const = np.zeros(n)
         for e in range(self.m):
-            if key[1][e]:
-                const += key[1][e] * self.levels[e][stages[e]] * self.B[:, e]
+            const += (self.offsets[e][stages[e]] + key[1][e] * self.levels[e][stages[e]]) * self.B[:, e]
         return base.forcing(t, omega) - v @ base.damping.T - x @ base.stage_stiffness(stages).T - const
 
     def _lambdas(self, S: list[int], y: FloatArray) -> FloatArray:
@@ -297,43 +327,82 @@ class FrictionIntegrator:
         AS, BS = self.A[S], self.B[:, S]
         return y @ np.linalg.solve(AS @ BS, AS).T
 
+    def _band(self, e: int, stage: int, locked: bool) -> tuple[float, float]:
+        """The band [lo, hi] of a held element's torque λ_e: ±r_ej when stuck on stage j; when
+        locked at the jump i above its stage i, [−r_ei, J_ei + r_e,i+1] (λ relative to the stage-i
+        value f(d_i⁻), which y holds)."""
+        r = self.levels[e]
+        if locked:
+            return -float(r[stage]), float(self.jumps[e][stage] + r[stage + 1])
+        return -float(r[stage]), float(r[stage])
+
     def _settle(self, t: float, z: FloatArray, stages: tuple[int, ...], candidates: list[int],
-                sigma: list[int], omega: float, tol: float = 1e-12) -> _Key:
-        """The active-set choice of the stuck set among ``candidates`` (module docstring); a
-        torque exceeding its band by less than ``tol`` (relative) still holds."""
+                sigma: list[int], omega: float, tol: float = 1e-12,
+                locked: tuple[bool, ...] | None = None) -> tuple[_Key, tuple[int, ...], tuple[bool, ...]]:
+        """The active-set choice of the held set among ``candidates`` (module docstring): stuck
+        elements and elements ``locked`` at a jump; a torque beyond its band by less than ``tol``
+        (relative) still holds. A released lock leaves upwards (stage i + 1, σ = +1) when its torque
+        exceeds the band, else downwards (stage i, σ = −1). Returns (key, stages, locked)."""
         S = sorted(set(candidates))
         sigma = list(sigma)
+        st = list(stages)
+        lk = [False] * self.m if locked is None else list(locked)
+        for e in range(self.m):
+            if e not in S:
+                lk[e] = False
         for e in S:
             sigma[e] = 0
         while S:
             key = (tuple(e in S for e in range(self.m)), tuple(sigma))
-            lam = self._lambdas(S, self._free_acceleration(key, stages, t, z, omega))
-            worst, e_w, l_w = 0.0, -1, 0.0
+            lam = self._lambdas(S, self._free_acceleration(key, tuple(st), t, z, omega))
+            worst, e_w, up_w = 0.0, -1, False
             for e, lam_e in zip(S, lam.tolist()):
-                r = float(self.levels[e][stages[e]])
-                excess = abs(lam_e) - r
-                if excess > tol * max(r, abs(lam_e), 1e-300) and excess > worst:
-                    worst, e_w, l_w = excess, e, lam_e
+                lo, hi = self._band(e, st[e], lk[e])
+                excess = max(lo - lam_e, lam_e - hi)
+                if excess > tol * max(hi, -lo, abs(lam_e), 1e-300) and excess > worst:
+                    worst, e_w, up_w = excess, e, lam_e > hi
             if e_w < 0:
                 break
             S.remove(e_w)
-            sigma[e_w] = 1 if l_w > 0 else -1
-        return tuple(e in S for e in range(self.m)), tuple(sigma)
+            if lk[e_w]:
+                lk[e_w] = False
+                if up_w:
+                    st[e_w] += 1
+            sigma[e_w] = (1 if up_w else -1) if self.has_friction[e_w] else 0
+        return (tuple(e in S for e in range(self.m)), tuple(sigma)), tuple(st), tuple(lk)
 
-    def _initial_key(self, t: float, z: FloatArray, stages: tuple[int, ...], omega: float) -> _Key:
+    def _hold_columns(self, S: list[int]) -> FloatArray:
+        """W = B_S (A_S B_S)⁻¹ (n, |S|): column w_e moves element e alone (a_e·w_e = 1, a_k·w_e = 0 for
+        the other held k) along the constraint forces."""
+        AS, BS = self.A[S], self.B[:, S]
+        return BS @ np.linalg.inv(AS @ BS)
+
+    def _initial_key(self, t: float, z: FloatArray, stages: tuple[int, ...],
+                     omega: float) -> tuple[_Key, tuple[int, ...], tuple[bool, ...]]:
+        """The mode at the start: friction elements at rest are stick candidates; an element within
+        round-off of a jump of its law, at rest, is a lock candidate (on the stage below the jump)."""
         n = self.n
         dv = self.A @ z[n:]
+        dd = self.A @ z[:n]
         tol = 64.0 * _EPS * self.velocity_scale(omega)
         sigma = [0] * self.m
+        st = list(stages)
+        lk = [False] * self.m
         cands = []
         for e in range(self.m):
-            if not self.has_friction[e]:
+            at_rest = abs(dv[e]) <= tol
+            bp, J = self.breakpoints[e], self.jumps[e]
+            near = np.flatnonzero((J > 0) & (np.abs(bp - dd[e]) <= 64.0 * _EPS * np.maximum(self._L, np.abs(bp))))
+            if at_rest and near.size:
+                st[e], lk[e] = int(near[0]), True
+                cands.append(e)
+            elif not self.has_friction[e]:
                 continue
-            if abs(dv[e]) <= tol:
+            elif at_rest:
                 cands.append(e)
             else:
                 sigma[e] = 1 if dv[e] > 0 else -1
-        return self._settle(t, z, stages, cands, sigma, omega)
+        return self._settle(t, z, tuple(st), cands, sigma, omega, locked=tuple(lk))
 
     def _field(self, key: _Key, stages: tuple[int, ...], t: float, z: FloatArray, omega: float) -> FloatArray:
         """φ = (x', x'') of the mode ``key`` at (t, z), (2n,)."""
@@ -354,7 +423,7 @@ class FrictionIntegrator:
         t0, t1 = float(t0), float(t1)
         if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
             raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
-        rec: dict[str, list] = {k: [] for k in ("ts", "st", "sk", "seg", "et", "ee", "ek", "ev")}
+        rec: dict[str, list] = {k: [] for k in ("ts", "st", "sk", "lk", "seg", "et", "ee", "ek", "ev")}
         z1, M = self._march(z, t0, t1, omega, rec)
         ts = np.asarray(rec["ts"], dtype=float)
         return FrictionTrajectory(
@@ -363,6 +432,7 @@ class FrictionIntegrator:
             stuck=np.asarray(rec["sk"], dtype=bool).reshape(-1, self.m), segments=tuple(rec["seg"]),
             event_times=np.asarray(rec["et"], dtype=float), event_elements=np.asarray(rec["ee"], dtype=np.int64),
             event_kinds=np.asarray(rec["ek"], dtype=np.int64), event_values=np.asarray(rec["ev"], dtype=float),
+            locked=np.asarray(rec["lk"], dtype=bool).reshape(-1, self.m),
         )
 
     def advance(self, z0: FloatArray, t0: float, t1: float, omega: float) -> tuple[FloatArray, FloatArray]:
@@ -373,16 +443,26 @@ class FrictionIntegrator:
                rec: dict[str, list] | None) -> tuple[FloatArray, FloatArray]:
         n, m = self.n, self.m
         stages = self._flow(((False,) * m, (0,) * m), omega).stages_at(t0, z)
-        key = self._initial_key(t0, z, stages, omega)
+        key, stages, locked = self._initial_key(t0, z, stages, omega)
         t = t0
         M = np.eye(2 * n)
         S = [e for e in range(m) if key[0][e]]
         if S:  # a start in a stick: a perturbation of δ_e' slips and sticks again at once, which
-            # removes it (the entry saltation, whichever its sign): δx' → P_S δx'
-            AS, BS = self.A[S], self.B[:, S]
-            M[n:, n:] -= BS @ np.linalg.solve(AS @ BS, AS)
+            # removes it (the entry saltation, whichever its sign): δx' → P_S δx'; a start in a lock
+            # also removes the perturbation of δ_e (it spirals into the same lock): δx → δx − w_e a_e·δx
+            W = self._hold_columns(S)
+            M[n:, n:] -= W @ self.A[S]
+            for k, e in enumerate(S):
+                if locked[e]:
+                    a = self.A[e]
+                    d = float(self.breakpoints[e][stages[e]])
+                    z[:n] += a * ((d - float(a @ z[:n])) / float(a @ a))
+                    z[n:] -= W[:, k] * float(a @ z[n:])
+                    M[:n, :n] -= np.outer(W[:, k], a)
+        x_lock = self.options.lock_excursion * self._L
         events = 0
         idle = 0
+        last = (-1, -1, math.nan)  # the last event (element, kind, breakpoint): names a chatter
         while True:
             flow = self._flow(key, omega)
             sol = self._solution(flow, key, stages)
@@ -398,17 +478,22 @@ class FrictionIntegrator:
                 tau_b, e_b, direction = first_exit(seg, lo, hi, tau_lim, sol.grid_step, flow.samples_per_scale)
             else:
                 tau_b, e_b, direction = tau_lim, -1, 0
-            tau_f, e_f, kind_f, sign_f = self._friction_event(seg, sol, key, stages, tau_b, omega)
+            tau_f, e_f, kind_f, sign_f = self._friction_event(seg, sol, key, stages, tau_b, omega, locked)
             if e_f >= 0 and tau_f <= tau_b:
                 tau, e_ev, kind = tau_f, e_f, kind_f
             elif e_b >= 0:
                 tau, e_ev, kind = tau_b, e_b, CROSSING
+                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
+                i_bp = stages[e_ev] if direction > 0 else stages[e_ev] - 1
+                if self.jumps[e_ev][i_bp] > 0.0 or self.levels[e_ev][i_bp] != self.levels[e_ev][i_bp + 1]:
+                    tau = self._polish_crossing(seg, e_ev, bound, tau, tau_lim)
             else:
                 tau, e_ev, kind = tau_b, -1, -1
             if rec is not None and (tau > 0.0 or not rec["ts"]):
                 rec["ts"].append(t)
                 rec["st"].append(stages)
                 rec["sk"].append(stuck)
+                rec["lk"].append(locked)
                 rec["seg"].append(seg)
             if tau > 0.0:
                 M = sol.transition(tau) @ M
@@ -431,36 +516,54 @@ class FrictionIntegrator:
                 continue
             events += 1
             if events > self.options.max_events:
-                raise ConvergenceError(
-                    f"more than `max_events` = {self.options.max_events} events between t0 = {t0!r} and t1 = {t1!r} "
-                    "(stick–slip chatter?): raise NonsmoothOptions(max_events=...) or shorten the interval"
-                )
+                raise ConvergenceError(self._budget_message(t0, t1, last))
             a = self.A[e_ev]
             phi_minus = self._field(key, stages, t, zc, omega)
             value = math.nan
+            normal: FloatArray | None = None
             if kind == CROSSING:
-                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
                 zc[:n] += a * ((bound - float(a @ zc[:n])) / float(a @ a))
                 value = bound
-                stages = stages[:e_ev] + (stages[e_ev] + direction,) + stages[e_ev + 1:]
+                new_stages = stages[:e_ev] + (stages[e_ev] + direction,) + stages[e_ev + 1:]
                 cands = [e for e in range(m) if stuck[e]]
-                new_key = self._settle(t, zc, stages, cands, list(key[1]), omega)
-                normal = np.concatenate((a, np.zeros(n)))
+                new_key, new_stages, new_locked = self._settle(t, zc, new_stages, cands, list(key[1]), omega,
+                                                               locked=locked)
+                held = self._lock_entry(t, zc, e_ev, i_bp, stages, new_key, new_stages, locked, omega, x_lock) \
+                    if self.jumps[e_ev][i_bp] > 0.0 and x_lock > 0.0 else None
+                if held is not None:  # the chatter's limit: locked at the jump
+                    kind = LOCK
+                    new_key, new_stages, new_locked = held
+                    S = [e for e in range(m) if new_key[0][e]]
+                    w = self._hold_columns(S)[:, S.index(e_ev)]
+                    zc[n:] -= w * float(a @ zc[n:])  # the relay torque's momentum along w_e (∝ P b_e)
+                    Q = np.eye(n) - np.outer(w, a)
+                    M = np.vstack((Q @ M[:n], Q @ M[n:]))  # S = blockdiag(Π, Π): the 1/δ_e' terms cancel
+                else:
+                    normal = np.concatenate((a, np.zeros(n)))
+                stages, locked = new_stages, new_locked
             elif kind == STICK:
                 zc[n:] -= a * (float(a @ zc[n:]) / float(a @ a))
                 cands = [e for e in range(m) if stuck[e]] + [e_ev]
                 # a velocity zero again at once (no time passed): the torque sits on its band's edge
                 # (a touch); the round-off that tipped it over must not keep it slipping forever
-                new_key = self._settle(t, zc, stages, cands, list(key[1]), omega, 1e-12 if idle == 0 else 1e-6)
+                new_key, stages, locked = self._settle(t, zc, stages, cands, list(key[1]), omega,
+                                                       1e-12 if idle == 0 else 1e-6, locked=locked)
                 if not new_key[0][e_ev]:
                     kind = REVERSAL
                 normal = np.concatenate((np.zeros(n), a))
-            else:  # RELEASE: the fields agree at the band's edge
+            else:  # RELEASE of a stick or a lock: the fields agree at the band's edge
                 sigma = list(key[1])
-                sigma[e_ev] = sign_f
+                sigma[e_ev] = sign_f if self.has_friction[e_ev] else 0
+                st = list(stages)
+                lk = list(locked)
+                if lk[e_ev]:
+                    kind = UNLOCK
+                    value = float(self.breakpoints[e_ev][st[e_ev]])
+                    lk[e_ev] = False
+                    if sign_f > 0:
+                        st[e_ev] += 1
                 cands = [e for e in range(m) if stuck[e] and e != e_ev]
-                new_key = self._settle(t, zc, stages, cands, sigma, omega)
-                normal = None
+                new_key, stages, locked = self._settle(t, zc, tuple(st), cands, sigma, omega, locked=tuple(lk))
             if normal is not None:
                 phi_plus = self._field(new_key, stages, t, zc, omega)
                 denom = float(normal @ phi_minus)
@@ -471,13 +574,67 @@ class FrictionIntegrator:
                 rec["ee"].append(e_ev)
                 rec["ek"].append(kind)
                 rec["ev"].append(value)
+            last = (e_ev, kind, value)
             key, z = new_key, zc
 
+    def _polish_crossing(self, seg: Segment, e: int, bound: float, tau: float, tau_max: float) -> float:
+        """The crossing time of a breakpoint where the field jumps, polished by Newton steps on
+        δ_e(τ) − d to the last bit: an error dτ there becomes an error (a⁺ − a⁻) dτ in δ_e'."""
+        tp = tau
+        for _ in range(3):
+            dd, vv, _ = seg.element_point(tp, e)
+            if vv == 0.0:
+                break
+            dt = (dd - bound) / vv
+            tp -= dt
+            if abs(dt) <= 2.0 * _EPS * abs(tp):
+                break
+        if 0.0 < tp <= tau_max and abs(tp - tau) <= 1e-6 * max(tau, 1e-300) + 1e-12:
+            return tp
+        return tau
+
+    def _lock_entry(self, t: float, z: FloatArray, e: int, i: int, stages: tuple[int, ...], key: _Key,
+                    new_stages: tuple[int, ...], locked: tuple[bool, ...], omega: float,
+                    x_lock: float) -> tuple[_Key, tuple[int, ...], tuple[bool, ...]] | None:
+        """At a crossing of the jump i of element ``e`` (state ``z``; the ordinary crossing's mode
+        ``key`` on ``new_stages``): the locked mode when the acceleration on the side entered
+        points back, the next excursion δ_e'²/(2|δ_e''⁺|) is at most ``x_lock`` and the lock band
+        holds the element's torque (the active set keeps it held); else None."""
+        n = self.n
+        a = self.A[e]
+        v = float(a @ z[n:])
+        acc = float(a @ self._field(key, new_stages, t, z, omega)[n:])
+        if not (acc * v < 0.0 and v * v <= 2.0 * abs(acc) * x_lock):
+            return None
+        st = list(new_stages)
+        st[e] = i
+        lk = list(locked)
+        lk[e] = True
+        cands = [k for k in range(self.m) if key[0][k]] + [e]
+        held = self._settle(t, z, tuple(st), cands, list(key[1]), omega, locked=tuple(lk))
+        return held if held[2][e] else None
+
+    def _budget_message(self, t0: float, t1: float, last: tuple[int, int, float]) -> str:
+        e, kind, value = last
+        base = f"more than `max_events` = {self.options.max_events} events between t0 = {t0!r} and t1 = {t1!r}"
+        if kind == CROSSING and e >= 0:
+            i = int(np.searchsorted(self.breakpoints[e], value))
+            r = self.levels[e]
+            if i < self.jumps[e].size and self.jumps[e][i] > 0.0 and r[i] == 0.0 and r[i + 1] == 0.0:
+                name = self.base.elements[e].name
+                return (f"{base}: element {name!r} chatters into a lock at the jump of its law at δ = {value:g} "
+                        "without friction there (its crossings decay only exponentially, at about a third of the "
+                        "damping rate; the lock is reached when an excursion falls below `lock_excursion`); raise "
+                        "NonsmoothOptions(max_events=...) or `lock_excursion`, or shorten the interval")
+        return f"{base} (stick–slip chatter?): raise NonsmoothOptions(max_events=...) or shorten the interval"
+
     def _friction_event(self, seg: Segment, sol: StageSolution, key: _Key, stages: tuple[int, ...],
-                        tau_end: float, omega: float) -> tuple[float, int, int, int]:
+                        tau_end: float, omega: float,
+                        locked: tuple[bool, ...] | None = None) -> tuple[float, int, int, int]:
         """The first friction event in (0, ``tau_end``]: (τ, element, kind, sign) — a velocity zero
         of a slipping element with friction (kind STICK, refined to a stick or a reversal by the
-        caller) or a stuck element's torque reaching ±r (RELEASE, sign of λ); element −1 if none."""
+        caller) or a held element's torque leaving its band (±r stuck, [−r_i, J_i + r_i+1] locked:
+        RELEASE, +1 above the band, −1 below); element −1 if none."""
         n, m = self.n, self.m
         stuck, sigma = key
         slip = [e for e in range(m) if self.has_friction[e] and not stuck[e] and sigma[e]]
@@ -485,7 +642,10 @@ class FrictionIntegrator:
         if tau_end <= 0.0 or not (slip or S):
             return tau_end, -1, -1, 0
         step = min(sol.grid_step, self._base_step(omega))
-        r_S = np.array([self.levels[e][stages[e]] for e in S])
+        lk = (False,) * m if locked is None else locked
+        bands = [self._band(e, stages[e], lk[e]) for e in S]
+        lo_S = np.array([b[0] for b in bands])
+        hi_S = np.array([b[1] for b in bands])
         if S:
 
             def lam_at(taus: FloatArray, z: FloatArray) -> FloatArray:
@@ -509,21 +669,22 @@ class FrictionIntegrator:
                         best = (hit, e, STICK, 0)
             if S:
                 lam = lam_at(taus, z)  # (k+1, |S|)
-                over = np.abs(lam[1:]) > r_S
+                over = (lam[1:] > hi_S) | (lam[1:] < lo_S)
                 for j, e in enumerate(S):
                     if not over[:, j].any():
                         continue
                     i = int(over[:, j].argmax()) + 1
-                    s = 1.0 if lam[i, j] > 0 else -1.0
+                    s = 1.0 if lam[i, j] > hi_S[j] else -1.0
+                    edge = float(hi_S[j] if s > 0 else lo_S[j])
                     if taus[i - 1] >= best[0]:
                         continue
 
-                    def g(tau: float, j: int = j, s: float = s) -> float:
+                    def g(tau: float, j: int = j, edge: float = edge) -> float:
                         zz = seg.end_state(tau)[None]
-                        return float(lam_at(np.array([tau]), zz)[0, j]) - s * r_S[j]
+                        return float(lam_at(np.array([tau]), zz)[0, j]) - edge
 
-                    ga = float(lam[i - 1, j]) - s * r_S[j]
-                    gb = float(lam[i, j]) - s * r_S[j]
+                    ga = float(lam[i - 1, j]) - edge
+                    gb = float(lam[i, j]) - edge
                     if ga * gb > 0:  # at the start already beyond (round-off): release at once
                         hit = float(taus[i - 1])
                     else:
