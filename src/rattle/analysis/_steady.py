@@ -60,9 +60,13 @@ from .. import _limits
 from .._typing import FloatArray
 from .._validate import check_int, check_positive, check_state, numerical_failures
 from ..errors import Status
-from ..model import Chain, Model, System, check_analysable_model
+from ..errors import ConvergenceError
+from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check_analysable_model
 from ..results._steady import METHODS, SteadyState
-from ..timeint import ExactIntegrator, SystemIntegrator, SystemTrajectory, Trajectory
+from ..timeint import (
+    ExactIntegrator, ExactMeasures, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator, NonsmoothTrajectory,
+    SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory,
+)
 from ..timeint._flow import check_system_state
 from ..timeint._shooting import _newton_shooting, _Shot, _state_scale
 from ..timeint._system_shooting import _newton_system, _SystemShot, system_state_scale
@@ -178,6 +182,10 @@ class _ModelFlow:
         s = traj.sample(t)
         return np.column_stack((s.delta, s.velocity))
 
+    @staticmethod
+    def measures(traj: Trajectory) -> ExactMeasures:
+        return traj.measures()
+
 
 class _SystemFlow:
     """A :class:`~rattle.model.System` on :class:`SystemIntegrator` (z = (x, x'), 2n states)."""
@@ -201,6 +209,195 @@ class _SystemFlow:
         x, v = traj.derivatives(np.asarray(t, dtype=float), 1)
         return np.concatenate((x, v), axis=-1)
 
+    @staticmethod
+    def measures(traj: SystemTrajectory) -> SystemMeasures:
+        return traj.measures()
+
+
+class _Failed:
+    """A shooting solve whose flow could not be followed (an event budget exceeded): never
+    accepted (residual ∞)."""
+
+    residual = math.inf
+    iterations = 0
+
+    def __init__(self, x: FloatArray, evaluations: int = 1) -> None:
+        self.x, self.evaluations = x, evaluations
+
+
+class _NonsmoothFlow:
+    """The single equation with a discontinuous law (:class:`~rattle.model.NonsmoothSystem`) on
+    :class:`NonsmoothIntegrator`: state (δ, δ'), scaled by (L, L ν) as
+    :func:`~rattle.timeint.shoot_nonsmooth_orbit` scales its residual; the period map's
+    sensitivity carries the saltation matrices (a stick or lock phase contributes an exact zero
+    multiplier), so the acceptance tests of the acceleration hold unchanged."""
+
+    def __init__(self, system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float) -> None:
+        self.integ, self.omega = integ, omega
+        self.dim = 2
+        self.scale = np.array([system.length_scale(), integ.velocity_scale(omega)])
+
+    def advance(self, x: FloatArray, T: float) -> FloatArray:
+        return self.integ.propagate(x, 0.0, T, self.omega).state1
+
+    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _Shot | _Failed:
+        try:
+            return _newton_shooting(self.integ, self.omega, x, n, tol, iterations, self.scale,  # type: ignore[arg-type]
+                                    _MAX_HALVINGS)
+        except ConvergenceError:  # a trial state the event-driven flow cannot follow: no orbit
+            return _Failed(np.asarray(x, dtype=float).copy())
+
+    def propagate(self, x: FloatArray, T: float) -> NonsmoothTrajectory:
+        return self.integ.propagate(x, 0.0, T, self.omega)
+
+    @staticmethod
+    def section(traj: NonsmoothTrajectory, t: FloatArray) -> FloatArray:
+        d, v, _ = traj.sample(np.asarray(t, dtype=float))
+        return np.column_stack((d, v))
+
+    @staticmethod
+    def measures(traj: NonsmoothTrajectory) -> ExactMeasures:
+        return nonsmooth_measures(traj)
+
+
+class _FrictionFlow:
+    """A chain with friction (:class:`~rattle.model.FrictionSystem`) on
+    :class:`FrictionIntegrator`: z = (x, x'), 2n states, scaled by L and L max(Ω, ω_n) as
+    :func:`~rattle.timeint.shoot_friction_orbit` scales its residual (saltation monodromy)."""
+
+    def __init__(self, system: FrictionSystem, integ: FrictionIntegrator, omega: float) -> None:
+        self.integ, self.omega = integ, omega
+        n = system.n
+        self.dim = 2 * n
+        self.scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
+
+    def advance(self, x: FloatArray, T: float) -> FloatArray:
+        return self.integ.advance(x, 0.0, T, self.omega)[0]
+
+    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _SystemShot | _Failed:
+        try:
+            return _newton_system(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
+        except ConvergenceError:
+            return _Failed(np.asarray(x, dtype=float).copy())
+
+    def propagate(self, x: FloatArray, T: float) -> FrictionTrajectory:
+        return self.integ.propagate(x, 0.0, T, self.omega)
+
+    @staticmethod
+    def section(traj: FrictionTrajectory, t: FloatArray) -> FloatArray:
+        return traj.sample(np.asarray(t, dtype=float))[0]
+
+    @staticmethod
+    def measures(traj: FrictionTrajectory) -> SystemMeasures:
+        return friction_measures(traj)
+
+
+# ---------------------------------------------------------------------------------------------
+# Measures of the exact non-smooth trajectories
+# ---------------------------------------------------------------------------------------------
+_EXTREMA_PER_SCALE = 40  # grid points per time scale bracketing the extrema of a segment
+
+
+def nonsmooth_measures(traj: NonsmoothTrajectory) -> ExactMeasures:
+    """The measures of δ over a :class:`~rattle.timeint.NonsmoothTrajectory`: mean and rms by
+    its own quadrature (:meth:`mean_and_rms`, Gauss–Legendre inside the segments), rms about the
+    mean likewise, the extremes of δ and δ'' by :meth:`extremes` (δ'' jumps at a switching: both
+    one-sided values count, a stick or lock contributes δ'' = 0)."""
+    T = traj.t1 - traj.t0
+    if not T > 0.0:
+        raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
+    mean, rms = traj.mean_and_rms()
+    ms_ac = traj.integrate(lambda t, d, v, a: (d - mean) ** 2) / T
+    dmin, dmax, amin, amax = traj.extremes()
+    return ExactMeasures(mean=mean, rms=rms, rms_ac=math.sqrt(max(ms_ac, 0.0)), delta_min=dmin, delta_max=dmax,
+                         p2p=dmax - dmin, acc_min=amin, acc_max=amax, acc_p2p=amax - amin)
+
+
+def _root(fun, a: float, b: float) -> float:  # type: ignore[no-untyped-def]
+    """A root of the scalar ``fun`` bracketed on [a, b] by grid samples (the scalar evaluation
+    may differ from them in round-off: then the end nearer zero)."""
+    from scipy.optimize import brentq
+
+    fa, fb = fun(a), fun(b)
+    if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
+        return a if abs(fa) <= abs(fb) else b
+    return float(brentq(fun, a, b, xtol=4.0 * np.finfo(float).eps * max(abs(b), 1e-300), maxiter=200))
+
+
+def friction_measures(traj: FrictionTrajectory) -> SystemMeasures:
+    """The measures of every element's deflection δ_e = a_e·x over a
+    :class:`~rattle.timeint.FrictionTrajectory`: mean and rms by its own quadrature
+    (:meth:`element_mean_and_rms`), rms about the mean likewise; the extremes on every segment
+    (the motion is analytic there) from a grid of 40 points per time scale that includes both
+    segment ends — so δ_e'' counts its one-sided values at every switching — refined where δ_e'
+    changes sign (δ extremes, by Brent's method on the segment's exact solution) and at the grid
+    extrema of δ_e'' and in the first and last cell of every segment (bounded Brent
+    minimisation)."""
+    from scipy.optimize import minimize_scalar
+
+    T = traj.t1 - traj.t0
+    if not T > 0.0:
+        raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
+    fsys = traj.system
+    A = fsys.system.element_rows
+    n, m = fsys.n, A.shape[0]
+    mean, rms = traj.element_mean_and_rms()
+    ms_ac = traj.integrate(lambda z: (z[:, :n] @ A.T - mean) ** 2) / T
+    dmin, dmax = np.full(m, np.inf), np.full(m, -np.inf)
+    amin, amax = np.full(m, np.inf), np.full(m, -np.inf)
+    k_seg = len(traj.segments)
+    for i, seg in enumerate(traj.segments):
+        length = float(traj.t_end[i] - traj.t_start[i])
+        if length < 0.0 or (length == 0.0 and k_seg > 1):
+            continue
+        scale = float(seg.sol.time_scale)
+        if not math.isfinite(scale) or scale <= 0.0:
+            scale = max(T, 1.0)
+        cells = max(2, math.ceil(length / (scale / _EXTREMA_PER_SCALE)))
+        tg = np.linspace(0.0, length, cells + 1)
+        z, zd = seg.state(tg)
+        d, v, a = z[:, :n] @ A.T, z[:, n:] @ A.T, zd[:, n:] @ A.T
+        dmin, dmax = np.minimum(dmin, d.min(axis=0)), np.maximum(dmax, d.max(axis=0))
+        amin, amax = np.minimum(amin, a.min(axis=0)), np.maximum(amax, a.max(axis=0))
+        if length == 0.0:
+            continue
+        for e in range(m):
+            ve, ae = v[:, e], a[:, e]
+            for q in np.flatnonzero((ve[:-1] > 0.0) != (ve[1:] > 0.0)).tolist():
+                tq = _root(lambda x, e=e: seg.element_point(x, e)[1], float(tg[q]), float(tg[q + 1]))
+                val = seg.element_point(tq, e)[0]
+                dmin[e], dmax[e] = min(dmin[e], val), max(dmax[e], val)
+            da = np.diff(ae)
+            if not np.any(da):
+                continue
+            # an interior grid extremum, and both ways the first and the last cell (an extremum
+            # next to a segment end leaves no sign change of the grid differences)
+            brackets = [(float(tg[q - 1]), float(tg[q + 1]), 1.0 if da[q - 1] < 0.0 else -1.0)
+                        for q in (np.flatnonzero(da[:-1] * da[1:] < 0.0) + 1).tolist()]
+            for lo_c, hi_c in ((tg[0], tg[1]), (tg[-2], tg[-1])):
+                brackets += [(float(lo_c), float(hi_c), 1.0), (float(lo_c), float(hi_c), -1.0)]
+            for lo_c, hi_c, sign in brackets:  # sign +1: a minimum of δ_e'', −1: a maximum
+                res = minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
+                                      bounds=(lo_c, hi_c), method="bounded",
+                                      options={"xatol": 1e-12 * max(length, 1.0)})
+                val = seg.element_point(float(res.x), e)[2]
+                amin[e], amax[e] = min(amin[e], val), max(amax[e], val)
+    return SystemMeasures(names=fsys.element_names, mean=mean, rms=rms, rms_ac=np.sqrt(np.maximum(ms_ac, 0.0)),
+                          delta_min=dmin, delta_max=dmax, p2p=dmax - dmin, acc_min=amin, acc_max=amax,
+                          acc_p2p=amax - amin)
+
+
+def stick_fraction(traj: NonsmoothTrajectory | FrictionTrajectory) -> float | FloatArray:
+    """The fraction of the trajectory's time held (stuck by friction or locked at a jump): a
+    number for the single equation, one per element (m,) for a chain with friction."""
+    T = traj.t1 - traj.t0
+    if isinstance(traj, FrictionTrajectory):
+        return traj.stick_time() / T
+    return float(traj.stick_time / T)
+
+
+_Flow = _ModelFlow | _SystemFlow | _NonsmoothFlow | _FrictionFlow
+
 
 def _proper_divisors(n: int) -> list[int]:
     return [m for m in range(1, n) if n % m == 0]
@@ -219,7 +416,7 @@ class _Candidate:
 class _Settler:
     """The settling loop of :func:`steady_state` (one call)."""
 
-    def __init__(self, flow: _ModelFlow | _SystemFlow, omega: float, x0: FloatArray, opts: SteadyStateOptions,
+    def __init__(self, flow: _Flow, omega: float, x0: FloatArray, opts: SteadyStateOptions,
                  names: tuple[str, ...]) -> None:
         self.flow, self.omega, self.opts, self.names = flow, omega, opts, names
         self.T = _TWO_PI / omega
@@ -358,7 +555,7 @@ class _Settler:
             omega=self.omega, period=n, status=Status.CONVERGED, periods=self.i,
             shooting_periods=self.shooting_periods, state0=shot.x.copy(), final_state=shot.x.copy(),
             cycle=self.cycle_points(shot, n), poincare=self.poincare(), trajectory=traj,
-            measures=traj.measures(), multipliers=shot.multipliers(), residual=shot.residual,
+            measures=self.flow.measures(traj), multipliers=shot.multipliers(), residual=shot.residual,
             element_names=self.names,
         )
 
@@ -372,7 +569,7 @@ class _Settler:
         return SteadyState(
             omega=self.omega, period=n, status=Status.SETTLED, periods=i + n,
             shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
-            cycle=cycle, poincare=self.poincare(), trajectory=traj, measures=traj.measures(),
+            cycle=cycle, poincare=self.poincare(), trajectory=traj, measures=self.flow.measures(traj),
             multipliers=mult, residual=float(np.max(self.d[i - n : i + 1, n])), element_names=self.names,
         )
 
@@ -384,7 +581,7 @@ class _Settler:
         return SteadyState(
             omega=self.omega, period=0, status=Status.MAX_PERIODS, periods=i + rec,
             shooting_periods=self.shooting_periods, state0=x, final_state=traj.state1.copy(),
-            cycle=np.empty((0, self.flow.dim)), poincare=section, trajectory=traj, measures=traj.measures(),
+            cycle=np.empty((0, self.flow.dim)), poincare=section, trajectory=traj, measures=self.flow.measures(traj),
             multipliers=None, residual=float(np.min(self.d[i, 1:])), element_names=self.names,
         )
 
@@ -406,32 +603,87 @@ class _Settler:
         return self.unsettled()
 
 
-def static_state(model: Model | Chain | System, omega: float | None = None) -> FloatArray:
+def _nonsmooth_rest(system: NonsmoothSystem) -> float:
+    """δ_s of the law at rest, k f(δ_s) = F_m with f's jumps (friction aside): on a stage with
+    positive slope, or at a breakpoint whose jump spans F_m/k (the lock band without friction)."""
+    st = system.law.stages
+    target = system.excitation.mean / system.k
+    edges = np.concatenate(([-np.inf], st.breakpoints, [np.inf]))
+    for j, (s, e) in enumerate(zip(st.slopes, st.offsets)):
+        lo, hi = edges[j], edges[j + 1]
+        if j > 0 and st.slopes[j - 1] * lo + st.offsets[j - 1] <= target <= s * lo + e:
+            return float(lo)  # held at the breakpoint by its jump
+        if s > 0:
+            x = (target - e) / s
+            if lo <= x <= hi:
+                return float(x)
+        elif abs(target - e) <= 1e-15 * max(1.0, abs(target)):
+            return float(0.5 * (lo + hi)) if np.isfinite(lo + hi) else float(lo if np.isfinite(lo) else hi)
+    return 0.0
+
+
+def static_state(model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
+                 omega: float | None = None) -> FloatArray:
     """The static equilibrium at rest as a state: (δ_s, 0) for the single equation, (x_s, 0)
-    (2n,) for a chain or System (under the mean torques at ``omega`` when they depend on it)."""
+    (2n,) for a chain or System (under the mean torques at ``omega`` when they depend on it).
+    A :class:`~rattle.model.NonsmoothSystem`: k f(δ_s) = F_m with the law's jumps (at a
+    breakpoint whose jump spans F_m/k, δ_s is the breakpoint); a
+    :class:`~rattle.model.FrictionSystem`: the equilibrium of its smooth System."""
     if isinstance(model, Model):
         return np.array([model.static_equilibrium(), 0.0])
+    if isinstance(model, NonsmoothSystem):
+        return np.array([_nonsmooth_rest(model), 0.0])
+    if isinstance(model, FrictionSystem):
+        model = model.system
     system = model.system() if isinstance(model, Chain) else model
     return np.concatenate((system.static_equilibrium(omega), np.zeros(system.n)))
 
 
-def make_integrator(model: Model | Chain | System) -> ExactIntegrator | SystemIntegrator:
+def make_integrator(
+    model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
+) -> ExactIntegrator | SystemIntegrator | NonsmoothIntegrator | FrictionIntegrator:
     """The exact integrator :func:`steady_state` uses for ``model``: :class:`ExactIntegrator`
     for the single equation (its fast scalar path), :class:`SystemIntegrator` of the System
-    otherwise (reuse it across calls to share its cache)."""
+    for a chain, :class:`NonsmoothIntegrator` or :class:`FrictionIntegrator` for the
+    discontinuous laws (reuse it across calls to share its cache)."""
     if isinstance(model, Model):
         return ExactIntegrator(model)
+    if isinstance(model, NonsmoothSystem):
+        return NonsmoothIntegrator(model)
+    if isinstance(model, FrictionSystem):
+        return FrictionIntegrator(model)
     return SystemIntegrator(model.system() if isinstance(model, Chain) else model)
+
+
+def _discontinuous_flow(
+    model: NonsmoothSystem | FrictionSystem, omega: float, x0: object, integrator: object,
+) -> tuple[_NonsmoothFlow | _FrictionFlow, FloatArray, tuple[str, ...]]:
+    """The flow, start state and element names of a discontinuous law."""
+    if isinstance(model, NonsmoothSystem):
+        x = check_state(x0) if x0 is not None else static_state(model)
+        integ = NonsmoothIntegrator(model) if integrator is None else integrator
+        if not isinstance(integ, NonsmoothIntegrator):
+            raise TypeError(f"`integrator` must be a NonsmoothIntegrator for a NonsmoothSystem, got {integrator!r}")
+        if integ.system is not model and integ.system != model:
+            raise ValueError("`integrator` was built for a different system than `model`")
+        return _NonsmoothFlow(model, integ, omega), x, ()
+    x = check_system_state(x0, model.n, "x0") if x0 is not None else static_state(model, omega)
+    finteg = FrictionIntegrator(model) if integrator is None else integrator
+    if not isinstance(finteg, FrictionIntegrator):
+        raise TypeError(f"`integrator` must be a FrictionIntegrator for a FrictionSystem, got {integrator!r}")
+    if finteg.fsys is not model:
+        raise ValueError("`integrator` was built for a different system than `model`")
+    return _FrictionFlow(model, finteg, omega), x, model.element_names
 
 
 @numerical_failures
 def steady_state(
-    model: Model | Chain | System,
+    model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
     omega: float,
     x0: FloatArray | tuple[float, float] | None = None,
     *,
     options: SteadyStateOptions | None = None,
-    integrator: ExactIntegrator | SystemIntegrator | None = None,
+    integrator: ExactIntegrator | SystemIntegrator | NonsmoothIntegrator | FrictionIntegrator | None = None,
 ) -> SteadyState:
     """Steady motion reached from ``x0`` at the forcing frequency ``omega``, and its period.
 
@@ -445,10 +697,20 @@ def steady_state(
     :class:`~rattle.model.System`) on :class:`SystemIntegrator`, state z = (x, x') of its n
     coordinates, with the measures of every clearance element (the flat fields: the first).
 
+    The discontinuous laws run on their event-driven exact integrators, the same loop on top:
+    δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (a :class:`~rattle.model.NonsmoothSystem`: jumps
+    and Coulomb friction, Filippov sticking, locks at jumps) on :class:`NonsmoothIntegrator`,
+    state (δ, δ'), scaled by (L, L ν); a chain with friction x'' + C x' + K x + Σ_e b_e [f_e(δ_e)
+    + r_e(δ_e) sgn δ_e'] = F(t) (a :class:`~rattle.model.FrictionSystem`) on
+    :class:`FrictionIntegrator`, state (x, x'), with the measures of every element. Their shooting
+    uses the exact monodromy with the saltation matrices (a stick or lock phase gives an exact
+    zero multiplier, a stable direction); the measures come from the exact trajectories, the
+    extremes of δ'' with their one-sided values at the switchings.
+
     Parameters
     ----------
-    model : Model, Chain or System
-        The equations of motion (continuous piecewise-linear laws).
+    model : Model, Chain, System, NonsmoothSystem or FrictionSystem
+        The equations of motion.
     omega : float
         Forcing frequency Ω (rad/s), > 0.
     x0 : array_like, shape (2,) or (2n,), optional
@@ -456,7 +718,7 @@ def steady_state(
         x'_n) for a chain; default the static equilibrium at rest.
     options : SteadyStateOptions, optional
         Tolerances and budget (default ``SteadyStateOptions()``).
-    integrator : ExactIntegrator or SystemIntegrator, optional
+    integrator : ExactIntegrator, SystemIntegrator, NonsmoothIntegrator or FrictionIntegrator, optional
         The exact integrator of ``model`` (:func:`make_integrator`; reuse one across calls to
         share its cache).
 
@@ -469,6 +731,12 @@ def steady_state(
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
         raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
+    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+        from .._validate import check_omega
+
+        omega = check_omega(omega)
+        dflow, x, dnames = _discontinuous_flow(model, omega, x0, integrator)
+        return _Settler(dflow, omega, x.copy(), opts, dnames).run()
     if isinstance(model, System):
         from .._validate import check_omega
 
@@ -499,4 +767,5 @@ def steady_state(
     return _Settler(flow, omega, x.copy(), opts, names).run()
 
 
-__all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS", "static_state", "make_integrator"]
+__all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS", "static_state", "make_integrator",
+           "nonsmooth_measures", "friction_measures", "stick_fraction"]

@@ -9,6 +9,13 @@ from the state the previous one ended in (on the Poincaré section, forcing phas
 from the static equilibrium at rest. Where several stable motions coexist the sweep therefore
 follows the one it is on until it disappears, and jumps there: the up sweep of a softening
 resonance drops near its upper fold, the down sweep jumps up near the lower fold.
+
+The discontinuous laws sweep the same way on their event-driven exact integrators: the single
+equation with torque jumps and Coulomb friction, δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t)
+(:class:`~rattle.model.NonsmoothSystem`), and a chain with friction on its elements
+(:class:`~rattle.model.FrictionSystem`); their rows also carry the fraction of the orbit (or of
+the record, period 0) held stuck or locked: ``stick_fraction`` (the single equation) or
+``NAME_stick_fraction`` per element, as extra columns.
 """
 
 from __future__ import annotations
@@ -28,12 +35,12 @@ from .._typing import FloatArray
 from .. import _limits, _validate
 from ..engines import die_with_parent
 from ..errors import RattleError
-from ..model import Model, check_analysable_model
+from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
 from ..results._sweep import SweepResult
 from ..results._sweep import SWEEP_ELEMENT_COLUMNS
 
 from ._frequency_response import check_range
-from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state
+from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
 logger = logging.getLogger("rattle")
 
@@ -75,6 +82,9 @@ def sweep_direction(
     for name in names:
         for c in SWEEP_ELEMENT_COLUMNS:
             rows[f"{name}_{c}"] = np.empty(n)
+    sticks = _stick_columns(model)
+    for key in sticks:
+        rows[key] = np.empty(n)
     for i, w in enumerate(omegas):
         s = steady_state(model, float(w), x, options=options, integrator=integ)
         for name in _ROW_SCALARS:
@@ -94,12 +104,43 @@ def sweep_direction(
                 values = getattr(em, c)
                 for k, nm in enumerate(names):
                     rows[f"{nm}_{c}"][i] = values[k]
+        if sticks:
+            held = np.atleast_1d(stick_fraction(s.trajectory))  # type: ignore[arg-type]
+            for k, key in enumerate(sticks):
+                rows[key][i] = held[k]
         x = s.final_state
         logger.debug("%s sweep Ω = %.6g: period %d (%s), rms %.6g", direction, w, s.period, s.method, s.rms)
         if report is not None:
             report(direction)
     rows["direction"] = np.full(n, direction, dtype="<U4")
     return rows
+
+
+def _stick_columns(model: object) -> tuple[str, ...]:
+    """The stick-fraction columns of a discontinuous law's rows: ``stick_fraction`` for the single
+    equation, ``NAME_stick_fraction`` per element of a chain with friction; none otherwise."""
+    if isinstance(model, NonsmoothSystem):
+        return ("stick_fraction",)
+    if isinstance(model, FrictionSystem):
+        return tuple(f"{nm}_stick_fraction" for nm in model.element_names)
+    return ()
+
+
+class _Bounds:
+    """The frequency bounds of a discontinuous law (:mod:`rattle._limits` reads ``system()``):
+    the smooth System of a chain with friction; for the single equation its stiffest stage's
+    natural frequency sqrt(k s_max) and damping rate c."""
+
+    def __init__(self, model: NonsmoothSystem | FrictionSystem) -> None:
+        self.model = model
+
+    def system(self) -> Any:
+        if isinstance(self.model, FrictionSystem):
+            return self.model.system
+        from types import SimpleNamespace
+
+        ws = float(np.sqrt(self.model.k * float(np.max(self.model.law.stages.slopes))))
+        return SimpleNamespace(stiffest_frequency=lambda: ws, damping=np.array([[self.model.c]]))
 
 
 def _run_timed(model: Model, omegas: FloatArray, direction: str, options: SteadyStateOptions,
@@ -233,7 +274,7 @@ class _Progress:
 
 @_validate.numerical_failures
 def time_sweep(
-    model: Model,
+    model: Model | Any,
     omega: Sequence[float] = (0.1, 3.0),
     points: int = 200,
     direction: str = "up",
@@ -253,9 +294,13 @@ def time_sweep(
 
     Parameters
     ----------
-    model : Model or Chain
+    model : Model, Chain, NonsmoothSystem or FrictionSystem
         The model; a chain is simulated on all its coordinates (state (x, x')), its rows measure
-        the first clearance element and ``element_columns`` every element.
+        the first clearance element and ``element_columns`` every element. A discontinuous law
+        (jumps and Coulomb friction: :class:`~rattle.model.NonsmoothSystem`, or a chain with
+        friction on its elements: :class:`~rattle.model.FrictionSystem`) runs on its event-driven
+        exact integrator; its rows also carry the stick fraction (``extra_columns``:
+        ``stick_fraction``, or ``NAME_stick_fraction`` per element).
     omega : (float, float)
         Frequency range (Ω_min, Ω_max) in rad/s, 0 < Ω_min < Ω_max.
     points : int
@@ -280,8 +325,11 @@ def time_sweep(
         ``sweep.csv`` columns, effort, states and provenance.
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
-    check_analysable_model(model)
-    lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
+    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+        lo, hi = _limits.check_frequency_range(_Bounds(model), *check_range(omega), simulate=True)
+    else:
+        check_analysable_model(model)
+        lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
     points = _limits.check_points(points)
     if not isinstance(direction, str) or direction not in DIRECTIONS:
         raise ValueError(
@@ -310,6 +358,7 @@ def time_sweep(
     columns = {name: np.concatenate([r[name] for r in ordered]) for name in ordered[0]}
     names = getattr(model, "element_names", None) or ()
     element_columns = {f"{nm}_{c}": columns.pop(f"{nm}_{c}") for nm in names for c in SWEEP_ELEMENT_COLUMNS}
+    extra_columns = {key: columns.pop(key) for key in _stick_columns(model)}
     timings = {f"{d} sweep": runs[d][1] for d in DIRECTIONS[direction]}
     timings["total"] = t_total
     settings = {
@@ -317,7 +366,8 @@ def time_sweep(
         "steady_state": options.to_dict(),
     }
     logger.info("time sweep %s: %d frequencies in %.3g s", direction, points * len(grids), t_total)
-    return SweepResult(model=model, settings=settings, timings=timings, element_columns=element_columns, **columns)
+    return SweepResult(model=model, settings=settings, timings=timings, element_columns=element_columns,
+                       extra_columns=extra_columns, **columns)
 
 
 __all__ = ["time_sweep", "sweep_direction", "DIRECTIONS"]

@@ -70,8 +70,14 @@ class SweepResult:
     written after the SPEC columns; the states are z = (x, x') of its n coordinates ((P, 2n)),
     the multipliers (P, 2n).
 
-    ``extra_columns``: columns written last, e.g. the sound pressure levels of
-    :meth:`with_sound` (``spl_db``, ``spl_dba``, ``spl_linear_db``).
+    A discontinuous law (:class:`~rattle.model.NonsmoothSystem`: jumps and Coulomb friction on
+    the single equation; :class:`~rattle.model.FrictionSystem`: a chain with friction on its
+    elements): the same columns, from its exact event-driven trajectories, and in
+    ``extra_columns`` the fraction of each row's orbit (of its record for period 0) held stuck or
+    locked — ``stick_fraction``, or ``NAME_stick_fraction`` per element of the chain.
+
+    ``extra_columns``: columns written last, e.g. the stick fractions above or the sound pressure
+    levels of :meth:`with_sound` (``spl_db``, ``spl_dba``, ``spl_linear_db``).
     """
 
     model: Model
@@ -194,6 +200,17 @@ class SweepResult:
                 for j in jumps))
         else:
             lines.append("jumps: none")
+        for key, col in self.extra_columns.items():  # a discontinuous law: the time held stuck or locked
+            if not key.endswith("stick_fraction") or not len(col):
+                continue
+            what = "held (stuck or locked)" if key == "stick_fraction" else f"{key[: -len('_stick_fraction')]} held"
+            col = np.asarray(col, dtype=float)
+            i = int(np.argmax(col))
+            if not col[i] > 0.0:
+                lines.append(f"{what}: never")
+                continue
+            lines.append(f"{what}: {int(np.sum(col > 0))} of {col.size} rows, at most {100 * col[i]:.3g} % of the "
+                         f"period at Ω = {self.omega[i]:.5g} ({self.direction[i]} sweep)")
         lines.append(
             f"effort: {int(np.sum(self.periods))} forcing periods simulated, "
             f"{int(np.sum(self.shooting_periods))} in Newton shooting"
@@ -263,10 +280,18 @@ class SweepResult:
         non-periodic row (period 0) the record of ``record_periods`` forcing periods the sweep
         measured (``settings["steady_state"]``). The integrator is deterministic, so these are the
         trajectories the sweep's measures were taken on."""
-        from ..timeint import ExactIntegrator, SystemIntegrator
+        from ..model import FrictionSystem, NonsmoothSystem
+        from ..timeint import ExactIntegrator, FrictionIntegrator, NonsmoothIntegrator, SystemIntegrator
 
-        integ: Any = ExactIntegrator(self.model) if isinstance(self.model, Model) else SystemIntegrator(
-            self.model.system())
+        integ: Any
+        if isinstance(self.model, Model):
+            integ = ExactIntegrator(self.model)
+        elif isinstance(self.model, NonsmoothSystem):
+            integ = NonsmoothIntegrator(self.model)
+        elif isinstance(self.model, FrictionSystem):
+            integ = FrictionIntegrator(self.model)
+        else:
+            integ = SystemIntegrator(self.model.system())
         record = int(self.settings.get("steady_state", {}).get("record_periods", _RECORD_PERIODS))
         for w, p, x in zip(self.omega, self.period, self.state0):
             window = int(p) if p > 0 else record
