@@ -183,19 +183,24 @@ def _law_keys(run_config: Any) -> str:
     return " and ".join(keys) or "`model.elastic`"
 
 
+#: What the refusal of a discontinuous law adds for a command.
+_COMPARE_HINT = {"compare": " (run `rattle frf` and `rattle sweep` to set the response and the sweep side by side)"}
+
+
 def refuse_discontinuous(run_config: Any, command: str) -> None:
     """Exit 2 (nothing written) when ``rattle COMMAND`` cannot solve the configuration's law yet."""
     if getattr(run_config, "chain_friction", False):
         raise ConfigError(
             f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
             f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance of the chain checked by "
-            "exact shooting with Filippov sticking) or `rattle orbit` (one orbit at a frequency), or remove the friction"
+            "exact shooting with Filippov sticking), `rattle sweep` (the exact time-domain sweep) or `rattle orbit` "
+            f"(one orbit at a frequency){_COMPARE_HINT.get(command, '')}, or remove the friction"
         )
     if run_config.discontinuous:
         raise ConfigError(
             f"{_law_keys(run_config)}: a discontinuous law (a torque jump or friction) is not supported by "
             f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance checked by exact "
-            "shooting) or `rattle orbit`"
+            f"shooting), `rattle sweep` (the exact time-domain sweep) or `rattle orbit`{_COMPARE_HINT.get(command, '')}"
         )
 
 
@@ -305,14 +310,19 @@ def sweep_command(
     At N equally spaced frequencies the motion is simulated exactly until it settles (period
     1 … 8 of the forcing period, or 0 when none is found), the state carried from one frequency
     to the next as in a run-up or run-down.
+
+    A discontinuous law (a torque jump or friction), or a chain with friction on its elements, is
+    simulated by its exact event-driven integrator (Filippov sticking, locks at jumps); sweep.csv
+    then also has the fraction of each row's period held stuck or locked (stick_fraction, or
+    NAME_stick_fraction per element).
     """
     if direction is None:  # checked here: click's own message for a missing choice spans lines
         raise ConfigError("`--direction` is required: give --direction up, down or both")
     precheck(config, output, points=points, workers=workers)
     run_config = _io().load_config(config)
-    refuse_discontinuous(run_config, "sweep")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
-    analysis = override_analysis(run_config.analysis, run_config.model, labels=labels, omega_min=w_min, omega_max=w_max)
+    analysis = override_analysis(run_config.analysis, run_config.bounds_model, labels=labels, omega_min=w_min,
+                                 omega_max=w_max)
     t_start = time.perf_counter()
     from ..analysis import time_sweep  # only now: all input has been validated
 
