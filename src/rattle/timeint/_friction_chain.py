@@ -61,10 +61,11 @@ element at rest within round-off of a jump at the start is a lock candidate, wit
 
 with h = a_e·x − d (breakpoint; nᵀφ⁻ = δ_e'), h = a_e·x' (velocity zero; nᵀφ⁻ = δ_e''⁻). On entry
 into a stick φ⁺ is the sliding field, nᵀφ⁺ = 0, and nᵀ S = 0: the δ_e'-perturbation is removed.
-At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. A crossing of a jump has φ⁺ ≠ φ⁻ (the
-stages on each side) and S ≠ I. Between events the sensitivity is the mode's exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the
-Floquet multipliers of :func:`shoot_friction_orbit`. Not resolved: a tangential touch of a
-switching surface (grazing: the map is not differentiable there) and stuck sets closing a loop.
+At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. A crossing of a jump has
+φ⁺ ≠ φ⁻ (the stages on each side) and S ≠ I. Between events the sensitivity is the mode's
+exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the Floquet multipliers of
+:func:`shoot_friction_orbit`. Not resolved: a tangential touch of a switching surface (grazing: the
+map is not differentiable there) and stuck sets closing a loop.
 """
 
 from __future__ import annotations
@@ -379,12 +380,18 @@ class FrictionIntegrator:
 
     def _initial_key(self, t: float, z: FloatArray, stages: tuple[int, ...],
                      omega: float) -> tuple[_Key, tuple[int, ...], tuple[bool, ...]]:
-        """The mode at the start: friction elements at rest are stick candidates; an element within
-        round-off of a jump of its law, at rest, is a lock candidate (on the stage below the jump)."""
+        """The mode at the start: friction elements at rest are stick candidates; an element at rest
+        on a jump of its law (within round-off, or within the neighbourhood the chatter snaps from:
+        ``lock_excursion``) is a lock candidate (on the stage below the jump)."""
         n = self.n
         dv = self.A @ z[n:]
         dd = self.A @ z[:n]
         tol = 64.0 * _EPS * self.velocity_scale(omega)
+        # a lock's neighbourhood: where the chatter would snap into it anyway (an excursion of at
+        # most lock_excursion · L: |δ_e − d_i| and δ_e'²/(2 L ω²) below it), or round-off
+        lx = self.options.lock_excursion
+        tol_d = max(64.0 * _EPS, lx)
+        tol_v = max(tol, math.sqrt(2.0 * lx) * self.velocity_scale(omega))
         sigma = [0] * self.m
         st = list(stages)
         lk = [False] * self.m
@@ -392,8 +399,8 @@ class FrictionIntegrator:
         for e in range(self.m):
             at_rest = abs(dv[e]) <= tol
             bp, J = self.breakpoints[e], self.jumps[e]
-            near = np.flatnonzero((J > 0) & (np.abs(bp - dd[e]) <= 64.0 * _EPS * np.maximum(self._L, np.abs(bp))))
-            if at_rest and near.size:
+            near = np.flatnonzero((J > 0) & (np.abs(bp - dd[e]) <= tol_d * np.maximum(self._L, np.abs(bp))))
+            if abs(dv[e]) <= tol_v and near.size:
                 st[e], lk[e] = int(near[0]), True
                 cands.append(e)
             elif not self.has_friction[e]:
@@ -489,6 +496,14 @@ class FrictionIntegrator:
                     tau = self._polish_crossing(seg, e_ev, bound, tau, tau_lim)
             else:
                 tau, e_ev, kind = tau_b, -1, -1
+            missed = self._missed_exit(seg, lo, hi, tau, e_ev if kind == CROSSING else -1) if tau > 0.0 else None
+            if missed is not None:  # an excursion beyond a breakpoint the crossing search stepped over
+                tau, e_ev, direction = missed
+                kind = CROSSING
+                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
+                i_bp = stages[e_ev] if direction > 0 else stages[e_ev] - 1
+                if self.jumps[e_ev][i_bp] > 0.0 or self.levels[e_ev][i_bp] != self.levels[e_ev][i_bp + 1]:
+                    tau = self._polish_crossing(seg, e_ev, bound, tau, tau)
             if rec is not None and (tau > 0.0 or not rec["ts"]):
                 rec["ts"].append(t)
                 rec["st"].append(stages)
@@ -576,6 +591,43 @@ class FrictionIntegrator:
                 rec["ev"].append(value)
             last = (e_ev, kind, value)
             key, z = new_key, zc
+
+    def _missed_exit(self, seg: Segment, lo: FloatArray, hi: FloatArray, tau: float,
+                     skip: int) -> tuple[float, int, int] | None:
+        """The first breakpoint crossing in (0, ``tau``) of an element found outside its stage at
+        ``tau`` (other than ``skip``, the element whose crossing ends the segment): (τ, element,
+        direction), or None. The crossing search brackets an exit by a change of sign of δ_e' in a
+        grid cell, which an element starting at rest (released) does not show when its excursion
+        beyond a breakpoint and back fits in the first cell; its velocity zero at the excursion's
+        top then ends the segment outside the stage."""
+        n = self.n
+        d = self.A @ seg.end_state(tau)[:n]
+        out = []
+        for e in range(self.m):
+            if e == skip or not (np.isfinite(lo[e]) or np.isfinite(hi[e])):
+                continue
+            floor = seg.element_floors(e)[0] + 8.0 * _EPS * max(abs(lo[e]) if np.isfinite(lo[e]) else 0.0,
+                                                                  abs(hi[e]) if np.isfinite(hi[e]) else 0.0)
+            if d[e] - hi[e] > floor or lo[e] - d[e] > floor:
+                out.append(e)
+        if not out:
+            return None
+        taus = np.linspace(0.0, tau, 129)
+        dd, _ = seg.scan(taus)
+        best: tuple[float, int, int] | None = None
+        for e in out:
+            beyond = (dd[1:, e] >= hi[e]) | (dd[1:, e] < lo[e])
+            i = int(beyond.argmax()) + 1
+            up = bool(dd[i, e] >= hi[e])
+            bound = float(hi[e] if up else lo[e])
+
+            def gap(t: float, e: int = e, bound: float = bound) -> float:
+                return seg.element_point(t, e)[0] - bound
+
+            hit = _brent(gap, float(taus[i - 1]), float(taus[i]), 0.0, 0.0)
+            if best is None or hit < best[0]:
+                best = (hit, e, 1 if up else -1)
+        return best
 
     def _polish_crossing(self, seg: Segment, e: int, bound: float, tau: float, tau_max: float) -> float:
         """The crossing time of a breakpoint where the field jumps, polished by Newton steps on
