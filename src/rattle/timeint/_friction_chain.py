@@ -455,17 +455,22 @@ class FrictionIntegrator:
         M = np.eye(2 * n)
         S = [e for e in range(m) if key[0][e]]
         if S:  # a start in a stick: a perturbation of δ_e' slips and sticks again at once, which
-            # removes it (the entry saltation, whichever its sign): δx' → P_S δx'; a start in a lock
-            # also removes the perturbation of δ_e (it spirals into the same lock): δx → δx − w_e a_e·δx
+            # removes it (the entry saltation, whichever its sign): δx' → P_S δx'. A start in a lock
+            # also removes the perturbation ε = a_e·δx of δ_e: the element chatters back into the
+            # same lock, moving along w_e (δx → δx − w_e ε), and the damping acts on that motion,
+            # −C ∫x' dt = C w_e ε, of which the held elements keep P_S C w_e ε (first order in ε,
+            # while the chatter lasts O(√ε)): δx' → P_S (δx' + C w_e a_e·δx).
             W = self._hold_columns(S)
-            M[n:, n:] -= W @ self.A[S]
+            P = np.eye(n) - W @ self.A[S]
+            D = np.zeros((n, n))
             for k, e in enumerate(S):
                 if locked[e]:
                     a = self.A[e]
                     d = float(self.breakpoints[e][stages[e]])
                     z[:n] += a * ((d - float(a @ z[:n])) / float(a @ a))
                     z[n:] -= W[:, k] * float(a @ z[n:])
-                    M[:n, :n] -= np.outer(W[:, k], a)
+                    D += np.outer(W[:, k], a)
+            M = np.block([[np.eye(n) - D, np.zeros((n, n))], [P @ self.base.damping @ D, P]])
         x_lock = self.options.lock_excursion * self._L
         events = 0
         idle = 0
