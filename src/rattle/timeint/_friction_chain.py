@@ -53,7 +53,10 @@ limit removes v along w_e = B_S (A_S B_S)⁻¹ ê_e (a_e·w_e = 1, a_k·w_e = 0 
 x' ← x' − w_e (a_e·x'), momentum-conserving. Its saltation, the crossing's with the locked field
 as φ⁺ composed with that removal (the 1/v terms lie along w_e and cancel), is
 S = blockdiag(Π, Π), Π = I − w_e a_eᵀ (0 for one coordinate: the single equation's lock). An
-element at rest within round-off of a jump at the start is a lock candidate, with that saltation.
+element at rest on a jump at the start (within round-off, or within the neighbourhood the chatter
+snaps from) is a lock candidate. A start in a lock removes a displacement ε = a_e·δx by the
+chatter back into it, which moves x along w_e within O(√ε) while the damping acts on that motion:
+δx → Π δx, δx' → P_S (δx' + C w_e ε) (P_S = I − B_S (A_S B_S)⁻¹ A_S), to first order in ε.
 
 **Saltation.** Across a switching surface h(z) = 0 (normal n = ∇h) from the field φ⁻ to φ⁺,
 
@@ -562,8 +565,9 @@ class FrictionIntegrator:
                     normal = np.concatenate((a, np.zeros(n)))
                 stages, locked = new_stages, new_locked
             elif kind == STICK:
-                zc[n:] -= a * (float(a @ zc[n:]) / float(a @ a))
                 cands = [e for e in range(m) if stuck[e]] + [e_ev]
+                # δ_e' = 0 (round-off, or the rest of a chatter), the other held elements left at rest
+                zc[n:] -= self._hold_columns(cands)[:, -1] * float(a @ zc[n:])
                 # a velocity zero again at once (no time passed): the torque sits on its band's edge
                 # (a touch); the round-off that tipped it over must not keep it slipping forever
                 new_key, stages, locked = self._settle(t, zc, stages, cands, list(key[1]), omega,
