@@ -140,3 +140,33 @@ def test_a_bad_range_of_a_discontinuous_law_is_refused():
         time_sweep(_preload(), omega=(1e-6, 1.0), points=3)
     with pytest.raises(ValueError, match="omega"):
         time_sweep(_two_inertias(), omega=(0.5, 1e4), points=3)
+
+
+def test_compare_sets_the_response_beside_the_exact_sweep():
+    import json
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from rattle.analysis import RegularisationOptions, compare
+
+    ns = _preload()
+    reg = RegularisationOptions(harmonics=32, refine=None)
+    result = compare(ns, omega=(0.6, 0.65), points=3, regularisation=reg)
+    assert result.discontinuous and result.at == () and result.orbits == ()
+    assert result.frf.harmonics == 32 and len(result.sweep) == 6
+    ag = result.agreement()
+    assert ag["rows"] == ag["compared"] == 6 and ag["largest"] < 1e-4 and ag["without"] == []
+    meta = json.loads(json.dumps(result.metadata()))
+    assert meta["frf"]["matched"] == len(result.frf) and meta["agreement"]["compared"] == 6
+    assert "sweep against the response: 6 of 6" in result.summary()
+    fig, axes = result.plot()
+    assert axes["stick"] is not None and axes.primary is axes["frf"]
+    with pytest.raises(ValueError, match="`at`"):
+        compare(ns, omega=(0.6, 0.65), points=3, at=[0.62], regularisation=reg)
+    with pytest.raises(ValueError, match="`harmonics`"):
+        compare(ns, omega=(0.6, 0.65), points=3, harmonics=16)
+    with pytest.raises(ValueError, match="`regularisation`"):
+        from rattle import reference_case
+
+        compare(reference_case(), points=3, regularisation=reg)

@@ -1,8 +1,8 @@
 """``rattle`` on a chain with Coulomb friction on its elements (``[[model.elements]] friction``):
 ``rattle frf`` writes the chain's non-smooth response (a FrictionResponse) as one set, ``rattle
-orbit`` one exact orbit with the regularised HB's beside it (a FrictionOrbitResult); compare and
-map refuse it (exit 2, nothing written) and say that frf and orbit solve it (``rattle sweep`` on
-it: test_cli_nonsmooth_sweep.py)."""
+orbit`` one exact orbit with the regularised HB's beside it (a FrictionOrbitResult); map refuses
+it (exit 2, nothing written) and says that frf and orbit solve it (``rattle sweep`` and ``rattle
+compare`` on it: test_cli_nonsmooth_sweep.py)."""
 
 from __future__ import annotations
 
@@ -49,8 +49,8 @@ harmonics = 16
 """
 
 
-@pytest.mark.parametrize("args", [["compare"], ["map", "--vary", "mean=0.04,0.05"]])
-def test_compare_and_map_refuse_a_chain_with_friction_and_write_nothing(tmp_path, args):
+@pytest.mark.parametrize("args", [["map", "--vary", "mean=0.04,0.05"]])
+def test_map_refuses_a_chain_with_friction_and_writes_nothing(tmp_path, args):
     config = write_config(tmp_path, CHAIN)
     result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
     assert_bad_input(result, "`model.elements[0].friction`", "a chain with Coulomb friction on its elements",

@@ -94,7 +94,7 @@ def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
     assert math.isfinite(float(table["mu1_abs"][i])) and float(table["stick_time"][i]) == 0.0
 
 
-@pytest.mark.parametrize("args", [["compare"], ["map", "--vary", "damping=0.04,0.05"]])  # sweep: test_cli_nonsmooth_sweep.py
+@pytest.mark.parametrize("args", [["map", "--vary", "damping=0.04,0.05"]])  # sweep, compare: test_cli_nonsmooth_sweep.py
 def test_commands_that_cannot_solve_the_law_refuse_it_and_write_nothing(tmp_path, args):
     config = write_config(tmp_path, PRELOAD)
     result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)

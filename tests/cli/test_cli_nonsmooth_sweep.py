@@ -1,7 +1,9 @@
-"""``rattle sweep`` on the discontinuous laws: a preload with friction (the single equation) and a
-chain with friction on its elements are swept by their exact event-driven integrators and written
-as the usual set (sweep.csv, sweep.json, sweep.png); ``rattle compare`` and ``rattle map`` still
-refuse them (exit 2, nothing written)."""
+"""``rattle sweep`` and ``rattle compare`` on the discontinuous laws: a preload with friction (the
+single equation) and a chain with friction on its elements are swept by their exact event-driven
+integrators and written as the usual set (sweep.csv, sweep.json, sweep.png); compare sets the
+regularised HB's response (checked by exact shooting) beside that sweep (frf.csv, sweep.csv,
+compare.json, compare.png). ``--at`` and ``--measured`` of compare, and ``rattle map``, are refused
+(exit 2, nothing written)."""
 
 from __future__ import annotations
 
@@ -112,13 +114,47 @@ def test_sweep_of_a_chain_with_friction_writes_per_element_columns(tmp_path):
     assert abs(float(orbit.stick_fraction[0]) - float(table["clutch_stick_fraction"][1])) <= 1e-9
 
 
+def test_compare_of_a_preload_with_friction_writes_the_set(tmp_path):
+    config = write_config(tmp_path, PRELOAD.replace("harmonics = 32", "harmonics = 32\nrefine = 0"))
+    result = invoke(["compare", str(config), "--points", "3", "--omega-min", "0.6", "--omega-max", "0.65", "-q",
+                     "-o", "out"], tmp_path)
+    assert result.exit_code == 0, result.stderr
+    out = tmp_path / "out"
+    assert sorted(p.name for p in out.iterdir()) == ["compare.json", "compare.png", "frf.csv", "sweep.csv"]
+    assert (out / "compare.png").read_bytes()[:8] == PNG
+    frf, sweep = read_csv(out / "frf.csv"), read_csv(out / "sweep.csv")
+    assert "rms_hb" in frf and "matched" in frf and "stick_fraction" in sweep and len(sweep["omega"]) == 6
+    meta = json.loads((out / "compare.json").read_text())
+    assert meta["command"] == "compare" and meta["orbits"] == []
+    agreement = meta["agreement"]
+    assert agreement["rows"] == agreement["compared"] == 6 and agreement["largest"] < 1e-4
+    assert "sweep against the response: 6 of 6 settled period-1 rows" in result.stdout
+
+
+def test_compare_of_a_chain_with_friction_writes_the_set(tmp_path):
+    config = write_config(tmp_path, CHAIN)
+    result = invoke(["compare", str(config), "--points", "2", "--omega-min", "0.9", "--omega-max", "0.95", "-q",
+                     "-o", "out"], tmp_path)
+    assert result.exit_code == 0, result.stderr
+    out = tmp_path / "out"
+    assert sorted(p.name for p in out.iterdir()) == ["compare.json", "compare.png", "frf.csv", "sweep.csv"]
+    assert "clutch_rms_hb" in read_csv(out / "frf.csv") and "clutch_stick_fraction" in read_csv(out / "sweep.csv")
+    agreement = json.loads((out / "compare.json").read_text())["agreement"]
+    assert agreement["compared"] == agreement["rows"] == 4 and agreement["largest"] < 1e-9
+
+
 @pytest.mark.parametrize("text, keys", [(PRELOAD, "`model.elastic.preload` and `model.elastic.friction`"),
                                         (CHAIN, "`model.elements[0].friction`")])
-@pytest.mark.parametrize("args", [["compare"], ["map", "--vary", "mean=0.04,0.05"]])
-def test_compare_and_map_still_refuse_the_discontinuous_laws_and_write_nothing(tmp_path, text, keys, args):
+@pytest.mark.parametrize("args, fragment", [
+    (["compare", "--at", "0.6"], "`--at` is not supported for a discontinuous law"),
+    (["compare", "--measured", "run.csv"], "`--measured` is not supported for a discontinuous law"),
+    (["map", "--vary", "mean=0.04,0.05"], "not supported by `rattle map` yet"),
+])
+def test_the_options_and_commands_that_remain_refused_exit_2_and_write_nothing(tmp_path, text, keys, args, fragment):
     config = write_config(tmp_path, text)
+    (tmp_path / "run.csv").write_text("omega,acc_p2p\n0.6,0.1\n0.65,0.1\n", encoding="utf-8")
     result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
-    assert_bad_input(result, keys, f"not supported by `rattle {args[0]}` yet", "use `rattle frf`", "`rattle sweep`")
-    if args[0] == "compare":
-        assert "side by side" in result.stderr
+    assert_bad_input(result, keys, fragment)
+    if args[0] == "map":
+        assert "`rattle sweep`" in result.stderr
     assert not (tmp_path / "out").exists()

@@ -17,6 +17,13 @@ Frequencies picked automatically (``at=None``), at most one per rule, on the swe
    to 8 found);
 3. **resonance** — only when fewer than two were found above: the frequency of the largest
    stable rms on the FRF (the grid point nearest to it).
+
+A discontinuous law (:class:`~rattle.model.NonsmoothSystem`: jumps and Coulomb friction) or a
+chain with friction on its elements (:class:`~rattle.model.FrictionSystem`): the frequency
+response is the regularised harmonic balance checked row by row by exact shooting
+(:func:`nonsmooth_response`), the sweep runs on the exact event-driven integrator, and the two are
+set side by side without detailed orbits (``at`` is refused): every settled period-1 row of the
+sweep against the response's exact rms at its frequency (:meth:`Comparison.agreement`).
 """
 
 from __future__ import annotations
@@ -32,7 +39,7 @@ import numpy as np
 from .. import _limits, _validate
 from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
-from ..model import Model, check_analysable_model
+from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
 from ..results import Comparison, FrequencyResponse, PeriodicOrbit, SteadyState, SweepResult
 from ._frequency_response import frequency_response
 from ._frequency_response import check_range
@@ -40,7 +47,8 @@ from ._orbit import MAX_PERIOD, periodic_orbit
 from ._regimes import confirm_with_sweep
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
 from ._steady import SteadyStateOptions, make_integrator, steady_state
-from ._time_sweep import time_sweep
+from ._regularisation import RegularisationOptions
+from ._time_sweep import _Bounds, time_sweep
 
 #: Automatic picks: the up/down sweeps must differ by this fraction of the largest rms for the
 #: multi-valued pick to go where they differ most.
@@ -155,12 +163,17 @@ def compare(
     options: SteadyStateOptions | None = None,
     workers: int = 1,
     callback: Callable[[int, int], None] | None = None,
+    regularisation: RegularisationOptions | None = None,
 ) -> Comparison:
     """Frequency response and time-domain sweep over ``omega``, with orbits at a few frequencies.
 
     Parameters
     ----------
-    model : Model
+    model : Model, Chain, NonsmoothSystem or FrictionSystem
+        A discontinuous law (the last two): the regularised harmonic balance checked by exact
+        shooting (:func:`nonsmooth_response` with ``regularisation``) against the exact sweep,
+        without detailed orbits (``at`` must be None; ``harmonics`` is then
+        ``regularisation.harmonics``).
     omega : (float, float), default (0.1, 3.0)
         Frequency range (rad/s).
     harmonics : int, default 32
@@ -180,11 +193,25 @@ def compare(
         Processes for the sweep (2: the up and down sweeps at once).
     callback : callable, optional
         ``callback(done, total)`` after each sweep frequency (for a progress bar).
+    regularisation : RegularisationOptions, optional
+        A discontinuous law's harmonic-balance settings (default those of
+        :func:`nonsmooth_response`); refused for a continuous model.
 
     Returns
     -------
     Comparison
     """
+    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+        if samples is not None or hb is not None or stability != "monodromy":
+            raise ValueError("`samples`, `hb` and `stability` do not apply to a discontinuous law: give its "
+                             "harmonic-balance settings as `regularisation` (RegularisationOptions)")
+        if harmonics != DEFAULT_HARMONICS and regularisation is None:
+            raise ValueError(f"`harmonics` = {harmonics!r}: give a discontinuous law's harmonics in `regularisation` "
+                             "(RegularisationOptions(harmonics=...))")
+        return _compare_discontinuous(model, omega, points, at, regularisation, newton, continuation, options,
+                                      workers, callback)
+    if regularisation is not None:
+        raise ValueError("`regularisation` applies only to a discontinuous law (a NonsmoothSystem or FrictionSystem)")
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file
     # (all of them before the frequency response, so that a bad `points` is not found after it).
     check_analysable_model(model)
@@ -239,6 +266,38 @@ def compare(
         settings={"omega": [lo, hi], **run.record(), "points": points,
                   "at": None if at is None else list(chosen or []), "workers": workers},
         timings={"frequency_response": t1 - t0, "sweep": t2 - t1, "orbits": t3 - t2, "total": t3 - t0},
+    )
+
+
+def _compare_discontinuous(
+    model: NonsmoothSystem | FrictionSystem, omega: tuple[float, float], points: int, at: Sequence[float] | None,
+    regularisation: RegularisationOptions | None, newton: NewtonOptions | None,
+    continuation: ContinuationOptions | None, options: SteadyStateOptions | None, workers: int,
+    callback: Callable[[int, int], None] | None,
+) -> Comparison:
+    """:func:`compare` on a discontinuous law: its response and its exact sweep, side by side."""
+    from ._nonsmooth import nonsmooth_response
+
+    lo, hi = _limits.check_frequency_range(_Bounds(model), *check_range(omega), simulate=True)
+    _limits.check_points(points)
+    _limits.check_workers(workers)
+    _validate.check_instance(options, "options", SteadyStateOptions, "a SteadyStateOptions")
+    _validate.check_instance(regularisation, "regularisation", RegularisationOptions, "a RegularisationOptions")
+    _limits.check_callback(callback)
+    if at is not None:
+        raise ValueError("`at` is not supported for a discontinuous law: its comparison has no detailed orbits "
+                         "(use nonsmooth_orbit at a frequency); leave `at` None")
+    t0 = time.perf_counter()
+    frf = nonsmooth_response(model, (lo, hi), regularisation, continuation=continuation, newton=newton)
+    t1 = time.perf_counter()
+    sweep = time_sweep(model, omega=(lo, hi), points=points, direction="both", options=options,
+                       workers=workers, callback=callback)
+    t2 = time.perf_counter()
+    return Comparison(
+        model=model, frf=frf, sweep=sweep, at=(), reasons=(), orbits=(), simulations=(),  # type: ignore[arg-type]
+        settings={"omega": [lo, hi], "harmonics": frf.harmonics, "regularisation": frf.regularisation,
+                  "points": points, "at": None, "workers": workers},
+        timings={"frequency_response": t1 - t0, "sweep": t2 - t1, "total": t2 - t0},
     )
 
 

@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 
 __all__ = [
     "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_frf", "run_nonsmooth_orbit",
-    "run_friction_orbit",
+    "run_friction_orbit", "run_discontinuous_compare",
     "frf_command", "sweep_command", "orbit_command", "compare_command", "map_command", "demo_command",
 ]
 
@@ -183,10 +183,6 @@ def _law_keys(run_config: Any) -> str:
     return " and ".join(keys) or "`model.elastic`"
 
 
-#: What the refusal of a discontinuous law adds for a command.
-_COMPARE_HINT = {"compare": " (run `rattle frf` and `rattle sweep` to set the response and the sweep side by side)"}
-
-
 def refuse_discontinuous(run_config: Any, command: str) -> None:
     """Exit 2 (nothing written) when ``rattle COMMAND`` cannot solve the configuration's law yet."""
     if getattr(run_config, "chain_friction", False):
@@ -194,13 +190,13 @@ def refuse_discontinuous(run_config: Any, command: str) -> None:
             f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
             f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance of the chain checked by "
             "exact shooting with Filippov sticking), `rattle sweep` (the exact time-domain sweep) or `rattle orbit` "
-            f"(one orbit at a frequency){_COMPARE_HINT.get(command, '')}, or remove the friction"
+            "(one orbit at a frequency), or remove the friction"
         )
     if run_config.discontinuous:
         raise ConfigError(
             f"{_law_keys(run_config)}: a discontinuous law (a torque jump or friction) is not supported by "
             f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance checked by exact "
-            f"shooting), `rattle sweep` (the exact time-domain sweep) or `rattle orbit`{_COMPARE_HINT.get(command, '')}"
+            "shooting), `rattle sweep` (the exact time-domain sweep) or `rattle orbit`"
         )
 
 
@@ -568,11 +564,22 @@ def compare_command(
         except ConfigError as exc:
             raise ConfigError(f"`--measured`: {exc}") from None
     run_config = _io().load_config(config)
-    refuse_discontinuous(run_config, "compare")
+    if run_config.discontinuous:
+        for given, option in ((at, "--at"), (measured, "--measured")):
+            if given is not None:
+                raise ConfigError(
+                    f"`{option}` is not supported for a discontinuous law ({_law_keys(run_config)}) yet: its comparison "
+                    f"sets the response and the exact sweep side by side without time histories; leave {option} out")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
-        run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
+        run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
+        omega_max=w_max,
     )
+    if run_config.discontinuous:
+        run_discontinuous_compare(run_config, config, analysis, output, points, workers, quiet, {
+            "points": points, "workers": workers, "harmonics": harmonics, "omega_min": omega_min,
+            "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max})
+        return
     at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
     measured_run = None if measured is None else _io().read_measured_csv(
         measured, speed_order=getattr(run_config.model, "speed_order", None),
@@ -613,6 +620,34 @@ def compare_command(
         steps += [("compare.png", lambda path: save_figure(draw_measured, path)), ("measured.csv", beside.to_csv)]
     written = write_set(output, COMPARE_FILES, steps)
     echo_written(summary, written, output)
+
+
+def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisSettings, output: Path, points: int,
+                              workers: int, quiet: bool, options: dict[str, Any]) -> None:
+    """``rattle compare`` on a discontinuous law, or a chain with friction on its elements:
+    :func:`rattle.analysis.compare` with the file's ``[analysis]`` (harmonics, regularisation,
+    refine) — the regularised harmonic balance checked by exact shooting against the exact up and
+    down sweep, written as frf.csv (the response's columns), sweep.csv, compare.json, compare.png."""
+    t_start = time.perf_counter()
+    from ..analysis import RegularisationOptions, compare  # only now: all input has been validated
+
+    reg = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
+                                refine=analysis.refine or None)
+    logger.info("comparing the response of a discontinuous law (regularised harmonic balance, H = %d, ε = %g, checked "
+                "by exact shooting) with its exact up and down sweep", reg.harmonics, reg.regularisation)
+    bar = ProgressBar("sweep up+down", enabled=not quiet)
+    try:
+        result = compare(run_config.model, omega=analysis.omega, points=points, workers=workers, callback=bar,
+                         regularisation=reg)
+    finally:
+        bar.close()
+    meta = sections("compare", config, run_config, analysis, options)
+    written = write_set(output, COMPARE_FILES, [
+        ("frf.csv", result.frf.to_csv), ("sweep.csv", result.sweep.to_csv),
+        ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
+        ("compare.png", lambda path: save_plot(result, path)),
+    ])
+    echo_written(result.summary(), written, output)
 
 
 # --------------------------------------------------------------------------------------------

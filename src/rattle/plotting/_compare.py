@@ -111,6 +111,10 @@ def compare_plot(
     from ._frf import _draw_panel, speed_axis
     from ._sweep import _draw_sweep
 
+    if getattr(comparison, "discontinuous", False):
+        if measured is not None:
+            raise ValueError("`measured` is not supported for a discontinuous law's comparison")
+        return _discontinuous_plot(comparison, fig, title)
     frf, sweep = comparison.frf, comparison.sweep
     names = tuple(getattr(sweep, "element_names", ()) or ())
     m = max(1, len(names))
@@ -210,6 +214,84 @@ def compare_plot(
     aliases = {"frf": ax_frf, "histories": rows[0], "frf_panels": frf_axes,
                "element_histories": dict(zip(names, rows))}
     return fig, PlotAxes(panels, aliases=aliases)
+
+
+def _discontinuous_plot(comparison: "Comparison", fig: Any, title: str | None) -> tuple[Any, PlotAxes]:
+    """A discontinuous law's comparison: per element (the single equation: δ) the response's exact
+    rms (solid where stable, dotted where not; rows not matched left out), the regularised HB's
+    dashed, and the up (▲) and down (▼) sweep points over them; below, the stick fraction of the
+    response's rows (line) and of the sweep's (markers)."""
+    import matplotlib.pyplot as plt
+
+    from ._sweep import _draw_sweep
+
+    frf, sweep = comparison.frf, comparison.sweep
+    names = tuple(getattr(frf, "element_names", ()) or ())
+    m = max(1, len(names))
+    if fig is None:
+        fig = plt.figure(figsize=(10, 3.2 + 3.4 * m), layout="constrained")
+    gs = fig.add_gridspec(m + 1, 1, height_ratios=(3.0,) * m + (1.2,))
+    axes = [fig.add_subplot(gs[k, 0]) for k in range(m)]
+    ax_s = fig.add_subplot(gs[m, 0], sharex=axes[0])
+    w = np.asarray(frf.omega, dtype=float)
+    matched = np.asarray(frf.matched, dtype=bool)
+    stable = np.asarray(frf.stable, dtype=bool)
+    rms = np.asarray(frf.rms, dtype=float).reshape(len(w), -1)
+    rms_hb = np.asarray(frf.rms_hb, dtype=float).reshape(len(w), -1)
+    if names:
+        held = np.asarray(frf.stick_fraction, dtype=float).reshape(len(w), -1)
+        sweep_held = [sweep.extra_columns.get(f"{nm}_stick_fraction") for nm in names]
+    else:
+        held = (np.asarray(frf.stick_time, dtype=float) * w / (2.0 * math.pi)).reshape(-1, 1)
+        sweep_held = [sweep.extra_columns.get("stick_fraction")]
+    for k, ax in enumerate(axes):
+        ax.plot(w, rms_hb[:, k], "--", color="0.55", lw=0.9,
+                label=f"regularised HB (H = {frf.harmonics}, ε = {frf.regularisation:g})")
+        ax.plot(w, np.where(matched & stable, rms[:, k], np.nan), "-", color="tab:green", lw=1.6,
+                label="exact orbit, stable")
+        if np.any(matched & ~stable):
+            ax.plot(w, np.where(matched & ~stable, rms[:, k], np.nan), ":", color="tab:green", lw=1.3,
+                    label="exact orbit, unstable")
+        y = np.asarray(sweep.element_columns[f"{names[k]}_rms"] if names else sweep.rms, dtype=float)
+        _draw_sweep(sweep, ax, y, True, False, legend=False)
+        ax.set_ylabel(f"{names[k]}: δ rms (rad)" if names else "δ rms (rad)")
+        ax.set_xlabel("")
+        ax.legend(fontsize=8, loc="best", framealpha=0.9)
+        if k:
+            ax.set_title(f"element {names[k]}", fontsize=10)
+    ag = comparison.agreement()
+    text = (f"sweep against response: {ag['compared']} of {ag['rows']} settled period-1 rows compared, median "
+            f"relative rms difference {ag['median']:.2g}" if ag["compared"] else
+            f"sweep against response: none of {ag['rows']} settled period-1 rows on a stable matched stretch")
+    axes[0].set_title(
+        "Response (exact orbits, regularised HB) against the exact sweep "
+        f"({int(np.sum(sweep.direction == 'up'))} Ω per direction)"
+        + (f" — element {names[0]}" if names else "") + f"\n{text}", fontsize=10)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    direction = np.asarray(sweep.direction).astype(str)
+    for k in range(m):
+        c = colours[k % len(colours)]
+        label = f"{names[k]}: " if names else ""
+        ax_s.plot(w, np.where(matched, held[:, k], np.nan), "-", color=c, lw=1.2, label=f"{label}response")
+        if sweep_held[k] is not None:
+            for d in ("up", "down"):
+                sel = direction == d
+                if np.any(sel):
+                    marker, _, _ = DIRECTION_STYLES[d]
+                    ax_s.plot(np.asarray(sweep.omega)[sel], np.asarray(sweep_held[k])[sel], marker, color=c, ms=4,
+                              ls="none", label=f"{label}sweep {d}")
+    ax_s.set_ylim(-0.02, 1.02)
+    ax_s.set_ylabel("stick / period")
+    ax_s.set_xlabel("Ω (rad/s)")
+    ax_s.grid(True, alpha=0.3)
+    ax_s.legend(fontsize=7, loc="best", ncol=2)
+    if title is not None:
+        fig.suptitle(title)
+    if names:
+        panels = {f"{name}_frf": ax for name, ax in zip(names, axes)}
+        panels["stick"] = ax_s
+        return fig, PlotAxes(panels, aliases={"frf": axes[0], "histories": [], "frf_panels": axes})
+    return fig, PlotAxes({"frf": axes[0], "stick": ax_s}, aliases={"histories": []})
 
 
 def _draw_measured(measured: "MeasuredComparison", quantity: str, ax: Any) -> None:
