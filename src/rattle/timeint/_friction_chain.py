@@ -316,8 +316,8 @@ class FrictionIntegrator:
 
     def _free_acceleration(self, key: _Key, stages: tuple[int, ...], t: FloatArray | float, z: FloatArray,
                            omega: float) -> FloatArray:
-        """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,) (z: t.shape + (2n,));
-        o_ej the law's own offsets (jumps included)."""
+        """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,)
+        (z: t.shape + (2n,)); o_ej the law's own offsets (jumps included)."""
         n = self.n
         base = self.base
         x, v = z[..., :n], z[..., n:]
