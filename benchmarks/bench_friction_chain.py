@@ -8,9 +8,11 @@ rows, rows matched by the exact orbit, the fraction of matched rows whose HB rms
 is within 0.5 % of the exact one at ε and after the ε-ladder (rows off by more than 0.5 % taken
 down to ε = 1e-3; Richardson where linear), stability agreement (exact saltation monodromy of the
 exact orbit vs that of one period of exact flow from the HB state), rows that stick, time.
+``--case preload``: the same chain with a torque-converter lock-up clutch in place of the damper
+(a torque jump ±0.03 K_e at δ = 0 with friction 0.01; the exact flow locks it at the jump).
 
 Run:  OMP_NUM_THREADS=1 python benchmarks/bench_friction_chain.py [--harmonics 64 128] [--no-refine] [--lo 0.4] [--eps 0.001]
-      [--stability regularised]
+      [--stability regularised] [--case preload]
 
 Measured 2026-12-01 (2 cores shared with other jobs, two runs at a time: times are upper bounds):
 
@@ -35,7 +37,19 @@ import time
 import numpy as np
 
 from rattle.analysis import RegularisationOptions, friction_response
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Torque
+from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Preload, Torque
+
+
+def preload_chain() -> Chain:
+    """The same chain with a torque-converter lock-up clutch in place of the damper: a torque jump
+    of ±0.03 K_e at δ = 0 (Preload) with friction 0.01 beside it."""
+    return Chain(inertias=(1.0, 0.5, 2.0),
+                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
+                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
+                 elements=(Element(name="tcc", between=(1, 2), stiffness=1.0, law=Preload(preload=0.03),
+                                   friction=Friction(levels=0.01)),
+                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
+                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
 
 
 def chain() -> Chain:
@@ -55,12 +69,14 @@ def main() -> None:
     ap.add_argument("--lo", type=float, default=0.2)
     ap.add_argument("--hi", type=float, default=2.0)
     ap.add_argument("--eps", type=float, default=0.01)
+    ap.add_argument("--case", choices=("clutch", "preload"), default="clutch",
+                    help="the damper with friction per stage, or a lock-up clutch with a torque jump")
     ap.add_argument("--stability", choices=("saltation", "regularised"), default="saltation",
                     help="the HB orbit's own multipliers: the exact flow from its state, or the regularised monodromy")
     args = ap.parse_args()
-    fs = chain().friction_system()
+    fs = (chain() if args.case == "clutch" else preload_chain()).friction_system()
     wn = fs.frequency_scale()
-    print(f"chain: 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = {args.eps:g}, "
+    print(f"chain ({args.case}): 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = {args.eps:g}, "
           f"HB stability {args.stability}")
     for H in args.harmonics:
         opts = RegularisationOptions(harmonics=H, regularisation=args.eps, refine=None if args.no_refine else 0.005,

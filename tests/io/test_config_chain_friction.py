@@ -213,3 +213,18 @@ def test_load_case_solves_a_chain_with_friction_by_frequency_response_only(tmp_p
         case.periodic_orbit(1.0)
     with pytest.raises(TypeError, match="use `frequency_response\\(\\)`$"):
         case.compare()
+
+
+@pytest.mark.parametrize("units", ["dimensionless", "SI"])
+def test_a_preload_element_round_trips(units):
+    """to_dict → TOML → config_from_dict gives the same jump law and friction (× K_e back to N m)."""
+    import tomllib
+
+    data = _preload_chain(friction=0.01, clearance_deg=0.5, slope=0.4)
+    data["model"]["units"] = units
+    rc = config_from_dict(data)
+    out = rc.to_dict()
+    assert out["model"]["elements"][0]["type"] == "preload"
+    assert out["model"]["elements"][0]["preload"] == pytest.approx(0.05, rel=1e-15)  # as written
+    again = config_from_dict(tomllib.loads(dumps_toml(out)))
+    assert again.model.laws == rc.model.laws

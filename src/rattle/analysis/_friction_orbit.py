@@ -79,10 +79,11 @@ def _flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTr
 
 
 def _stuck_all_period(flow: FrictionTrajectory | None) -> list[int]:
-    """The elements that stick at least :data:`HOLD_FRACTION` of the period on ``flow``."""
+    """The elements that stick at least :data:`HOLD_FRACTION` of the period on ``flow`` (held by
+    friction: a lock at a jump of the law is one orbit, not a family)."""
     if flow is None:
         return []
-    frac = flow.stick_time() / (flow.t1 - flow.t0)
+    frac = (flow.stick_time() - flow.lock_time()) / (flow.t1 - flow.t0)
     return [int(e) for e in np.flatnonzero(frac >= HOLD_FRACTION)]
 
 

@@ -58,7 +58,7 @@ from ..model import FrictionSystem
 from ..results import FrictionResponse
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionTrajectory, shoot_friction_orbit
-from ..timeint._friction_chain import CROSSING, STICK
+from ..timeint._friction_chain import CROSSING, LOCK, STICK
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -125,10 +125,11 @@ def _held_elements(flow: FrictionTrajectory | None, E: FloatArray) -> dict[int, 
     element sticks the whole period the exact periodic orbits form a family (its stuck deflection
     is free within the friction band; a multiplier 1): the regularised HB picks one member by its
     creep balance, and the exact orbit checked against it is the member with the same stuck
-    deflection (:func:`~rattle.timeint.shoot_friction_orbit` ``hold``)."""
+    deflection (:func:`~rattle.timeint.shoot_friction_orbit` ``hold``). A lock at a jump of the
+    law does not count: its deflection is the jump's, one orbit, no family."""
     if flow is None:
         return {}
-    frac = flow.stick_time() / (flow.t1 - flow.t0)
+    frac = (flow.stick_time() - flow.lock_time()) / (flow.t1 - flow.t0)
     return {int(e): float(E[e][0]) for e in np.flatnonzero(frac >= HOLD_FRACTION)}
 
 
@@ -333,9 +334,9 @@ def friction_response(
             assert traj is not None
             mean[i], rms[i] = traj.element_mean_and_rms()
             stick[i] = traj.stick_time() / (2.0 * math.pi / w)
-            for e in range(m):  # the switching pattern: stick phases and breakpoint crossings per period
+            for e in range(m):  # the switching pattern: stick or lock phases and breakpoint crossings per period
                 mine = traj.event_elements == e
-                pattern[i, e] = int(np.sum(mine & (traj.event_kinds == STICK)))
+                pattern[i, e] = int(np.sum(mine & np.isin(traj.event_kinds, (STICK, LOCK))))
                 pattern[i, m + e] = int(np.sum(mine & (traj.event_kinds == CROSSING)))
             mult[i] = _multipliers(traj.sensitivity)
             if mu_hb is None:

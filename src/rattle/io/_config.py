@@ -314,7 +314,8 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         if rest.discontinuous:
             raise check.error(
                 "`paths` (sound paths) is not supported with a discontinuous law (`model.elastic.preload`, "
-                "`model.elastic.friction` or a `model.elements[k].friction`) yet: the sound pressure is computed "
+                "`model.elastic.friction`, a `model.elements[k].friction` or a `model.elements[k]` with type = "
+                "\"preload\") yet: the sound pressure is computed "
                 "from the smooth laws' responses; remove [[paths]] (rattle frf gives the law's response without it)"
             )
         return with_paths(rest, data["paths"], source_name)
@@ -381,14 +382,21 @@ def _nonsmooth_to_toml_dict(system: NonsmoothSystem, model: Model | None, analys
 
 def _friction_chain_to_toml_dict(system: FrictionSystem, chain: Any, analysis: AnalysisSettings,
                                  units: str) -> dict[str, Any]:
-    """The tables of a chain with friction (round trip through :func:`config_from_dict`): the
-    chain without its friction, each element's ``friction`` as written (relative to its stiffness
-    K_e, or × K_e back to N m with ``units = "SI"``)."""
+    """The tables of a chain with friction or preloads (round trip through
+    :func:`config_from_dict`): the chain without them (``chain``, every law's continuous part),
+    each element's ``friction`` as written and a preloaded element's ``type = "preload"`` with its
+    keys (both relative to its stiffness K_e, or × K_e back to N m with ``units = "SI"``)."""
     out = model_to_toml_dict(chain, analysis)
     for e, (law, element) in enumerate(zip(system.laws, chain.elements)):
+        scale = element.stiffness if units == "SI" else 1.0
+        table = out["model"]["elements"][e]
+        if isinstance(law.elastic, Preload):
+            for key in ("type", "b", "alpha", "breakpoints", "slopes"):
+                table.pop(key, None)
+            table.update(type="preload", preload=law.elastic.preload * scale, clearance=law.elastic.clearance,
+                         slope=law.elastic.slope)
         if law.friction is not None and any(law.friction.levels):
-            scale = element.stiffness if units == "SI" else 1.0
-            out["model"]["elements"][e]["friction"] = [r * scale for r in law.friction.levels]
+            table["friction"] = [r * scale for r in law.friction.levels]
     return out
 
 
@@ -435,7 +443,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.regularisation` = {_show(table['regularisation'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0), "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
+                "a `model.elements[k].preload` > 0), "
                 "whose jumps the harmonic balance smooths; this law is continuous and solved without it: remove "
                 "`analysis.regularisation`"
             )
@@ -448,7 +457,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.refine` = {_show(table['refine'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0), "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
+                "a `model.elements[k].preload` > 0), "
                 "whose regularised harmonic balance it refines; this law is continuous: remove `analysis.refine`"
             )
         refine = table["refine"]
