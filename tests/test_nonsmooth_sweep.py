@@ -107,6 +107,11 @@ def test_up_and_down_sweeps_of_a_preload_show_the_hysteresis_on_stable_exact_orb
     assert any(j.direction == "up" and j.kind == "up" for j in sweep.jumps())  # the run-up jumps onto the peak
     assert "stick_fraction" in sweep.extra_columns and np.all(sweep.extra_columns["stick_fraction"] == 0.0)
     assert list(sweep.columns())[-1] == "stick_fraction"
+    import matplotlib
+
+    matplotlib.use("Agg")
+    _, axes = sweep.plot()  # the rms, and the stick fractions below
+    assert axes["stick"].get_ylabel() == "stick / period" and axes.primary is axes["response"]
     for w, p, x, rms, settled in zip(sweep.omega, sweep.period, sweep.state0, sweep.rms, sweep.settled):
         assert settled
         orbit = shoot_nonsmooth_orbit(ns, float(w), x, period=int(p))

@@ -80,7 +80,9 @@ def sweep_plot(
         One panel ``response`` (the given ``ax`` when there is one). A chain's sweep
         (per-element columns) drawn without ``ax``: one panel per clearance element
         (``quantity`` of its deflection), keyed by its name, sharing Ω; the primary is the
-        first element's.
+        first element's. A discontinuous law's sweep (``stick_fraction`` columns) drawn without
+        ``ax``: below them a panel ``stick``, the fraction of each row's period held stuck or
+        locked per direction (and element).
     """
     import matplotlib.pyplot as plt
 
@@ -88,7 +90,26 @@ def sweep_plot(
     if quantity not in _QUANTITIES:
         raise ValueError(f"`quantity` must be one of {sorted(_QUANTITIES)}, got {quantity!r}")
     names = tuple(getattr(sweep, "element_names", ()) or ())
-    sound = ax is None and "spl_db" in (getattr(sweep, "extra_columns", {}) or {})  # [[paths]]: an SPL panel below
+    extra = getattr(sweep, "extra_columns", {}) or {}
+    sound = ax is None and "spl_db" in extra  # [[paths]]: an SPL panel below
+    # a discontinuous law: the stick fractions in a panel below
+    sticks = [k for k in extra if k.endswith("stick_fraction")] if ax is None else []
+    if sticks:
+        fig, axes = plt.subplots(max(1, len(names)) + 1, 1, figsize=(8, 3.0 + 3.0 * max(1, len(names))), sharex=True,
+                                 layout="constrained", squeeze=False,
+                                 height_ratios=(3.0,) * max(1, len(names)) + (1.3,))
+        ax_s = axes[-1, 0]
+        for k, ax_k in enumerate(axes[:-1, 0]):
+            y = sweep.element_columns[f"{names[k]}_{quantity}"] if names else getattr(sweep, quantity)
+            _draw_sweep(sweep, ax_k, np.asarray(y, dtype=float), annotate, lines, legend=k == 0)
+            ax_k.set_ylabel(f"{names[k]}: {_QUANTITIES[quantity]}" if names else _QUANTITIES[quantity])
+            first = title if title is not None else "Time-domain frequency sweep (steady state at each Ω)"
+            ax_k.set_title(first + (f" — element {names[k]}" if names and k == 0 else "") if k == 0
+                           else f"element {names[k]}", fontsize=10 if names else None)
+            ax_k.set_xlabel("")
+        _draw_stick_panel(sweep, ax_s, sticks, lines)
+        tags = [*(names or ("response",)), "stick"]
+        return fig, PlotAxes(zip(tags, axes[:, 0]))
     if names and ax is None:  # a chain: one panel per element, sharing Ω
         fig, axes = plt.subplots(len(names) + sound, 1, figsize=(8, 1.5 + 3.0 * (len(names) + sound)), sharex=True,
                                  layout="constrained", squeeze=False)
@@ -134,6 +155,33 @@ def _draw_sound_panel(sweep: "SweepResult", ax: Any, annotate: bool, lines: bool
         ax.legend(fontsize=8, loc="best", framealpha=0.9)
     ax.set_ylabel("sound pressure level (dB re 20 µPa)")
     ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)
+
+
+def _draw_stick_panel(sweep: "SweepResult", ax: Any, keys: list[str], lines: bool) -> None:
+    """The fraction of each row's period held stuck or locked (a discontinuous law's sweep), per
+    direction and element."""
+    from ._frf import speed_axis
+
+    sx, xlabel = speed_axis(sweep)
+    omega = np.asarray(sweep.omega, dtype=float) * sx
+    direction = np.asarray(sweep.direction).astype(str)
+    for j, key in enumerate(keys):
+        y = np.asarray(sweep.extra_columns[key], dtype=float)
+        who = "" if key == "stick_fraction" else f"{key[: -len('_stick_fraction')]}: "
+        for d in ("up", "down"):
+            sel = np.nonzero(direction == d)[0]
+            if not sel.size:
+                continue
+            marker, color, _ = DIRECTION_STYLES[d]
+            if lines:
+                ax.plot(omega[sel], y[sel], "-", color=color, lw=0.8, alpha=0.6)
+            ax.plot(omega[sel], y[sel], marker, color=color, ms=4, ls="none", alpha=1.0 if j == 0 else 0.6,
+                    label=f"{who}sweep {d}")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_ylabel("stick / period")
+    ax.set_xlabel(xlabel)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="best", ncol=2)
 
 
 def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:
