@@ -116,8 +116,8 @@ class Comparison:
         frf = self.frf
         stable = np.asarray(frf.stable, dtype=bool) & np.asarray(frf.matched, dtype=bool)
         return [
-            f"regularised harmonic balance (H = {frf.harmonics}, ε = {frf.regularisation:g}) checked by exact shooting: "
-            f"{len(frf)} rows over Ω = {float(np.min(frf.omega)):.4g} … {float(np.max(frf.omega)):.4g}, "
+            f"regularised harmonic balance (H = {frf.harmonics}, ε = {frf.regularisation:g}) checked by exact "
+            f"shooting: {len(frf)} rows over Ω = {float(np.min(frf.omega)):.4g} … {float(np.max(frf.omega)):.4g}, "
             f"{int(np.sum(frf.matched))} matched, {int(np.sum(stable))} matched and stable; "
             f"{frf.status.name.lower()}" + (f": {frf.message}" if frf.message else ""),
         ]
