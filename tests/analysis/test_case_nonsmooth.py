@@ -1,5 +1,6 @@
 """A case file with a preload or friction from Python: load_case dispatches to the front ends of the
-discontinuous laws with the file's settings, and Model.from_toml refuses it clearly."""
+discontinuous laws with the file's settings (response, orbit, sweep, comparison), and
+Model.from_toml refuses it clearly."""
 
 from __future__ import annotations
 
@@ -46,8 +47,11 @@ def test_load_case_runs_the_discontinuous_front_ends_on_the_file_settings(tmp_pa
     assert isinstance(orbit, NonsmoothOrbitResult) and orbit.converged
     i = int(np.argmin(np.abs(frf.omega - 1.21)))
     assert orbit.rms == pytest.approx(frf.rms[i], rel=0.05)  # the same branch, a row nearby
-    for name in ("compare", "time_sweep"):
-        with pytest.raises(TypeError, match=f"`{name}`"):
-            getattr(case, name)()
+    sweep = case.time_sweep(points=4, direction="up")  # the exact event-driven sweep over the file's range
+    assert sweep.omega[0] == pytest.approx(1.2) and sweep.omega[-1] == pytest.approx(1.23)
+    held = np.asarray(sweep.extra_columns["stick_fraction"])
+    assert held.shape == (4,) and np.all((held >= 0) & (held <= 1))
+    both = case.compare(points=4)
+    assert both.frf.harmonics == 32 and both.frf.regularisation == 0.02 and len(both.sweep.omega) == 8
     with pytest.raises(ConfigError, match="load_case"):
         rattle.Model.from_toml(path)

@@ -48,12 +48,6 @@ class Case:
         return RegularisationOptions(harmonics=a.harmonics, regularisation=a.regularisation,
                                      refine=a.refine or None)
 
-    def _continuous_only(self, what: str) -> None:
-        if self.discontinuous:
-            also = "" if isinstance(self.model, FrictionSystem) else " or `periodic_orbit(omega)`"
-            raise TypeError(f"`{what}` is not available for a discontinuous law (preload or friction) yet: "
-                            f"use `frequency_response()`{also}")
-
     @property
     def analysis(self) -> AnalysisSettings:
         return self.config.analysis
@@ -80,24 +74,26 @@ class Case:
     def periodic_orbit(self, omega: float, **options: Any) -> Any:
         """:func:`rattle.periodic_orbit` at ``omega`` with the file's harmonics, the primary branch
         followed over ``analysis.omega`` (as ``rattle orbit CONFIG --omega W``); for a
-        discontinuous law :func:`rattle.analysis.nonsmooth_orbit` with :meth:`regularisation_options`;
-        not available for a chain with friction yet (TypeError)."""
-        if isinstance(self.model, FrictionSystem):
-            raise TypeError("`periodic_orbit` is not available for a chain with friction on its elements yet: use "
-                            "`frequency_response()` (rattle.analysis.nonsmooth_response on the FrictionSystem)")
+        discontinuous law, or a chain with friction or preloads on its elements,
+        :func:`rattle.analysis.nonsmooth_orbit` with :meth:`regularisation_options`."""
         if self.discontinuous:
             kw: dict[str, Any] = {"options": self.regularisation_options(), **options}
             return nonsmooth_orbit(self.model, omega, **kw)  # type: ignore[arg-type]
         return periodic_orbit(self.model, omega, **self._with_analysis(options, "search_range"))
 
     def compare(self, **options: Any) -> Any:
-        """:func:`rattle.compare` over the file's range with its harmonics (as ``rattle compare``)."""
-        self._continuous_only("compare")
+        """:func:`rattle.compare` over the file's range with its harmonics (as ``rattle compare``);
+        for a discontinuous law with :meth:`regularisation_options` (its response beside the exact
+        sweep)."""
+        if self.discontinuous:
+            kw: dict[str, Any] = {"omega": self.analysis.omega, "regularisation": self.regularisation_options(),
+                                  **options}
+            return compare(self.model, **kw)  # type: ignore[arg-type]
         return compare(self.model, **self._with_analysis(options, "omega"))
 
     def time_sweep(self, **options: Any) -> Any:
-        """:func:`rattle.time_sweep` over the file's range (as ``rattle sweep``)."""
-        self._continuous_only("time_sweep")
+        """:func:`rattle.time_sweep` over the file's range (as ``rattle sweep``; the exact
+        event-driven flow for a discontinuous law)."""
         kw = {"omega": self.analysis.omega, **options}
         return time_sweep(self.model, **kw)
 
