@@ -14,6 +14,7 @@ from ..model import Model
 from ._frequency_response import FrequencyResponse
 from ._orbit import PeriodicOrbit
 from ._sweep import SweepResult
+from ._plotter import plot_with
 
 if TYPE_CHECKING:  # annotations only
     from ._steady import SteadyState
@@ -177,6 +178,4 @@ class Comparison:
     def plot(self, fig: Any = None, *, samples: int = 256, title: str | None = None) -> tuple[Any, Any]:
         """The FRF with the sweep points over it, and a row of time histories; returns
         (figure, :class:`rattle.plotting.PlotAxes`). See :func:`rattle.plotting.compare_plot`."""
-        from ..plotting import compare_plot
-
-        return compare_plot(self, fig=fig, samples=samples, title=title)
+        return plot_with("compare_plot", self, fig=fig, samples=samples, title=title)

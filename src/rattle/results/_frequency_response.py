@@ -16,6 +16,8 @@ from ..hb import resize_harmonics
 from ._columns import FRF_COLUMNS
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model, check_analysable_model
+from ._plotter import plot_with
+from ._sound import sound_pressure
 
 #: Per-element columns of a chain's ``frf.csv`` (SPEC §5): ``NAME_`` + each of these.
 ELEMENT_COLUMNS: tuple[str, ...] = ("mean", "rms", "rms_ac", "p2p", "acc_p2p", "min", "max", "regime")
@@ -342,8 +344,6 @@ class FrequencyResponse:
         objects; :func:`rattle.results.sound_pressure`): ``spl_db`` (sound pressure level at the
         receiver, dB re 20 µPa), ``spl_dba`` (A-weighted, dB(A)) and ``spl_linear_db`` (the linear
         system's level at the same Ω)."""
-        from ._sound import sound_pressure
-
         sp = sound_pressure(self, paths)
         with warnings.catch_warnings():  # the same harmonics: warned about once, above
             warnings.simplefilter("ignore")
@@ -363,9 +363,7 @@ class FrequencyResponse:
         """rms vs Ω (stable solid, unstable dashed, bifurcations marked, linear overlaid);
         returns (figure, :class:`rattle.plotting.PlotAxes`). See
         :func:`rattle.plotting.frequency_response_plot`."""
-        from ..plotting import frequency_response_plot
-
-        return frequency_response_plot(self, ax=ax, **kwargs)
+        return plot_with("frequency_response_plot", self, ax=ax, **kwargs)
 
 
 

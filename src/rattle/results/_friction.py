@@ -26,6 +26,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
 from ..stability import classify_loss
+from ._plotter import plot_with
 
 #: The per-element columns of :meth:`FrictionResponse.columns`, NAME_ prefixed, in this order.
 FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated")
@@ -303,9 +304,7 @@ class FrictionResponse:
         """rms vs Ω per element (exact solid, HB dashed, unstable marked, stick ranges shaded) and
         the stick fractions; returns (figure, PlotAxes). See
         :func:`rattle.plotting.friction_response_plot`."""
-        from ..plotting import friction_response_plot
-
-        return friction_response_plot(self)
+        return plot_with("friction_response_plot", self)
 
 
 __all__ = ["FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS", "FrictionResponse"]

@@ -27,6 +27,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
+from ._plotter import plot_with
 
 #: The per-element columns of :meth:`FrictionOrbitResult.to_csv`, NAME_ prefixed, after ``t``.
 FRICTION_ORBIT_ELEMENT_COLUMNS = ("delta", "velocity", "stuck", "delta_hb")
@@ -256,9 +257,7 @@ class FrictionOrbitResult:
     def plot(self) -> tuple:
         """δ_e(t) exact and HB, one panel per element, the stick phases shaded; returns
         (figure, PlotAxes). See :func:`rattle.plotting.friction_orbit_plot`."""
-        from ..plotting import friction_orbit_plot
-
-        return friction_orbit_plot(self)
+        return plot_with("friction_orbit_plot", self)
 
     def __repr__(self) -> str:
         if not self.converged:

@@ -23,6 +23,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
 from ..stability import classify_loss
+from ._plotter import plot_with
 
 #: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
 NONSMOOTH_COLUMNS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
@@ -158,9 +159,7 @@ class NonsmoothResponse:
     def plot(self) -> tuple:
         """The exact and HB rms vs Ω with the stability changes, and the stick fraction; returns
         (figure, PlotAxes). See :func:`rattle.plotting.nonsmooth_response_plot`."""
-        from ..plotting import nonsmooth_response_plot
-
-        return nonsmooth_response_plot(self)
+        return plot_with("nonsmooth_response_plot", self)
 
     def to_csv(self, path: str | Path) -> Path:
         """Write :meth:`columns` to ``path`` atomically."""

@@ -25,6 +25,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..model import NonsmoothSystem
 from ..timeint import NonsmoothOrbit
+from ._plotter import plot_with
 
 #: The columns of :meth:`NonsmoothOrbitResult.to_csv`.
 NONSMOOTH_ORBIT_COLUMNS = ("t", "delta", "velocity", "acceleration", "mode", "delta_hb")
@@ -236,9 +237,7 @@ class NonsmoothOrbitResult:
     def plot(self) -> tuple:
         """δ(t) exact and HB, δ'(t) and the phase portrait with the stick and lock phases shaded;
         returns (figure, PlotAxes). See :func:`rattle.plotting.nonsmooth_orbit_plot`."""
-        from ..plotting import nonsmooth_orbit_plot
-
-        return nonsmooth_orbit_plot(self)
+        return plot_with("nonsmooth_orbit_plot", self)
 
     def __repr__(self) -> str:
         if self.orbit is None:

@@ -14,6 +14,7 @@ from .._typing import ComplexArray, FloatArray
 from ._columns import ORBIT_COLUMNS
 from ..measures import acceleration_batch, element_accelerations, evaluate_batch
 from ..model import Model
+from ._plotter import plot_with
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._steady import SteadyState
@@ -411,9 +412,7 @@ class PeriodicOrbit:
     ) -> tuple[Any, Any]:
         """δ(t), δ'(t), δ''(t), the phase portrait and the amplitude spectrum; returns
         (figure, :class:`rattle.plotting.PlotAxes`). See :func:`rattle.plotting.orbit_plot`."""
-        from ..plotting import orbit_plot
-
-        return orbit_plot(self, fig=fig, samples=samples, periods=periods, title=title)
+        return plot_with("orbit_plot", self, fig=fig, samples=samples, periods=periods, title=title)
 
 
 __all__ = ["PeriodicOrbit", "OrbitSolution", "ORBIT_SOURCES"]

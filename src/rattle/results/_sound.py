@@ -253,6 +253,10 @@ def _linear_harmonics(model: Any, omega: FloatArray, K: int) -> ComplexArray:
 # ---------------------------------------------------------------------------------------------
 # Front ends
 # ---------------------------------------------------------------------------------------------
+#: The fields of a frequency response that :func:`sound_pressure` reads.
+_FRF_FIELDS = ("model", "omega", "period", "harmonics", "coefficients")
+
+
 def sound_pressure(frf: Any, paths: SoundPath | Sequence[SoundPath], *, a_weighting: bool = False,
                    linear: bool = True) -> SoundPressure:
     """Sound pressure at the receiver for every row of a frequency response (module docstring).
@@ -279,9 +283,8 @@ def sound_pressure(frf: Any, paths: SoundPath | Sequence[SoundPath], *, a_weight
         When a harmonic with more than :data:`UNCOVERED_WARNING` of a source's mean-square
         acceleration lies outside a path's table (transmitted as zero).
     """
-    from ._frequency_response import FrequencyResponse
-
-    if not isinstance(frf, FrequencyResponse):
+    if not all(hasattr(frf, a) for a in _FRF_FIELDS):  # a FrequencyResponse (read by its fields: the
+        # response class sits above this module and calls it from with_sound)
         raise TypeError(f"`frf` must be a FrequencyResponse (rattle.frequency_response), got {type(frf).__name__}")
     paths_t = _check_paths(paths, frf.model)
     system = frf.model.system()

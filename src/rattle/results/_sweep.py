@@ -14,6 +14,7 @@ from .._typing import BoolArray, ComplexArray, FloatArray, IntArray
 from ._columns import SWEEP_COLUMNS
 from ._steady import METHOD_STATUS
 from ..model import Model
+from ._plotter import plot_with
 
 #: Per-element columns of a chain's ``sweep.csv``: ``NAME_`` + each of these (the measures of
 #: element NAME's deflection, as the SPEC columns are of the first element's).
@@ -341,9 +342,7 @@ class SweepResult:
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """rms vs Ω of each direction; returns (figure, :class:`rattle.plotting.PlotAxes`). See
         :func:`rattle.plotting.sweep_plot`."""
-        from ..plotting import sweep_plot  # type: ignore[attr-defined]
-
-        return sweep_plot(self, ax=ax, **kwargs)
+        return plot_with("sweep_plot", self, ax=ax, **kwargs)
 
 
 _ROW_FIELDS: tuple[str, ...] = (
