@@ -159,6 +159,11 @@ def test_a_preload_element_makes_the_chain_a_friction_system_with_its_jump():
     np.testing.assert_array_equal(rc.model.laws[0].stages.jumps, [0.05, 0.05])
     assert isinstance(rc.continuous_model, Chain) and not rc.continuous_model.discontinuous
     rc.continuous_model.system()  # the smooth chain exists (the bounds read it)
+    # a jump's default regularisation is the single equation's (0.001 makes the continuation crawl)
+    assert rc.analysis.regularisation == 0.01
+    from rattle.analysis._friction_response import chain_regularisation
+
+    assert chain_regularisation(rc.model) == 0.01 and chain_regularisation(config_from_dict(_chain(0.01)).model) == 0.001
     # without friction, the jump alone
     rc = config_from_dict(_preload_chain())
     assert isinstance(rc.model, FrictionSystem) and rc.model.has_jumps and not rc.model.has_friction

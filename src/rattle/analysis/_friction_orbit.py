@@ -47,7 +47,7 @@ from ..model import FrictionSystem
 from ..results import FrictionOrbitResult
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
-from ._friction_response import CHAIN_REGULARISATION, _start, friction_balance_factory
+from ._friction_response import _start, chain_regularisation, friction_balance_factory
 from ._regularisation import RegularisationOptions
 
 #: Periods of the exact flow run before shooting again when the shooting from the start fails.
@@ -136,7 +136,7 @@ def friction_orbit(
     (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε,
     ``match`` and ``stability``, how the HB orbit's own multipliers are found; the ladder settings
     are not used here. None: the defaults with
-    ε = :data:`~rattle.analysis._friction_response.CHAIN_REGULARISATION`). ``x0`` = (x, x') at
+    ε = :func:`~rattle.analysis._friction_response.chain_regularisation`). ``x0`` = (x, x') at
     t = 0 (2n numbers) starts the exact shooting instead of the HB orbit's state.
 
     A failed exact shooting is reported in the result (``converged`` False, ``message``); a failed
@@ -147,7 +147,7 @@ def friction_orbit(
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     omega = check_omega(omega)
-    opts = RegularisationOptions(regularisation=CHAIN_REGULARISATION) if options is None else options
+    opts = RegularisationOptions(regularisation=chain_regularisation(system)) if options is None else options
     if not isinstance(opts, RegularisationOptions):
         raise TypeError(f"`options` must be a RegularisationOptions or None, got {opts!r}")
     n, m = system.n, system.m

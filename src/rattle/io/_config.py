@@ -336,7 +336,8 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
             )
         analysis_t = {**analysis_t, "omega": [float(forcing_frequency(r, engine.base_order)) for r in engine.rpm]}
         omega_names = {"omega_min": "engine.speed_rpm[0]", "omega_max": "engine.speed_rpm[1]"}
-    analysis = _analysis(check, analysis_t, discontinuous=tables.discontinuous, chain=tables.chain is not None)
+    analysis = _analysis(check, analysis_t, discontinuous=tables.discontinuous,
+                         chain=tables.chain is not None and not tables.chain.has_jumps)
     if engine is not None and analysis.harmonics < engine.harmonics:
         raise check.error(
             f"`analysis.harmonics` must be >= {engine.harmonics}: the highest of `engine.orders` is harmonic "
@@ -437,7 +438,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
               chain: bool = False) -> AnalysisSettings:
     """``[analysis]``; for a discontinuous law also ``regularisation`` (refused otherwise; default
     :data:`DEFAULT_REGULARISATION`, :data:`DEFAULT_CHAIN_REGULARISATION` for a ``chain`` with
-    friction), and the harmonics default :data:`DEFAULT_NONSMOOTH_HARMONICS`."""
+    friction and no jump on its elements: a jump's position step at 0.001 makes the continuation
+    crawl, docs/nonsmooth.md), and the harmonics default :data:`DEFAULT_NONSMOOTH_HARMONICS`."""
     regularisation = None
     if "regularisation" in table:
         if not discontinuous:
