@@ -207,17 +207,18 @@ def test_sound_paths_with_chain_friction_are_refused():
     _refused(data, "`paths`", "`model.elements[k].friction`", "remove [[paths]]")
 
 
-def test_load_case_solves_a_chain_with_friction_by_frequency_response_only(tmp_path):
+def test_load_case_reads_a_chain_with_friction_with_the_chain_defaults(tmp_path):
+    """load_case keeps the chain's settings; its orbit is the chain's (FrictionOrbitResult)."""
+    from rattle.results import FrictionOrbitResult
+
     path = tmp_path / "case.toml"
     path.write_text(dumps_toml(config_from_dict(_chain([0.0, 0.03, 0.0])).to_dict()), encoding="utf-8")
     case = load_case(path)
     assert case.discontinuous and isinstance(case.model, FrictionSystem)
     opts = case.regularisation_options()
     assert (opts.harmonics, opts.regularisation, opts.refine) == (128, 0.001, 0.005)
-    with pytest.raises(TypeError, match="chain with friction"):
-        case.periodic_orbit(1.0)
-    with pytest.raises(TypeError, match="use `frequency_response\\(\\)`$"):
-        case.compare()
+    orbit = case.periodic_orbit(1.0, options=type(opts)(harmonics=16, regularisation=0.01))
+    assert isinstance(orbit, FrictionOrbitResult) and orbit.converged
 
 
 @pytest.mark.parametrize("units", ["dimensionless", "SI"])
