@@ -281,3 +281,28 @@ def test_frf_on_an_engine_chain_with_friction_and_a_drag_by_speed(tmp_path):
     table = read_csv(tmp_path / "out" / "frf.csv")
     assert all(table["matched"])
     assert np.nanmax(np.abs(np.asarray(table["rms_error"], dtype=float))) < 0.05
+
+
+#: CHAIN with a lock-up clutch in place of the damper: a torque jump ±0.03 K_e at δ = 0, friction 0.01.
+PRELOAD_CHAIN = CHAIN.replace('type = "clutch"\nalpha = 0.25\nb = 0.1\nfriction = [0.0, 0.03, 0.0]',
+                              'type = "preload"\npreload = 0.03\nfriction = 0.01')
+
+
+def test_a_preload_element_is_solved_by_orbit_and_named_where_refused(tmp_path):
+    """``rattle orbit`` on the chain with a preloaded element: the exact orbit (rms that of Newton
+    shooting from rest to 1e-9), orbit.json naming the jump law; ``rattle map`` refuses it naming
+    both keys; the default ε of a chain with a jump is 0.01."""
+    from rattle.timeint import shoot_friction_orbit
+
+    assert PRELOAD_CHAIN != CHAIN
+    config = write_config(tmp_path, PRELOAD_CHAIN)
+    result = invoke(["orbit", str(config), "--omega", "0.9", "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    meta = json.loads((tmp_path / "out" / "orbit.json").read_text())
+    assert meta["settings"]["regularisation"] == 0.01
+    assert meta["system"]["elements"][0]["law"] == {"type": "preload", "preload": 0.03, "clearance": 0.0, "slope": 1.0}
+    exact = shoot_friction_orbit(load_config(config).model, 0.9, np.zeros(4))
+    assert exact.converged and abs(float(exact.rms[0]) - meta["orbit"]["elements"][0]["rms"]) <= 1e-9
+    result = invoke(["map", str(config), "--vary", "mean=0.04,0.05", "-o", "map"], tmp_path)
+    assert_bad_input(result, "`model.elements[0].preload` and `model.elements[0].friction`")
+    assert not (tmp_path / "map").exists()

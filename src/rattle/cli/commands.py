@@ -173,9 +173,11 @@ def run_frf(
 
 def _law_keys(run_config: Any) -> str:
     """The keys that make the configuration's law discontinuous, as the user wrote them."""
-    if getattr(run_config, "chain_friction", False):  # a chain with friction on its elements
+    if getattr(run_config, "chain_friction", False):  # a chain with friction or preloads on its elements
         system = run_config.model
-        keys = [f"`model.elements[{e}].friction`" for e in range(system.m) if system.friction_levels(e).any()]
+        keys = [f"`model.elements[{e}].{k}`" for e in range(system.m)
+                for k, on in (("preload", bool(system.laws[e].stages.jumps.any())),
+                              ("friction", bool(system.friction_levels(e).any()))) if on]
         return " and ".join(keys) or "`model.elements`"
     law = run_config.model.law
     keys = [f"`model.elastic.{k}`" for k, on in (("preload", bool(law.stages.jumps.any())),
@@ -414,14 +416,10 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
     Only the period-1 orbit; ``--omega-min``/``--omega-max`` (a search range of the smooth laws) are
     refused. Raises ConvergenceError (exit 1) after writing the set when the exact shooting failed.
     """
-    _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
-    analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
-    check_omega(omega, model=run_config.bounds_model)
+    analysis, options = _nonsmooth_orbit_settings(run_config, omega, period, harmonics, omega_min, omega_max)
     t_start = time.perf_counter()
-    from ..analysis import RegularisationOptions, nonsmooth_orbit  # only now: all input has been validated
+    from ..analysis import nonsmooth_orbit  # only now: all input has been validated
 
-    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
-                                    refine=analysis.refine or None)
     logger.info("computing the orbit of a discontinuous law at Ω = %g: regularised harmonic balance (H = %d, ε = %g) "
                 "and exact shooting", omega, options.harmonics, options.regularisation)
     result = nonsmooth_orbit(run_config.model, omega, options)
@@ -461,6 +459,20 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
                                f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
 
 
+def _nonsmooth_orbit_settings(run_config: Any, omega: float, period: int, harmonics: int | None,
+                              omega_min: float | None, omega_max: float | None) -> tuple[AnalysisSettings, Any]:
+    """The checked settings of ``rattle orbit`` on a discontinuous law or a chain with friction:
+    the options refused there (:func:`_nonsmooth_orbit_options`), ``--omega`` within the bounds,
+    and the file's analysis with ``--harmonics`` as its RegularisationOptions."""
+    _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
+    analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
+    check_omega(omega, model=run_config.bounds_model)
+    from ..analysis import RegularisationOptions
+
+    return analysis, RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
+                                           refine=analysis.refine or None)
+
+
 def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | None, omega_max: float | None) -> None:
     """Exit 2 on the options the orbit of a discontinuous law (or of a chain with friction) does not
     take: ``--period`` other than 1, ``--omega-min``/``--omega-max``."""
@@ -486,21 +498,17 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     Only the period-1 orbit; ``--omega-min``/``--omega-max`` are refused (exit 2). Raises
     ConvergenceError (exit 1) after writing the set when the exact shooting failed.
     """
-    _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
-    analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
-    check_omega(omega, model=run_config.bounds_model)
+    analysis, options = _nonsmooth_orbit_settings(run_config, omega, period, harmonics, omega_min, omega_max)
     t_start = time.perf_counter()
-    from ..analysis import RegularisationOptions, friction_orbit  # only now: all input has been validated
+    from ..analysis import friction_orbit  # only now: all input has been validated
 
     system = run_config.model
-    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
-                                    refine=analysis.refine or None)
     logger.info("computing the orbit of a chain with friction at Ω = %g: regularised harmonic balance (H = %d, "
                 "ε = %g) and exact shooting", omega, options.harmonics, options.regularisation)
     result = friction_orbit(system, omega, options)
     timings = {"friction_orbit": time.perf_counter() - t_start}
-    elements = [{"name": name, "law": element.law.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}
-                for e, (name, element) in enumerate(zip(system.element_names, system.system.elements))]
+    elements = [{"name": name, "law": law.elastic.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}
+                for e, (name, law) in enumerate(zip(system.element_names, system.laws))]
     meta = {
         "settings": {"method": "exact event-driven shooting of the chain (Filippov sticking, saltation monodromy) "
                                "started from its regularised harmonic balance (rattle.analysis.friction_orbit)",

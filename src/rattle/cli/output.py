@@ -337,10 +337,10 @@ def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str,
                                                                       "status", "message")}
     matched = np.asarray(result.matched, dtype=bool)
     stick = np.nan_to_num(np.asarray(result.stick_fraction, dtype=float).reshape(len(result), -1))
-    elements = [{"name": name, "law": element.law.to_dict(),
+    elements = [{"name": name, "law": law.elastic.to_dict(),
                  "friction": [float(r) for r in system.friction_levels(e)],
                  "sticking_rows": int(np.count_nonzero(matched & (stick[:, e] > 0)))}
-                for e, (name, element) in enumerate(zip(system.element_names, system.system.elements))]
+                for e, (name, law) in enumerate(zip(system.element_names, system.laws))]
     return {
         "settings": {
             "method": "regularised harmonic balance of the chain continued over Ω, every point checked by exact "
