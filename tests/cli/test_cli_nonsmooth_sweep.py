@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from _cli_helpers import PNG, assert_bad_input, invoke, write_config
+from test_cli_chain_friction import CHAIN as FRICTION_CHAIN
 from rattle.io import load_config, read_csv
 from rattle.timeint import shoot_friction_orbit, shoot_nonsmooth_orbit
 
@@ -38,38 +39,9 @@ omega = [0.5, 0.7]
 harmonics = 32
 """
 
-#: Two inertias, the second grounded by a soft link; a clutch with friction on its idle stage.
-CHAIN = """\
-[model]
-inertias = [1.0, 1.0]
-
-[[model.links]]
-between = [2, 0]
-stiffness = 0.1
-damping = 0.05
-
-[[model.links]]
-between = [1, 2]
-damping = 0.02
-
-[[model.elements]]
-name = "clutch"
-between = [1, 2]
-stiffness = 1.0
-type = "clutch"
-alpha = 0.25
-b = 0.1
-friction = [0.0, 0.03, 0.0]
-
-[[excitation.torques]]
-inertia = 1
-mean = 0.05
-amplitudes = [0.06]
-
-[analysis]
-omega = [0.55, 0.65]
-harmonics = 16
-"""
+#: test_cli_chain_friction.py's chain (two inertias, a clutch with friction on its idle stage) over
+#: Ω = 0.55 … 0.65.
+CHAIN = FRICTION_CHAIN.replace("omega = [0.9, 0.95]", "omega = [0.55, 0.65]")
 
 
 def test_sweep_of_a_preload_with_friction_writes_the_set(tmp_path):
