@@ -175,3 +175,19 @@ def test_compare_sets_the_response_beside_the_exact_sweep():
         from rattle import reference_case
 
         compare(reference_case(), points=3, regularisation=reg)
+
+
+def test_regimes_of_the_discontinuous_steady_states_follow_their_orbits():
+    """SteadyState.regimes() of a discontinuous law is its exact orbit's regime (a jump at δ = 0
+    on neither side), per element for a chain, from the breakpoints the trajectory crossed."""
+    ns = _preload()
+    s = steady_state(ns, 0.5)
+    orbit = shoot_nonsmooth_orbit(ns, 0.5, (0.0, 0.0))
+    assert s.regimes() == (orbit.regime,) and s.regime == orbit.regime
+    fs = _two_inertias()
+    s = steady_state(fs, 0.6)
+    crossed = s.trajectory.crossed_breakpoints(0)
+    want = "no_impact" if crossed.size == 0 else (
+        "single_sided" if np.all(crossed >= 0) or np.all(crossed <= 0) else "double_sided")
+    assert s.regimes() == (want,)
+    assert s.regime in ("no_impact", "single_sided", "double_sided")

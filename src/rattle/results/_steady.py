@@ -175,13 +175,16 @@ class SteadyState:
     def regimes(self) -> tuple[str, ...]:
         """``no_impact``, ``single_sided`` or ``double_sided`` (SPEC §1) of every element over
         ``trajectory``."""
-        from ..timeint import SystemTrajectory
+        from ..timeint import FrictionTrajectory, NonsmoothTrajectory, SystemTrajectory
 
         traj = self.trajectory
         if isinstance(traj, SystemTrajectory):
             m = traj.system.m
             return tuple(_regime_of(traj.crossing_breakpoints[traj.crossing_elements == e]) for e in range(m))
-        return (_regime_of(traj.crossed_breakpoints),)
+        if isinstance(traj, FrictionTrajectory):  # a jump at δ = 0 is on neither side (as for one orbit)
+            return tuple(_regime_of(traj.crossed_breakpoints(e), zero_on_either_side=True)
+                         for e in range(traj.system.m))
+        return (_regime_of(traj.crossed_breakpoints, zero_on_either_side=isinstance(traj, NonsmoothTrajectory)),)
 
     @property
     def regime(self) -> str:
@@ -196,12 +199,16 @@ class SteadyState:
         )
 
 
-def _regime_of(crossed: FloatArray) -> str:
+def _regime_of(crossed: FloatArray, zero_on_either_side: bool = False) -> str:
+    """The regime from the breakpoints crossed; ``zero_on_either_side``: a breakpoint at δ = 0 (a
+    discontinuous law's jump) counts with either side, so crossing only it is ``single_sided``."""
     if crossed.size == 0:
         return "no_impact"
-    if np.all(crossed > 0.0) or np.all(crossed < 0.0):
-        return "single_sided"
-    return "double_sided"
+    if zero_on_either_side:
+        one_side = bool(np.all(crossed >= 0.0) or np.all(crossed <= 0.0))
+    else:
+        one_side = bool(np.all(crossed > 0.0) or np.all(crossed < 0.0))
+    return "single_sided" if one_side else "double_sided"
 
 
 __all__ = ["SteadyState", "METHODS", "METHOD_STATUS"]
