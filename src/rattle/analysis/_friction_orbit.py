@@ -47,18 +47,25 @@ from ..model import FrictionSystem
 from ..results import FrictionOrbitResult
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
-from ._friction_response import _start, chain_regularisation, friction_balance_factory
+from ._friction_response import (
+    FLOW_FAILURES,
+    _departures,
+    _hb_flow,
+    _hb_multipliers,
+    _hb_samples,
+    _orbit_spectrum,
+    _settled,
+    _start,
+    _stuck_elements,
+    chain_regularisation,
+    friction_balance_factory,
+)
 from ._regularisation import RegularisationOptions
 
 #: Periods of the exact flow run before shooting again when the shooting from the start fails.
 SETTLE_PERIODS = 100
 #: Equally spaced samples per period of the result (every event time is added).
 ORBIT_POINTS = 512
-#: An element stuck at least this fraction of one period of the exact flow is held (a family of
-#: orbits; :func:`~rattle.timeint.shoot_friction_orbit` ``hold``).
-HOLD_FRACTION = 0.9
-
-_FAILURES = (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError)
 
 
 def _check_x0(value: object, n: int) -> FloatArray:
@@ -70,29 +77,12 @@ def _check_x0(value: object, n: int) -> FloatArray:
     return z.copy()
 
 
-def _flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
-    """One period of the exact flow from ``z0`` at t = 0; None when it cannot be followed."""
-    try:
-        return integ.propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
-    except _FAILURES:
-        return None
-
-
-def _stuck_all_period(flow: FrictionTrajectory | None) -> list[int]:
-    """The elements that stick at least :data:`HOLD_FRACTION` of the period on ``flow`` (held by
-    friction: a lock at a jump of the law is one orbit, not a family)."""
-    if flow is None:
-        return []
-    frac = (flow.stick_time() - flow.lock_time()) / (flow.t1 - flow.t0)
-    return [int(e) for e in np.flatnonzero(frac >= HOLD_FRACTION)]
-
-
 def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: FrictionIntegrator,
            hold: dict[int, float] | None = None) -> tuple[FrictionOrbit | None, str]:
     """The exact orbit from ``z0`` (``hold`` the elements held), or (None, why)."""
     try:
         orbit = shoot_friction_orbit(system, omega, z0, integrator=integ, max_iterations=30, hold=hold or None)
-    except _FAILURES as exc:  # e.g. the event budget of a chattering orbit, a loop of stuck elements
+    except FLOW_FAILURES as exc:  # e.g. the event budget of a chattering orbit, a loop of stuck elements
         return None, f"{type(exc).__name__}: {exc}"
     if not orbit.converged:
         return None, f"Newton shooting stopped after {orbit.iterations} steps at residual {orbit.residual:.3g}"
@@ -101,26 +91,13 @@ def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: Friction
     return orbit, ""
 
 
-def _settle(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FloatArray | None:
-    """The state after :data:`SETTLE_PERIODS` periods of the exact flow from ``z0``; None when the
-    flow cannot be followed."""
-    T = 2.0 * math.pi / omega
-    z = np.asarray(z0, dtype=float)
-    try:
-        for _ in range(SETTLE_PERIODS):
-            z = integ.advance(z, 0.0, T, omega)[0]
-    except _FAILURES:
-        return None
-    return z if np.all(np.isfinite(z)) else None
-
-
-def _gap(orbit: FrictionOrbit, E: FloatArray, omega: float, basis_eval, free: list[int]) -> float:  # type: ignore[no-untyped-def]
+def _gap(orbit: FrictionOrbit, pb: RegularisedSystemBalance, E: FloatArray, omega: float, free: list[int]) -> float:
     """The largest departure of the exact δ_e(t) (``free`` elements) from the HB's (series rows
     ``E``) on 64 samples, relative to the HB δ_e's peak-to-peak."""
     t = np.arange(64) * (2.0 * math.pi / omega / 64)
-    d_hb = np.stack([basis_eval(E[e], omega, t) for e in range(E.shape[0])], axis=1)
+    d_hb = _hb_samples(pb, E, omega, t)
     size = np.maximum(np.ptp(d_hb, axis=0), 1e-12 * max(float(np.max(np.abs(d_hb))), 1e-300))
-    gap = np.max(np.abs(orbit.trajectory.element_samples(t)[0] - d_hb), axis=0) / size
+    gap = _departures(orbit.trajectory, d_hb, t, size)
     return float(np.max(gap[free])) if free else 0.0
 
 
@@ -156,7 +133,6 @@ def friction_orbit(
     make = friction_balance_factory(system)
     problem = make(eps, H)  # raises on too few harmonics for the excitation
     integ = FrictionIntegrator(system)
-    T = 2.0 * math.pi / omega
     notes: list[str] = []
 
     # 1. the regularised HB at Ω
@@ -169,11 +145,11 @@ def friction_orbit(
         notes.append(f"the regularised HB failed ({exc})")
     E = problem.element_series(q) if q is not None else None
     z_hb = problem.state_at_zero(q, omega) if q is not None else None
-    hb_flow = _flow(integ, z_hb, omega) if z_hb is not None else None
+    hb_flow = _hb_flow(integ, z_hb, omega) if z_hb is not None else None
 
     # 2. the exact orbit
     orbit: FrictionOrbit | None = None
-    start, held_set = "", [] if E is None else _stuck_all_period(hb_flow)
+    start, held_set = "", [] if E is None else _stuck_elements(hb_flow)
     held: dict[int, float] = {}
     if start_x is not None:
         orbit, why = _shoot(system, omega, start_x, integ)
@@ -186,7 +162,7 @@ def friction_orbit(
             hold = {e: float(E[e][0]) for e in held_set}
             free = [e for e in range(m) if e not in held_set]
             orbit, why = _shoot(system, omega, z_hb, integ, hold)
-            if orbit is not None and _gap(orbit, E, omega, problem.basis.evaluate, free) <= opts.match:
+            if orbit is not None and _gap(orbit, problem, E, omega, free) <= opts.match:
                 start, held = "held", hold
                 names = ", ".join(system.element_names[e] for e in held_set)
                 notes.append(f"{names} stuck the whole period, held at the HB's mean deflection")
@@ -204,13 +180,13 @@ def friction_orbit(
         where = "`x0`" if start_x is not None else ("the HB state" if z_hb is not None else "the linearised chain")
         if origin is None:
             origin = problem.state_at_zero(problem.linear_solution(omega), omega)
-        settled = _settle(integ, origin, omega)
+        settled = _settled(integ, origin, omega, SETTLE_PERIODS)
         if settled is None:
             notes.append(f"the exact flow from {where} could not be followed for {SETTLE_PERIODS} periods")
         else:
             orbit, why = _shoot(system, omega, settled, integ)
             if orbit is None:
-                stuck = _stuck_all_period(_flow(integ, settled, omega))
+                stuck = _stuck_elements(_hb_flow(integ, settled, omega))
                 if stuck:
                     rows = system.system.element_rows.reshape(m, n)
                     hold = {e: float(rows[e] @ settled[:n]) for e in stuck}
@@ -226,17 +202,15 @@ def friction_orbit(
 
     # 3. the HB from the exact orbit's spectrum when the first failed
     if q is None and orbit is not None:
-        N = problem.basis.samples
-        x = orbit.trajectory.sample(np.arange(N) * (T / N))[0][:, :n]
         try:
-            q = _start_from(make, problem.basis.analyze(x.T).reshape(-1), omega, eps, H)
+            q = _start_from(make, _orbit_spectrum(problem, orbit.trajectory, omega), omega, eps, H)
             hb_start = "exact"
             notes.append("the HB was solved from the exact orbit's spectrum")
         except RattleError as exc:
             notes.append(f"the HB from the exact orbit's spectrum failed too ({exc})")
         if q is not None:
             E = problem.element_series(q)
-            hb_flow = _flow(integ, problem.state_at_zero(q, omega), omega)
+            hb_flow = _hb_flow(integ, problem.state_at_zero(q, omega), omega)
     if q is None and orbit is None:
         raise ConvergenceError(f"no periodic orbit at `omega` = {omega:g}: " + "; ".join(notes)
                                + "; try another `regularisation` or `harmonics`, or give `x0`")
@@ -251,11 +225,6 @@ def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> Float
 
     return regularisation_limit(make, omega, q0, eps_start=eps, eps_min=eps, harmonics=H, max_harmonics=H,
                                 tail_tol=math.inf).last.q
-
-
-def _multipliers(M: FloatArray) -> np.ndarray:
-    mu = np.linalg.eigvals(M).astype(complex)
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
 def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
@@ -291,15 +260,13 @@ def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: fl
     if q is not None and opts.stability == "regularised":
         try:
             mu = regularised_system_multipliers(problem, q, omega)
-        except _FAILURES:
+        except FLOW_FAILURES:
             mu = None
-    elif hb_flow is not None and q is not None:
-        mu = _multipliers(hb_flow.sensitivity)
+    elif q is not None:
+        mu = _hb_multipliers(hb_flow)
     if mu is not None and np.all(np.isfinite(mu)):
         mult_hb = mu
-    k = np.arange(1, H + 1) * omega
-    ph = np.multiply.outer(t, k)
-    delta_hb = coeff[:, 0] + np.cos(ph) @ coeff[:, 1 : H + 1].T + np.sin(ph) @ coeff[:, H + 1 :].T
+    delta_hb = _hb_samples(problem, coeff, omega, t)
     rpm = system.speed_rpm(omega)
     return FrictionOrbitResult(
         omega=omega, speed_rpm=None if rpm is None else float(rpm), element_names=system.element_names,  # type: ignore[arg-type]

@@ -101,17 +101,22 @@ def friction_balance_factory(system: FrictionSystem) -> Callable[[float, int], R
     return make
 
 
+#: What the exact flow or its shooting raises when it cannot follow the motion (the event budget
+#: of a chatter, a loop of stuck elements, a singular step): the row or orbit is then not found.
+FLOW_FAILURES = (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError)
+
+
 def _multipliers(M: FloatArray) -> np.ndarray:
     mu = np.linalg.eigvals(M).astype(complex)
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
 def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
-    """One period of the exact flow from the HB orbit's state ``z0`` at t = 0; None when it cannot
-    be followed (the event budget, a loop of stuck elements)."""
+    """One period of the exact flow from the state ``z0`` at t = 0 (the HB orbit's, or a settled
+    one); None when it cannot be followed (:data:`FLOW_FAILURES`)."""
     try:
         return integ.propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
-    except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+    except FLOW_FAILURES:
         return None
 
 
@@ -130,18 +135,34 @@ def _hb_multipliers(flow: FrictionTrajectory | None) -> np.ndarray | None:
 HOLD_FRACTION = 0.9
 
 
-def _held_elements(flow: FrictionTrajectory | None, E: FloatArray) -> dict[int, float]:
-    """{element: the HB's mean deflection (row of the element series ``E``)} of the elements that
-    stick at least :data:`HOLD_FRACTION` of the period on ``flow`` (:func:`_hb_flow`). Where an
-    element sticks the whole period the exact periodic orbits form a family (its stuck deflection
-    is free within the friction band; a multiplier 1): the regularised HB picks one member by its
-    creep balance, and the exact orbit checked against it is the member with the same stuck
-    deflection (:func:`~rattle.timeint.shoot_friction_orbit` ``hold``). A lock at a jump of the
-    law does not count: its deflection is the jump's, one orbit, no family."""
+def _stuck_elements(flow: FrictionTrajectory | None) -> list[int]:
+    """The elements that friction holds at least :data:`HOLD_FRACTION` of the period on ``flow``
+    (:func:`_hb_flow`). Where an element sticks the whole period the exact periodic orbits form a
+    family (its stuck deflection is free within the friction band; a multiplier 1). A lock at a
+    jump of the law does not count: its deflection is the jump's, one orbit, no family."""
     if flow is None:
-        return {}
+        return []
     frac = (flow.stick_time() - flow.lock_time()) / (flow.t1 - flow.t0)
-    return {int(e): float(E[e][0]) for e in np.flatnonzero(frac >= HOLD_FRACTION)}
+    return [int(e) for e in np.flatnonzero(frac >= HOLD_FRACTION)]
+
+
+def _held_elements(flow: FrictionTrajectory | None, E: FloatArray) -> dict[int, float]:
+    """{element: the HB's mean deflection (row of the element series ``E``)} of the
+    :func:`_stuck_elements` on ``flow``: the regularised HB picks one member of their family by
+    its creep balance, and the exact orbit checked against it is the member with the same stuck
+    deflection (:func:`~rattle.timeint.shoot_friction_orbit` ``hold``)."""
+    return {e: float(E[e][0]) for e in _stuck_elements(flow)}
+
+
+def _hb_samples(pb: RegularisedSystemBalance, E: FloatArray, omega: float, t: FloatArray) -> FloatArray:
+    """δ_e(t) of the HB orbit with element series ``E`` (m, 2H+1) at the times ``t``, shape (t.size, m)."""
+    return np.stack([pb.basis.evaluate(E[e], omega, t) for e in range(E.shape[0])], axis=1)
+
+
+def _departures(traj: FrictionTrajectory, d_hb: FloatArray, t: FloatArray, size: FloatArray) -> FloatArray:
+    """Per element, the largest departure of the exact δ_e(t) on ``traj`` from the HB's samples
+    ``d_hb`` at ``t``, relative to ``size`` (the HB δ_e's peak-to-peak), shape (m,)."""
+    return np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size
 
 
 def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, q: FloatArray,
@@ -156,8 +177,7 @@ def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], 
     pb = make(last.eps, last.harmonics)
     E = pb.element_series(last.q)
     size = np.maximum(np.ptp(pb.basis.synthesize(E), axis=1), 1e-12 * pb.length_scale)
-    d_hb = np.stack([pb.basis.evaluate(E[e], omega, t) for e in range(E.shape[0])], axis=1)
-    gap = np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size
+    gap = _departures(traj, _hb_samples(pb, E, omega, t), t, size)
     return float(np.max(gap[elements])) if elements else 0.0
 
 
@@ -192,25 +212,43 @@ def _damped_newton(pb: RegularisedSystemBalance, q: FloatArray, omega: float, it
 SETTLE_PERIODS = 40
 
 
+def _settled(integ: FrictionIntegrator, z0: FloatArray, omega: float, periods: int) -> FloatArray | None:
+    """The state after ``periods`` forcing periods of the exact flow from ``z0``; None when the
+    flow cannot be followed (:data:`FLOW_FAILURES`) or leaves the finite numbers."""
+    T = 2.0 * math.pi / omega
+    z = np.asarray(z0, dtype=float)
+    try:
+        for _ in range(periods):
+            z = integ.advance(z, 0.0, T, omega)[0]
+    except FLOW_FAILURES:
+        return None
+    return z if np.all(np.isfinite(z)) else None
+
+
+def _orbit_spectrum(pb: RegularisedSystemBalance, traj: FrictionTrajectory, omega: float) -> FloatArray:
+    """The Fourier series (pb's H, the HB's unknowns q) of the coordinates along one period of
+    ``traj`` at forcing frequency ``omega``, from pb's N samples."""
+    N = pb.basis.samples
+    x = traj.sample(np.arange(N) * (2.0 * math.pi / omega / N))[0][:, : pb.n_coordinates]
+    return pb.basis.analyze(x.T).reshape(-1)
+
+
 def _exact_spectrum(pb: RegularisedSystemBalance, omega: float) -> FloatArray | None:
     """The start's last fallback: the Fourier series (pb's H) of the exact periodic orbit reached
     by simulating :data:`SETTLE_PERIODS` periods from the linear solution's state and shooting;
     None when that fails."""
     fs: FrictionSystem = pb.fsys
     integ = FrictionIntegrator(fs)
-    T = 2.0 * math.pi / omega
     try:
-        z = pb.state_at_zero(pb.linear_solution(omega), omega)
-        for _ in range(SETTLE_PERIODS):
-            z = integ.advance(z, 0.0, T, omega)[0]
+        z = _settled(integ, pb.state_at_zero(pb.linear_solution(omega), omega), omega, SETTLE_PERIODS)
+        if z is None:
+            return None
         orbit = shoot_friction_orbit(fs, omega, z, integrator=integ, max_iterations=30)
-    except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+    except FLOW_FAILURES:
         return None
     if not orbit.converged:
         return None
-    N = pb.basis.samples
-    x = orbit.trajectory.sample(np.arange(N) * (T / N))[0][:, : fs.n]
-    return pb.basis.analyze(x.T).reshape(-1)
+    return _orbit_spectrum(pb, orbit.trajectory, omega)
 
 
 def _start(make: Callable[[float, int], RegularisedSystemBalance], omega: float, eps: float, H: int,
@@ -312,28 +350,28 @@ def friction_response(
             else regularised_system_multipliers(problem, q, w)
         try:
             orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30)
-        except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        except FLOW_FAILURES:
             orbit = None
         t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / w / MATCH_SAMPLES)
         E = problem.element_series(q)
-        d_hb = np.stack([problem.basis.evaluate(E[e], w, t) for e in range(m)], axis=1)  # (64, m)
+        d_hb = _hb_samples(problem, E, w, t)  # (64, m)
         size = np.maximum(np.ptp(problem.basis.synthesize(E), axis=1), 1e-12 * L)
         traj = None
         if orbit is not None and orbit.converged:  # one orbit: every δ_e(t) within `match` of the HB's
             traj = orbit.trajectory
-            dist_all[i] = float(np.max(np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size))
+            dist_all[i] = float(np.max(_departures(traj, d_hb, t, size)))
             matched[i] = dist_all[i] <= match
         if not matched[i]:  # an element stuck (nearly) the whole period: a family of exact orbits
             held = _held_elements(hb_flow, E)
             if held:
                 try:
                     orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30, hold=held)
-                except (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+                except FLOW_FAILURES:
                     orbit = None
                 if orbit is not None and orbit.converged and all(orbit.stick_fraction[e] >= 1.0 - 1e-9 for e in held):
                     free = [e for e in range(m) if e not in held]
                     traj = orbit.trajectory
-                    gap = np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size
+                    gap = _departures(traj, d_hb, t, size)
                     dist_all[i] = float(np.max(gap[free])) if free else 0.0
                     matched[i] = dist_all[i] <= match
                     if not matched[i] and dist_all[i] <= 3.0 * match:
