@@ -434,12 +434,7 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
         "orbit": result.summary(),
         "timings": timings,
     }
-    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, "harmonics": harmonics})
-    written = write_set(output, ORBIT_FILES, [
-        ("orbit.csv", result.to_csv),
-        ("orbit.json", metadata_writer(meta, sections_, t_start)),
-        ("orbit.png", lambda path: save_plot(result, path)),
-    ])
+    written = _write_nonsmooth_orbit(result, meta, config, run_config, analysis, output, omega, harmonics, t_start)
     lines = [f"orbit at Ω = {omega:.6g} (period {result.period:.6g} s): "
              + (f"exact rms {result.rms:.6g} rad, mean {result.mean:.6g} rad, {result.regime}, "
                 f"{'stable' if result.stable else 'unstable'} (|μ| = {abs(result.multipliers[0]):.3g}, "
@@ -455,8 +450,26 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
         lines.append(result.message)
     echo_written("\n".join(lines), written, output)
     if not ok:
-        raise ConvergenceError(f"the exact orbit at `--omega` {omega:g} was not found ({result.message}); the "
-                               f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
+        raise _orbit_not_found(omega, result.message, written, output)
+
+
+def _write_nonsmooth_orbit(result: Any, meta: dict[str, Any], config: Path, run_config: Any,
+                           analysis: AnalysisSettings, output: Path, omega: float, harmonics: int | None,
+                           t_start: float) -> list[str]:
+    """orbit.csv, orbit.json (``meta`` with the run's sections) and orbit.png of the orbit of a
+    discontinuous law or a chain with friction, written as one set; the names written."""
+    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, "harmonics": harmonics})
+    return write_set(output, ORBIT_FILES, [
+        ("orbit.csv", result.to_csv),
+        ("orbit.json", metadata_writer(meta, sections_, t_start)),
+        ("orbit.png", lambda path: save_plot(result, path)),
+    ])
+
+
+def _orbit_not_found(omega: float, message: str, written: list[str], output: Path) -> ConvergenceError:
+    """The exit-1 error after the set of an orbit whose exact shooting failed was written."""
+    return ConvergenceError(f"the exact orbit at `--omega` {omega:g} was not found ({message}); the "
+                            f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
 
 
 def _nonsmooth_orbit_settings(run_config: Any, omega: float, period: int, harmonics: int | None,
@@ -519,16 +532,10 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
         "orbit": result.metadata(),
         "timings": timings,
     }
-    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, "harmonics": harmonics})
-    written = write_set(output, ORBIT_FILES, [
-        ("orbit.csv", result.to_csv),
-        ("orbit.json", metadata_writer(meta, sections_, t_start)),
-        ("orbit.png", lambda path: save_plot(result, path)),
-    ])
+    written = _write_nonsmooth_orbit(result, meta, config, run_config, analysis, output, omega, harmonics, t_start)
     echo_written(result.summary(), written, output)
     if not result.converged:
-        raise ConvergenceError(f"the exact orbit at `--omega` {omega:g} was not found ({result.message}); the "
-                               f"regularised HB orbit was written to {', '.join(str(output / n) for n in written)}")
+        raise _orbit_not_found(omega, result.message, written, output)
 
 
 @click.command("compare", short_help="Frequency response and time-domain sweep together.")
