@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -655,24 +656,31 @@ def make_integrator(
     return SystemIntegrator(model.system() if isinstance(model, Chain) else model)
 
 
+def _checked_integrator(integrator: object, cls: type, target: object, owner: str, what: str, noun: str) -> Any:
+    """``integrator``, or a new ``cls(target)`` when None: refused (TypeError) when not a ``cls``
+    (``what`` says which, e.g. "a SystemIntegrator for a chain"), and (ValueError) when its
+    ``owner`` attribute is another ``noun`` than ``target``."""
+    integ = cls(target) if integrator is None else integrator
+    if not isinstance(integ, cls):
+        raise TypeError(f"`integrator` must be {what}, got {integrator!r}")
+    built_for = getattr(integ, owner)
+    if built_for is not target and built_for != target:
+        raise ValueError(f"`integrator` was built for a different {noun} than `model`")
+    return integ
+
+
 def _discontinuous_flow(
     model: NonsmoothSystem | FrictionSystem, omega: float, x0: object, integrator: object,
 ) -> tuple[_NonsmoothFlow | _FrictionFlow, FloatArray, tuple[str, ...]]:
     """The flow, start state and element names of a discontinuous law."""
     if isinstance(model, NonsmoothSystem):
         x = check_state(x0) if x0 is not None else static_state(model)
-        integ = NonsmoothIntegrator(model) if integrator is None else integrator
-        if not isinstance(integ, NonsmoothIntegrator):
-            raise TypeError(f"`integrator` must be a NonsmoothIntegrator for a NonsmoothSystem, got {integrator!r}")
-        if integ.system is not model and integ.system != model:
-            raise ValueError("`integrator` was built for a different system than `model`")
+        integ = _checked_integrator(integrator, NonsmoothIntegrator, model, "system",
+                                    "a NonsmoothIntegrator for a NonsmoothSystem", "system")
         return _NonsmoothFlow(model, integ, omega), x, ()
     x = check_system_state(x0, model.n, "x0") if x0 is not None else static_state(model, omega)
-    finteg = FrictionIntegrator(model) if integrator is None else integrator
-    if not isinstance(finteg, FrictionIntegrator):
-        raise TypeError(f"`integrator` must be a FrictionIntegrator for a FrictionSystem, got {integrator!r}")
-    if finteg.fsys is not model:
-        raise ValueError("`integrator` was built for a different system than `model`")
+    finteg = _checked_integrator(integrator, FrictionIntegrator, model, "fsys",
+                                 "a FrictionIntegrator for a FrictionSystem", "system")
     return _FrictionFlow(model, finteg, omega), x, model.element_names
 
 
@@ -748,20 +756,14 @@ def steady_state(
         system = None if isinstance(model, Model) else model.system()
     if system is None:
         x = check_state(x0) if x0 is not None else static_state(model)
-        integ = ExactIntegrator(model) if integrator is None else integrator
-        if not isinstance(integ, ExactIntegrator):
-            raise TypeError(f"`integrator` must be an ExactIntegrator for a Model, got {integrator!r}")
-        if integ.model is not model and integ.model != model:
-            raise ValueError("`integrator` was built for a different model than `model`")
+        integ = _checked_integrator(integrator, ExactIntegrator, model, "model", "an ExactIntegrator for a Model",
+                                    "model")
         flow: _ModelFlow | _SystemFlow = _ModelFlow(model, integ, omega)  # type: ignore[arg-type]
         names: tuple[str, ...] = ()
     else:
         x = check_system_state(x0, system.n, "x0") if x0 is not None else static_state(system, omega)
-        sinteg = SystemIntegrator(system) if integrator is None else integrator
-        if not isinstance(sinteg, SystemIntegrator):
-            raise TypeError(f"`integrator` must be a SystemIntegrator for a chain, got {integrator!r}")
-        if sinteg.system is not system:
-            raise ValueError("`integrator` was built for a different system than `model`")
+        sinteg = _checked_integrator(integrator, SystemIntegrator, system, "system", "a SystemIntegrator for a chain",
+                                     "system")
         flow = _SystemFlow(system, sinteg, omega)
         names = tuple(e.name for e in system.elements)
     return _Settler(flow, omega, x.copy(), opts, names).run()
