@@ -498,20 +498,14 @@ class FrictionIntegrator:
                 tau, e_ev, kind = tau_f, e_f, kind_f
             elif e_b >= 0:
                 tau, e_ev, kind = tau_b, e_b, CROSSING
-                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
-                i_bp = stages[e_ev] if direction > 0 else stages[e_ev] - 1
-                if self.jumps[e_ev][i_bp] > 0.0 or self.levels[e_ev][i_bp] != self.levels[e_ev][i_bp + 1]:
-                    tau = self._polish_crossing(seg, e_ev, bound, tau, tau_lim)
+                tau = self._crossing_time(seg, e_ev, direction, lo, hi, stages, tau, tau_lim)
             else:
                 tau, e_ev, kind = tau_b, -1, -1
             missed = self._missed_exit(seg, lo, hi, tau, e_ev if kind == CROSSING else -1) if tau > 0.0 else None
             if missed is not None:  # an excursion beyond a breakpoint the crossing search stepped over
                 tau, e_ev, direction = missed
                 kind = CROSSING
-                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
-                i_bp = stages[e_ev] if direction > 0 else stages[e_ev] - 1
-                if self.jumps[e_ev][i_bp] > 0.0 or self.levels[e_ev][i_bp] != self.levels[e_ev][i_bp + 1]:
-                    tau = self._polish_crossing(seg, e_ev, bound, tau, tau)
+                tau = self._crossing_time(seg, e_ev, direction, lo, hi, stages, tau, tau)
             if rec is not None and (tau > 0.0 or not rec["ts"]):
                 rec["ts"].append(t)
                 rec["st"].append(stages)
@@ -545,6 +539,8 @@ class FrictionIntegrator:
             value = math.nan
             normal: FloatArray | None = None
             if kind == CROSSING:
+                bound = float(hi[e_ev] if direction > 0 else lo[e_ev])
+                i_bp = stages[e_ev] if direction > 0 else stages[e_ev] - 1
                 zc[:n] += a * ((bound - float(a @ zc[:n])) / float(a @ a))
                 value = bound
                 new_stages = stages[:e_ev] + (stages[e_ev] + direction,) + stages[e_ev + 1:]
@@ -637,6 +633,16 @@ class FrictionIntegrator:
             if best is None or hit < best[0]:
                 best = (hit, e, 1 if up else -1)
         return best
+
+    def _crossing_time(self, seg: Segment, e: int, direction: int, lo: FloatArray, hi: FloatArray,
+                       stages: tuple[int, ...], tau: float, tau_max: float) -> float:
+        """The time ``tau`` of element ``e``'s crossing of its stage bound (``hi`` upwards, ``lo``
+        downwards), polished (:meth:`_polish_crossing`) where the field jumps there: a jump of
+        the law or a change of friction level."""
+        i_bp = stages[e] if direction > 0 else stages[e] - 1
+        if self.jumps[e][i_bp] > 0.0 or self.levels[e][i_bp] != self.levels[e][i_bp + 1]:
+            return self._polish_crossing(seg, e, float(hi[e] if direction > 0 else lo[e]), tau, tau_max)
+        return tau
 
     def _polish_crossing(self, seg: Segment, e: int, bound: float, tau: float, tau_max: float) -> float:
         """The crossing time of a breakpoint where the field jumps, polished by Newton steps on
