@@ -57,11 +57,12 @@ from ..hb import HBOptions, RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionResponse
 from ..stability import regularised_system_multipliers
-from ..timeint import FrictionIntegrator, FrictionTrajectory, shoot_friction_orbit
+from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
+    RegularisationStep,
     regularisation_limit,
 )
 
@@ -135,6 +136,13 @@ def _hb_multipliers(flow: FrictionTrajectory | None) -> np.ndarray | None:
 HOLD_FRACTION = 0.9
 
 
+def _holds_part(flow: FrictionTrajectory | None, orbit: FrictionOrbit | None) -> bool:
+    """Whether an element sticks or locks some of the period on ``flow`` (:func:`_hb_flow`) or on
+    the converged exact ``orbit``."""
+    trajs = [flow] + ([orbit.trajectory] if orbit is not None and orbit.converged else [])
+    return any(tr is not None and bool(np.any(tr.stick_time() > 0.0)) for tr in trajs)
+
+
 def _stuck_elements(flow: FrictionTrajectory | None) -> list[int]:
     """The elements that friction holds at least :data:`HOLD_FRACTION` of the period on ``flow``
     (:func:`_hb_flow`). Where an element sticks the whole period the exact periodic orbits form a
@@ -165,20 +173,50 @@ def _departures(traj: FrictionTrajectory, d_hb: FloatArray, t: FloatArray, size:
     return np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size
 
 
-def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, q: FloatArray,
-                        opts: RegularisationOptions, traj: FrictionTrajectory, t: FloatArray,
-                        elements: list[int]) -> float:
-    """The largest departure of the exact δ_e(t) (``elements``) from the HB's at the end of the ε
-    ladder (:func:`_ladder`), relative to the HB δ_e's peak-to-peak; inf when the ladder stalls."""
-    try:
-        last = _ladder(make, omega, q, opts, False).last
-    except RattleError:
-        return math.inf
+def _gap_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, last: RegularisationStep, traj: FrictionTrajectory, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Per element, the largest departure of the exact δ_e(t) on ``traj`` from the HB's at the
+    ladder's rung ``last`` (absolute), and that HB δ_e's peak-to-peak, (m,) each."""
     pb = make(last.eps, last.harmonics)
     E = pb.element_series(last.q)
     size = np.maximum(np.ptp(pb.basis.synthesize(E), axis=1), 1e-12 * pb.length_scale)
-    gap = _departures(traj, _hb_samples(pb, E, omega, t), t, size)
-    return float(np.max(gap[elements])) if elements else 0.0
+    return _departures(traj, _hb_samples(pb, E, omega, t), t, np.ones_like(size)), size
+
+
+def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, lad: RegularisationLimit,
+                        traj: FrictionTrajectory, t: FloatArray, elements: list[int]) -> float:
+    """The largest departure of the exact δ_e(t) (``elements``) from the HB's at the end of the ε
+    ladder ``lad`` (:func:`_ladder`), relative to the HB δ_e's peak-to-peak."""
+    gap, size = _gap_at_limit(make, omega, lad.last, traj, t)
+    return float(np.max(gap[elements] / size[elements])) if elements else 0.0
+
+
+def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], system: FrictionSystem,
+                    integ: FrictionIntegrator, omega: float, lad: RegularisationLimit,
+                    t: FloatArray) -> tuple[FrictionTrajectory, float] | None:
+    """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` and its departure
+    from that HB orbit (:func:`_held_scale`); None when the shooting fails."""
+    last = lad.last
+    pb = make(last.eps, last.harmonics)
+    try:
+        orbit = shoot_friction_orbit(system, omega, pb.state_at_zero(last.q, omega), integrator=integ,
+                                     max_iterations=30)
+    except FLOW_FAILURES:
+        return None
+    if not orbit.converged:
+        return None
+    traj = orbit.trajectory
+    gap, size = _gap_at_limit(make, omega, last, traj, t)
+    return traj, float(np.max(gap / _held_scale(traj, size)))
+
+
+def _held_scale(traj: FrictionTrajectory, size: FloatArray) -> FloatArray:
+    """The scale of each element's departure: its HB δ_e's peak-to-peak ``size``, or, for an
+    element the exact orbit ``traj`` holds (stuck or locked) part of the period, the chain's largest
+    one. A held element moves within the regularisation's width of its stuck deflection or jump
+    (a lock's regularised deflection is ε_δ artanh(τ/J), a few ε_δ, where the exact one is 0): its
+    own peak-to-peak is then of the order of the regularisation and no scale to measure by."""
+    held = traj.stick_time() > 0.0
+    return np.where(held, np.max(size), size)
 
 
 def _damped_newton(pb: RegularisedSystemBalance, q: FloatArray, omega: float, iterations: int = 200) -> FloatArray | None:
@@ -341,6 +379,19 @@ def friction_response(
     mult, mult_hb = np.full((P, 2 * n), np.nan + 0j), np.full((P, 2 * n), np.nan + 0j)
     matched, dist_all = np.zeros(P, dtype=bool), np.full(P, np.nan)
     pattern = np.full((P, 2 * m), -1, dtype=np.int64)
+    ladders: dict[tuple[int, bool], RegularisationLimit | None] = {}  # (row, deep): the row's ladder
+
+    def _row_ladder(i: int, w: float, q: FloatArray, off: bool = False) -> RegularisationLimit | None:
+        """Row i's ladder (:func:`_ladder`; None when it stalls), found once: the match at the
+        limit and the refinement share it."""
+        key = (i, bool(off and opts.deep_eps is not None))
+        if key not in ladders:
+            try:
+                ladders[key] = _ladder(make, w, q, opts, off)
+            except RattleError:
+                ladders[key] = None
+        return ladders[key]
+
     for i, pt in enumerate(points):
         w, q = float(pt.omega), pt.q
         rms_hb[i] = problem.element_rms(q)
@@ -377,8 +428,18 @@ def friction_response(
                     if not matched[i] and dist_all[i] <= 3.0 * match:
                         # the regularised stick creeps (~ε_v), and the held element's creep moves the
                         # others: compare again with the HB at its smallest ε
-                        dist_all[i] = _departure_at_limit(make, w, q, opts, traj, t, free)
+                        lad = _row_ladder(i, w, q)
+                        dist_all[i] = math.inf if lad is None else _departure_at_limit(make, w, lad, traj, t, free)
                         matched[i] = dist_all[i] <= match
+        if not matched[i] and _holds_part(hb_flow, orbit):
+            # an element stuck or locked part of the period, which the HB at ε resolves only to its
+            # regularisation's width: the exact orbit is the limit of the HB's as ε → 0 when the
+            # flow shot from the HB at the ladder's end matches that HB orbit
+            lad = _row_ladder(i, w, q)
+            found = None if lad is None else _match_at_limit(make, system, integ, w, lad, t)
+            if found is not None:
+                traj, dist_all[i] = found
+                matched[i] = dist_all[i] <= match
         if matched[i]:
             assert traj is not None
             mean[i], rms[i] = traj.element_mean_and_rms()
@@ -406,8 +467,9 @@ def friction_response(
     lim_eps, lim_H, lim_rms, lim_rich, lim_lin, lim_mu = [], [], [], [], [], []
     for i in pick.tolist():
         try:
-            lad = _ladder(make, float(points[i].omega), points[i].q, opts,
-                          bool(refine is not None and err[i] > refine))
+            lad = _row_ladder(i, float(points[i].omega), points[i].q, bool(refine is not None and err[i] > refine))
+            if lad is None:
+                raise ConvergenceError(f"the ladder stalled at Ω = {float(points[i].omega):g}")
             assert lad.last.element_rms is not None
             lim_eps.append(lad.last.eps)
             lim_H.append(lad.last.harmonics)
