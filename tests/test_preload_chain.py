@@ -462,3 +462,29 @@ def test_bad_jump_laws_and_mismatched_stages_are_refused():
         FrictionSystem(system=fs.system, laws=(NonsmoothLaw(elastic=Preload(preload=0.1, clearance=0.01)), fs.laws[1]))
     with pytest.raises(ValueError, match="`elastic` must hold one entry per element"):
         FrictionSystem.from_system(fs.system, (None, None), elastic=(None,))
+
+
+def test_a_release_with_a_round_off_velocity_against_its_slip_keeps_slipping():
+    """A stuck element released at rest keeps a velocity of round-off size, here +3.5e-18 against
+    its slip direction σ = −1; its slip must start (σ δ' rises, turns and falls through 0 a few
+    hundredths later), not be read as an immediate velocity zero (which re-stuck and re-released
+    it at the same instant until the integrator gave up). The state: one period before that
+    release on the benchmark chain with a lock-up clutch (bench_friction_chain.py --case preload)
+    at Ω = 0.687 ω_n, exact to the bit."""
+    fs = Chain(inertias=(1.0, 0.5, 2.0),
+               links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
+                      Link(between=(3, 0), stiffness=1.0, damping=0.1)),
+               elements=(Element(name="tcc", between=(1, 2), stiffness=1.0, law=Preload(preload=0.03),
+                                 friction=Friction(levels=0.01)),
+                         Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
+               torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),)).friction_system()
+    z0 = np.array([float.fromhex(h) for h in ("0x1.532aa4c44dd98p-6", "0x1.3602bd039c122p-7", "0x1.3b2ab9b36341ep-5",
+                                              "0x1.118a900a7486ap-7", "-0x1.5084ab740df30p-8",
+                                              "-0x1.3b416185a1fb4p-9")])
+    omega = float.fromhex("0x1.0e7c634a05950p+1")
+    tr = FrictionIntegrator(fs).propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
+    names = [EVENT_NAMES[k] for k in tr.event_kinds]
+    i = names.index("release")
+    # after the release the clutch slips (no event at the same instant), then stops or reverses
+    assert tr.event_times[i + 1] > tr.event_times[i] + 1e-3
+    assert np.all(np.isfinite(tr.state1))

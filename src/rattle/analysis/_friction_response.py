@@ -16,6 +16,15 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    exact (Filippov), the monodromy with saltation matrices) from the HB orbit's state at t = 0.
    The two are one orbit (``matched``) when the shooting converged and every element's δ_e(t)
    stays within ``match`` × (the HB δ_e's peak-to-peak) of the HB's on 64 samples of the period.
+   Where the shooting fails, or an element sticks or locks part of the period (on the flow from
+   the HB state or on the exact orbit) and that check fails, the row is checked at the limit of
+   its regularisation: the
+   HB is followed at fixed Ω down the ε ladder (:func:`_ladder`, the rungs kept for step 3), the
+   exact flow is shot from the HB state at the ladder's end, and the two are one orbit when every
+   δ_e(t) stays within ``match`` of that HB's, an element held part of the period measured on the
+   chain's scale (the largest HB δ peak-to-peak): its regularised deflection is of the order of
+   the steps' width (at a lock ε_δ artanh(τ/J), a few ε_δ where the exact δ_e is 0), so its own
+   peak-to-peak is no scale to measure by. The exact orbit is then the limit ε → 0 of the HB's.
    The exact orbit gives the answer (every element's rms, mean, stick fraction; the 2n
    multipliers); the HB's own values stand beside them: its rms and its multipliers. Those are,
    by ``stability`` (:class:`~rattle.analysis.RegularisationOptions`), ``"saltation"``: the
@@ -37,7 +46,8 @@ a period (the shooting, a few ms per Newton step, and the HB orbit's monodromy) 
 ladder per refined row. Where an element sticks the whole period the exact orbits form a family
 (its stuck deflection is free within the friction band; a multiplier 1, counted as inside the
 unit circle up to :data:`UNIT_TOL`) while the regularised HB picks one (its creep balance): the
-shooting may end on another member, and the row is then left unmatched. Not resolved: grazing (a tangential touch of a breakpoint or of zero
+shooting may end on another member, and the row is then left unmatched. A row checked at the
+limit costs its ladder (a few Newton solves per rung; shared with step 3). Not resolved: grazing (a tangential touch of a breakpoint or of zero
 relative velocity) and stuck sets closing a loop (the exact integrator's limits); such rows are
 left unmatched.
 """
@@ -403,6 +413,7 @@ def friction_response(
             orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30)
         except FLOW_FAILURES:
             orbit = None
+        shot_failed = orbit is None or not orbit.converged
         t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / w / MATCH_SAMPLES)
         E = problem.element_series(q)
         d_hb = _hb_samples(problem, E, w, t)  # (64, m)
@@ -431,10 +442,12 @@ def friction_response(
                         lad = _row_ladder(i, w, q)
                         dist_all[i] = math.inf if lad is None else _departure_at_limit(make, w, lad, traj, t, free)
                         matched[i] = dist_all[i] <= match
-        if not matched[i] and _holds_part(hb_flow, orbit):
-            # an element stuck or locked part of the period, which the HB at ε resolves only to its
-            # regularisation's width: the exact orbit is the limit of the HB's as ε → 0 when the
-            # flow shot from the HB at the ladder's end matches that HB orbit
+        if not matched[i] and (shot_failed or _holds_part(hb_flow, orbit)):
+            # the shooting from the HB at ε failed (outside Newton's reach of the exact orbit: near
+            # a fold or a period doubling the HB's error moves it), or an element sticks or locks
+            # part of the period, which the HB at ε resolves only to its regularisation's width:
+            # the exact orbit is the limit of the HB's as ε → 0 when the flow shot from the HB at
+            # the ladder's end matches that HB orbit
             lad = _row_ladder(i, w, q)
             found = None if lad is None else _match_at_limit(make, system, integ, w, lad, t)
             if found is not None:

@@ -780,9 +780,10 @@ class FrictionIntegrator:
         for i in range(1, taus.size):
             lo_v, hi_v = float(sv[i - 1]), float(sv[i])
             if hi_v <= 0.0:
-                if lo_v > 0.0:
+                if lo_v > floor or (lo_v > 0.0 and i > 1):
                     return _brent(vel, float(taus[i - 1]), float(taus[i]), lo_v, hi_v)
-                if i == 1 and lo_v <= floor:  # starts at rest: a positive excursion first?
+                if i == 1 and lo_v <= floor:  # starts at rest (a round-off velocity of either sign):
+                    # a positive excursion first?
                     if hi_v >= -floor:
                         continue
                     if sa[0] > 0.0 > sa[1]:  # σ δ' rises, turns, and falls through 0 in the cell
