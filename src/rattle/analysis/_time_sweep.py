@@ -34,12 +34,13 @@ import numpy as np
 from .._typing import FloatArray
 from .. import _limits, _validate
 from ..engines import die_with_parent
-from ..errors import RattleError
+from ..errors import ConfigError, RattleError
 from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
 from ..results._sweep import SweepResult
-from ..results._sweep import SWEEP_ELEMENT_COLUMNS
+from ..results._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED
 
 from ._frequency_response import check_range
+from ._friction_response import FLOW_FAILURES
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
 logger = logging.getLogger("rattle")
@@ -64,6 +65,13 @@ def sweep_direction(
 
     Returns the sweep's rows as a dict of arrays (see :class:`~rattle.results.SweepResult`);
     ``report(direction)`` is called after each frequency.
+
+    Numerical trouble at one frequency (``steady_state`` raising a
+    :class:`~rattle.errors.RattleError` other than bad input, or for the discontinuous laws what
+    their event-driven flow raises when it cannot be followed: :func:`_failures`) fails that row
+    only: it is recorded as failed (measures and states NaN, ``period`` −1, ``method``
+    ``"failed"``, ``failure`` the reason; a warning names Ω and the reason) and the sweep carries
+    on from the last state computed (the failed frequency's is unknown) on a fresh integrator.
     """
     integ = make_integrator(model)
     x = static_state(model, float(omegas[0]) if len(omegas) else None)
@@ -85,8 +93,22 @@ def sweep_direction(
     sticks = _stick_columns(model)
     for key in sticks:
         rows[key] = np.empty(n)
+    rows["failure"] = np.full(n, "", dtype=object)
+    failures = _failures(model)
     for i, w in enumerate(omegas):
-        s = steady_state(model, float(w), x, options=options, integrator=integ)
+        try:
+            s = steady_state(model, float(w), x, options=options, integrator=integ)
+        except failures as exc:
+            if isinstance(exc, ConfigError):  # bad input fails the whole sweep, as before
+                raise
+            reason = _reason(exc)
+            _fail_row(rows, i, float(w), reason)
+            logger.warning("%s sweep Ω = %.6g: no steady state (%s); the row is recorded as failed and the sweep "
+                           "carries on from the last state computed", direction, w, reason)
+            integ = make_integrator(model)  # a fresh one: nothing of the failed run is carried on
+            if report is not None:
+                report(direction)
+            continue
         for name in _ROW_SCALARS:
             rows[name][i] = getattr(s, name)
         rows["period"][i] = s.period
@@ -114,6 +136,41 @@ def sweep_direction(
             report(direction)
     rows["direction"] = np.full(n, direction, dtype="<U4")
     return rows
+
+
+def _failures(model: object) -> tuple[type[BaseException], ...]:
+    """The exceptions of ``steady_state`` that fail one row of a sweep instead of the sweep:
+    rattle's own (:class:`~rattle.errors.RattleError`), and for the discontinuous laws also what
+    their event-driven flow raises when it cannot be followed (:data:`FLOW_FAILURES`: a singular
+    step, a loop of stuck elements, values beyond double precision)."""
+    return FLOW_FAILURES if isinstance(model, (NonsmoothSystem, FrictionSystem)) else (RattleError,)
+
+
+def _reason(exc: BaseException) -> str:
+    """The failure on one line: rattle's message, another exception's with its type's name."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if isinstance(exc, RattleError) else f"{text} ({type(exc).__name__})"
+
+
+def _fail_row(rows: dict[str, np.ndarray], i: int, omega: float, reason: str) -> None:
+    """Row ``i`` (at ``omega``) as failed: every measure and state NaN, ``period``
+    :data:`~rattle.results._sweep.FAILED_PERIOD` (−1), ``method`` ``"failed"``, not settled, no
+    effort counted, ``failure`` the reason."""
+    for key, col in rows.items():
+        if key == "omega":
+            col[i] = omega
+        elif key == "failure":
+            col[i] = reason
+        elif key == "period":
+            col[i] = FAILED_PERIOD
+        elif key == "method":
+            col[i] = SWEEP_FAILED
+        elif key == "settled":
+            col[i] = False
+        elif key in ("periods", "shooting_periods"):
+            col[i] = 0
+        else:
+            col[i] = np.nan
 
 
 def _stick_columns(model: object) -> tuple[str, ...]:

@@ -8,8 +8,11 @@ numerics only then, calls one front end of the library and hands the result to
 
 from __future__ import annotations
 
+import contextlib
+import logging
+import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -283,6 +286,38 @@ def frf_command(
 # --------------------------------------------------------------------------------------------
 # Time-domain commands: sweep, orbit, compare
 # --------------------------------------------------------------------------------------------
+class _SweepWarnings(logging.Handler):
+    """The library's warnings during a sweep (a frequency whose steady state failed) as
+    ``rattle: warning: …`` lines, above the progress bar; attached only when ``-v`` does not
+    already print its log."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+
+    def emit(self, record: logging.LogRecord) -> None:
+        text = " ".join(record.getMessage().split())
+        try:
+            from tqdm import tqdm
+        except ImportError:  # pragma: no cover - tqdm is a dependency
+            warning(text)
+            return
+        with tqdm.external_write_mode(file=sys.stderr):  # the bar cleared, written, drawn again
+            warning(text)
+
+
+@contextlib.contextmanager
+def _sweep_warnings() -> Iterator[None]:
+    if any(h.get_name() == "rattle-cli" for h in logger.handlers):  # -v: printed already
+        yield
+        return
+    handler = _SweepWarnings()
+    logger.addHandler(handler)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+
+
 @click.command("sweep", short_help="Time-domain frequency sweep (steady state at each frequency).")
 @common_options
 @click.argument("config", type=click.Path(path_type=Path))
@@ -313,6 +348,11 @@ def sweep_command(
     simulated by its exact event-driven integrator (Filippov sticking, locks at jumps); sweep.csv
     then also has the fraction of each row's period held stuck or locked (stick_fraction, or
     NAME_stick_fraction per element).
+
+    A frequency whose steady state fails numerically (e.g. an exact flow that chatters into a
+    lock beyond its event budget) is written as a failed row (period -1, the measures nan) and
+    the sweep carries on; the three files are still written, the failed frequencies and the
+    reason are printed, and the command exits with status 1.
     """
     if direction is None:  # checked here: click's own message for a missing choice spans lines
         raise ConfigError("`--direction` is required: give --direction up, down or both")
@@ -326,8 +366,9 @@ def sweep_command(
 
     bar = ProgressBar(f"sweep {direction}", enabled=not quiet)
     try:
-        result = time_sweep(run_config.model, omega=analysis.omega, points=points, direction=direction,
-                            workers=workers, callback=bar)
+        with _sweep_warnings():
+            result = time_sweep(run_config.model, omega=analysis.omega, points=points, direction=direction,
+                                workers=workers, callback=bar)
     finally:
         bar.close()
     if run_config.paths:  # SPEC §6: the sound pressure level of every row's simulated motion
@@ -342,6 +383,12 @@ def sweep_command(
         ("sweep.png", lambda path: save_plot(result, path)),
     ])
     echo_written(result.summary(), written, output)
+    if not result.complete:  # the rows computed are written; the failed ones exit 1, as a partial frf
+        raise ConvergenceError(
+            f"sweep incomplete: {result.message}; all rows were written (the failed ones as period -1 and nan) to "
+            f"{', '.join(str(output / name) for name in written)}",
+            partial=result,
+        )
 
 
 @click.command("orbit", short_help="Every periodic orbit at one forcing frequency, against the simulation.")

@@ -57,7 +57,9 @@ def sweep_plot(
     joined in sweep order, so that the jumps at the ends of a multi-valued region show as
     vertical steps at different Ω. Points whose motion has a period other than 1 are ringed in
     a colour per period, and each run of them is labelled with its period ("P2"); period 0
-    (no period up to 8: quasi-periodic or chaotic) is ringed in black and labelled "P0".
+    (no period up to 8: quasi-periodic or chaotic) is ringed in black and labelled "P0". A failed
+    row (no steady state, period −1, NaN measures) has no point: its line breaks there and a
+    dotted grey vertical line marks its Ω.
 
     Parameters
     ----------
@@ -200,6 +202,8 @@ def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool
             ax.plot(omega[sel], y_all[sel], "-", color=color, lw=0.9, alpha=0.7)
         ax.plot(omega[sel], y_all[sel], marker, color=color, ms=4.5, ls="none", label=label)
     for p in sorted(set(period.tolist()) - {1}):  # then a ring colour per period other than 1
+        if p < 0:  # a failed row (no steady state): nothing to ring
+            continue
         m = period == p
         ax.plot(omega[m], y_all[m], "o", ms=10, mfc="none", mec=PERIOD_COLORS.get(p, "tab:gray"), mew=1.4,
                 ls="none", label=period_label(p))
@@ -209,7 +213,7 @@ def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool
             om, y, per = omega[sel], y_all[sel], period[sel]
             up = name != "down"
             for i0, i1 in _runs(per):
-                if per[i0] == 1:
+                if per[i0] == 1 or per[i0] < 0:
                     continue
                 j = (i0 + i1 - 1) // 2
                 ax.annotate(
@@ -217,6 +221,10 @@ def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool
                     textcoords="offset points", ha="center", va="bottom" if up else "top",
                     fontsize=8, color=PERIOD_COLORS.get(int(per[i0]), "tab:gray"), fontweight="bold",
                 )
+    failed = np.flatnonzero(period < 0)  # failed rows (NaN measures: no point drawn): a dotted line at Ω
+    for k, i in enumerate(failed):
+        ax.axvline(omega[i], color="0.5", ls=":", lw=0.9, zorder=0,
+                   label="no steady state (failed)" if k == 0 else None)
     ax.set_xlabel(xlabel)
     ax.grid(True, alpha=0.3)
     if legend:

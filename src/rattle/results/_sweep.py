@@ -26,6 +26,13 @@ _RECORD_PERIODS = 50
 #: Sweep directions, in the order ``both`` runs them.
 SWEEP_DIRECTIONS: tuple[str, ...] = ("up", "down")
 
+#: ``method`` of a failed row: the steady state at its frequency raised numerical trouble.
+SWEEP_FAILED = "failed"
+#: ``period`` of a failed row (0 keeps its meaning: a motion with no period up to the limit).
+FAILED_PERIOD = -1
+#: Failed frequencies :attr:`SweepResult.message` lists per direction.
+_LISTED = 10
+
 
 class Jump(NamedTuple):
     """An abrupt change of the rms between two consecutive frequencies of one sweep direction:
@@ -79,6 +86,14 @@ class SweepResult:
 
     ``extra_columns``: columns written last, e.g. the stick fractions above or the sound pressure
     levels of :meth:`with_sound` (``spl_db``, ``spl_dba``, ``spl_linear_db``).
+
+    A failed row — the steady state at its frequency raised numerical trouble (e.g. an exact
+    event-driven flow that chatters into a lock beyond its event budget): ``omega`` and
+    ``direction`` as given, every measure, state and multiplier NaN, ``period``
+    :data:`FAILED_PERIOD` (−1), ``method`` ``"failed"``, ``settled`` False, no effort counted
+    (``periods`` = ``shooting_periods`` = 0), and ``failure`` the reason (``""`` on every
+    computed row). The sweep carried on from the last state computed. :attr:`complete` is False
+    and :attr:`message` names the failed frequencies.
     """
 
     model: Model
@@ -103,6 +118,11 @@ class SweepResult:
     timings: dict[str, float] = field(default_factory=dict)
     element_columns: dict[str, np.ndarray] = field(default_factory=dict)
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
+    failure: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.failure is None:  # a sweep without failures: "" on every row
+            object.__setattr__(self, "failure", np.full(int(np.size(self.omega)), "", dtype=object))
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -116,8 +136,45 @@ class SweepResult:
     def status(self) -> np.ndarray:
         """How each row's steady state ended: an object array of :class:`~rattle.errors.Status`
         (``CONVERGED``, ``SETTLED`` or ``MAX_PERIODS``, as ``SteadyState.status``), read from
-        ``method``."""
-        return np.array([METHOD_STATUS[str(m)] for m in self.method], dtype=object)
+        ``method``; None on a failed row (no steady state: its reason in ``failure``)."""
+        return np.array([METHOD_STATUS.get(str(m)) for m in self.method], dtype=object)
+
+    @property
+    def failed(self) -> BoolArray:
+        """True on the rows whose steady state failed (``method`` ``"failed"``)."""
+        return np.asarray(self.method) == SWEEP_FAILED
+
+    @property
+    def complete(self) -> bool:
+        """True when every row was computed (no failed row)."""
+        return not bool(np.any(self.failed))
+
+    @property
+    def message(self) -> str:
+        """``""`` for a complete sweep; else one line naming the failed frequencies of each
+        direction (the first :data:`_LISTED` of them) and the first row's reason (with how many
+        other reasons there are: every row's is in ``failure``)."""
+        if self.complete:
+            return ""
+        rows = np.flatnonzero(self.failed)
+        reasons = list(dict.fromkeys(str(r) for r in self.failure[rows]))  # type: ignore[index]
+        i = int(rows[0])
+        text = (f"no steady state at {rows.size} of {len(self)} frequencies ({self._failed_text()}; recorded as "
+                f"failed rows, the sweep carried on from the last state computed): at {self.direction[i]} Ω = "
+                f"{self.omega[i]:.6g}: {reasons[0]}")
+        if len(reasons) > 1:
+            text += f" (and {len(reasons) - 1} other reason{'s' if len(reasons) > 2 else ''} at other rows)"
+        return text
+
+    def _failed_text(self) -> str:
+        """The failed frequencies by direction (the first :data:`_LISTED` of each)."""
+        where = []
+        for d in self.directions:
+            w = self.omega[(self.direction == d) & self.failed]
+            if w.size:
+                more = f", … ({w.size} in all)" if w.size > _LISTED else ""
+                where.append(f"{d} sweep Ω = {', '.join(f'{x:.6g}' for x in w[:_LISTED])}{more}")
+        return "; ".join(where)
 
     @property
     def directions(self) -> tuple[str, ...]:
@@ -138,8 +195,11 @@ class SweepResult:
         parts = []
         for d in self.directions:
             m = self.direction == d
-            counts = np.bincount(self.period[m], minlength=1)
+            counts = np.bincount(self.period[m & ~self.failed], minlength=1)
             per = ", ".join(f"{int(c)}×P{p}" for p, c in enumerate(counts) if c)
+            failed = int(np.sum(m & self.failed))
+            if failed:
+                per += (", " if per else "") + f"{failed} failed"
             parts.append(f"{d}: {int(np.sum(m))} points ({per})")
         span = f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}" if len(self) else "empty"
         return f"SweepResult({span}; {'; '.join(parts)}; jumps at {self._jump_text()})"
@@ -182,15 +242,18 @@ class SweepResult:
         for d in self.directions:
             m = self.direction == d
             w = self.omega[m]
-            counts = np.bincount(self.period[m], minlength=1)
+            ok = ~self.failed[m]
+            counts = np.bincount(self.period[m][ok], minlength=1)
             per = ", ".join(f"period {p}: {int(c)}" for p, c in enumerate(counts) if c and p)
             if counts[0]:
                 per += (", " if per else "") + f"not periodic (period 0): {int(counts[0])}"
-            i = int(np.argmax(self.rms[m]))
-            lines.append(
-                f"{d} sweep: {int(np.sum(m))} frequencies over Ω = {w.min():.4g} … {w.max():.4g} ({per}); "
-                f"largest rms {self.rms[m][i]:.5g} rad at Ω = {w[i]:.5g}"
-            )
+            if not ok.all():
+                per += (", " if per else "") + f"failed: {int(np.sum(~ok))}"
+            line = f"{d} sweep: {int(np.sum(m))} frequencies over Ω = {w.min():.4g} … {w.max():.4g} ({per})"
+            if ok.any():
+                i = int(np.flatnonzero(ok)[np.argmax(self.rms[m][ok])])
+                line += f"; largest rms {self.rms[m][i]:.5g} rad at Ω = {w[i]:.5g}"
+            lines.append(line)
         jumps = self.jumps()
         order = getattr(self.model, "speed_order", None)
         rpm = (lambda w: "") if order is None else (lambda w: f" ({w * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
@@ -205,7 +268,7 @@ class SweepResult:
             if not key.endswith("stick_fraction") or not len(col):
                 continue
             what = "held (stuck or locked)" if key == "stick_fraction" else f"{key[: -len('_stick_fraction')]} held"
-            col = np.asarray(col, dtype=float)
+            col = np.where(self.failed, -np.inf, np.asarray(col, dtype=float))  # a failed row holds nothing
             i = int(np.argmax(col))
             if not col[i] > 0.0:
                 lines.append(f"{what}: never")
@@ -218,11 +281,14 @@ class SweepResult:
         )
         if self.timings:
             lines.append("time: " + ", ".join(f"{k} {v:.3g} s" for k, v in self.timings.items()))
+        if not self.complete:
+            lines.append(f"failed (no steady state): {self._failed_text()}")
         return "\n".join(lines)
 
     def jumps(self, threshold: float = 0.15) -> list[Jump]:
         """Abrupt rms changes between consecutive frequencies of each direction.
 
+        Failed rows are left out: the step is then taken between the computed rows on either side.
         A step from row i to i + 1 of one direction is a jump when the rms changes by more than
         ``threshold`` times the larger of the two values, and by more than four times the larger
         change over the neighbouring steps (so that a steep but smooth resonance flank is not
@@ -243,7 +309,7 @@ class SweepResult:
             raise ValueError(f"`threshold` must be a number > 0, got {threshold!r}")
         out: list[Jump] = []
         for d in self.directions:
-            rows = np.flatnonzero(self.direction == d)
+            rows = np.flatnonzero((self.direction == d) & ~self.failed)
             r, w = self.rms[rows], self.omega[rows]
             if r.size < 2:
                 continue
@@ -257,13 +323,16 @@ class SweepResult:
         return out
 
     def metadata(self) -> dict[str, Any]:
-        """Settings, timings, effort, periods found and jumps, JSON-serialisable."""
-        return {
+        """Settings, timings, effort, periods found (of the computed rows) and jumps, JSON-serialisable;
+        with failed rows also ``complete`` (False), ``message`` and ``failures`` (per failed row:
+        ``direction``, ``omega``, ``reason``)."""
+        ok = ~self.failed
+        meta: dict[str, Any] = {
             "settings": self.settings,
             "timings": self.timings,
             "points": len(self),
             "directions": list(self.directions),
-            "periods_found": {str(int(p)): int(c) for p, c in zip(*np.unique(self.period, return_counts=True))},
+            "periods_found": {str(int(p)): int(c) for p, c in zip(*np.unique(self.period[ok], return_counts=True))},
             "effort": {
                 "simulated_periods": int(np.sum(self.periods)),
                 "shooting_periods": int(np.sum(self.shooting_periods)),
@@ -274,13 +343,20 @@ class SweepResult:
                 for j in self.jumps()
             ],
         }
+        if not self.complete:
+            meta["complete"] = False
+            meta["message"] = self.message
+            meta["failures"] = [{"direction": str(self.direction[i]), "omega": float(self.omega[i]),
+                                 "reason": str(self.failure[i])}  # type: ignore[index]
+                                for i in np.flatnonzero(self.failed)]
+        return meta
 
     def records(self) -> Iterator[tuple[Any, int]]:
         """The recorded motion of every row, again: (exact trajectory from t = 0, window in forcing
         periods) — the orbit from ``state0`` over its ``period`` forcing periods, or for a
         non-periodic row (period 0) the record of ``record_periods`` forcing periods the sweep
         measured (``settings["steady_state"]``). The integrator is deterministic, so these are the
-        trajectories the sweep's measures were taken on."""
+        trajectories the sweep's measures were taken on. A failed row has none: (None, 0)."""
         from ..model import FrictionSystem, NonsmoothSystem
         from ..timeint import ExactIntegrator, FrictionIntegrator, NonsmoothIntegrator, SystemIntegrator
 
@@ -294,7 +370,10 @@ class SweepResult:
         else:
             integ = SystemIntegrator(self.model.system())
         record = int(self.settings.get("steady_state", {}).get("record_periods", _RECORD_PERIODS))
-        for w, p, x in zip(self.omega, self.period, self.state0):
+        for w, p, x, m in zip(self.omega, self.period, self.state0, self.method):
+            if m == SWEEP_FAILED:
+                yield None, 0
+                continue
             window = int(p) if p > 0 else record
             yield integ.propagate(x, 0.0, window * 2.0 * np.pi / float(w), float(w)), window
 
@@ -305,7 +384,7 @@ class SweepResult:
         ``spl_linear_db`` (the linear system at the same Ω, :func:`rattle.results.linear_sound_pressure`),
         as :meth:`FrequencyResponse.with_sound <rattle.results.FrequencyResponse.with_sound>` does.
         A periodic row's level is that of its orbit's Fourier series; a non-periodic row's is an
-        estimate from its record (rectangular window). One warning names the row with the largest
+        estimate from its record (rectangular window); a failed row's NaN. One warning names the row with the largest
         share of a source's content outside a path table, when any exceeds
         :data:`~rattle.results._sound.UNCOVERED_WARNING`."""
         from ._sound import _check_paths, _warn_uncovered, linear_sound_pressure, motion_sound_pressure
@@ -315,6 +394,8 @@ class SweepResult:
         spl, dba = np.full(P, np.nan), np.full(P, np.nan)
         worst = None
         for i, (traj, window) in enumerate(self.records()):
+            if traj is None:  # a failed row
+                continue
             plain, weighted = motion_sound_pressure(self.model, traj, float(self.omega[i]), window, paths_t,
                                                     a_weighting=(False, True), warn=False)
             spl[i], dba[i] = plain.spl_db[0], weighted.spl_db[0]
@@ -347,7 +428,8 @@ class SweepResult:
 
 _ROW_FIELDS: tuple[str, ...] = (
     "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period", "delta_min", "delta_max",
-    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers",
+    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers", "failure",
 )
 
-__all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS", "SWEEP_ELEMENT_COLUMNS"]
+__all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS", "SWEEP_ELEMENT_COLUMNS", "SWEEP_FAILED",
+           "FAILED_PERIOD"]
