@@ -15,8 +15,8 @@ import rattle.analysis._time_sweep as ts
 from rattle.analysis import SteadyStateOptions, steady_state, time_sweep
 from rattle.analysis._steady import static_state
 from rattle.cli import cli
-from rattle.errors import ConvergenceError, Status
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.errors import ConfigError, ConvergenceError, Status
+from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload, reference_case
 from rattle.results._sweep import FAILED_PERIOD, SWEEP_FAILED
 from rattle.timeint import NonsmoothIntegrator, NonsmoothOptions
 
@@ -43,7 +43,7 @@ def small_budget(monkeypatch):
 
 def _failing_at(monkeypatch, bad: set[float], exc: type[BaseException] = ConvergenceError) -> None:
     """``steady_state`` in the sweep raising ``exc`` at the frequencies ``bad`` (rounded to 6 digits)."""
-    real = ts.steady_state
+    real = steady_state  # the library's, also when an earlier call patched the sweep's
 
     def fake(model, omega, *args, **kwargs):
         if round(omega, 6) in bad:
@@ -123,10 +123,34 @@ def test_one_failure_in_the_middle_carries_the_last_good_state(monkeypatch):
     assert r.select("up").failure[4] == "made to fail at 1.5"
 
 
+def test_a_flow_that_cannot_be_followed_fails_its_row_with_the_error_named(monkeypatch):
+    """The discontinuous laws: a singular step (LinAlgError) or an overflow is numerical trouble
+    of that frequency, its reason naming the error's type."""
+    _failing_at(monkeypatch, {0.6}, np.linalg.LinAlgError)
+    r = time_sweep(_preload(), omega=_GRID, points=10, direction="up")
+    assert list(np.flatnonzero(r.failed)) == [1] and r.failure[1] == "made to fail at 0.6 (LinAlgError)"
+    assert np.all(np.isfinite(r.rms[2:]))
+
+
+def test_a_smooth_model_fails_rows_on_rattle_errors_only(monkeypatch):
+    model = reference_case()
+    _failing_at(monkeypatch, {0.6})
+    r = time_sweep(model, omega=(0.5, 0.9), points=5, direction="up")  # 0.5, 0.6, …, 0.9
+    assert list(np.flatnonzero(r.failed)) == [1] and r.failure[1] == "made to fail at 0.6"
+    assert np.all(r.settled[r.failed == False])  # noqa: E712
+    # a ValueError of the smooth integrators is not taken for numerical trouble: it stops the sweep
+    _failing_at(monkeypatch, {0.7}, ValueError)
+    with pytest.raises(ValueError, match="made to fail at 0.7"):
+        time_sweep(model, omega=(0.5, 0.9), points=5, direction="up")
+
+
 def test_programming_errors_and_bad_input_still_stop_the_sweep(monkeypatch):
     ns = _preload()
     _failing_at(monkeypatch, {0.6}, TypeError)
     with pytest.raises(TypeError, match="made to fail"):
+        time_sweep(ns, omega=_GRID, points=10, direction="up")
+    _failing_at(monkeypatch, {0.9}, ConfigError)  # bad input, though a RattleError
+    with pytest.raises(ConfigError, match="made to fail"):
         time_sweep(ns, omega=_GRID, points=10, direction="up")
 
 
@@ -193,6 +217,9 @@ def test_the_command_writes_its_files_names_the_failures_and_exits_1(small_budge
     err = [line for line in res.output.splitlines() if line.startswith("rattle: error:")]
     assert len(err) == 1 and "no steady state at 3 of 10 frequencies" in err[0]
     assert "up sweep Ω = 0.3, 0.6, 0.9" in err[0] and "max_events" in err[0] and "sweep.csv" in err[0]
+    warned = [line for line in res.output.splitlines() if line.startswith("rattle: warning:")]
+    assert len(warned) == 3 and warned[0].startswith("rattle: warning: up sweep Ω = 0.3: no steady state")
+    assert "failed (no steady state): up sweep Ω = 0.3, 0.6, 0.9" in res.output  # the summary
     meta = json.loads((out / "sweep.json").read_text())
     assert len(meta["failures"]) == 3 and meta["complete"] is False
     rows = (out / "sweep.csv").read_text().splitlines()[1:]

@@ -143,7 +143,9 @@ def _failures(model: object) -> tuple[type[BaseException], ...]:
     rattle's own (:class:`~rattle.errors.RattleError`), and for the discontinuous laws also what
     their event-driven flow raises when it cannot be followed (:data:`FLOW_FAILURES`: a singular
     step, a loop of stuck elements, values beyond double precision)."""
-    return FLOW_FAILURES if isinstance(model, (NonsmoothSystem, FrictionSystem)) else (RattleError,)
+    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+        return tuple(dict.fromkeys((RattleError, *FLOW_FAILURES)))
+    return (RattleError,)
 
 
 def _reason(exc: BaseException) -> str:

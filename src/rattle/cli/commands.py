@@ -295,14 +295,17 @@ class _SweepWarnings(logging.Handler):
         super().__init__(logging.WARNING)
 
     def emit(self, record: logging.LogRecord) -> None:
-        text = " ".join(record.getMessage().split())
         try:
-            from tqdm import tqdm
-        except ImportError:  # pragma: no cover - tqdm is a dependency
-            warning(text)
-            return
-        with tqdm.external_write_mode(file=sys.stderr):  # the bar cleared, written, drawn again
-            warning(text)
+            text = " ".join(record.getMessage().split())
+            try:
+                from tqdm import tqdm
+            except ImportError:  # pragma: no cover - tqdm is a dependency
+                warning(text)
+                return
+            with tqdm.external_write_mode(file=sys.stderr):  # the bar cleared, written, drawn again
+                warning(text)
+        except Exception:  # a warning that cannot be shown never stops the sweep
+            self.handleError(record)
 
 
 @contextlib.contextmanager
