@@ -16,7 +16,7 @@ from rattle.analysis import SteadyStateOptions, steady_state, time_sweep
 from rattle.analysis._steady import static_state
 from rattle.cli import cli
 from rattle.errors import ConfigError, ConvergenceError, Status
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload, reference_case
+from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload, SoundPath, reference_case
 from rattle.results._sweep import FAILED_PERIOD, SWEEP_FAILED
 from rattle.timeint import NonsmoothIntegrator, NonsmoothOptions
 
@@ -137,7 +137,12 @@ def test_a_smooth_model_fails_rows_on_rattle_errors_only(monkeypatch):
     _failing_at(monkeypatch, {0.6})
     r = time_sweep(model, omega=(0.5, 0.9), points=5, direction="up")  # 0.5, 0.6, …, 0.9
     assert list(np.flatnonzero(r.failed)) == [1] and r.failure[1] == "made to fail at 0.6"
-    assert np.all(r.settled[r.failed == False])  # noqa: E712
+    assert np.all(r.settled[~r.failed])
+    # the sound at the receiver: none for the failed row, the linear reference still there
+    path = SoundPath(source="delta", frequency_hz=[1e-6, 1e6], magnitude=[1.0, 1.0], phase_deg=[0.0, 0.0])
+    sound = r.with_sound([path]).extra_columns
+    assert np.isnan(sound["spl_db"][1]) and np.isnan(sound["spl_dba"][1]) and np.isfinite(sound["spl_linear_db"][1])
+    assert np.all(np.isfinite(sound["spl_db"][~r.failed]))
     # a ValueError of the smooth integrators is not taken for numerical trouble: it stops the sweep
     _failing_at(monkeypatch, {0.7}, ValueError)
     with pytest.raises(ValueError, match="made to fail at 0.7"):

@@ -381,7 +381,10 @@ def time_sweep(
     -------
     SweepResult
         One row per frequency in sweep order (up rows first for ``both``), with the SPEC
-        ``sweep.csv`` columns, effort, states and provenance.
+        ``sweep.csv`` columns, effort, states and provenance. A frequency whose steady state
+        raised numerical trouble is a failed row (NaN measures, ``period`` −1, ``method``
+        ``"failed"``, the reason in ``failure``; logged as a warning) and the sweep went on from
+        the last state computed: ``complete`` is then False and ``message`` names them.
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     if isinstance(model, (NonsmoothSystem, FrictionSystem)):
