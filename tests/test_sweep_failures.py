@@ -229,3 +229,22 @@ def test_the_command_writes_its_files_names_the_failures_and_exits_1(small_budge
     assert len(meta["failures"]) == 3 and meta["complete"] is False
     rows = (out / "sweep.csv").read_text().splitlines()[1:]
     assert [row.split(",")[7] for row in rows] == ["-1"] * 3 + ["1"] * 7
+
+
+def test_compare_picks_no_failed_row_and_starts_no_simulation_from_one(monkeypatch):
+    """compare on the reference clutch over its hysteresis (multi-valued, 0.75–0.88): a failed
+    sweep row there (rms nan) neither becomes the multi-valued pick nor a start state."""
+    from rattle.analysis import compare
+    from rattle.analysis._compare import pick_frequencies
+
+    model = reference_case()
+    grid = np.linspace(0.7, 0.95, 11)
+    bad = {round(float(w), 6) for w in grid[3:8]}  # the middle of the multi-valued range, both ways
+    _failing_at(monkeypatch, bad)
+    cmp = compare(model, omega=(0.7, 0.95), points=11, harmonics=8)
+    assert np.sum(cmp.sweep.failed) == 2 * len(bad)
+    picks = pick_frequencies(cmp.frf, cmp.sweep)
+    assert picks and all(np.isfinite(w) for w, _ in picks)
+    for states in cmp.simulations:  # every simulation started from a computed state
+        for s in states.values():
+            assert np.all(np.isfinite(s.state0)) and s.settled

@@ -88,8 +88,10 @@ def pick_frequencies(frf: FrequencyResponse, sweep: SweepResult) -> list[tuple[f
         r_up = np.interp(grid, up.omega, up.rms)
         r_down = np.interp(grid, down.omega[::-1], down.rms[::-1])
         diff = np.where(multi, np.abs(r_up - r_down), -1.0)
+        diff = np.where(np.isfinite(diff), diff, -1.0)  # next to a failed sweep row (rms nan): no difference known
         i = int(np.argmax(diff))
-        if diff[i] > _HYSTERESIS_MIN * float(np.max(sweep.rms)):
+        top = float(np.nanmax(sweep.rms)) if np.any(np.isfinite(sweep.rms)) else math.inf
+        if diff[i] > _HYSTERESIS_MIN * top:
             picks.append((float(grid[i]), "multi-valued"))
         else:
             i0, i1 = max(_runs(multi), key=lambda r: r[1] - r[0])
@@ -244,7 +246,8 @@ def compare(
         for d in sweep.directions:
             part = sweep.select(d)
             i = int(np.argmin(np.abs(part.omega - w)))
-            if abs(part.omega[i] - w) <= 0.5 * spacing * (1 + 1e-9):
+            if abs(part.omega[i] - w) <= 0.5 * spacing * (1 + 1e-9) and np.all(np.isfinite(part.state0[i])):
+                # (a failed sweep row has no state to start from)
                 states[d] = steady_state(model, w, part.state0[i], options=options, integrator=integ)
         sweep_periods = [s.period for s in states.values() if 2 <= s.period <= MAX_PERIOD]
         period = sweep_periods[0] if sweep_periods else 1
