@@ -248,3 +248,18 @@ def test_compare_picks_no_failed_row_and_starts_no_simulation_from_one(monkeypat
     for states in cmp.simulations:  # every simulation started from a computed state
         for s in states.values():
             assert np.all(np.isfinite(s.state0)) and s.settled
+
+
+def test_rattle_compare_writes_its_set_and_exits_1_when_its_sweep_failed(small_budget, tmp_path):
+    """`rattle compare` on the preloaded spring (a discontinuous law: the regularised HB beside
+    the exact sweep) whose sweep fails at 0.3, 0.6 and 0.9: the set is written, the failures are
+    warned of and the run ends as a partial one."""
+    config = tmp_path / "preload.toml"
+    config.write_text(_CONFIG.replace("omega = [0.3, 3.0]", "omega = [0.3, 1.2]\nharmonics = 16\nrefine = 0"))
+    out = tmp_path / "cmp"
+    res = CliRunner().invoke(cli, ["compare", str(config), "--points", "4", "-o", str(out), "-q"])
+    assert res.exit_code == 1, res.output
+    assert {"frf.csv", "sweep.csv", "compare.json"} <= {p.name for p in out.iterdir()}
+    err = [line for line in res.output.splitlines() if line.startswith("rattle: error:")]
+    assert len(err) == 1 and "sweep incomplete" in err[0] and "Ω = 0.3, 0.6, 0.9" in err[0]
+    assert sum(line.startswith("rattle: warning:") for line in res.output.splitlines()) == 6  # up and down

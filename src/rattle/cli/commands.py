@@ -386,11 +386,17 @@ def sweep_command(
         ("sweep.png", lambda path: save_plot(result, path)),
     ])
     echo_written(result.summary(), written, output)
-    if not result.complete:  # the rows computed are written; the failed ones exit 1, as a partial frf
+    _raise_if_incomplete(result, written, output)
+
+
+def _raise_if_incomplete(sweep: Any, written: Sequence[str], output: Path) -> None:
+    """The exit-1 error after the set was written, when a frequency of the time-domain sweep
+    ``sweep`` failed (its rows computed are written; the failed ones as in a partial frf)."""
+    if not sweep.complete:
         raise ConvergenceError(
-            f"sweep incomplete: {result.message}; all rows were written (the failed ones as period -1 and nan) to "
+            f"sweep incomplete: {sweep.message}; all rows were written (the failed ones as period -1 and nan) to "
             f"{', '.join(str(output / name) for name in written)}",
-            partial=result,
+            partial=sweep,
         )
 
 
@@ -654,8 +660,9 @@ def compare_command(
 
     bar = ProgressBar("sweep up+down", enabled=not quiet)
     try:
-        result = compare(run_config.model, omega=analysis.omega, harmonics=analysis.harmonics, points=points,
-                         at=at_values, workers=workers, callback=bar)
+        with _sweep_warnings():
+            result = compare(run_config.model, omega=analysis.omega, harmonics=analysis.harmonics, points=points,
+                             at=at_values, workers=workers, callback=bar)
     finally:
         bar.close()
     meta = sections("compare", config, run_config, analysis, {
@@ -685,6 +692,7 @@ def compare_command(
         steps += [("compare.png", lambda path: save_figure(draw_measured, path)), ("measured.csv", beside.to_csv)]
     written = write_set(output, COMPARE_FILES, steps)
     echo_written(summary, written, output)
+    _raise_if_incomplete(result.sweep, written, output)
 
 
 def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisSettings, output: Path, points: int,
@@ -702,8 +710,9 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
                 "by exact shooting) with its exact up and down sweep", reg.harmonics, reg.regularisation)
     bar = ProgressBar("sweep up+down", enabled=not quiet)
     try:
-        result = compare(run_config.model, omega=analysis.omega, points=points, workers=workers, callback=bar,
-                         regularisation=reg)
+        with _sweep_warnings():
+            result = compare(run_config.model, omega=analysis.omega, points=points, workers=workers, callback=bar,
+                             regularisation=reg)
     finally:
         bar.close()
     meta = sections("compare", config, run_config, analysis, options)
@@ -713,6 +722,7 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
         ("compare.png", lambda path: save_plot(result, path)),
     ])
     echo_written(result.summary(), written, output)
+    _raise_if_incomplete(result.sweep, written, output)
 
 
 # --------------------------------------------------------------------------------------------
