@@ -69,6 +69,7 @@ from ..results import FrictionResponse
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
+from ..timeint._shooting import monodromy_multipliers
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -117,11 +118,6 @@ def friction_balance_factory(system: FrictionSystem) -> Callable[[float, int], R
 FLOW_FAILURES = (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError)
 
 
-def _multipliers(M: FloatArray) -> np.ndarray:
-    mu = np.linalg.eigvals(M).astype(complex)
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
-
-
 def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
     """One period of the exact flow from the state ``z0`` at t = 0 (the HB orbit's, or a settled
     one); None when it cannot be followed (:data:`FLOW_FAILURES`)."""
@@ -137,7 +133,7 @@ def _hb_multipliers(flow: FrictionTrajectory | None) -> np.ndarray | None:
     None without that flow."""
     if flow is None:
         return None
-    mu = _multipliers(flow.sensitivity)
+    mu = monodromy_multipliers(flow.sensitivity)
     return mu if np.all(np.isfinite(mu)) else None
 
 
@@ -461,7 +457,7 @@ def friction_response(
                 mine = traj.event_elements == e
                 pattern[i, e] = int(np.sum(mine & np.isin(traj.event_kinds, (STICK, LOCK))))
                 pattern[i, m + e] = int(np.sum(mine & (traj.event_kinds == CROSSING)))
-            mult[i] = _multipliers(traj.sensitivity)
+            mult[i] = monodromy_multipliers(traj.sensitivity)
             if mu_hb is None:
                 mu_hb = mult[i]
         if mu_hb is not None:

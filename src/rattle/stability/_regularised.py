@@ -35,11 +35,11 @@ range of Ω that narrows with ε.
 from __future__ import annotations
 
 import numpy as np
-
-from .._typing import ComplexArray, FloatArray
 import scipy.linalg
 
+from .._typing import ComplexArray, FloatArray
 from ..hb import RegularisedBalance, RegularisedSystemBalance
+from ..timeint._shooting import monodromy_multipliers
 
 
 def _shifted(q: FloatArray, H: int, phase: float) -> FloatArray:
@@ -106,8 +106,7 @@ def regularised_monodromy(problem: RegularisedBalance, q: FloatArray, omega: flo
 def regularised_multipliers(problem: RegularisedBalance, q: FloatArray, omega: float,
                             steps: int | None = None) -> ComplexArray:
     """The Floquet multipliers of :func:`regularised_monodromy`, largest modulus first."""
-    mu = np.linalg.eigvals(regularised_monodromy(problem, q, omega, steps)).astype(complex)
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
+    return monodromy_multipliers(regularised_monodromy(problem, q, omega, steps))
 
 
 def regularised_system_monodromy(problem: RegularisedSystemBalance, q: FloatArray, omega: float,
@@ -148,8 +147,7 @@ def regularised_system_monodromy(problem: RegularisedSystemBalance, q: FloatArra
 def regularised_system_multipliers(problem: RegularisedSystemBalance, q: FloatArray, omega: float,
                                    steps: int | None = None) -> ComplexArray:
     """The 2n Floquet multipliers of :func:`regularised_system_monodromy`, largest modulus first."""
-    mu = np.linalg.eigvals(regularised_system_monodromy(problem, q, omega, steps)).astype(complex)
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
+    return monodromy_multipliers(regularised_system_monodromy(problem, q, omega, steps))
 
 
 __all__ = ["regularised_monodromy", "regularised_multipliers", "regularised_system_monodromy",

@@ -80,7 +80,7 @@ from types import SimpleNamespace
 import numpy as np
 from scipy.optimize import brentq
 
-from .._typing import ComplexArray, FloatArray
+from .._typing import FloatArray
 from .._validate import check_omega, check_shooting
 from ..errors import ConvergenceError
 from ..model import FrictionSystem, System
@@ -88,7 +88,7 @@ from ..model._system import ReducedElement
 from ._events import first_exit
 from ._flow import check_system_state
 from ._nonsmooth import NonsmoothOptions
-from ._shooting import ShotOrbit
+from ._shooting import ShotOrbit, monodromy_multipliers
 from ._stage_flow import Segment, StageSolution, SystemStages
 from ._system_shooting import _newton_system
 
@@ -820,11 +820,6 @@ class FrictionOrbit(ShotOrbit):
     stick_fraction: FloatArray
 
 
-def _multipliers(M: FloatArray) -> ComplexArray:
-    mu = np.linalg.eigvals(M).astype(complex)
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
-
-
 def _newton_held(integ: FrictionIntegrator, omega: float, z: FloatArray, T: float, hold: dict[int, float],
                  scale: FloatArray, tol: float, max_iterations: int) -> tuple[FloatArray, float, int]:
     """Gauss–Newton on [φ(z0) − z0; a_e·x0 − d_e (e held)] = 0 with the Jacobian [[M − I]; [a_e, 0]]
@@ -909,7 +904,7 @@ def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *
         traj = shot.trajectory  # type: ignore[assignment]
     mean, rms = traj.element_mean_and_rms()
     return FrictionOrbit(state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
-                         multipliers=_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,
+                         multipliers=monodromy_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,
                          residual=res, trajectory=traj, mean=mean, rms=rms, stick_fraction=traj.stick_time() / T)
 
 

@@ -24,6 +24,14 @@ from ._exact import ExactIntegrator, Trajectory
 _MAX_HALVINGS = 12
 
 
+
+def monodromy_multipliers(M: FloatArray) -> ComplexArray:
+    """The Floquet multipliers: the eigenvalues of the monodromy matrix ``M``, largest modulus
+    first (a stable sort: equal moduli keep the solver's order)."""
+    mu = np.linalg.eigvals(M).astype(complex)
+    return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
 class ShotOrbit:
     """What every Newton shooting on an exact flow returns (:class:`ShootingOrbit`,
@@ -155,8 +163,7 @@ class _Shot:
 
     def multipliers(self) -> ComplexArray:
         """Eigenvalues of the monodromy matrix, largest modulus first."""
-        mult = np.linalg.eigvals(self.trajectory.sensitivity).astype(complex)
-        return mult[np.argsort(-np.abs(mult), kind="stable")]
+        return monodromy_multipliers(self.trajectory.sensitivity)
 
 
 def _newton_shooting(

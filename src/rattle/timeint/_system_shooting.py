@@ -26,7 +26,7 @@ from ._flow import (
     SystemTrajectory,
     check_system_state,
 )
-from ._shooting import ShotOrbit
+from ._shooting import ShotOrbit, monodromy_multipliers
 
 _MAX_HALVINGS = 12
 
@@ -61,11 +61,6 @@ def system_state_scale(system: System, omega: float) -> FloatArray:
     length = system.length_scale()
     nu = max(float(omega), system.stiffest_frequency())
     return np.concatenate((np.full(system.n, length), np.full(system.n, length * nu)))
-
-
-def _multipliers(M: FloatArray) -> ComplexArray:
-    mult = np.linalg.eigvals(M).astype(complex)
-    return mult[np.argsort(-np.abs(mult), kind="stable")]
 
 
 def shoot_system_orbit(
@@ -119,7 +114,7 @@ def shoot_system_orbit(
     traj = shot.trajectory
     return SystemOrbit(
         state0=shot.x, omega=omega, period=int(period), monodromy=traj.sensitivity,
-        multipliers=_multipliers(traj.sensitivity),
+        multipliers=monodromy_multipliers(traj.sensitivity),
         converged=shot.residual <= tol, iterations=shot.iterations, residual=shot.residual,
         evaluations=shot.evaluations, trajectory=traj, measures=traj.measures(),
     )
@@ -138,7 +133,7 @@ class _SystemShot:
 
     def multipliers(self) -> ComplexArray:
         """Eigenvalues of the monodromy matrix, largest modulus first."""
-        return _multipliers(self.trajectory.sensitivity)
+        return monodromy_multipliers(self.trajectory.sensitivity)
 
 
 def _newton_system(integ: SystemIntegrator | Any, omega: float, z0: FloatArray, period: int, tol: float,
