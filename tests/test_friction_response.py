@@ -273,6 +273,12 @@ def test_a_clutch_locked_part_of_the_period_is_matched_at_the_regularisations_li
     assert np.all(r.stick_fraction[:, 1] == 0.0)  # the gear has no friction
     assert np.all(r.rms[:, 0] < 1e-3) and np.all(r.rms_hb[:, 0] > 3.0 * r.rms[:, 0])
     assert np.max(np.abs(r.element_rms_error[:, 1])) < 0.01
+    # what the summary and frf.json say: the held clutch apart, the moving gear within 1 %
+    np.testing.assert_allclose(r.moving_rms_error, np.abs(r.element_rms_error[:, 1]))
+    md = r.metadata()
+    assert md["held_rows"] == len(r) and md["within_0_5_percent"] == 0
+    assert md["within_0_5_percent_moving"] == int(np.sum(np.abs(r.element_rms_error[:, 1]) <= 0.005))
+    assert "resolves that element only to the regularisation's width" in r.summary()
     # the plain check (departure relative to the element's own HB peak-to-peak at ε) fails here:
     make = friction_balance_factory(fs)
     pb, w = make(0.01, 32), float(r.omega[0])
