@@ -165,7 +165,8 @@ def test_frf_json_holds_the_settings_the_elements_and_the_measured_error(frf_run
     matched = np.asarray(table["matched"], dtype=bool)
     err = np.abs(np.asarray(table["rms_error"], dtype=float)[matched])
     assert meta["command"] == "frf" and meta["status"] == "success" and meta["version"]
-    assert meta["analysis"] == {"omega": [0.8, 0.82], "harmonics": 32, "regularisation": 0.001, "refine": 0.005}
+    assert meta["analysis"] == {"omega": [0.8, 0.82], "harmonics": 32, "regularisation": 0.001, "refine": 0.005,
+                                "limit_harmonics": 32}  # a chain's ladder keeps its H by default
     assert meta["settings"]["harmonics"] == 32 and meta["settings"]["regularisation"] == 0.001
     assert meta["system"]["coordinates"] == 2
     assert meta["system"]["elements"] == [{"name": "clutch", "law": {"type": "clutch", "alpha": 0.25, "b": 0.1},

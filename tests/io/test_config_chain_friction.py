@@ -216,7 +216,7 @@ def test_load_case_reads_a_chain_with_friction_with_the_chain_defaults(tmp_path)
     case = load_case(path)
     assert case.discontinuous and isinstance(case.model, FrictionSystem)
     opts = case.regularisation_options()
-    assert (opts.harmonics, opts.regularisation, opts.refine) == (128, 0.001, 0.005)
+    assert (opts.harmonics, opts.regularisation, opts.refine, opts.limit_harmonics) == (128, 0.001, 0.005, 128)
     orbit = case.periodic_orbit(1.0, options=type(opts)(harmonics=16, regularisation=0.01))
     assert isinstance(orbit, FrictionOrbitResult) and orbit.converged
 
@@ -234,3 +234,27 @@ def test_a_preload_element_round_trips(units):
     assert out["model"]["elements"][0]["preload"] == pytest.approx(0.05, rel=1e-15)  # as written
     again = config_from_dict(tomllib.loads(dumps_toml(out)))
     assert again.model.laws == rc.model.laws
+
+
+def test_limit_harmonics_defaults_to_the_chains_harmonics_and_is_read_checked_and_written():
+    """A chain's ladder keeps its H unless the file says otherwise; the single equation keeps the
+    library's 256 (None here); a continuous law refuses the key; bad values name it."""
+    from rattle.io import config_from_dict as read
+
+    data = _chain(0.01)
+    data["analysis"]["harmonics"] = 48
+    assert read(data).analysis.limit_harmonics == 48
+    data["analysis"]["limit_harmonics"] = 96
+    rc = read(data)
+    assert rc.analysis.limit_harmonics == 96 and rc.analysis.to_dict()["limit_harmonics"] == 96
+    assert read(rc.to_dict()).analysis == rc.analysis  # written and read back whole
+    single = {"model": {"inertia": 1.0, "damping": 0.05, "stiffness": 1.0,
+                        "elastic": {"type": "preload", "preload": 0.03}},
+              "excitation": {"mean": 0.05, "amplitudes": [0.03]}, "analysis": {"omega": [0.3, 1.5]}}
+    assert read(single).analysis.limit_harmonics is None
+    smooth = _chain()
+    smooth["analysis"]["limit_harmonics"] = 64
+    _refused(smooth, "`analysis.limit_harmonics`", "applies only to a discontinuous law")
+    for bad in (0, 2.5, "64", 10_000):
+        data["analysis"]["limit_harmonics"] = bad
+        _refused(data, "limit_harmonics")

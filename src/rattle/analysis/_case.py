@@ -22,6 +22,15 @@ from ._orbit import periodic_orbit
 from ._time_sweep import time_sweep
 
 
+def regularisation_options(analysis: AnalysisSettings) -> RegularisationOptions:
+    """The :class:`RegularisationOptions` of a case file's ``[analysis]`` (``harmonics``,
+    ``regularisation``, ``refine``: 0 none, ``limit_harmonics``: None the default) for a
+    discontinuous law: what ``rattle frf``, ``orbit`` and ``compare`` and :class:`Case` run with."""
+    kw = {} if analysis.limit_harmonics is None else {"limit_harmonics": analysis.limit_harmonics}
+    return RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
+                                 refine=analysis.refine or None, **kw)
+
+
 @dataclass(frozen=True, slots=True)
 class Case:
     """A validated case file: its ``config`` (:class:`~rattle.io.RunConfig`), with ``model``,
@@ -43,10 +52,9 @@ class Case:
         return isinstance(self.config.model, (NonsmoothSystem, FrictionSystem))
 
     def regularisation_options(self) -> RegularisationOptions:
-        """The file's ``harmonics``, ``regularisation`` and ``refine`` for a discontinuous law."""
-        a = self.analysis
-        return RegularisationOptions(harmonics=a.harmonics, regularisation=a.regularisation,
-                                     refine=a.refine or None)
+        """The file's ``harmonics``, ``regularisation``, ``refine`` and ``limit_harmonics`` for a
+        discontinuous law (:func:`regularisation_options`)."""
+        return regularisation_options(self.analysis)
 
     @property
     def analysis(self) -> AnalysisSettings:

@@ -57,7 +57,7 @@ from ._friction_response import (
     _settled,
     _start,
     _stuck_elements,
-    chain_regularisation,
+    chain_options,
     friction_balance_factory,
 )
 from ._regularisation import RegularisationOptions
@@ -112,8 +112,7 @@ def friction_orbit(
     (module docstring), with the HB settings ``options``
     (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε,
     ``match`` and ``stability``, how the HB orbit's own multipliers are found; the ladder settings
-    are not used here. None: the defaults with
-    ε = :func:`~rattle.analysis._friction_response.chain_regularisation`). ``x0`` = (x, x') at
+    are not used here. None: :func:`~rattle.analysis._friction_response.chain_options`). ``x0`` = (x, x') at
     t = 0 (2n numbers) starts the exact shooting instead of the HB orbit's state.
 
     A failed exact shooting is reported in the result (``converged`` False, ``message``); a failed
@@ -124,7 +123,7 @@ def friction_orbit(
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     omega = check_omega(omega)
-    opts = RegularisationOptions(regularisation=chain_regularisation(system)) if options is None else options
+    opts = chain_options(system) if options is None else options
     if not isinstance(opts, RegularisationOptions):
         raise TypeError(f"`options` must be a RegularisationOptions or None, got {opts!r}")
     n, m = system.n, system.m

@@ -218,10 +218,10 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
         are written first, and the error names the files (exit status 1, as the smooth frf).
     """
     t_start = time.perf_counter()
-    from ..analysis import RegularisationOptions, nonsmooth_response  # only now: all input has been validated
+    from ..analysis import nonsmooth_response  # only now: all input has been validated
+    from ..analysis._case import regularisation_options
 
-    options = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
-                                    refine=analysis.refine or None)
+    options = regularisation_options(analysis)
     logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised harmonic "
                 "balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
                 analysis.omega_max, options.harmonics, options.regularisation)
@@ -536,10 +536,9 @@ def _nonsmooth_orbit_settings(run_config: Any, omega: float, period: int, harmon
     _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
     analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
     check_omega(omega, model=run_config.bounds_model)
-    from ..analysis import RegularisationOptions
+    from ..analysis._case import regularisation_options
 
-    return analysis, RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
-                                           refine=analysis.refine or None)
+    return analysis, regularisation_options(analysis)
 
 
 def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | None, omega_max: float | None) -> None:
@@ -702,10 +701,10 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
     refine) — the regularised harmonic balance checked by exact shooting against the exact up and
     down sweep, written as frf.csv (the response's columns), sweep.csv, compare.json, compare.png."""
     t_start = time.perf_counter()
-    from ..analysis import RegularisationOptions, compare  # only now: all input has been validated
+    from ..analysis import compare  # only now: all input has been validated
+    from ..analysis._case import regularisation_options
 
-    reg = RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
-                                refine=analysis.refine or None)
+    reg = regularisation_options(analysis)
     logger.info("comparing the response of a discontinuous law (regularised harmonic balance, H = %d, ε = %g, checked "
                 "by exact shooting) with its exact up and down sweep", reg.harmonics, reg.regularisation)
     bar = ProgressBar("sweep up+down", enabled=not quiet)

@@ -9,6 +9,8 @@ A configuration file holds the model tables and the run's own tables::
                          regularisation        a discontinuous law's ε, optional (default 0.01; 0.001 for a
                                                chain with friction on its elements)
                          refine                a discontinuous law's refinement, optional (default 0.005)
+                         limit_harmonics       the refinement's largest H, optional (default 256; a chain
+                                               with friction or jumps on its elements: its harmonics)
     [[paths]]            the sound paths (SPEC §6, :mod:`._paths`)
 
 This module reads the ``[analysis]`` table and joins it to the model: with an ``[engine]`` the
@@ -116,6 +118,9 @@ class AnalysisSettings:
     refine : float or None
         For a discontinuous law: the relative HB rms error against the exact orbit above which a
         row's regularisation is continued to its limit (0: never); None for a continuous law.
+    limit_harmonics : int or None
+        For a discontinuous law: the most harmonics the regularisation's ladder may raise H to
+        (at or below ``harmonics``: H is kept); None: the library's default (256).
     """
 
     omega_min: float = DEFAULT_OMEGA[0]
@@ -123,6 +128,7 @@ class AnalysisSettings:
     harmonics: int = DEFAULT_HARMONICS
     regularisation: float | None = None
     refine: float | None = None
+    limit_harmonics: int | None = None
 
     def __post_init__(self) -> None:
         omega_min = _check_real("omega_min", self.omega_min)
@@ -157,6 +163,9 @@ class AnalysisSettings:
                     f"limit) must satisfy 0 <= refine < 1, got {tol!r}; use 0.005 (0.5 %), or 0 to turn it off"
                 )
             object.__setattr__(self, "refine", tol)
+        if self.limit_harmonics is not None:
+            lim = _limits.check_harmonics(self.limit_harmonics, "limit_harmonics")
+            object.__setattr__(self, "limit_harmonics", int(lim))
         object.__setattr__(self, "omega_min", omega_min)
         object.__setattr__(self, "omega_max", omega_max)
         object.__setattr__(self, "harmonics", int(harmonics))
@@ -174,6 +183,8 @@ class AnalysisSettings:
             out["regularisation"] = self.regularisation
         if self.refine is not None:
             out["refine"] = self.refine
+        if self.limit_harmonics is not None:
+            out["limit_harmonics"] = self.limit_harmonics
         return out
 
 
@@ -250,13 +261,14 @@ class RunConfig:
 # --------------------------------------------------------------------------------------------
 # Schema of [analysis] (the model tables: rattle.model._tables)
 # --------------------------------------------------------------------------------------------
-_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine")
+_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine", "limit_harmonics")
 _EXAMPLES.update({
     "analysis": "[analysis] with omega = [0.1, 3.0], harmonics = 32",
     "analysis.omega": "omega = [0.1, 3.0]",
     "analysis.harmonics": "harmonics = 32",
     "analysis.regularisation": "regularisation = 0.01",
     "analysis.refine": "refine = 0.005",
+    "analysis.limit_harmonics": "limit_harmonics = 64",
 })
 
 
@@ -337,7 +349,8 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         analysis_t = {**analysis_t, "omega": [float(forcing_frequency(r, engine.base_order)) for r in engine.rpm]}
         omega_names = {"omega_min": "engine.speed_rpm[0]", "omega_max": "engine.speed_rpm[1]"}
     analysis = _analysis(check, analysis_t, discontinuous=tables.discontinuous,
-                         chain=tables.chain is not None and not tables.chain.has_jumps)
+                         chain=tables.chain is not None and not tables.chain.has_jumps,
+                         system=tables.chain is not None)
     if engine is not None and analysis.harmonics < engine.harmonics:
         raise check.error(
             f"`analysis.harmonics` must be >= {engine.harmonics}: the highest of `engine.orders` is harmonic "
@@ -435,11 +448,13 @@ def check_analysis(
 
 
 def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = False,
-              chain: bool = False) -> AnalysisSettings:
+              chain: bool = False, system: bool = False) -> AnalysisSettings:
     """``[analysis]``; for a discontinuous law also ``regularisation`` (refused otherwise; default
     :data:`DEFAULT_REGULARISATION`, :data:`DEFAULT_CHAIN_REGULARISATION` for a ``chain`` with
     friction and no jump on its elements: a jump's position step at 0.001 makes the continuation
-    crawl, docs/nonsmooth.md), and the harmonics default :data:`DEFAULT_NONSMOOTH_HARMONICS`."""
+    crawl, docs/nonsmooth.md), and the harmonics default :data:`DEFAULT_NONSMOOTH_HARMONICS`;
+    ``limit_harmonics`` (discontinuous laws only) defaults to the harmonics for a chain (``system``)
+    with friction or jumps on its elements."""
     regularisation = None
     if "regularisation" in table:
         if not discontinuous:
@@ -474,11 +489,29 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         )
     harmonics = table.get("harmonics", DEFAULT_NONSMOOTH_HARMONICS if discontinuous else DEFAULT_HARMONICS)
     check.integer(harmonics, "analysis.harmonics")
+    limit_harmonics = None
+    if "limit_harmonics" in table:
+        if not discontinuous:
+            raise check.error(
+                f"`analysis.limit_harmonics` = {_show(table['limit_harmonics'])} applies only to a discontinuous law "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
+                "a `model.elements[k].preload` > 0), whose regularisation it continues to its limit; this law is "
+                "continuous: remove `analysis.limit_harmonics`"
+            )
+        limit_harmonics = table["limit_harmonics"]
+        check.integer(limit_harmonics, "analysis.limit_harmonics")
+    elif system and discontinuous:
+        # a chain's ladder keeps its H: each doubling multiplies a dense Jacobian of n(2H + 1)
+        # unknowns (at n = 3, H = 256 about 40 s a row against 2 s at H = 64, measured in
+        # docs/nonsmooth.md), and H = harmonics meets 0.5 % away from special points there
+        limit_harmonics = harmonics
     return check.build(
         AnalysisSettings,
         {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics",
-         "regularisation": "analysis.regularisation", "refine": "analysis.refine"},
+         "regularisation": "analysis.regularisation", "refine": "analysis.refine",
+         "limit_harmonics": "analysis.limit_harmonics"},
         omega_min=omega[0], omega_max=omega[1], harmonics=harmonics, regularisation=regularisation, refine=refine,
+        limit_harmonics=limit_harmonics,
     )
 
 
