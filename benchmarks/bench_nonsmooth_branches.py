@@ -22,6 +22,7 @@ import time
 
 import numpy as np
 
+import rattle.analysis._nonsmooth as _ns
 from rattle.analysis import RegularisationOptions, nonsmooth_response
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
 
@@ -29,6 +30,34 @@ LAWS = [(0.05, 0.0), (0.05, 0.02), (0.2, 0.05)]
 if len(sys.argv) > 3:  # a subset, e.g. "0" for the first law only
     LAWS = [LAWS[int(i)] for i in sys.argv[3].split(",")]
 DEEP = float(sys.argv[4]) if len(sys.argv) > 4 else None
+
+SHOTS: list[tuple[float, str]] = []  # (Ω, outcome) of every exact shooting, in call order
+_shoot = _ns.shoot_nonsmooth_orbit
+
+
+def _recorded(system, omega, state, **kw):  # type: ignore[no-untyped-def]
+    try:
+        orbit = _shoot(system, omega, state, **kw)
+    except Exception:
+        SHOTS.append((float(omega), "failed"))
+        raise
+    SHOTS.append((float(omega), "converged" if orbit.converged else "failed"))
+    return orbit
+
+
+_ns.shoot_nonsmooth_orbit = _recorded  # the bench's diagnosis only: why a row is unmatched
+
+
+def _unmatched_ranges(res, shots: dict[float, list[str]]) -> str:
+    """The unmatched rows as Ω ranges of consecutive rows, each with how many of its rows' plain
+    shootings failed (F) or converged to an orbit that departs from the HB's (D)."""
+    out = []
+    idx = np.flatnonzero(~res.matched)
+    for grp in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []:
+        first = [shots.get(float(res.omega[i]), ["?"])[0] for i in grp]
+        out.append(f"{res.omega[grp].min():.4f}…{res.omega[grp].max():.4f} ({grp.size}: "
+                   f"{first.count('failed')} F, {first.count('converged')} D)")
+    return "; ".join(out) if out else "none"
 
 
 def main() -> None:
@@ -38,10 +67,14 @@ def main() -> None:
         law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r) if r else None)
         sysx = NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
                                excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
+        SHOTS.clear()
         t0 = time.perf_counter()
         res = nonsmooth_response(sysx, (0.3, 2.0), RegularisationOptions(harmonics=H, regularisation=eps, refine=0.005,
                                                                           deep_eps=DEEP))
         wall = time.perf_counter() - t0
+        shots: dict[float, list[str]] = {}
+        for w, how in SHOTS:
+            shots.setdefault(w, []).append(how)
         m = np.flatnonzero(res.matched)
         e = np.abs(res.rms_error[m])
         best = np.abs(res.hb_error[m])
@@ -55,6 +88,7 @@ def main() -> None:
             near[max(0, i - 1) : i + 3] = True
         print(f"T_p = {tp}, r = {r}: {len(res)} rows, {m.size} matched, {res.limit_index.size} refined, {wall:.0f} s "
               f"({res.status.value})")
+        print(f"  unmatched Ω (F: the plain shooting failed, D: it departed from the HB): {_unmatched_ranges(res, shots)}")
         print(f"  |rms error| at ε = {eps}: median {np.median(e):.1e}, max {np.max(e):.1e}, within 0.5 %: "
               f"{np.mean(e <= 5e-3):.1%}")
         print(f"  at the HB's smallest ε: max {np.max(best):.1e}, within 0.5 %: {np.mean(best <= 5e-3):.1%}"
@@ -84,6 +118,7 @@ def main() -> None:
             dist = np.array([np.min(np.abs(res.omega[i] - specials2)) / res.omega[i] for i in off])
             print(f"  the {off.size} rows off by more than 0.5 %: distance in Ω to the nearest special point "
                   f"median {np.median(dist):.1%}, max {np.max(dist):.1%} (the farthest at Ω = {res.omega[off[np.argmax(dist)]]:.4f})")
+            print("    " + "; ".join(f"Ω = {res.omega[i]:.4f}: {res.hb_error[i]:+.1e}, {d:.2%}" for i, d in zip(off, dist)))
         worst = m[np.argsort(-best)[:3]]
         print("  worst rows: " + "; ".join(f"Ω = {res.omega[i]:.4f} stick {res.stick_time[i] * res.omega[i] / (2 * math.pi):.2f} "
                                         f"of T, error {res.hb_error[i]:+.1e}" for i in worst))

@@ -13,11 +13,24 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    matrices, of one period of the exact flow from the HB state, or on request the smooth one of
    the regularised equation, :func:`~rattle.stability.regularised_multipliers`) are kept beside
    them, so the regularisation's effect is measured at every point (``rms_error``);
-3. a shooting that does not converge, or converges to an orbit whose δ(t) departs from the HB
-   orbit's by more than ``match`` of its peak-to-peak anywhere on the period (64 samples), is
-   flagged ``matched = False``: there the HB point has no exact counterpart nearby (usually near a
-   fold or a grazing, where the exact orbit has moved away or Newton stalls) and only the HB values
-   stand.
+3. the two are one orbit (``matched``) when the shooting converged and the exact δ(t) stays
+   within ``match`` × (the HB δ's peak-to-peak) of the HB's on 64 samples of the period. Where
+   the shooting fails (outside Newton's reach of the exact orbit: near a fold or a grazing the
+   HB's error at ε moves its state away), or δ sticks or locks part of the period (on the exact
+   flow from the HB state or on the exact orbit) and that check fails, the row is checked at the
+   limit of its regularisation: the HB is followed at fixed Ω down the ε ladder (ε → ``limit_eps``,
+   H ≤ ``limit_harmonics``, :func:`~rattle.analysis._regularisation.regularisation_limit`; the
+   rungs kept for step 4), the exact flow is shot from the HB state at the ladder's end, and the
+   two are one orbit when the exact δ(t) stays within ``match`` of that HB's, relative to that
+   HB δ's peak-to-peak. The exact orbit is then the limit ε → 0 of the HB's. With one coordinate
+   the plain relative scale stays the right one at the limit: a held phase is a part of δ's own
+   period (δ constant while stuck, at the jump's breakpoint while locked), the motion outside it
+   sets the peak-to-peak, and the regularised δ there departs from the exact one by the steps'
+   width ε_δ (and its creep), which the ladder shrinks; unlike an element of a chain held while
+   the others move, its own peak-to-peak is no regularisation-sized scale. An orbit held the
+   whole period (the exact orbits a family, δ free within the friction band) is not resolved
+   this way. Rows matched by neither check are ``matched = False``: there the HB point has no
+   exact counterpart nearby and only the HB values stand;
 
 4. where a matched row's HB rms misses the exact one by more than ``refine`` (0.5 % by default),
    the regularisation is continued at that row towards its limit (ε down to ``limit_eps``, H up to
@@ -25,8 +38,9 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    HB's rms at the smallest ε is kept beside the exact one (``hb_error``): the HB's accuracy is
    then measured at its limit, row by row.
 
-Cost: one continuation of 2H + 1 unknowns plus one exact shooting (a few ms) per point, and a
-ladder (0.5–2 s) per refined row.
+Cost: one continuation of 2H + 1 unknowns plus one exact shooting and one exact period (the HB
+orbit's monodromy; a few ms) per point, and a ladder (0.5–2 s) per row checked at the limit or
+refined, found once per row: a row checked at the limit and then refined shares it.
 """
 
 from __future__ import annotations
@@ -39,12 +53,12 @@ import numpy as np
 from .._typing import FloatArray
 from .._validate import check_range
 from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
-from ..errors import RattleError, Status
+from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
-from ..timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
+from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -52,26 +66,72 @@ from ._regularisation import (
 )
 
 
+#: Samples of the period on which the exact δ(t) is compared with the HB's.
+MATCH_SAMPLES = 64
+
+
 def _rms(q: FloatArray, H: int) -> float:
     return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
 
 
-def _hb_multipliers(problem: RegularisedBalance, integ: NonsmoothIntegrator, q: FloatArray, omega: float,
-                    state: tuple[float, float], method: str) -> np.ndarray:
+def _hb_flow(integ: NonsmoothIntegrator, state: tuple[float, float], omega: float) -> NonsmoothTrajectory | None:
+    """One period of the exact flow from ``state`` (the HB orbit's at t = 0); None when it cannot
+    be followed (the event budget of a chattering flow)."""
+    try:
+        return integ.propagate(np.asarray(state, dtype=float), 0.0, 2.0 * math.pi / omega, omega)
+    except (RattleError, ValueError, ArithmeticError):
+        return None
+
+
+def _hb_multipliers(problem: RegularisedBalance, flow: NonsmoothTrajectory | None, q: FloatArray,
+                    omega: float, method: str) -> np.ndarray:
     """The Floquet multipliers of the HB orbit (2,), largest modulus first: ``"saltation"`` the
     non-smooth monodromy (stage matrices and saltation matrices at every switching) of one period
-    of the exact flow from the HB orbit's state at t = 0; ``"regularised"`` the smooth monodromy of
-    the regularised equation along the HB orbit (:func:`~rattle.stability.regularised_multipliers`).
-    The first falls back to the second when the flow cannot be followed (the event budget)."""
-    if method == "saltation":
+    of the exact flow from the HB orbit's state at t = 0 (``flow``, :func:`_hb_flow`);
+    ``"regularised"`` the smooth monodromy of the regularised equation along the HB orbit
+    (:func:`~rattle.stability.regularised_multipliers`). The first falls back to the second when
+    the flow cannot be followed (the event budget)."""
+    if method == "saltation" and flow is not None:
         try:
-            M = integ.propagate(np.asarray(state, dtype=float), 0.0, 2.0 * math.pi / omega, omega).sensitivity
-            mu = np.linalg.eigvals(M).astype(complex)
+            mu = np.linalg.eigvals(flow.sensitivity).astype(complex)
             if np.all(np.isfinite(mu)):
                 return mu[np.argsort(-np.abs(mu), kind="stable")]
-        except (RattleError, ValueError, ArithmeticError):
+        except (ValueError, ArithmeticError):
             pass
     return regularised_multipliers(problem, q, omega)
+
+
+def _departure(problem: RegularisedBalance, q: FloatArray, omega: float, traj: NonsmoothTrajectory,
+               scale: float) -> float:
+    """The largest departure of the exact δ(t) on ``traj`` from the HB orbit ``q`` of ``problem``
+    on :data:`MATCH_SAMPLES` samples of the period, relative to ``scale``."""
+    t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / omega / MATCH_SAMPLES)
+    return float(np.max(np.abs(traj.sample(t)[0] - problem.basis.evaluate(q, omega, t)))) / scale
+
+
+def _holds(flow: NonsmoothTrajectory | None, orbit: NonsmoothOrbit | None) -> bool:
+    """Whether δ sticks or locks some of the period on the exact ``flow`` from the HB state or on
+    the converged exact ``orbit``."""
+    trajs = [flow] + ([orbit.trajectory] if orbit is not None and orbit.converged else [])
+    return any(tr is not None and tr.stick_time > 0.0 for tr in trajs)
+
+
+def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: NonsmoothSystem,
+                    integ: NonsmoothIntegrator, omega: float, lad: RegularisationLimit,
+                    L: float) -> tuple[NonsmoothOrbit, float] | None:
+    """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` and its departure
+    from that HB orbit, relative to that HB δ's peak-to-peak; None when the shooting fails."""
+    last = lad.last
+    pb = make(last.eps, last.harmonics)
+    d0, v0 = (float(a[0]) for a in pb.samples(last.q, omega))
+    try:
+        orbit = shoot_nonsmooth_orbit(system, omega, (d0, v0), integrator=integ, max_iterations=30)
+    except (RattleError, ValueError, ArithmeticError):
+        return None
+    if not orbit.converged:
+        return None
+    size = max(float(np.ptp(pb.basis.synthesize(last.q))), 1e-12 * L)
+    return orbit, _departure(pb, last.q, omega, orbit.trajectory, size)
 
 
 def _deeper(make: Callable[[float, int], RegularisedBalance], lad: RegularisationLimit,
@@ -140,22 +200,48 @@ def nonsmooth_response(
     integ = NonsmoothIntegrator(system)
     rows: dict[str, list] = {k: [] for k in ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched",
                                              "mean", "p2p", "acc_p2p", "regime", "sticks", "crossings")}
-    for pt in points:
+    ladders: dict[int, RegularisationLimit | None] = {}  # row: its ladder (None: it stalled)
+
+    def _row_ladder(i: int) -> RegularisationLimit | None:
+        """Row i's ladder (ε → ``limit_eps``, H ≤ ``limit_harmonics``), found once: the match at
+        the limit and the refinement share it."""
+        if i not in ladders:
+            try:
+                ladders[i] = regularisation_limit(make, float(points[i].omega), points[i].q, eps_start=regularisation,
+                                                  eps_min=min(limit_eps, regularisation), harmonics=harmonics,
+                                                  max_harmonics=max(limit_harmonics, harmonics))
+            except RattleError:
+                ladders[i] = None
+        return ladders[i]
+
+    for i, pt in enumerate(points):
         w, q = float(pt.omega), pt.q
         rms_hb = _rms(q, harmonics)
         d0, v0 = (float(a[0]) for a in problem.samples(q, w))
-        mu_hb = _hb_multipliers(problem, integ, q, w, (d0, v0), opts.stability)
+        flow = _hb_flow(integ, (d0, v0), w) if opts.stability == "saltation" else None
+        mu_hb = _hb_multipliers(problem, flow, q, w, opts.stability)
         size = max(float(np.ptp(problem.basis.synthesize(q))), 1e-12 * L)
         orbit = None
         try:
             orbit = shoot_nonsmooth_orbit(system, w, (d0, v0), integrator=integ, max_iterations=30)
         except (RattleError, ValueError, ArithmeticError):  # e.g. the event budget of a chattering orbit
             orbit = None
-        ok = orbit is not None and orbit.converged
+        shot_failed = orbit is None or not orbit.converged
+        ok = not shot_failed
         if ok:  # the same orbit: δ(t) of the two within `match` of the HB orbit's peak-to-peak
-            t = np.arange(64) * (2.0 * math.pi / w / 64)
-            dist = float(np.max(np.abs(orbit.trajectory.sample(t)[0] - problem.basis.evaluate(q, w, t)))) / size
-            ok = dist <= match
+            ok = _departure(problem, q, w, orbit.trajectory, size) <= match
+        if not ok:
+            if flow is None and opts.stability != "saltation":
+                flow = _hb_flow(integ, (d0, v0), w)
+            if shot_failed or _holds(flow, orbit):
+                # the shooting from the HB at ε failed (outside Newton's reach of the exact orbit), or
+                # δ sticks or locks part of the period, which the HB at ε resolves only to the steps'
+                # width: the exact orbit is the limit of the HB's as ε → 0 when the flow shot from
+                # the HB at the ladder's end matches that HB orbit
+                lad = _row_ladder(i)
+                found = None if lad is None else _match_at_limit(make, system, integ, w, lad, L)
+                if found is not None and found[1] <= match:
+                    orbit, ok = found[0], True
         rows["omega"].append(w)
         rows["rms_hb"].append(rms_hb)
         rows["mult_hb"].append(mu_hb)
@@ -193,9 +279,9 @@ def nonsmooth_response(
     lim_eps, lim_rms, lim_rich, lim_lin = [], [], [], []
     for i in pick:
         try:
-            lad = regularisation_limit(make, float(points[i].omega), points[i].q, eps_start=regularisation,
-                                       eps_min=min(limit_eps, regularisation), harmonics=harmonics,
-                                       max_harmonics=max(limit_harmonics, harmonics))
+            lad = _row_ladder(int(i))
+            if lad is None:
+                raise ConvergenceError(f"the ladder stalled at Ω = {float(points[i].omega):g}")
             if refine is not None and opts.deep_eps is not None and matched[i] and not lad.linear \
                     and abs(lad.last.rms / rms[i] - 1.0) > refine and opts.deep_eps < lad.last.eps:
                 lad = _deeper(make, lad, opts)  # not yet in the linear range and still off: narrower, more harmonics
