@@ -18,13 +18,15 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    stays within ``match`` × (the HB δ_e's peak-to-peak) of the HB's on 64 samples of the period.
    Where the shooting fails, or an element sticks or locks part of the period (on the flow from
    the HB state or on the exact orbit) and that check fails, the row is checked at the limit of
-   its regularisation: the
-   HB is followed at fixed Ω down the ε ladder (:func:`_ladder`, the rungs kept for step 3), the
-   exact flow is shot from the HB state at the ladder's end, and the two are one orbit when every
-   δ_e(t) stays within ``match`` of that HB's, an element held part of the period measured on the
-   chain's scale (the largest HB δ peak-to-peak): its regularised deflection is of the order of
-   the steps' width (at a lock ε_δ artanh(τ/J), a few ε_δ where the exact δ_e is 0), so its own
-   peak-to-peak is no scale to measure by. The exact orbit is then the limit ε → 0 of the HB's.
+   its regularisation: the HB is followed at fixed Ω down the ε ladder (:func:`_ladder`, the
+   rungs kept for step 3), the exact flow is shot from the HB state at the ladder's end, and the
+   two are one orbit when every δ_e(t) stays within ``match`` of that HB's, an element held part
+   of the period measured on the chain's scale (the largest HB δ peak-to-peak): its regularised
+   deflection is of the order of the steps' width (at a lock ε_δ artanh(τ/J), a few ε_δ where the
+   exact δ_e is 0), so its own peak-to-peak is no scale to measure by. The exact orbit is then
+   the limit ε → 0 of the HB's, unless the ladder left the row's branch (a fold in ε; Newton
+   then finds another orbit on the way down): so the elements the exact orbit does not hold must
+   also stay within :data:`LADDER_GUARD` × ``match`` of the HB orbit at the row's own ε.
    The exact orbit gives the answer (every element's rms, mean, stick fraction; the 2n
    multipliers); the HB's own values stand beside them: its rms and its multipliers. Those are,
    by ``stability`` (:class:`~rattle.analysis.RegularisationOptions`), ``"saltation"``: the
@@ -208,10 +210,14 @@ def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], 
 
 
 def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], system: FrictionSystem,
-                    integ: FrictionIntegrator, omega: float, lad: RegularisationLimit,
-                    t: FloatArray) -> tuple[FrictionTrajectory, float] | None:
+                    integ: FrictionIntegrator, omega: float, lad: RegularisationLimit, t: FloatArray,
+                    d_hb: FloatArray, size_hb: FloatArray, match: float) -> tuple[FrictionTrajectory, float] | None:
     """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` and its departure
-    from that HB orbit (:func:`_held_scale`); None when the shooting fails."""
+    from that HB orbit (:func:`_held_scale`); None when the shooting fails. The departure is inf
+    when an element the exact orbit does not hold departs from the HB orbit at the row's own ε
+    (samples ``d_hb`` at ``t``, peak-to-peak ``size_hb``) by more than :data:`LADDER_GUARD` ×
+    ``match`` of that peak-to-peak: the ladder then left the row's branch (a fold in ε: the
+    regularised orbit at ε has no limit there, and Newton found another orbit on the way down)."""
     last = lad.last
     pb = make(last.eps, last.harmonics)
     try:
@@ -223,7 +229,19 @@ def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], syst
         return None
     traj = orbit.trajectory
     gap, size = _gap_at_limit(make, omega, last, traj, t)
+    moving = traj.stick_time() <= 0.0
+    at_eps = _departures(traj, d_hb, t, size_hb)
+    if np.any(at_eps[moving] > LADDER_GUARD * match):
+        return traj, math.inf
     return traj, float(np.max(gap / _held_scale(traj, size)))
+
+
+#: The check at the limit rejects an exact orbit whose elements that move (not held) depart from
+#: the HB orbit at the row's own ε by more than this many times `match` of its peak-to-peak.
+#: Measured on the lock-up clutch chain (examples/chain_lockup_clutch.toml's chain, ε = 0.01,
+#: H = 64, Ω = 2.2 … 3.3 rad/s): the gear of the true limits departs by 0.042 … 0.077 at ε (the
+#: held clutch's regularised width moves it), that of orbits the ladder jumped to by 0.34 … 2.5.
+LADDER_GUARD = 2.0
 
 
 def _held_scale(traj: FrictionTrajectory, size: FloatArray) -> FloatArray:
@@ -455,7 +473,7 @@ def friction_response(
             # the exact orbit is the limit of the HB's as ε → 0 when the flow shot from the HB at
             # the ladder's end matches that HB orbit
             lad = _row_ladder(i, w, q)
-            found = None if lad is None else _match_at_limit(make, system, integ, w, lad, t)
+            found = None if lad is None else _match_at_limit(make, system, integ, w, lad, t, d_hb, size, match)
             if found is not None:
                 traj, dist_all[i] = found
                 matched[i] = dist_all[i] <= match

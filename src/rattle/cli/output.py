@@ -329,7 +329,8 @@ def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str,
     ``RegularisationOptions``), the elements (law, friction level per stage relative to the
     element's stiffness, the matched rows where it sticks), status and message, the rows, and the
     response's own counts and measured HB error (:meth:`FrictionResponse.metadata`: matched,
-    within_0_5_percent, within_0_5_percent_moving, held_rows, max_rms_error, median_rms_error,
+    within_0_5_percent, within_0_5_percent_moving, within_0_5_percent_moving_estimate, held_rows,
+    max_rms_error, median_rms_error,
     stability_agrees, unstable_rows, sticking_rows, refined_rows, refined_max_error), and
     ``timings``."""
     import numpy as np

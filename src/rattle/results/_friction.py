@@ -239,6 +239,7 @@ class FrictionResponse:
             "elements": list(self.element_names), "rows": len(self), "matched": matched,
             "within_0_5_percent": int(np.sum(err <= 0.005)),
             "within_0_5_percent_moving": int(np.sum(self.moving_rms_error[self.matched] <= 0.005)),
+            "within_0_5_percent_moving_estimate": int(np.sum(self.moving_hb_error[self.matched] <= 0.005)),
             "held_rows": int(np.sum(np.any(self._held(), axis=1) & self.matched)),
             "max_rms_error": num(float(np.max(err))) if err.size else None,
             "median_rms_error": num(float(np.median(err))) if err.size else None,
@@ -278,9 +279,19 @@ class FrictionResponse:
         not matched; 0 where every element is held). A held element (stuck or locked part of the
         period) moves within the regularisation's width of its stuck deflection or jump, where the
         HB resolves it only to a few widths ε_δ: its relative error says little of the orbit."""
-        err = np.abs(self.element_rms_error)
-        out = np.max(np.where(self._held(), 0.0, np.nan_to_num(err, nan=np.inf)), axis=1) if len(self) \
-            else np.zeros(0)
+        return self._moving(self.rms_hb)
+
+    @property
+    def moving_hb_error(self) -> FloatArray:
+        """(P,): :attr:`moving_rms_error` of the HB's ε → 0 estimate (:attr:`rms_hb_estimate`)."""
+        return self._moving(self.rms_hb_estimate)
+
+    def _moving(self, hb: FloatArray) -> FloatArray:
+        if not len(self):
+            return np.zeros(0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            err = np.abs(hb / self.rms - 1.0)
+        out = np.max(np.where(self._held(), 0.0, np.nan_to_num(err, nan=np.inf)), axis=1)
         return np.where(self.matched, out, np.nan)
 
     def summary(self) -> str:
@@ -300,7 +311,9 @@ class FrictionResponse:
             if md["held_rows"]:
                 lines.append(f"on the {md['held_rows']} rows where an element is held (stuck or locked part of the "
                              f"period) the HB resolves that element only to the regularisation's width; the elements "
-                             f"moving: within 0.5 % on {md['within_0_5_percent_moving']} of {md['matched']} rows")
+                             f"moving: within 0.5 % on {md['within_0_5_percent_moving']} of {md['matched']} rows"
+                             + (f" at ε, on {md['within_0_5_percent_moving_estimate']} with the HB's ε → 0 estimate"
+                                if self.limit_index.size else ""))
             lines.append(f"stability (exact vs HB monodromy) agrees on {md['stability_agrees']} of {md['matched']} "
                          f"({md['stability_agrees_limit']} with the HB at its limit where refined)")
         if self.limit_index.size:
