@@ -30,13 +30,14 @@ def test_the_example_is_a_chain_with_a_preloaded_clutch_and_a_gear():
 
 
 def test_the_example_slips_then_locks_as_stated():
-    from rattle.analysis import RegularisationOptions, friction_response
+    from rattle.analysis import friction_response
+    from rattle.analysis._case import regularisation_options
 
     cfg = load_config(EXAMPLES / NAME)
     H = cfg.analysis.harmonics
-    r = friction_response(cfg.model, cfg.analysis.omega,
-                          RegularisationOptions(harmonics=H, regularisation=cfg.analysis.regularisation,
-                                                refine=None, limit_harmonics=H))
+    opts = regularisation_options(cfg.analysis)  # what `rattle frf` runs with: the file's settings whole
+    assert (opts.harmonics, opts.limit_harmonics, opts.refine) == (H, H, None)  # a chain's ladder keeps its H
+    r = friction_response(cfg.model, cfg.analysis.omega, opts)
     assert r.status.success and len(r) >= 6 and np.sum(r.matched) >= 4
     m = r.matched
     stick = np.nan_to_num(r.stick_fraction[:, 0])
