@@ -1,6 +1,22 @@
-"""Configuration texts shared by the tests (one source for the reference clutch as TOML)."""
+"""Cases shared by the tests: the reference clutch as TOML, the chain with a lock-up clutch."""
 
 from __future__ import annotations
+
+from rattle.model import Backlash, Chain, Element, Friction, Link, Preload, Torque
+
+
+def lockup_chain() -> Chain:
+    """A grounded 3-inertia chain with a torque-converter lock-up clutch (a torque jump ±0.03 K_e
+    at δ = 0, friction 0.01) between inertias 1 and 2 and a gear with backlash (b = 0.02) between
+    2 and 3, forced by 0.05 + 0.1 cos Ωt on inertia 1 (benchmarks/bench_friction_chain.py
+    ``--case preload``, examples/chain_lockup_clutch.toml)."""
+    return Chain(inertias=(1.0, 0.5, 2.0),
+                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
+                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
+                 elements=(Element(name="tcc", between=(1, 2), stiffness=1.0, law=Preload(preload=0.03),
+                                   friction=Friction(levels=0.01)),
+                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
+                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
 
 
 def clutch_toml(omega: tuple[float, float] = (0.1, 3.0), harmonics: int = 32) -> str:

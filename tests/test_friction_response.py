@@ -28,9 +28,11 @@ from rattle.analysis import RegularisationOptions, friction_response, nonsmooth_
 from rattle.analysis._friction_response import _start, friction_balance_factory
 from rattle.analysis._regularisation import regularisation_limit
 from rattle.continuation import ContinuationOptions
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, FrictionSystem, Link, Preload, Torque
+from rattle.model import Backlash, Chain, Clutch, Element, Friction, FrictionSystem, Link, Torque
 from rattle.results import FrictionResponse
 from rattle.timeint import shoot_friction_orbit, shoot_system_orbit
+
+from _cases import lockup_chain  # tests/ is on sys.path through its conftest
 
 STICK = (0.02, 0.05, 0.02)  # friction levels per clutch stage (relative to its stiffness)
 SLIP = (0.01, 0.03, 0.01)
@@ -243,18 +245,6 @@ def test_without_options_a_chain_is_solved_at_its_own_default_regularisation() -
     assert np.all(r.matched) and np.abs(r.element_rms_error).max() <= 0.005
 
 
-def _lockup_chain() -> Chain:
-    """The 3-inertia chain with a torque-converter lock-up clutch (a torque jump ±0.03 at δ = 0,
-    friction 0.01) in place of the damper (benchmarks/bench_friction_chain.py ``--case preload``)."""
-    return Chain(inertias=(1.0, 0.5, 2.0),
-                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-                 elements=(Element(name="tcc", between=(1, 2), stiffness=1.0, law=Preload(preload=0.03),
-                                   friction=Friction(levels=0.01)),
-                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
-
-
 def test_a_clutch_locked_part_of_the_period_is_matched_at_the_regularisations_limit() -> None:
     """At 0.76–0.78 ω_n the lock-up clutch is held ~45 % of the period (locked at its jump or
     stuck beside it) with an exact rms ~6e-4 rad; the HB at ε = 0.01 gives it a deflection of the
@@ -262,7 +252,7 @@ def test_a_clutch_locked_part_of_the_period_is_matched_at_the_regularisations_li
     the exact δ(t) by more than `match` of its own peak-to-peak, so the row is matched at the
     limit: the flow shot from the HB at the ladder's end (ε = 1e-3) against that HB, the held
     element measured on the chain's scale. The gear, moving freely, is within 1 % at ε."""
-    fs = _lockup_chain().friction_system()
+    fs = lockup_chain().friction_system()
     wn = fs.frequency_scale()
     opts = RegularisationOptions(harmonics=32, regularisation=0.01, refine=None, limit=0, limit_harmonics=32)
     r = friction_response(fs, (0.76 * wn, 0.78 * wn), opts, continuation=WIDE)

@@ -31,6 +31,8 @@ from rattle.model._system import single_equation_system
 from rattle.timeint import FrictionIntegrator, NonsmoothIntegrator, NonsmoothOptions, shoot_friction_orbit
 from rattle.timeint._friction_chain import EVENT_NAMES, LOCK, UNLOCK
 
+from _cases import lockup_chain  # tests/ is on sys.path through its conftest
+
 
 def _counts(traj):
     out = dict.fromkeys(EVENT_NAMES, 0)
@@ -471,13 +473,7 @@ def test_a_release_with_a_round_off_velocity_against_its_slip_keeps_slipping():
     it at the same instant until the integrator gave up). The state: one period before that
     release on the benchmark chain with a lock-up clutch (bench_friction_chain.py --case preload)
     at Ω = 0.687 ω_n, exact to the bit."""
-    fs = Chain(inertias=(1.0, 0.5, 2.0),
-               links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                      Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-               elements=(Element(name="tcc", between=(1, 2), stiffness=1.0, law=Preload(preload=0.03),
-                                 friction=Friction(levels=0.01)),
-                         Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-               torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),)).friction_system()
+    fs = lockup_chain().friction_system()
     z0 = np.array([float.fromhex(h) for h in ("0x1.532aa4c44dd98p-6", "0x1.3602bd039c122p-7", "0x1.3b2ab9b36341ep-5",
                                               "0x1.118a900a7486ap-7", "-0x1.5084ab740df30p-8",
                                               "-0x1.3b416185a1fb4p-9")])
