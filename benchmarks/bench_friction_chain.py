@@ -32,8 +32,9 @@ Measured 2026-12-01 (2 cores shared with other jobs, two runs at a time: times a
   matched, 649 s (another job on the second core); away from special points the moving elements'
   ε→0 estimate within 0.5 % on 100 % (max 0.49 %), stability 100 %; the held clutch (144 rows,
   exact rms median 0.002 rad) off by a median 7.2e-5 rad (max 4.3e-4).
-- ``--harmonics 64 --lo 0.4 --eps 0.001`` (same day, before the guard): 487 rows, 478 matched,
-  away from special points 100 % within 0.5 % at ε, stability 99.6 %; 429 s.
+- ``--harmonics 64 --lo 0.4 --eps 0.001`` (same day, with the guard): 487 rows, 478 matched (443
+  before the check at the limit), away from special points 100 % within 0.5 % at ε, stability
+  99.6 %; 266 s.
 """
 
 from __future__ import annotations
