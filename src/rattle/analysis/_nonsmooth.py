@@ -22,7 +22,9 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    H ≤ ``limit_harmonics``, :func:`~rattle.analysis._regularisation.regularisation_limit`; the
    rungs kept for step 4), the exact flow is shot from the HB state at the ladder's end, and the
    two are one orbit when the exact δ(t) stays within ``match`` of that HB's, relative to that
-   HB δ's peak-to-peak. The exact orbit is then the limit ε → 0 of the HB's. With one coordinate
+   HB δ's peak-to-peak, and no rung of the ladder moved δ(t) by more than :data:`LADDER_GUARD`
+   of its peak-to-peak (a larger step is a jump to another orbit: at a fold in ε the regularised
+   orbit has no limit). The exact orbit is then the limit ε → 0 of the HB's. With one coordinate
    the plain relative scale stays the right one at the limit: a held phase is a part of δ's own
    period (δ constant while stuck, at the jump's breakpoint while locked), the motion outside it
    sets the peak-to-peak, and the regularised δ there departs from the exact one by the steps'
@@ -130,8 +132,33 @@ def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: No
         return None
     if not orbit.converged:
         return None
+    if _ladder_step(make, lad, omega, L) > LADDER_GUARD:
+        return orbit, math.inf  # the ladder left the row's branch: its end is another orbit's
     size = max(float(np.ptp(pb.basis.synthesize(last.q))), 1e-12 * L)
     return orbit, _departure(pb, last.q, omega, orbit.trajectory, size)
+
+
+#: The check at the limit trusts a ladder whose rungs each move δ(t) by at most this fraction of
+#: its peak-to-peak. Following one orbit down in ε (each rung halves it), a rung moves δ(t) by
+#: about half of what is left of the regularisation's error; a rung that jumps to another orbit
+#: (a fold in ε: the regularised orbit at ε has no limit, Newton finds another on the way down)
+#: moves it by the distance between the two orbits, of the order of the peak-to-peak.
+LADDER_GUARD = 0.2
+
+
+def _ladder_step(make: Callable[[float, int], RegularisedBalance], lad: RegularisationLimit, omega: float,
+                 L: float) -> float:
+    """The largest change of δ(t) between two successive rungs of ``lad`` on :data:`MATCH_SAMPLES`
+    samples of the period, relative to the earlier rung's peak-to-peak."""
+    t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / omega / MATCH_SAMPLES)
+    prev: FloatArray | None = None
+    worst = 0.0
+    for step in lad.steps:
+        d = make(step.eps, step.harmonics).basis.evaluate(step.q, omega, t)
+        if prev is not None:
+            worst = max(worst, float(np.max(np.abs(d - prev))) / max(float(np.ptp(prev)), 1e-12 * L))
+        prev = d
+    return worst
 
 
 def _deeper(make: Callable[[float, int], RegularisedBalance], lad: RegularisationLimit,
