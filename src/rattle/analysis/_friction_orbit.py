@@ -47,8 +47,8 @@ from ..model import FrictionSystem
 from ..results import FrictionOrbitResult
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
+from ..timeint._shooting import FLOW_FAILURES
 from ._friction_response import (
-    FLOW_FAILURES,
     _departures,
     _hb_flow,
     _hb_multipliers,

@@ -72,7 +72,7 @@ from ..results import FrictionResponse
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
-from ..timeint._shooting import monodromy_multipliers
+from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -105,6 +105,8 @@ def chain_options(system: FrictionSystem) -> RegularisationOptions:
     0.5 % away from special points with H fixed."""
     base = RegularisationOptions(regularisation=chain_regularisation(system))
     return dataclasses.replace(base, limit_harmonics=base.harmonics)
+
+
 #: Samples per period on which the exact and the HB orbits are compared.
 MATCH_SAMPLES = 64
 #: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
@@ -124,11 +126,6 @@ def friction_balance_factory(system: FrictionSystem) -> Callable[[float, int], R
         return pb if pb.eps == eps else pb.with_regularisation(eps)
 
     return make
-
-
-#: What the exact flow or its shooting raises when it cannot follow the motion (the event budget
-#: of a chatter, a loop of stuck elements, a singular step): the row or orbit is then not found.
-FLOW_FAILURES = (RattleError, ValueError, ArithmeticError, np.linalg.LinAlgError)
 
 
 def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
@@ -192,7 +189,8 @@ def _departures(traj: FrictionTrajectory, d_hb: FloatArray, t: FloatArray, size:
     return np.max(np.abs(traj.element_samples(t)[0] - d_hb), axis=0) / size
 
 
-def _gap_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, last: RegularisationStep, traj: FrictionTrajectory, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _gap_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, last: RegularisationStep,
+                  traj: FrictionTrajectory, t: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Per element, the largest departure of the exact δ_e(t) on ``traj`` from the HB's at the
     ladder's rung ``last`` (absolute), and that HB δ_e's peak-to-peak, (m,) each."""
     pb = make(last.eps, last.harmonics)
@@ -228,11 +226,10 @@ def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], syst
     if not orbit.converged:
         return None
     traj = orbit.trajectory
-    gap, size = _gap_at_limit(make, omega, last, traj, t)
     moving = traj.stick_time() <= 0.0
-    at_eps = _departures(traj, d_hb, t, size_hb)
-    if np.any(at_eps[moving] > LADDER_GUARD * match):
+    if np.any(_departures(traj, d_hb, t, size_hb)[moving] > LADDER_GUARD * match):
         return traj, math.inf
+    gap, size = _gap_at_limit(make, omega, last, traj, t)
     return traj, float(np.max(gap / _held_scale(traj, size)))
 
 

@@ -22,9 +22,9 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    H ≤ ``limit_harmonics``, :func:`~rattle.analysis._regularisation.regularisation_limit`; the
    rungs kept for step 4), the exact flow is shot from the HB state at the ladder's end, and the
    two are one orbit when the exact δ(t) stays within ``match`` of that HB's, relative to that
-   HB δ's peak-to-peak, and no rung of the ladder moved δ(t) by more than :data:`LADDER_GUARD`
-   of its peak-to-peak (a larger step is a jump to another orbit: at a fold in ε the regularised
-   orbit has no limit). The exact orbit is then the limit ε → 0 of the HB's. With one coordinate
+   HB δ's peak-to-peak, and no rung of the ladder moved δ(t) by more than
+   :data:`LADDER_STEP_GUARD` of its peak-to-peak (a larger step is a jump to another orbit: at a
+   fold in ε the regularised orbit has no limit). The exact orbit is then the limit ε → 0 of the HB's. With one coordinate
    the plain relative scale stays the right one at the limit: a held phase is a part of δ's own
    period (δ constant while stuck, at the jump's breakpoint while locked), the motion outside it
    sets the peak-to-peak, and the regularised δ there departs from the exact one by the steps'
@@ -61,6 +61,7 @@ from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
+from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -81,7 +82,7 @@ def _hb_flow(integ: NonsmoothIntegrator, state: tuple[float, float], omega: floa
     be followed (the event budget of a chattering flow)."""
     try:
         return integ.propagate(np.asarray(state, dtype=float), 0.0, 2.0 * math.pi / omega, omega)
-    except (RattleError, ValueError, ArithmeticError):
+    except FLOW_FAILURES:
         return None
 
 
@@ -95,9 +96,9 @@ def _hb_multipliers(problem: RegularisedBalance, flow: NonsmoothTrajectory | Non
     the flow cannot be followed (the event budget)."""
     if method == "saltation" and flow is not None:
         try:
-            mu = np.linalg.eigvals(flow.sensitivity).astype(complex)
+            mu = monodromy_multipliers(flow.sensitivity)
             if np.all(np.isfinite(mu)):
-                return mu[np.argsort(-np.abs(mu), kind="stable")]
+                return mu
         except (ValueError, ArithmeticError):
             pass
     return regularised_multipliers(problem, q, omega)
@@ -128,11 +129,11 @@ def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: No
     d0, v0 = (float(a[0]) for a in pb.samples(last.q, omega))
     try:
         orbit = shoot_nonsmooth_orbit(system, omega, (d0, v0), integrator=integ, max_iterations=30)
-    except (RattleError, ValueError, ArithmeticError):
+    except FLOW_FAILURES:
         return None
     if not orbit.converged:
         return None
-    if _ladder_step(make, lad, omega, L) > LADDER_GUARD:
+    if _ladder_step(make, lad, omega, L) > LADDER_STEP_GUARD:
         return orbit, math.inf  # the ladder left the row's branch: its end is another orbit's
     size = max(float(np.ptp(pb.basis.synthesize(last.q))), 1e-12 * L)
     return orbit, _departure(pb, last.q, omega, orbit.trajectory, size)
@@ -143,7 +144,7 @@ def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: No
 #: about half of what is left of the regularisation's error; a rung that jumps to another orbit
 #: (a fold in ε: the regularised orbit at ε has no limit, Newton finds another on the way down)
 #: moves it by the distance between the two orbits, of the order of the peak-to-peak.
-LADDER_GUARD = 0.2
+LADDER_STEP_GUARD = 0.2
 
 
 def _ladder_step(make: Callable[[float, int], RegularisedBalance], lad: RegularisationLimit, omega: float,
@@ -251,7 +252,7 @@ def nonsmooth_response(
         orbit = None
         try:
             orbit = shoot_nonsmooth_orbit(system, w, (d0, v0), integrator=integ, max_iterations=30)
-        except (RattleError, ValueError, ArithmeticError):  # e.g. the event budget of a chattering orbit
+        except FLOW_FAILURES:  # e.g. the event budget of a chattering orbit
             orbit = None
         shot_failed = orbit is None or not orbit.converged
         ok = not shot_failed

@@ -33,11 +33,12 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_omega, check_state
-from ..errors import ConvergenceError, RattleError
+from ..errors import ConvergenceError
 from ..hb import RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionOrbitResult, NonsmoothOrbitResult
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
+from ..timeint._shooting import FLOW_FAILURES
 from ._nonsmooth import RegularisationOptions, balance_factory
 from ._regularisation import regularisation_limit
 
@@ -61,7 +62,7 @@ def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
     """The exact orbit from ``x0``, or (None, why)."""
     try:
         orbit = shoot_nonsmooth_orbit(system, omega, x0, integrator=integ, max_iterations=30)
-    except (RattleError, ValueError, ArithmeticError) as exc:  # e.g. the event budget of a chattering orbit
+    except FLOW_FAILURES as exc:  # e.g. the event budget of a chattering orbit
         return None, f"{type(exc).__name__}: {exc}"
     if not orbit.converged:
         return None, f"Newton shooting stopped after {orbit.iterations} steps at residual {orbit.residual:.3g}"
@@ -73,7 +74,7 @@ def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
     """The exact flow run for :data:`SETTLE_PERIODS` periods from ``x0``, then shot; or (None, why)."""
     try:
         settled = integ.propagate(x0, 0.0, SETTLE_PERIODS * 2.0 * math.pi / omega, omega).state1
-    except (RattleError, ValueError, ArithmeticError) as exc:
+    except FLOW_FAILURES as exc:
         return None, f"{type(exc).__name__}: {exc}"
     return _shoot(system, omega, settled, integ)
 

@@ -38,9 +38,9 @@ from ..errors import ConfigError, RattleError
 from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
 from ..results._sweep import SweepResult
 from ..results._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED
+from ..timeint._shooting import FLOW_FAILURES
 
 from ._frequency_response import check_range
-from ._friction_response import FLOW_FAILURES
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
 logger = logging.getLogger("rattle")
@@ -143,9 +143,7 @@ def _failures(model: object) -> tuple[type[BaseException], ...]:
     rattle's own (:class:`~rattle.errors.RattleError`), and for the discontinuous laws also what
     their event-driven flow raises when it cannot be followed (:data:`FLOW_FAILURES`: a singular
     step, a loop of stuck elements, values beyond double precision)."""
-    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
-        return tuple(dict.fromkeys((RattleError, *FLOW_FAILURES)))
-    return (RattleError,)
+    return FLOW_FAILURES if isinstance(model, (NonsmoothSystem, FrictionSystem)) else (RattleError,)
 
 
 def _reason(exc: BaseException) -> str:

@@ -18,11 +18,18 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from .._validate import check_omega, check_shooting
+from ..errors import RattleError
 from ..model import Model
 from ._exact import ExactIntegrator, Trajectory
 
 _MAX_HALVINGS = 12
 
+
+
+#: What an exact flow or its shooting raises when it cannot follow the motion (the event budget
+#: of a chatter, a loop of stuck elements, a singular step; numpy's LinAlgError is a ValueError):
+#: the callers then report the orbit or row as not found instead of stopping.
+FLOW_FAILURES: tuple[type[Exception], ...] = (RattleError, ValueError, ArithmeticError)
 
 
 def monodromy_multipliers(M: FloatArray) -> ComplexArray:
