@@ -1,4 +1,5 @@
-"""Cases shared by the tests: the reference clutch as TOML, the chain with a lock-up clutch."""
+"""Cases shared by the tests: the reference clutch and the torque converter's preloaded spring as
+TOML, the chain with a lock-up clutch."""
 
 from __future__ import annotations
 
@@ -40,3 +41,27 @@ amplitudes = [0.03]
 omega = [{omega[0]!r}, {omega[1]!r}]
 harmonics = {harmonics}
 """
+
+
+def preload_spring_toml(omega: tuple[float, float], harmonics: int | None = None) -> str:
+    """The torque converter's preloaded spring (T_p = 0.03) with friction r = 0.02, K = I = 1,
+    C = 0.05, F = 0.05 + 0.03 cos Ωt, as a configuration file over ``omega`` (with ``harmonics``
+    when given): it sticks part of every period at Ω = 0.5 … 0.7."""
+    lines = f"omega = [{omega[0]!r}, {omega[1]!r}]\n" + ("" if harmonics is None else f"harmonics = {harmonics}\n")
+    return f"""\
+[model]
+inertia = 1.0
+damping = 0.05
+stiffness = 1.0
+
+[model.elastic]
+type = "preload"
+preload = 0.03
+friction = 0.02
+
+[excitation]
+mean = 0.05
+amplitudes = [0.03]
+
+[analysis]
+{lines}"""

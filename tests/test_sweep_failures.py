@@ -20,6 +20,8 @@ from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Pr
 from rattle.results._sweep import FAILED_PERIOD, SWEEP_FAILED
 from rattle.timeint import NonsmoothIntegrator, NonsmoothOptions
 
+from _cases import preload_spring_toml  # tests/ is on sys.path through its conftest
+
 #: A budget of switching events per integration small enough that the sticking orbits below
 #: Ω ≈ 1 (seven switchings a period, more on the way there) exhaust it, and large enough for the
 #: orbits above (four a period).
@@ -192,24 +194,7 @@ def test_the_files_and_the_plot_cope_with_failed_rows(small_budget, tmp_path):
     plt.close(fig)
 
 
-_CONFIG = """
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "preload"
-preload = 0.03
-friction = 0.02
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.3, 3.0]
-"""
+_CONFIG = preload_spring_toml((0.3, 3.0))
 
 
 def test_the_command_writes_its_files_names_the_failures_and_exits_1(small_budget, tmp_path):

@@ -12,6 +12,7 @@ import json
 import numpy as np
 import pytest
 
+from _cases import preload_spring_toml
 from _cli_helpers import PNG, assert_bad_input, invoke, write_config
 from test_cli_chain_friction import CHAIN as FRICTION_CHAIN
 from rattle.io import load_config, read_csv
@@ -19,25 +20,7 @@ from rattle.timeint import shoot_friction_orbit, shoot_nonsmooth_orbit
 
 #: The torque converter's preloaded spring (T_p = 0.03) with friction r = 0.02: at Ω = 0.5 … 0.7
 #: it sticks part of every period.
-PRELOAD = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "preload"
-preload = 0.03
-friction = 0.02
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.5, 0.7]
-harmonics = 32
-"""
+PRELOAD = preload_spring_toml((0.5, 0.7), harmonics=32)
 
 #: test_cli_chain_friction.py's chain (two inertias, a clutch with friction on its idle stage) over
 #: Ω = 0.55 … 0.65.
