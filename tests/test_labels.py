@@ -86,6 +86,22 @@ def test_no_stable_periodic_only_with_subharmonics_computed_and_the_simulation_a
     assert d.kind == "no_stable_computed" and "period 4" in d.label
 
 
+def test_a_failed_sweep_frequency_adds_no_period_to_a_label():
+    """A sweep row whose steady state failed (period −1) saw nothing: it is counted, never said."""
+    guessed = Region("unstable_period_doubling", 1.0, 2.0, "period-1 unstable (period doubling): …",
+                     {"subharmonics_computed": False, "period": 1})
+    computed = Region("no_stable_computed", 1.0, 2.0, "no stable orbit of period ≤ 4 computed",
+                      {"subharmonics_computed": True, "max_period": 4})
+    (a,) = confirm_with_sweep((guessed,), _sweep([1.2, 1.5, 1.8], [-1, 2, -1]))
+    assert "simulation: period 2 " in a.label and "period -1" not in a.label
+    assert a.detail["sweep_periods"] == [2] and a.detail["sweep_failed"] == 2
+    (b,) = confirm_with_sweep((computed,), _sweep([1.2, 1.5], [-1, -1]))  # nothing seen: nothing said
+    assert b.kind == "no_stable_computed" and b.label == computed.label
+    assert b.detail["sweep_periods"] == [] and b.detail["sweep_failed"] == 2
+    (c,) = confirm_with_sweep((computed,), _sweep([1.2, 1.5, 3.0], [0, 0, -1]))  # the failure lies outside
+    assert c.kind == "no_stable_periodic" and "sweep_failed" not in c.detail
+
+
 def test_cli_frf_prints_no_false_label(tmp_path):
 
     from _cli_helpers import invoke, write_config

@@ -202,12 +202,17 @@ def confirm_with_sweep(regions: tuple[Region, ...], sweep: Any) -> tuple[Region,
     Only an interval whose sub-harmonics were computed (``no_stable_computed``) and where the
     simulation found no period ≤ 8 (period 0) becomes ``no_stable_periodic``, "no stable
     periodic solution (quasi-periodic or chaotic)"; without sub-harmonics computed the label
-    keeps saying so."""
+    keeps saying so. A sweep frequency whose steady state failed (period −1) tells nothing about
+    the attractors: it is left out of the periods and counted in ``detail["sweep_failed"]``."""
     out = []
+    period = np.asarray(sweep.period)
+    failed = period < 0  # a frequency whose steady state failed (period −1) saw nothing
     for r in regions:
         inside = (sweep.omega >= r.omega_min) & (sweep.omega <= r.omega_max)
-        periods = sorted(set(int(p) for p in sweep.period[inside]))
+        periods = sorted(set(int(p) for p in period[inside & ~failed]))
         detail = dict(r.detail, sweep_periods=periods)
+        if np.any(inside & failed):
+            detail["sweep_failed"] = int(np.sum(inside & failed))
         label, kind = r.label, r.kind
         if kind in UNSTABLE_KINDS and periods:
             if periods == [0] and kind in ("no_stable_computed", "no_stable_periodic"):
