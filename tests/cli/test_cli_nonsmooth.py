@@ -103,15 +103,11 @@ def test_commands_that_cannot_solve_the_law_refuse_it_and_write_nothing(tmp_path
     assert not (tmp_path / "out").exists()
 
 
-def test_a_bad_friction_list_and_subharmonics_are_refused_with_nothing_written(tmp_path):
+def test_a_bad_friction_list_is_refused_with_nothing_written(tmp_path):
     config = write_config(tmp_path, PRELOAD.replace("friction = 0.02", "friction = [0.02, 0.0, 0.02]"))
     result = invoke(["frf", str(config), "-o", "out"], tmp_path)
     assert_bad_input(result, "`model.elastic.friction` must hold one level", 'type = "preload" has 2 stages',
                      "got 3 levels")
-    assert not (tmp_path / "out").exists()
-    config = write_config(tmp_path, PRELOAD)
-    result = invoke(["frf", str(config), "--subharmonics", "-o", "out"], tmp_path)
-    assert_bad_input(result, "`--subharmonics`", "discontinuous law")
     assert not (tmp_path / "out").exists()
     config = write_config(tmp_path, PRELOAD.replace("preload = 0.05\nfriction = 0.02", "preload = 0.0")
                           .replace("harmonics = 32", "harmonics = 32\nregularisation = 0.01"))
@@ -188,3 +184,54 @@ def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkey
     assert "were written to" in result.stderr and "frf.csv" in result.stderr
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["frf.csv", "frf.json", "frf.png"]
     assert json.loads((tmp_path / "out" / "frf.json").read_text())["status"] == "max_steps"
+
+
+#: The torque converter's preloaded spring (examples/torque_converter_preload.toml) around its
+#: period doublings at Ω ≈ 0.545 and 0.562.
+TORQUE_CONVERTER = """\
+[model]
+inertia = 1.0
+damping = 0.05
+stiffness = 1.0
+
+[model.elastic]
+type = "preload"
+preload = 0.03
+
+[excitation]
+mean = 0.05
+amplitudes = [0.03]
+
+[analysis]
+omega = [0.53, 0.575]
+harmonics = 64
+"""
+
+
+def test_frf_subharmonics_writes_the_period_two_branch_with_the_primary(tmp_path):
+    config = write_config(tmp_path, TORQUE_CONVERTER)
+    result = invoke(["frf", str(config), "--subharmonics", "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    table = read_csv(tmp_path / "out" / "frf.csv")
+    branch, period = np.asarray(table["branch"]), np.asarray(table["period"])
+    assert set(branch.tolist()) == {0, 1}
+    assert np.all(period[branch == 0] == 1) and np.all(period[branch == 1] == 2)
+    assert np.all(np.diff(np.flatnonzero(branch == 1)) == 1)  # the primary's rows first, then the branch's
+    two = branch == 1
+    matched = np.asarray(table["matched"], dtype=bool)
+    assert np.any(two & matched & np.asarray(table["stable"], dtype=bool))
+    meta = json.loads((tmp_path / "out" / "frf.json").read_text())
+    (b,) = meta["branches"]
+    assert b["branch"] == 1 and b["period"] == 2 and b["points"] == int(two.sum())
+    assert b["matched"] == int((two & matched).sum()) and b["stable"] > 0 and b["rms_error_max"] < 0.005
+    assert meta["options"]["subharmonics"] is True
+    assert "branch 1 (period 2" in result.stdout and "stable over Ω" in result.stdout
+
+
+def test_frf_without_subharmonics_points_to_them_at_a_period_doubling(tmp_path):
+    config = write_config(tmp_path, TORQUE_CONVERTER)
+    result = invoke(["frf", str(config), "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    assert "run with --subharmonics" in result.stdout
+    assert set(np.asarray(read_csv(tmp_path / "out" / "frf.csv")["branch"]).tolist()) == {0}
+    assert json.loads((tmp_path / "out" / "frf.json").read_text())["branches"] == []

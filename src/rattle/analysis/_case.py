@@ -73,7 +73,8 @@ class Case:
         For a discontinuous law, or a chain with friction on its elements:
         :func:`rattle.analysis.nonsmooth_response` over the file's range with
         :meth:`regularisation_options` (keywords ``omega``, ``options``, ``continuation``,
-        ``newton`` override)."""
+        ``newton``, ``subharmonics`` override; ``subharmonics=True`` follows the period-2 branches
+        of a one-equation law)."""
         if self.discontinuous:
             kw: dict[str, Any] = {"omega": self.analysis.omega, "options": self.regularisation_options(), **options}
             return nonsmooth_response(self.model, **kw)  # type: ignore[arg-type]

@@ -47,6 +47,7 @@ refined, found once per row: a row checked at the limit and then refined shares 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 
@@ -54,7 +55,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_range
-from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
+from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, NewtonOptions, solve_fixed
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
@@ -62,6 +63,7 @@ from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
+from ._branches import odd_indices
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -77,11 +79,12 @@ def _rms(q: FloatArray, H: int) -> float:
     return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
 
 
-def _hb_flow(integ: NonsmoothIntegrator, state: tuple[float, float], omega: float) -> NonsmoothTrajectory | None:
-    """One period of the exact flow from ``state`` (the HB orbit's at t = 0); None when it cannot
-    be followed (the event budget of a chattering flow)."""
+def _hb_flow(integ: NonsmoothIntegrator, state: tuple[float, float], omega: float,
+             period: int = 1) -> NonsmoothTrajectory | None:
+    """One period p 2π/Ω of the exact flow from ``state`` (the HB orbit's at t = 0); None when it
+    cannot be followed (the event budget of a chattering flow)."""
     try:
-        return integ.propagate(np.asarray(state, dtype=float), 0.0, 2.0 * math.pi / omega, omega)
+        return integ.propagate(np.asarray(state, dtype=float), 0.0, period * 2.0 * math.pi / omega, omega)
     except FLOW_FAILURES:
         return None
 
@@ -107,9 +110,31 @@ def _hb_multipliers(problem: RegularisedBalance, flow: NonsmoothTrajectory | Non
 def _departure(problem: RegularisedBalance, q: FloatArray, omega: float, traj: NonsmoothTrajectory,
                scale: float) -> float:
     """The largest departure of the exact δ(t) on ``traj`` from the HB orbit ``q`` of ``problem``
-    on :data:`MATCH_SAMPLES` samples of the period, relative to ``scale``."""
-    t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / omega / MATCH_SAMPLES)
-    return float(np.max(np.abs(traj.sample(t)[0] - problem.basis.evaluate(q, omega, t)))) / scale
+    (period p = ``problem.period``) on :data:`MATCH_SAMPLES` samples of its period p 2π/Ω,
+    relative to ``scale``."""
+    p = problem.period
+    t = np.arange(MATCH_SAMPLES) * (p * 2.0 * math.pi / omega / MATCH_SAMPLES)
+    return float(np.max(np.abs(traj.sample(t)[0] - problem.basis.evaluate(q, omega / p, t)))) / scale
+
+
+#: An exact orbit shot over p forcing periods repeats after fewer when δ comes back within this
+#: share of its peak-to-peak (the shooting converges to 1e-12 of the length scale).
+REPEAT_TOL = 1e-7
+
+
+def _repeats_early(orbit: NonsmoothOrbit, omega: float, period: int) -> bool:
+    """Whether the exact ``orbit`` of ``period`` forcing periods repeats after a divisor d < p of
+    them (δ and δ' back within :data:`REPEAT_TOL` of its peak-to-peak): near the ends of a
+    sub-harmonic branch, where the exact period doubling lies on the other side of the row, the
+    shooting lands on the period-1 orbit run p times."""
+    T = 2.0 * math.pi / omega
+    size = max(float(np.ptp(orbit.trajectory.sample(np.linspace(0.0, period * T, 64 * period + 1))[0])), 1e-300)
+    for k in range(1, period):
+        if period % k == 0:
+            d, v = orbit.trajectory.sample(np.array([0.0, k * T]))[:2]
+            if max(abs(float(d[1] - d[0])), abs(float(v[1] - v[0])) / omega) <= REPEAT_TOL * size:
+                return True
+    return False
 
 
 def _holds(flow: NonsmoothTrajectory | None, orbit: NonsmoothOrbit | None) -> bool:
@@ -128,7 +153,7 @@ def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: No
     pb = make(last.eps, last.harmonics)
     d0, v0 = (float(a[0]) for a in pb.samples(last.q, omega))
     try:
-        orbit = shoot_nonsmooth_orbit(system, omega, (d0, v0), integrator=integ, max_iterations=30)
+        orbit = shoot_nonsmooth_orbit(system, omega, (d0, v0), period=pb.period, integrator=integ, max_iterations=30)
     except FLOW_FAILURES:
         return None
     if not orbit.converged:
@@ -151,11 +176,12 @@ def _ladder_step(make: Callable[[float, int], RegularisedBalance], lad: Regulari
                  L: float) -> float:
     """The largest change of δ(t) between two successive rungs of ``lad`` on :data:`MATCH_SAMPLES`
     samples of the period, relative to the earlier rung's peak-to-peak."""
-    t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / omega / MATCH_SAMPLES)
+    p = make(lad.last.eps, lad.last.harmonics).period
+    t = np.arange(MATCH_SAMPLES) * (p * 2.0 * math.pi / omega / MATCH_SAMPLES)
     prev: FloatArray | None = None
     worst = 0.0
     for step in lad.steps:
-        d = make(step.eps, step.harmonics).basis.evaluate(step.q, omega, t)
+        d = make(step.eps, step.harmonics).basis.evaluate(step.q, omega / p, t)
         if prev is not None:
             worst = max(worst, float(np.max(np.abs(d - prev))) / max(float(np.ptp(prev)), 1e-12 * L))
         prev = d
@@ -175,16 +201,16 @@ def _deeper(make: Callable[[float, int], RegularisedBalance], lad: Regularisatio
     return RegularisationLimit(omega=lad.omega, steps=lad.steps + more.steps[1:])
 
 
-def balance_factory(system: NonsmoothSystem) -> Callable[[float, int], RegularisedBalance]:
-    """``make(ε, H)``: the regularised HB of ``system`` at relative width ε with H harmonics, on
-    the scales every front end uses (the law's length scale L, ω_n = √(k s_max))."""
+def balance_factory(system: NonsmoothSystem, period: int = 1) -> Callable[[float, int], RegularisedBalance]:
+    """``make(ε, H)``: the regularised HB of ``system`` at relative width ε with H harmonics of
+    Ω/``period``, on the scales every front end uses (the law's length scale L, ω_n = √(k s_max))."""
     exc = system.excitation
     L = system.length_scale()
     wn = math.sqrt(system.k * float(np.max(system.law.stages.slopes)))
 
     def make(eps: float, H: int) -> RegularisedBalance:
         return RegularisedBalance(system.c, system, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
-                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))
+                                  length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H), period=period)
 
     return make
 
@@ -196,12 +222,20 @@ def nonsmooth_response(
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
+    subharmonics: bool = False,
 ) -> NonsmoothResponse | FrictionResponse:
     """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring), with
-    the settings ``options`` (:class:`RegularisationOptions`). A chain with friction
-    (:class:`~rattle.model.FrictionSystem`) goes to
-    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`)."""
+    the settings ``options`` (:class:`RegularisationOptions`); with ``subharmonics`` also the
+    period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
+    ``branches``. A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
+    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`;
+    its period-1 branch only)."""
+    if not isinstance(subharmonics, bool):
+        raise TypeError(f"`subharmonics` must be True or False, got {subharmonics!r}")
     if isinstance(system, FrictionSystem):
+        if subharmonics:
+            raise ValueError("`subharmonics` is not supported for a chain with friction or jumps on its elements "
+                             "yet: only its period-1 branch is followed; leave `subharmonics` out")
         from ._friction_response import friction_response
 
         return friction_response(system, omega, options, continuation=continuation, newton=newton)
@@ -212,10 +246,8 @@ def nonsmooth_response(
     opts = RegularisationOptions() if options is None else options
     if not isinstance(opts, RegularisationOptions):
         raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
-    harmonics, regularisation, match = opts.harmonics, opts.regularisation, opts.match
-    limit, limit_eps, limit_harmonics, refine = opts.limit, opts.limit_eps, opts.limit_harmonics, opts.refine
+    harmonics, regularisation = opts.harmonics, opts.regularisation
     make = balance_factory(system)
-    L = system.length_scale()
     problem = make(regularisation, harmonics)
     # the start: solved where the steps are wide (ε = 0.1), then narrowed to ε by homotopy
     start = regularisation_limit(make, lo, np.zeros(problem.size), eps_start=max(0.1, regularisation),
@@ -225,9 +257,74 @@ def nonsmooth_response(
                                   options=continuation or ContinuationOptions(),
                                   newton=newton or NewtonOptions())
     points = stepper.run()
+    primary = _check_branch(system, make, opts, points, stepper.status or Status.SUCCESS, stepper.message)
+    if subharmonics:
+        branches = nonsmooth_subharmonics(system, primary, (lo, hi), opts, continuation=continuation, newton=newton)
+        primary = dataclasses.replace(primary, branches=branches)
+    return primary
+
+
+_ROW_KEYS = ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched", "mean", "p2p", "acc_p2p",
+             "regime", "sticks", "crossings", "state")
+
+
+def _add_row(rows: dict[str, list], orbit: NonsmoothOrbit | None, mu_hb: np.ndarray) -> None:
+    """Append the exact ``orbit``'s measures to ``rows`` (its stability, switching pattern and
+    state at t = 0), or, without one, nan and the HB orbit's multipliers ``mu_hb``."""
+    if orbit is not None:
+        d_lo, d_hi, a_lo, a_hi = orbit.trajectory.extremes()
+        rows["rms"].append(orbit.rms)
+        rows["mean"].append(orbit.mean)
+        rows["p2p"].append(d_hi - d_lo)
+        rows["acc_p2p"].append(a_hi - a_lo)
+        rows["regime"].append(orbit.regime)
+        rows["mult"].append(np.asarray(orbit.multipliers, dtype=complex)[:2])
+        rows["stable"].append(bool(orbit.stable))
+        rows["stick"].append(float(orbit.trajectory.stick_time))
+        kinds = orbit.trajectory.event_kind  # the switching pattern: held phases and crossings per period
+        rows["sticks"].append(sum(k in ("stick", "lock") for k in kinds))
+        rows["crossings"].append(sum(k == "crossing" for k in kinds))
+        rows["state"].append(np.asarray(orbit.state0, dtype=float))
+        return
+    rows["state"].append(np.full(2, np.nan))
+    rows["sticks"].append(-1)
+    rows["crossings"].append(-1)
+    for key in ("rms", "mean", "p2p", "acc_p2p", "stick"):
+        rows[key].append(math.nan)
+    rows["regime"].append("")
+    rows["mult"].append(mu_hb)
+    rows["stable"].append(bool(np.all(np.abs(mu_hb) < 1.0)))
+
+
+def _response(rows: dict[str, list], **fields: object) -> NonsmoothResponse:
+    """The :class:`NonsmoothResponse` of the collected ``rows`` and the other ``fields``."""
+    rms, mean = np.array(rows["rms"], dtype=float), np.array(rows["mean"], dtype=float)
+    return NonsmoothResponse(
+        omega=np.array(rows["omega"], dtype=float), rms_hb=np.array(rows["rms_hb"], dtype=float), mean=mean, rms=rms,
+        rms_ac=np.sqrt(np.maximum(rms**2 - mean**2, 0.0)), p2p=np.array(rows["p2p"], dtype=float),
+        acc_p2p=np.array(rows["acc_p2p"], dtype=float), regime=np.array(rows["regime"], dtype=object),
+        stable=np.array(rows["stable"], dtype=bool), multipliers=np.array(rows["mult"], dtype=complex).reshape(-1, 2),
+        multipliers_hb=np.array(rows["mult_hb"], dtype=complex).reshape(-1, 2),
+        stick_time=np.array(rows["stick"], dtype=float), sticks=np.array(rows["sticks"], dtype=np.int64),
+        crossings=np.array(rows["crossings"], dtype=np.int64), matched=np.array(rows["matched"], dtype=bool),
+        states=np.array(rows["state"], dtype=float).reshape(-1, 2), **fields,  # type: ignore[arg-type]
+    )
+
+
+def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], RegularisedBalance],
+                  opts: RegularisationOptions, points: list[BranchPoint], status: Status, message: str, *,
+                  branch: int = 0, origin: str = "") -> NonsmoothResponse:
+    """Steps 2–4 of the module docstring on the continued ``points`` of one branch (of the period
+    p of ``make``'s problems: the exact orbits are shot over p forcing periods)."""
+    harmonics, regularisation, match = opts.harmonics, opts.regularisation, opts.match
+    limit, limit_eps, limit_harmonics, refine = opts.limit, opts.limit_eps, opts.limit_harmonics, opts.refine
+    if points:
+        harmonics = points[0].q.size // 2
+    problem = make(regularisation, harmonics)
+    period = problem.period
+    L = system.length_scale()
     integ = NonsmoothIntegrator(system)
-    rows: dict[str, list] = {k: [] for k in ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched",
-                                             "mean", "p2p", "acc_p2p", "regime", "sticks", "crossings")}
+    rows: dict[str, list] = {k: [] for k in _ROW_KEYS}
     ladders: dict[int, RegularisationLimit | None] = {}  # row: its ladder (None: it stalled)
 
     def _row_ladder(i: int) -> RegularisationLimit | None:
@@ -246,12 +343,12 @@ def nonsmooth_response(
         w, q = float(pt.omega), pt.q
         rms_hb = _rms(q, harmonics)
         d0, v0 = (float(a[0]) for a in problem.samples(q, w))
-        flow = _hb_flow(integ, (d0, v0), w) if opts.stability == "saltation" else None
+        flow = _hb_flow(integ, (d0, v0), w, period) if opts.stability == "saltation" else None
         mu_hb = _hb_multipliers(problem, flow, q, w, opts.stability)
         size = max(float(np.ptp(problem.basis.synthesize(q))), 1e-12 * L)
         orbit = None
         try:
-            orbit = shoot_nonsmooth_orbit(system, w, (d0, v0), integrator=integ, max_iterations=30)
+            orbit = shoot_nonsmooth_orbit(system, w, (d0, v0), period=period, integrator=integ, max_iterations=30)
         except FLOW_FAILURES:  # e.g. the event budget of a chattering orbit
             orbit = None
         shot_failed = orbit is None or not orbit.converged
@@ -260,7 +357,7 @@ def nonsmooth_response(
             ok = _departure(problem, q, w, orbit.trajectory, size) <= match
         if not ok:
             if flow is None and opts.stability != "saltation":
-                flow = _hb_flow(integ, (d0, v0), w)
+                flow = _hb_flow(integ, (d0, v0), w, period)
             if shot_failed or _holds(flow, orbit):
                 # the shooting from the HB at ε failed (outside Newton's reach of the exact orbit), or
                 # δ sticks or locks part of the period, which the HB at ε resolves only to the steps'
@@ -270,31 +367,13 @@ def nonsmooth_response(
                 found = None if lad is None else _match_at_limit(make, system, integ, w, lad, L)
                 if found is not None and found[1] <= match:
                     orbit, ok = found[0], True
+        if ok and period > 1 and _repeats_early(orbit, w, period):
+            ok = False  # the exact orbit there is of a lower period: no exact counterpart of this one
         rows["omega"].append(w)
         rows["rms_hb"].append(rms_hb)
         rows["mult_hb"].append(mu_hb)
         rows["matched"].append(ok)
-        if ok:
-            d_lo, d_hi, a_lo, a_hi = orbit.trajectory.extremes()
-            rows["rms"].append(orbit.rms)
-            rows["mean"].append(orbit.mean)
-            rows["p2p"].append(d_hi - d_lo)
-            rows["acc_p2p"].append(a_hi - a_lo)
-            rows["regime"].append(orbit.regime)
-            rows["mult"].append(np.asarray(orbit.multipliers, dtype=complex)[:2])
-            rows["stable"].append(bool(orbit.stable))
-            rows["stick"].append(float(orbit.trajectory.stick_time))
-            kinds = orbit.trajectory.event_kind  # the switching pattern: held phases and crossings per period
-            rows["sticks"].append(sum(k in ("stick", "lock") for k in kinds))
-            rows["crossings"].append(sum(k == "crossing" for k in kinds))
-        else:
-            rows["sticks"].append(-1)
-            rows["crossings"].append(-1)
-            for key in ("rms", "mean", "p2p", "acc_p2p", "stick"):
-                rows[key].append(math.nan)
-            rows["regime"].append("")
-            rows["mult"].append(mu_hb)
-            rows["stable"].append(bool(np.all(np.abs(mu_hb) < 1.0)))
+        _add_row(rows, orbit if ok else None, mu_hb)
     rms = np.array(rows["rms"])
     rms_hb = np.array(rows["rms_hb"])
     matched = np.array(rows["matched"], dtype=bool)
@@ -322,19 +401,196 @@ def nonsmooth_response(
             lim_rms.append(math.nan)
             lim_rich.append(math.nan)
             lim_lin.append(False)
-    mean = np.array(rows["mean"])
-    return NonsmoothResponse(
-        omega=np.array(rows["omega"]), rms_hb=rms_hb, mean=mean, rms=rms,
-        rms_ac=np.sqrt(np.maximum(rms**2 - mean**2, 0.0)), p2p=np.array(rows["p2p"]),
-        acc_p2p=np.array(rows["acc_p2p"]), regime=np.array(rows["regime"], dtype=object),
-        stable=np.array(rows["stable"], dtype=bool), multipliers=np.array(rows["mult"]).reshape(-1, 2),
-        multipliers_hb=np.array(rows["mult_hb"]).reshape(-1, 2), stick_time=np.array(rows["stick"]),
-        sticks=np.array(rows["sticks"], dtype=np.int64), crossings=np.array(rows["crossings"], dtype=np.int64),
-        matched=matched, status=stepper.status or Status.SUCCESS,
-        message=stepper.message, regularisation=float(regularisation), harmonics=int(harmonics),
-        limit_index=np.asarray(pick, dtype=int), limit_eps=np.array(lim_eps), limit_rms=np.array(lim_rms),
-        limit_richardson=np.array(lim_rich), limit_linear=np.array(lim_lin, dtype=bool),
+    return _response(
+        rows, status=status, message=message, regularisation=float(regularisation), harmonics=int(harmonics),
+        period=int(period), branch=int(branch), origin=origin, limit_index=np.asarray(pick, dtype=int),
+        limit_eps=np.array(lim_eps), limit_rms=np.array(lim_rms), limit_richardson=np.array(lim_rich),
+        limit_linear=np.array(lim_lin, dtype=bool),
     )
 
 
-__all__ = ["NonsmoothResponse", "RegularisationOptions", "nonsmooth_response"]
+#: A period-2 orbit counts as one (not the period-1 orbit run twice) while its odd harmonics of
+#: Ω/2 carry at least this share of δ's fluctuation (rms); a branch that falls below it has
+#: rejoined a period-1 branch.
+ODD_SHARE = 1e-4
+
+
+def _odd_share(q: FloatArray) -> float:
+    """‖odd harmonics‖ / ‖all harmonics‖ of a series of Ω/2 (0 for a period-1 orbit)."""
+    H = (q.size - 1) // 2
+    odd = odd_indices(H)
+    total = float(np.linalg.norm(q[1:]))
+    return float(np.linalg.norm(q[odd])) / total if total > 0 else 0.0
+
+
+def _period_two_orbit(system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float,
+                      state: FloatArray) -> NonsmoothOrbit | None:
+    """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``, one
+    of whose multipliers lies near −1: shot over two forcing periods from the period-1 state pushed
+    along that multiplier's eigenvector, by 2 %, 10 % and 30 % of the orbit's peak-to-peak, either
+    way; None when every shot converges back to the period-1 orbit or fails."""
+    try:
+        one = shoot_nonsmooth_orbit(system, omega, state, integrator=integ, max_iterations=30)
+    except FLOW_FAILURES:
+        return None
+    if not one.converged:
+        return None
+    mu, vec = np.linalg.eig(np.asarray(one.monodromy, dtype=float))
+    negative = [k for k in range(mu.size) if mu[k].real < 0.0 and abs(mu[k].imag) <= 1e-9 * max(1.0, abs(mu[k]))]
+    if not negative:
+        return None
+    k = min(negative, key=lambda k: abs(mu[k].real + 1.0))
+    scale = np.array([system.length_scale(), integ.velocity_scale(omega)])
+    v = np.real(vec[:, k]) / scale
+    v = v / np.linalg.norm(v) * scale  # unit length in the scaled state
+    size = max(float(np.ptp(one.trajectory.sample(np.linspace(0.0, 2.0 * math.pi / omega, 65))[0])),
+               1e-12 * system.length_scale())
+    z1 = np.asarray(one.state0, dtype=float)
+    for amp in (0.02, 0.1, 0.3):
+        for sign in (1.0, -1.0):
+            z0 = z1 + sign * amp * size / system.length_scale() * v
+            try:
+                two = shoot_nonsmooth_orbit(system, omega, z0, period=2, integrator=integ, max_iterations=40)
+            except FLOW_FAILURES:
+                continue
+            if not two.converged:
+                continue
+            T = 2.0 * math.pi / omega
+            d = two.trajectory.sample(np.array([0.0, T]))[0]
+            if abs(float(d[1] - d[0])) > 1e-3 * size:  # not the period-1 orbit run twice
+                return two
+    return None
+
+
+def _period_two_start(make2: Callable[[float, int], RegularisedBalance], orbit: NonsmoothOrbit, omega: float,
+                      eps: float, H2: int, newton: NewtonOptions | None) -> FloatArray | None:
+    """The regularised period-2 HB orbit (H2 harmonics of Ω/2) at ε next to the exact period-2
+    ``orbit``: Newton from the exact orbit's spectrum, else the homotopy in ε from wider steps; None
+    when neither converges to an orbit of period 2 (:data:`ODD_SHARE`)."""
+    pb = make2(eps, H2)
+    N = pb.basis.samples
+    t = np.arange(N) * (2.0 * 2.0 * math.pi / omega / N)
+    q0 = pb.basis.analyze(orbit.trajectory.sample(t)[0])
+    res = solve_fixed(pb, q0, omega, newton or NewtonOptions())
+    if res.converged and _odd_share(res.q) >= 100 * ODD_SHARE:
+        return res.q
+    for wide in (4.0 * eps, 10.0 * eps):
+        try:
+            q = regularisation_limit(make2, omega, q0, eps_start=min(wide, 0.3), eps_min=eps, harmonics=H2,
+                                     max_harmonics=H2, tail_tol=math.inf, newton=newton).last.q
+        except RattleError:
+            continue
+        if _odd_share(q) >= 100 * ODD_SHARE:
+            return q
+    return None
+
+
+def _follow_both_ways(problem: RegularisedBalance, q: FloatArray, omega: float, lo: float, hi: float,
+                      continuation: ContinuationOptions | None,
+                      newton: NewtonOptions | None) -> tuple[list[BranchPoint], Status, str]:
+    """The period-2 branch through (q, Ω) continued down to ``lo`` and up to ``hi``, each way until
+    it rejoins a period-1 branch (its odd harmonics fall below :data:`ODD_SHARE` of the
+    fluctuation, or change sign) or leaves the range: the points in order of the branch."""
+    parts: list[list[BranchPoint]] = []
+    ends: list[str] = []
+    status = Status.SUCCESS
+    for rng in ((lo, omega), (omega, hi)):
+        if rng[1] - rng[0] <= 1e-9 * hi:
+            parts.append([])
+            continue
+        odd = odd_indices((q.size - 1) // 2)
+        prev = {"odd": q[odd].copy()}
+
+        def rejoined(pt: BranchPoint, prev: dict = prev, odd: np.ndarray = odd) -> str | None:
+            o = pt.q[odd]
+            flipped = float(o @ prev["odd"]) < 0.0
+            prev["odd"] = o.copy()
+            if flipped or _odd_share(pt.q) < ODD_SHARE:
+                return f"the period-2 branch rejoined a period-1 branch near Ω = {pt.omega:.6g}"
+            return None
+
+        stepper = ContinuationStepper(problem, q, omega, rng, options=continuation or ContinuationOptions(),
+                                      newton=newton or NewtonOptions(), stop=rejoined)
+        pts = stepper.run()
+        if stepper.status is Status.STOPPED and pts:
+            pts = pts[:-1]  # the point past the rejoin is the period-1 orbit written twice
+        parts.append(pts)
+        if stepper.message:
+            ends.append(stepper.message)
+        if stepper.status not in (Status.SUCCESS, Status.STOPPED, None):
+            status = stepper.status
+    down, up = parts
+    points = list(reversed(down[1:])) + up if up else list(reversed(down))
+    return points, status, "; ".join(ends)
+
+
+def nonsmooth_subharmonics(
+    system: NonsmoothSystem,
+    primary: NonsmoothResponse,
+    omega: tuple[float, float],
+    options: RegularisationOptions | None = None,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+) -> tuple[NonsmoothResponse, ...]:
+    """The period-2 branches born at the period doublings of the period-1 branch ``primary``
+    (:func:`nonsmooth_response` of ``system`` with the same ``options``) within ``omega``.
+
+    At each period doubling (``primary.bifurcation``, between two matched rows) the exact
+    period-1 orbit on the side where a multiplier lies beyond −1 (else on the other side) is
+    pushed along that multiplier's eigenvector and shot over two forcing periods: the exact
+    period-2 orbit found there seeds the regularised HB of period 2 (2H harmonics of Ω/2, the
+    same resolution in time), which is continued both ways until it rejoins a period-1 branch
+    (its odd harmonics vanish) or leaves the range. Every point is then checked as on the primary
+    branch (steps 2–4 of the module docstring, the exact orbits shot over two forcing periods).
+    A period doubling that lies on a branch already found (its other end) starts none. A
+    doubling where no exact period-2 orbit is found next to it starts none either; the
+    returned branches are what was found, numbered 1, 2, … in order of Ω."""
+    if not isinstance(system, NonsmoothSystem):
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation), got {system!r}")
+    if not isinstance(primary, NonsmoothResponse):
+        raise TypeError(f"`primary` must be the NonsmoothResponse of `system`, got {primary!r}")
+    lo, hi = check_range(omega)
+    opts = RegularisationOptions() if options is None else options
+    if not isinstance(opts, RegularisationOptions):
+        raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
+    make2 = balance_factory(system, period=2)
+    H2 = 2 * opts.harmonics
+    integ = NonsmoothIntegrator(system)
+    matched = np.flatnonzero(primary.matched)
+    kinds = primary.bifurcation
+    spans: list[tuple[float, float]] = []
+    out: list[NonsmoothResponse] = []
+    for a, b in zip(matched[:-1].tolist(), matched[1:].tolist()):
+        if kinds[b] != "period_doubling":
+            continue
+        w_a, w_b = float(primary.omega[a]), float(primary.omega[b])
+        if any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
+            continue  # the other end of a branch already followed
+        beyond = [i for i in (a, b) if np.any((primary.multipliers[i].real < -1.0)
+                                               & (np.abs(primary.multipliers[i].imag) < 1e-9))]
+        order = beyond + [i for i in (a, b) if i not in beyond]
+        seed = None
+        for i in order:
+            seed = _period_two_orbit(system, integ, float(primary.omega[i]), primary.states[i])
+            if seed is not None:
+                w0 = float(primary.omega[i])
+                break
+        if seed is None:
+            continue
+        q2 = _period_two_start(make2, seed, w0, opts.regularisation, H2, newton)
+        if q2 is None:
+            continue
+        points, status, message = _follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
+                                                    continuation, newton)
+        if not points:
+            continue
+        ws = [float(p.omega) for p in points]
+        spans.append((min(ws), max(ws)))
+        out.append(_check_branch(system, make2, opts, points, status, message, branch=len(out) + 1,
+                                 origin=f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} "
+                                        f"and {max(w_a, w_b):.6g}"))
+    return tuple(out)
+
+
+__all__ = ["NonsmoothResponse", "RegularisationOptions", "nonsmooth_response", "nonsmooth_subharmonics"]

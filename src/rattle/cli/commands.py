@@ -205,11 +205,13 @@ def refuse_discontinuous(run_config: Any, command: str) -> None:
         )
 
 
-def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path, sections: dict[str, Any]) -> None:
+def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path, sections: dict[str, Any],
+                      subharmonics: bool = False) -> None:
     """``rattle frf`` on a discontinuous law, or a chain with friction on its elements:
     :func:`rattle.analysis.nonsmooth_response` (a NonsmoothResponse, or a FrictionResponse for the
     chain) with the file's ``[analysis]`` (harmonics, regularisation, refine), written as one set
-    frf.csv, frf.json, frf.png.
+    frf.csv, frf.json, frf.png; with ``subharmonics`` (one equation only) the period-2 branches
+    born at its period doublings too.
 
     Raises
     ------
@@ -225,7 +227,7 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
     logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised harmonic "
                 "balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
                 analysis.omega_max, options.harmonics, options.regularisation)
-    result = nonsmooth_response(run_config.model, analysis.omega, options)
+    result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics)
     timings = {"nonsmooth_response": time.perf_counter() - t_start}
     chain = getattr(run_config, "chain_friction", False)  # a FrictionResponse, one column set per element
     meta = (friction_metadata if chain else nonsmooth_metadata)(result, run_config.model, options, timings)
@@ -234,7 +236,8 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
         ("frf.json", metadata_writer(meta, sections, t_start)),
         ("frf.png", lambda path: save_plot(result, path)),
     ])
-    echo_written((friction_summary if chain else nonsmooth_summary)(result, options), written, output)
+    summary = friction_summary(result, options) if chain else nonsmooth_summary(result, options, subharmonics)
+    echo_written(summary, written, output)
     if not result.status.success:
         raise ConvergenceError(
             f"frequency response incomplete: {result.message or result.status.message}; the points computed "
@@ -262,13 +265,17 @@ def frf_command(
     """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
 
     With --subharmonics every period-doubling point found on the primary branch starts a
-    period-2 branch (and so on, up to period 4); each branch has its colour in frf.png.
+    period-2 branch (and so on, up to period 4); each branch has its colour in frf.png. On a
+    discontinuous law (one equation) the period-2 branches born at the period doublings of the
+    period-1 branch, every point checked by exact shooting over two periods; on a chain with
+    friction or jumps on its elements it is refused.
     """
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
-    if run_config.discontinuous and subharmonics:
-        raise ConfigError(f"`--subharmonics` is not supported for a discontinuous law ({_law_keys(run_config)}) "
-                          "yet: only its period-1 branch is followed; leave --subharmonics out")
+    if getattr(run_config, "chain_friction", False) and subharmonics:
+        raise ConfigError(f"`--subharmonics` is not supported for a chain with friction or jumps on its elements "
+                          f"({_law_keys(run_config)}) yet: only its period-1 branch is followed; leave "
+                          "--subharmonics out")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
@@ -277,7 +284,8 @@ def frf_command(
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None}
     if run_config.discontinuous:
-        run_nonsmooth_frf(run_config, analysis, output, sections("frf", config, run_config, analysis, options))
+        run_nonsmooth_frf(run_config, analysis, output, sections("frf", config, run_config, analysis, options),
+                          subharmonics=subharmonics)
         return
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
             subharmonics=subharmonics, paths=run_config.paths)

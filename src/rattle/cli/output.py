@@ -267,8 +267,41 @@ def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str
         "hb_error_max": _largest(getattr(result, "hb_error", None), matched),
         "bifurcations": [{"kind": str(labels[i]), "index": int(i), "omega": float(result.omega[i])}
                          for i in range(len(result)) if labels[i]],
+        "branches": [_branch_metadata(b) for b in getattr(result, "branches", ())],
         "timings": dict(timings),
     }
+
+
+def _branch_metadata(branch: Any) -> dict[str, Any]:
+    """One sub-harmonic branch of a discontinuous law in ``frf.json``: its number, period, where
+    it was born, how its continuation ended, its rows (all, matched, stable), its Ω range, the
+    HB's largest |rms_error| over the matched rows and its stability changes."""
+    import numpy as np
+
+    matched = np.asarray(branch.matched, dtype=bool)
+    labels = branch.bifurcation
+    return {
+        "branch": int(branch.branch), "period": int(branch.period), "origin": branch.origin,
+        "status": branch.status.name.lower(), "message": branch.message or branch.status.message,
+        "points": len(branch), "matched": int(np.count_nonzero(matched)),
+        "stable": int(np.count_nonzero(matched & np.asarray(branch.stable, dtype=bool))),
+        "omega_min": float(np.min(branch.omega)), "omega_max": float(np.max(branch.omega)),
+        "rms_error_max": _largest(branch.rms_error, matched),
+        "bifurcations": [{"kind": str(labels[i]), "index": int(i), "omega": float(branch.omega[i])}
+                         for i in range(len(branch)) if labels[i]],
+    }
+
+
+def _stable_spans(branch: Any) -> str:
+    """The Ω ranges of a branch's consecutive matched stable rows, as text."""
+    import numpy as np
+
+    ok = np.asarray(branch.matched, dtype=bool) & np.asarray(branch.stable, dtype=bool)
+    idx = np.flatnonzero(ok)
+    if idx.size == 0:
+        return "nowhere"
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    return ", ".join(f"{float(np.min(branch.omega[r])):.5g} … {float(np.max(branch.omega[r])):.5g}" for r in runs)
 
 
 def _largest(values: Any, rows: Any) -> float | None:
@@ -282,8 +315,9 @@ def _largest(values: Any, rows: Any) -> float | None:
     return float(np.max(v)) if v.size else None
 
 
-def nonsmooth_summary(result: Any, options: Any) -> str:
-    """What ``rattle frf`` prints for a discontinuous law."""
+def nonsmooth_summary(result: Any, options: Any, subharmonics: bool = False) -> str:
+    """What ``rattle frf`` prints for a discontinuous law (``subharmonics``: whether the
+    sub-harmonic branches were asked for)."""
     import numpy as np
 
     n = len(result)
@@ -317,6 +351,16 @@ def nonsmooth_summary(result: Any, options: Any) -> str:
     if changes:
         lines.append("bifurcations (between rows; grazing: a crossing or a stick phase appears or vanishes): "
                      + ", ".join(changes))
+    for b in getattr(result, "branches", ()):
+        m = np.asarray(b.matched, dtype=bool)
+        worst = _largest(b.rms_error, m)
+        lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
+                     f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {int(np.count_nonzero(m))} matched by exact "
+                     f"shooting over {b.period} periods; stable over Ω = {_stable_spans(b)}"
+                     + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
+    if "period_doubling" in set(labels.tolist()) and not getattr(result, "branches", ()):
+        lines.append("no period-2 orbit was found next to the period doubling(s)" if subharmonics else
+                     "period doubling found: run with --subharmonics for the period-2 branches born there")
     return "\n".join(lines)
 
 

@@ -5,7 +5,8 @@ dashed where unstable, points the exact shooting did not match left out) and the
 harmonic balance's rms (thin grey), with the labelled changes of stability, and the Ω-ranges where
 the exact orbit sticks or locks for part of the period shaded; bottom panel: the fraction of the
 period the exact orbit sticks (or locks), where the friction holds the clutch, filled in the same
-colour.
+colour. Sub-harmonic branches (``response.branches``) are drawn in their own colours in both
+panels (their stick fraction over their own period).
 
 :func:`nonsmooth_orbit_plot`. One period of one orbit: δ(t) exact with the HB's δ(t) dashed and the
 breakpoints (where the law jumps or its friction changes) as horizontal lines; δ'(t); the phase
@@ -23,6 +24,9 @@ from ._axes import PlotAxes
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import NonsmoothOrbitResult, NonsmoothResponse
+
+#: Colours of the sub-harmonic branches, in order (the period-1 branch is tab:blue).
+_BRANCH_COLOURS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 
 _MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D", "grazing": "^", "grazing_sliding": "v"}
 
@@ -63,6 +67,15 @@ def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]
         sel = labels == kind
         if np.any(sel):
             ax.plot(w[sel], response.rms[sel], marker, color="tab:red", ms=5, ls="none", label=kind.replace("_", " "))
+    for k, br in enumerate(response.branches):  # the sub-harmonic branches, each in its colour
+        colour = _BRANCH_COLOURS[k % len(_BRANCH_COLOURS)]
+        for stable, style in ((True, "-"), (False, "--")):
+            y = np.where(br.matched & (br.stable == stable), br.rms, np.nan)
+            ax.plot(br.omega, y, style, color=colour, lw=1.4,
+                    label=f"branch {br.branch}: period {br.period}, exact" if stable else None)
+        ax.plot(br.omega, br.rms_hb, "-", color="0.6", lw=0.8)
+        fr = np.where(br.matched, br.stick_time / (br.period * 2.0 * np.pi / br.omega), np.nan)
+        ax_s.plot(br.omega, fr, "-", color=colour, lw=1.0)
     held = matched & (np.nan_to_num(response.stick_time) > 0.0)
     for i, (a, b) in enumerate(_held_runs(w, held)):
         ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="exact orbit sticks or locks" if i == 0 else None)

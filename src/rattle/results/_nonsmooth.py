@@ -26,7 +26,7 @@ from ..stability import classify_loss
 from ._plotter import plot_with
 
 #: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
-NONSMOOTH_COLUMNS = ("omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
+NONSMOOTH_COLUMNS = ("branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
                      "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs", "eps_limit", "rms_hb_limit",
                      "rms_hb_extrapolated", "rms_error_limit", "sticks", "crossings")
 
@@ -50,7 +50,14 @@ class NonsmoothResponse:
     ``limit_linear`` whether the ladder's last rungs lie on a line in ε (Richardson's value then
     holds). As columns (nan at the other rows): ``eps_limit``, ``rms_hb_limit``,
     ``rms_hb_extrapolated`` (Richardson's value where linear) and ``rms_error_limit``;
-    :attr:`hb_error` is the error of the HB's ε → 0 estimate on every row."""
+    :attr:`hb_error` is the error of the HB's ε → 0 estimate on every row.
+
+    ``period`` p: the orbits repeat after p forcing periods (1: the primary branch; 2: a
+    sub-harmonic branch born at a period doubling, :func:`rattle.analysis.nonsmooth_subharmonics`);
+    ``branch`` its number (0 the primary), ``origin`` where it was born; ``states`` (P, 2) the
+    exact orbit's (δ, δ') at t = 0 (nan where not matched). The primary branch carries the
+    sub-harmonic ones in ``branches`` (empty unless asked for); :meth:`to_csv` writes them all,
+    the primary's rows first."""
 
     omega: FloatArray
     rms_hb: FloatArray
@@ -76,11 +83,18 @@ class NonsmoothResponse:
     limit_linear: np.ndarray
     sticks: np.ndarray | None = None
     crossings: np.ndarray | None = None
+    period: int = 1
+    branch: int = 0
+    origin: str = ""
+    states: FloatArray | None = None
+    branches: tuple[NonsmoothResponse, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("sticks", "crossings"):  # not given: unknown (-1) on every row
             if getattr(self, name) is None:
                 object.__setattr__(self, name, np.full(self.omega.size, -1, dtype=np.int64))
+        if self.states is None:
+            object.__setattr__(self, "states", np.full((self.omega.size, 2), np.nan))
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -145,6 +159,8 @@ class NonsmoothResponse:
         """The rows as columns :data:`NONSMOOTH_COLUMNS`."""
         mu, mu_hb = np.abs(self.multipliers), np.abs(self.multipliers_hb)
         return {
+            "branch": np.full(len(self), self.branch, dtype=np.int64),
+            "period": np.full(len(self), self.period, dtype=np.int64),
             "omega": self.omega, "mean": self.mean, "rms": self.rms, "rms_ac": self.rms_ac, "p2p": self.p2p,
             "acc_p2p": self.acc_p2p, "regime": self.regime, "stable": self.stable, "bifurcation": self.bifurcation,
             "rms_hb": self.rms_hb, "rms_error": self.rms_error, "matched": self.matched,
@@ -161,12 +177,16 @@ class NonsmoothResponse:
         (figure, PlotAxes). See :func:`rattle.plotting.nonsmooth_response_plot`."""
         return plot_with("nonsmooth_response_plot", self)
 
+    def all_columns(self) -> dict[str, np.ndarray]:
+        """:meth:`columns` of this branch followed by those of each of :attr:`branches`."""
+        parts = [self.columns()] + [b.columns() for b in self.branches]
+        return {k: np.concatenate([np.asarray(p[k]) for p in parts]) for k in NONSMOOTH_COLUMNS}
+
     def to_csv(self, path: str | Path) -> Path:
-        """Write :meth:`columns` to ``path`` atomically."""
+        """Write :meth:`all_columns` (this branch, then its sub-harmonic ones) to ``path`` atomically."""
         from ..files._csv import write_csv
 
-        cols = self.columns()
-        write_csv(path, cols, list(NONSMOOTH_COLUMNS))
+        write_csv(path, self.all_columns(), list(NONSMOOTH_COLUMNS))
         return Path(path)
 
 
