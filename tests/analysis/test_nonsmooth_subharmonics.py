@@ -77,30 +77,34 @@ def test_every_row_is_a_genuine_period_two_orbit(response):
         assert abs(d[2] - d[0]) < 1e-8 * size, (w, d)
 
 
-def test_the_stable_period_two_orbit_is_the_attractor_of_a_long_simulation(response):
-    """Independent of the shooting and the HB: the exact flow started on the unstable period-1
-    orbit, nudged, settles after 300 forcing periods onto the branch's orbit (rms within 1e-6
-    relative, stroboscopic states alternating between the branch's two)."""
-    (br,) = response.branches
-    i = int(np.argmin(np.abs(br.omega - 0.552)))
-    assert br.stable[i]
+def _settles_on(system: NonsmoothSystem, primary, br, i: int) -> None:
+    """The exact flow started on the period-1 orbit next to row ``i`` of ``br``, nudged, settles
+    after 300 forcing periods onto that row's period-2 orbit: its rms within 1e-6 relative, and
+    one of its two stroboscopic states the row's state at t = 0."""
     w = float(br.omega[i])
     T = 2.0 * math.pi / w
-    i1 = int(np.argmin(np.abs(response.omega - w)))
-    z = np.asarray(response.states[i1], dtype=float) + np.array([1e-4, 0.0])
-    if not np.all(np.isfinite(z)):
-        pytest.skip("the period-1 row next to it is not matched")
-    integ = NonsmoothIntegrator(_system())
-    z = integ.propagate(z, 0.0, 300 * T, w).sample(np.array([300 * T]))  # whole periods: the phase is 0 again
-    z = np.array([z[0][0], z[1][0]])
+    i1 = int(np.argmin(np.abs(np.where(primary.matched, primary.omega, np.inf) - w)))
+    z = np.asarray(primary.states[i1], dtype=float) + np.array([1e-4, 0.0])
+    integ = NonsmoothIntegrator(system)
+    end = integ.propagate(z, 0.0, 300 * T, w).sample(np.array([300 * T]))  # whole periods: the phase is 0 again
+    z = np.array([end[0][0], end[1][0]])
     tr = integ.propagate(z, 0.0, 2.0 * T, w)
-    t = np.linspace(0.0, 2.0 * T, 4097)
+    t = np.linspace(0.0, 2.0 * T, 8193)
     d = tr.sample(t)[0]
     rms = math.sqrt(float(np.trapezoid(d * d, t)) / (2.0 * T))
     assert rms == pytest.approx(float(br.rms[i]), rel=1e-6)
-    # one of its stroboscopic states is the branch's state at t = 0 (the other half a cycle on)
-    starts = [z, np.array([x[0] for x in tr.sample(np.array([T]))[:2]])]
-    assert min(np.max(np.abs(s - br.states[i]) / np.array([0.1, 0.1])) for s in starts) < 1e-6
+    half = tr.sample(np.array([T]))
+    starts = [z, np.array([half[0][0], half[1][0]])]
+    assert min(float(np.max(np.abs(s - br.states[i]))) for s in starts) < 1e-7
+
+
+def test_the_stable_period_two_orbit_is_the_attractor_of_a_long_simulation(response):
+    """Independent of the shooting and the HB: a long exact simulation from the unstable period-1
+    orbit ends on the branch's stable period-2 orbit."""
+    (br,) = response.branches
+    i = int(np.argmin(np.abs(br.omega - 0.552)))
+    assert br.stable[i] and br.matched[i]
+    _settles_on(_system(), response, br, i)
 
 
 def test_the_hb_of_period_two_is_within_half_a_percent_where_matched(response):
@@ -130,3 +134,42 @@ def test_without_a_period_doubling_no_branch_is_started():
     res = nonsmooth_response(_system(), (0.8, 0.85), OPTIONS)
     assert "period_doubling" not in set(res.bifurcation.tolist())
     assert nonsmooth_subharmonics(_system(), res, (0.8, 0.85), OPTIONS) == ()
+
+
+def test_where_friction_sticks_the_branch_is_followed_by_exact_shooting():
+    """examples/clutch_friction.toml (friction washers per stage) past its period doubling at
+    Ω ≈ 0.422: its period-2 orbit sticks once per period, and the regularised HB of period 2 at
+    ε = 0.01 has no orbit next to it (Newton from the exact spectrum falls back to period 1), so
+    the branch is followed by exact shooting alone; it is stable and the attractor of a long
+    exact simulation."""
+    from pathlib import Path
+
+    from rattle.analysis._case import regularisation_options
+    from rattle.io import load_config
+
+    cfg = load_config(Path(__file__).parents[2] / "examples" / "clutch_friction.toml")
+    res = nonsmooth_response(cfg.model, (0.418, 0.428), regularisation_options(cfg.analysis), subharmonics=True)
+    (br,) = res.branches
+    assert br.followed == "exact shooting" and br.period == 2 and "no orbit next to the exact one" in br.message
+    assert len(br) >= 3 and bool(np.all(br.matched)) and bool(np.all(np.isnan(br.rms_hb)))
+    assert bool(np.all(br.stick_time > 0.0)) and bool(np.all(br.sticks >= 1))
+    assert float(np.min(br.omega)) < 0.4225 and float(np.max(br.omega)) == pytest.approx(0.428)
+    integ = NonsmoothIntegrator(cfg.model)
+    for i in range(len(br)):  # each a genuine period-2 orbit
+        T = 2.0 * math.pi / float(br.omega[i])
+        d = integ.propagate(br.states[i], 0.0, 2.0 * T, float(br.omega[i])).sample(np.array([0.0, T, 2.0 * T]))[0]
+        assert abs(d[1] - d[0]) > 1e-4 * float(br.p2p[i]) and abs(d[2] - d[0]) < 1e-8 * float(br.p2p[i])
+    i = int(np.flatnonzero(br.stable)[-1])
+    _settles_on(cfg.model, res, br, i)
+
+
+def test_a_ladder_that_leaves_the_orbit_gives_no_estimate():
+    """On the period-2 branch born at Ω ≈ 0.75, just past its own period doubling (Ω ≈ 0.763), the
+    ladder in ε at a few rows jumps to another orbit (its end was 17 % off the exact rms): those
+    rows keep their ε (no estimate at the limit), and every estimate kept is within 1 %."""
+    res = nonsmooth_response(_system(), (0.744, 0.766), OPTIONS, subharmonics=True)
+    (br,) = res.branches
+    stalled = br.omega[br.limit_index][~np.isfinite(br.limit_rms)]
+    assert stalled.size >= 1 and np.all((stalled > 0.762) & (stalled < 0.766)), stalled
+    err = np.abs(br.hb_error[br.matched])
+    assert float(np.nanmax(err)) < 0.01

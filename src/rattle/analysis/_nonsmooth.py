@@ -392,11 +392,13 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
             if refine is not None and opts.deep_eps is not None and matched[i] and not lad.linear \
                     and abs(lad.last.rms / rms[i] - 1.0) > refine and opts.deep_eps < lad.last.eps:
                 lad = _deeper(make, lad, opts)  # not yet in the linear range and still off: narrower, more harmonics
+            if _ladder_step(make, lad, float(points[i].omega), L) > LADDER_STEP_GUARD:
+                raise ConvergenceError(f"the ladder at Ω = {float(points[i].omega):g} left the row's orbit")
             lim_eps.append(lad.last.eps)
             lim_rms.append(lad.last.rms)
             lim_rich.append(lad.extrapolated_rms)
             lim_lin.append(lad.linear)
-        except RattleError:  # the ladder stalled: the row keeps its ε
+        except RattleError:  # the ladder stalled, or jumped to another orbit (a fold in ε): the row keeps its ε
             lim_eps.append(math.nan)
             lim_rms.append(math.nan)
             lim_rich.append(math.nan)
@@ -543,6 +545,10 @@ def nonsmooth_subharmonics(
     same resolution in time), which is continued both ways until it rejoins a period-1 branch
     (its odd harmonics vanish) or leaves the range. Every point is then checked as on the primary
     branch (steps 2–4 of the module docstring, the exact orbits shot over two forcing periods).
+    Where the regularised HB at ε has no period-2 orbit next to the exact one (Newton from the
+    exact orbit's spectrum falls back to the period-1 orbit: where friction sticks, the
+    regularisation's creep moves the period doubling), the exact branch is followed by exact
+    shooting alone over the primary's frequencies (``followed`` "exact shooting", no HB values).
     A period doubling that lies on a branch already found (its other end) starts none. A
     doubling where no exact period-2 orbit is found next to it starts none either; the
     returned branches are what was found, numbered 1, 2, … in order of Ω."""
@@ -570,27 +576,98 @@ def nonsmooth_subharmonics(
         beyond = [i for i in (a, b) if np.any((primary.multipliers[i].real < -1.0)
                                                & (np.abs(primary.multipliers[i].imag) < 1e-9))]
         order = beyond + [i for i in (a, b) if i not in beyond]
-        seed = None
+        origin = f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
+        seeds = []
+        branch = None
         for i in order:
             seed = _period_two_orbit(system, integ, float(primary.omega[i]), primary.states[i])
-            if seed is not None:
-                w0 = float(primary.omega[i])
+            if seed is None:
+                continue
+            w0 = float(primary.omega[i])
+            seeds.append((w0, seed))
+            q2 = _period_two_start(make2, seed, w0, opts.regularisation, H2, newton)
+            if q2 is None:
+                continue
+            points, status, message = _follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
+                                                        continuation, newton)
+            if points:
+                branch = _check_branch(system, make2, opts, points, status, message, branch=len(out) + 1,
+                                       origin=origin)
                 break
-        if seed is None:
+        if branch is None and seeds:  # the regularised HB has no period-2 orbit there: the exact flow alone
+            grid = np.unique(primary.omega[(primary.omega >= lo) & (primary.omega <= hi)])
+            branch = _exact_branch(system, integ, seeds[0][1], seeds[0][0], grid, opts, branch=len(out) + 1,
+                                   origin=origin)
+        if branch is None:
             continue
-        q2 = _period_two_start(make2, seed, w0, opts.regularisation, H2, newton)
-        if q2 is None:
-            continue
-        points, status, message = _follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
-                                                    continuation, newton)
-        if not points:
-            continue
-        ws = [float(p.omega) for p in points]
-        spans.append((min(ws), max(ws)))
-        out.append(_check_branch(system, make2, opts, points, status, message, branch=len(out) + 1,
-                                 origin=f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} "
-                                        f"and {max(w_a, w_b):.6g}"))
+        spans.append((float(np.min(branch.omega)), float(np.max(branch.omega))))
+        out.append(branch)
     return tuple(out)
+
+
+def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: NonsmoothOrbit, omega: float,
+                  grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> NonsmoothResponse:
+    """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
+    ``grid`` each way by Newton shooting over two periods from the orbit at the previous
+    frequency (natural continuation), until the shooting fails, its orbit repeats after one
+    period (the branch rejoined a period-1 branch) or the grid ends. Used where the regularised
+    HB of period 2 has no orbit next to the exact one (e.g. where friction sticks: the
+    regularisation's creep moves the period doubling); the rows carry no HB values (nan)."""
+    ends: list[str] = []
+    sides: list[list[tuple[float, NonsmoothOrbit]]] = []
+
+    def shoot(w: float, prev: NonsmoothOrbit) -> NonsmoothOrbit | str:
+        try:
+            orbit = shoot_nonsmooth_orbit(system, w, prev.state0, period=2, integrator=integ, max_iterations=40)
+        except FLOW_FAILURES as exc:
+            return f"the exact shooting failed at Ω = {w:.6g} ({exc})"
+        if not orbit.converged:
+            return f"the exact shooting did not converge at Ω = {w:.6g} (a fold or the end of the branch)"
+        if _repeats_early(orbit, w, 2):
+            return (f"the shooting at Ω = {w:.6g} lands on an orbit of period 1 (the branch rejoined a period-1 "
+                    "branch, or ends at a fold)")
+        return orbit
+
+    def advance(prev: NonsmoothOrbit, w0: float, w1: float, depth: int = 0) -> tuple[list, str]:
+        """From the orbit ``prev`` at w0 to w1, halving the step up to 4 times where the shooting
+        fails: the orbits reached, and why it stopped short ("" when it reached w1)."""
+        got = shoot(w1, prev)
+        if not isinstance(got, str):
+            return [(w1, got)], ""
+        if depth >= 4:
+            return [], got
+        mid = 0.5 * (w0 + w1)
+        first, why = advance(prev, w0, mid, depth + 1)
+        if why:
+            return first, why
+        second, why = advance(first[-1][1], mid, w1, depth + 1)
+        return first + second, why
+
+    for ws in (grid[grid < omega][::-1], grid[grid > omega]):
+        side: list[tuple[float, NonsmoothOrbit]] = []
+        prev, w_prev = seed, omega
+        for w in ws.tolist():
+            reached, why = advance(prev, w_prev, w)
+            side.extend(reached)
+            if why:
+                ends.append(why)
+                break
+            prev, w_prev = reached[-1][1], w
+        sides.append(side)
+    down, up = sides
+    rows: dict[str, list] = {k: [] for k in _ROW_KEYS}
+    for w, orbit in list(reversed(down)) + [(omega, seed)] + up:
+        rows["omega"].append(w)
+        rows["rms_hb"].append(math.nan)
+        rows["mult_hb"].append(np.full(2, np.nan + 0j))
+        rows["matched"].append(True)
+        _add_row(rows, orbit, np.full(2, np.nan + 0j))
+    message = "followed by exact shooting alone (the regularised HB of period 2 has no orbit next to the exact one " \
+              "there); " + "; ".join(ends)
+    return _response(rows, status=Status.SUCCESS, message=message, regularisation=float(opts.regularisation),
+                     harmonics=0, period=2, branch=branch, origin=origin, followed="exact shooting",
+                     limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0), limit_rms=np.zeros(0),
+                     limit_richardson=np.zeros(0), limit_linear=np.zeros(0, dtype=bool))
 
 
 __all__ = ["NonsmoothResponse", "RegularisationOptions", "nonsmooth_response", "nonsmooth_subharmonics"]

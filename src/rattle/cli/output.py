@@ -282,6 +282,7 @@ def _branch_metadata(branch: Any) -> dict[str, Any]:
     labels = branch.bifurcation
     return {
         "branch": int(branch.branch), "period": int(branch.period), "origin": branch.origin,
+        "followed": branch.followed,
         "status": branch.status.name.lower(), "message": branch.message or branch.status.message,
         "points": len(branch), "matched": int(np.count_nonzero(matched)),
         "stable": int(np.count_nonzero(matched & np.asarray(branch.stable, dtype=bool))),
@@ -354,9 +355,11 @@ def nonsmooth_summary(result: Any, options: Any, subharmonics: bool = False) -> 
     for b in getattr(result, "branches", ()):
         m = np.asarray(b.matched, dtype=bool)
         worst = _largest(b.rms_error, m)
+        how = (f"{int(np.count_nonzero(m))} matched by exact shooting over {b.period} periods"
+               if b.followed == "harmonic balance" else
+               "followed by exact shooting alone (the regularised HB has no period-2 orbit next to the exact one)")
         lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
-                     f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {int(np.count_nonzero(m))} matched by exact "
-                     f"shooting over {b.period} periods; stable over Ω = {_stable_spans(b)}"
+                     f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {how}; stable over Ω = {_stable_spans(b)}"
                      + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
     if "period_doubling" in set(labels.tolist()) and not getattr(result, "branches", ()):
         lines.append("no period-2 orbit was found next to the period doubling(s)" if subharmonics else

@@ -57,7 +57,10 @@ class NonsmoothResponse:
     ``branch`` its number (0 the primary), ``origin`` where it was born; ``states`` (P, 2) the
     exact orbit's (δ, δ') at t = 0 (nan where not matched). The primary branch carries the
     sub-harmonic ones in ``branches`` (empty unless asked for); :meth:`to_csv` writes them all,
-    the primary's rows first."""
+    the primary's rows first. ``followed``: how the branch was continued, ``"harmonic balance"``
+    (the regularised HB, every row checked by exact shooting) or ``"exact shooting"`` (a
+    sub-harmonic branch the regularised HB has no orbit for: every row an exact orbit, ``matched``
+    true, the HB's columns nan)."""
 
     omega: FloatArray
     rms_hb: FloatArray
@@ -88,6 +91,7 @@ class NonsmoothResponse:
     origin: str = ""
     states: FloatArray | None = None
     branches: tuple[NonsmoothResponse, ...] = ()
+    followed: str = "harmonic balance"
 
     def __post_init__(self) -> None:
         for name in ("sticks", "crossings"):  # not given: unknown (-1) on every row
