@@ -43,11 +43,13 @@ harmonics = {harmonics}
 """
 
 
-def preload_spring_toml(omega: tuple[float, float], harmonics: int | None = None) -> str:
-    """The torque converter's preloaded spring (T_p = 0.03) with friction r = 0.02, K = I = 1,
-    C = 0.05, F = 0.05 + 0.03 cos Ωt, as a configuration file over ``omega`` (with ``harmonics``
-    when given): it sticks part of every period at Ω = 0.5 … 0.7."""
+def preload_spring_toml(omega: tuple[float, float], harmonics: int | None = None, friction: float | None = 0.02) -> str:
+    """The torque converter's preloaded spring (T_p = 0.03) with friction r = ``friction`` (None:
+    none), K = I = 1, C = 0.05, F = 0.05 + 0.03 cos Ωt, as a configuration file over ``omega``
+    (with ``harmonics`` when given): with r = 0.02 it sticks part of every period at Ω = 0.5 … 0.7;
+    without friction it is examples/torque_converter_preload.toml."""
     lines = f"omega = [{omega[0]!r}, {omega[1]!r}]\n" + ("" if harmonics is None else f"harmonics = {harmonics}\n")
+    rub = "" if friction is None else f"friction = {friction!r}\n"
     return f"""\
 [model]
 inertia = 1.0
@@ -57,8 +59,7 @@ stiffness = 1.0
 [model.elastic]
 type = "preload"
 preload = 0.03
-friction = 0.02
-
+{rub}
 [excitation]
 mean = 0.05
 amplitudes = [0.03]

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _cases import preload_spring_toml
 from _cli_helpers import PNG, assert_bad_input, invoke, write_config
 from rattle.io import load_config, read_csv
 from rattle.results._nonsmooth import NONSMOOTH_COLUMNS
@@ -188,24 +189,7 @@ def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkey
 
 #: The torque converter's preloaded spring (examples/torque_converter_preload.toml) around its
 #: period doublings at Ω ≈ 0.545 and 0.562.
-TORQUE_CONVERTER = """\
-[model]
-inertia = 1.0
-damping = 0.05
-stiffness = 1.0
-
-[model.elastic]
-type = "preload"
-preload = 0.03
-
-[excitation]
-mean = 0.05
-amplitudes = [0.03]
-
-[analysis]
-omega = [0.53, 0.575]
-harmonics = 64
-"""
+TORQUE_CONVERTER = preload_spring_toml((0.53, 0.575), 64, friction=None)
 
 
 def test_frf_subharmonics_writes_the_period_two_branch_with_the_primary(tmp_path):
