@@ -69,11 +69,11 @@ def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]
             ax.plot(w[sel], response.rms[sel], marker, color="tab:red", ms=5, ls="none", label=kind.replace("_", " "))
     for k, br in enumerate(response.branches):  # the sub-harmonic branches, each in its colour
         colour = _BRANCH_COLOURS[k % len(_BRANCH_COLOURS)]
+        ax.plot(br.omega, br.rms_hb, "-", color="0.6", lw=0.8, zorder=1)
         for stable, style in ((True, "-"), (False, "--")):
             y = np.where(br.matched & (br.stable == stable), br.rms, np.nan)
-            ax.plot(br.omega, y, style, color=colour, lw=1.4,
+            ax.plot(br.omega, y, style, color=colour, lw=1.6, zorder=3,
                     label=f"branch {br.branch}: period {br.period}, exact" if stable else None)
-        ax.plot(br.omega, br.rms_hb, "-", color="0.6", lw=0.8)
         fr = np.where(br.matched, br.stick_time / (br.period * 2.0 * np.pi / br.omega), np.nan)
         ax_s.plot(br.omega, fr, "-", color=colour, lw=1.0)
     held = matched & (np.nan_to_num(response.stick_time) > 0.0)
