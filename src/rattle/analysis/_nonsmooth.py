@@ -38,7 +38,12 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    the regularisation is continued at that row towards its limit (ε down to ``limit_eps``, H up to
    ``limit_harmonics``; :func:`~rattle.analysis._regularisation.regularisation_limit`) and the
    HB's rms at the smallest ε is kept beside the exact one (``hb_error``): the HB's accuracy is
-   then measured at its limit, row by row.
+   then measured at its limit, row by row. A ladder one of whose rungs moved δ(t) by more than
+   :data:`LADDER_STEP_GUARD` of its peak-to-peak left the row's orbit on its way down (a fold in
+   ε): it gives no value, and the row keeps its error at ε.
+
+With ``subharmonics`` the period-2 branches born at the period doublings follow
+(:func:`nonsmooth_subharmonics`), each checked by the same steps over two forcing periods.
 
 Cost: one continuation of 2H + 1 unknowns plus one exact shooting and one exact period (the HB
 orbit's monodromy; a few ms) per point, and a ladder (0.5–2 s) per row checked at the limit or
