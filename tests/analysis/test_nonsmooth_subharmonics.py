@@ -173,3 +173,23 @@ def test_a_ladder_that_leaves_the_orbit_gives_no_estimate():
     assert stalled.size >= 1 and np.all((stalled > 0.762) & (stalled < 0.766)), stalled
     err = np.abs(br.hb_error[br.matched])
     assert float(np.nanmax(err)) < 0.01
+
+
+def test_nonsmooth_orbit_of_period_two_is_the_branch_orbit(response):
+    """``nonsmooth_orbit(..., period=2)`` at a row of the period-2 branch finds the same exact
+    orbit (rms to 1e-9) and the same HB of period 2; a chain and a period 3 are refused."""
+    from rattle.analysis import nonsmooth_orbit
+
+    (br,) = response.branches
+    i = int(np.argmin(np.abs(br.omega - 0.552)))
+    res = nonsmooth_orbit(_system(), float(br.omega[i]), OPTIONS, period=2)
+    assert res.periods == 2 and res.orbit is not None and res.orbit.period == 2
+    assert res.rms == pytest.approx(float(br.rms[i]), rel=1e-9) and res.stable == bool(br.stable[i])
+    assert res.rms_hb == pytest.approx(float(br.rms_hb[i]), rel=1e-6) and res.matched
+    assert res.period == pytest.approx(2 * 2 * math.pi / float(br.omega[i]))
+    with pytest.raises(ValueError, match="`period` must be 1 or 2"):
+        nonsmooth_orbit(_system(), 0.552, OPTIONS, period=3)
+    from _cases import lockup_chain
+
+    with pytest.raises(ValueError, match="`period` 2 is not supported for a chain"):
+        nonsmooth_orbit(lockup_chain().friction_system(), 2.05, period=2)

@@ -157,8 +157,8 @@ def test_orbit_writes_the_exact_orbit_with_its_stick_phase(tmp_path):
 
 def test_orbit_of_a_discontinuous_law_refuses_period_and_range_options(tmp_path):
     config = write_config(tmp_path, PRELOAD)
-    assert_bad_input(invoke(["orbit", str(config), "--omega", "1.2", "--period", "2", "-o", "out"], tmp_path),
-                     "`--period` 2", "only the period-1 orbit")
+    assert_bad_input(invoke(["orbit", str(config), "--omega", "1.2", "--period", "3", "-o", "out"], tmp_path),
+                     "`--period` 3", "period 1 or 2")
     assert_bad_input(invoke(["orbit", str(config), "--omega", "1.2", "--omega-min", "1.0", "-o", "out"], tmp_path),
                      "`--omega-min` is not used for a discontinuous law")
     assert_bad_input(invoke(["orbit", str(config), "--omega", "1e-9", "-o", "out"], tmp_path), "`--omega`")
@@ -219,3 +219,25 @@ def test_frf_without_subharmonics_points_to_them_at_a_period_doubling(tmp_path):
     assert "run with --subharmonics" in result.stdout
     assert set(np.asarray(read_csv(tmp_path / "out" / "frf.csv")["branch"]).tolist()) == {0}
     assert json.loads((tmp_path / "out" / "frf.json").read_text())["branches"] == []
+
+
+def test_orbit_period_two_writes_the_period_doubled_orbit(tmp_path):
+    """``rattle orbit --period 2`` inside the torque converter's period-2 window: the exact orbit
+    over two forcing periods (not the period-1 orbit run twice), stable, with its HB of period 2
+    beside it; where the motion has period 1 it exits 1 with nothing written."""
+    config = write_config(tmp_path, TORQUE_CONVERTER)
+    result = invoke(["orbit", str(config), "--omega", "0.552", "--period", "2", "-o", "out"], tmp_path)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    meta = json.loads((tmp_path / "out" / "orbit.json").read_text())
+    orbit = meta["orbit"]
+    assert orbit["periods"] == 2 and orbit["period"] == pytest.approx(2 * 2 * math.pi / 0.552, rel=1e-12)
+    assert orbit["stable"] is True and orbit["matched"] is True and abs(orbit["rms_error"]) < 0.005
+    assert meta["settings"]["period"] == 2 and meta["settings"]["harmonics"] == 128
+    table = read_csv(tmp_path / "out" / "orbit.csv")
+    t, d = (np.asarray(table[k], dtype=float) for k in ("t", "delta"))
+    T = 2 * math.pi / 0.552
+    half = int(np.argmin(np.abs(t - T)))
+    assert t[-1] == pytest.approx(2 * T) and abs(d[half] - d[0]) > 1e-3 * np.ptp(d)
+    result = invoke(["orbit", str(config), "--omega", "0.7", "--period", "2", "-o", "out2"], tmp_path)
+    assert result.exit_code == 1 and "no periodic orbit of period 2" in result.stderr
+    assert not (tmp_path / "out2").exists()

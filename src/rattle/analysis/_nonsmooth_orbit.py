@@ -85,6 +85,7 @@ def nonsmooth_orbit(
     options: RegularisationOptions | None = None,
     *,
     x0: FloatArray | tuple[float, float] | None = None,
+    period: int = 1,
 ) -> NonsmoothOrbitResult | FrictionOrbitResult:
     """The periodic orbit at forcing frequency ``omega`` (module docstring), with the HB settings
     ``options`` (:class:`RegularisationOptions`: ``harmonics``, ``regularisation`` and ``match``;
@@ -96,11 +97,19 @@ def nonsmooth_orbit(
     A failed exact shooting is reported in the result (``orbit`` None, ``message``); a failed HB
     leaves nan coefficients. Raises :class:`~rattle.errors.ConvergenceError` when neither is found.
 
+    ``period`` 2 asks for a sub-harmonic orbit of period 2 (one equation only;
+    :func:`_period_two`): found from the exact flow, its HB of period 2 solved from its spectrum.
+
     A chain with friction on its elements (:class:`~rattle.model.FrictionSystem`) goes to
     :func:`~rattle.analysis._friction_orbit.friction_orbit` (a :class:`FrictionOrbitResult`;
-    ``x0`` then the chain's state (x, x'), 2n values).
+    ``x0`` then the chain's state (x, x'), 2n values; period 1 only).
     """
+    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period not in (1, 2):
+        raise ValueError(f"`period` must be 1 or 2 (a period-2 sub-harmonic orbit), got {period!r}")
     if isinstance(system, FrictionSystem):
+        if period != 1:
+            raise ValueError("`period` 2 is not supported for a chain with friction or jumps on its elements yet: "
+                             "only its period-1 orbit is computed")
         from ._friction_orbit import friction_orbit
 
         return friction_orbit(system, omega, options, x0=x0)
@@ -112,6 +121,8 @@ def nonsmooth_orbit(
     if not isinstance(opts, RegularisationOptions):
         raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
     start_x = None if x0 is None else check_state(x0)
+    if period == 2:
+        return _period_two(system, omega, opts, start_x)
     H, eps = opts.harmonics, opts.regularisation
     make = balance_factory(system)
     integ = NonsmoothIntegrator(system)
@@ -161,6 +172,68 @@ def nonsmooth_orbit(
                                 coefficients=coefficients, regularisation=float(eps), harmonics=int(H),
                                 hb_state=hb_state, hb_start=hb_start, match=float(opts.match),
                                 settle_periods=SETTLE_PERIODS)
+
+
+def _period_two(system: NonsmoothSystem, omega: float, opts: RegularisationOptions,
+                x0: FloatArray | None) -> NonsmoothOrbitResult:
+    """The period-2 orbit at ``omega``: the exact one first, then its regularised HB of period 2.
+
+    1. The period-1 orbit (as :func:`nonsmooth_orbit`, from ``x0`` or the HB state); where one of
+       its multipliers lies beyond −1 the period-2 orbit next to it is shot from it pushed along
+       that multiplier's eigenvector (:func:`~rattle.analysis._nonsmooth._period_two_orbit`);
+    2. else the exact flow is run for :data:`SETTLE_PERIODS` × 2 forcing periods from ``x0`` (or
+       rest) and shot over two periods from where it arrived;
+    3. an orbit that repeats after one period is not one of period 2; the HB of period 2 (2H
+       harmonics of Ω/2) is solved from the exact orbit's spectrum
+       (:func:`~rattle.analysis._nonsmooth._period_two_start`; nan when it falls back to period 1,
+       as where friction sticks).
+
+    Raises :class:`~rattle.errors.ConvergenceError` when no exact orbit of period 2 is found."""
+    from ._nonsmooth import _period_two_orbit, _period_two_start, _repeats_early
+
+    integ = NonsmoothIntegrator(system)
+    notes: list[str] = []
+    one = nonsmooth_orbit(system, omega, opts, x0=x0)
+    seed, start = None, ""
+    if one.orbit is not None:
+        mu = np.asarray(one.orbit.multipliers)
+        if np.any((mu.real < -1.0) & (np.abs(mu.imag) < 1e-9)):
+            seed = _period_two_orbit(system, integ, omega, one.orbit.state0)
+            start = "hb" if seed is not None else ""
+            if seed is None:
+                notes.append("the period-1 orbit is unstable by a multiplier beyond −1, but no period-2 orbit was "
+                             "found next to it")
+    if seed is None:
+        origin = x0 if x0 is not None else np.zeros(2)
+        try:
+            settled = integ.propagate(origin, 0.0, 2 * SETTLE_PERIODS * 2.0 * math.pi / omega, omega).state1
+            seed = shoot_nonsmooth_orbit(system, omega, settled, period=2, integrator=integ, max_iterations=40)
+        except FLOW_FAILURES as exc:
+            seed = None
+            notes.append(f"settling failed ({type(exc).__name__}: {exc})")
+        if seed is not None and (not seed.converged or _repeats_early(seed, omega, 2)):
+            notes.append("the motion settled from " + ("`x0`" if x0 is not None else "rest")
+                         + (" repeats after one forcing period" if seed.converged else " could not be shot over two"))
+            seed = None
+        start = "settled" if seed is not None else ""
+    if seed is None:
+        raise ConvergenceError(f"no periodic orbit of period 2 at `omega` = {omega:g}: " + "; ".join(notes)
+                               + "; the orbit there is of period 1 (rattle orbit without --period), or, in the "
+                               "library, give `x0` near a period-2 motion")
+    H2 = 2 * opts.harmonics
+    make2 = balance_factory(system, period=2)
+    q = _period_two_start(make2, seed, omega, opts.regularisation, H2, None)
+    hb_state = np.full(2, math.nan)
+    if q is None:
+        notes.append("the regularised HB of period 2 has no orbit next to the exact one (it falls back to "
+                     "period 1): only the exact orbit is given")
+        q = np.full(2 * H2 + 1, math.nan)
+    else:
+        hb_state = np.array([float(a[0]) for a in make2(opts.regularisation, H2).samples(q, omega)])
+    return NonsmoothOrbitResult(system=system, omega=omega, orbit=seed, message="; ".join(notes), start=start,
+                                coefficients=np.asarray(q, dtype=float), regularisation=float(opts.regularisation),
+                                harmonics=int(H2), hb_state=hb_state, hb_start="exact" if np.isfinite(q[0]) else "",
+                                match=float(opts.match), settle_periods=SETTLE_PERIODS, periods=2)
 
 
 __all__ = ["NonsmoothOrbitResult", "nonsmooth_orbit"]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -477,8 +478,8 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
     HB orbit at Ω and the exact orbit shot from it, with its stick and lock phases), written as one
     set orbit.csv, orbit.json, orbit.png.
 
-    Only the period-1 orbit; ``--omega-min``/``--omega-max`` (a search range of the smooth laws) are
-    refused. Raises ConvergenceError (exit 1) after writing the set when the exact shooting failed.
+    ``--period`` 1 or 2 (2: the period-doubled orbit, found from the exact flow); ``--omega-min``/
+    ``--omega-max`` (a search range of the smooth laws) are refused. Raises ConvergenceError (exit 1) after writing the set when the exact shooting failed.
     """
     analysis, options = _nonsmooth_orbit_settings(run_config, omega, period, harmonics, omega_min, omega_max)
     t_start = time.perf_counter()
@@ -486,13 +487,13 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
 
     logger.info("computing the orbit of a discontinuous law at Ω = %g: regularised harmonic balance (H = %d, ε = %g) "
                 "and exact shooting", omega, options.harmonics, options.regularisation)
-    result = nonsmooth_orbit(run_config.model, omega, options)
+    result = nonsmooth_orbit(run_config.model, omega, options, period=period)
     timings = {"nonsmooth_orbit": time.perf_counter() - t_start}
     ok = result.orbit is not None and bool(result.converged)
     meta = {
         "settings": {"method": "exact event-driven shooting started from the regularised harmonic balance "
-                               "(rattle.analysis.nonsmooth_orbit)", "harmonics": options.harmonics,
-                     "regularisation": options.regularisation, "match": options.match},
+                               "(rattle.analysis.nonsmooth_orbit)", "harmonics": result.harmonics,
+                     "regularisation": options.regularisation, "match": options.match, "period": period},
         "status": "converged" if ok else "failed",
         "message": result.message or ("" if ok else "the exact shooting did not converge"),
         "orbit": result.summary(),
@@ -505,8 +506,10 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
                 f"{abs(result.multipliers[1]):.3g})" if ok else "no exact orbit")]
     if ok:
         held = sum(b - a for a, b, _ in result.stick_intervals)
-        lines.append(f"regularised HB (H = {options.harmonics}, ε = {options.regularisation:g}): rms {result.rms_hb:.6g} "
-                     f"(error {result.rms_error:.2g}); {'matched' if result.matched else 'NOT matched'}")
+        if math.isfinite(result.rms_hb):
+            lines.append(f"regularised HB (H = {result.harmonics}, ε = {options.regularisation:g}): rms "
+                         f"{result.rms_hb:.6g} (error {result.rms_error:.2g}); "
+                         f"{'matched' if result.matched else 'NOT matched'}")
         if result.stick_intervals:
             lines.append(f"sticks or locks {len(result.stick_intervals)} time(s) per period, {held:.4g} s "
                          f"({held / result.period:.0%} of the period)")
@@ -555,9 +558,12 @@ def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | No
     law = _law_keys(run_config)
     what = ("a chain with friction on its elements" if getattr(run_config, "chain_friction", False)
             else "a discontinuous law")
-    if period != 1:
+    chain = getattr(run_config, "chain_friction", False)
+    if period != 1 and (chain or period > 2):
         raise ConfigError(f"`--period` {period}: only the period-1 orbit of {what} ({law}) is computed yet; "
-                          "leave --period out")
+                          "leave --period out" if chain else
+                          f"`--period` {period}: the orbit of {what} ({law}) is computed for period 1 or 2; "
+                          "use --period 2 for a period-doubled orbit")
     for option, value in (("--omega-min", omega_min), ("--omega-max", omega_max)):
         if value is not None:
             raise ConfigError(f"`{option}` is not used for {what} ({law}): its orbit is computed at --omega alone, "

@@ -139,7 +139,7 @@ def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tu
     ax_d.set_xlim(0.0, T)
     ax_p.set_xlabel("δ (rad)")
     ax_p.set_ylabel("δ' (rad/s)")
-    title = f"Ω = {result.omega:.6g} rad/s"
+    title = f"Ω = {result.omega:.6g} rad/s" + (f", period {result.periods} (sub-harmonic)" if result.periods > 1 else "")
     if result.orbit is not None:
         title += (f": rms {result.rms:.4g} rad (HB {result.rms_error:+.1e}), "
                   f"{'stable' if result.stable else 'unstable'}, held {result.stick_time:.3g} of {T:.3g} s")

@@ -51,7 +51,8 @@ class NonsmoothOrbitResult:
     t = 0; ``hb_start`` how the HB was solved: ``"rest"`` (from rest, ε narrowed from 0.1),
     ``"exact"`` (from the exact orbit's spectrum, after the first failed), ``""`` failed;
     ``match`` the largest :attr:`hb_distance` for the two orbits to count as one
-    (:attr:`matched`)."""
+    (:attr:`matched`); ``periods`` p: the orbit repeats after p forcing periods (2: a sub-harmonic
+    orbit; its HB series then holds harmonics of Ω/2, and "per period" means over p 2π/Ω)."""
 
     system: NonsmoothSystem
     omega: float
@@ -65,12 +66,13 @@ class NonsmoothOrbitResult:
     hb_start: str = "rest"
     match: float = 0.1
     settle_periods: int = 100
+    periods: int = 1
 
     # --- the periods and the HB series ------------------------------------------------------
     @property
     def period(self) -> float:
-        """T = 2π/Ω (s)."""
-        return 2.0 * math.pi / self.omega
+        """T = p 2π/Ω (s): the orbit repeats after p = ``periods`` forcing periods."""
+        return self.periods * 2.0 * math.pi / self.omega
 
     @property
     def converged(self) -> bool:
@@ -84,7 +86,7 @@ class NonsmoothOrbitResult:
         q = self.coefficients
         H = self.harmonics
         t = np.asarray(t, dtype=float)
-        kw = np.arange(1, H + 1) * self.omega
+        kw = np.arange(1, H + 1) * (self.omega / self.periods)  # harmonics of the orbit's own frequency Ω/p
         ph = np.multiply.outer(t, kw)
         a, b = q[1 : H + 1], q[H + 1 :]
         if derivative == 0:
@@ -214,12 +216,12 @@ class NonsmoothOrbitResult:
 
     def summary(self) -> dict[str, Any]:
         """The scalars of the orbit as plain Python values (JSON-ready; nan stays nan, None for
-        ``stable`` without an exact orbit): omega, period, rms, mean, rms_hb, rms_error,
+        ``stable`` without an exact orbit): omega, period (s), periods (p), rms, mean, rms_hb, rms_error,
         hb_distance, matched, stable, mu1_abs, mu2_abs, stick_time, regime, start, hb_start,
         regularisation, harmonics, message, and ``phases``: [[t_start, t_end, kind], …]."""
         mu = np.abs(self.multipliers)
         return {
-            "omega": self.omega, "period": self.period, "rms": self.rms, "mean": self.mean, "rms_hb": self.rms_hb,
+            "omega": self.omega, "period": self.period, "periods": self.periods, "rms": self.rms, "mean": self.mean, "rms_hb": self.rms_hb,
             "rms_error": self.rms_error, "hb_distance": self.hb_distance, "matched": self.matched,
             "stable": self.stable, "mu1_abs": float(mu[0]), "mu2_abs": float(mu[1]), "stick_time": self.stick_time,
             "regime": self.regime, "start": self.start, "hb_start": self.hb_start,
