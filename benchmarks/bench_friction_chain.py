@@ -40,24 +40,18 @@ Measured 2026-12-01 (2 cores shared with other jobs, two runs at a time: times a
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from _cases import lockup_chain
+
 from rattle.analysis import RegularisationOptions, friction_response
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Preload, Torque
-
-
-def preload_chain() -> Chain:
-    """The same chain with a torque-converter lock-up clutch in place of the damper: a torque jump
-    of ±0.03 K_e at δ = 0 (Preload) with friction 0.01 beside it."""
-    return Chain(inertias=(1.0, 0.5, 2.0),
-                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-                 elements=(Element(name="tcc", between=(1, 2), stiffness=1.0, law=Preload(preload=0.03),
-                                   friction=Friction(levels=0.01)),
-                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
+from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Torque
 
 
 def chain() -> Chain:
@@ -82,7 +76,7 @@ def main() -> None:
     ap.add_argument("--stability", choices=("saltation", "regularised"), default="saltation",
                     help="the HB orbit's own multipliers: the exact flow from its state, or the regularised monodromy")
     args = ap.parse_args()
-    fs = (chain() if args.case == "clutch" else preload_chain()).friction_system()
+    fs = (chain() if args.case == "clutch" else lockup_chain()).friction_system()
     wn = fs.frequency_scale()
     print(f"chain ({args.case}): 3 inertias, elements {fs.element_names}, ω_n = {wn:.4g} rad/s, Ω = {args.lo} … {args.hi} ω_n, ε = {args.eps:g}, "
           f"HB stability {args.stability}")
