@@ -112,13 +112,18 @@ def _hb_multipliers(problem: RegularisedBalance, flow: NonsmoothTrajectory | Non
     return regularised_multipliers(problem, q, omega)
 
 
+def _match_times(omega: float, period: int) -> FloatArray:
+    """:data:`MATCH_SAMPLES` equally spaced times over the period p 2π/Ω."""
+    return np.arange(MATCH_SAMPLES) * (period * 2.0 * math.pi / omega / MATCH_SAMPLES)
+
+
 def _departure(problem: RegularisedBalance, q: FloatArray, omega: float, traj: NonsmoothTrajectory,
                scale: float) -> float:
     """The largest departure of the exact δ(t) on ``traj`` from the HB orbit ``q`` of ``problem``
     (period p = ``problem.period``) on :data:`MATCH_SAMPLES` samples of its period p 2π/Ω,
     relative to ``scale``."""
     p = problem.period
-    t = np.arange(MATCH_SAMPLES) * (p * 2.0 * math.pi / omega / MATCH_SAMPLES)
+    t = _match_times(omega, p)
     return float(np.max(np.abs(traj.sample(t)[0] - problem.basis.evaluate(q, omega / p, t)))) / scale
 
 
@@ -127,11 +132,12 @@ def _departure(problem: RegularisedBalance, q: FloatArray, omega: float, traj: N
 REPEAT_TOL = 1e-7
 
 
-def _repeats_early(orbit: NonsmoothOrbit, omega: float, period: int) -> bool:
-    """Whether the exact ``orbit`` of ``period`` forcing periods repeats after a divisor d < p of
-    them (δ and δ' back within :data:`REPEAT_TOL` of its peak-to-peak): near the ends of a
-    sub-harmonic branch, where the exact period doubling lies on the other side of the row, the
-    shooting lands on the period-1 orbit run p times."""
+def _repeats_early(orbit: NonsmoothOrbit) -> bool:
+    """Whether the exact ``orbit`` of p forcing periods repeats after a divisor d < p of them (δ
+    and δ' back within :data:`REPEAT_TOL` of its peak-to-peak): near the ends of a sub-harmonic
+    branch, where the exact period doubling lies on the other side of the row, the shooting lands
+    on the period-1 orbit run p times."""
+    omega, period = orbit.omega, orbit.period
     T = 2.0 * math.pi / omega
     size = max(float(np.ptp(orbit.trajectory.sample(np.linspace(0.0, period * T, 64 * period + 1))[0])), 1e-300)
     for k in range(1, period):
@@ -152,8 +158,9 @@ def _holds(flow: NonsmoothTrajectory | None, orbit: NonsmoothOrbit | None) -> bo
 def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: NonsmoothSystem,
                     integ: NonsmoothIntegrator, omega: float, lad: RegularisationLimit,
                     L: float) -> tuple[NonsmoothOrbit, float] | None:
-    """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` and its departure
-    from that HB orbit, relative to that HB δ's peak-to-peak; None when the shooting fails."""
+    """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` (one that stayed
+    on the row's orbit, :data:`LADDER_STEP_GUARD`) and its departure from that HB orbit, relative
+    to that HB δ's peak-to-peak; None when the shooting fails."""
     last = lad.last
     pb = make(last.eps, last.harmonics)
     d0, v0 = (float(a[0]) for a in pb.samples(last.q, omega))
@@ -163,8 +170,6 @@ def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: No
         return None
     if not orbit.converged:
         return None
-    if _ladder_step(make, lad, omega, L) > LADDER_STEP_GUARD:
-        return orbit, math.inf  # the ladder left the row's branch: its end is another orbit's
     size = max(float(np.ptp(pb.basis.synthesize(last.q))), 1e-12 * L)
     return orbit, _departure(pb, last.q, omega, orbit.trajectory, size)
 
@@ -182,7 +187,7 @@ def _ladder_step(make: Callable[[float, int], RegularisedBalance], lad: Regulari
     """The largest change of δ(t) between two successive rungs of ``lad`` on :data:`MATCH_SAMPLES`
     samples of the period, relative to the earlier rung's peak-to-peak."""
     p = make(lad.last.eps, lad.last.harmonics).period
-    t = np.arange(MATCH_SAMPLES) * (p * 2.0 * math.pi / omega / MATCH_SAMPLES)
+    t = _match_times(omega, p)
     prev: FloatArray | None = None
     worst = 0.0
     for step in lad.steps:
@@ -334,12 +339,16 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
 
     def _row_ladder(i: int) -> RegularisationLimit | None:
         """Row i's ladder (ε → ``limit_eps``, H ≤ ``limit_harmonics``), found once: the match at
-        the limit and the refinement share it."""
+        the limit and the refinement share it. None when it stalls, or when one of its rungs moved
+        δ(t) by more than :data:`LADDER_STEP_GUARD` of its peak-to-peak: it left the row's orbit
+        (a fold in ε), and its end is another orbit's."""
         if i not in ladders:
+            w = float(points[i].omega)
             try:
-                ladders[i] = regularisation_limit(make, float(points[i].omega), points[i].q, eps_start=regularisation,
-                                                  eps_min=min(limit_eps, regularisation), harmonics=harmonics,
-                                                  max_harmonics=max(limit_harmonics, harmonics))
+                lad = regularisation_limit(make, w, points[i].q, eps_start=regularisation,
+                                           eps_min=min(limit_eps, regularisation), harmonics=harmonics,
+                                           max_harmonics=max(limit_harmonics, harmonics))
+                ladders[i] = None if _ladder_step(make, lad, w, L) > LADDER_STEP_GUARD else lad
             except RattleError:
                 ladders[i] = None
         return ladders[i]
@@ -372,7 +381,7 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
                 found = None if lad is None else _match_at_limit(make, system, integ, w, lad, L)
                 if found is not None and found[1] <= match:
                     orbit, ok = found[0], True
-        if ok and period > 1 and _repeats_early(orbit, w, period):
+        if ok and period > 1 and _repeats_early(orbit):
             ok = False  # the exact orbit there is of a lower period: no exact counterpart of this one
         rows["omega"].append(w)
         rows["rms_hb"].append(rms_hb)
@@ -393,12 +402,12 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
         try:
             lad = _row_ladder(int(i))
             if lad is None:
-                raise ConvergenceError(f"the ladder stalled at Ω = {float(points[i].omega):g}")
+                raise ConvergenceError(f"the ladder at Ω = {float(points[i].omega):g} stalled or left the row's orbit")
             if refine is not None and opts.deep_eps is not None and matched[i] and not lad.linear \
                     and abs(lad.last.rms / rms[i] - 1.0) > refine and opts.deep_eps < lad.last.eps:
                 lad = _deeper(make, lad, opts)  # not yet in the linear range and still off: narrower, more harmonics
-            if _ladder_step(make, lad, float(points[i].omega), L) > LADDER_STEP_GUARD:
-                raise ConvergenceError(f"the ladder at Ω = {float(points[i].omega):g} left the row's orbit")
+                if _ladder_step(make, lad, float(points[i].omega), L) > LADDER_STEP_GUARD:
+                    raise ConvergenceError(f"the deeper ladder at Ω = {float(points[i].omega):g} left the row's orbit")
             lim_eps.append(lad.last.eps)
             lim_rms.append(lad.last.rms)
             lim_rich.append(lad.extrapolated_rms)
@@ -428,6 +437,13 @@ def _odd_share(q: FloatArray) -> float:
     odd = odd_indices(H)
     total = float(np.linalg.norm(q[1:]))
     return float(np.linalg.norm(q[odd])) / total if total > 0 else 0.0
+
+
+def beyond_minus_one(multipliers: np.ndarray) -> bool:
+    """Whether one of the real ``multipliers`` lies beyond −1: the orbit is unstable by a period
+    doubling, and a period-2 orbit is born next to it."""
+    mu = np.asarray(multipliers)
+    return bool(np.any((mu.real < -1.0) & (np.abs(mu.imag) < 1e-9)))
 
 
 def _period_two_orbit(system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float,
@@ -578,8 +594,7 @@ def nonsmooth_subharmonics(
         w_a, w_b = float(primary.omega[a]), float(primary.omega[b])
         if any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
             continue  # the other end of a branch already followed
-        beyond = [i for i in (a, b) if np.any((primary.multipliers[i].real < -1.0)
-                                               & (np.abs(primary.multipliers[i].imag) < 1e-9))]
+        beyond = [i for i in (a, b) if beyond_minus_one(primary.multipliers[i])]
         order = beyond + [i for i in (a, b) if i not in beyond]
         origin = f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
         seeds = []
@@ -628,7 +643,7 @@ def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: Non
             return f"the exact shooting failed at Ω = {w:.6g} ({exc})"
         if not orbit.converged:
             return f"the exact shooting did not converge at Ω = {w:.6g} (a fold or the end of the branch)"
-        if _repeats_early(orbit, w, 2):
+        if _repeats_early(orbit):
             return (f"the shooting at Ω = {w:.6g} lands on an orbit of period 1 (the branch rejoined a period-1 "
                     "branch, or ends at a fold)")
         return orbit

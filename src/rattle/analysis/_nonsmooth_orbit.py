@@ -57,11 +57,12 @@ def _hb_orbit(make: Callable[[float, int], RegularisedBalance], omega: float, q0
     return q, np.array([d0, v0])
 
 
-def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
-           integ: NonsmoothIntegrator) -> tuple[NonsmoothOrbit | None, str]:
-    """The exact orbit from ``x0``, or (None, why)."""
+def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: NonsmoothIntegrator, period: int = 1,
+           max_iterations: int = 30) -> tuple[NonsmoothOrbit | None, str]:
+    """The exact orbit of ``period`` forcing periods from ``x0``, or (None, why)."""
     try:
-        orbit = shoot_nonsmooth_orbit(system, omega, x0, integrator=integ, max_iterations=30)
+        orbit = shoot_nonsmooth_orbit(system, omega, x0, period=period, integrator=integ,
+                                      max_iterations=max_iterations)
     except FLOW_FAILURES as exc:  # e.g. the event budget of a chattering orbit
         return None, f"{type(exc).__name__}: {exc}"
     if not orbit.converged:
@@ -69,14 +70,15 @@ def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
     return orbit, ""
 
 
-def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray,
-                      integ: NonsmoothIntegrator) -> tuple[NonsmoothOrbit | None, str]:
-    """The exact flow run for :data:`SETTLE_PERIODS` periods from ``x0``, then shot; or (None, why)."""
+def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: NonsmoothIntegrator,
+                      period: int = 1, max_iterations: int = 30) -> tuple[NonsmoothOrbit | None, str]:
+    """The exact flow run for :data:`SETTLE_PERIODS` orbit periods (× ``period`` forcing periods)
+    from ``x0``, then shot over ``period`` forcing periods; or (None, why)."""
     try:
-        settled = integ.propagate(x0, 0.0, SETTLE_PERIODS * 2.0 * math.pi / omega, omega).state1
+        settled = integ.propagate(x0, 0.0, SETTLE_PERIODS * period * 2.0 * math.pi / omega, omega).state1
     except FLOW_FAILURES as exc:
         return None, f"{type(exc).__name__}: {exc}"
-    return _shoot(system, omega, settled, integ)
+    return _shoot(system, omega, settled, integ, period, max_iterations)
 
 
 def nonsmooth_orbit(
@@ -189,31 +191,27 @@ def _period_two(system: NonsmoothSystem, omega: float, opts: RegularisationOptio
        as where friction sticks).
 
     Raises :class:`~rattle.errors.ConvergenceError` when no exact orbit of period 2 is found."""
-    from ._nonsmooth import _period_two_orbit, _period_two_start, _repeats_early
+    from ._nonsmooth import _period_two_orbit, _period_two_start, _repeats_early, beyond_minus_one
 
     integ = NonsmoothIntegrator(system)
     notes: list[str] = []
     one = nonsmooth_orbit(system, omega, opts, x0=x0)
     seed, start = None, ""
     if one.orbit is not None:
-        mu = np.asarray(one.orbit.multipliers)
-        if np.any((mu.real < -1.0) & (np.abs(mu.imag) < 1e-9)):
+        if beyond_minus_one(one.orbit.multipliers):
             seed = _period_two_orbit(system, integ, omega, one.orbit.state0)
             start = "hb" if seed is not None else ""
             if seed is None:
                 notes.append("the period-1 orbit is unstable by a multiplier beyond −1, but no period-2 orbit was "
                              "found next to it")
     if seed is None:
-        origin = x0 if x0 is not None else np.zeros(2)
-        try:
-            settled = integ.propagate(origin, 0.0, 2 * SETTLE_PERIODS * 2.0 * math.pi / omega, omega).state1
-            seed = shoot_nonsmooth_orbit(system, omega, settled, period=2, integrator=integ, max_iterations=40)
-        except FLOW_FAILURES as exc:
-            seed = None
-            notes.append(f"settling failed ({type(exc).__name__}: {exc})")
-        if seed is not None and (not seed.converged or _repeats_early(seed, omega, 2)):
-            notes.append("the motion settled from " + ("`x0`" if x0 is not None else "rest")
-                         + (" repeats after one forcing period" if seed.converged else " could not be shot over two"))
+        where = "`x0`" if x0 is not None else "rest"
+        seed, why = _settle_and_shoot(system, omega, x0 if x0 is not None else np.zeros(2), integ, period=2,
+                                      max_iterations=40)
+        if seed is None:
+            notes.append(f"the motion settled from {where} could not be shot over two periods ({why})")
+        elif _repeats_early(seed):
+            notes.append(f"the motion settled from {where} repeats after one forcing period")
             seed = None
         start = "settled" if seed is not None else ""
     if seed is None:
