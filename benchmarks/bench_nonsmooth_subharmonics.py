@@ -41,17 +41,15 @@ import numpy as np
 from rattle.analysis import nonsmooth_response, nonsmooth_subharmonics
 from rattle.analysis._case import regularisation_options
 from rattle.io import load_config
+from rattle.plotting._nonsmooth import _held_runs
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 DEFAULT = ("torque_converter_preload.toml", "clutch_friction.toml")
 
 
 def _spans(omega: np.ndarray, ok: np.ndarray) -> str:
-    idx = np.flatnonzero(ok)
-    if idx.size == 0:
-        return "none"
-    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
-    return ", ".join(f"{omega[r].min():.4f} … {omega[r].max():.4f}" for r in runs)
+    runs = _held_runs(omega, ok)
+    return ", ".join(f"{a:.4f} … {b:.4f}" for a, b in runs) if runs else "none"
 
 
 def _report(br) -> None:  # type: ignore[no-untyped-def]

@@ -294,15 +294,15 @@ def _branch_metadata(branch: Any) -> dict[str, Any]:
 
 
 def _stable_spans(branch: Any) -> str:
-    """The Ω ranges of a branch's consecutive matched stable rows, as text."""
+    """The Ω ranges of a branch's consecutive matched stable rows, as text (the runs its plot
+    shades, :func:`rattle.plotting._nonsmooth._held_runs`)."""
     import numpy as np
 
+    from ..plotting._nonsmooth import _held_runs
+
     ok = np.asarray(branch.matched, dtype=bool) & np.asarray(branch.stable, dtype=bool)
-    idx = np.flatnonzero(ok)
-    if idx.size == 0:
-        return "nowhere"
-    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
-    return ", ".join(f"{float(np.min(branch.omega[r])):.5g} … {float(np.max(branch.omega[r])):.5g}" for r in runs)
+    runs = _held_runs(np.asarray(branch.omega, dtype=float), ok)
+    return ", ".join(f"{a:.5g} … {b:.5g}" for a, b in runs) if runs else "nowhere"
 
 
 def _largest(values: Any, rows: Any) -> float | None:
