@@ -138,7 +138,7 @@ def test_columns_csv_and_json(sticking: FrictionResponse, slipping: FrictionResp
     with open(path, newline="") as fh:
         rows = list(csv.reader(fh))
     header = rows[0]
-    assert header[:3] == ["omega", "clutch_rms", "clutch_rms_hb"]
+    assert header[:5] == ["branch", "period", "omega", "clutch_rms", "clutch_rms_hb"]
     for name in ("clutch", "gear"):
         for col in ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated"):
             assert f"{name}_{col}" in header
@@ -147,7 +147,7 @@ def test_columns_csv_and_json(sticking: FrictionResponse, slipping: FrictionResp
     assert "speed_rpm" not in header and len(rows) == len(sticking) + 1
     i = header.index("clutch_rms")
     np.testing.assert_allclose([float(x[i]) for x in rows[1:]], sticking.rms[:, 0], rtol=1e-12)
-    assert slipping.column_names()[:2] == ["omega", "speed_rpm"]
+    assert slipping.column_names()[:4] == ["branch", "period", "omega", "speed_rpm"]
     doc = json.loads(json.dumps(sticking.to_dict()))
     assert doc["metadata"]["rows"] == len(sticking) and doc["metadata"]["matched"] == len(sticking)
     assert doc["metadata"]["elements"] == ["clutch", "gear"]

@@ -119,11 +119,7 @@ def test_the_hb_of_period_two_is_within_half_a_percent_where_matched(response):
     assert agree >= 0.95, agree
 
 
-def test_subharmonics_are_refused_on_a_chain_and_checked():
-    from _cases import lockup_chain
-
-    with pytest.raises(ValueError, match="`subharmonics` is not supported for a chain"):
-        nonsmooth_response(lockup_chain().friction_system(), (2.0, 2.1), subharmonics=True)
+def test_subharmonics_arguments_are_checked():
     with pytest.raises(TypeError, match="`subharmonics` must be True or False"):
         nonsmooth_response(_system(), RANGE, OPTIONS, subharmonics="yes")
     with pytest.raises(TypeError, match="`primary` must be the NonsmoothResponse"):

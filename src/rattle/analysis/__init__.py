@@ -5,6 +5,7 @@ from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
 from ._friction_orbit import friction_orbit
 from ._friction_response import friction_response
+from ._friction_subharmonics import friction_subharmonics
 from ._nonsmooth import RegularisationOptions, nonsmooth_response, nonsmooth_subharmonics
 from ._nonsmooth_orbit import nonsmooth_orbit
 from ._harmonics import adaptive_frequency_response, truncation_error
@@ -16,6 +17,6 @@ from ._time_sweep import time_sweep
 __all__ = [
     "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare",
     "steady_state", "SteadyStateOptions", "nonsmooth_response", "nonsmooth_subharmonics", "RegularisationOptions",
-    "nonsmooth_orbit", "friction_response", "friction_orbit",
+    "nonsmooth_orbit", "friction_response", "friction_subharmonics", "friction_orbit",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
 ]

@@ -114,25 +114,27 @@ MATCH_SAMPLES = 64
 UNIT_TOL = 1e-8
 
 
-def friction_balance_factory(system: FrictionSystem) -> Callable[[float, int], RegularisedSystemBalance]:
+def friction_balance_factory(system: FrictionSystem, period: int = 1) -> Callable[[float, int], RegularisedSystemBalance]:
     """``make(ε, H)``: the regularised HB of the chain ``system`` at relative width ε with H
-    harmonics (one problem built per H; another ε shares its matrices)."""
+    harmonics, of solution period ``period`` forcing periods (one problem built per H; another ε
+    shares its matrices)."""
     built: dict[int, RegularisedSystemBalance] = {}
 
     def make(eps: float, H: int) -> RegularisedSystemBalance:
         pb = built.get(H)
         if pb is None:
-            pb = built[H] = RegularisedSystemBalance(system, regularisation=eps, options=HBOptions(harmonics=H))
+            pb = built[H] = RegularisedSystemBalance(system, regularisation=eps, options=HBOptions(harmonics=H),
+                                                     period=period)
         return pb if pb.eps == eps else pb.with_regularisation(eps)
 
     return make
 
 
-def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float) -> FrictionTrajectory | None:
-    """One period of the exact flow from the state ``z0`` at t = 0 (the HB orbit's, or a settled
-    one); None when it cannot be followed (:data:`FLOW_FAILURES`)."""
+def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float, period: int = 1) -> FrictionTrajectory | None:
+    """``period`` forcing periods of the exact flow from the state ``z0`` at t = 0 (the HB orbit's,
+    or a settled one); None when it cannot be followed (:data:`FLOW_FAILURES`)."""
     try:
-        return integ.propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
+        return integ.propagate(z0, 0.0, period * 2.0 * math.pi / omega, omega)
     except FLOW_FAILURES:
         return None
 
@@ -179,8 +181,10 @@ def _held_elements(flow: FrictionTrajectory | None, E: FloatArray) -> dict[int, 
 
 
 def _hb_samples(pb: RegularisedSystemBalance, E: FloatArray, omega: float, t: FloatArray) -> FloatArray:
-    """δ_e(t) of the HB orbit with element series ``E`` (m, 2H+1) at the times ``t``, shape (t.size, m)."""
-    return np.stack([pb.basis.evaluate(E[e], omega, t) for e in range(E.shape[0])], axis=1)
+    """δ_e(t) of the HB orbit with element series ``E`` (m, 2H+1) at forcing frequency Ω = ``omega``
+    at the times ``t``, shape (t.size, m)."""
+    w = pb.base_frequency(omega)
+    return np.stack([pb.basis.evaluate(E[e], w, t) for e in range(E.shape[0])], axis=1)
 
 
 def _departures(traj: FrictionTrajectory, d_hb: FloatArray, t: FloatArray, size: FloatArray) -> FloatArray:
@@ -219,8 +223,8 @@ def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], syst
     last = lad.last
     pb = make(last.eps, last.harmonics)
     try:
-        orbit = shoot_friction_orbit(system, omega, pb.state_at_zero(last.q, omega), integrator=integ,
-                                     max_iterations=30)
+        orbit = shoot_friction_orbit(system, omega, pb.state_at_zero(last.q, omega), period=pb.period,
+                                     integrator=integ, max_iterations=30)
     except FLOW_FAILURES:
         return None
     if not orbit.converged:
@@ -296,10 +300,10 @@ def _settled(integ: FrictionIntegrator, z0: FloatArray, omega: float, periods: i
 
 
 def _orbit_spectrum(pb: RegularisedSystemBalance, traj: FrictionTrajectory, omega: float) -> FloatArray:
-    """The Fourier series (pb's H, the HB's unknowns q) of the coordinates along one period of
-    ``traj`` at forcing frequency ``omega``, from pb's N samples."""
+    """The Fourier series (pb's H, the HB's unknowns q) of the coordinates along one solution
+    period (pb's p forcing periods) of ``traj`` at forcing frequency ``omega``, from pb's N samples."""
     N = pb.basis.samples
-    x = traj.sample(np.arange(N) * (2.0 * math.pi / omega / N))[0][:, : pb.n_coordinates]
+    x = traj.sample(np.arange(N) * (pb.period * 2.0 * math.pi / omega / N))[0][:, : pb.n_coordinates]
     return pb.basis.analyze(x.T).reshape(-1)
 
 
@@ -394,19 +398,64 @@ def friction_response(
         raise TypeError(f"`continuation` must be a ContinuationOptions or None, got {continuation!r}")
     if newton is not None and not isinstance(newton, NewtonOptions):
         raise TypeError(f"`newton` must be a NewtonOptions or None, got {newton!r}")
-    H, eps, match, refine = opts.harmonics, opts.regularisation, opts.match, opts.refine
+    H, eps = opts.harmonics, opts.regularisation
     make = friction_balance_factory(system)
     problem = make(eps, H)  # raises on too few harmonics for the excitation
     start = _start(make, lo, eps, H, None)
     stepper = ContinuationStepper(problem, start, lo, (lo, hi), options=continuation or ContinuationOptions(),
                                   newton=newton or NewtonOptions())
     points = stepper.run()
-    integ = FrictionIntegrator(system)
+    return check_branch(system, make, points, opts, FrictionIntegrator(system),
+                        status=stepper.status or Status.SUCCESS, message=stepper.message)
+
+
+def period_gap(traj: FrictionTrajectory, omega: float) -> float:
+    """max_e max_t |δ_e(t + T) − δ_e(t)| / ptp(δ_e) over the first period of the trajectory
+    ``traj`` of two forcing periods or more (T = 2π/Ω): 0 for a period-1 orbit run twice."""
+    T = 2.0 * math.pi / omega
+    t = np.arange(MATCH_SAMPLES) * (T / MATCH_SAMPLES)
+    d0, d1 = traj.element_samples(t)[0], traj.element_samples(t + T)[0]
+    size = np.maximum(np.ptp(np.concatenate((d0, d1)), axis=0), 1e-300)
+    return float(np.max(np.max(np.abs(d1 - d0), axis=0) / size))
+
+
+def exact_measures(traj: FrictionTrajectory, omega: float,
+                   period: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, np.ndarray, np.ndarray]:
+    """A row's values from the exact orbit ``traj`` of ``period`` forcing periods: every element's
+    mean and rms, the fraction of the period it sticks, z(0), the switching pattern (stick or lock
+    phases of each element, then its breakpoint crossings, per period) and the multipliers."""
+    m = traj.stick_time().size
+    mean, rms = traj.element_mean_and_rms()
+    stick = traj.stick_time() / (period * 2.0 * math.pi / omega)
+    pattern = np.empty(2 * m, dtype=np.int64)
+    for e in range(m):
+        mine = traj.event_elements == e
+        pattern[e] = int(np.sum(mine & np.isin(traj.event_kinds, (STICK, LOCK))))
+        pattern[m + e] = int(np.sum(mine & (traj.event_kinds == CROSSING)))
+    return mean, rms, stick, np.asarray(traj.state0, dtype=float), pattern, monodromy_multipliers(traj.sensitivity)
+
+
+#: An exact orbit shot over p > 1 forcing periods repeats after one when every δ_e comes back
+#: within this share of its peak-to-peak (the shooting converges to 1e-12 of the length scale).
+REPEAT_TOL = 1e-6
+
+
+def check_branch(system: FrictionSystem, make: Callable[[float, int], RegularisedSystemBalance],
+                 points: list, opts: RegularisationOptions, integ: FrictionIntegrator, *,  # type: ignore[type-arg]
+                 status: Status, message: str, branch: int = 0, origin: str = "") -> FrictionResponse:
+    """The rows of a continued HB branch ``points`` (:class:`~rattle.continuation.ContinuationPoint`
+    of ``make(ε, H)``'s problem, whose period p forcing periods is the orbits'), each checked by exact
+    shooting over p periods and refined at its regularisation's limit (module docstring, steps 2
+    and 3). A row of p > 1 whose exact orbit repeats after one forcing period is not matched."""
+    H, eps, match, refine = opts.harmonics, opts.regularisation, opts.match, opts.refine
+    problem = make(eps, H)
+    p = problem.period
     n, m = system.n, system.m
     L = problem.length_scale
     P = len(points)
     rms_hb = np.empty((P, m))
     rms, mean, stick = (np.full((P, m), np.nan) for _ in range(3))
+    states = np.full((P, 2 * n), np.nan)
     mult, mult_hb = np.full((P, 2 * n), np.nan + 0j), np.full((P, 2 * n), np.nan + 0j)
     matched, dist_all = np.zeros(P, dtype=bool), np.full(P, np.nan)
     pattern = np.full((P, 2 * m), -1, dtype=np.int64)
@@ -427,17 +476,17 @@ def friction_response(
         w, q = float(pt.omega), pt.q
         rms_hb[i] = problem.element_rms(q)
         z0 = problem.state_at_zero(q, w)
-        hb_flow = _hb_flow(integ, z0, w)
+        hb_flow = _hb_flow(integ, z0, w, p)
         mu_hb = _hb_multipliers(hb_flow) if opts.stability == "saltation" \
             else regularised_system_multipliers(problem, q, w)
         try:
-            orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30)
+            orbit = shoot_friction_orbit(system, w, z0, period=p, integrator=integ, max_iterations=30)
         except FLOW_FAILURES:
             orbit = None
         shot_failed = orbit is None or not orbit.converged
-        t = np.arange(MATCH_SAMPLES) * (2.0 * math.pi / w / MATCH_SAMPLES)
+        t = np.arange(MATCH_SAMPLES * p) * (2.0 * math.pi / w / MATCH_SAMPLES)
         E = problem.element_series(q)
-        d_hb = _hb_samples(problem, E, w, t)  # (64, m)
+        d_hb = _hb_samples(problem, E, w, t)  # (64 p, m)
         size = np.maximum(np.ptp(problem.basis.synthesize(E), axis=1), 1e-12 * L)
         traj = None
         if orbit is not None and orbit.converged:  # one orbit: every δ_e(t) within `match` of the HB's
@@ -448,7 +497,8 @@ def friction_response(
             held = _held_elements(hb_flow, E)
             if held:
                 try:
-                    orbit = shoot_friction_orbit(system, w, z0, integrator=integ, max_iterations=30, hold=held)
+                    orbit = shoot_friction_orbit(system, w, z0, period=p, integrator=integ, max_iterations=30,
+                                                 hold=held)
                 except FLOW_FAILURES:
                     orbit = None
                 if orbit is not None and orbit.converged and all(orbit.stick_fraction[e] >= 1.0 - 1e-9 for e in held):
@@ -474,15 +524,11 @@ def friction_response(
             if found is not None:
                 traj, dist_all[i] = found
                 matched[i] = dist_all[i] <= match
+        if matched[i] and traj is not None and p > 1 and period_gap(traj, w) <= REPEAT_TOL:
+            matched[i] = False  # a period-1 orbit: the branch has rejoined the primary there
         if matched[i]:
             assert traj is not None
-            mean[i], rms[i] = traj.element_mean_and_rms()
-            stick[i] = traj.stick_time() / (2.0 * math.pi / w)
-            for e in range(m):  # the switching pattern: stick or lock phases and breakpoint crossings per period
-                mine = traj.event_elements == e
-                pattern[i, e] = int(np.sum(mine & np.isin(traj.event_kinds, (STICK, LOCK))))
-                pattern[i, m + e] = int(np.sum(mine & (traj.event_kinds == CROSSING)))
-            mult[i] = monodromy_multipliers(traj.sensitivity)
+            mean[i], rms[i], stick[i], states[i], pattern[i], mult[i] = exact_measures(traj, w, p)
             if mu_hb is None:
                 mu_hb = mult[i]
         if mu_hb is not None:
@@ -512,7 +558,7 @@ def friction_response(
             lim_lin.append(lad.linear)
             w = float(points[i].omega)
             last = make(lad.last.eps, lad.last.harmonics)
-            mu_lim = _hb_multipliers(_hb_flow(integ, last.state_at_zero(lad.last.q, w), w)) \
+            mu_lim = _hb_multipliers(_hb_flow(integ, last.state_at_zero(lad.last.q, w), w, p)) \
                 if opts.stability == "saltation" else regularised_system_multipliers(last, lad.last.q, w)
             lim_mu.append(np.full(2 * n, np.nan + 0j) if mu_lim is None else mu_lim)
         except RattleError:  # the ladder stalled: the row keeps its ε
@@ -528,13 +574,14 @@ def friction_response(
         omega=omegas, rpm=None if rpm is None else np.asarray(rpm, dtype=float), element_names=system.element_names,
         rms=rms, rms_hb=rms_hb, mean=mean, stick_fraction=stick, matched=matched, match_distance=dist_all,
         stable=stable, stable_hb=stable_hb, multipliers=mult, multipliers_hb=mult_hb,
-        status=stepper.status or Status.SUCCESS, message=stepper.message, regularisation=float(eps), harmonics=int(H),
+        status=status, message=message, regularisation=float(eps), harmonics=int(H),
         limit_index=np.asarray(pick, dtype=int), limit_eps=np.array(lim_eps, dtype=float),
         limit_harmonics=np.array(lim_H, dtype=int), limit_rms=np.array(lim_rms, dtype=float).reshape(-1, m),
         limit_richardson=np.array(lim_rich, dtype=float).reshape(-1, m),
         limit_linear=np.array(lim_lin, dtype=bool),
         limit_multipliers=np.array(lim_mu, dtype=complex).reshape(-1, 2 * n), pattern=pattern,
+        period=p, branch=branch, origin=origin, states=states,
     )
 
 
-__all__ = ["FrictionResponse", "friction_balance_factory", "friction_response"]
+__all__ = ["FrictionResponse", "check_branch", "exact_measures", "period_gap", "friction_balance_factory", "friction_response"]

@@ -68,7 +68,9 @@ from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
-from ._branches import odd_indices
+from ._friction_response import friction_response
+from ._friction_subharmonics import friction_subharmonics
+from ._period_two import ODD_SHARE, beyond_minus_one, follow_both_ways, follow_exactly, odd_share
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -238,17 +240,16 @@ def nonsmooth_response(
     the settings ``options`` (:class:`RegularisationOptions`); with ``subharmonics`` also the
     period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
     ``branches``. A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
-    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`;
-    its period-1 branch only)."""
+    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`),
+    with ``subharmonics`` also to :func:`~rattle.analysis.friction_subharmonics`."""
     if not isinstance(subharmonics, bool):
         raise TypeError(f"`subharmonics` must be True or False, got {subharmonics!r}")
     if isinstance(system, FrictionSystem):
+        chain = friction_response(system, omega, options, continuation=continuation, newton=newton)
         if subharmonics:
-            raise ValueError("`subharmonics` is not supported for a chain with friction or jumps on its elements "
-                             "yet: only its period-1 branch is followed; leave `subharmonics` out")
-        from ._friction_response import friction_response
-
-        return friction_response(system, omega, options, continuation=continuation, newton=newton)
+            chain = dataclasses.replace(chain, branches=friction_subharmonics(
+                system, chain, omega, options, continuation=continuation, newton=newton))
+        return chain
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
                         f"friction, Chain.friction_system()), got {system!r}")
@@ -425,27 +426,6 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
     )
 
 
-#: A period-2 orbit counts as one (not the period-1 orbit run twice) while its odd harmonics of
-#: Ω/2 carry at least this share of δ's fluctuation (rms); a branch that falls below it has
-#: rejoined a period-1 branch.
-ODD_SHARE = 1e-4
-
-
-def _odd_share(q: FloatArray) -> float:
-    """‖odd harmonics‖ / ‖all harmonics‖ of a series of Ω/2 (0 for a period-1 orbit)."""
-    H = (q.size - 1) // 2
-    odd = odd_indices(H)
-    total = float(np.linalg.norm(q[1:]))
-    return float(np.linalg.norm(q[odd])) / total if total > 0 else 0.0
-
-
-def beyond_minus_one(multipliers: np.ndarray) -> bool:
-    """Whether one of the real ``multipliers`` lies beyond −1: the orbit is unstable by a period
-    doubling, and a period-2 orbit is born next to it."""
-    mu = np.asarray(multipliers)
-    return bool(np.any((mu.real < -1.0) & (np.abs(mu.imag) < 1e-9)))
-
-
 def _period_two_orbit(system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float,
                       state: FloatArray) -> NonsmoothOrbit | None:
     """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``, one
@@ -495,7 +475,7 @@ def _period_two_start(make2: Callable[[float, int], RegularisedBalance], orbit: 
     t = np.arange(N) * (2.0 * 2.0 * math.pi / omega / N)
     q0 = pb.basis.analyze(orbit.trajectory.sample(t)[0])
     res = solve_fixed(pb, q0, omega, newton or NewtonOptions())
-    if res.converged and _odd_share(res.q) >= 100 * ODD_SHARE:
+    if res.converged and odd_share(res.q) >= 100 * ODD_SHARE:
         return res.q
     for wide in (4.0 * eps, 10.0 * eps):
         try:
@@ -503,48 +483,9 @@ def _period_two_start(make2: Callable[[float, int], RegularisedBalance], orbit: 
                                      max_harmonics=H2, tail_tol=math.inf, newton=newton).last.q
         except RattleError:
             continue
-        if _odd_share(q) >= 100 * ODD_SHARE:
+        if odd_share(q) >= 100 * ODD_SHARE:
             return q
     return None
-
-
-def _follow_both_ways(problem: RegularisedBalance, q: FloatArray, omega: float, lo: float, hi: float,
-                      continuation: ContinuationOptions | None,
-                      newton: NewtonOptions | None) -> tuple[list[BranchPoint], Status, str]:
-    """The period-2 branch through (q, Ω) continued down to ``lo`` and up to ``hi``, each way until
-    it rejoins a period-1 branch (its odd harmonics fall below :data:`ODD_SHARE` of the
-    fluctuation, or change sign) or leaves the range: the points in order of the branch."""
-    parts: list[list[BranchPoint]] = []
-    ends: list[str] = []
-    status = Status.SUCCESS
-    for rng in ((lo, omega), (omega, hi)):
-        if rng[1] - rng[0] <= 1e-9 * hi:
-            parts.append([])
-            continue
-        odd = odd_indices((q.size - 1) // 2)
-        prev = {"odd": q[odd].copy()}
-
-        def rejoined(pt: BranchPoint, prev: dict = prev, odd: np.ndarray = odd) -> str | None:
-            o = pt.q[odd]
-            flipped = float(o @ prev["odd"]) < 0.0
-            prev["odd"] = o.copy()
-            if flipped or _odd_share(pt.q) < ODD_SHARE:
-                return f"the period-2 branch rejoined a period-1 branch near Ω = {pt.omega:.6g}"
-            return None
-
-        stepper = ContinuationStepper(problem, q, omega, rng, options=continuation or ContinuationOptions(),
-                                      newton=newton or NewtonOptions(), stop=rejoined)
-        pts = stepper.run()
-        if stepper.status is Status.STOPPED and pts:
-            pts = pts[:-1]  # the point past the rejoin is the period-1 orbit written twice
-        parts.append(pts)
-        if stepper.message:
-            ends.append(stepper.message)
-        if stepper.status not in (Status.SUCCESS, Status.STOPPED, None):
-            status = stepper.status
-    down, up = parts
-    points = list(reversed(down[1:])) + up if up else list(reversed(down))
-    return points, status, "; ".join(ends)
 
 
 def nonsmooth_subharmonics(
@@ -608,7 +549,7 @@ def nonsmooth_subharmonics(
             q2 = _period_two_start(make2, seed, w0, opts.regularisation, H2, newton)
             if q2 is None:
                 continue
-            points, status, message = _follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
+            points, status, message = follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
                                                         continuation, newton)
             if points:
                 branch = _check_branch(system, make2, opts, points, status, message, branch=len(out) + 1,
@@ -633,9 +574,6 @@ def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: Non
     period (the branch rejoined a period-1 branch) or the grid ends. Used where the regularised
     HB of period 2 has no orbit next to the exact one (e.g. where friction sticks: the
     regularisation's creep moves the period doubling); the rows carry no HB values (nan)."""
-    ends: list[str] = []
-    sides: list[list[tuple[float, NonsmoothOrbit]]] = []
-
     def shoot(w: float, prev: NonsmoothOrbit) -> NonsmoothOrbit | str:
         try:
             orbit = shoot_nonsmooth_orbit(system, w, prev.state0, period=2, integrator=integ, max_iterations=40)
@@ -648,35 +586,9 @@ def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: Non
                     "branch, or ends at a fold)")
         return orbit
 
-    def advance(prev: NonsmoothOrbit, w0: float, w1: float, depth: int = 0) -> tuple[list, str]:
-        """From the orbit ``prev`` at w0 to w1, halving the step up to 4 times where the shooting
-        fails: the orbits reached, and why it stopped short ("" when it reached w1)."""
-        got = shoot(w1, prev)
-        if not isinstance(got, str):
-            return [(w1, got)], ""
-        if depth >= 4:
-            return [], got
-        mid = 0.5 * (w0 + w1)
-        first, why = advance(prev, w0, mid, depth + 1)
-        if why:
-            return first, why
-        second, why = advance(first[-1][1], mid, w1, depth + 1)
-        return first + second, why
-
-    for ws in (grid[grid < omega][::-1], grid[grid > omega]):
-        side: list[tuple[float, NonsmoothOrbit]] = []
-        prev, w_prev = seed, omega
-        for w in ws.tolist():
-            reached, why = advance(prev, w_prev, w)
-            side.extend(reached)
-            if why:
-                ends.append(why)
-                break
-            prev, w_prev = reached[-1][1], w
-        sides.append(side)
-    down, up = sides
+    pairs, ends = follow_exactly(shoot, seed, omega, grid)
     rows: dict[str, list] = {k: [] for k in _ROW_KEYS}
-    for w, orbit in list(reversed(down)) + [(omega, seed)] + up:
+    for w, orbit in pairs:
         rows["omega"].append(w)
         rows["rms_hb"].append(math.nan)
         rows["mult_hb"].append(np.full(2, np.nan + 0j))

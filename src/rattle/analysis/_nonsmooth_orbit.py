@@ -191,7 +191,8 @@ def _period_two(system: NonsmoothSystem, omega: float, opts: RegularisationOptio
        as where friction sticks).
 
     Raises :class:`~rattle.errors.ConvergenceError` when no exact orbit of period 2 is found."""
-    from ._nonsmooth import _period_two_orbit, _period_two_start, _repeats_early, beyond_minus_one
+    from ._nonsmooth import _period_two_orbit, _period_two_start, _repeats_early
+    from ._period_two import beyond_minus_one
 
     integ = NonsmoothIntegrator(system)
     notes: list[str] = []

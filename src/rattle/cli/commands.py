@@ -211,8 +211,8 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
     """``rattle frf`` on a discontinuous law, or a chain with friction on its elements:
     :func:`rattle.analysis.nonsmooth_response` (a NonsmoothResponse, or a FrictionResponse for the
     chain) with the file's ``[analysis]`` (harmonics, regularisation, refine), written as one set
-    frf.csv, frf.json, frf.png; with ``subharmonics`` (one equation only) the period-2 branches
-    born at its period doublings too.
+    frf.csv, frf.json, frf.png; with ``subharmonics`` the period-2 branches born at its period
+    doublings too.
 
     Raises
     ------
@@ -237,7 +237,7 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
         ("frf.json", metadata_writer(meta, sections, t_start)),
         ("frf.png", lambda path: save_plot(result, path)),
     ])
-    summary = friction_summary(result, options) if chain else nonsmooth_summary(result, options, subharmonics)
+    summary = (friction_summary if chain else nonsmooth_summary)(result, options, subharmonics)
     echo_written(summary, written, output)
     if not result.status.success:
         raise ConvergenceError(
@@ -267,16 +267,12 @@ def frf_command(
 
     With --subharmonics every period-doubling point found on the primary branch starts a
     period-2 branch (and so on, up to period 4); each branch has its colour in frf.png. On a
-    discontinuous law (one equation) the period-2 branches born at the period doublings of the
-    period-1 branch, every point checked by exact shooting over two periods; on a chain with
-    friction or jumps on its elements it is refused.
+    discontinuous law, or a chain with friction or jumps on its elements, the period-2 branches
+    born at the period doublings of the period-1 branch, every point checked by exact shooting
+    over two periods.
     """
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
-    if getattr(run_config, "chain_friction", False) and subharmonics:
-        raise ConfigError(f"`--subharmonics` is not supported for a chain with friction or jumps on its elements "
-                          f"({_law_keys(run_config)}) yet: only its period-1 branch is followed; leave "
-                          "--subharmonics out")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,

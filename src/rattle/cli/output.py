@@ -316,6 +316,28 @@ def _largest(values: Any, rows: Any) -> float | None:
     return float(np.max(v)) if v.size else None
 
 
+def _branch_lines(result: Any, subharmonics: bool) -> list[str]:
+    """The summary's lines on the sub-harmonic branches of ``result`` (a discontinuous law's or a
+    chain's), or on the period doublings that started none (``subharmonics``: whether they were
+    asked for)."""
+    import numpy as np
+
+    lines = []
+    for b in getattr(result, "branches", ()):
+        m = np.asarray(b.matched, dtype=bool)
+        worst = _largest(b.rms_error, m)
+        how = (f"{int(np.count_nonzero(m))} matched by exact shooting over {b.period} periods"
+               if b.followed == "harmonic balance" else
+               "followed by exact shooting alone (the regularised HB has no period-2 orbit next to the exact one)")
+        lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
+                     f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {how}; stable over Ω = {_stable_spans(b)}"
+                     + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
+    if "period_doubling" in set(result.bifurcation.tolist()) and not getattr(result, "branches", ()):
+        lines.append("no period-2 orbit was found next to the period doubling(s)" if subharmonics else
+                     "period doubling found: run with --subharmonics for the period-2 branches born there")
+    return lines
+
+
 def nonsmooth_summary(result: Any, options: Any, subharmonics: bool = False) -> str:
     """What ``rattle frf`` prints for a discontinuous law (``subharmonics``: whether the
     sub-harmonic branches were asked for)."""
@@ -352,18 +374,7 @@ def nonsmooth_summary(result: Any, options: Any, subharmonics: bool = False) -> 
     if changes:
         lines.append("bifurcations (between rows; grazing: a crossing or a stick phase appears or vanishes): "
                      + ", ".join(changes))
-    for b in getattr(result, "branches", ()):
-        m = np.asarray(b.matched, dtype=bool)
-        worst = _largest(b.rms_error, m)
-        how = (f"{int(np.count_nonzero(m))} matched by exact shooting over {b.period} periods"
-               if b.followed == "harmonic balance" else
-               "followed by exact shooting alone (the regularised HB has no period-2 orbit next to the exact one)")
-        lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
-                     f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {how}; stable over Ω = {_stable_spans(b)}"
-                     + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
-    if "period_doubling" in set(labels.tolist()) and not getattr(result, "branches", ()):
-        lines.append("no period-2 orbit was found next to the period doubling(s)" if subharmonics else
-                     "period doubling found: run with --subharmonics for the period-2 branches born there")
+    lines.extend(_branch_lines(result, subharmonics))
     return "\n".join(lines)
 
 
@@ -404,14 +415,15 @@ def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str,
         "message": result.message or result.status.message,
         "points": len(result),
         **own,
+        "branches": [_branch_metadata(b) for b in getattr(result, "branches", ())],
         "timings": dict(timings),
     }
 
 
-def friction_summary(result: Any, options: Any) -> str:
+def friction_summary(result: Any, options: Any, subharmonics: bool = False) -> str:
     """What ``rattle frf`` prints for a chain with friction on its elements: the response's summary
-    (:meth:`FrictionResponse.summary`), the continuation's status, and every element's largest
-    exact rms."""
+    (:meth:`FrictionResponse.summary`), the continuation's status, every element's largest exact
+    rms, and the sub-harmonic branches (``subharmonics``: whether they were asked for)."""
     import numpy as np
 
     lines = [result.summary(), f"status: {result.status.name.lower()} — {result.message or result.status.message}"]
@@ -422,6 +434,7 @@ def friction_summary(result: Any, options: Any) -> str:
         if np.any(np.isfinite(col)):
             j = int(np.nanargmax(col))
             lines.append(f"{name}: largest exact rms {col[j]:.5g} rad at Ω = {result.omega[j]:.5g}")
+    lines.extend(_branch_lines(result, subharmonics))
     return "\n".join(lines)
 
 

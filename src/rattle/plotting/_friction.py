@@ -4,7 +4,9 @@
 element: the exact orbits solid where stable, thin dotted where unstable (with × markers), the
 regularised harmonic balance dashed; the stability changes labelled; the Ω-ranges where some
 element of the exact orbit sticks for part of the period shaded. Bottom panel: each element's
-stick fraction (the part of the period its friction holds it).
+stick fraction (the part of the period its friction holds it). The sub-harmonic branches
+(``response.branches``) are drawn dash-dotted in each element's colour (stable; unstable thin
+dotted).
 """
 
 from __future__ import annotations
@@ -48,6 +50,14 @@ def friction_response_plot(response: FrictionResponse) -> tuple[Any, PlotAxes]:
                 ax.plot(w[sel], response.rms[sel, e], marker, color="tab:red", ms=5, ls="none",
                         label=kind.replace("_", " ") if e == 0 else None)
         ax_s.plot(w, np.where(matched, response.stick_fraction[:, e], np.nan), "-", color=c, lw=1.2, label=name)
+        for br in response.branches:  # the sub-harmonic branches: the element's colour, dash-dotted
+            ok = br.matched & br.stable
+            ax.plot(br.omega, np.where(ok, br.rms[:, e], np.nan), "-.", color=c, lw=2.2, alpha=0.75,
+                    label=f"{name}: period {br.period}, branch {br.branch}, stable")
+            if np.any(br.matched & ~br.stable):
+                ax.plot(br.omega, np.where(br.matched & ~br.stable, br.rms[:, e], np.nan), ":", color=c, lw=1.0,
+                        alpha=0.75)
+            ax_s.plot(br.omega, np.where(br.matched, br.stick_fraction[:, e], np.nan), "-.", color=c, lw=1.0)
     held = matched & (np.nan_to_num(response.stick_fraction).max(axis=1) > 0.0) if len(response) else matched
     for i, (a, b) in enumerate(_held_runs(w, held)):
         ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="an element sticks" if i == 0 else None)

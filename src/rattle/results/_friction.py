@@ -55,7 +55,16 @@ class FrictionResponse:
     whether the last three rungs lie on a line in ε for every element (Richardson's value then
     holds), ``limit_multipliers`` (k, 2n) the multipliers of the HB orbit at the smallest ε
     (:attr:`stable_hb_limit`). ``pattern`` (P, 2m): the exact orbit's stick phases (columns 0 … m−1)
-    and breakpoint crossings (m … 2m−1) per period of every element, −1 where not matched."""
+    and breakpoint crossings (m … 2m−1) per period of every element, −1 where not matched.
+
+    ``period`` p: the orbits repeat after p forcing periods (1: the primary branch; 2: a
+    sub-harmonic branch born at a period doubling, :func:`rattle.analysis.friction_subharmonics`);
+    ``branch`` its number (0 the primary), ``origin`` where it was born; ``states`` (P, 2n) the
+    exact orbit's z(0) = (x, x') (nan where not matched). The primary branch carries the
+    sub-harmonic ones in ``branches`` (empty unless asked for); :meth:`to_csv` writes them all, the
+    primary's rows first. ``followed``: how the branch was continued, ``"harmonic balance"`` or
+    ``"exact shooting"`` (a sub-harmonic branch the regularised HB has no orbit for: every row an
+    exact orbit, the HB columns nan)."""
 
     omega: FloatArray
     rpm: FloatArray | None
@@ -82,6 +91,12 @@ class FrictionResponse:
     limit_linear: np.ndarray
     limit_multipliers: ComplexArray | None = None
     pattern: np.ndarray | None = None
+    period: int = 1
+    branch: int = 0
+    origin: str = ""
+    states: FloatArray | None = None
+    branches: tuple[FrictionResponse, ...] = ()
+    followed: str = "harmonic balance"
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -190,15 +205,16 @@ class FrictionResponse:
 
     # --- output -------------------------------------------------------------------------------
     def column_names(self) -> list[str]:
-        """omega, speed_rpm (with an engine order), NAME_ + :data:`FRICTION_ELEMENT_COLUMNS` per element,
-        then :data:`FRICTION_TAIL_COLUMNS`."""
-        head = ["omega"] + ([] if self.rpm is None else ["speed_rpm"])
+        """branch, period, omega, speed_rpm (with an engine order), NAME_ + :data:`FRICTION_ELEMENT_COLUMNS`
+        per element, then :data:`FRICTION_TAIL_COLUMNS`."""
+        head = ["branch", "period", "omega"] + ([] if self.rpm is None else ["speed_rpm"])
         per = [f"{name}_{c}" for name in self.element_names for c in FRICTION_ELEMENT_COLUMNS]
         return head + per + list(FRICTION_TAIL_COLUMNS)
 
     def columns(self) -> dict[str, np.ndarray]:
         """The rows as columns, in the order of :meth:`column_names`."""
-        cols: dict[str, np.ndarray] = {"omega": self.omega}
+        cols: dict[str, np.ndarray] = {"branch": np.full(len(self), self.branch, dtype=np.int64),
+                                       "period": np.full(len(self), self.period, dtype=np.int64), "omega": self.omega}
         if self.rpm is not None:
             cols["speed_rpm"] = self.rpm
         err = self.element_rms_error
@@ -217,11 +233,16 @@ class FrictionResponse:
                     stable_hb_limit=self.stable_hb_limit)
         return cols
 
+    def all_columns(self) -> dict[str, np.ndarray]:
+        """:meth:`columns` of this branch followed by those of each of :attr:`branches`."""
+        parts = [self.columns()] + [b.columns() for b in self.branches]
+        return {k: np.concatenate([np.asarray(p[k]) for p in parts]) for k in parts[0]}
+
     def to_csv(self, path: str | Path) -> Path:
-        """Write :meth:`columns` to ``path`` atomically."""
+        """Write :meth:`all_columns` (this branch, then its sub-harmonic ones) to ``path`` atomically."""
         from ..files._csv import write_csv
 
-        write_csv(path, self.columns(), self.column_names())
+        write_csv(path, self.all_columns(), self.column_names())
         return Path(path)
 
     def metadata(self) -> dict[str, Any]:

@@ -1,0 +1,134 @@
+"""Period-2 branches of the regularised harmonic balance: shared by the single equation
+(:func:`rattle.analysis.nonsmooth_subharmonics`) and the chain with friction
+(:func:`rattle.analysis.friction_subharmonics`).
+
+A period-2 orbit is written with H₂ harmonics of ω = Ω/2: its odd harmonics are what the
+period-1 orbit run twice does not have. Its share of the fluctuation,
+
+    s(q) = ‖q_odd‖ / ‖q_{k ≥ 1}‖   (over every coordinate's series),
+
+tells a period-2 orbit (s ≥ :data:`ODD_SHARE`) from the period-1 orbit it rejoins at a period
+doubling (s → 0, and the odd part changes sign as the branch passes through it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TypeVar
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..continuation import BranchPoint, ContinuationOptions, ContinuationProblem, ContinuationStepper, NewtonOptions
+from ..errors import Status
+from ._branches import odd_indices
+
+T = TypeVar("T")
+
+#: A period-2 orbit counts as one (not the period-1 orbit run twice) while its odd harmonics of
+#: Ω/2 carry at least this share of δ's fluctuation (rms); a branch that falls below it has
+#: rejoined a period-1 branch.
+ODD_SHARE = 1e-4
+
+
+def _odd(q: FloatArray, coordinates: int) -> np.ndarray:
+    """The indices of the odd harmonics in ``q`` (``coordinates`` series of 2H + 1, coordinate-major)."""
+    return odd_indices((q.size // coordinates - 1) // 2, coordinates)
+
+
+def odd_share(q: FloatArray, coordinates: int = 1) -> float:
+    """s(q) = ‖odd harmonics‖ / ‖all harmonics‖ of ``coordinates`` series of Ω/2 (module
+    docstring; 0 for a period-1 orbit)."""
+    q = np.asarray(q, dtype=float)
+    fluct = q.reshape(coordinates, -1)[:, 1:]
+    total = float(np.linalg.norm(fluct))
+    return float(np.linalg.norm(q[_odd(q, coordinates)])) / total if total > 0 else 0.0
+
+
+def beyond_minus_one(multipliers: np.ndarray) -> bool:
+    """Whether one of the real ``multipliers`` lies beyond −1: the orbit is unstable by a period
+    doubling, and a period-2 orbit is born next to it."""
+    mu = np.asarray(multipliers)
+    return bool(np.any((mu.real < -1.0) & (np.abs(mu.imag) < 1e-9)))
+
+
+def follow_both_ways(problem: ContinuationProblem, q: FloatArray, omega: float, lo: float, hi: float,
+                     continuation: ContinuationOptions | None,
+                     newton: NewtonOptions | None) -> tuple[list[BranchPoint], Status, str]:
+    """The period-2 branch of ``problem`` (a regularised HB of period 2; a chain's when it has
+    ``n_coordinates``) through (q, Ω) continued down to ``lo`` and up to ``hi``, each way until it
+    rejoins a period-1 branch (its odd harmonics fall below :data:`ODD_SHARE` of the fluctuation,
+    or change sign) or leaves the range: the points in order of the branch."""
+    n = int(getattr(problem, "n_coordinates", 1))
+    odd = _odd(q, n)
+    parts: list[list[BranchPoint]] = []
+    ends: list[str] = []
+    status = Status.SUCCESS
+    for rng in ((lo, omega), (omega, hi)):
+        if rng[1] - rng[0] <= 1e-9 * hi:
+            parts.append([])
+            continue
+        prev = {"odd": q[odd].copy()}
+
+        def rejoined(pt: BranchPoint, prev: dict = prev) -> str | None:  # type: ignore[type-arg]
+            o = pt.q[odd]
+            flipped = float(o @ prev["odd"]) < 0.0
+            prev["odd"] = o.copy()
+            if flipped or odd_share(pt.q, n) < ODD_SHARE:
+                return f"the period-2 branch rejoined a period-1 branch near Ω = {pt.omega:.6g}"
+            return None
+
+        stepper = ContinuationStepper(problem, q, omega, rng, options=continuation or ContinuationOptions(),
+                                      newton=newton or NewtonOptions(), stop=rejoined)
+        pts = stepper.run()
+        if stepper.status is Status.STOPPED and pts:
+            pts = pts[:-1]  # the point past the rejoin is the period-1 orbit written twice
+        parts.append(pts)
+        if stepper.message:
+            ends.append(stepper.message)
+        if stepper.status not in (Status.SUCCESS, Status.STOPPED, None):
+            status = stepper.status
+    down, up = parts
+    points = list(reversed(down[1:])) + up if up else list(reversed(down))
+    return points, status, "; ".join(ends)
+
+
+def follow_exactly(shoot: Callable[[float, T], T | str], seed: T, omega: float,
+                   grid: FloatArray) -> tuple[list[tuple[float, T]], list[str]]:
+    """An exact branch through the orbit ``seed`` at ``omega`` followed over the frequencies
+    ``grid`` each way by natural continuation: ``shoot(Ω, previous orbit)`` gives the orbit at Ω
+    from the previous one, or why it failed (a string). Where it fails the step is halved up to
+    4 times; the side ends at the first failure left. Returns the (Ω, orbit) pairs in order of Ω
+    (the seed included) and why each side ended."""
+    ends: list[str] = []
+
+    def advance(prev: T, w0: float, w1: float, depth: int = 0) -> tuple[list[tuple[float, T]], str]:
+        got = shoot(w1, prev)
+        if not isinstance(got, str):
+            return [(w1, got)], ""
+        if depth >= 4:
+            return [], got
+        mid = 0.5 * (w0 + w1)
+        first, why = advance(prev, w0, mid, depth + 1)
+        if why:
+            return first, why
+        second, why = advance(first[-1][1], mid, w1, depth + 1)
+        return first + second, why
+
+    sides: list[list[tuple[float, T]]] = []
+    for ws in (grid[grid < omega][::-1], grid[grid > omega]):
+        side: list[tuple[float, T]] = []
+        prev, w_prev = seed, omega
+        for w in ws.tolist():
+            reached, why = advance(prev, w_prev, w)
+            side.extend(reached)
+            if why:
+                ends.append(why)
+                break
+            prev, w_prev = reached[-1][1], w
+        sides.append(side)
+    down, up = sides
+    return list(reversed(down)) + [(omega, seed)] + up, ends
+
+
+__all__ = ["ODD_SHARE", "beyond_minus_one", "follow_both_ways", "follow_exactly", "odd_share"]
