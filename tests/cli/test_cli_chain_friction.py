@@ -59,7 +59,7 @@ def test_map_refuses_a_chain_with_friction_and_writes_nothing(tmp_path, args):
 
 
 @pytest.mark.parametrize("args, fragments", [
-    (["--period", "2"], ["`--period` 2", "only the period-1 orbit of a chain with friction", "leave --period out"]),
+    (["--period", "3"], ["`--period` 3", "a chain with friction on its elements", "computed for period 1 or 2"]),
     (["--omega-min", "0.5"], ["`--omega-min` is not used for a chain with friction", "leave it out"]),
     (["--omega-max", "1.5"], ["`--omega-max` is not used for a chain with friction"]),
     (["--harmonics", "0"], ["`--harmonics`"]),

@@ -35,6 +35,7 @@ settling).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -53,12 +54,14 @@ from ._friction_response import (
     _hb_flow,
     _hb_multipliers,
     _hb_samples,
+    REPEAT_TOL,
     _orbit_spectrum,
     _settled,
     _start,
     _stuck_elements,
     chain_options,
     friction_balance_factory,
+    period_gap,
 )
 from ._regularisation import RegularisationOptions
 
@@ -78,10 +81,12 @@ def _check_x0(value: object, n: int) -> FloatArray:
 
 
 def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: FrictionIntegrator,
-           hold: dict[int, float] | None = None) -> tuple[FrictionOrbit | None, str]:
-    """The exact orbit from ``z0`` (``hold`` the elements held), or (None, why)."""
+           hold: dict[int, float] | None = None, period: int = 1) -> tuple[FrictionOrbit | None, str]:
+    """The exact orbit of ``period`` forcing periods from ``z0`` (``hold`` the elements held), or
+    (None, why)."""
     try:
-        orbit = shoot_friction_orbit(system, omega, z0, integrator=integ, max_iterations=30, hold=hold or None)
+        orbit = shoot_friction_orbit(system, omega, z0, period=period, integrator=integ, max_iterations=30,
+                                     hold=hold or None)
     except FLOW_FAILURES as exc:  # e.g. the event budget of a chattering orbit, a loop of stuck elements
         return None, f"{type(exc).__name__}: {exc}"
     if not orbit.converged:
@@ -107,19 +112,26 @@ def friction_orbit(
     options: RegularisationOptions | None = None,
     *,
     x0: FloatArray | None = None,
+    period: int = 1,
 ) -> FrictionOrbitResult:
     """The periodic orbit of the chain with friction ``system`` at forcing frequency ``omega``
     (module docstring), with the HB settings ``options``
     (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε,
     ``match`` and ``stability``, how the HB orbit's own multipliers are found; the ladder settings
     are not used here. None: :func:`~rattle.analysis._friction_response.chain_options`). ``x0`` = (x, x') at
-    t = 0 (2n numbers) starts the exact shooting instead of the HB orbit's state.
+    t = 0 (2n numbers) starts the exact shooting instead of the HB orbit's state. ``period`` 2:
+    the period-doubled orbit (:func:`_period_two`; raises ConvergenceError where the motion has
+    period 1).
 
     A failed exact shooting is reported in the result (``converged`` False, ``message``); a failed
     HB leaves nan series. Raises :class:`~rattle.errors.ConvergenceError` when neither is found,
     TypeError/ValueError on bad arguments (``system`` not a FrictionSystem, ``omega`` not finite
     and > 0, ``options`` not a RegularisationOptions or with too few harmonics for the
-    excitation, ``x0`` not a finite state of shape (2n,))."""
+    excitation, ``x0`` not a finite state of shape (2n,), ``period`` not 1 or 2)."""
+    if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period not in (1, 2):
+        raise ValueError(f"`period` must be 1 or 2, got {period!r}")
+    if period == 2:
+        return _period_two(system, omega, options, x0)
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     omega = check_omega(omega)
@@ -218,6 +230,71 @@ def friction_orbit(
     return _result(system, problem, omega, opts, orbit, q, E, hb_flow, start, hb_start, held, notes)
 
 
+def _period_two(system: FrictionSystem, omega: float, options: RegularisationOptions | None,
+                x0: FloatArray | None) -> FrictionOrbitResult:
+    """The period-2 orbit of the chain at ``omega``: the exact one first, then its regularised HB
+    of period 2.
+
+    1. The period-1 orbit (:func:`friction_orbit`, from ``x0`` or the HB state); where one of its
+       multipliers lies beyond −1 the period-2 orbit next to it is shot from it pushed along that
+       multiplier's eigenvector (:func:`~rattle.analysis._friction_subharmonics.period_two_orbit`);
+    2. else the exact flow is run for 2 × :data:`SETTLE_PERIODS` forcing periods from ``x0`` (or
+       the period-1 orbit's state, or rest) and shot over two periods from where it arrived;
+    3. an orbit that repeats after one period is not one of period 2; the HB of period 2 (2H
+       harmonics of Ω/2) is solved from the exact orbit's spectrum (nan when it falls back to
+       period 1, as where friction sticks).
+
+    Raises :class:`~rattle.errors.ConvergenceError` when no exact orbit of period 2 is found."""
+    from ._friction_subharmonics import _period_two_start, period_two_orbit
+    from ._period_two import beyond_minus_one
+
+    one = friction_orbit(system, omega, options, x0=x0)  # validates every argument
+    opts = chain_options(system) if options is None else options
+    n = system.n
+    integ = FrictionIntegrator(system)
+    notes: list[str] = []
+    seed, start = None, ""
+    if one.converged and beyond_minus_one(one.multipliers):
+        seed = period_two_orbit(system, integ, omega, one.state0)
+        start = "x0" if x0 is not None else "hb"
+        if seed is None:
+            notes.append("the period-1 orbit is unstable by a multiplier beyond −1, but no period-2 orbit was found "
+                         "next to it")
+    if seed is None:
+        where = "`x0`" if x0 is not None else ("the period-1 orbit" if one.converged else "rest")
+        origin = _check_x0(x0, n) if x0 is not None else (one.state0 if one.converged else np.zeros(2 * n))
+        settled = _settled(integ, origin, omega, 2 * SETTLE_PERIODS)
+        if settled is None:
+            notes.append(f"the exact flow from {where} could not be followed for {2 * SETTLE_PERIODS} periods")
+        else:
+            orbit, why = _shoot(system, omega, settled, integ, period=2)
+            if orbit is None:
+                notes.append(f"the motion settled from {where} could not be shot over two periods ({why})")
+            elif period_gap(orbit.trajectory, omega) <= REPEAT_TOL:
+                notes.append(f"the motion settled from {where} repeats after one forcing period")
+            else:
+                seed, start = orbit, "settled"
+    if seed is None:
+        raise ConvergenceError(f"no periodic orbit of period 2 at `omega` = {omega:g}: " + "; ".join(notes)
+                               + "; the orbit there is of period 1 (rattle orbit without --period), or, in the "
+                               "library, give `x0` near a period-2 motion")
+    H2 = 2 * opts.harmonics
+    opts2 = dataclasses.replace(opts, harmonics=H2, limit_harmonics=max(opts.limit_harmonics, H2),
+                                deep_harmonics=max(opts.deep_harmonics, H2))
+    make2 = friction_balance_factory(system, period=2)
+    problem = make2(opts.regularisation, H2)
+    q = _period_two_start(make2, seed, omega, opts.regularisation, H2, None)
+    E = hb_flow = None
+    if q is None:
+        notes.append("the regularised HB of period 2 has no orbit next to the exact one (it falls back to period 1): "
+                     "only the exact orbit is given")
+    else:
+        E = problem.element_series(q)
+        hb_flow = _hb_flow(integ, problem.state_at_zero(q, omega), omega, 2)
+    return _result(system, problem, omega, opts2, seed, q, E, hb_flow, start, "exact" if q is not None else "", {},
+                   notes, periods=2)
+
+
 def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> FloatArray:  # type: ignore[no-untyped-def]
     """The HB at ε from the series ``q0`` (Newton at ε; raises RattleError)."""
     from ._regularisation import regularisation_limit
@@ -228,10 +305,11 @@ def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> Float
 
 def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
             q: FloatArray | None, E: FloatArray | None, hb_flow: FrictionTrajectory | None, start: str,
-            hb_start: str, held: dict[int, float], notes: list[str]) -> FrictionOrbitResult:
-    """The result's samples and measures (:class:`~rattle.results.FrictionOrbitResult`)."""
+            hb_start: str, held: dict[int, float], notes: list[str], periods: int = 1) -> FrictionOrbitResult:
+    """The result's samples and measures (:class:`~rattle.results.FrictionOrbitResult`) over the
+    orbit's ``periods`` forcing periods (``problem``'s and ``opts``' H those of that period)."""
     n, m, H = system.n, system.m, opts.harmonics
-    T = 2.0 * math.pi / omega
+    T = periods * 2.0 * math.pi / omega
     t = np.linspace(0.0, T, ORBIT_POINTS + 1)
     nan_m = np.full(m, math.nan)
     if orbit is not None:
@@ -274,7 +352,7 @@ def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: fl
         status=Status.CONVERGED if orbit is not None else Status.MAX_ITERATIONS, message="; ".join(notes),
         start=start, coefficients_hb=coeff, delta_hb=delta_hb, rms_hb=rms_hb, multipliers_hb=mult_hb,
         regularisation=float(opts.regularisation), harmonics=int(H), hb_start=hb_start, match=float(opts.match),
-        held=tuple(system.element_names[e] for e in held), settle_periods=SETTLE_PERIODS,
+        held=tuple(system.element_names[e] for e in held), settle_periods=SETTLE_PERIODS, periods=periods,
     )
 
 

@@ -554,11 +554,8 @@ def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | No
     law = _law_keys(run_config)
     what = ("a chain with friction on its elements" if getattr(run_config, "chain_friction", False)
             else "a discontinuous law")
-    chain = getattr(run_config, "chain_friction", False)
-    if period != 1 and (chain or period > 2):
-        raise ConfigError(f"`--period` {period}: only the period-1 orbit of {what} ({law}) is computed yet; "
-                          "leave --period out" if chain else
-                          f"`--period` {period}: the orbit of {what} ({law}) is computed for period 1 or 2; "
+    if period > 2:
+        raise ConfigError(f"`--period` {period}: the orbit of {what} ({law}) is computed for period 1 or 2; "
                           "use --period 2 for a period-doubled orbit")
     for option, value in (("--omega-min", omega_min), ("--omega-max", omega_max)):
         if value is not None:
@@ -573,8 +570,9 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     shot from it, every element's stick phases), written as one set orbit.csv, orbit.json,
     orbit.png.
 
-    Only the period-1 orbit; ``--omega-min``/``--omega-max`` are refused (exit 2). Raises
-    ConvergenceError (exit 1) after writing the set when the exact shooting failed.
+    ``period`` 1 or 2 (above 2, and ``--omega-min``/``--omega-max``, are refused: exit 2). Raises
+    ConvergenceError (exit 1) after writing the set when the exact shooting failed, and before
+    writing anything when no orbit of period 2 exists there.
     """
     analysis, options = _nonsmooth_orbit_settings(run_config, omega, period, harmonics, omega_min, omega_max)
     t_start = time.perf_counter()
@@ -583,14 +581,15 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     system = run_config.model
     logger.info("computing the orbit of a chain with friction at Ω = %g: regularised harmonic balance (H = %d, "
                 "ε = %g) and exact shooting", omega, options.harmonics, options.regularisation)
-    result = friction_orbit(system, omega, options)
+    result = friction_orbit(system, omega, options, period=period)
     timings = {"friction_orbit": time.perf_counter() - t_start}
     elements = [{"name": name, "law": law.elastic.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}
                 for e, (name, law) in enumerate(zip(system.element_names, system.laws))]
     meta = {
         "settings": {"method": "exact event-driven shooting of the chain (Filippov sticking, saltation monodromy) "
                                "started from its regularised harmonic balance (rattle.analysis.friction_orbit)",
-                     "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match},
+                     "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
+                     "period": period},
         "system": {"coordinates": int(system.n), "elements": elements},
         "status": "converged" if result.converged else "failed",
         "message": result.message or ("" if result.converged else "the exact shooting did not converge"),

@@ -5,8 +5,8 @@ element: the exact orbits solid where stable, thin dotted where unstable (with Ã
 regularised harmonic balance dashed; the stability changes labelled; the Î©-ranges where some
 element of the exact orbit sticks for part of the period shaded. Bottom panel: each element's
 stick fraction (the part of the period its friction holds it). The sub-harmonic branches
-(``response.branches``) are drawn dash-dotted in each element's colour (stable; unstable thin
-dotted).
+(``response.branches``) are drawn dash-dotted in each element's colour (stable thick, unstable
+thin).
 """
 
 from __future__ import annotations
@@ -51,12 +51,10 @@ def friction_response_plot(response: FrictionResponse) -> tuple[Any, PlotAxes]:
                         label=kind.replace("_", " ") if e == 0 else None)
         ax_s.plot(w, np.where(matched, response.stick_fraction[:, e], np.nan), "-", color=c, lw=1.2, label=name)
         for br in response.branches:  # the sub-harmonic branches: the element's colour, dash-dotted
-            ok = br.matched & br.stable
-            ax.plot(br.omega, np.where(ok, br.rms[:, e], np.nan), "-.", color=c, lw=2.2, alpha=0.75,
-                    label=f"{name}: period {br.period}, branch {br.branch}, stable")
-            if np.any(br.matched & ~br.stable):
-                ax.plot(br.omega, np.where(br.matched & ~br.stable, br.rms[:, e], np.nan), ":", color=c, lw=1.0,
-                        alpha=0.75)
+            for ok, lw, kind in ((br.matched & br.stable, 2.2, "stable"), (br.matched & ~br.stable, 0.9, "unstable")):
+                if np.any(ok):
+                    ax.plot(br.omega, np.where(ok, br.rms[:, e], np.nan), "-.", color=c, lw=lw, alpha=0.75,
+                            label=f"{name}: period {br.period}, branch {br.branch}, {kind}")
             ax_s.plot(br.omega, np.where(br.matched, br.stick_fraction[:, e], np.nan), "-.", color=c, lw=1.0)
     held = matched & (np.nan_to_num(response.stick_fraction).max(axis=1) > 0.0) if len(response) else matched
     for i, (a, b) in enumerate(_held_runs(w, held)):

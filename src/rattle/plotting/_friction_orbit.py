@@ -43,7 +43,8 @@ def friction_orbit_plot(result: FrictionOrbitResult) -> tuple[Any, PlotAxes]:
                        label="stick (friction holds)" if i == 0 else None)
         text = name
         if result.converged:
-            text += (f": rms {result.rms[e]:.4g} rad (HB {result.element_rms_error[e]:+.1e}), "
+            err = result.element_rms_error[e]
+            text += (f": rms {result.rms[e]:.4g} rad ({f'HB {err:+.1e}' if np.isfinite(err) else 'no HB'}), "
                      f"sticks {result.stick_fraction[e]:.1%} of the period")
         ax.set_title(text, fontsize="small", loc="left")
         ax.set_ylabel(f"δ {name} (rad)")
@@ -56,7 +57,8 @@ def friction_orbit_plot(result: FrictionOrbitResult) -> tuple[Any, PlotAxes]:
     if result.speed_rpm is not None:
         title += f" ({result.speed_rpm:.5g} rpm)"
     if result.converged:
-        title += f": {'stable' if result.stable else 'unstable'} (max |μ| = {result.mu_abs:.3g}), period {T:.4g} s"
+        title += (f": {'stable' if result.stable else 'unstable'} (max |μ| = {result.mu_abs:.3g}), period {T:.4g} s"
+                  + ("" if result.periods == 1 else f" ({result.periods} forcing periods)"))
     else:
         title += ": no exact orbit (HB only)"
     fig.suptitle(title, fontsize="medium")

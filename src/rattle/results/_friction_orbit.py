@@ -68,7 +68,9 @@ class FrictionOrbitResult:
     regularised chain's monodromy along it, by the options' ``stability``; nan where not found), ``hb_start`` how it was solved (``"linear"``: from the linearised
     chain, ε narrowed from wide steps; ``"exact"``: from the exact orbit's spectrum, after that
     failed; ``""`` failed). ``match``: the largest :attr:`match_distance` for the two orbits to
-    count as one (:attr:`matched`)."""
+    count as one (:attr:`matched`). ``periods`` p: the orbit repeats after p forcing periods (1,
+    or 2 for a period-doubled orbit, ``friction_orbit(..., period=2)``); ``t`` then spans
+    [0, pT], and the HB series (2H harmonics) is one of Ω/p."""
 
     omega: float
     speed_rpm: float | None
@@ -97,12 +99,13 @@ class FrictionOrbitResult:
     match: float = 0.1
     held: tuple[str, ...] = ()
     settle_periods: int = 100
+    periods: int = 1
 
     # --- the period and the HB series --------------------------------------------------------
     @property
     def period(self) -> float:
-        """T = 2π/Ω (s)."""
-        return 2.0 * math.pi / self.omega
+        """The orbit's period p·2π/Ω (s), p = :attr:`periods` forcing periods."""
+        return self.periods * 2.0 * math.pi / self.omega
 
     @property
     def m(self) -> int:
@@ -117,7 +120,7 @@ class FrictionOrbitResult:
         Q = self.coefficients_hb
         H = self.harmonics
         t = np.asarray(t, dtype=float)
-        kw = np.arange(1, H + 1) * self.omega
+        kw = np.arange(1, H + 1) * (self.omega / self.periods)
         ph = np.multiply.outer(t, kw)
         a, b = Q[:, 1 : H + 1].T, Q[:, H + 1 :].T
         if derivative == 0:
@@ -220,7 +223,7 @@ class FrictionOrbitResult:
             "method": "exact event-driven shooting (Filippov sticking, saltation monodromy) started from the "
                       "chain's regularised harmonic balance (rattle.analysis.friction_orbit)",
             "omega": self.omega, "speed_rpm": None if self.speed_rpm is None else _num(self.speed_rpm),
-            "period": self.period, "converged": bool(self.converged), "status": self.status.name.lower(),
+            "period": self.period, "periods": self.periods, "converged": bool(self.converged), "status": self.status.name.lower(),
             "message": self.message, "start": self.start, "hb_start": self.hb_start, "held": list(self.held),
             "regularisation": self.regularisation, "harmonics": self.harmonics,
             "stable": self.stable, "stable_hb": self.stable_hb, "mu_abs": _num(self.mu_abs),
@@ -232,7 +235,8 @@ class FrictionOrbitResult:
 
     def summary(self) -> str:
         """A few lines: the orbit, every element's exact and HB rms and stick phases, the stability."""
-        lines = [f"orbit at Ω = {self.omega:.6g} rad/s (period {self.period:.6g} s)"
+        lines = [f"orbit at Ω = {self.omega:.6g} rad/s (period {self.period:.6g} s"
+                 + ("" if self.periods == 1 else f", {self.periods} forcing periods") + ")"
                  + ("" if self.speed_rpm is None else f", engine speed {self.speed_rpm:.5g} rpm")
                  + f": chain with friction, elements {', '.join(self.element_names)}"]
         hb = f"HB (H = {self.harmonics}, ε = {self.regularisation:g})"
@@ -247,9 +251,10 @@ class FrictionOrbitResult:
             else:
                 lines.append(f"{name}: no exact orbit; {hb} rms {self.rms_hb[e]:.6g}")
         if self.converged:
+            how = (f"{'matched' if self.matched else 'NOT matched'} by the HB orbit (distance {self.match_distance:.2g})"
+                   if np.isfinite(self.match_distance) else "no HB orbit beside it")
             lines.append(f"{'stable' if self.stable else 'unstable'} (max |μ| = {self.mu_abs:.4g}); exact orbit from "
-                         f"{self.start}, {'matched' if self.matched else 'NOT matched'} by the HB orbit "
-                         f"(distance {self.match_distance:.2g})")
+                         f"{self.start}, {how}")
         if self.message:
             lines.append(self.message)
         return "\n".join(lines)
