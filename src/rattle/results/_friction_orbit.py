@@ -246,8 +246,9 @@ class FrictionOrbitResult:
                 phases = self.stick_intervals[e]
                 stick = (f"sticks {self.stick_fraction[e]:.1%} of the period in {len(phases)} phase(s)"
                          if phases else "slips throughout")
-                lines.append(f"{name}: exact rms {self.rms[e]:.6g} rad, mean {self.mean[e]:.6g} rad, {stick}; "
-                             f"{hb} rms {self.rms_hb[e]:.6g} (error {err[e]:+.2g})")
+                hb_text = (f"{hb} rms {self.rms_hb[e]:.6g} (error {err[e]:+.2g})" if np.isfinite(self.rms_hb[e])
+                           else "no HB orbit")
+                lines.append(f"{name}: exact rms {self.rms[e]:.6g} rad, mean {self.mean[e]:.6g} rad, {stick}; {hb_text}")
             else:
                 lines.append(f"{name}: no exact orbit; {hb} rms {self.rms_hb[e]:.6g}")
         if self.converged:
