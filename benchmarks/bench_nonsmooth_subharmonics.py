@@ -2,9 +2,11 @@
 
 Run:  OMP_NUM_THREADS=1 python benchmarks/bench_nonsmooth_subharmonics.py [EXAMPLE ...]
 
-For each example (default: examples/torque_converter_preload.toml and examples/clutch_friction.toml,
-over their own ``[analysis]`` range, harmonics and regularisation) the period-1 branch and then its
-period-2 branches (:func:`rattle.analysis.nonsmooth_subharmonics`), side by side in one run:
+For each example (default: examples/torque_converter_preload.toml, examples/clutch_friction.toml and
+the chain examples/chain_clutch_friction.toml, over their own ``[analysis]`` range, harmonics and
+regularisation) the period-1 branch and then its period-2 branches
+(:func:`rattle.analysis.nonsmooth_subharmonics`, or :func:`rattle.analysis.friction_subharmonics`
+for a chain), side by side in one run:
 
 - the time of the period-1 branch and of the sub-harmonic branches, and their ratio;
 - per branch: how it was followed (the regularised HB, every row checked by exact shooting over
@@ -38,13 +40,14 @@ from pathlib import Path
 
 import numpy as np
 
-from rattle.analysis import nonsmooth_response, nonsmooth_subharmonics
+from rattle.analysis import friction_subharmonics, nonsmooth_response, nonsmooth_subharmonics
 from rattle.analysis._case import regularisation_options
 from rattle.io import load_config
+from rattle.model import FrictionSystem
 from rattle.plotting._nonsmooth import _held_runs
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-DEFAULT = ("torque_converter_preload.toml", "clutch_friction.toml")
+DEFAULT = ("torque_converter_preload.toml", "clutch_friction.toml", "chain_clutch_friction.toml")
 
 
 def _spans(omega: np.ndarray, ok: np.ndarray) -> str:
@@ -85,7 +88,8 @@ def main() -> None:
         t0 = time.perf_counter()
         primary = nonsmooth_response(cfg.model, cfg.analysis.omega, opts)
         t1 = time.perf_counter()
-        branches = nonsmooth_subharmonics(cfg.model, primary, cfg.analysis.omega, opts)
+        follow = friction_subharmonics if isinstance(cfg.model, FrictionSystem) else nonsmooth_subharmonics
+        branches = follow(cfg.model, primary, cfg.analysis.omega, opts)
         t2 = time.perf_counter()
         print(f"{path.name}: Ω = {cfg.analysis.omega[0]:g} … {cfg.analysis.omega[1]:g}, H = {opts.harmonics}, "
               f"ε = {opts.regularisation:g}; period-1 branch {len(primary)} rows in {t1 - t0:.1f} s, "
