@@ -60,6 +60,11 @@ from ._regularisation import RegularisationOptions, regularisation_limit
 #: A seed shot over two periods counts as a period-2 orbit when some δ_e(t + T) departs from
 #: δ_e(t) by more than this share of its peak-to-peak (:func:`period_gap`).
 SEED_GAP = 1e-3
+#: Newton iterations of an exact shooting over two periods, from a seed's pushed start or from the
+#: orbit at the neighbouring frequency of the exact branch: a start that converges does so in a
+#: few (each iteration costs two periods of the exact flow, 30–50 ms on the test chains); one that
+#: has not by then is given up (a fold: the step is halved; a seed: the next push is tried).
+EXACT_ITERATIONS = 20
 
 
 def period_two_orbit(system: FrictionSystem, integ: FrictionIntegrator, omega: float,
@@ -90,7 +95,8 @@ def period_two_orbit(system: FrictionSystem, integ: FrictionIntegrator, omega: f
         for sign in (1.0, -1.0):
             z0 = z1 + sign * amp * size / system.length_scale() * v
             try:
-                two = shoot_friction_orbit(system, omega, z0, period=2, integrator=integ, max_iterations=40)
+                two = shoot_friction_orbit(system, omega, z0, period=2, integrator=integ,
+                                           max_iterations=EXACT_ITERATIONS)
             except FLOW_FAILURES:
                 continue
             if two.converged and period_gap(two.trajectory, omega) > SEED_GAP:
@@ -190,12 +196,6 @@ def friction_subharmonics(
         spans.append((float(np.min(branch.omega)), float(np.max(branch.omega))))
         out.append(branch)
     return tuple(out)
-
-
-#: Newton iterations of a step of the exact branch's natural continuation: from the orbit at the
-#: neighbouring frequency it converges in a few (each costs two periods of the exact flow, ~30 ms
-#: on the test chain); one that has not converged by then has met a fold, and the step is halved.
-EXACT_ITERATIONS = 20
 
 
 def _exact_branch(system: FrictionSystem, integ: FrictionIntegrator, seed: FrictionOrbit, omega: float,
