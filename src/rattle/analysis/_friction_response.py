@@ -27,6 +27,9 @@ For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(
    the limit ε → 0 of the HB's, unless the ladder left the row's branch (a fold in ε; Newton
    then finds another orbit on the way down): so the elements the exact orbit does not hold must
    also stay within :data:`LADDER_GUARD` × ``match`` of the HB orbit at the row's own ε.
+   A row still unmatched after the whole branch is checked is shot again from the exact orbit of
+   the nearest matched row on either side (a step away in Ω: near a fold the HB's error at ε can
+   move its own state out of Newton's reach) and compared with its HB as above.
    The exact orbit gives the answer (every element's rms, mean, stick fraction; the 2n
    multipliers); the HB's own values stand beside them: its rms and its multipliers. Those are,
    by ``stability`` (:class:`~rattle.analysis.RegularisationOptions`), ``"saltation"``: the
@@ -229,12 +232,21 @@ def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], syst
         return None
     if not orbit.converged:
         return None
-    traj = orbit.trajectory
+    return orbit.trajectory, _distance_at_limit(make, omega, last, orbit.trajectory, t, d_hb, size_hb, match)
+
+
+def _distance_at_limit(make: Callable[[float, int], RegularisedSystemBalance], omega: float, last: RegularisationStep,
+                       traj: FrictionTrajectory, t: FloatArray, d_hb: FloatArray, size_hb: FloatArray,
+                       match: float) -> float:
+    """The departure of the exact orbit ``traj`` from the HB orbit at the ladder's rung ``last``
+    (:func:`_held_scale`), or inf when an element the exact orbit does not hold departs from the
+    HB orbit at the row's own ε (samples ``d_hb`` at ``t``, peak-to-peak ``size_hb``) by more than
+    :data:`LADDER_GUARD` × ``match`` of that peak-to-peak (:func:`_match_at_limit`)."""
     moving = traj.stick_time() <= 0.0
     if np.any(_departures(traj, d_hb, t, size_hb)[moving] > LADDER_GUARD * match):
-        return traj, math.inf
+        return math.inf
     gap, size = _gap_at_limit(make, omega, last, traj, t)
-    return traj, float(np.max(gap / _held_scale(traj, size)))
+    return float(np.max(gap / _held_scale(traj, size)))
 
 
 #: The check at the limit rejects an exact orbit whose elements that move (not held) depart from
@@ -460,6 +472,7 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
     matched, dist_all = np.zeros(P, dtype=bool), np.full(P, np.nan)
     pattern = np.full((P, 2 * m), -1, dtype=np.int64)
     ladders: dict[tuple[int, bool], RegularisationLimit | None] = {}  # (row, deep): the row's ladder
+    checks: list[tuple[FloatArray, FloatArray, FloatArray]] = []  # per row: times, HB δ_e there, HB peak-to-peaks
 
     def _row_ladder(i: int, w: float, q: FloatArray, off: bool = False) -> RegularisationLimit | None:
         """Row i's ladder (:func:`_ladder`; None when it stalls), found once: the match at the
@@ -488,6 +501,7 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
         E = problem.element_series(q)
         d_hb = _hb_samples(problem, E, w, t)  # (64 p, m)
         size = np.maximum(np.ptp(problem.basis.synthesize(E), axis=1), 1e-12 * L)
+        checks.append((t, d_hb, size))
         traj = None
         if orbit is not None and orbit.converged:  # one orbit: every δ_e(t) within `match` of the HB's
             traj = orbit.trajectory
@@ -535,6 +549,30 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
             mult_hb[i] = mu_hb
         if not matched[i]:
             mult[i] = mult_hb[i]
+    sources = np.flatnonzero(matched)
+    for i in np.flatnonzero(~matched).tolist():
+        # shot again from the exact orbit of the nearest matched row on either side: near a fold
+        # the HB's error at ε moves its state out of Newton's reach, while the neighbour's exact
+        # state, a step away in Ω, is within it; the orbit found is compared with the HB as the
+        # row's own shot would have been (at the end of its ladder where it has one)
+        w = float(points[i].omega)
+        t, d_hb, size = checks[i]
+        before, after = sources[sources < i], sources[sources > i]
+        for j in sorted([int(x) for x in (before[-1:].tolist() + after[:1].tolist())], key=lambda j: abs(j - i)):
+            try:
+                orbit = shoot_friction_orbit(system, w, states[j], period=p, integrator=integ, max_iterations=30)
+            except FLOW_FAILURES:
+                continue
+            if not orbit.converged or (p > 1 and period_gap(orbit.trajectory, w) <= REPEAT_TOL):
+                continue
+            traj = orbit.trajectory
+            lad = ladders.get((i, False))  # the row was checked at its limit: compared as there
+            d = float(np.max(_departures(traj, d_hb, t, _held_scale(traj, size)))) if lad is None \
+                else _distance_at_limit(make, w, lad.last, traj, t, d_hb, size, match)
+            if d <= match:
+                matched[i], dist_all[i] = True, d
+                mean[i], rms[i], stick[i], states[i], pattern[i], mult[i] = exact_measures(traj, w, p)
+                break
     stable = np.abs(mult).max(axis=1) < 1.0 + UNIT_TOL  # nan (nothing known) → False
     stable_hb = np.abs(mult_hb).max(axis=1) < 1.0 + UNIT_TOL
     with np.errstate(invalid="ignore", divide="ignore"):
