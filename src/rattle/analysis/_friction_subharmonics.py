@@ -38,8 +38,8 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_range
-from ..continuation import ContinuationOptions, NewtonOptions, solve_fixed
-from ..errors import RattleError, Status
+from ..continuation import ContinuationOptions, NewtonOptions
+from ..errors import Status
 from ..model import FrictionSystem
 from ..results import FrictionResponse
 from ..timeint import FrictionIntegrator, FrictionOrbit, shoot_friction_orbit
@@ -54,8 +54,8 @@ from ._friction_response import (
     friction_balance_factory,
     period_gap,
 )
-from ._period_two import ODD_SHARE, beyond_minus_one, follow_both_ways, follow_exactly, odd_share
-from ._regularisation import RegularisationOptions, regularisation_limit
+from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb
+from ._regularisation import RegularisationOptions
 
 #: A seed shot over two periods counts as a period-2 orbit when some δ_e(t + T) departs from
 #: δ_e(t) by more than this share of its peak-to-peak (:func:`period_gap`).
@@ -109,20 +109,8 @@ def _period_two_start(make2, orbit: FrictionOrbit, omega: float, eps: float, H2:
     """The regularised period-2 HB orbit (H2 harmonics of Ω/2) at ε next to the exact period-2
     ``orbit`` (module docstring, step 2); None when none carries odd harmonics."""
     pb = make2(eps, H2)
-    n = pb.n_coordinates
-    q0 = _orbit_spectrum(pb, orbit.trajectory, omega)
-    res = solve_fixed(pb, q0, omega, newton or NewtonOptions())
-    if res.converged and odd_share(res.q, n) >= 100 * ODD_SHARE:
-        return res.q
-    for wide in (4.0 * eps, 10.0 * eps):
-        try:
-            q = regularisation_limit(make2, omega, q0, eps_start=min(wide, 0.3), eps_min=eps, harmonics=H2,
-                                     max_harmonics=H2, tail_tol=math.inf, newton=newton).last.q
-        except RattleError:
-            continue
-        if odd_share(q, n) >= 100 * ODD_SHARE:
-            return q
-    return None
+    return period_two_hb(make2, _orbit_spectrum(pb, orbit.trajectory, omega), omega, eps, H2, newton,
+                         pb.n_coordinates)
 
 
 def friction_subharmonics(
@@ -156,18 +144,11 @@ def friction_subharmonics(
     make2 = friction_balance_factory(system, period=2)
     integ = FrictionIntegrator(system)
     states = primary.states
-    matched = np.flatnonzero(primary.matched)
-    kinds = primary.bifurcation
     spans: list[tuple[float, float]] = []
     out: list[FrictionResponse] = []
-    for a, b in zip(matched[:-1].tolist(), matched[1:].tolist()):
-        if kinds[b] != "period_doubling" or states is None:
-            continue
-        w_a, w_b = float(primary.omega[a]), float(primary.omega[b])
-        if any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
+    for w_a, w_b, order in doublings(primary.omega, primary.matched, primary.bifurcation, primary.multipliers):
+        if states is None or any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
             continue  # the other end of a branch already followed
-        beyond = [i for i in (a, b) if beyond_minus_one(primary.multipliers[i])]
-        order = beyond + [i for i in (a, b) if i not in beyond]
         where = f"between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
         origin = f"period doubling of the period-1 branch {where}"
         branch: FrictionResponse | None = None

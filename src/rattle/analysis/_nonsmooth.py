@@ -60,7 +60,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_range
-from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, NewtonOptions, solve_fixed
+from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
@@ -70,7 +70,7 @@ from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, 
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
 from ._friction_response import friction_response
 from ._friction_subharmonics import friction_subharmonics
-from ._period_two import ODD_SHARE, beyond_minus_one, follow_both_ways, follow_exactly, odd_share
+from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -473,19 +473,7 @@ def _period_two_start(make2: Callable[[float, int], RegularisedBalance], orbit: 
     pb = make2(eps, H2)
     N = pb.basis.samples
     t = np.arange(N) * (2.0 * 2.0 * math.pi / omega / N)
-    q0 = pb.basis.analyze(orbit.trajectory.sample(t)[0])
-    res = solve_fixed(pb, q0, omega, newton or NewtonOptions())
-    if res.converged and odd_share(res.q) >= 100 * ODD_SHARE:
-        return res.q
-    for wide in (4.0 * eps, 10.0 * eps):
-        try:
-            q = regularisation_limit(make2, omega, q0, eps_start=min(wide, 0.3), eps_min=eps, harmonics=H2,
-                                     max_harmonics=H2, tail_tol=math.inf, newton=newton).last.q
-        except RattleError:
-            continue
-        if odd_share(q) >= 100 * ODD_SHARE:
-            return q
-    return None
+    return period_two_hb(make2, pb.basis.analyze(orbit.trajectory.sample(t)[0]), omega, eps, H2, newton)
 
 
 def nonsmooth_subharmonics(
@@ -525,18 +513,11 @@ def nonsmooth_subharmonics(
     make2 = balance_factory(system, period=2)
     H2 = 2 * opts.harmonics
     integ = NonsmoothIntegrator(system)
-    matched = np.flatnonzero(primary.matched)
-    kinds = primary.bifurcation
     spans: list[tuple[float, float]] = []
     out: list[NonsmoothResponse] = []
-    for a, b in zip(matched[:-1].tolist(), matched[1:].tolist()):
-        if kinds[b] != "period_doubling":
-            continue
-        w_a, w_b = float(primary.omega[a]), float(primary.omega[b])
+    for w_a, w_b, order in doublings(primary.omega, primary.matched, primary.bifurcation, primary.multipliers):
         if any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
             continue  # the other end of a branch already followed
-        beyond = [i for i in (a, b) if beyond_minus_one(primary.multipliers[i])]
-        order = beyond + [i for i in (a, b) if i not in beyond]
         origin = f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
         seeds = []
         branch = None

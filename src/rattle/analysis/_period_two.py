@@ -13,15 +13,24 @@ doubling (s → 0, and the odd part changes sign as the branch passes through it
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
 from .._typing import FloatArray
-from ..continuation import BranchPoint, ContinuationOptions, ContinuationProblem, ContinuationStepper, NewtonOptions
-from ..errors import Status
+from ..continuation import (
+    BranchPoint,
+    ContinuationOptions,
+    ContinuationProblem,
+    ContinuationStepper,
+    NewtonOptions,
+    solve_fixed,
+)
+from ..errors import RattleError, Status
 from ._branches import odd_indices
+from ._regularisation import regularisation_limit
 
 T = TypeVar("T")
 
@@ -50,6 +59,42 @@ def beyond_minus_one(multipliers: np.ndarray) -> bool:
     doubling, and a period-2 orbit is born next to it."""
     mu = np.asarray(multipliers)
     return bool(np.any((mu.real < -1.0) & (np.abs(mu.imag) < 1e-9)))
+
+
+def doublings(omega: FloatArray, matched: np.ndarray, labels: np.ndarray,
+              multipliers: np.ndarray) -> list[tuple[float, float, list[int]]]:
+    """The period doublings of a period-1 branch (rows ``omega``, ``matched``, bifurcation
+    ``labels``, exact ``multipliers``): per doubling labelled between two matched rows a and b,
+    (Ω_a, Ω_b, [a, b] ordered with the row whose multiplier lies beyond −1 first: the side where
+    the period-2 orbit is born when the doubling is supercritical)."""
+    rows = np.flatnonzero(matched)
+    out = []
+    for a, b in zip(rows[:-1].tolist(), rows[1:].tolist()):
+        if labels[b] != "period_doubling":
+            continue
+        beyond = [i for i in (a, b) if beyond_minus_one(multipliers[i])]
+        out.append((float(omega[a]), float(omega[b]), beyond + [i for i in (a, b) if i not in beyond]))
+    return out
+
+
+def period_two_hb(make2: Callable[[float, int], Any], q0: FloatArray, omega: float, eps: float, harmonics: int,
+                  newton: NewtonOptions | None, coordinates: int = 1) -> FloatArray | None:
+    """The regularised HB orbit of period 2 (``make2(ε, H)``'s problem, ``harmonics`` of Ω/2) at ε
+    next to the series ``q0`` (an exact period-2 orbit's spectrum): Newton from ``q0`` at ε, else
+    the ladder in ε from 4ε or 10ε down; None when none keeps 1e-2 of its fluctuation in the odd
+    harmonics (it fell back to the period-1 orbit written twice)."""
+    res = solve_fixed(make2(eps, harmonics), q0, omega, newton or NewtonOptions())
+    if res.converged and odd_share(res.q, coordinates) >= 100 * ODD_SHARE:
+        return res.q
+    for wide in (4.0 * eps, 10.0 * eps):
+        try:
+            q = regularisation_limit(make2, omega, q0, eps_start=min(wide, 0.3), eps_min=eps, harmonics=harmonics,
+                                     max_harmonics=harmonics, tail_tol=math.inf, newton=newton).last.q
+        except RattleError:
+            continue
+        if odd_share(q, coordinates) >= 100 * ODD_SHARE:
+            return q
+    return None
 
 
 def follow_both_ways(problem: ContinuationProblem, q: FloatArray, omega: float, lo: float, hi: float,
@@ -131,4 +176,5 @@ def follow_exactly(shoot: Callable[[float, T], T | str], seed: T, omega: float,
     return list(reversed(down)) + [(omega, seed)] + up, ends
 
 
-__all__ = ["ODD_SHARE", "beyond_minus_one", "follow_both_ways", "follow_exactly", "odd_share"]
+__all__ = ["ODD_SHARE", "beyond_minus_one", "doublings", "follow_both_ways", "follow_exactly", "odd_share",
+           "period_two_hb"]
