@@ -48,20 +48,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from _cases import lockup_chain
+from _cases import clutch_gear_chain, lockup_chain
 
 from rattle.analysis import RegularisationOptions, friction_response
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Torque
+from rattle.model import Chain
 
 
 def chain() -> Chain:
-    return Chain(inertias=(1.0, 0.5, 2.0),
-                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-                 elements=(Element(name="clutch", between=(1, 2), stiffness=1.0, law=Clutch(alpha=0.2, b=0.1),
-                                   friction=Friction(levels=(0.02, 0.05, 0.02))),
-                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
+    return clutch_gear_chain()
 
 
 def main() -> None:

@@ -1,9 +1,9 @@
 """Cases shared by the tests: the reference clutch and the torque converter's preloaded spring as
-TOML, the chain with a lock-up clutch."""
+TOML, the chain with a lock-up clutch, the clutch-and-gear chain with friction per stage."""
 
 from __future__ import annotations
 
-from rattle.model import Backlash, Chain, Element, Friction, Link, Preload, Torque
+from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Preload, Torque
 
 
 def lockup_chain() -> Chain:
@@ -18,6 +18,22 @@ def lockup_chain() -> Chain:
                                    friction=Friction(levels=0.01)),
                            Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
                  torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
+
+
+def clutch_gear_chain(levels: tuple[float, ...] | None = (0.02, 0.05, 0.02), amplitude: float = 0.1,
+                      speed_order: float | None = None) -> Chain:
+    """The grounded 3-inertia chain of the friction benchmarks (benchmarks/bench_friction_chain.py):
+    a clutch (α = 0.2, b = 0.1) with friction ``levels`` per stage (None: none) between inertias 1
+    and 2 and a gear with backlash (b = 0.02) between 2 and 3, forced by 0.05 + ``amplitude`` cos Ωt
+    on inertia 1 (``speed_order``: an engine order for the rpm column). With the default levels
+    the clutch sticks part of every period near Ω = 1.3."""
+    return Chain(inertias=(1.0, 0.5, 2.0),
+                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
+                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
+                 elements=(Element(name="clutch", between=(1, 2), stiffness=1.0, law=Clutch(alpha=0.2, b=0.1),
+                                   friction=None if levels is None else Friction(levels=levels)),
+                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
+                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(amplitude,)),), speed_order=speed_order)
 
 
 def clutch_toml(omega: tuple[float, float] = (0.1, 3.0), harmonics: int = 32) -> str:

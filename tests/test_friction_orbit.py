@@ -17,11 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _cases import clutch_gear_chain  # tests/ is on sys.path through its conftest
+
 import rattle.analysis._friction_orbit as friction_orbit_module
 from rattle.analysis import RegularisationOptions, friction_orbit
 from rattle.errors import ConvergenceError, Status
 from rattle.io import load_config, read_csv
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, FrictionSystem, Link, Torque
+from rattle.model import FrictionSystem
 from rattle.results import FRICTION_ORBIT_ELEMENT_COLUMNS, FrictionOrbitResult
 from rattle.timeint import shoot_friction_orbit
 
@@ -46,13 +48,7 @@ def result(system: FrictionSystem) -> FrictionOrbitResult:
 
 
 def _three_inertias() -> FrictionSystem:
-    return Chain(inertias=(1.0, 0.5, 2.0),
-                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-                 elements=(Element(name="clutch", between=(1, 2), stiffness=1.0, law=Clutch(alpha=0.2, b=0.1),
-                                   friction=Friction(levels=(0.02, 0.05, 0.02))),
-                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),)).friction_system()
+    return clutch_gear_chain().friction_system()
 
 
 def test_the_exact_orbit_is_the_independent_shooting_from_rest(system, result):

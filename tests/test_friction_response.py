@@ -28,11 +28,11 @@ from rattle.analysis import RegularisationOptions, friction_response, nonsmooth_
 from rattle.analysis._friction_response import _start, friction_balance_factory
 from rattle.analysis._regularisation import regularisation_limit
 from rattle.continuation import ContinuationOptions
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, FrictionSystem, Link, Torque
+from rattle.model import Chain, FrictionSystem
 from rattle.results import FrictionResponse
 from rattle.timeint import shoot_friction_orbit, shoot_system_orbit
 
-from _cases import lockup_chain  # tests/ is on sys.path through its conftest
+from _cases import clutch_gear_chain, lockup_chain  # tests/ is on sys.path through its conftest
 
 STICK = (0.02, 0.05, 0.02)  # friction levels per clutch stage (relative to its stiffness)
 SLIP = (0.01, 0.03, 0.01)
@@ -40,13 +40,7 @@ WIDE = ContinuationOptions(max_step=0.3)
 
 
 def _chain(levels: tuple[float, ...] | None, amplitude: float, speed_order: float | None = None) -> Chain:
-    return Chain(inertias=(1.0, 0.5, 2.0),
-                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-                 elements=(Element(name="clutch", between=(1, 2), stiffness=1.0, law=Clutch(alpha=0.2, b=0.1),
-                                   friction=None if levels is None else Friction(levels=levels)),
-                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(amplitude,)),), speed_order=speed_order)
+    return clutch_gear_chain(levels, amplitude, speed_order)
 
 
 @pytest.fixture(scope="module")

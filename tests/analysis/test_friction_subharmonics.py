@@ -16,12 +16,13 @@ import math
 import numpy as np
 import pytest
 
+from _cases import clutch_gear_chain
 from _cli_helpers import invoke, write_config
 from rattle.analysis import RegularisationOptions, friction_subharmonics, nonsmooth_response
 from rattle.analysis._friction_response import period_gap
 from rattle.continuation import ContinuationOptions
 from rattle.io import read_csv
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Torque
+from rattle.model import Chain
 from rattle.timeint import FrictionIntegrator, shoot_friction_orbit
 
 RANGE = (1.30, 1.38)
@@ -29,13 +30,7 @@ WIDE = ContinuationOptions(max_step=0.3)
 
 
 def _chain() -> Chain:
-    return Chain(inertias=(1.0, 0.5, 2.0),
-                 links=(Link(between=(1, 0), stiffness=0.5, damping=0.05), Link(between=(2, 3), damping=0.05),
-                        Link(between=(3, 0), stiffness=1.0, damping=0.1)),
-                 elements=(Element(name="clutch", between=(1, 2), stiffness=1.0, law=Clutch(alpha=0.2, b=0.1),
-                                   friction=Friction(levels=(0.02, 0.05, 0.02))),
-                           Element(name="gear", between=(2, 3), stiffness=3.0, law=Backlash(b=0.02))),
-                 torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.1,)),))
+    return clutch_gear_chain()  # the clutch sticks 12–17 % of the period near Ω = 1.3
 
 
 @pytest.fixture(scope="module")
