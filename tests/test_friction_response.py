@@ -275,3 +275,29 @@ def test_a_clutch_locked_part_of_the_period_is_matched_at_the_regularisations_li
     assert gap > opts.match
     # both stability verdicts agree (the period-1 orbit with the gear rattling is unstable here)
     np.testing.assert_array_equal(r.stable, r.stable_hb)
+
+
+def test_a_row_whose_own_shooting_fails_is_matched_from_its_neighbours_exact_orbit(slipping, monkeypatch):
+    """Where the shooting from a row's HB state fails (near a fold the HB's error at ε moves that
+    state out of Newton's reach), the row is shot again from the exact orbit of its nearest matched
+    neighbour: with every shooting at one row's Ω forced to fail unless it starts on a known exact
+    orbit, that row is still matched, on the same exact orbit (rms to 1e-9)."""
+    import rattle.analysis._friction_response as module
+    from rattle.errors import ConvergenceError
+
+    k = len(slipping) // 2
+    target, known = float(slipping.omega[k]), slipping.states[slipping.matched]
+    real = module.shoot_friction_orbit
+
+    def failing(system, omega, z0, **kwargs):  # type: ignore[no-untyped-def]
+        if omega == target and not np.any(np.all(np.abs(known - np.asarray(z0)) <= 1e-13, axis=1)):
+            raise ConvergenceError("forced to fail from the HB state")
+        return real(system, omega, z0, **kwargs)
+
+    monkeypatch.setattr(module, "shoot_friction_orbit", failing)
+    fs = _chain(SLIP, 0.2, speed_order=2.0).friction_system()
+    r = friction_response(fs, (1.28, 1.3), RegularisationOptions(harmonics=32), continuation=WIDE)
+    assert len(r) == len(slipping) and r.omega[k] == target
+    assert r.matched[k] and np.all(r.matched == slipping.matched)
+    np.testing.assert_allclose(r.rms[k], slipping.rms[k], rtol=1e-9)
+    assert r.match_distance[k] <= 0.1
