@@ -185,7 +185,10 @@ def test_nonsmooth_orbit_of_period_two_is_the_branch_orbit(response):
     assert res.period == pytest.approx(2 * 2 * math.pi / float(br.omega[i]))
     with pytest.raises(ValueError, match="`period` must be 1 or 2"):
         nonsmooth_orbit(_system(), 0.552, OPTIONS, period=3)
-    from _cases import lockup_chain
+    from _cases import clutch_gear_chain
+    from rattle.errors import ConvergenceError
 
-    with pytest.raises(ValueError, match="`period` 2 is not supported for a chain"):
-        nonsmooth_orbit(lockup_chain().friction_system(), 2.05, period=2)
+    # a chain goes to friction_orbit, period 2 included (there the motion has period 1)
+    with pytest.raises(ConvergenceError, match="no periodic orbit of period 2 at `omega` = 1.312"):
+        nonsmooth_orbit(clutch_gear_chain().friction_system(), 1.312,
+                        RegularisationOptions(harmonics=32, regularisation=0.001), period=2)

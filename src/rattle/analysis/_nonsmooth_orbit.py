@@ -99,22 +99,20 @@ def nonsmooth_orbit(
     A failed exact shooting is reported in the result (``orbit`` None, ``message``); a failed HB
     leaves nan coefficients. Raises :class:`~rattle.errors.ConvergenceError` when neither is found.
 
-    ``period`` 2 asks for a sub-harmonic orbit of period 2 (one equation only;
-    :func:`_period_two`): found from the exact flow, its HB of period 2 solved from its spectrum.
+    ``period`` 2 asks for a sub-harmonic orbit of period 2 (:func:`_period_two`; a chain's likewise
+    in :func:`~rattle.analysis._friction_orbit.friction_orbit`): found from the exact flow, its HB of
+    period 2 solved from its spectrum.
 
     A chain with friction on its elements (:class:`~rattle.model.FrictionSystem`) goes to
     :func:`~rattle.analysis._friction_orbit.friction_orbit` (a :class:`FrictionOrbitResult`;
-    ``x0`` then the chain's state (x, x'), 2n values; period 1 only).
+    ``x0`` then the chain's state (x, x'), 2n values).
     """
     if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period not in (1, 2):
         raise ValueError(f"`period` must be 1 or 2 (a period-2 sub-harmonic orbit), got {period!r}")
     if isinstance(system, FrictionSystem):
-        if period != 1:
-            raise ValueError("`period` 2 is not supported for a chain with friction or jumps on its elements yet: "
-                             "only its period-1 orbit is computed")
         from ._friction_orbit import friction_orbit
 
-        return friction_orbit(system, omega, options, x0=x0)
+        return friction_orbit(system, omega, options, x0=x0, period=period)
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
                         f"friction on its elements; rattle.model), got {system!r}")
