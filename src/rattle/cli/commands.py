@@ -430,10 +430,11 @@ def orbit_command(
     the requested period); orbit.json lists them all. A chain: those of its first clearance
     element, then NAME_delta and NAME_acceleration of every element.
 
-    A discontinuous law, or a chain with friction on its elements: the period-1 orbit at W alone,
-    exact (event-driven shooting, sticking exact) and regularised harmonic balance side by side;
-    orbit.csv holds t and per element NAME_delta, NAME_velocity, NAME_stuck, NAME_delta_hb for the
-    chain. --period other than 1 and --omega-min/--omega-max are refused there.
+    A discontinuous law, or a chain with friction on its elements: the orbit at W alone (period 1,
+    or 2 with --period 2: exit 1 where the motion has period 1), exact (event-driven shooting,
+    sticking exact) and regularised harmonic balance side by side; orbit.csv holds t and per
+    element NAME_delta, NAME_velocity, NAME_stuck, NAME_delta_hb for the chain. --period above 2
+    and --omega-min/--omega-max are refused there.
     """
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
