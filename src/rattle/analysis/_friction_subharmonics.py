@@ -54,7 +54,7 @@ from ._friction_response import (
     friction_balance_factory,
     period_gap,
 )
-from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb
+from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import RegularisationOptions
 
 #: A seed shot over two periods counts as a period-2 orbit when some δ_e(t + T) departs from
@@ -78,29 +78,17 @@ def period_two_orbit(system: FrictionSystem, integ: FrictionIntegrator, omega: f
         return None
     if not one.converged:
         return None
-    mu, vec = np.linalg.eig(np.asarray(one.trajectory.sensitivity, dtype=float))
-    negative = [k for k in range(mu.size) if mu[k].real < 0.0 and abs(mu[k].imag) <= 1e-9 * max(1.0, abs(mu[k]))]
-    if not negative:
-        return None
-    k = min(negative, key=lambda k: abs(mu[k].real + 1.0))
-    n = system.n
-    scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
-    v = np.real(vec[:, k]) / scale
-    v = v / np.linalg.norm(v) * scale  # unit length in the scaled state
-    T = 2.0 * math.pi / omega
-    d = one.trajectory.element_samples(np.linspace(0.0, T, 65))[0]
-    size = max(float(np.max(np.ptp(d, axis=0))), 1e-12 * system.length_scale())
-    z1 = np.asarray(one.state0, dtype=float)
-    for amp in (0.02, 0.1, 0.3):
-        for sign in (1.0, -1.0):
-            z0 = z1 + sign * amp * size / system.length_scale() * v
-            try:
-                two = shoot_friction_orbit(system, omega, z0, period=2, integrator=integ,
-                                           max_iterations=EXACT_ITERATIONS)
-            except FLOW_FAILURES:
-                continue
-            if two.converged and period_gap(two.trajectory, omega) > SEED_GAP:
-                return two
+    n, L = system.n, system.length_scale()
+    scale = np.concatenate((np.full(n, L), np.full(n, integ.velocity_scale(omega))))
+    d = one.trajectory.element_samples(np.linspace(0.0, 2.0 * math.pi / omega, 65))[0]
+    size = max(float(np.max(np.ptp(d, axis=0))), 1e-12 * L)
+    for z0 in pushed_starts(one.trajectory.sensitivity, one.state0, scale, size, L):
+        try:
+            two = shoot_friction_orbit(system, omega, z0, period=2, integrator=integ, max_iterations=EXACT_ITERATIONS)
+        except FLOW_FAILURES:
+            continue
+        if two.converged and period_gap(two.trajectory, omega) > SEED_GAP:
+            return two
     return None
 
 

@@ -70,7 +70,7 @@ from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, 
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
 from ._friction_response import friction_response
 from ._friction_subharmonics import friction_subharmonics
-from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb
+from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -430,38 +430,29 @@ def _period_two_orbit(system: NonsmoothSystem, integ: NonsmoothIntegrator, omega
                       state: FloatArray) -> NonsmoothOrbit | None:
     """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``, one
     of whose multipliers lies near −1: shot over two forcing periods from the period-1 state pushed
-    along that multiplier's eigenvector, by 2 %, 10 % and 30 % of the orbit's peak-to-peak, either
-    way; None when every shot converges back to the period-1 orbit or fails."""
+    along that multiplier's eigenvector (:func:`~._period_two.pushed_starts`: by 2 %, 10 % and 30 % of
+    the orbit's peak-to-peak, either way); None when every shot converges back to the period-1
+    orbit or fails."""
     try:
         one = shoot_nonsmooth_orbit(system, omega, state, integrator=integ, max_iterations=30)
     except FLOW_FAILURES:
         return None
     if not one.converged:
         return None
-    mu, vec = np.linalg.eig(np.asarray(one.monodromy, dtype=float))
-    negative = [k for k in range(mu.size) if mu[k].real < 0.0 and abs(mu[k].imag) <= 1e-9 * max(1.0, abs(mu[k]))]
-    if not negative:
-        return None
-    k = min(negative, key=lambda k: abs(mu[k].real + 1.0))
-    scale = np.array([system.length_scale(), integ.velocity_scale(omega)])
-    v = np.real(vec[:, k]) / scale
-    v = v / np.linalg.norm(v) * scale  # unit length in the scaled state
-    size = max(float(np.ptp(one.trajectory.sample(np.linspace(0.0, 2.0 * math.pi / omega, 65))[0])),
-               1e-12 * system.length_scale())
-    z1 = np.asarray(one.state0, dtype=float)
-    for amp in (0.02, 0.1, 0.3):
-        for sign in (1.0, -1.0):
-            z0 = z1 + sign * amp * size / system.length_scale() * v
-            try:
-                two = shoot_nonsmooth_orbit(system, omega, z0, period=2, integrator=integ, max_iterations=40)
-            except FLOW_FAILURES:
-                continue
-            if not two.converged:
-                continue
-            T = 2.0 * math.pi / omega
-            d = two.trajectory.sample(np.array([0.0, T]))[0]
-            if abs(float(d[1] - d[0])) > 1e-3 * size:  # not the period-1 orbit run twice
-                return two
+    L = system.length_scale()
+    scale = np.array([L, integ.velocity_scale(omega)])
+    T = 2.0 * math.pi / omega
+    size = max(float(np.ptp(one.trajectory.sample(np.linspace(0.0, T, 65))[0])), 1e-12 * L)
+    for z0 in pushed_starts(one.monodromy, one.state0, scale, size, L):
+        try:
+            two = shoot_nonsmooth_orbit(system, omega, z0, period=2, integrator=integ, max_iterations=40)
+        except FLOW_FAILURES:
+            continue
+        if not two.converged:
+            continue
+        d = two.trajectory.sample(np.array([0.0, T]))[0]
+        if abs(float(d[1] - d[0])) > 1e-3 * size:  # not the period-1 orbit run twice
+            return two
     return None
 
 

@@ -77,6 +77,29 @@ def doublings(omega: FloatArray, matched: np.ndarray, labels: np.ndarray,
     return out
 
 
+#: A period-2 seed is shot from the period-1 state pushed along the eigenvector by these shares of
+#: the orbit's peak-to-peak, each either way, in this order.
+PUSHES = (0.02, 0.1, 0.3)
+
+
+def pushed_starts(monodromy: FloatArray, state: FloatArray, scale: FloatArray, size: float,
+                  length: float) -> list[FloatArray]:
+    """The starts of the shooting for a period-2 orbit next to the period-1 orbit through ``state``
+    whose ``monodromy`` has a multiplier near −1: the state pushed along the eigenvector v of the
+    negative real multiplier nearest −1 (unit length in the state scaled by ``scale``), by a of
+    :data:`PUSHES` times ``size`` (the orbit's peak-to-peak) relative to ``length`` (L), either
+    way: z = state ± a · size / L · v. Empty when no multiplier is real and negative."""
+    mu, vec = np.linalg.eig(np.asarray(monodromy, dtype=float))
+    negative = [k for k in range(mu.size) if mu[k].real < 0.0 and abs(mu[k].imag) <= 1e-9 * max(1.0, abs(mu[k]))]
+    if not negative:
+        return []
+    k = min(negative, key=lambda k: abs(mu[k].real + 1.0))
+    v = np.real(vec[:, k]) / scale
+    v = v / np.linalg.norm(v) * scale  # unit length in the scaled state
+    z1 = np.asarray(state, dtype=float)
+    return [z1 + sign * amp * size / length * v for amp in PUSHES for sign in (1.0, -1.0)]
+
+
 def period_two_hb(make2: Callable[[float, int], Any], q0: FloatArray, omega: float, eps: float, harmonics: int,
                   newton: NewtonOptions | None, coordinates: int = 1) -> FloatArray | None:
     """The regularised HB orbit of period 2 (``make2(ε, H)``'s problem, ``harmonics`` of Ω/2) at ε
@@ -176,5 +199,5 @@ def follow_exactly(shoot: Callable[[float, T], T | str], seed: T, omega: float,
     return list(reversed(down)) + [(omega, seed)] + up, ends
 
 
-__all__ = ["ODD_SHARE", "beyond_minus_one", "doublings", "follow_both_ways", "follow_exactly", "odd_share",
-           "period_two_hb"]
+__all__ = ["ODD_SHARE", "PUSHES", "beyond_minus_one", "doublings", "follow_both_ways", "follow_exactly",
+           "odd_share", "period_two_hb", "pushed_starts"]
