@@ -54,7 +54,7 @@ from ._friction_response import (
     friction_balance_factory,
     period_gap,
 )
-from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
+from ._period_two import branches_at_doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import RegularisationOptions
 
 #: A seed shot over two periods counts as a period-2 orbit when some δ_e(t + T) departs from
@@ -132,39 +132,25 @@ def friction_subharmonics(
     make2 = friction_balance_factory(system, period=2)
     integ = FrictionIntegrator(system)
     states = primary.states
-    spans: list[tuple[float, float]] = []
-    out: list[FrictionResponse] = []
-    for w_a, w_b, order in doublings(primary.omega, primary.matched, primary.bifurcation, primary.multipliers):
-        if states is None or any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
-            continue  # the other end of a branch already followed
-        where = f"between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
-        origin = f"period doubling of the period-1 branch {where}"
-        branch: FrictionResponse | None = None
-        seed_at: tuple[float, FrictionOrbit] | None = None
-        for i in order:
-            w0 = float(primary.omega[i])
-            seed = period_two_orbit(system, integ, w0, states[i])
-            if seed is None:
-                continue
-            seed_at = seed_at or (w0, seed)
-            q2 = _period_two_start(make2, seed, w0, opts.regularisation, H2, newton)
-            if q2 is None:
-                continue
-            points, status, message = follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
-                                                       continuation, newton)
-            if points:
-                branch = check_branch(system, make2, points, opts2, integ, status=status, message=message,
-                                      branch=len(out) + 1, origin=origin)
-                break
-        if branch is None and seed_at is not None:  # the regularised HB has no period-2 orbit there
-            grid = np.unique(primary.omega[(primary.omega >= lo) & (primary.omega <= hi)])
-            branch = _exact_branch(system, integ, seed_at[1], seed_at[0], grid, opts, branch=len(out) + 1,
-                                   origin=origin)
-        if branch is None:
-            continue
-        spans.append((float(np.min(branch.omega)), float(np.max(branch.omega))))
-        out.append(branch)
-    return tuple(out)
+
+    def seed(i: int) -> FrictionOrbit | None:
+        return None if states is None else period_two_orbit(system, integ, float(primary.omega[i]), states[i])
+
+    def from_seed(w0: float, orbit: FrictionOrbit, number: int, origin: str) -> FrictionResponse | None:
+        q2 = _period_two_start(make2, orbit, w0, opts.regularisation, H2, newton)
+        if q2 is None:
+            return None
+        points, status, message = follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi, continuation,
+                                                   newton)
+        if not points:
+            return None
+        return check_branch(system, make2, points, opts2, integ, status=status, message=message, branch=number,
+                            origin=origin)
+
+    def exact(w0: float, orbit: FrictionOrbit, grid: FloatArray, number: int, origin: str) -> FrictionResponse:
+        return _exact_branch(system, integ, orbit, w0, grid, opts, branch=number, origin=origin)
+
+    return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
 def _exact_branch(system: FrictionSystem, integ: FrictionIntegrator, seed: FrictionOrbit, omega: float,

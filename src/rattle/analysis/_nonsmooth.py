@@ -70,7 +70,7 @@ from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, 
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
 from ._friction_response import friction_response
 from ._friction_subharmonics import friction_subharmonics
-from ._period_two import doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
+from ._period_two import branches_at_doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -504,38 +504,24 @@ def nonsmooth_subharmonics(
     make2 = balance_factory(system, period=2)
     H2 = 2 * opts.harmonics
     integ = NonsmoothIntegrator(system)
-    spans: list[tuple[float, float]] = []
-    out: list[NonsmoothResponse] = []
-    for w_a, w_b, order in doublings(primary.omega, primary.matched, primary.bifurcation, primary.multipliers):
-        if any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
-            continue  # the other end of a branch already followed
-        origin = f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
-        seeds = []
-        branch = None
-        for i in order:
-            seed = _period_two_orbit(system, integ, float(primary.omega[i]), primary.states[i])
-            if seed is None:
-                continue
-            w0 = float(primary.omega[i])
-            seeds.append((w0, seed))
-            q2 = _period_two_start(make2, seed, w0, opts.regularisation, H2, newton)
-            if q2 is None:
-                continue
-            points, status, message = follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi,
-                                                        continuation, newton)
-            if points:
-                branch = _check_branch(system, make2, opts, points, status, message, branch=len(out) + 1,
-                                       origin=origin)
-                break
-        if branch is None and seeds:  # the regularised HB has no period-2 orbit there: the exact flow alone
-            grid = np.unique(primary.omega[(primary.omega >= lo) & (primary.omega <= hi)])
-            branch = _exact_branch(system, integ, seeds[0][1], seeds[0][0], grid, opts, branch=len(out) + 1,
-                                   origin=origin)
-        if branch is None:
-            continue
-        spans.append((float(np.min(branch.omega)), float(np.max(branch.omega))))
-        out.append(branch)
-    return tuple(out)
+
+    def seed(i: int) -> NonsmoothOrbit | None:
+        return _period_two_orbit(system, integ, float(primary.omega[i]), primary.states[i])
+
+    def from_seed(w0: float, orbit: NonsmoothOrbit, number: int, origin: str) -> NonsmoothResponse | None:
+        q2 = _period_two_start(make2, orbit, w0, opts.regularisation, H2, newton)
+        if q2 is None:
+            return None
+        points, status, message = follow_both_ways(make2(opts.regularisation, H2), q2, w0, lo, hi, continuation,
+                                                   newton)
+        if not points:
+            return None
+        return _check_branch(system, make2, opts, points, status, message, branch=number, origin=origin)
+
+    def exact(w0: float, orbit: NonsmoothOrbit, grid: FloatArray, number: int, origin: str) -> NonsmoothResponse:
+        return _exact_branch(system, integ, orbit, w0, grid, opts, branch=number, origin=origin)
+
+    return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
 def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: NonsmoothOrbit, omega: float,

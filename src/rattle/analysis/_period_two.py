@@ -32,7 +32,8 @@ from ..errors import RattleError, Status
 from ._branches import odd_indices
 from ._regularisation import regularisation_limit
 
-T = TypeVar("T")
+T = TypeVar("T")  # an exact orbit
+B = TypeVar("B")  # a branch (a response with ``omega``)
 
 #: A period-2 orbit counts as one (not the period-1 orbit run twice) while its odd harmonics of
 #: Ω/2 carry at least this share of δ's fluctuation (rms); a branch that falls below it has
@@ -120,6 +121,45 @@ def period_two_hb(make2: Callable[[float, int], Any], q0: FloatArray, omega: flo
     return None
 
 
+def branches_at_doublings(primary: Any, lo: float, hi: float, seed: Callable[[int], T | None],
+                          from_seed: Callable[[float, T, int, str], B | None],
+                          exact: Callable[[float, T, FloatArray, int, str], B]) -> tuple[B, ...]:
+    """The period-2 branches born at the period doublings of the period-1 branch ``primary`` (rows
+    ``omega``, ``matched``, ``bifurcation``, ``multipliers``) within [``lo``, ``hi``], numbered
+    1, 2, … in order of Ω (each with ``omega``). Per doubling (:func:`doublings`), row by row in
+    the order given there: ``seed(row)`` the exact period-2 orbit next to it (None: none), then
+    ``from_seed(Ω, seed, number, origin)`` the branch followed by the regularised HB from it (None:
+    the HB has no period-2 orbit there). Where no row gives one, ``exact(Ω, first seed, grid,
+    number, origin)`` follows the first seed by exact shooting over the primary's frequencies
+    ``grid``. A doubling lying on a branch already found (its other end) starts none; one without
+    a seed starts none either."""
+    spans: list[tuple[float, float]] = []
+    out: list[B] = []
+    for w_a, w_b, order in doublings(primary.omega, primary.matched, primary.bifurcation, primary.multipliers):
+        if any(s0 <= w <= s1 for s0, s1 in spans for w in (w_a, w_b)):
+            continue  # the other end of a branch already followed
+        origin = f"period doubling of the period-1 branch between Ω = {min(w_a, w_b):.6g} and {max(w_a, w_b):.6g}"
+        branch: B | None = None
+        first: tuple[float, T] | None = None
+        for i in order:
+            orbit = seed(i)
+            if orbit is None:
+                continue
+            w0 = float(primary.omega[i])
+            first = first or (w0, orbit)
+            branch = from_seed(w0, orbit, len(out) + 1, origin)
+            if branch is not None:
+                break
+        if branch is None and first is not None:  # the regularised HB has no period-2 orbit there
+            grid = np.unique(primary.omega[(primary.omega >= lo) & (primary.omega <= hi)])
+            branch = exact(first[0], first[1], grid, len(out) + 1, origin)
+        if branch is None:
+            continue
+        spans.append((float(np.min(branch.omega)), float(np.max(branch.omega))))  # type: ignore[attr-defined]
+        out.append(branch)
+    return tuple(out)
+
+
 def follow_both_ways(problem: ContinuationProblem, q: FloatArray, omega: float, lo: float, hi: float,
                      continuation: ContinuationOptions | None,
                      newton: NewtonOptions | None) -> tuple[list[BranchPoint], Status, str]:
@@ -199,5 +239,5 @@ def follow_exactly(shoot: Callable[[float, T], T | str], seed: T, omega: float,
     return list(reversed(down)) + [(omega, seed)] + up, ends
 
 
-__all__ = ["ODD_SHARE", "PUSHES", "beyond_minus_one", "doublings", "follow_both_ways", "follow_exactly",
+__all__ = ["ODD_SHARE", "PUSHES", "beyond_minus_one", "branches_at_doublings", "doublings", "follow_both_ways", "follow_exactly",
            "odd_share", "period_two_hb", "pushed_starts"]
