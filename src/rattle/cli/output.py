@@ -267,13 +267,13 @@ def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str
         "hb_error_max": _largest(getattr(result, "hb_error", None), matched),
         "bifurcations": [{"kind": str(labels[i]), "index": int(i), "omega": float(result.omega[i])}
                          for i in range(len(result)) if labels[i]],
-        "branches": [_branch_metadata(b) for b in getattr(result, "branches", ())],
+        "branches": [_branch_metadata(b) for b in result.branches],
         "timings": dict(timings),
     }
 
 
 def _branch_metadata(branch: Any) -> dict[str, Any]:
-    """One sub-harmonic branch of a discontinuous law in ``frf.json``: its number, period, where
+    """One sub-harmonic branch (a discontinuous law's or a chain's) in ``frf.json``: its number, period, where
     it was born, how its continuation ended, its rows (all, matched, stable), its Ω range, the
     HB's largest |rms_error| over the matched rows and its stability changes."""
     import numpy as np
@@ -323,7 +323,7 @@ def _branch_lines(result: Any, subharmonics: bool) -> list[str]:
     import numpy as np
 
     lines = []
-    for b in getattr(result, "branches", ()):
+    for b in result.branches:
         m = np.asarray(b.matched, dtype=bool)
         worst = _largest(b.rms_error, m)
         how = (f"{int(np.count_nonzero(m))} matched by exact shooting over {b.period} periods"
@@ -332,7 +332,7 @@ def _branch_lines(result: Any, subharmonics: bool) -> list[str]:
         lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
                      f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {how}; stable over Ω = {_stable_spans(b)}"
                      + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
-    if "period_doubling" in set(result.bifurcation.tolist()) and not getattr(result, "branches", ()):
+    if "period_doubling" in set(result.bifurcation.tolist()) and not result.branches:
         lines.append("no period-2 orbit was found next to the period doubling(s)" if subharmonics else
                      "period doubling found: run with --subharmonics for the period-2 branches born there")
     return lines
@@ -415,7 +415,7 @@ def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str,
         "message": result.message or result.status.message,
         "points": len(result),
         **own,
-        "branches": [_branch_metadata(b) for b in getattr(result, "branches", ())],
+        "branches": [_branch_metadata(b) for b in result.branches],
         "timings": dict(timings),
     }
 
