@@ -50,11 +50,11 @@ from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._shooting import FLOW_FAILURES
 from ._friction_response import (
+    REPEAT_TOL,
     _departures,
     _hb_flow,
     _hb_multipliers,
     _hb_samples,
-    REPEAT_TOL,
     _orbit_spectrum,
     _settled,
     _start,
