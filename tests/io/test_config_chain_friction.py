@@ -258,3 +258,29 @@ def test_limit_harmonics_defaults_to_the_chains_harmonics_and_is_read_checked_an
     for bad in (0, 2.5, "64", 10_000):
         data["analysis"]["limit_harmonics"] = bad
         _refused(data, "limit_harmonics")
+
+
+def test_held_limit_is_read_checked_written_and_carried_into_the_options():
+    """`[analysis] held_limit = true` on a chain with friction (or jumps) on its elements: read,
+    written back, carried into RegularisationOptions(held=True); refused on a smooth chain and on
+    the single equation (no element to narrow), and when not a boolean."""
+    from rattle.analysis._case import regularisation_options
+    from rattle.io import config_from_dict as read
+
+    data = _chain(0.01)
+    assert read(data).analysis.held_limit is None and not regularisation_options(read(data).analysis).held
+    data["analysis"]["held_limit"] = True
+    rc = read(data)
+    assert rc.analysis.held_limit is True and rc.analysis.to_dict()["held_limit"] is True
+    assert read(rc.to_dict()).analysis == rc.analysis
+    assert regularisation_options(rc.analysis).held
+    smooth = _chain()
+    smooth["analysis"]["held_limit"] = True
+    _refused(smooth, "`analysis.held_limit`", "applies only to a chain with friction or a torque jump")
+    single = {"model": {"inertia": 1.0, "damping": 0.05, "stiffness": 1.0,
+                        "elastic": {"type": "preload", "preload": 0.03}},
+              "excitation": {"mean": 0.05, "amplitudes": [0.03]}, "analysis": {"omega": [0.3, 1.5], "held_limit": True}}
+    _refused(single, "`analysis.held_limit`", "applies only to a chain")
+    for bad in (1, "yes", 0.0):
+        data["analysis"]["held_limit"] = bad
+        _refused(data, "held_limit", "true or false")

@@ -24,9 +24,12 @@ from ._time_sweep import time_sweep
 
 def regularisation_options(analysis: AnalysisSettings) -> RegularisationOptions:
     """The :class:`RegularisationOptions` of a case file's ``[analysis]`` (``harmonics``,
-    ``regularisation``, ``refine``: 0 none, ``limit_harmonics``: None the default) for a
+    ``regularisation``, ``refine``: 0 none, ``limit_harmonics``: None the default,
+    ``held_limit``: ``held``) for a
     discontinuous law: what ``rattle frf``, ``orbit`` and ``compare`` and :class:`Case` run with."""
-    kw = {} if analysis.limit_harmonics is None else {"limit_harmonics": analysis.limit_harmonics}
+    kw: dict = {} if analysis.limit_harmonics is None else {"limit_harmonics": analysis.limit_harmonics}
+    if analysis.held_limit:
+        kw["held"] = True
     return RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
                                  refine=analysis.refine or None, **kw)
 

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 
 import numpy as np
 
@@ -45,7 +46,7 @@ from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import RegularisedSystemBalance
 from ..model import FrictionSystem
-from ..results import FrictionOrbitResult
+from ..results import FrictionOrbitResult, HeldLimitRecord
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._shooting import FLOW_FAILURES
@@ -63,6 +64,7 @@ from ._friction_response import (
     friction_balance_factory,
     period_gap,
 )
+from ._held_limit import held_limit
 from ._regularisation import RegularisationOptions
 
 #: Periods of the exact flow run before shooting again when the shooting from the start fails.
@@ -227,7 +229,39 @@ def friction_orbit(
                                + "; try another `regularisation` or `harmonics`, or give `x0`")
     if orbit is None:
         notes.insert(0, f"no exact orbit at Ω = {omega:g}")
-    return _result(system, problem, omega, opts, orbit, q, E, hb_flow, start, hb_start, held, notes)
+    record = _held(system, make, omega, opts, orbit, q, notes) if opts.held else None
+    return _result(system, problem, omega, opts, orbit, q, E, hb_flow, start, hb_start, held, notes,
+                   held_record=record)
+
+
+def _held(system: FrictionSystem, make, omega: float, opts: RegularisationOptions,  # type: ignore[no-untyped-def]
+          orbit: FrictionOrbit | None, q: FloatArray | None, notes: list[str]) -> HeldLimitRecord | None:
+    """The HB with the steps of the elements the exact orbit holds part of the period (0 < stick
+    fraction < 1) narrowed to their limit: the chain's ε first continued to ``limit_eps`` (if
+    wider), then :func:`~rattle.analysis._held_limit.held_limit` at ``held_harmonics``. None
+    without an exact and an HB orbit or a held element, or when the ladder fails (said in
+    ``notes``)."""
+    if orbit is None or q is None:
+        return None
+    elements = [e for e in range(system.m) if 0.0 < float(orbit.stick_fraction[e]) < 1.0]
+    if not elements:
+        return None
+    t0 = time.perf_counter()
+    H, eps = opts.harmonics, opts.regularisation
+    try:
+        if opts.limit_eps < eps:
+            from ._regularisation import regularisation_limit
+
+            q = regularisation_limit(make, omega, q, eps_start=eps, eps_min=opts.limit_eps, harmonics=H,
+                                     max_harmonics=H, tail_tol=math.inf).last.q
+            eps = opts.limit_eps
+        hl = held_limit(make(eps, H), q, omega, elements, harmonics=opts.held_harmonics)
+    except RattleError as exc:
+        notes.append(f"the held elements' ladder failed ({exc})")
+        return None
+    return HeldLimitRecord(elements=tuple(system.element_names[e] for e in hl.elements), rms=hl.rms,
+                           status=hl.status, scale=hl.scale, eps=float(eps), harmonics=hl.harmonics,
+                           samples=int(hl.samples[-1]), change=hl.change, seconds=time.perf_counter() - t0)
 
 
 def _period_two(system: FrictionSystem, omega: float, options: RegularisationOptions | None,
@@ -305,7 +339,8 @@ def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> Float
 
 def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
             q: FloatArray | None, E: FloatArray | None, hb_flow: FrictionTrajectory | None, start: str,
-            hb_start: str, held: dict[int, float], notes: list[str], periods: int = 1) -> FrictionOrbitResult:
+            hb_start: str, held: dict[int, float], notes: list[str], periods: int = 1,
+            held_record: HeldLimitRecord | None = None) -> FrictionOrbitResult:
     """The result's samples and measures (:class:`~rattle.results.FrictionOrbitResult`) over the
     orbit's ``periods`` forcing periods (``problem``'s and ``opts``' H those of that period)."""
     n, m, H = system.n, system.m, opts.harmonics
@@ -353,6 +388,7 @@ def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: fl
         start=start, coefficients_hb=coeff, delta_hb=delta_hb, rms_hb=rms_hb, multipliers_hb=mult_hb,
         regularisation=float(opts.regularisation), harmonics=int(H), hb_start=hb_start, match=float(opts.match),
         held=tuple(system.element_names[e] for e in held), settle_periods=SETTLE_PERIODS, periods=periods,
+        held_limit=held_record,
     )
 
 

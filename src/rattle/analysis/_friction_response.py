@@ -76,6 +76,7 @@ from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
+from ._held_limit import held_limit
 from ._regularisation import (
     RegularisationLimit,
     RegularisationOptions,
@@ -606,6 +607,25 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
             lim_rich.append(np.full(m, np.nan))
             lim_lin.append(False)
             lim_mu.append(np.full(2 * n, np.nan + 0j))
+    held_idx, held_rms, held_status, held_scale = [], [], [], []
+    if opts.held:
+        part = (np.nan_to_num(stick) > 0) & (np.nan_to_num(stick) < 1.0)
+        for i in np.flatnonzero(matched & part.any(axis=1)).tolist():
+            w = float(points[i].omega)
+            lad = _row_ladder(i, w, points[i].q)
+            held_idx.append(i)
+            try:
+                if lad is None:
+                    raise ConvergenceError(f"the ladder stalled at Ω = {w:g}")
+                hl = held_limit(make(lad.last.eps, lad.last.harmonics), lad.last.q, w, np.flatnonzero(part[i]).tolist(),
+                                harmonics=opts.held_harmonics)
+                held_rms.append(hl.rms)
+                held_status.append(hl.status)
+                held_scale.append(hl.scale)
+            except RattleError:
+                held_rms.append(np.full(m, np.nan))
+                held_status.append("failed")
+                held_scale.append(math.nan)
     omegas = np.array([float(p.omega) for p in points])
     rpm = system.speed_rpm(omegas)
     return FrictionResponse(
@@ -619,6 +639,8 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
         limit_linear=np.array(lim_lin, dtype=bool),
         limit_multipliers=np.array(lim_mu, dtype=complex).reshape(-1, 2 * n), pattern=pattern,
         period=p, branch=branch, origin=origin, states=states,
+        held_index=np.array(held_idx, dtype=int), held_rms=np.array(held_rms, dtype=float).reshape(-1, m),
+        held_status=np.array(held_status, dtype=object), held_scale=np.array(held_scale, dtype=float),
     )
 
 

@@ -235,9 +235,14 @@ class RegularisationOptions:
     deep_eps: float | None = None
     deep_harmonics: int = 512
     stability: str = "saltation"
+    held: bool = False
+    held_harmonics: int = 256
 
     def __post_init__(self) -> None:
-        for name in ("harmonics", "limit_harmonics", "deep_harmonics"):
+        if not isinstance(self.held, (bool, np.bool_)):
+            raise TypeError(f"`held` must be True or False, got {self.held!r}")
+        object.__setattr__(self, "held", bool(self.held))
+        for name in ("harmonics", "limit_harmonics", "deep_harmonics", "held_harmonics"):
             object.__setattr__(self, name, check_int(name, getattr(self, name), 1))
             try:
                 HBOptions(harmonics=getattr(self, name))  # its bounds

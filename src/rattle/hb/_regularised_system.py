@@ -16,7 +16,10 @@ to the element stiffness, which b_e carries):
 
 L the system's length scale with friction (:meth:`FrictionSystem.length_scale`) and ω_n its
 highest natural frequency (:meth:`FrictionSystem.frequency_scale`); both are fixed (the law
-does not depend on Ω), so ε is the only knob.
+does not depend on Ω), so ε is the only knob. An element may have narrower steps of its own
+(:meth:`RegularisedSystemBalance.with_element_scales`): element e's widths are then s_e ε_δ and
+s_e ε_v (s_e = 1 by default), which resolves an element whose own motion is much smaller than L
+(one held part of the period) without narrowing every element's steps.
 
 The unknowns are those of :class:`~rattle.hb.HarmonicBalance`: q = vec(Q), Q (n, 2H+1)
 coordinate-major, row i the real series [a_0, a_1 … a_H, b_1 … b_H] of x_i at base frequency
@@ -61,6 +64,9 @@ from ._residual import (
 )
 
 _gesv = scipy.linalg.lapack.dgesv
+
+#: The most AFT samples :meth:`RegularisedSystemBalance.with_samples` takes (a few (m, N) arrays).
+MAX_SAMPLES = 1 << 20
 
 
 class RegularisedSystemBalance:
@@ -123,6 +129,7 @@ class RegularisedSystemBalance:
         self._laws = fsys.laws
         self._tables = product_tables(H, 2 * m)
         self._lin_pos, self._lin_vals = self._linear_pattern()
+        self._scales = np.ones(m)
 
     def _linear_pattern(self) -> tuple[np.ndarray, FloatArray]:
         """The linear part's Jacobian I ⊗ ∇(ω)² + C ⊗ ∇(ω) + K ⊗ I = ω² L2 + ω L1 + L0 by its
@@ -184,12 +191,51 @@ class RegularisedSystemBalance:
         """(ε_δ, ε_v): the widths of the smooth steps in δ (rad) and δ' (rad/s)."""
         return self.eps * self._L, self.eps * self._L * self._wn
 
-    def with_regularisation(self, regularisation: float) -> RegularisedSystemBalance:
-        """The same problem with another ε (shares the matrices)."""
-        eps = _check_regularisation(regularisation)
+    @property
+    def element_scales(self) -> FloatArray:
+        """s_e (m,): element e's steps have the widths s_e ε_δ and s_e ε_v (1 by default)."""
+        return self._scales.copy()
+
+    @property
+    def element_widths(self) -> FloatArray:
+        """(m, 2): every element's step widths (s_e ε_δ, s_e ε_v)."""
+        ed, ev = self.widths
+        return np.column_stack((self._scales * ed, self._scales * ev))
+
+    def _copy(self) -> RegularisedSystemBalance:
         out = object.__new__(RegularisedSystemBalance)
         out.__dict__.update(self.__dict__)
-        out.eps = eps
+        return out
+
+    def with_regularisation(self, regularisation: float) -> RegularisedSystemBalance:
+        """The same problem with another ε (shares the matrices)."""
+        out = self._copy()
+        out.eps = _check_regularisation(regularisation)
+        return out
+
+    def with_element_scales(self, scales: FloatArray) -> RegularisedSystemBalance:
+        """The same problem with element e's steps s_e times as wide as the chain's (``scales``
+        (m,), each finite and > 0; shares the matrices)."""
+        s = np.asarray(scales, dtype=float)
+        if s.shape != (self.n_elements,) or not np.all(np.isfinite(s)) or not np.all(s > 0):
+            raise ValueError(f"`scales` must be {self.n_elements} finite numbers > 0 (one per element), got "
+                             f"{np.asarray(scales)!r}")
+        out = self._copy()
+        out._scales = s.copy()
+        return out
+
+    def with_samples(self, samples: int) -> RegularisedSystemBalance:
+        """The same problem with N = ``samples`` AFT samples per period (N ≥ 4H + 2; the residual
+        and its Jacobian are computed by FFT, so N is bounded by memory only: 2^20 at most).
+        Steps much narrower in time than T/N are not resolved by the samples (Newton stalls):
+        narrow steps need more of them."""
+        H = self.basis.harmonics
+        if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) \
+                or not 4 * H + 2 <= samples <= MAX_SAMPLES:
+            raise ValueError(f"`samples` must be an integer in [4H + 2, {MAX_SAMPLES}] = [{4 * H + 2}, {MAX_SAMPLES}], "
+                             f"got {samples!r}")
+        out = self._copy()
+        out.basis = FourierBasis(H, int(samples))
         return out
 
     def base_frequency(self, omega: float) -> float:
@@ -270,9 +316,8 @@ class RegularisedSystemBalance:
         m, N = self.n_elements, self.basis.samples
         samples = self.basis.synthesize(np.concatenate((self._A @ Q, self._A @ dQ)))  # (2m, N)
         g, gd, gv = np.empty((m, N)), np.empty((m, N)), np.empty((m, N))
-        ed, ev = self.widths
-        for e, law in enumerate(self._laws):
-            g[e], gd[e], gv[e] = law.regularised(samples[e], samples[m + e], ed, ev)
+        for e, (law, (ed, ev)) in enumerate(zip(self._laws, self.element_widths)):
+            g[e], gd[e], gv[e] = law.regularised(samples[e], samples[m + e], float(ed), float(ev))
         return Q, dQ, g, gd, gv
 
     def samples(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray]:

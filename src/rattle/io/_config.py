@@ -121,6 +121,10 @@ class AnalysisSettings:
     limit_harmonics : int or None
         For a discontinuous law: the most harmonics the regularisation's ladder may raise H to
         (at or below ``harmonics``: H is kept); None: the library's default (256).
+    held_limit : bool or None
+        For a chain with friction or torque jumps on its elements: narrow the steps of an element
+        held part of the period to their limit (``RegularisationOptions(held=True)``); None
+        otherwise.
     """
 
     omega_min: float = DEFAULT_OMEGA[0]
@@ -129,6 +133,7 @@ class AnalysisSettings:
     regularisation: float | None = None
     refine: float | None = None
     limit_harmonics: int | None = None
+    held_limit: bool | None = None
 
     def __post_init__(self) -> None:
         omega_min = _check_real("omega_min", self.omega_min)
@@ -185,6 +190,8 @@ class AnalysisSettings:
             out["refine"] = self.refine
         if self.limit_harmonics is not None:
             out["limit_harmonics"] = self.limit_harmonics
+        if self.held_limit is not None:
+            out["held_limit"] = self.held_limit
         return out
 
 
@@ -261,7 +268,7 @@ class RunConfig:
 # --------------------------------------------------------------------------------------------
 # Schema of [analysis] (the model tables: rattle.model._tables)
 # --------------------------------------------------------------------------------------------
-_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine", "limit_harmonics")
+_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine", "limit_harmonics", "held_limit")
 _EXAMPLES.update({
     "analysis": "[analysis] with omega = [0.1, 3.0], harmonics = 32",
     "analysis.omega": "omega = [0.1, 3.0]",
@@ -269,6 +276,7 @@ _EXAMPLES.update({
     "analysis.regularisation": "regularisation = 0.01",
     "analysis.refine": "refine = 0.005",
     "analysis.limit_harmonics": "limit_harmonics = 64",
+    "analysis.held_limit": "held_limit = true",
 })
 
 
@@ -505,13 +513,25 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         # unknowns (at n = 3, H = 256 about 40 s a row against 2 s at H = 64, measured in
         # docs/nonsmooth.md), and H = harmonics meets 0.5 % away from special points there
         limit_harmonics = harmonics
+    held_limit = None
+    if "held_limit" in table:
+        if not (system and discontinuous):
+            raise check.error(
+                f"`analysis.held_limit` = {_show(table['held_limit'])} applies only to a chain with friction or a "
+                "torque jump on its elements (a `model.elements[k].friction` level > 0 or a `model.elements[k].preload` "
+                "> 0), whose held elements' steps it narrows: remove `analysis.held_limit`"
+            )
+        held_limit = table["held_limit"]
+        if not isinstance(held_limit, bool):
+            raise check.error(f"`analysis.held_limit` must be true or false, got {_show(held_limit)}; "
+                              f"write e.g. {_example('analysis.held_limit')}")
     return check.build(
         AnalysisSettings,
         {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics",
          "regularisation": "analysis.regularisation", "refine": "analysis.refine",
-         "limit_harmonics": "analysis.limit_harmonics"},
+         "limit_harmonics": "analysis.limit_harmonics", "held_limit": "analysis.held_limit"},
         omega_min=omega[0], omega_max=omega[1], harmonics=harmonics, regularisation=regularisation, refine=refine,
-        limit_harmonics=limit_harmonics,
+        limit_harmonics=limit_harmonics, held_limit=held_limit,
     )
 
 

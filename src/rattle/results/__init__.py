@@ -8,7 +8,7 @@ them when loaded.
 from ._columns import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 from ._comparison import Comparison
 from ._friction import FRICTION_ELEMENT_COLUMNS, FRICTION_TAIL_COLUMNS, FrictionResponse
-from ._friction_orbit import FRICTION_ORBIT_ELEMENT_COLUMNS, FrictionOrbitResult
+from ._friction_orbit import FRICTION_ORBIT_ELEMENT_COLUMNS, FrictionOrbitResult, HeldLimitRecord
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, compare_measured
 from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothResponse
@@ -25,5 +25,5 @@ __all__ = [
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
     "NonsmoothResponse", "NONSMOOTH_COLUMNS", "FrictionResponse", "FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS",
-    "NonsmoothOrbitResult", "NONSMOOTH_ORBIT_COLUMNS", "FrictionOrbitResult", "FRICTION_ORBIT_ELEMENT_COLUMNS",
+    "NonsmoothOrbitResult", "NONSMOOTH_ORBIT_COLUMNS", "FrictionOrbitResult", "FRICTION_ORBIT_ELEMENT_COLUMNS", "HeldLimitRecord",
 ]

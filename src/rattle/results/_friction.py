@@ -17,7 +17,7 @@ multiplier that crossed (:func:`rattle.stability.classify_loss`): fold (+1), per
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +29,8 @@ from ..stability import classify_loss
 from ._plotter import plot_with
 
 #: The per-element columns of :meth:`FrictionResponse.columns`, NAME_ prefixed, in this order.
-FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated")
+FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated",
+                            "rms_hb_held")
 #: The columns closing each row.
 FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "mu_abs", "mu_hb_abs", "rms_error", "bifurcation",
                          "eps_limit", "match_distance", "stable_hb_limit")
@@ -64,7 +65,15 @@ class FrictionResponse:
     sub-harmonic ones in ``branches`` (empty unless asked for); :meth:`to_csv` writes them all, the
     primary's rows first. ``followed``: how the branch was continued, ``"harmonic balance"`` or
     ``"exact shooting"`` (a sub-harmonic branch the regularised HB has no orbit for: every row an
-    exact orbit, the HB columns nan)."""
+    exact orbit, the HB columns nan).
+
+    With ``RegularisationOptions(held=True)``: at the matched rows ``held_index`` where the exact
+    orbit holds an element part of the period, the HB with that element's own steps narrowed to
+    their limit (:func:`rattle.analysis._held_limit.held_limit`): ``held_rms`` (k, m) every
+    element's HB rms there (nan: the ladder failed), ``held_status`` (k,) ``"converged"``,
+    ``"stalled"``, ``"floor"`` or ``"failed"``, ``held_scale`` (k,) the held steps' width relative
+    to the chain's at the last rung. The HB's ε → 0 estimate of a held element
+    (:attr:`rms_hb_estimate`) is then that rms."""
 
     omega: FloatArray
     rpm: FloatArray | None
@@ -97,6 +106,10 @@ class FrictionResponse:
     states: FloatArray | None = None
     branches: tuple[FrictionResponse, ...] = ()
     followed: str = "harmonic balance"
+    held_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    held_rms: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    held_status: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=object))
+    held_scale: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -151,10 +164,20 @@ class FrictionResponse:
         """As :attr:`stability_agrees` with the HB at its limit (:attr:`stable_hb_limit`)."""
         return self.matched & (self.stable == self.stable_hb_limit)
 
-    def _per_row(self, values: np.ndarray) -> np.ndarray:
+    def _per_row(self, values: np.ndarray, index: np.ndarray | None = None) -> np.ndarray:
         out = np.full((len(self),) + values.shape[1:], np.nan)
-        out[self.limit_index] = values
+        out[self.limit_index if index is None else index] = values
         return out
+
+    @property
+    def rms_hb_held(self) -> FloatArray:
+        """(P, m): the HB rms of every element held part of the period with its own steps narrowed
+        to their limit (:attr:`held_rms`), nan elsewhere (the elements that move, the rows without)."""
+        m = len(self.element_names)
+        if not self.held_index.size:
+            return np.full((len(self), m), np.nan)
+        out = self._per_row(self.held_rms.reshape(-1, m), self.held_index)
+        return np.where(self._held_part(), out, np.nan)
 
     @property
     def rms_hb_limit(self) -> FloatArray:
@@ -169,10 +192,12 @@ class FrictionResponse:
 
     @property
     def rms_hb_estimate(self) -> FloatArray:
-        """(P, m): the HB's ε → 0 estimate: Richardson's value where it holds, else the rms at the
-        ladder's smallest ε, else ``rms_hb``."""
-        ext, lim = self.rms_hb_extrapolated, self.rms_hb_limit
-        return np.where(np.isfinite(ext), ext, np.where(np.isfinite(lim), lim, self.rms_hb))
+        """(P, m): the HB's ε → 0 estimate: of an element held part of the period, its rms with its
+        own steps narrowed (:attr:`rms_hb_held`) where computed; else Richardson's value where it
+        holds, else the rms at the ladder's smallest ε, else ``rms_hb``."""
+        ext, lim, held = self.rms_hb_extrapolated, self.rms_hb_limit, self.rms_hb_held
+        out = np.where(np.isfinite(ext), ext, np.where(np.isfinite(lim), lim, self.rms_hb))
+        return np.where(np.isfinite(held), held, out)
 
     @property
     def hb_error(self) -> FloatArray:
@@ -218,7 +243,7 @@ class FrictionResponse:
         if self.rpm is not None:
             cols["speed_rpm"] = self.rpm
         err = self.element_rms_error
-        lim, ext = self.rms_hb_limit, self.rms_hb_extrapolated
+        lim, ext, held = self.rms_hb_limit, self.rms_hb_extrapolated, self.rms_hb_held
         for e, name in enumerate(self.element_names):
             cols[f"{name}_rms"] = self.rms[:, e]
             cols[f"{name}_rms_hb"] = self.rms_hb[:, e]
@@ -227,6 +252,7 @@ class FrictionResponse:
             cols[f"{name}_rms_error"] = err[:, e]
             cols[f"{name}_rms_hb_limit"] = lim[:, e]
             cols[f"{name}_rms_hb_extrapolated"] = ext[:, e]
+            cols[f"{name}_rms_hb_held"] = held[:, e]
         cols.update(matched=self.matched, stable=self.stable, stable_hb=self.stable_hb, mu_abs=self.mu_abs,
                     mu_hb_abs=self.mu_hb_abs, rms_error=self.rms_error, bifurcation=self.bifurcation,
                     eps_limit=self._per_row(self.limit_eps), match_distance=self.match_distance,
@@ -269,6 +295,7 @@ class FrictionResponse:
             "unstable_rows": int(np.sum(~self.stable)),
             "sticking_rows": int(np.sum(np.nan_to_num(self.stick_fraction).max(axis=1) > 0)) if len(self) else 0,
             "refined_rows": int(self.limit_index.size),
+            **self._held_counts(),
             "refined_max_error": num(float(np.nanmax(self.hb_error[self.limit_index])))
             if self.limit_index.size and np.any(np.isfinite(self.hb_error[self.limit_index])) else None,
             "status": self.status.name,
@@ -293,6 +320,27 @@ class FrictionResponse:
     def _held(self) -> np.ndarray:
         """(P, m): the element is held (stuck or locked) part of the period on the exact orbit."""
         return np.nan_to_num(self.stick_fraction) > 0
+
+    def _held_part(self) -> np.ndarray:
+        """(P, m): held part of the period, not all of it (0 < stick fraction < 1)."""
+        st = np.nan_to_num(self.stick_fraction)
+        return (st > 0) & (st < 1.0)
+
+    def _held_counts(self) -> dict[str, Any]:
+        """held_limit_rows (rows with the held elements' own ladder), held_limit_within_0_5_percent
+        (of those, the rows where every held element's narrowed HB rms is within 0.5 % of the
+        exact one), held_limit_max_error, held_limit_converged."""
+        if not self.held_index.size:
+            return {"held_limit_rows": 0}
+        with np.errstate(invalid="ignore", divide="ignore"):
+            err = np.abs(self.rms_hb_held / self.rms - 1.0)[self.held_index]
+        part = self._held_part()[self.held_index]
+        worst = np.max(np.where(part, np.nan_to_num(err, nan=np.inf), 0.0), axis=1)
+        finite = worst[np.isfinite(worst)]
+        return {"held_limit_rows": int(self.held_index.size),
+                "held_limit_within_0_5_percent": int(np.sum(worst <= 0.005)),
+                "held_limit_max_error": float(np.max(finite)) if finite.size else None,
+                "held_limit_converged": int(np.sum(self.held_status == "converged"))}
 
     @property
     def moving_rms_error(self) -> FloatArray:
@@ -337,6 +385,12 @@ class FrictionResponse:
                                 if self.limit_index.size else ""))
             lines.append(f"stability (exact vs HB monodromy) agrees on {md['stability_agrees']} of {md['matched']} "
                          f"({md['stability_agrees_limit']} with the HB at its limit where refined)")
+        if self.held_index.size:
+            worst = md["held_limit_max_error"]
+            lines.append(f"held elements' own steps narrowed to their limit on {md['held_limit_rows']} rows "
+                         f"({md['held_limit_converged']} converged): their HB rms within 0.5 % of the exact on "
+                         f"{md['held_limit_within_0_5_percent']}"
+                         + ("" if worst is None else f", max {100 * worst:.3g} %"))
         if self.limit_index.size:
             txt = "n/a" if md["refined_max_error"] is None else f"{100 * md['refined_max_error']:.3g} %"
             lines.append(f"regularisation continued towards ε → 0 on {self.limit_index.size} rows "

@@ -43,6 +43,33 @@ def _num(x: float) -> float | None:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
+class HeldLimitRecord:
+    """The HB with the steps of the elements held part of the period narrowed to their limit
+    (:func:`rattle.analysis._held_limit.held_limit`): ``elements`` the names narrowed, ``rms`` (m,)
+    every element's HB rms at the last rung, ``status`` ``"converged"`` (the held rms moved by less
+    than the tolerance over the last halving of the width), ``"stalled"`` (Newton failed) or
+    ``"floor"``; ``scale`` the held steps' width relative to the chain's at the last rung, ``eps``
+    the chain's ε, ``harmonics`` H and ``samples`` N of the last rung, ``change`` the held rms's
+    last relative change over a halving of the width, ``seconds`` the time it took."""
+
+    elements: tuple[str, ...]
+    rms: FloatArray
+    status: str
+    scale: float
+    eps: float
+    harmonics: int
+    samples: int
+    change: float
+    seconds: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """The record as plain values (nan → None)."""
+        return {"elements": list(self.elements), "rms": [_num(v) for v in self.rms], "status": self.status,
+                "scale": _num(self.scale), "eps": _num(self.eps), "harmonics": int(self.harmonics),
+                "samples": int(self.samples), "change": _num(self.change), "seconds": _num(self.seconds)}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
 class FrictionOrbitResult:
     """The exact and regularised orbits of a chain with friction at one forcing frequency (module
     docstring); N samples, m elements, n coordinates.
@@ -70,7 +97,9 @@ class FrictionOrbitResult:
     failed; ``""`` failed). ``match``: the largest :attr:`match_distance` for the two orbits to
     count as one (:attr:`matched`). ``periods`` p: the orbit repeats after p forcing periods (1,
     or 2 for a period-doubled orbit, ``friction_orbit(..., period=2)``); ``t`` then spans
-    [0, pT], and the HB series (2H harmonics) is one of Ω/p."""
+    [0, pT], and the HB series (2H harmonics) is one of Ω/p. ``held_limit``: with
+    ``RegularisationOptions(held=True)`` and an element held part of the period, the HB with that
+    element's own steps narrowed to their limit (:class:`HeldLimitRecord`; None otherwise)."""
 
     omega: float
     speed_rpm: float | None
@@ -100,6 +129,7 @@ class FrictionOrbitResult:
     held: tuple[str, ...] = ()
     settle_periods: int = 100
     periods: int = 1
+    held_limit: HeldLimitRecord | None = None
 
     # --- the period and the HB series --------------------------------------------------------
     @property
@@ -134,6 +164,14 @@ class FrictionOrbitResult:
         rms; nan where the exact rms is 0 or missing."""
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(self.rms > 0.0, self.rms_hb / self.rms - 1.0, np.nan)
+
+    @property
+    def held_limit_error(self) -> FloatArray:
+        """rms_held / rms − 1 per element (m,) of :attr:`held_limit` (nan without it)."""
+        if self.held_limit is None:
+            return np.full(self.m, np.nan)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.rms > 0.0, self.held_limit.rms / self.rms - 1.0, np.nan)
 
     @property
     def rms_error(self) -> float:
@@ -231,6 +269,8 @@ class FrictionOrbitResult:
             "multipliers_hb_abs": [_num(v) for v in np.abs(self.multipliers_hb)],
             "match": self.match, "match_distance": _num(self.match_distance), "matched": self.matched,
             "rms_error": _num(self.rms_error), "elements": elements,
+            "held_limit": None if self.held_limit is None else {
+                **self.held_limit.to_dict(), "rms_error": [_num(v) for v in self.held_limit_error]},
         }
 
     def summary(self) -> str:
@@ -251,6 +291,12 @@ class FrictionOrbitResult:
                 lines.append(f"{name}: exact rms {self.rms[e]:.6g} rad, mean {self.mean[e]:.6g} rad, {stick}; {hb_text}")
             else:
                 lines.append(f"{name}: no exact orbit; {hb} rms {self.rms_hb[e]:.6g}")
+        if self.held_limit is not None:
+            hl, herr = self.held_limit, self.held_limit_error
+            parts = ", ".join(f"{name} rms {hl.rms[e]:.6g} (error {herr[e]:+.2g})" for e, name in enumerate(self.element_names)
+                              if name in hl.elements)
+            lines.append(f"held elements' own steps narrowed to {hl.scale:.2g} of the chain's (ε = {hl.eps:g}, "
+                         f"H = {hl.harmonics}, N = {hl.samples}; {hl.status}, {hl.seconds:.0f} s): {parts}")
         if self.converged:
             how = (f"{'matched' if self.matched else 'NOT matched'} by the HB orbit (distance {self.match_distance:.2g})"
                    if np.isfinite(self.match_distance) else "no HB orbit beside it")
@@ -273,4 +319,4 @@ class FrictionOrbitResult:
                 f"{'stable' if self.stable else 'unstable'}, from {self.start})")
 
 
-__all__ = ["FRICTION_ORBIT_ELEMENT_COLUMNS", "FrictionOrbitResult"]
+__all__ = ["FRICTION_ORBIT_ELEMENT_COLUMNS", "FrictionOrbitResult", "HeldLimitRecord"]

@@ -129,11 +129,10 @@ def regularised_system_monodromy(problem: RegularisedSystemBalance, q: FloatArra
     cols = system.element_columns.reshape(n, m)
     Kt = np.broadcast_to(np.asarray(system.stiffness, dtype=float), (N, n, n)).copy()
     Ct = np.broadcast_to(np.asarray(system.damping, dtype=float), (N, n, n)).copy()
-    ed, ev = problem.widths
-    for e, law in enumerate(problem.fsys.laws):
+    for e, (law, (ed, ev)) in enumerate(zip(problem.fsys.laws, problem.element_widths)):
         d = problem.basis.evaluate(E[e], w, t)
         v = problem.basis.evaluate(E[e], w, t, derivative=1)
-        _, g_d, g_v = law.regularised(d, v, ed, ev)
+        _, g_d, g_v = law.regularised(d, v, float(ed), float(ev))
         W = np.outer(cols[:, e], rows[e])  # b_e a_eᵀ
         Kt += g_d[:, None, None] * W
         Ct += g_v[:, None, None] * W
