@@ -22,9 +22,9 @@ narrow. With a scale s on the held elements (1 on the others, the chain's ε kep
    is left is the truncation at H), when Newton fails at the smallest factor with the most samples
    (``"stalled"``), or at s = ``min_scale`` (``"floor"``).
 
-Measured on the lock-up chain of the tests (docs/nonsmooth.md, "The held element's own
-steps"): the held clutch's HB rms, 20–31 % off at ε = 1e-3 with the chain's widths, comes within
-0.1–0.4 % of the exact orbit's in 40–70 s a row (H = 256).
+Measured on the lock-up chain of the tests (docs/nonsmooth.md, "A held element's own
+steps"): the held clutch's HB rms, 26–60 % off at ε = 1e-3 with the chain's widths, comes within
+0.07–0.34 % of the exact orbit's in 67–292 s a row (H = 256).
 """
 
 from __future__ import annotations

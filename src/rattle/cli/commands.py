@@ -590,7 +590,8 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
         "settings": {"method": "exact event-driven shooting of the chain (Filippov sticking, saltation monodromy) "
                                "started from its regularised harmonic balance (rattle.analysis.friction_orbit)",
                      "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
-                     "period": period},
+                     "period": period, "held_limit": options.held, "held_harmonics": options.held_harmonics,
+                     "limit_eps": options.limit_eps},
         "system": {"coordinates": int(system.n), "elements": elements},
         "status": "converged" if result.converged else "failed",
         "message": result.message or ("" if result.converged else "the exact shooting did not converge"),
