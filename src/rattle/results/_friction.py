@@ -379,7 +379,9 @@ class FrictionResponse:
                          f"{100 * (md['median_rms_error'] or 0):.3g} %")
             if md["held_rows"]:
                 lines.append(f"on the {md['held_rows']} rows where an element is held (stuck or locked part of the "
-                             f"period) the HB resolves that element only to the regularisation's width; the elements "
+                             f"period) the HB with the chain's widths resolves that element only to their width"
+                             + (" (its own steps narrowed below)" if self.held_index.size
+                                else " (`held` narrows its own steps)") + "; the elements "
                              f"moving: within 0.5 % on {md['within_0_5_percent_moving']} of {md['matched']} rows"
                              + (f" at ε, on {md['within_0_5_percent_moving_estimate']} with the HB's ε → 0 estimate"
                                 if self.limit_index.size else ""))
