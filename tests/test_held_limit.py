@@ -1,7 +1,8 @@
 """A chain element held part of the period: its own steps narrowed to their limit.
 
 - :meth:`RegularisedSystemBalance.with_element_scales`: every element scaled by s is the chain at
-  s ε (round-off); one element scaled keeps the analytic Jacobian (central differences);
+  s ε (round-off); one element scaled keeps the analytic Jacobian (central differences, in
+  tests/test_regularised_system.py);
 - :meth:`RegularisedSystemBalance.with_samples`: more AFT samples change a smooth orbit's residual
   by the aliasing only; bad values refused;
 - :func:`held_limit` on the lock-up chain (tests/_cases.lockup_chain) at Ω = 2.11, where the clutch
@@ -25,7 +26,6 @@ from rattle.analysis import RegularisationOptions, friction_orbit
 from rattle.analysis._friction_orbit import _start
 from rattle.analysis._friction_response import friction_balance_factory
 from rattle.analysis._held_limit import HELD_STATUSES, held_limit
-from rattle.hb import HBOptions, RegularisedSystemBalance
 
 OMEGA = 2.11  # rad/s: the clutch held ~30 % of the period
 
@@ -52,26 +52,6 @@ def test_element_scales_are_the_chains_widths_per_element(lockup) -> None:  # ty
     np.testing.assert_array_equal(pb.with_element_scales(np.array([1.0, 0.25])).residual(q, OMEGA), pb.residual(q, OMEGA))
     np.testing.assert_allclose(pb.with_element_scales(np.array([0.25, 1.0])).residual(q, OMEGA),
                                narrower.residual(q, OMEGA), rtol=0, atol=1e-15)
-
-
-def test_one_elements_scale_keeps_the_analytic_jacobian() -> None:
-    fs = lockup_chain().friction_system()
-    pb = RegularisedSystemBalance(fs, regularisation=0.05, options=HBOptions(harmonics=6)).with_element_scales(
-        np.array([0.3, 1.0]))
-    w = 0.7 * pb.parameter_scale
-    rng = np.random.default_rng(3)
-    q = pb.linear_solution(w) + 0.02 * pb.length_scale * rng.standard_normal(pb.size)
-    R, J, Rw = pb.residual_jacobian(q, w)
-    np.testing.assert_array_equal(R, pb.residual(q, w))
-    h = 1e-6 * pb.length_scale
-    fd = np.empty_like(J)
-    for j in range(pb.size):
-        e = np.zeros(pb.size)
-        e[j] = h
-        fd[:, j] = (pb.residual(q + e, w) - pb.residual(q - e, w)) / (2 * h)
-    assert np.max(np.abs(fd - J)) <= 1e-7 * np.max(np.abs(J))
-    hw = 1e-6 * w
-    assert np.max(np.abs((pb.residual(q, w + hw) - pb.residual(q, w - hw)) / (2 * hw) - Rw)) <= 1e-7 * np.max(np.abs(Rw))
 
 
 def test_more_samples_change_a_smooth_orbits_residual_by_the_aliasing_only(lockup) -> None:  # type: ignore[no-untyped-def]

@@ -2,7 +2,8 @@
 
 :class:`RegularisedSystemBalance` is checked against
 - central finite differences of its own residual (∂R/∂q and ∂R/∂Ω, chains of 2 and 3 inertias,
-  grounded and free, friction levels per stage);
+  grounded and free, friction levels per stage, with the chain's step widths and with one
+  element's own narrower steps);
 - :class:`HarmonicBalance` of the same chain without friction (the regularised law of a continuous
   law without friction is the law itself: residual and Jacobians equal to round-off, a speed-dependent
   drag included);
@@ -104,11 +105,16 @@ def _ladder(pb: RegularisedSystemBalance, omega: float) -> np.ndarray:
     return q
 
 
+@pytest.mark.parametrize("scaled", [False, True])
 @pytest.mark.parametrize("kind", ["g2", "f2", "f3", "g3"])
-def test_jacobians_match_finite_differences(kind: str) -> None:
+def test_jacobians_match_finite_differences(kind: str, scaled: bool) -> None:
+    """``scaled``: the first element (the clutch, with friction) with steps 0.3 times the chain's
+    (:meth:`RegularisedSystemBalance.with_element_scales`), the others the chain's."""
     fs = _chain(kind).friction_system()
     assert fs.has_friction
     pb = RegularisedSystemBalance(fs, regularisation=0.05, options=HBOptions(harmonics=8))
+    if scaled:
+        pb = pb.with_element_scales(np.r_[0.3, np.ones(fs.m - 1)])
     w = 0.7 * pb.parameter_scale
     q = _random_q(pb, w)
     R, J, Rw = pb.residual_jacobian(q, w)
