@@ -124,7 +124,7 @@ def test_recovery_finishes_a_journalled_commit_and_drops_an_unfinished_one(tmp_p
     (unfinished / "frf.csv").write_text("half")
     live = out / f"{STAGING_PREFIX}{os.getppid()}-cccc"
     live.mkdir()
-    assert sorted(recover_staging(out)) == sorted([done.name, unfinished.name])
+    assert sorted(recover_staging(out, FRF_FILES)) == sorted([done.name, unfinished.name])
     assert (out / "frf.csv").read_text() == "new csv" and (out / "frf.json").read_text() == "new json"
     assert not (out / "frf.png").exists()
     assert not done.exists() and not unfinished.exists() and live.exists()

@@ -15,7 +15,7 @@ from .._lazy import lazy_exports
 #: reaches ``._read`` and ``._atomic`` without numpy, which ``._csv`` and ``._metadata`` need.
 _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
-                     "recover_staging"], "._atomic"),
+                     "recover_staging", "RecoveryWarning"], "._atomic"),
     **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
     **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
@@ -25,7 +25,8 @@ _LAZY: dict[str, str] = {
 
 if TYPE_CHECKING:
     from ._atomic import (
-        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging,
+        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, RecoveryWarning,
+        recover_staging,
     )
     from ._csv import format_csv, read_csv, write_csv
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
@@ -34,7 +35,7 @@ if TYPE_CHECKING:
 __all__ = [
     "MAX_CONFIG_BYTES", "OutputSet", "STAGING_PREFIX", "atomic_path", "atomic_write_bytes", "atomic_write_text",
     "check_input_file", "environment", "format_csv", "metadata_document", "rattle_version", "read_bounded",
-    "read_csv", "recover_staging", "to_jsonable", "write_csv", "write_metadata",
+    "read_csv", "recover_staging", "RecoveryWarning", "to_jsonable", "write_csv", "write_metadata",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)

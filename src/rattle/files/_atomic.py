@@ -16,14 +16,17 @@ import json
 import os
 import shutil
 import signal
+import stat
 import tempfile
 import threading
+import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 __all__ = [
-    "atomic_path", "atomic_write_bytes", "atomic_write_text", "OutputSet", "recover_staging", "STAGING_PREFIX",
+    "atomic_path", "atomic_write_bytes", "atomic_write_text", "OutputSet", "recover_staging", "RecoveryWarning",
+    "STAGING_PREFIX",
 ]
 
 
@@ -202,22 +205,128 @@ def _move_in(directory: Path, staging: Path, moves: Sequence[str], removals: Seq
     _fsync_dir(directory)
 
 
-def recover_staging(directory: str | os.PathLike[str]) -> list[str]:
+#: A journal larger than this, or listing more names than this, is not one this module wrote.
+_JOURNAL_MAX_BYTES = 1 << 20
+_JOURNAL_MAX_NAMES = 10_000
+
+
+def _plain_name(name: object) -> bool:
+    """A name that can only mean a file directly inside one folder: a non-empty str without
+    separators, NUL or a leading dot (which also excludes ``.`` and ``..``), at most 255 bytes."""
+    if not isinstance(name, str) or not name or name.startswith(".") or "\x00" in name:
+        return False
+    if "/" in name or os.sep in name or (os.altsep and os.altsep in name):
+        return False
+    try:
+        return len(os.fsencode(name)) <= 255
+    except UnicodeError:
+        return False
+
+
+def _read_journal(journal: Path) -> dict[str, Any] | None:
+    """The journal's content, or None when it is not a regular file of a sane size holding a JSON
+    object (opened without following a symlink and without blocking on a FIFO)."""
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        fd = os.open(journal, flags)
+    except OSError:
+        return None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > _JOURNAL_MAX_BYTES:
+            return None
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            data = fh.read(_JOURNAL_MAX_BYTES + 1)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    try:
+        plan = json.loads(data.decode("utf-8"))
+    except (UnicodeError, ValueError, RecursionError):
+        return None
+    return plan if isinstance(plan, dict) else None
+
+
+def _journal_plan(directory: Path, staging: Path, plan: dict[str, Any],
+                  names: frozenset[str] | None) -> tuple[list[str], list[str], list[str]]:
+    """The moves and removals of a journal that recovery can prove are its own, and what it refused.
+
+    A move is allowed for a plain name whose staged file is a regular file inside ``staging`` (not
+    a symlink); a removal for a plain name that is a member of the output set ``names`` (with
+    ``names`` None, the set is the journal's own moves) and, in ``directory``, a regular file or a
+    symlink (unlinking a symlink never touches its target). Anything else — separators, ``..``,
+    absolute paths, hidden names, folders, special files, names outside the set — is refused.
+    """
+    moves_in, removals_in = plan.get("moves"), plan.get("removals")
+    refused: list[str] = []
+    if not isinstance(moves_in, list) or not isinstance(removals_in, list) \
+            or len(moves_in) + len(removals_in) > _JOURNAL_MAX_NAMES:
+        return [], [], ["the journal's lists (not lists, or too long)"]
+    moves: list[str] = []
+    for name in moves_in:
+        if _plain_name(name) and name not in moves:
+            try:
+                st = os.lstat(staging / name)
+            except OSError:  # already moved by the run that was killed: nothing to do
+                if (directory / name).is_file():
+                    moves.append(name)
+                    continue
+                refused.append(repr(name))
+                continue
+            if stat.S_ISREG(st.st_mode):
+                moves.append(name)
+                continue
+        refused.append(repr(name))
+    own = names if names is not None else frozenset(moves)
+    removals: list[str] = []
+    for name in removals_in:
+        if _plain_name(name) and name in own and name not in moves:
+            try:
+                st = os.lstat(directory / name)
+            except FileNotFoundError:
+                continue
+            except OSError:
+                refused.append(repr(name))
+                continue
+            if stat.S_ISREG(st.st_mode) or stat.S_ISLNK(st.st_mode):
+                removals.append(name)
+                continue
+        refused.append(repr(name))
+    return moves, removals, refused
+
+
+def recover_staging(directory: str | os.PathLike[str], names: Sequence[str] | None = None) -> list[str]:
     """Finish or discard the staging folders that runs killed outright (SIGKILL, power loss) left
     in ``directory``; return the names of the folders handled.
 
     A folder whose journal exists had its set complete: its renames are finished (roll forward).
     A folder without a journal never got that far: it is removed (roll back; the earlier files are
     untouched). Folders of live processes (the pid is part of the name) are left alone.
+
+    A journal is data read from disk, so recovery acts only on names it can prove are its own:
+    files staged inside the staging folder (moved in) and members of the output set ``names``
+    (removed; with ``names`` None only names the journal also moves). A name with a separator,
+    ``..``, an absolute path, a hidden name, a symlink or special file staged, or a name outside
+    the set is refused with a :class:`RecoveryWarning` and left alone; nothing outside
+    ``directory`` is ever moved or deleted.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The output directory.
+    names : sequence of str, optional
+        The output set of the run that recovers (its files may be removed as stale).
     """
     directory = Path(directory)
+    own = None if names is None else frozenset(str(n) for n in names)
     handled: list[str] = []
     try:
         entries = list(directory.iterdir())
     except OSError:
         return handled
     for entry in entries:
-        if not entry.name.startswith(STAGING_PREFIX) or not entry.is_dir() or entry.is_symlink():
+        if not entry.name.startswith(STAGING_PREFIX) or entry.is_symlink() or not entry.is_dir():
             continue
         try:
             pid = int(entry.name[len(STAGING_PREFIX):].split("-", 1)[0])
@@ -226,14 +335,30 @@ def recover_staging(directory: str | os.PathLike[str]) -> list[str]:
         if pid == os.getpid() or _pid_alive(pid):
             continue
         journal = entry / _JOURNAL
-        with contextlib.suppress(OSError, ValueError, TypeError, KeyError):
-            if journal.is_file():
-                plan = json.loads(journal.read_text(encoding="utf-8"))
+        if os.path.lexists(journal):
+            plan = _read_journal(journal)
+            if plan is None:
+                moves, removals, refused = [], [], ["the journal (not a JSON object of a sane size)"]
+            else:
+                moves, removals, refused = _journal_plan(directory, entry, plan, own)
+            if refused:
+                shown = ", ".join(refused[:5]) + (f" and {len(refused) - 5} more" if len(refused) > 5 else "")
+                warnings.warn(f"recovering {entry}: refused {shown}: not a file of this output set; left alone",
+                              RecoveryWarning, stacklevel=2)
+            try:
                 with _signals_held():
-                    _move_in(directory, entry, [str(n) for n in plan["moves"]], [str(n) for n in plan["removals"]])
+                    _move_in(directory, entry, moves, removals)
+            except OSError as exc:
+                warnings.warn(f"recovering {entry}: {exc}; the folder is left for the next run", RecoveryWarning,
+                              stacklevel=2)
+                continue
         shutil.rmtree(entry, ignore_errors=True)
         handled.append(entry.name)
     return handled
+
+
+class RecoveryWarning(UserWarning):
+    """A staging folder's journal named something that recovery cannot prove is its own."""
 
 
 class OutputSet:
@@ -299,7 +424,7 @@ class OutputSet:
         self.directory.mkdir(parents=True, exist_ok=True)
         self._created = missing  # deepest first
         try:
-            recover_staging(self.directory)
+            recover_staging(self.directory, self.names)
             self.staging = Path(tempfile.mkdtemp(dir=self.directory, prefix=f"{STAGING_PREFIX}{os.getpid()}-"))
         except BaseException:
             self.discard()

@@ -16,7 +16,7 @@ from .._lazy import lazy_exports
 #: and ``._csv``/``._metadata`` need.
 _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
-                     "recover_staging"], "..files._atomic"),
+                     "recover_staging", "RecoveryWarning"], "..files._atomic"),
     **dict.fromkeys(["DEFAULT_HARMONICS", "DEFAULT_OMEGA", "AnalysisSettings", "RunConfig", "check_harmonics",
                      "config_from_dict", "dumps_toml", "load_config", "model_to_toml_dict",
                      "rename_keys"], "._config"),
@@ -36,7 +36,8 @@ _MOVED: dict[str, str] = dict.fromkeys(["FRF_COLUMNS", "ORBIT_COLUMNS", "SWEEP_C
 
 if TYPE_CHECKING:
     from ..files._atomic import (
-        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, recover_staging,
+        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, RecoveryWarning,
+        recover_staging,
     )
     from ._config import (
         DEFAULT_HARMONICS, DEFAULT_OMEGA, AnalysisSettings, RunConfig, check_harmonics, config_from_dict, dumps_toml,
@@ -62,7 +63,8 @@ __all__ = [
     # metadata
     "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
     # atomic writes, output sets, bounded reads
-    "atomic_write_text", "atomic_write_bytes", "atomic_path", "OutputSet", "recover_staging", "STAGING_PREFIX",
+    "atomic_write_text", "atomic_write_bytes", "atomic_path", "OutputSet", "recover_staging", "RecoveryWarning",
+    "STAGING_PREFIX",
     "read_bounded", "check_input_file", "MAX_CONFIG_BYTES",
 ]
 
