@@ -169,6 +169,22 @@ class DaskEngine:
         return client, client.close
 
     @staticmethod
+    def _confirm_cancelled(client: Any, keys: Sequence[Any], timeout: float = 5.0) -> None:
+        """Wait (at most ``timeout`` s) until the scheduler holds none of ``keys`` in memory.
+
+        ``Client.cancel`` only queues the cancellation on the client's batched stream and returns;
+        a task submitted just before (its graph queued on the same stream) may still finish and be
+        held for a moment. A run that ends leaves nothing of its own on a shared cluster, so the
+        scheduler is asked until it has released them (a handful of round trips).
+        """
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            states = client.sync(client.scheduler.get_task_status, keys=list(keys))
+            if all(state in (None, "released", "forgotten") for state in states.values()):
+                return
+            time.sleep(0.01)
+
+    @staticmethod
     def _threads(client: Any) -> int:
         try:
             return int(sum(client.nthreads().values()))
@@ -234,7 +250,10 @@ class DaskEngine:
         finally:
             if futures:
                 try:
+                    keys = [f.key for f in futures]
                     client.cancel(list(futures), force=True)
+                    futures.clear()
+                    self._confirm_cancelled(client, keys)
                 except Exception:  # pragma: no cover - the client is going anyway
                     pass
             release()

@@ -584,6 +584,17 @@ class FrictionIntegrator:
                         st[e_ev] += 1
                 cands = [e for e in range(m) if stuck[e] and e != e_ev]
                 new_key, stages, locked = self._settle(t, zc, tuple(st), cands, sigma, omega, locked=tuple(lk))
+                if kind == UNLOCK and not new_key[0][e_ev]:
+                    # Released at the band's edge: δ_e' = 0 and δ_e'' = 0 there, growing the way
+                    # it leaves (sign_f). Round-off in δ_e' pointing back (~1e-17) would cross
+                    # the jump back at once and snap into the lock again for ~1e-13 (a spurious
+                    # lock/unlock pair, CPU-dependent). Leave as the reference does: δ_e' not back,
+                    # δ_e a hair (64 ε L) on the side it leaves to.
+                    vb = float(a @ zc[n:])
+                    if vb * sign_f < 0.0:
+                        zc[n:] -= self._hold_columns([e_ev])[:, 0] * vb
+                    hair = 64.0 * _EPS * max(self._L, abs(value))
+                    zc[:n] += a * ((value + sign_f * hair - float(a @ zc[:n])) / float(a @ a))
             if normal is not None:
                 phi_plus = self._field(new_key, stages, t, zc, omega)
                 denom = float(normal @ phi_minus)
