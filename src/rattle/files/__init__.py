@@ -17,7 +17,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
                      "recover_staging", "RecoveryWarning"], "._atomic"),
     **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
-    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "._read"),
+    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "read_toml", "check_input_file"], "._read"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
                     "._metadata"),
 }
@@ -30,12 +30,12 @@ if TYPE_CHECKING:
     )
     from ._csv import format_csv, read_csv, write_csv
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
-    from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
+    from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded, read_toml
 
 __all__ = [
     "MAX_CONFIG_BYTES", "OutputSet", "STAGING_PREFIX", "atomic_path", "atomic_write_bytes", "atomic_write_text",
     "check_input_file", "environment", "format_csv", "metadata_document", "rattle_version", "read_bounded",
-    "read_csv", "recover_staging", "RecoveryWarning", "to_jsonable", "write_csv", "write_metadata",
+    "read_csv", "read_toml", "recover_staging", "RecoveryWarning", "to_jsonable", "write_csv", "write_metadata",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)

@@ -11,21 +11,22 @@ from typing import TYPE_CHECKING
 
 from .._lazy import lazy_exports
 
-#: Public name → the module that defines it. Imported on first use (PEP 562): the command line
-#: reaches ``rattle.files._read`` and ``._atomic`` without numpy, which ``._config`` (the model)
-#: and ``._csv``/``._metadata`` need.
+#: Public name → the module that defines it, or for the file primitives their public home
+#: :mod:`rattle.files` (itself lazy). Imported on first use (PEP 562): the command line reaches the
+#: bounded reads and atomic writes without numpy, which ``._config`` (the model) and the CSV and
+#: metadata primitives need.
 _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
-                     "recover_staging", "RecoveryWarning"], "..files._atomic"),
+                     "recover_staging", "RecoveryWarning"], "..files"),
     **dict.fromkeys(["DEFAULT_HARMONICS", "DEFAULT_OMEGA", "AnalysisSettings", "RunConfig", "check_harmonics",
                      "config_from_dict", "dumps_toml", "load_config", "model_to_toml_dict",
                      "rename_keys"], "._config"),
-    **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "..files._csv"),
+    **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "..files"),
     **dict.fromkeys(["read_path_csv", "PATH_COLUMNS"], "._paths"),
     **dict.fromkeys(["read_measured_csv", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS"], "._measured"),
-    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "..files._read"),
+    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "..files"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
-                    "..files._metadata"),
+                    "..files"),
 }
 
 
@@ -35,19 +36,17 @@ _MOVED: dict[str, str] = dict.fromkeys(["FRF_COLUMNS", "ORBIT_COLUMNS", "SWEEP_C
 
 
 if TYPE_CHECKING:
-    from ..files._atomic import (
-        STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, RecoveryWarning,
-        recover_staging,
+    from ..files import (
+        MAX_CONFIG_BYTES, STAGING_PREFIX, OutputSet, RecoveryWarning, atomic_path, atomic_write_bytes,
+        atomic_write_text, check_input_file, environment, format_csv, metadata_document, rattle_version, read_bounded,
+        read_csv, recover_staging, to_jsonable, write_csv, write_metadata,
     )
     from ._config import (
         DEFAULT_HARMONICS, DEFAULT_OMEGA, AnalysisSettings, RunConfig, check_harmonics, config_from_dict, dumps_toml,
         load_config, model_to_toml_dict, rename_keys,
     )
-    from ..files._csv import format_csv, read_csv, write_csv
     from ._paths import PATH_COLUMNS, read_path_csv
     from ._measured import MEASURED_SPEED_COLUMNS, MEASURED_VALUE_COLUMNS, read_measured_csv
-    from ..files._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
-    from ..files._read import MAX_CONFIG_BYTES, check_input_file, read_bounded
 
 __all__ = [
     # configuration

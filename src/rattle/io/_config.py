@@ -46,11 +46,8 @@ import numpy as np
 
 from .. import _limits
 from ..errors import ConfigError
-from ..files._read import read_toml
-from ..model import Model, check_analysable_model
-from ..model._discontinuous import Preload
-from ..model._elastic import _check_real
-from ..model._engine import forcing_frequency
+from ..files import read_toml
+from ..model import Model, Preload, check_analysable_model, forcing_frequency
 from ..model._friction_system import FrictionSystem
 from ..model._nonsmooth_system import NonsmoothSystem
 from ..model._table_checks import (
@@ -136,8 +133,8 @@ class AnalysisSettings:
     held_limit: bool | None = None
 
     def __post_init__(self) -> None:
-        omega_min = _check_real("omega_min", self.omega_min)
-        omega_max = _check_real("omega_max", self.omega_max)
+        omega_min = _limits.check_magnitude(self.omega_min, "omega_min")
+        omega_max = _limits.check_magnitude(self.omega_max, "omega_max")
         if omega_min <= 0:
             raise ValueError(
                 f"`omega_min` must be > 0 rad/s (a forcing frequency), got {omega_min!r}; "
@@ -152,7 +149,7 @@ class AnalysisSettings:
         # The same rule (and upper bound, from memory and time) as the library's `harmonics`.
         harmonics = _limits.check_harmonics(self.harmonics, "harmonics")
         if self.regularisation is not None:
-            eps = _check_real("regularisation", self.regularisation)
+            eps = _limits.check_magnitude(self.regularisation, "regularisation")
             if not 0.0 < eps < 1.0:
                 raise ValueError(
                     f"`regularisation` (relative width ε of the smooth steps replacing the jumps and the friction) "
@@ -161,7 +158,7 @@ class AnalysisSettings:
                 )
             object.__setattr__(self, "regularisation", eps)
         if self.refine is not None:
-            tol = _check_real("refine", self.refine)
+            tol = _limits.check_magnitude(self.refine, "refine")
             if not 0.0 <= tol < 1.0:
                 raise ValueError(
                     f"`refine` (the relative HB rms error above which a row's regularisation is continued to its "

@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..files._read import read_bounded
+from ..files import read_bounded
 
 __all__ = ["MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS", "MAX_MEASURED_BYTES", "MAX_MEASURED_ROWS",
            "read_measured_csv"]

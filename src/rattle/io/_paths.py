@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..files._read import read_bounded
+from ..files import read_bounded
 
 __all__ = ["PATH_COLUMNS", "PATHS_KEYS", "MAX_PATH_BYTES", "read_path_csv", "paths_from_config", "with_paths"]
 
@@ -65,7 +65,7 @@ def read_path_csv(file: str | os.PathLike[str], source: str, *, key: str = "file
         Whatever breaks a rule of the module docstring; the message names ``key``, the line and
         the fix.
     """
-    from ..model._paths import SoundPath
+    from ..model import SoundPath
 
     name = os.fspath(file)
     where = f"`{key}` ({name!r})"
