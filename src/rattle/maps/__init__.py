@@ -6,7 +6,7 @@ Layer: above :mod:`rattle.analysis` (which computes one combination) and :mod:`r
 (configuration tables, atomic writes); below the command line.
 
 The names are loaded on first use (PEP 562), so that ``rattle map`` can check its ``--vary``
-arguments (:mod:`rattle.maps._vary`) without importing the numerics.
+arguments (:func:`parse_all`, :func:`parameters`, :func:`build_all`) without importing the numerics.
 """
 
 from __future__ import annotations
@@ -18,19 +18,25 @@ from .._lazy import lazy_exports
 _LAZY: dict[str, str] = {
     "AttractorSearch": "..analysis._attractors",
     **dict.fromkeys(["response_map", "DEFAULT_OMEGA_POINTS"], "._map"),
-    "map_report": "._report",
+    **dict.fromkeys(["map_report", "common_intervals", "format_intervals"], "._report"),
     **dict.fromkeys(["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"],
                     "._result"),
+    **dict.fromkeys(["parse_all", "parameters", "combinations", "build_all"], "._vary"),
 }
 
 __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS",
-           "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS"]
+           "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS",
+           # the summary's Ω intervals (``rattle map``'s report and map.json)
+           "common_intervals", "format_intervals",
+           # the --vary arguments: parsed, resolved to parameters, every combination's model built
+           "parse_all", "parameters", "combinations", "build_all"]
 
 
 if TYPE_CHECKING:
     from ..analysis._attractors import AttractorSearch
     from ._map import DEFAULT_OMEGA_POINTS, response_map
-    from ._report import map_report
+    from ._report import common_intervals, format_intervals, map_report
     from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap
+    from ._vary import build_all, combinations, parameters, parse_all
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)

@@ -31,8 +31,7 @@ from ..analysis._frequency_response import _frequency_response
 from ..analysis._grid import solutions_on_grid
 from ..analysis._settings import RunSettings
 from ..errors import RattleError
-from ..results import FrequencyResponse
-from ..results._sound import UNCOVERED_WARNING, coefficient_sound_pressure
+from ..results import UNCOVERED_WARNING, FrequencyResponse, coefficient_sound_pressure
 from ._result import INTERVAL_KINDS, CellResult, grid_runs
 
 
@@ -79,7 +78,7 @@ def summarise(census: Census, grid: np.ndarray) -> dict[str, Any]:
 
 def sound_levels(model: Any, census: Census, grid: np.ndarray, paths: tuple[Any, ...]) -> tuple[np.ndarray, str]:
     """``spl_max_stable_db`` on the grid: per grid frequency the largest sound pressure level at
-    the receiver (:func:`rattle.results._sound.coefficient_sound_pressure`, the paper's eq. 1 on
+    the receiver (:func:`rattle.results.coefficient_sound_pressure`, the paper's eq. 1 on
     each solution's own harmonics k Ω/period) over the stable periodic solutions of every branch
     there, NaN where there is none; and a note (empty, or the largest share of a source's
     mean-square acceleration outside a path table, when above UNCOVERED_WARNING: the level is then

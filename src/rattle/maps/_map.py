@@ -176,10 +176,10 @@ def response_map(
     orders = {getattr(m, "speed_order", None) for m in models}
     speed_order = orders.pop() if len(orders) == 1 else None  # rpm only when one order holds for all
     if paths_t:  # every source must exist in every combination's model
-        from ..results._sound import _check_paths
+        from ..results import check_sound_paths
 
         for m in models:
-            _check_paths(paths_t, m)
+            check_sound_paths(paths_t, m)
 
     settings = {**run.record(), "omega": [lo, hi], "omega_points": omega_points, "max_period": max_period,
                 "search": asdict(search)}

@@ -337,7 +337,7 @@ class ResponseMap:
         """Write ``map.csv`` (SPEC §7) to ``path`` atomically; returns the path."""
         from pathlib import Path
 
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.columns(), self.column_names)
         return Path(path)
@@ -347,7 +347,7 @@ class ResponseMap:
         dependency), atomically; returns the path."""
         from pathlib import Path
 
-        from ..files._atomic import atomic_path
+        from ..files import atomic_path
 
         with atomic_path(path) as tmp:
             self.dataset.to_netcdf(tmp, engine="scipy")
@@ -357,7 +357,7 @@ class ResponseMap:
         """Heat map of the largest stable rms over (parameter, Ω), impacts hatched, the
         rattle-free region outlined; returns (figure, PlotAxes). See
         :func:`rattle.plotting.plot_map`."""
-        from ..plotting._map import plot_map
+        from ..plotting import plot_map
 
         return plot_map(self, parameter=parameter, **kwargs)
 

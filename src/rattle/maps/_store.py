@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from .._release import version as rattle_version
-from ..files._atomic import atomic_write_text
+from ..files import atomic_write_text
 
 logger = logging.getLogger("rattle")
 

@@ -14,7 +14,10 @@ from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, com
 from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothResponse
 from ._nonsmooth_orbit import NONSMOOTH_ORBIT_COLUMNS, NonsmoothOrbitResult
 from ._orbit import OrbitSolution, PeriodicOrbit
-from ._sound import SoundPressure, a_weighting_db, linear_sound_pressure, motion_sound_pressure, sound_pressure
+from ._sound import (
+    UNCOVERED_WARNING, SoundPressure, a_weighting_db, check_sound_paths, coefficient_sound_pressure,
+    linear_sound_pressure, motion_sound_pressure, sound_pressure,
+)
 from ._steady import SteadyState
 from ._sweep import SweepResult
 
@@ -23,6 +26,7 @@ __all__ = [
     "SweepResult", "SteadyState", "PeriodicOrbit", "OrbitSolution", "Comparison",
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
+    "coefficient_sound_pressure", "check_sound_paths", "UNCOVERED_WARNING",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
     "NonsmoothResponse", "NONSMOOTH_COLUMNS", "FrictionResponse", "FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS",
     "NonsmoothOrbitResult", "NONSMOOTH_ORBIT_COLUMNS", "FrictionOrbitResult", "FRICTION_ORBIT_ELEMENT_COLUMNS", "HeldLimitRecord",

@@ -354,7 +354,7 @@ class FrequencyResponse:
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
         """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.columns(), self.column_names)
         return Path(path)

@@ -266,7 +266,7 @@ class FrictionResponse:
 
     def to_csv(self, path: str | Path) -> Path:
         """Write :meth:`all_columns` (this branch, then its sub-harmonic ones) to ``path`` atomically."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.all_columns(), self.column_names())
         return Path(path)

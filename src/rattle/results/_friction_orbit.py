@@ -241,7 +241,7 @@ class FrictionOrbitResult:
 
     def to_csv(self, path: str | Path) -> Path:
         """Write :meth:`columns` to ``path`` atomically; returns the path."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.columns(), self.column_names())
         return Path(path)

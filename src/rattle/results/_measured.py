@@ -313,7 +313,7 @@ class MeasuredComparison:
     def to_csv(self, path: str | Path) -> Path:
         """Write ``measured.csv`` (:meth:`column_names`) to ``path`` atomically (``nan`` where there
         is no computed value)."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.columns(), self.column_names())
         return Path(path)

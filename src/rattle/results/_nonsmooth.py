@@ -188,7 +188,7 @@ class NonsmoothResponse:
 
     def to_csv(self, path: str | Path) -> Path:
         """Write :meth:`all_columns` (this branch, then its sub-harmonic ones) to ``path`` atomically."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.all_columns(), list(NONSMOOTH_COLUMNS))
         return Path(path)

@@ -231,7 +231,7 @@ class NonsmoothOrbitResult:
 
     def to_csv(self, path: str | Path, points: int = 512) -> Path:
         """Write :meth:`columns` to ``path`` atomically; returns the path."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         write_csv(path, self.columns(points), list(NONSMOOTH_ORBIT_COLUMNS))
         return Path(path)

@@ -401,7 +401,7 @@ class PeriodicOrbit:
         acceleration`` over one full solution period (``samples`` per forcing period, both ends
         included), for ``solution`` (default the :attr:`selected` one). A chain: those of its
         first element, then ``NAME_delta``, ``NAME_acceleration`` of every element NAME."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         hist = self.time_history(solution, samples=samples)
         write_csv(path, hist, [*ORBIT_COLUMNS, *(k for k in hist if k not in ORBIT_COLUMNS)])

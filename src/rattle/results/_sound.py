@@ -52,12 +52,12 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from .._validate import as_float_array
-from ..model import check_analysable_model
-from ..model._paths import SoundPath, check_source, parse_source
+from ..model import SoundPath, check_analysable_model
+from ..model._paths import check_source, parse_source
 
 __all__ = ["SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "P_REF",
            "UNCOVERED_WARNING", "motion_sound_pressure", "coefficient_sound_pressure", "record_harmonics",
-           "record_samples"]
+           "record_samples", "check_sound_paths"]
 
 #: Reference sound pressure of the sound pressure level (Pa): 20 µPa.
 P_REF = 20e-6
@@ -142,8 +142,23 @@ class SoundPressure:
 # ---------------------------------------------------------------------------------------------
 # Sources
 # ---------------------------------------------------------------------------------------------
-def _check_paths(paths: object, model: Any) -> tuple[SoundPath, ...]:
-    """``paths`` as a tuple of SoundPath whose sources exist in ``model``."""
+def check_sound_paths(paths: object, model: Any) -> tuple[SoundPath, ...]:
+    """``paths`` as a tuple of SoundPath whose sources exist in ``model``.
+
+    Parameters
+    ----------
+    paths : SoundPath or sequence of SoundPath
+        One path or at least one.
+    model : Model or Chain
+        The model whose element names (and, for a chain, inertia numbers) the sources must name.
+
+    Raises
+    ------
+    TypeError
+        ``paths`` is neither a SoundPath nor a sequence of them.
+    ValueError
+        No path, or a source that names no element (or inertia) of ``model``.
+    """
     if isinstance(paths, SoundPath):
         paths = (paths,)
     if isinstance(paths, (str, bytes)) or not isinstance(paths, Sequence):
@@ -286,7 +301,7 @@ def sound_pressure(frf: Any, paths: SoundPath | Sequence[SoundPath], *, a_weight
     if not all(hasattr(frf, a) for a in _FRF_FIELDS):  # a FrequencyResponse (read by its fields: the
         # response class sits above this module and calls it from with_sound)
         raise TypeError(f"`frf` must be a FrequencyResponse (rattle.frequency_response), got {type(frf).__name__}")
-    paths_t = _check_paths(paths, frf.model)
+    paths_t = check_sound_paths(paths, frf.model)
     system = frf.model.system()
     n = system.n
     P = len(frf)
@@ -316,7 +331,7 @@ def linear_sound_pressure(model: Any, omega: FloatArray, paths: SoundPath | Sequ
     omega = as_float_array(omega, "omega", "frequencies in rad/s (numbers)").ravel()
     if omega.size > 10**6 or not np.all(np.isfinite(omega) & (omega > 0)):
         raise ValueError(f"`omega` must hold at most 10⁶ finite frequencies > 0 rad/s, got {omega.size} values")
-    paths_t = _check_paths(paths, model)
+    paths_t = check_sound_paths(paths, model)
     K = max(model.system().forced_harmonics, 1)
     result = _pressure(model, paths_t, _linear_harmonics(model, omega, K), omega, np.ones(omega.size, dtype=int),
                        omega, a_weighting, None)
@@ -383,7 +398,7 @@ def motion_sound_pressure(model: Any, trajectory: Any, omega: float, window: int
     time-domain pressure p(t) = Re Σ_k P_k e^{ikωt} (Parseval). The result's ``period`` is
     ``window``. ``a_weighting`` a sequence of flags gives a list, one SoundPressure per flag
     (the harmonics computed once)."""
-    paths_t = _check_paths(paths, model)
+    paths_t = check_sound_paths(paths, model)
     window = int(window)
     Xdd = record_harmonics(trajectory, float(omega), window, record_samples(float(omega), window, paths_t))[None]
     flags = [a_weighting] if isinstance(a_weighting, bool) else list(a_weighting)
@@ -402,7 +417,7 @@ def coefficient_sound_pressure(model: Any, q: FloatArray, omega: FloatArray, per
     ω = Ω/period), at forcing frequencies ``omega`` (P,) with periods ``period`` (P,): as
     :func:`sound_pressure` for a frequency response (X''_k = −(kω)² (a_k − i b_k)), without
     the linear reference."""
-    paths_t = _check_paths(paths, model)
+    paths_t = check_sound_paths(paths, model)
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     period = np.broadcast_to(np.asarray(period, dtype=int), omega.shape).copy()
     n = model.system().n

@@ -386,10 +386,10 @@ class SweepResult:
         A periodic row's level is that of its orbit's Fourier series; a non-periodic row's is an
         estimate from its record (rectangular window); a failed row's NaN. One warning names the row with the largest
         share of a source's content outside a path table, when any exceeds
-        :data:`~rattle.results._sound.UNCOVERED_WARNING`."""
-        from ._sound import _check_paths, _warn_uncovered, linear_sound_pressure, motion_sound_pressure
+        :data:`~rattle.results.UNCOVERED_WARNING`."""
+        from ._sound import _warn_uncovered, check_sound_paths, linear_sound_pressure, motion_sound_pressure
 
-        paths_t = _check_paths(paths, self.model)
+        paths_t = check_sound_paths(paths, self.model)
         P = len(self)
         spl, dba = np.full(P, np.nan), np.full(P, np.nan)
         worst = None
@@ -414,7 +414,7 @@ class SweepResult:
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
         """Write the SPEC columns to ``path`` atomically (see ``rattle.io``)."""
-        from ..files._csv import write_csv
+        from ..files import write_csv
 
         cols = self.columns()
         write_csv(path, cols, list(cols))
