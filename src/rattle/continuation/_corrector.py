@@ -8,6 +8,8 @@ unit direction t, the corrector solves
 
 by Newton on the bordered Jacobian [∂R/∂q L, ∂R/∂p p_s; tᵀ]; the tangent at a solution is the
 null vector of [∂R/∂q L, ∂R/∂p p_s], normalised and oriented along a reference direction.
+An iterate whose parameter leaves the problem's open ``domain`` (default p > 0) fails the
+correction: the residual is not evaluated there.
 """
 
 from __future__ import annotations
@@ -28,21 +30,27 @@ _gesv = scipy.linalg.lapack.dgesv
 @dataclass(slots=True)
 class Corrected:
     """A converged corrector result: scaled ``y``, Newton ``iterations``, scaled ``residual`` and
-    the Jacobians ``Rq`` = ∂R/∂q and ``Rw`` = ∂R/∂p (the parameter, Ω in rattle) at ``y``."""
+    the Jacobians ``Rq`` = ∂R/∂q and ``Rp`` = ∂R/∂p at ``y``."""
 
     y: FloatArray
     iterations: int
     residual: float
     Rq: FloatArray
-    Rw: FloatArray
+    Rp: FloatArray
 
 
 class ArclengthCorrector:
-    """Scaling, bordered solves, tangents and the plane-constrained Newton corrector."""
+    """Scaling, bordered solves, tangents and the plane-constrained Newton corrector.
 
-    def __init__(self, problem: ContinuationProblem, newton: NewtonOptions) -> None:
+    ``domain`` the open interval of parameters at which ``problem`` may be evaluated (default
+    p > 0: a frequency, a forcing scale, a width)."""
+
+    def __init__(
+        self, problem: ContinuationProblem, newton: NewtonOptions, domain: tuple[float, float] = (0.0, math.inf)
+    ) -> None:
         self.problem = problem
         self.newton = newton
+        self.domain = (float(domain[0]), float(domain[1]))
         n = problem.size
         self.scale = np.empty(n + 1)
         L = problem.length_scale
@@ -51,34 +59,34 @@ class ArclengthCorrector:
         # ∂R/∂q L: one number scales every column (the common case), else one per column.
         self._q_scale = self.scale[0] if np.ndim(L) == 0 else self.scale[:n]
 
-    def to_scaled(self, q: FloatArray, omega: float) -> FloatArray:
-        """y = (q / L, p / p_s) of the point (q, p = ``omega``)."""
+    def to_scaled(self, q: FloatArray, p: float) -> FloatArray:
+        """y = (q / L, p / p_s) of the point (q, p)."""
         y = np.empty(q.size + 1)
         y[:-1] = q
-        y[-1] = omega
+        y[-1] = p
         return y / self.scale
 
     def unscale(self, y: FloatArray) -> tuple[FloatArray, float]:
         """(q, p) of the scaled point y."""
         return y[:-1] * self.scale[:-1], float(y[-1] * self.scale[-1])
 
-    def bordered_solve(self, Rq: FloatArray, Rw: FloatArray, t: FloatArray, rhs: FloatArray) -> FloatArray | None:
+    def bordered_solve(self, Rq: FloatArray, Rp: FloatArray, t: FloatArray, rhs: FloatArray) -> FloatArray | None:
         """Solve [∂R/∂q L, ∂R/∂p p_s; tᵀ] x = rhs (LAPACK gesv; None if singular)."""
         n = Rq.shape[0]
         A = np.empty((n + 1, n + 1), order="F")
         np.multiply(Rq, self._q_scale, out=A[:n, :n])
-        np.multiply(Rw, self.scale[n], out=A[:n, n])
+        np.multiply(Rp, self.scale[n], out=A[:n, n])
         A[n] = t
         _, _, x, info = _gesv(A, rhs, overwrite_a=1, overwrite_b=0)
         if info != 0 or not np.all(np.isfinite(x)):
             return None
         return x
 
-    def tangent(self, Rq: FloatArray, Rw: FloatArray, reference: FloatArray) -> FloatArray | None:
+    def tangent(self, Rq: FloatArray, Rp: FloatArray, reference: FloatArray) -> FloatArray | None:
         """Unit tangent (scaled) with positive projection on ``reference``."""
         rhs = np.zeros(Rq.shape[0] + 1)
         rhs[-1] = 1.0
-        tau = self.bordered_solve(Rq, Rw, reference, rhs)
+        tau = self.bordered_solve(Rq, Rp, reference, rhs)
         return None if tau is None else tau / np.linalg.norm(tau)
 
     def correct(self, y_pred: FloatArray, t: FloatArray) -> Corrected | None:
@@ -90,11 +98,12 @@ class ArclengthCorrector:
         n = problem.size
         rhs = np.empty(n + 1)
         first_res = None
+        p_lo, p_hi = self.domain
         for it in range(opts.max_iterations + 1):
-            q, w = self.unscale(y)
-            if w <= 0:  # the parameter is a frequency: positive
+            q, p = self.unscale(y)
+            if not p_lo < p < p_hi:  # outside the problem's domain (e.g. a frequency <= 0)
                 return None
-            R, Rq, Rw = problem.residual_jacobian(q, w)
+            R, Rq, Rp = problem.residual_jacobian(q, p)
             res = float(np.max(np.abs(R))) / Fs
             if not math.isfinite(res):
                 return None
@@ -103,12 +112,12 @@ class ArclengthCorrector:
             elif res > 1e4 * max(first_res, 1e-3):
                 return None  # diverging
             if it > 0 and res <= opts.residual_tol and step_norm <= opts.step_tol:
-                return Corrected(y, it, res, Rq, Rw)
+                return Corrected(y, it, res, Rq, Rp)
             if it == opts.max_iterations:
                 return None
             rhs[:n] = -R
             rhs[n] = -float(t @ (y - y_pred))
-            dy = self.bordered_solve(Rq, Rw, t, rhs)
+            dy = self.bordered_solve(Rq, Rp, t, rhs)
             if dy is None:
                 return None
             y += dy

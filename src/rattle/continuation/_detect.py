@@ -32,30 +32,35 @@ from ._corrector import ArclengthCorrector, Corrected
 
 @dataclass(frozen=True, slots=True)
 class LocatedPoint:
-    """A located special point: unknowns ``q``, parameter ``omega``, the test function's
+    """A located special point: unknowns ``q``, parameter ``p``, the test function's
     ``value`` there, corrector ``iterations`` and scaled ``residual``."""
 
     q: FloatArray
-    omega: float
+    p: float
     value: float
     iterations: int
     residual: float
+
+    @property
+    def omega(self) -> float:
+        """``p`` under the name rattle's frequency responses read it by (their parameter is Ω)."""
+        return self.p
 
 
 def locate_on_segment(
     corrector: ArclengthCorrector,
     q_a: FloatArray,
-    omega_a: float,
+    p_a: float,
     q_b: FloatArray,
-    omega_b: float,
+    p_b: float,
     test: Callable[[FloatArray, float, Corrected, FloatArray], float],
     *,
     xtol: float = 1e-10,
 ) -> LocatedPoint | None:
-    """Root of ``test(q, Ω, corrected, d)`` on the branch between two points, or None if the
-    test function has no sign change there or a correction fails."""
-    y_a = corrector.to_scaled(q_a, omega_a)
-    y_b = corrector.to_scaled(q_b, omega_b)
+    """Root of ``test(q, p, corrected, d)`` on the branch between two points (q_a, p_a) and
+    (q_b, p_b), or None if the test function has no sign change there or a correction fails."""
+    y_a = corrector.to_scaled(q_a, p_a)
+    y_b = corrector.to_scaled(q_b, p_b)
     length = float(np.linalg.norm(y_b - y_a))
     if length == 0.0:
         return None
@@ -66,8 +71,8 @@ def locate_on_segment(
         corr = corrector.correct(y_a + s * d, d)
         if corr is None:
             raise _CorrectorFailed
-        q, w = corrector.unscale(corr.y)
-        val = float(test(q, w, corr, d))
+        q, p = corrector.unscale(corr.y)
+        val = float(test(q, p, corr, d))
         cache[s] = (val, corr)
         return val
 
@@ -79,8 +84,8 @@ def locate_on_segment(
     except _CorrectorFailed:
         return None
     val, corr = cache[s_star] if s_star in cache else (psi(s_star), cache[s_star][1])
-    q, w = corrector.unscale(corr.y)
-    return LocatedPoint(q, w, val, corr.iterations, corr.residual)
+    q, p = corrector.unscale(corr.y)
+    return LocatedPoint(q, p, val, corr.iterations, corr.residual)
 
 
 class _CorrectorFailed(Exception):

@@ -74,7 +74,7 @@ class MonitorReading:
     distance: float = math.inf
 
 
-#: monitor(q, Ω, dq/ds, dΩ/ds) → reading; dq/ds, dΩ/ds the unit tangent in unscaled units.
+#: monitor(q, p, dq/ds, dp/ds) → reading; dq/ds, dp/ds the unit tangent in unscaled units.
 Monitor = Callable[[FloatArray, float, FloatArray, float], MonitorReading]
 
 

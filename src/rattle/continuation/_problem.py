@@ -17,7 +17,9 @@ through its scales (no separate norm method). Residuals are judged relative to `
 F_s: Newton has converged when ‖R‖∞ / F_s and max_i |Δq_i| / L_i are below the tolerances of
 :class:`~rattle.continuation.NewtonOptions`.
 
-rattle's two problems, both continued in the forcing frequency p = Ω:
+The parameter is whatever the problem makes it; the package assumes nothing of it beyond the
+open domain in which the residual may be evaluated (the stepper's ``domain``, by default p > 0).
+rattle's frequency responses continue two problems in the forcing frequency p = Ω:
 
 * :class:`~rattle.hb.HarmonicBalance` — q the Fourier coefficients of a periodic orbit, R the
   harmonic-balance residual; L the model's length scale, p_s = ω_n, F_s the forcing's size;

@@ -1,4 +1,8 @@
-"""Pseudo-arclength continuation of R(q, p) = 0 in its parameter p (in rattle: the forcing frequency Ω).
+"""Pseudo-arclength continuation of R(q, p) = 0 in its parameter p.
+
+The parameter is whatever the problem makes it: the forcing frequency Ω of a frequency response,
+the forcing scale λ of a start homotopy, … The stepper knows only its range [p_min, p_max], the
+open ``domain`` in which the problem may be evaluated, and the ``symbol`` its messages use.
 
 Keller's method on any :class:`~rattle.continuation.ContinuationProblem`, in scaled variables
 y = (q / L, p / p_s) (see ``_problem`` and ``_corrector``):
@@ -18,7 +22,7 @@ y = (q / L, p / p_s) (see ``_problem`` and ``_corrector``):
   so that every zero is bracketed by two consecutive points: no bifurcation is stepped over.
 
 The stepper yields one accepted point per :meth:`ContinuationStepper.step`; the run ends when the
-branch leaves the frequency range (the last point is placed exactly on the bound), when an
+branch leaves the parameter range (the last point is placed exactly on the bound), when an
 optional ``stop`` test fires, or with a :class:`~rattle.errors.Status` saying where and why.
 """
 
@@ -43,45 +47,58 @@ from ._problem import ContinuationProblem
 
 @dataclass(frozen=True, slots=True)
 class BranchPoint:
-    """An accepted solution: unknowns ``q``, parameter ``omega`` (the forcing frequency in rattle),
-    Newton ``iterations``, scaled ``residual``, unit ``tangent`` (scaled variables), the ``step``
-    that reached it and the monitor's ``reading`` there (None without a monitor)."""
+    """An accepted solution: unknowns ``q``, parameter ``p``, Newton ``iterations``, scaled
+    ``residual``, unit ``tangent`` (scaled variables), the ``step`` that reached it and the
+    monitor's ``reading`` there (None without a monitor)."""
 
     q: FloatArray
-    omega: float
+    p: float
     iterations: int
     residual: float
     tangent: FloatArray
     step: float
     reading: MonitorReading | None = None
 
+    @property
+    def omega(self) -> float:
+        """``p`` under the name rattle's frequency responses read it by (their parameter is Ω)."""
+        return self.p
+
 
 @dataclass(slots=True)
 class ContinuationStepper:
     """Step-by-step pseudo-arclength continuation (the low-level API).
 
-    ``problem`` any :class:`~rattle.continuation.ContinuationProblem` (harmonic balance, shooting),
-    ``q0`` a solution (or good guess) at the parameter ``omega0``; ``omega_range`` the parameter's
-    range (0 < min < max; the parameter is a frequency in rattle). Without
-    ``tangent`` the start must be one end of ``omega_range`` and the branch is followed into
-    the range; with ``tangent`` (a direction in scaled variables, e.g. the critical eigenvector
-    at a branch point) the start may be anywhere in the range and the branch is followed along
-    that direction. ``stop(point) -> str | None`` may end the run (status ``STOPPED``) with the
-    returned reason. ``monitor(q, Ω, dq/ds, dΩ/ds)`` returns the test functions whose zeros
-    are the special points (see ``_monitor``); with it no zero is stepped over. ``predictor``
-    a :class:`~rattle.continuation.AbstractPredictor` (default :class:`~rattle.continuation.Tangent`).
+    ``problem`` any :class:`~rattle.continuation.ContinuationProblem` (harmonic balance, shooting,
+    a homotopy), ``q0`` a solution (or good guess) at the parameter ``p0``; ``p_range`` the
+    parameter's range (min < max, inside ``domain``). Without ``tangent`` the start must be one
+    end of ``p_range`` and the branch is followed into the range; with ``tangent`` (a direction
+    in scaled variables, e.g. the critical eigenvector at a branch point) the start may be
+    anywhere in the range and the branch is followed along that direction.
+    ``stop(point) -> str | None`` may end the run (status ``STOPPED``) with the returned reason.
+    ``monitor(q, p, dq/ds, dp/ds)`` returns the test functions whose zeros are the special
+    points (see ``_monitor``); with it no zero is stepped over. ``predictor`` a
+    :class:`~rattle.continuation.AbstractPredictor` (default :class:`~rattle.continuation.Tangent`).
+
+    ``domain`` the open interval of parameters at which the problem may be evaluated (the
+    corrector rejects an iterate outside it); the default, p > 0, suits a frequency, a forcing
+    scale or a width; a homotopy parameter that may take any sign passes (−inf, inf).
+    ``symbol`` names the parameter in messages (default ``"Ω"``: most of rattle's branches are
+    frequency responses).
     """
 
     problem: ContinuationProblem
     q0: FloatArray
-    omega0: float
-    omega_range: tuple[float, float]
+    p0: float
+    p_range: tuple[float, float]
     options: ContinuationOptions = field(default_factory=ContinuationOptions)
     newton: NewtonOptions = field(default_factory=NewtonOptions)
     tangent: FloatArray | None = None
     stop: Callable[[BranchPoint], str | None] | None = None
     monitor: Monitor | None = None
     predictor: AbstractPredictor = field(default_factory=Tangent)
+    domain: tuple[float, float] = (0.0, math.inf)
+    symbol: str = "Ω"
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
@@ -97,25 +114,30 @@ class ContinuationStepper:
     _reading: MonitorReading | None = field(init=False, repr=False, default=None)
 
     def __post_init__(self) -> None:
-        lo, hi = self.omega_range
-        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
-            raise ValueError(f"`omega_range` must satisfy 0 < min < max, got {self.omega_range!r}")
+        lo, hi = self.p_range
+        d_lo, d_hi = self.domain
+        if not d_lo < d_hi:
+            raise ValueError(f"`domain` must be an interval (min < max), got {self.domain!r}")
+        if not (math.isfinite(lo) and math.isfinite(hi) and d_lo < lo < hi < d_hi):
+            raise ValueError(
+                f"`p_range` must satisfy {d_lo:g} < min < max < {d_hi:g} (inside `domain`), got {self.p_range!r}"
+            )
         if self.tangent is not None:
-            if not lo <= self.omega0 <= hi:
-                raise ValueError(f"`omega0` must lie in `omega_range` {self.omega_range}, got {self.omega0}")
+            if not lo <= self.p0 <= hi:
+                raise ValueError(f"`p0` must lie in `p_range` {self.p_range}, got {self.p0}")
             self._direction = 0.0
-        elif self.omega0 == lo:
+        elif self.p0 == lo:
             self._direction = 1.0
-        elif self.omega0 == hi:
+        elif self.p0 == hi:
             self._direction = -1.0
         else:
-            raise ValueError(f"`omega0` must be one end of `omega_range` {self.omega_range}, got {self.omega0}")
+            raise ValueError(f"`p0` must be one end of `p_range` {self.p_range}, got {self.p0}")
         if not isinstance(self.predictor, AbstractPredictor):
             raise TypeError(
                 f"`predictor` must be a predictor object (rattle.continuation.Tangent(), Secant()), got {self.predictor!r}"
             )
         self._start_time = time.perf_counter()
-        self.corrector = ArclengthCorrector(self.problem, self.newton)
+        self.corrector = ArclengthCorrector(self.problem, self.newton, domain=self.domain)
         self._ds = self.options.initial_step
 
     def _finish(self, status: Status, message: str = "") -> None:
@@ -126,48 +148,48 @@ class ContinuationStepper:
         """The monitor's reading at scaled point y with unit scaled tangent t (None: no monitor)."""
         if self.monitor is None:
             return None
-        q, w = self.corrector.unscale(y)
+        q, p = self.corrector.unscale(y)
         d = t * self.corrector.scale
-        return self.monitor(q, w, d[:-1], float(d[-1]))
+        return self.monitor(q, p, d[:-1], float(d[-1]))
 
     # --- public ----------------------------------------------------------------------------
     def start(self) -> BranchPoint | None:
-        """Converge the first point at ``omega0`` and compute its tangent.
+        """Converge the first point at ``p0`` and compute its tangent.
 
         A start given with a ``tangent`` that already solves R = 0 (e.g. a located branch point,
         where ∂R/∂q is singular and a Newton step would be ill-posed) is taken as it is.
         """
         if self.tangent is not None:
-            r0 = float(np.max(np.abs(self.problem.residual(self.q0, self.omega0)))) / self.problem.force_scale
+            r0 = float(np.max(np.abs(self.problem.residual(self.q0, self.p0)))) / self.problem.force_scale
             if r0 <= self.newton.residual_tol:
                 self._t = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
-                self._y = self.corrector.to_scaled(np.asarray(self.q0, dtype=float), self.omega0)
+                self._y = self.corrector.to_scaled(np.asarray(self.q0, dtype=float), self.p0)
                 self._reading = self._read(self._y, self._t)
-                pt = BranchPoint(np.array(self.q0, dtype=float), self.omega0, 0, r0, self._t.copy(), 0.0, self._reading)
+                pt = BranchPoint(np.array(self.q0, dtype=float), self.p0, 0, r0, self._t.copy(), 0.0, self._reading)
                 self.points.append(pt)
                 return pt
-        res = solve_fixed(self.problem, self.q0, self.omega0, self.newton)
+        res = solve_fixed(self.problem, self.q0, self.p0, self.newton)
         if not res.converged:
             self._finish(
                 Status.START_FAILED,
-                f"Newton did not converge at Ω = {self.omega0:g} ({res.message}, scaled residual {res.residual:.3g})",
+                f"Newton did not converge at {self.symbol} = {self.p0:g} ({res.message}, scaled residual {res.residual:.3g})",
             )
             return None
-        R, Rq, Rw = self.problem.residual_jacobian(res.q, self.omega0)
+        R, Rq, Rp = self.problem.residual_jacobian(res.q, self.p0)
         if self.tangent is not None:
             reference = np.asarray(self.tangent, dtype=float) / np.linalg.norm(self.tangent)
             t0: FloatArray | None = reference
         else:
             reference = np.zeros(self.problem.size + 1)
             reference[-1] = self._direction
-            t0 = self.corrector.tangent(Rq, Rw, reference)
+            t0 = self.corrector.tangent(Rq, Rp, reference)
         if t0 is None:
-            self._finish(Status.START_FAILED, f"singular Jacobian at the start Ω = {self.omega0:g}")
+            self._finish(Status.START_FAILED, f"singular Jacobian at the start {self.symbol} = {self.p0:g}")
             return None
         self._t = t0
-        self._y = self.corrector.to_scaled(res.q, self.omega0)
+        self._y = self.corrector.to_scaled(res.q, self.p0)
         self._reading = self._read(self._y, self._t)
-        pt = BranchPoint(res.q, self.omega0, res.iterations, res.residual, self._t.copy(), 0.0, self._reading)
+        pt = BranchPoint(res.q, self.p0, res.iterations, res.residual, self._t.copy(), 0.0, self._reading)
         self.points.append(pt)
         return pt
 
@@ -180,17 +202,17 @@ class ContinuationStepper:
         opts = self.options
         corr_ = self.corrector
         if len(self.points) >= opts.max_points:
-            self._finish(Status.MAX_STEPS, f"{Status.MAX_STEPS.message} ({opts.max_points} points, last Ω = {self.points[-1].omega:.6g})")
+            self._finish(Status.MAX_STEPS, f"{Status.MAX_STEPS.message} ({opts.max_points} points, last {self.symbol} = {self.points[-1].p:.6g})")
             return None
         if opts.max_time is not None and time.perf_counter() - self._start_time > opts.max_time:
-            self._finish(Status.MAX_TIME, f"{Status.MAX_TIME.message} ({opts.max_time} s, last Ω = {self.points[-1].omega:.6g})")
+            self._finish(Status.MAX_TIME, f"{Status.MAX_TIME.message} ({opts.max_time} s, last {self.symbol} = {self.points[-1].p:.6g})")
             return None
-        lo, hi = self.omega_range
+        lo, hi = self.p_range
         while True:
             ds = self._ds
             y_pred, normal = self.predictor.predict(self._y, self._t, ds, self._y_prev)
             corr = corr_.correct(y_pred, normal)
-            t_new = None if corr is None else corr_.tangent(corr.Rq, corr.Rw, self._t)
+            t_new = None if corr is None else corr_.tangent(corr.Rq, corr.Rp, self._t)
             at_floor = ds <= opts.min_step * 1.0000001
             if corr is not None and t_new is not None:
                 turn = math.acos(min(1.0, float(t_new @ self._t)))
@@ -209,36 +231,36 @@ class ContinuationStepper:
                     self.monitor_rejected += 1
             self.rejected += 1
             if at_floor:
-                _, w = corr_.unscale(self._y)
+                _, p = corr_.unscale(self._y)
                 self._finish(
                     Status.STEP_TOO_SMALL,
-                    f"{Status.STEP_TOO_SMALL.message}: Newton failed to converge beyond Ω = {w:.6g} "
+                    f"{Status.STEP_TOO_SMALL.message}: Newton failed to converge beyond {self.symbol} = {p:.6g} "
                     f"with step {ds:.3g} (after {len(self.points)} points)",
                 )
                 return None
             self._ds = max(opts.min_step, 0.5 * ds)
-        q, w = corr_.unscale(corr.y)
+        q, p = corr_.unscale(corr.y)
         # Leaving the range: place the last point exactly on the bound and end.
-        if w > hi or w < lo:
-            bound = hi if w > hi else lo
-            _, w_prev = corr_.unscale(self._y)
-            frac = (bound - w_prev) / (w - w_prev)
+        if p > hi or p < lo:
+            bound = hi if p > hi else lo
+            _, p_prev = corr_.unscale(self._y)
+            frac = (bound - p_prev) / (p - p_prev)
             y_guess = self._y + frac * (corr.y - self._y)
             end = solve_fixed(self.problem, corr_.unscale(y_guess)[0], bound, self.newton)
             start_side = self._direction != 0.0 and (bound == lo) == (self._direction > 0)
             status = Status.RETURNED if start_side else Status.SUCCESS
             if end.converged:
-                R, Rq, Rw = self.problem.residual_jacobian(end.q, bound)
-                t_end = corr_.tangent(Rq, Rw, self._t)
+                R, Rq, Rp = self.problem.residual_jacobian(end.q, bound)
+                t_end = corr_.tangent(Rq, Rp, self._t)
                 t_end = t_new if t_end is None else t_end
                 pt = BranchPoint(end.q, bound, end.iterations, end.residual, t_end, ds * frac,
                                  self._read(corr_.to_scaled(end.q, bound), t_end))
             else:  # keep the point just outside rather than nothing
-                pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds, reading)
+                pt = BranchPoint(q, p, corr.iterations, corr.residual, t_new, ds, reading)
             self.points.append(pt)
             self._finish(status)
             return pt
-        pt = BranchPoint(q, w, corr.iterations, corr.residual, t_new, ds, reading)
+        pt = BranchPoint(q, p, corr.iterations, corr.residual, t_new, ds, reading)
         self.points.append(pt)
         self._y_prev = self._y
         self._y, self._t, self._reading = corr.y, t_new, reading
