@@ -48,7 +48,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(["HBOptions", "HarmonicBalance"], ".hb"),
     **dict.fromkeys(
         ["AbstractElastic", "Backlash", "Chain", "Clutch", "Element", "Excitation", "Linear", "Link", "Model",
-         "Piecewise", "System", "Torque", "backlash_case", "reference_case"],
+         "Piecewise", "System", "Torque", "Unilateral", "backlash_case", "reference_case"],
         ".model",
     ),
     **dict.fromkeys(
@@ -76,7 +76,7 @@ _SUBPACKAGES = frozenset({
 __all__ = [
     "__version__",
     # models
-    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "AbstractElastic", "reference_case",
+    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "Unilateral", "AbstractElastic", "reference_case",
     "backlash_case", "Chain", "Link", "Element", "Torque", "System", "Drag",
     # sub-system builders (a data sheet → an ordinary chain element or chain)
     "clutch_damper", "hub_spline", "gear_pair", "loose_gear",
@@ -125,6 +125,7 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .hb import HarmonicBalance, HBOptions
     from .model import (
         AbstractElastic, Backlash, Chain, Clutch, Element, Excitation, Linear, Link, Model, Piecewise, System, Torque,
+        Unilateral,
         backlash_case, reference_case,
     )
     from .results import (

@@ -38,7 +38,7 @@ from rattle.io import (
     write_csv,
     write_metadata,
 )
-from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, reference_case
+from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, Unilateral, reference_case
 from rattle.results import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 
 # The SPEC §2 example, verbatim (comments included).
@@ -190,8 +190,8 @@ BROKEN: list[tuple[str, str, list[str]]] = [
      ["`excitation.offset` is not a known key", "mean, amplitudes, phases"]),
     ("unknown analysis key", edit("harmonics = 32", "harmonics = 32\npoints = 200"),
      ["`analysis.points` is not a known key", "omega, harmonics"]),
-    ("unknown elastic key", edit("b = 0.174533", "b = 0.174533\ngap = 0.1"),
-     ["`model.elastic.gap` is not a known key", 'type = "clutch" allows only type, alpha, b']),
+    ("unknown elastic key", edit("b = 0.174533", "b = 0.174533\nwidth = 0.1"),
+     ["`model.elastic.width` is not a known key", 'type = "clutch" allows only type, alpha, b']),
     # --- keys belonging to another elastic type
     ("alpha with backlash", edit("b = 0.1", "b = 0.1\nalpha = 0.25", MODEL + BACKLASH + EXCITATION),
      ['`model.elastic.alpha` does not belong to type = "backlash"', "parameters are: b", '"clutch"']),
@@ -258,7 +258,7 @@ BROKEN: list[tuple[str, str, list[str]]] = [
     ("negative damping", edit("damping = 0.05", "damping = -0.05"), ["`model.damping` must be >= 0, got -0.05"]),
     # --- elastic types and their parameters
     ("unknown elastic type", edit('type = "clutch"', 'type = "spring"'),
-     ['`model.elastic.type` must be one of "linear", "backlash", "clutch", "piecewise", "preload", got "spring" (a string)']),
+     ['`model.elastic.type` must be one of "linear", "backlash", "clutch", "piecewise", "unilateral", "preload", got "spring" (a string)']),
     ("elastic type wrong case", edit('type = "clutch"', 'type = "Clutch"'), ['got "Clutch"', 'did you mean "clutch"?']),
     ("elastic type not a string", edit('type = "clutch"', "type = 3"), ["`model.elastic.type` must be one of", "got 3 (an integer)"]),
     ("clutch alpha = 1", edit("alpha = 0.25", "alpha = 1.0"),
@@ -278,9 +278,13 @@ BROKEN: list[tuple[str, str, list[str]]] = [
     ("negative slope",
      edit("slopes = [1.0, 0.3, 0.05, 0.3, 1.0]", "slopes = [1.0, 0.3, -0.05, 0.3, 1.0]", MODEL + PIECEWISE + EXCITATION),
      ["`model.elastic.slopes[2]` must be >= 0, got -0.05"]),
-    ("zero outer slope",
-     edit("slopes = [1.0, 0.3, 0.05, 0.3, 1.0]", "slopes = [0.0, 0.3, 0.05, 0.3, 1.0]", MODEL + PIECEWISE + EXCITATION),
-     ["outer `model.elastic.slopes`", "must be > 0"]),
+    ("every slope zero",
+     edit("slopes = [1.0, 0.3, 0.05, 0.3, 1.0]", "slopes = [0.0, 0.0, 0.0, 0.0, 0.0]", MODEL + PIECEWISE + EXCITATION),
+     ["`model.elastic.slopes` must have at least one stage with slope > 0"]),
+    ("zero outer slope, the mean load pushing away from the stop",
+     edit("slopes = [1.0, 0.3, 0.05, 0.3, 1.0]", "slopes = [1.0, 0.3, 0.05, 0.3, 0.0]", MODEL + PIECEWISE + EXCITATION)
+     .replace("mean = 0.05", "mean = 0.9"),
+     ["`excitation.mean` = 0.9: no static equilibrium", "one-sided stop"]),
     # --- excitation
     ("empty amplitudes", edit("amplitudes = [0.03]\nphases = [0.0]", "amplitudes = []"),
      ["`excitation.amplitudes` must hold at least one harmonic amplitude, got []"]),
@@ -414,10 +418,12 @@ MODELS = [
     Model(inertia=0.5, damping=0.02, stiffness=4.0,
           elastic=Piecewise(breakpoints=(-0.3, -0.1, 0.05, 0.2), slopes=(1.0, 0.3, 0.05, 0.3, 1.0)),
           excitation=Excitation(mean=0.05, amplitudes=(0.03,))),
+    Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=Unilateral(gap=0.02, side="negative"),
+          excitation=Excitation(mean=-0.05, amplitudes=(0.03,))),
 ]
 
 
-@pytest.mark.parametrize("model", MODELS, ids=["clutch", "linear", "backlash", "piecewise"])
+@pytest.mark.parametrize("model", MODELS, ids=["clutch", "linear", "backlash", "piecewise", "unilateral"])
 def test_toml_round_trip(tmp_path: Path, model: Model) -> None:
     analysis = AnalysisSettings(omega_min=0.2, omega_max=2.0 / 3.0, harmonics=7)
     text = dumps_toml(model_to_toml_dict(model, analysis))

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, reference_case
+from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, Unilateral, reference_case
 
 
 @st.composite
@@ -85,7 +85,9 @@ def test_stage_arrays_are_read_only():
         (lambda: Piecewise(breakpoints=(0.1, 0.0), slopes=(1, 1, 1)), r"`breakpoints` must be strictly increasing"),
         (lambda: Piecewise(breakpoints=(0.1,), slopes=(1, 1, 1)), r"`slopes` must have one more entry"),
         (lambda: Piecewise(breakpoints=(0.1,), slopes=(1, -1)), r"`slopes\[1\]` must be >= 0"),
-        (lambda: Piecewise(breakpoints=(0.1,), slopes=(0.0, 1.0)), r"outer `slopes`"),
+        (lambda: Piecewise(breakpoints=(0.1,), slopes=(0.0, 0.0)), r"`slopes` must have at least one stage with slope > 0"),
+        (lambda: Unilateral(gap=-0.01), r"`gap` must be >= 0"),
+        (lambda: Unilateral(gap=0.01, side="left"), r"`side` must be \"positive\" or \"negative\""),
         (lambda: Piecewise(breakpoints="ab", slopes=(1.0,)), r"`breakpoints` must be a list"),
         (lambda: Excitation(mean=0.0, amplitudes=()), r"`amplitudes` must hold at least one"),
         (lambda: Excitation(mean=0.0, amplitudes=(1.0,), phases=(0.0, 1.0)), r"`phases` must have one entry"),

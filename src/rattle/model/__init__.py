@@ -8,7 +8,9 @@ from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw, PiecewiseJu
 from ._drag import Drag, SpeedLoad
 from ._friction_system import FrictionSystem
 from ._engine import base_order, engine_speed, engine_torque, firing_orders, forcing_frequency
-from ._elastic import ELASTIC_LAWS, AbstractElastic, Backlash, Clutch, Linear, Piecewise, Stages
+from ._elastic import (
+    ELASTIC_LAWS, UNILATERAL_SIDES, AbstractElastic, Backlash, Clutch, Linear, Piecewise, Stages, Unilateral,
+)
 from ._excitation import Excitation
 from ._model import Model
 from ._nonsmooth_system import NonsmoothSystem
@@ -18,7 +20,8 @@ from . import _tables  # noqa: F401  (loaded here: registers the reader of Model
 from .library import backlash_case, reference_case
 
 __all__ = [
-    "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "Stages", "ELASTIC_LAWS",
+    "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "Unilateral", "UNILATERAL_SIDES", "Stages",
+    "ELASTIC_LAWS",
     "Excitation", "Model", "System", "ReducedElement", "Chain", "Link", "Element", "Torque", "check_analysable_model", "reference_case", "backlash_case",
     "firing_orders", "engine_speed", "forcing_frequency", "base_order", "engine_torque",
     "SoundPath", "Drag", "SpeedLoad",

@@ -218,8 +218,10 @@ class Clutch(AbstractElastic):
 class Piecewise(AbstractElastic):
     """General continuous piecewise-linear law with f(0) = 0 (multi-stage, asymmetric).
 
-    ``breakpoints`` d_1 < … < d_k (rad) and ``slopes`` s_0 … s_k (k + 1 values, ≥ 0, the two
-    outer ones > 0 so that the law confines the motion).
+    ``breakpoints`` d_1 < … < d_k (rad) and ``slopes`` s_0 … s_k (k + 1 values, ≥ 0, not all
+    zero). An outer slope 0 (s_0 or s_k) is a one-sided stop — unilateral contact, see
+    :class:`Unilateral`; the model then needs a mean load that holds the element against the
+    stop (a static equilibrium), or a link that restores it.
 
     ::
 
@@ -251,11 +253,11 @@ class Piecewise(AbstractElastic):
         for i, v in enumerate(s):
             if v < 0:
                 raise ValueError(f"`slopes[{i}]` must be >= 0, got {v!r}")
-        if s[0] <= 0 or s[-1] <= 0:
-            raise ValueError(
-                f"the outer `slopes` (first and last) must be > 0 so that the law confines the "
-                f"motion, got {list(s)!r}"
-            )
+        if not any(v > 0 for v in s):
+            raise ValueError(f"`slopes` must have at least one stage with slope > 0 (all zero: no law), got {list(s)!r}")
+        # An outer slope 0 is a one-sided stop (unilateral contact): the law confines the motion on
+        # one side only. Whether the mean load holds the element against the stop (a static
+        # equilibrium) is the model's and the chain's rule, where the load is known.
         if d:
             widest = max(abs(d[0]), abs(d[-1]))
             warn_clearance(widest, "breakpoints[0]" if abs(d[0]) >= abs(d[-1]) else f"breakpoints[{len(d) - 1}]",
@@ -272,11 +274,62 @@ class Piecewise(AbstractElastic):
         return {"type": "piecewise", "breakpoints": list(self.breakpoints), "slopes": list(self.slopes)}
 
 
+#: The sides of a :class:`Unilateral` stop.
+UNILATERAL_SIDES = ("positive", "negative")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Unilateral(AbstractElastic):
+    """Unilateral contact: a stop on one side of a gap, nothing on the other (NLvib's
+    ``unilateralSpring``; a tooth against a stop).
+
+    ``side = "positive"``: f(δ) = δ − gap for δ > gap, 0 for δ ≤ gap;
+    ``side = "negative"``: f(δ) = δ + gap for δ < −gap, 0 for δ ≥ −gap (``gap`` ≥ 0, rad).
+
+    ::
+
+        f |          /            (side = "positive")
+          |         /  slope 1
+        --+--------'------ δ
+          0       gap
+
+    The piecewise law with breakpoints (gap,) and slopes (0, 1) (or (−gap,), (1, 0)). The free
+    side has no restoring torque: the model's mean load must hold the element against the stop
+    (a static equilibrium), or a link must restore it.
+    """
+
+    name: ClassVar[str] = "unilateral"
+    gap: float
+    side: str = "positive"
+    _data: Stages = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        gap = _check_real("gap", self.gap)
+        if gap < 0:
+            raise ValueError(f"`gap` must be >= 0 (the free travel before the stop, rad), got {gap!r}")
+        if not isinstance(self.side, str) or self.side not in UNILATERAL_SIDES:
+            raise ValueError(f"`side` must be \"positive\" or \"negative\" (where the stop is), got {self.side!r}")
+        if gap > 0:
+            warn_clearance(gap, "gap", stacklevel=4)
+        object.__setattr__(self, "gap", gap)
+        d, sl = ((gap,), (0.0, 1.0)) if self.side == "positive" else ((-gap,), (1.0, 0.0))
+        object.__setattr__(self, "_data", _stages(d, sl))
+
+    @property
+    def _stage_data(self) -> Stages:
+        return self._data
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "unilateral", "gap": self.gap, "side": self.side}
+
+
 ELASTIC_LAWS: dict[str, type[AbstractElastic]] = {
     "linear": Linear,
     "backlash": Backlash,
     "clutch": Clutch,
     "piecewise": Piecewise,
+    "unilateral": Unilateral,
 }
 
-__all__ = ["Stages", "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "ELASTIC_LAWS"]
+__all__ = ["Stages", "AbstractElastic", "Linear", "Backlash", "Clutch", "Piecewise", "Unilateral",
+           "UNILATERAL_SIDES", "ELASTIC_LAWS"]

@@ -51,12 +51,13 @@ class Model:
         if stiffness <= 0:
             raise ValueError(f"`stiffness` must be > 0, got {stiffness!r}")
         if not isinstance(self.elastic, AbstractElastic):
-            raise TypeError(f"`elastic` must be an elastic law (Linear, Backlash, Clutch, Piecewise), got {self.elastic!r}")
+            raise TypeError(f"`elastic` must be an elastic law (Linear, Backlash, Clutch, Piecewise, Unilateral), got {self.elastic!r}")
         if not isinstance(self.excitation, Excitation):
             raise TypeError(f"`excitation` must be an Excitation, got {self.excitation!r}")
         object.__setattr__(self, "inertia", inertia)
         object.__setattr__(self, "damping", damping)
         object.__setattr__(self, "stiffness", stiffness)
+        self.static_equilibrium()  # a one-sided stop the mean load does not hold: refused here
         # k = K/I, c = C/I, the force and deflection scales within 1e-50 … 1e50 (rattle._limits):
         # products of a few of them (an acceleration squared) must stay finite in double precision.
         check_scales(self)
@@ -90,11 +91,15 @@ class Model:
         """δ_s solving (K/I) f(δ_s) = F_m (unique on a stage with positive slope).
 
         When F_m balances a zero-slope stage exactly (a backlash with F_m = 0), the middle of
-        that stage is returned.
+        that stage is returned. A law with an outer slope 0 (a one-sided stop, unilateral
+        contact) has no isolated equilibrium when F_m does not hold the element against the stop:
+        F_m pushing away from it (none at all), or F_m = the law's force on the free side (every
+        δ there is one: the mean of the motion is not determined). Both raise ValueError.
         """
         st = self.elastic.stages
         target = self.excitation.mean / self.k
         edges = np.concatenate(([-np.inf], st.breakpoints, [np.inf]))
+        free_side = ""
         for j, (s, e) in enumerate(zip(st.slopes, st.offsets)):
             lo, hi = edges[j], edges[j + 1]
             if s > 0:
@@ -102,8 +107,25 @@ class Model:
                 if lo <= x <= hi:
                     return float(x)
             elif abs(target - e) <= 1e-15 * max(1.0, abs(target)):
-                return float(0.5 * (lo + hi)) if np.isfinite(lo + hi) else float(lo if np.isfinite(lo) else hi)
-        raise AssertionError("unreachable: a monotone law with positive outer slopes has an equilibrium")
+                if np.isfinite(lo + hi):
+                    return float(0.5 * (lo + hi))
+                free_side = "below" if np.isinf(lo) else "above"
+                break
+        stop = [f"δ {'>' if st.slopes[0] == 0 else '<'} {st.breakpoints[0 if st.slopes[0] == 0 else -1]:g}"
+                ] if st.breakpoints.size else []
+        if free_side:
+            raise ValueError(
+                f"`excitation.mean` = {self.excitation.mean:g}: the law is flat (slope 0) for every δ {free_side} "
+                f"{(lo if free_side == 'above' else hi):g} rad and the mean load is zero there, so nothing holds the "
+                "element against its one-sided stop: every δ on the free side is a static equilibrium and the mean of "
+                "the motion is not determined; give a mean load toward the stop"
+                + (f" ({stop[0]})" if stop else "")
+            )
+        raise ValueError(
+            f"`excitation.mean` = {self.excitation.mean:g}: no static equilibrium — the law's force never balances "
+            "the mean load (it pushes the element away from its one-sided stop, where the law is flat), so the "
+            "element drifts without end; reverse the mean load, or put the stop on the other side (`side`)"
+        )
 
     def length_scale(self) -> float:
         """A characteristic angle L (rad) for scaling: the static deflection, the breakpoints and

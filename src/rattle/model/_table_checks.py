@@ -28,7 +28,7 @@ _T = TypeVar("_T")
 
 #: Keys holding angles (rad) that may be given in degrees as ``KEY_deg``: in ``[model.elastic]``
 #: and every ``[[model.elements]]``.
-ANGLE_KEYS = ("b", "breakpoints")
+ANGLE_KEYS = ("b", "breakpoints", "gap")
 
 # Example lines for "add e.g. ..." hints: the SPEC §2 example file.
 _EXAMPLES = {
@@ -42,6 +42,8 @@ _EXAMPLES = {
     "model.elastic.b": "b = 0.174533",
     "model.elastic.breakpoints": "breakpoints = [-0.3, -0.1, 0.05, 0.2]",
     "model.elastic.slopes": "slopes = [1.0, 0.3, 0.05, 0.3, 1.0]",
+    "model.elastic.gap": "gap = 0.01",
+    "model.elastic.side": 'side = "positive"',
     "excitation": "[excitation] with mean = 0.05, amplitudes = [0.03]",
     "excitation.mean": "mean = 0.05",
     "excitation.amplitudes": "amplitudes = [0.03]",
@@ -211,6 +213,16 @@ class _Checker:
             )
         for i, item in enumerate(value):
             self.number(item, f"{key}[{i}]")
+
+    def string(self, value: Any, key: str) -> None:
+        """Check that ``value`` is a TOML string (its choices are the dataclass's rule)."""
+        if not isinstance(value, str):
+            raise self.error(f"`{key}` must be a string, got {_show(value)} ({_kind(value)}); write it in quotes, "
+                             f"e.g. {_example(key)}")
+
+    def value(self, kind: str, value: Any, key: str) -> None:
+        """Check ``value`` as a law parameter of ``kind`` "number", "array" or "string"."""
+        {"array": self.array, "string": self.string}.get(kind, self.number)(value, key)
 
     def integer(self, value: Any, key: str) -> None:
         """Check that ``value`` is a TOML integer."""

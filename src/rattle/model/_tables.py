@@ -3,7 +3,8 @@
 Schema of the physical tables (every other key is refused)::
 
     [model]              inertia, damping, stiffness      numbers, required
-    [model.elastic]      type                             "linear" | "backlash" | "clutch" | "piecewise" | "preload"
+    [model.elastic]      type                             "linear" | "backlash" | "clutch" | "piecewise" | "unilateral"
+                                                          | "preload"
                          + the parameters of that type    backlash: b; clutch: alpha, b;
                                                           piecewise: breakpoints, slopes;
                                                           preload: preload, clearance, slope
@@ -99,12 +100,13 @@ _EXAMPLES.update({
 
 
 def _law_params(law: type) -> dict[str, tuple[str, bool]]:
-    """Constructor parameters of an elastic law: name -> (kind "number"/"array", required)."""
+    """Constructor parameters of an elastic law: name -> (kind "number"/"array"/"string", required)."""
     params = {}
     for f in dataclasses.fields(law):  # type: ignore[arg-type]
         if not f.init:
             continue
-        kind = "array" if str(f.type).startswith(("tuple", "list", "Sequence")) else "number"
+        text = str(f.type)
+        kind = "array" if text.startswith(("tuple", "list", "Sequence")) else "string" if text == "str" else "number"
         required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
         params[f.name] = (kind, required)
     return params
@@ -223,7 +225,7 @@ def model_tables(data: Mapping[str, Any], source_name: str = "<dict>") -> ModelT
         check.number(model_t[key], f"model.{key}")
     for key, (kind, _) in law_params.items():
         if key in elastic_t:
-            (check.array if kind == "array" else check.number)(elastic_t[key], f"model.elastic.{key}")
+            check.value(kind, elastic_t[key], f"model.elastic.{key}")
     if "friction" in elastic_t:
         friction_t = elastic_t["friction"]
         (check.array if isinstance(friction_t, (list, tuple)) else check.number)(friction_t, "model.elastic.friction")
@@ -604,7 +606,7 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
         check.number(t["stiffness"], f"{where}.stiffness")
         for key, (kind, _) in law_params.items():
             if key in law_t:
-                (check.array if kind == "array" else check.number)(law_t[key], f"{where}.{key}")
+                check.value(kind, law_t[key], f"{where}.{key}")
         if "friction" in t:
             try:
                 (check.array if isinstance(t["friction"], (list, tuple)) else check.number)(t["friction"],
