@@ -263,7 +263,7 @@ def precheck(config: Path | None, output: Path, *, harmonics: int | None = None,
     the configuration file is an existing regular file within the size limit (from ``stat``), the
     options' bounds (``rattle._limits``), the output folder."""
     if config is not None:
-        from ..files._read import check_input_file  # no numpy
+        from ..files import check_input_file  # no numpy
 
         check_input_file(config)
     if harmonics is not None:

@@ -638,7 +638,7 @@ def compare_command(
     """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
     if measured is not None:
-        from ..files._read import check_input_file  # no numpy: refused at once
+        from ..files import check_input_file  # no numpy: refused at once
 
         try:
             check_input_file(measured, what="measured data file")
@@ -773,9 +773,9 @@ def map_command(
     the branches miss. Every combination finished is kept in OUTPUT/map.parts: a rerun of the
     same command into the same folder reads them back instead of recomputing them.
     """
-    from ..maps import _vary
+    from ..maps import build_all, combinations, parameters, parse_all
 
-    parsed = _vary.parse_all(vary)  # first: a malformed --vary needs no file
+    parsed = parse_all(vary)  # first: a malformed --vary needs no file
     precheck(config, output, harmonics=harmonics, workers=workers)
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
@@ -786,13 +786,13 @@ def map_command(
         run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
     )
     tables = _io().model_to_toml_dict(run_config.model, analysis)
-    params = _vary.parameters(tables, parsed)
-    _vary.build_all(tables, params)  # every combination's model, before any work
+    params = parameters(tables, parsed)
+    build_all(tables, params)  # every combination's model, before any work
     t_start = time.perf_counter()
     from ..maps import response_map  # only now: all input has been validated
 
     logger.info("response map: %d combinations × %d frequencies over %g … %g rad/s",
-                len(list(_vary.combinations(params))), omega_points, analysis.omega_min, analysis.omega_max)
+                len(list(combinations(params))), omega_points, analysis.omega_min, analysis.omega_max)
     bar = MapProgress("map", enabled=not quiet)
     try:
         result = response_map(run_config.model, params, omega=analysis.omega, omega_points=omega_points,
@@ -801,7 +801,7 @@ def map_command(
     finally:
         bar.close()
     from ..maps import map_report
-    from ..plotting._map import map_plot_names, plot_map
+    from ..plotting import map_plot_names, plot_map
 
     figures = map_plot_names(result)
     meta = sections("map", config, run_config, analysis, {

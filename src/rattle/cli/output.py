@@ -39,7 +39,7 @@ SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")
 ORBIT_FILES = ("orbit.csv", "orbit.json", "orbit.png")
 COMPARE_FILES = ("frf.csv", "sweep.csv", "compare.json", "compare.png", "measured.csv")
 #: ``rattle map``: with two or more varied parameters also ``map_<NAME>.png`` for each one after
-#: the first (:func:`rattle.plotting._map.map_plot_names`); ``map.md`` with ``--report``.
+#: the first (:func:`rattle.plotting.map_plot_names`); ``map.md`` with ``--report``.
 MAP_FILES = ("map.csv", "map.nc", "map.json", "map.png", "map.md")
 
 
@@ -295,13 +295,13 @@ def _branch_metadata(branch: Any) -> dict[str, Any]:
 
 def _stable_spans(branch: Any) -> str:
     """The Ω ranges of a branch's consecutive matched stable rows, as text (the runs its plot
-    shades, :func:`rattle.plotting._nonsmooth._held_runs`)."""
+    shades, :func:`rattle.plotting.held_runs`)."""
     import numpy as np
 
-    from ..plotting._nonsmooth import _held_runs
+    from ..plotting import held_runs
 
     ok = np.asarray(branch.matched, dtype=bool) & np.asarray(branch.stable, dtype=bool)
-    runs = _held_runs(np.asarray(branch.omega, dtype=float), ok)
+    runs = held_runs(np.asarray(branch.omega, dtype=float), ok)
     return ", ".join(f"{a:.5g} … {b:.5g}" for a, b in runs) if runs else "nowhere"
 
 
@@ -458,7 +458,7 @@ def map_json_writer(response_map: Any, sections: dict[str, Any], t_start: float)
     points, intervals, attractors, search, status, timings and whether it was read back."""
 
     def write(path: Path) -> None:
-        from ..maps._report import common_intervals
+        from ..maps import common_intervals
 
         combos = []
         for (index, values), cell in zip(response_map.combinations(), response_map.cells):
@@ -481,7 +481,7 @@ def map_json_writer(response_map: Any, sections: dict[str, Any], t_start: float)
 def map_summary(response_map: Any) -> str:
     """What ``rattle map`` prints: the map's size, what was read back or failed, and the Ω
     intervals rattle-free at every combination."""
-    from ..maps._report import common_intervals, format_intervals
+    from ..maps import common_intervals, format_intervals
 
     cells = response_map.cells
     resumed = sum(1 for c in cells if c.resumed)

@@ -14,12 +14,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..plotting._frf import (
-    branch_colors, branch_label, draw_branches, draw_regions, draw_special_points, frequency_response_plot, place_legend,
-    true_runs,
+from ..plotting import (
+    PlotAxes, amplitude_spectrum, branch_colors, branch_label, draw_branches, draw_regions, draw_special_points,
+    frequency_response_plot, place_legend, true_runs, unwrap,
 )
-from ..plotting._axes import PlotAxes, unwrap
-from ..plotting._orbit import amplitude_spectrum
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._report import LevelDifference
@@ -125,7 +123,7 @@ def _draw_sweep_points(sweep: "SweepResult", ax: Any) -> None:
     ticks along the bottom of the axes (up sweep lower, down sweep above it), coloured by period."""
     from matplotlib.transforms import blended_transform_factory
 
-    from ..plotting._sweep import PERIOD_COLORS, period_label
+    from ..plotting import PERIOD_COLORS, period_label
 
     direction = np.asarray(sweep.direction).astype(str)
     period = np.asarray(sweep.period, dtype=int)

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._axes import PlotAxes
-from ._nonsmooth import STICK_COLOUR, _held_runs
+from ._nonsmooth import STICK_COLOUR, held_runs
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import FrictionResponse
@@ -57,7 +57,7 @@ def friction_response_plot(response: FrictionResponse) -> tuple[Any, PlotAxes]:
                             label=f"{name}: period {br.period}, branch {br.branch}, {kind}")
             ax_s.plot(br.omega, np.where(br.matched, br.stick_fraction[:, e], np.nan), "-.", color=c, lw=1.0)
     held = matched & (np.nan_to_num(response.stick_fraction).max(axis=1) > 0.0) if len(response) else matched
-    for i, (a, b) in enumerate(_held_runs(w, held)):
+    for i, (a, b) in enumerate(held_runs(w, held)):
         ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="an element sticks" if i == 0 else None)
         ax_s.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0)
     ax.set_ylabel("δ rms (rad)")

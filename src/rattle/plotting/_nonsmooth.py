@@ -36,8 +36,21 @@ LOCK_COLOUR = "tab:orange"
 _SHADE_ALPHA = 0.25
 
 
-def _held_runs(omega: np.ndarray, held: np.ndarray) -> list[tuple[float, float]]:
-    """The Ω-ranges (min, max) of the consecutive runs of rows where ``held`` is true."""
+def held_runs(omega: np.ndarray, held: np.ndarray) -> list[tuple[float, float]]:
+    """The Ω-ranges (min, max) of the consecutive runs of rows where ``held`` is true.
+
+    Parameters
+    ----------
+    omega : ndarray, shape (P,)
+        The forcing frequency Ω of every row, in branch order.
+    held : ndarray of bool, shape (P,)
+        The rows to gather (e.g. where the exact orbit sticks or locks).
+
+    Returns
+    -------
+    list of (float, float)
+        One ``(min Ω, max Ω)`` per run of consecutive true rows, in row order; empty when none.
+    """
     runs: list[tuple[float, float]] = []
     idx = np.flatnonzero(held)
     if idx.size == 0:
@@ -77,7 +90,7 @@ def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]
         fr = np.where(br.matched, br.stick_time / (br.period * 2.0 * np.pi / br.omega), np.nan)
         ax_s.plot(br.omega, fr, "-", color=colour, lw=1.0)
     held = matched & (np.nan_to_num(response.stick_time) > 0.0)
-    for i, (a, b) in enumerate(_held_runs(w, held)):
+    for i, (a, b) in enumerate(held_runs(w, held)):
         ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="exact orbit sticks or locks" if i == 0 else None)
     ax.set_ylabel("δ rms (rad)")
     ax.legend(fontsize="small")
@@ -154,4 +167,4 @@ def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tu
     return fig, PlotAxes({"delta": ax_d, "velocity": ax_v, "phase": ax_p})
 
 
-__all__ = ["LOCK_COLOUR", "STICK_COLOUR", "nonsmooth_orbit_plot", "nonsmooth_response_plot"]
+__all__ = ["LOCK_COLOUR", "STICK_COLOUR", "held_runs", "nonsmooth_orbit_plot", "nonsmooth_response_plot"]
