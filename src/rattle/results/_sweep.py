@@ -34,16 +34,27 @@ FAILED_PERIOD = -1
 _LISTED = 10
 
 
-class Jump(NamedTuple):
-    """An abrupt change of the rms between two consecutive frequencies of one sweep direction:
-    ``direction``, ``omega_before`` → ``omega_after`` (rad/s, in sweep order) and the rms on
-    either side (rad). A named tuple: unpacks in that order."""
-
+class _JumpFields(NamedTuple):
     direction: str
     omega_before: float
     omega_after: float
     rms_before: float
     rms_after: float
+
+
+class Jump(_JumpFields):
+    """An abrupt change of the rms between two consecutive frequencies of one sweep direction:
+    ``direction``, ``omega_before`` → ``omega_after`` (rad/s, in sweep order) and the rms on
+    either side (rad). A named tuple: unpacks in that order. On a chain, ``element`` names the
+    element whose rms it is ("" for the single equation; an attribute, not unpacked)."""
+
+    element: str
+
+    def __new__(cls, direction: str, omega_before: float, omega_after: float, rms_before: float,
+                rms_after: float, element: str = "") -> "Jump":
+        self = super().__new__(cls, direction, omega_before, omega_after, rms_before, rms_after)
+        self.element = element
+        return self
 
     @property
     def omega(self) -> float:
@@ -54,6 +65,26 @@ class Jump(NamedTuple):
     def kind(self) -> str:
         """``up`` when the rms jumps up, ``down`` when it drops."""
         return "up" if self.rms_after > self.rms_before else "down"
+
+
+def _jump_steps(w: FloatArray, r: FloatArray, threshold: float) -> list[tuple[int, float]]:
+    """The steps i (row i → i + 1) of one sweep direction that are jumps (see
+    :meth:`SweepResult.jumps`), with their relative change."""
+    c = np.diff(r)
+    dw = np.diff(w)
+    rel = np.abs(c) / np.maximum(np.maximum(np.abs(r[:-1]), np.abs(r[1:])), 1e-300)
+    out = []
+    for i in np.flatnonzero(rel > threshold).tolist():
+        explained = False
+        for j in (i - 1, i + 1):
+            if 0 <= j < c.size and dw[j] != 0.0:
+                trend = c[j] * dw[i] / dw[j]  # the neighbour's change, scaled to this step
+                if trend * c[i] > 0.0 and abs(c[i]) <= 2.0 * abs(trend):
+                    explained = True
+                    break
+        if not explained:
+            out.append((i, float(rel[i])))
+    return out
 
 
 @dataclass(frozen=True, slots=True, eq=False)  # arrays: identity equality
@@ -259,7 +290,8 @@ class SweepResult:
         rpm = (lambda w: "") if order is None else (lambda w: f" ({w * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
         if jumps:
             lines.append("jumps: " + "; ".join(
-                f"{j.direction} sweep, rms {j.kind} {j.rms_before:.4g} → {j.rms_after:.4g} rad "
+                f"{j.direction} sweep, {j.element + ' ' if j.element else ''}rms {j.kind} {j.rms_before:.4g} → "
+                f"{j.rms_after:.4g} rad "
                 f"between Ω = {j.omega_before:.5g}{rpm(j.omega_before)} and {j.omega_after:.5g}{rpm(j.omega_after)}"
                 for j in jumps))
         else:
@@ -286,13 +318,24 @@ class SweepResult:
         return "\n".join(lines)
 
     def jumps(self, threshold: float = 0.15) -> list[Jump]:
-        """Abrupt rms changes between consecutive frequencies of each direction.
+        """Abrupt rms changes between consecutive frequencies of each direction, of every element.
 
         Failed rows are left out: the step is then taken between the computed rows on either side.
-        A step from row i to i + 1 of one direction is a jump when the rms changes by more than
-        ``threshold`` times the larger of the two values, and by more than four times the larger
-        change over the neighbouring steps (so that a steep but smooth resonance flank is not
-        taken for a jump).
+        A step c_i = r_{i+1} − r_i from row i to i + 1 of one direction is a jump when
+
+        * the rms changes by more than ``threshold`` times the larger of the two values, and
+        * the trend does not explain it: for each neighbouring step j = i − 1 and i + 1 that
+          exists, with the neighbour's change scaled to this step, t_j = c_j Δω_i/Δω_j, the change
+          has the other sign or is more than twice as large (c_i t_j ≤ 0 or |c_i| > 2 |t_j|).
+
+        A steep but smooth resonance flank or a coarsely sampled peak changes like its neighbours
+        (its change is explained from at least one side); a jump at a fold is not explained from
+        either side, also at the end of a steep flank (the branch it leaves was steepening toward
+        its fold) or at the last row of the sweep.
+
+        On a chain every element's rms is examined (a jump of the response may be large in one
+        element and small in the first): each step is reported once, for the element whose rms
+        changes most there relative to its size (``element``; "" for the single equation).
 
         Parameters
         ----------
@@ -303,23 +346,28 @@ class SweepResult:
         -------
         list of Jump
             In sweep order; each unpacks as (direction, omega_before, omega_after, rms_before,
-            rms_after).
+            rms_after); ``element`` names the element on a chain.
         """
         if not (isinstance(threshold, (int, float)) and not isinstance(threshold, bool) and threshold > 0):
             raise ValueError(f"`threshold` must be a number > 0, got {threshold!r}")
+        series = [("", self.rms)] if not self.element_names else \
+            [(name, self.element_columns[f"{name}_rms"]) for name in self.element_names]
         out: list[Jump] = []
         for d in self.directions:
             rows = np.flatnonzero((self.direction == d) & ~self.failed)
-            r, w = self.rms[rows], self.omega[rows]
-            if r.size < 2:
+            if rows.size < 2:
                 continue
-            change = np.abs(np.diff(r))
-            rel = change / np.maximum(np.maximum(np.abs(r[:-1]), np.abs(r[1:])), 1e-300)
-            for i in np.flatnonzero(rel > threshold):
-                neighbours = np.concatenate((change[max(0, i - 2) : i], change[i + 1 : i + 3]))
-                if neighbours.size and change[i] <= 4.0 * float(np.max(neighbours)):
-                    continue
-                out.append(Jump(d, float(w[i]), float(w[i + 1]), float(r[i]), float(r[i + 1])))
+            w = self.omega[rows]
+            found: dict[int, tuple[float, str]] = {}
+            for name, col in series:
+                r = np.asarray(col, dtype=float)[rows]
+                for i, rel in _jump_steps(w, r, float(threshold)):
+                    if i not in found or rel > found[i][0]:
+                        found[i] = (rel, name)
+            for i in sorted(found):
+                name = found[i][1]
+                r = self.rms[rows] if not name else np.asarray(self.element_columns[f"{name}_rms"])[rows]
+                out.append(Jump(d, float(w[i]), float(w[i + 1]), float(r[i]), float(r[i + 1]), name))
         return out
 
     def metadata(self) -> dict[str, Any]:
@@ -339,7 +387,7 @@ class SweepResult:
             },
             "jumps": [
                 {"direction": j.direction, "omega_before": j.omega_before, "omega_after": j.omega_after,
-                 "rms_before": j.rms_before, "rms_after": j.rms_after}
+                 "rms_before": j.rms_before, "rms_after": j.rms_after, **({"element": j.element} if j.element else {})}
                 for j in self.jumps()
             ],
         }
