@@ -56,7 +56,7 @@ def test_options_are_keyword_only_and_frozen():
 #: docs/python.md with it.
 PUBLIC_API = {
     "__version__",
-    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "AbstractElastic", "reference_case",
+    "Model", "Excitation", "Linear", "Backlash", "Clutch", "Piecewise", "Unilateral", "AbstractElastic", "reference_case",
     "backlash_case", "Chain", "Link", "Element", "Torque", "System",
     "load_case", "frequency_response", "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse",
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",

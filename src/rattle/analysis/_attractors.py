@@ -69,7 +69,7 @@ from ..hb import HarmonicBalance
 from ..results import FrequencyResponse
 from ..timeint import SystemTrajectory
 from ..timeint._system_shooting import system_state_scale
-from ._branches import branch_from_seed
+from ._branches import branch_from_seed, is_shorter_period
 from ._grid import GridSolution, section_states, solutions_on_grid
 from ._settings import RunSettings
 from ._steady import SteadyStateOptions, make_integrator, steady_state
@@ -266,6 +266,11 @@ class _Search:
         H = n * self.run.hb.harmonics
         hb = HarmonicBalance(self.model, self.run.for_harmonics(H), period=n)
         q = _coefficients(self.model, state, hb)
+        if is_shorter_period(q, len(self.system.coordinates), n):
+            # the simulation's period detection said n, its spectrum says a divisor of n
+            self.census.found.append({"omega": float(self.grid[j]), "period": n, "origin": origin, "branch": None,
+                                      "rms": float(state.rms), "note": "a shorter period's orbit: not continued"})
+            return
         record = self.add_branch_from(j, n, q, H, origin, float(state.rms))
         if record.get("branch") is not None and not self.explained(j, state):
             # The branch does not pass through the simulated orbit (HB with these harmonics
@@ -441,11 +446,7 @@ class _Search:
         if not res.converged:
             return
         Hn = hb.basis.harmonics
-        Q = res.q.reshape(n_coord, -1)
-        not_multiple = np.array([k % n != 0 for k in range(1, Hn + 1)])
-        sub = np.concatenate(([False], not_multiple, not_multiple))
-        dynamic = float(np.linalg.norm(Q[:, 1:]))
-        if dynamic == 0.0 or (n > 1 and float(np.linalg.norm(Q[:, sub])) < 1e-3 * dynamic):
+        if float(np.linalg.norm(res.q.reshape(n_coord, -1)[:, 1:])) == 0.0 or is_shorter_period(res.q, n_coord, n):
             return  # a solution of a shorter period written with period n
         sec = section_states(res.q, n_coord, w, n)
         if self.passes(j, n, sec[0], stable_only=False):

@@ -13,6 +13,8 @@ frequency range.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .._typing import FloatArray
@@ -65,6 +67,32 @@ def critical_mode(hb2: HarmonicBalance, q2: FloatArray, omega: float) -> FloatAr
 
 def _odd_part(q: FloatArray, odd: np.ndarray) -> FloatArray:
     return q[odd]
+
+
+#: A period-n solution whose harmonics that are not multiples of n carry less than this fraction
+#: of its dynamic part (the norm of every harmonic) is a solution of a shorter period written with
+#: period n (the period-1 orbit repeated): not a period-n attractor.
+SHORTER_PERIOD_RTOL = 1e-3
+
+
+def sub_harmonic_fraction(q: FloatArray, coordinates: int, period: int) -> float:
+    """‖harmonics k of Ω/n with n ∤ k‖ / ‖every harmonic k ≥ 1‖ of the period-n coefficients
+    ``q`` (``coordinates`` rows of 2H + 1: mean, cosines, sines); 1 for a period-1 solution,
+    0 for a motion without dynamic part."""
+    if period <= 1:
+        return 1.0
+    Q = np.asarray(q, dtype=float).reshape(coordinates, -1)
+    H = (Q.shape[1] - 1) // 2
+    not_multiple = np.array([k % period != 0 for k in range(1, H + 1)])
+    sub = np.concatenate(([False], not_multiple, not_multiple))
+    dynamic = float(np.linalg.norm(Q[:, 1:]))
+    return float(np.linalg.norm(Q[:, sub])) / dynamic if dynamic > 0.0 else 0.0
+
+
+def is_shorter_period(q: FloatArray, coordinates: int, period: int) -> bool:
+    """Whether period-``period`` coefficients are a solution of a shorter period (see
+    :data:`SHORTER_PERIOD_RTOL`)."""
+    return period > 1 and sub_harmonic_fraction(q, coordinates, period) < SHORTER_PERIOD_RTOL
 
 
 def switch_period_doubling(
@@ -121,7 +149,8 @@ def switch_period_doubling(
     return hb2, stepper
 
 
-__all__ = ["odd_indices", "critical_mode", "switch_period_doubling"]
+__all__ = ["odd_indices", "critical_mode", "switch_period_doubling", "sub_harmonic_fraction", "is_shorter_period",
+           "SHORTER_PERIOD_RTOL"]
 
 
 def period_doubling_branches(
@@ -218,6 +247,11 @@ def branch_from_seed(
     res = solve_harmonic_balance(hb, q_seed, omega, newton)
     if not res.converged:
         return None
+    n_coord = _coordinates(hb)
+    if is_shorter_period(res.q, n_coord, period):
+        return None  # the seed converged onto a shorter period's orbit written with this period
+    not_multiple = np.array([k % period != 0 for k in range(1, harmonics + 1)])
+    sub_mask = np.concatenate(([False], not_multiple, not_multiple))
     from ..continuation import ArclengthCorrector
 
     corrector = ArclengthCorrector(hb, newton)
@@ -231,21 +265,34 @@ def branch_from_seed(
         tangent = corrector.tangent(Rq, Rw, reference)
         if tangent is None:
             return None
-        count = {"n": 0}
+        count: dict[str, Any] = {"n": 0}
 
         def back_at_seed(pt: BranchPoint) -> str | None:
             count["n"] += 1
             y = corrector.to_scaled(pt.q, pt.omega)
             if count["n"] > 5 and np.linalg.norm(y - y_seed) < 0.5 * max(pt.step, 1e-9):
+                count["isola"] = True
                 return "the branch closed on itself (an isola)"
+            if period > 1:
+                # At a period doubling the period-n branch meets the orbit of period n/2, which is
+                # also a solution of the period-n balance: the sub-harmonic part (harmonics k with
+                # n ∤ k) goes through zero there. Stop on it (not onto the shorter period's branch)
+                # or where it changed sign between two points (past it, onto the branch's copy
+                # shifted by a forcing period: the same orbits again).
+                sub = pt.q.reshape(n_coord, -1)[:, sub_mask].ravel()
+                prev, count["sub"] = count.get("sub"), sub
+                count["past"] = prev is not None and float(sub @ prev) < 0.0
+                if count["past"] or is_shorter_period(pt.q, n_coord, period):
+                    return f"the period-{period} branch rejoined a shorter period's branch near Ω = {pt.omega:.6g}"
             return None
 
         stepper = ContinuationStepper(hb, res.q, omega, omega_range, run.continuation, newton,
                                       tangent=tangent, stop=back_at_seed, monitor=FloquetMonitor(hb))
         stepper.run()
-        halves.append(stepper.points)
+        # a point past the doubling is on the branch's shifted copy: the branch ends before it
+        halves.append(stepper.points[:-1] if count.get("past") and len(stepper.points) > 2 else stepper.points)
         statuses.append(stepper)
-        if stepper.status is Status.STOPPED:
+        if count.get("isola"):
             break  # an isola: one way round covers it
     points = halves[0] if len(halves) == 1 else halves[1][::-1] + halves[0][1:]
     status = statuses[0].status or Status.STOPPED
