@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import _limits, _validate
 from .._typing import FloatArray
-from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper
+from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, ForcingHomotopy
 from ..errors import ConvergenceError, Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
 from ..model import Model, check_analysable_model
@@ -30,136 +30,55 @@ def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
     return _validate.check_range(omega, name)
 
 
-def start_solution(hb: HarmonicBalance, omega: float, newton: NewtonOptions) -> tuple[FloatArray, str]:
+def start_solution(
+    hb: HarmonicBalance, omega: float, newton: NewtonOptions, *, continuation: ContinuationOptions | None = None,
+) -> tuple[FloatArray, str]:
     """A converged solution at Ω from the linear solution about the static equilibrium.
 
-    If Newton fails from there, the dynamic forcing λ·(F − F_0) is raised from λ = 0 (the
-    static solution) to 1: first in natural steps, each started from the previous solution;
-    where that stalls (the solution turns back in λ: a fold of the amplitude response, common
-    inside a bent resonance), by pseudo-arclength continuation in (q, λ), which follows the
-    solution curve through such folds (:func:`_amplitude_continuation`).
+    If Newton fails from there, the solution is reached by continuation in the scale λ of the
+    forcing's harmonics (the *start homotopy*):
+
+        R(q; Ω, λ) = R(q, Ω) + (1 − λ)(F − F_0) = 0,   λ from 0 to 1,
+
+    F the forcing coefficients, F_0 their means alone (:meth:`~rattle.hb.HarmonicBalance.static_forcing`):
+    at λ = 0 the static equilibrium, at λ = 1 the orbit sought. The branch is followed from
+    λ = 0 by :class:`~rattle.continuation.ContinuationStepper` on
+    :class:`~rattle.continuation.ForcingHomotopy` (pseudo-arclength in (q / L, λ), through every
+    fold in λ, common inside a bent resonance), and its last point is placed on λ = 1 by Newton
+    at the full forcing: the orbit the homotopy's branch connects to the static equilibrium.
+    The stepper's step control and budgets are ``continuation`` (those of the frequency
+    response being started; default ``ContinuationOptions()``; λ has scale 1). Raises
+    :class:`~rattle.errors.ConvergenceError` when the branch does not reach λ = 1.
     """
     q_lin = hb.linear_solution(omega)
     res = solve_harmonic_balance(hb, q_lin, omega, newton)
     if res.converged:
         return res.q, "linear solution + Newton"
-    full = hb.forcing.copy()
+    static = hb.static_forcing()
     n = hb.size // hb.basis.size  # coordinates; every block's a_0 is its mean
-    static = np.zeros_like(full)
-    static.reshape(n, -1)[:, 0] = full.reshape(n, -1)[:, 0]
     q = q_lin.copy()
-    q.reshape(n, -1)[:, 1:] = 0.0
-    lam, dlam = 0.0, 0.1
-    q_static = None
-    try:
-        while lam < 1.0 and dlam > 1e-4:
-            trial = min(1.0, lam + dlam)
-            hb.forcing = static + trial * (full - static)
-            r = solve_harmonic_balance(hb, q, omega, newton)
-            if r.converged:
-                q, lam = r.q, trial
-                if q_static is None:
-                    q_static = (r.q, trial)
-                dlam = min(0.5, 1.5 * dlam)
-            else:
-                dlam *= 0.5
-    finally:
-        hb.forcing = full
-    if lam >= 1.0:
-        return q, "amplitude homotopy"
-    stalled = lam
-    q_cont = _amplitude_continuation(hb, omega, q, lam, static, full, newton)
-    if q_cont is not None:
-        return q_cont, "amplitude continuation (through folds in the amplitude)"
+    q.reshape(n, -1)[:, 1:] = 0.0  # the guess at λ = 0: the means of the linear solution
+    homotopy = ForcingHomotopy(hb, omega, hb.forcing - static)
+    # Positional, as every stepper of a frequency response is built (tests spy on the signature);
+    # λ may take any value on the way (the residual is defined for all).
+    options = ContinuationOptions() if continuation is None else continuation
+    stepper = ContinuationStepper(homotopy, q, 0.0, (0.0, 1.0), options, newton, domain=(-np.inf, np.inf), symbol="λ")
+    points = stepper.run()
+    if stepper.status is Status.SUCCESS and points[-1].p == 1.0:
+        # The branch turned back in λ (a fold of the amplitude response) where dλ/ds changed sign.
+        dlam = np.array([pt.tangent[-1] for pt in points])
+        folds = bool(np.any(dlam[1:] * dlam[:-1] < 0.0))
+        return points[-1].q, ("amplitude continuation (through folds in the amplitude)" if folds
+                              else "amplitude homotopy")
+    reached = max((pt.p for pt in points), default=0.0)
     raise ConvergenceError(
         f"no periodic solution found at Ω = {omega:g}: Newton from the linear solution failed "
-        f"({res.message}, scaled residual {res.residual:.3g}) and the amplitude homotopy stalled at "
-        f"{stalled:.3g} of the forcing (also followed by arclength through folds); with "
-        f"{hb.basis.harmonics} harmonics the truncated problem may have "
-        "no solution there (a slow orbit through the stages needs many harmonics): give more "
+        f"({res.message}, scaled residual {res.residual:.3g}) and the amplitude homotopy, followed by "
+        f"arclength through folds from the static equilibrium, reached no more than {reached:.3g} of "
+        f"the forcing ({stepper.message}); with {hb.basis.harmonics} harmonics the truncated problem may "
+        "have no solution there (a slow orbit through the stages needs many harmonics): give more "
         "harmonics or start the range higher"
     )
-
-
-def _amplitude_continuation(
-    hb: HarmonicBalance, omega: float, q0: FloatArray, lam0: float, static: FloatArray, full: FloatArray,
-    newton: NewtonOptions, max_steps: int = 2000,
-) -> FloatArray | None:
-    """Pseudo-arclength continuation of R(q, Ω) with the forcing F_0 + λ (F − F_0), from the
-    converged (q0, λ0) to λ = 1, through folds in λ; the solution at λ = 1 (Newton at the full
-    forcing from the point interpolated where the curve crosses it), or None.
-
-    Variables y = (q / L, λ); the corrector solves R = 0 with tᵀ(y − y_pred) = 0 on the
-    bordered Jacobian [∂R/∂q L, −(F − F_0)]; the tangent is its null vector, oriented along the
-    previous one (initially towards increasing λ).
-    """
-    L, Fs = hb.length_scale, hb.force_scale
-    D = full - static
-    size = hb.size
-
-    def rj(y: FloatArray) -> tuple[FloatArray, FloatArray]:
-        hb.forcing = static + y[-1] * D
-        R, Rq, _ = hb.residual_jacobian(y[:-1] * L, omega)
-        J = np.empty((size, size + 1))
-        J[:, :size] = Rq * L
-        J[:, size] = -D
-        return R, J
-
-    def tangent(J: FloatArray, ref: FloatArray) -> FloatArray | None:
-        A = np.vstack((J, ref))
-        rhs = np.zeros(size + 1)
-        rhs[-1] = 1.0
-        try:
-            t = np.linalg.solve(A, rhs)
-        except np.linalg.LinAlgError:
-            return None
-        return t / np.linalg.norm(t) if np.all(np.isfinite(t)) else None
-
-    try:
-        y = np.concatenate((q0 / L, [lam0]))
-        _, J = rj(y)
-        ref = np.zeros(size + 1)
-        ref[-1] = 1.0
-        t = tangent(J, ref)
-        h = 0.05
-        for _ in range(max_steps if t is not None else 0):
-            yp = y + h * t
-            ok = False
-            yc = yp.copy()
-            for _it in range(newton.max_iterations):
-                R, J = rj(yc)
-                A = np.vstack((J, t))
-                rhs = np.concatenate((-R, [-float(t @ (yc - yp))]))
-                try:
-                    dy = np.linalg.solve(A, rhs)
-                except np.linalg.LinAlgError:
-                    break
-                yc = yc + dy
-                if not np.all(np.isfinite(yc)):
-                    break
-                if float(np.max(np.abs(R))) / Fs <= newton.residual_tol and float(np.max(np.abs(dy))) <= newton.step_tol:
-                    ok = True
-                    break
-            if not ok or float(np.linalg.norm(yc - y)) > 2.0 * h:
-                h *= 0.5
-                if h < 1e-7:
-                    return None
-                continue
-            if yc[-1] >= 1.0:  # crossed the full forcing: Newton there from the interpolated point
-                s = (1.0 - y[-1]) / (yc[-1] - y[-1])
-                q_guess = ((1.0 - s) * y[:-1] + s * yc[:-1]) * L
-                hb.forcing = full
-                r = solve_harmonic_balance(hb, q_guess, omega, newton)
-                return r.q if r.converged else None
-            _, J = rj(yc)
-            t_new = tangent(J, t)
-            if t_new is None:
-                return None
-            y, t = yc, t_new
-            h = min(2.0 * h, 0.25)
-        return None
-    finally:
-        hb.forcing = full
 
 
 @_validate.numerical_failures
@@ -269,7 +188,7 @@ def _frequency_response(
     hb = HarmonicBalance(model, hb_opts, period=period)
     omega0 = lo if start == "low" else hi
     try:
-        q0, how = start_solution(hb, omega0, newton_opts)
+        q0, how = start_solution(hb, omega0, newton_opts, continuation=cont_opts)
     except ConvergenceError:
         if throw:
             raise

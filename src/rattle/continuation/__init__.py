@@ -6,10 +6,13 @@ package knows nothing of how its residual is computed. :func:`solve_fixed` solve
 parameter, :class:`ContinuationStepper` follows its branch (predictor objects :class:`Tangent`,
 :class:`Secant`; bordered corrector :class:`ArclengthCorrector`; test-function monitoring
 :func:`check_segment`; special points located by :func:`locate_on_segment`).
+:class:`ForcingHomotopy` turns a problem at a fixed parameter into one continued in the scale λ
+of its forcing (the start of a branch where Newton alone does not converge).
 """
 
 from ._corrector import ArclengthCorrector, Corrected
 from ._detect import LocatedPoint, locate_on_segment
+from ._homotopy import ForcingHomotopy
 from ._monitor import Monitor, MonitorReading, SegmentVerdict, check_segment
 from ._newton import NewtonResult, solve_fixed
 from ._options import ContinuationOptions, NewtonOptions
@@ -21,5 +24,5 @@ __all__ = [
     "ContinuationProblem", "SupportsNewtonStep", "ContinuationOptions", "NewtonOptions", "NewtonResult",
     "solve_fixed", "ContinuationStepper", "BranchPoint", "AbstractPredictor", "Tangent", "Secant",
     "PREDICTORS", "predictor", "ArclengthCorrector", "Corrected", "LocatedPoint", "locate_on_segment",
-    "Monitor", "MonitorReading", "SegmentVerdict", "check_segment",
+    "Monitor", "MonitorReading", "SegmentVerdict", "check_segment", "ForcingHomotopy",
 ]

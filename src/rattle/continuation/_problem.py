@@ -26,7 +26,13 @@ rattle's frequency responses continue two problems in the forcing frequency p = 
   it has its own :meth:`newton_step` (full or condensed solve);
 * :class:`~rattle.timeint.ShootingProblem` — q = z(0) the state (x, x') on the Poincaré section,
   R = (φ_T(z(0)) − z(0)) / s the scaled period-map defect (T = p·2π/Ω), ∂R/∂q = (M − I)/s with
-  M the exact monodromy, ∂R/∂Ω from the exact flow.
+  M the exact monodromy, ∂R/∂Ω from the exact flow;
+
+and the start of a frequency response, where Newton alone fails, continues one in the scale λ of
+the forcing at a fixed Ω:
+
+* :class:`~rattle.continuation.ForcingHomotopy` — R(q; λ) = R(q, Ω) + (1 − λ)(F − F_0), the
+  harmonic balance with its forcing's harmonics scaled by λ (see ``_homotopy``).
 """
 
 from __future__ import annotations
