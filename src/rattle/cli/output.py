@@ -184,9 +184,14 @@ def write_set(output: Path, names: Sequence[str], steps: Sequence[tuple[str, Wri
                 logger.info("writing %s", name)
                 writer(staged.path(name))
             written = staged.commit()
-    except OSError as exc:
+    except OSError as exc:  # no space, no permission, a member that cannot be replaced: exit 1, one line
+        from ..files import WriteError, describe_os_error
+
+        if isinstance(exc, WriteError):
+            raise click.ClickException(f"{exc}; no file of the set was replaced") from exc
         where = f"{exc.filename}" if exc.filename else str(output)
-        raise click.ClickException(f"cannot write {where}: {exc.strerror or exc}") from exc
+        raise click.ClickException(f"cannot write {where}: {describe_os_error(exc)}; no file of the set was "
+                                   "replaced") from exc
     logger.info("moved %s into %s", ", ".join(written), output)
     return written
 

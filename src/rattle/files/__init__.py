@@ -15,9 +15,10 @@ from .._lazy import lazy_exports
 #: reaches ``._read`` and ``._atomic`` without numpy, which ``._csv`` and ``._metadata`` need.
 _LAZY: dict[str, str] = {
     **dict.fromkeys(["STAGING_PREFIX", "OutputSet", "atomic_path", "atomic_write_bytes", "atomic_write_text",
-                     "recover_staging", "RecoveryWarning"], "._atomic"),
+                     "recover_staging", "RecoveryWarning", "WriteError", "describe_os_error"], "._atomic"),
     **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "._csv"),
-    **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "read_toml", "check_input_file"], "._read"),
+    **dict.fromkeys(["MAX_CONFIG_BYTES", "MAX_TOML_DEPTH", "MAX_KEY_PARTS", "MAX_CSV_FIELD", "read_bounded", "read_toml",
+                     "check_input_file", "check_toml_bounds", "csv_rows"], "._read"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
                     "._metadata"),
 }
@@ -26,16 +27,21 @@ _LAZY: dict[str, str] = {
 if TYPE_CHECKING:
     from ._atomic import (
         STAGING_PREFIX, OutputSet, atomic_path, atomic_write_bytes, atomic_write_text, RecoveryWarning,
-        recover_staging,
+        WriteError, describe_os_error, recover_staging,
     )
     from ._csv import format_csv, read_csv, write_csv
     from ._metadata import environment, metadata_document, rattle_version, to_jsonable, write_metadata
-    from ._read import MAX_CONFIG_BYTES, check_input_file, read_bounded, read_toml
+    from ._read import (
+        MAX_CONFIG_BYTES, MAX_CSV_FIELD, MAX_KEY_PARTS, MAX_TOML_DEPTH, check_input_file, check_toml_bounds, csv_rows,
+        read_bounded, read_toml,
+    )
 
 __all__ = [
-    "MAX_CONFIG_BYTES", "OutputSet", "STAGING_PREFIX", "atomic_path", "atomic_write_bytes", "atomic_write_text",
+    "MAX_CONFIG_BYTES", "MAX_CSV_FIELD", "MAX_KEY_PARTS", "MAX_TOML_DEPTH", "check_toml_bounds", "csv_rows",
+    "OutputSet", "STAGING_PREFIX", "atomic_path", "atomic_write_bytes", "atomic_write_text",
     "check_input_file", "environment", "format_csv", "metadata_document", "rattle_version", "read_bounded",
     "read_csv", "read_toml", "recover_staging", "RecoveryWarning", "to_jsonable", "write_csv", "write_metadata",
+    "WriteError", "describe_os_error",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)

@@ -11,6 +11,7 @@ moved into place together, so that an interrupted run never leaves new and old f
 from __future__ import annotations
 
 import contextlib
+import errno
 import functools
 import json
 import os
@@ -24,10 +25,81 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..errors import ConfigError, RattleError
+
 __all__ = [
     "atomic_path", "atomic_write_bytes", "atomic_write_text", "OutputSet", "recover_staging", "RecoveryWarning",
-    "STAGING_PREFIX",
+    "STAGING_PREFIX", "WriteError", "describe_os_error",
 ]
+
+
+class WriteError(RattleError, OSError):
+    """A file or folder could not be written (no space, no permission, a folder where a file of
+    the set should go …). An :class:`OSError` with ``errno`` and ``filename`` set, whose message
+    is one line naming the path and the errno (``[Errno 28] No space left on device (ENOSPC)``);
+    what was there before is left as it was. The command line exits with status 1 on it."""
+
+    def __init__(self, message: str, *, code: int | None = None, filename: str | None = None) -> None:
+        OSError.__init__(self, message)
+        self.message = message
+        self.errno = code  # type: ignore[assignment]
+        self.strerror = os.strerror(code) if code is not None else None  # type: ignore[assignment]
+        self.filename = filename
+
+    def __str__(self) -> str:
+        return self.message
+
+    def __reduce__(self) -> Any:  # picklable across worker processes
+        return (_make_write_error, (self.message, self.errno, self.filename))
+
+
+#: OSError's own subclasses by errno: a WriteError is also the one ``open`` would have raised
+#: (``except FileNotFoundError`` keeps working).
+_ERRNO_CLASSES: dict[int, type[OSError]] = {
+    errno.ENOENT: FileNotFoundError, errno.EISDIR: IsADirectoryError, errno.ENOTDIR: NotADirectoryError,
+    errno.EACCES: PermissionError, errno.EPERM: PermissionError, errno.EEXIST: FileExistsError,
+}
+
+
+@functools.cache
+def _write_error_class(code: int | None) -> type[WriteError]:
+    base = _ERRNO_CLASSES.get(code) if code is not None else None
+    if base is None:
+        return WriteError
+    return type(f"WriteError{base.__name__}", (WriteError, base), {"__module__": __name__})
+
+
+def _make_write_error(message: str, code: int | None, filename: str | None) -> WriteError:
+    """A :class:`WriteError` (of the errno's OSError subclass too)."""
+    return _write_error_class(code)(message, code=code, filename=filename)
+
+
+def describe_os_error(exc: OSError) -> str:
+    """``[Errno 28] No space left on device (ENOSPC)``: the errno, its text and its symbol."""
+    code = exc.errno
+    if code is None:
+        return str(exc)
+    text = exc.strerror or os.strerror(code)
+    return f"[Errno {code}] {text} ({errno.errorcode.get(code, '?')})"
+
+
+def _write_error(exc: OSError, path: str | os.PathLike[str], what: str = "cannot write") -> WriteError:
+    if isinstance(exc, WriteError):
+        return exc
+    where = os.fspath(exc.filename) if exc.filename and "tmp" not in os.fspath(exc.filename) else os.fspath(path)
+    return _make_write_error(f"{what} {where!r}: {describe_os_error(exc)}", exc.errno, where)
+
+
+def _check_path(path: str | os.PathLike[str], what: str = "`path`") -> Path:
+    """``path`` as a Path, refusing one with a NUL byte (no system call can take it)."""
+    try:
+        target = Path(path)
+    except TypeError:
+        raise TypeError(f"{what} must be a str or os.PathLike, got {type(path).__name__} {path!r}") from None
+    if "\x00" in os.fspath(target):
+        raise ConfigError(f"{what} {os.fspath(target)!r} is not a valid path: it holds a NUL byte, which no file name "
+                          "can contain; give another path")
+    return target
 
 
 @functools.cache
@@ -67,10 +139,24 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     >>> with atomic_path(out / "frf.png") as tmp:  # doctest: +SKIP
     ...     fig.savefig(tmp, format="png")
     """
-    target = Path(path)
-    fd, name = tempfile.mkstemp(
-        dir=target.parent, prefix=f".{target.name}.", suffix=f".tmp{target.suffix}"
-    )
+    target = _check_path(path)
+    parent = target.parent
+    if not parent.is_dir():
+        kind = "does not exist" if not os.path.lexists(parent) else "is not a folder"
+        code = errno.ENOENT if not os.path.lexists(parent) else errno.ENOTDIR
+        raise _make_write_error(f"cannot write {os.fspath(target)!r}: its folder {os.fspath(parent)!r} {kind} "
+                                f"([Errno {code}] {os.strerror(code)} ({errno.errorcode[code]})); create the folder "
+                                "first or give another path", code, os.fspath(target))
+    if target.is_dir():
+        raise _make_write_error(f"cannot write {os.fspath(target)!r}: a folder is there ([Errno {errno.EISDIR}] "
+                                f"{os.strerror(errno.EISDIR)} (EISDIR)); give a file name", errno.EISDIR,
+                                os.fspath(target))
+    try:
+        fd, name = tempfile.mkstemp(
+            dir=parent, prefix=f".{target.name}.", suffix=f".tmp{target.suffix}"
+        )
+    except OSError as exc:
+        raise _write_error(exc, target) from None
     os.close(fd)
     tmp = Path(name)
     try:
@@ -82,6 +168,10 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         mode = target.stat().st_mode & 0o7777 if target.is_file() else _default_file_mode()
         os.chmod(tmp, mode)
         os.replace(tmp, target)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise _write_error(exc, target) from exc
     except BaseException:
         with contextlib.suppress(OSError):
             tmp.unlink()
@@ -203,6 +293,69 @@ def _move_in(directory: Path, staging: Path, moves: Sequence[str], removals: Seq
         if src.exists():  # absent only when a roll-forward repeats a partly done commit
             os.replace(src, directory / name)
     _fsync_dir(directory)
+
+
+_KIND_NAMES = {stat.S_IFDIR: "a folder", stat.S_IFIFO: "a named pipe (FIFO)", stat.S_IFSOCK: "a socket",
+               stat.S_IFCHR: "a character device", stat.S_IFBLK: "a block device"}
+
+
+def _check_replaceable(target: Path) -> None:
+    """Refuse (WriteError) a member of an output set whose place holds something that is neither
+    a file nor a symbolic link (a rename over a folder fails; a special file is not ours)."""
+    try:
+        st = os.lstat(target)
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise _write_error(exc, target) from None
+    if stat.S_ISREG(st.st_mode) or stat.S_ISLNK(st.st_mode):
+        return
+    kind = _KIND_NAMES.get(stat.S_IFMT(st.st_mode), "not a file")
+    code = errno.EISDIR if stat.S_ISDIR(st.st_mode) else errno.EEXIST
+    raise _make_write_error(
+        f"cannot write {os.fspath(target)!r}: {kind} is in the place of this output file ([Errno {code}] "
+        f"{os.strerror(code)} ({errno.errorcode[code]})); move it away and run again", code, os.fspath(target))
+
+
+def _move_in_or_back(directory: Path, staging: Path, moves: Sequence[str], removals: Sequence[str]) -> None:
+    """:func:`_move_in` for a run's own commit, all or nothing against errors: each file replaced
+    is first hard-linked into ``staging/.previous`` (a rename keeps the target present throughout),
+    and when a rename or a removal fails the journal is removed and what was done is undone
+    (raised as :class:`WriteError`). A SIGKILL in the middle leaves the journal: the next run rolls
+    forward (:func:`recover_staging`)."""
+    backup = staging / ".previous"
+    done: list[tuple[str, str]] = []  # (name, "kept": the earlier file is in backup | "new" | "lost")
+    try:
+        backup.mkdir(exist_ok=True)
+        for name in removals:
+            target = directory / name
+            if os.path.lexists(target):
+                os.replace(target, backup / name)
+                done.append((name, "kept"))
+        for name in moves:
+            target = directory / name
+            state = "new"
+            if os.path.lexists(target):
+                try:
+                    os.link(target, backup / name, follow_symlinks=False)
+                    state = "kept"
+                except OSError:  # a file system without hard links: this one cannot be undone
+                    state = "lost"
+            os.replace(staging / name, target)
+            done.append((name, state))
+        _fsync_dir(directory)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            (staging / _JOURNAL).unlink()  # first: a recovery must not roll this set forward
+        _fsync_dir(staging)
+        for name, state in reversed(done):
+            with contextlib.suppress(OSError):
+                if state == "kept":
+                    os.replace(backup / name, directory / name)
+                elif state == "new":
+                    (directory / name).unlink()
+        _fsync_dir(directory)
+        raise _write_error(exc, directory / os.path.basename(os.fspath(exc.filename or directory))) from None
 
 
 #: A journal larger than this, or listing more names than this, is not one this module wrote.
@@ -405,7 +558,7 @@ class OutputSet:
     """
 
     def __init__(self, directory: str | os.PathLike[str], names: Sequence[str]) -> None:
-        self.directory = Path(directory)
+        self.directory = _check_path(directory, "the output folder")
         self.names = tuple(names)
         for name in self.names:
             if not name or Path(name).name != name or name.startswith("."):
@@ -421,11 +574,19 @@ class OutputSet:
         while not d.exists() and d != d.parent:
             missing.append(d)
             d = d.parent
-        self.directory.mkdir(parents=True, exist_ok=True)
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            self._created = missing
+            self.discard()
+            raise _write_error(exc, self.directory, "cannot create the output folder") from None
         self._created = missing  # deepest first
         try:
             recover_staging(self.directory, self.names)
             self.staging = Path(tempfile.mkdtemp(dir=self.directory, prefix=f"{STAGING_PREFIX}{os.getpid()}-"))
+        except OSError as exc:
+            self.discard()
+            raise _write_error(exc, self.directory, "cannot write into the output folder") from None
         except BaseException:
             self.discard()
             raise
@@ -450,16 +611,23 @@ class OutputSet:
         staging = self.staging
         moves = [n for n in self.names if (staging / n).is_file()]
         removals = [n for n in self.names if n not in moves]
-        for name in moves:
-            _fsync(staging / name)
-        journal = staging / _JOURNAL
-        with open(journal, "w", encoding="utf-8") as fh:
-            json.dump({"directory": os.fspath(self.directory), "moves": moves, "removals": removals}, fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        _fsync_dir(staging)
+        # Every member's place must take a file: a folder or a special file there would stop the
+        # moves half-way. Checked before the commit point, so that nothing of the set lands.
+        for name in self.names:
+            _check_replaceable(self.directory / name)
+        try:
+            for name in moves:
+                _fsync(staging / name)
+            journal = staging / _JOURNAL
+            with open(journal, "w", encoding="utf-8") as fh:
+                json.dump({"directory": os.fspath(self.directory), "moves": moves, "removals": removals}, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+            _fsync_dir(staging)
+        except OSError as exc:  # no space for the journal: nothing has moved yet
+            raise _write_error(exc, self.directory) from None
         with _signals_held():
-            _move_in(self.directory, staging, moves, removals)
+            _move_in_or_back(self.directory, staging, moves, removals)
             shutil.rmtree(staging, ignore_errors=True)
             self.staging = None
         self._created = []

@@ -28,15 +28,13 @@ than :data:`MAX_MEASURED_ROWS` rows.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import os
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..files import read_bounded
+from ..files import csv_rows, read_bounded
 
 __all__ = ["MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS", "MAX_MEASURED_BYTES", "MAX_MEASURED_ROWS",
            "read_measured_csv"]
@@ -107,7 +105,10 @@ def read_measured_csv(
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise fail(f"is not UTF-8 text ({exc.reason} at byte {exc.start}); save it as UTF-8 CSV") from None
-    rows = [(n, [f.strip() for f in row]) for n, row in enumerate(csv.reader(io.StringIO(text)), start=1)]
+    try:
+        rows = csv_rows(text)  # a field over 128 KiB or a NUL byte: refused naming the line
+    except ConfigError as exc:
+        raise fail(str(exc)) from None
     rows = [(n, row) for n, row in rows if any(row) and not row[0].startswith("#")]
     known = (*MEASURED_SPEED_COLUMNS, *MEASURED_VALUE_COLUMNS)
     if not rows:

@@ -18,9 +18,7 @@ model or an inertia out of range.
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import io
 import math
 import os
 from collections.abc import Mapping
@@ -28,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..files import read_bounded
+from ..files import csv_rows, read_bounded
 
 __all__ = ["PATH_COLUMNS", "PATHS_KEYS", "MAX_PATH_BYTES", "read_path_csv", "paths_from_config", "with_paths"]
 
@@ -84,7 +82,10 @@ def read_path_csv(file: str | os.PathLike[str], source: str, *, key: str = "file
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise _fail(prefix, f"{where} is not UTF-8 text ({exc.reason} at byte {exc.start}); save it as UTF-8 CSV") from None
-    rows = [(n, [field.strip() for field in row]) for n, row in enumerate(csv.reader(io.StringIO(text)), start=1)]
+    try:
+        rows = csv_rows(text)  # a field over 128 KiB or a NUL byte: refused naming the line
+    except ConfigError as exc:
+        raise _fail(prefix, f"{where} {exc}") from None
     rows = [(n, row) for n, row in rows if any(row) and not row[0].startswith("#")]
     if not rows:
         raise _fail(prefix, f"{where} is empty; it needs the header line {','.join(PATH_COLUMNS)} and one row per "
