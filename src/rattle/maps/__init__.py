@@ -17,7 +17,7 @@ from .._lazy import lazy_exports
 
 _LAZY: dict[str, str] = {
     "AttractorSearch": "..analysis._attractors",
-    **dict.fromkeys(["response_map", "DEFAULT_OMEGA_POINTS"], "._map"),
+    **dict.fromkeys(["response_map", "DEFAULT_OMEGA_POINTS", "StoreWarning", "CallbackError"], "._map"),
     **dict.fromkeys(["map_report", "common_intervals", "format_intervals"], "._report"),
     **dict.fromkeys(["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"],
                     "._result"),
@@ -25,7 +25,7 @@ _LAZY: dict[str, str] = {
 }
 
 __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS",
-           "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS",
+           "MAP_COLUMNS", "INTERVAL_KINDS", "DEFAULT_OMEGA_POINTS", "StoreWarning", "CallbackError",
            # the summary's Ω intervals (``rattle map``'s report and map.json)
            "common_intervals", "format_intervals",
            # the --vary arguments: parsed, resolved to parameters, every combination's model built
@@ -34,7 +34,7 @@ __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "Respo
 
 if TYPE_CHECKING:
     from ..analysis._attractors import AttractorSearch
-    from ._map import DEFAULT_OMEGA_POINTS, response_map
+    from ._map import DEFAULT_OMEGA_POINTS, CallbackError, StoreWarning, response_map
     from ._report import common_intervals, format_intervals, map_report
     from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap
     from ._vary import build_all, combinations, parameters, parse_all

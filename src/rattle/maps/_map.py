@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
 from typing import Any
@@ -24,6 +25,8 @@ from typing import Any
 import numpy as np
 
 from .._validate import check_int
+from ..errors import RattleError
+from ..files import WriteError
 from ..analysis._attractors import AttractorSearch
 from ..analysis._frequency_response import check_range
 from ..analysis._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
@@ -36,6 +39,16 @@ from ._result import CellResult, Parameter, ResponseMap
 DEFAULT_OMEGA_POINTS = 146
 
 ProgressCallback = Callable[[int, int, int], None]
+
+
+class StoreWarning(UserWarning):
+    """Parts of a map's store were damaged or foreign and are computed again (one warning per run,
+    naming them and what was wrong)."""
+
+
+class CallbackError(RattleError, RuntimeError):
+    """A callback handed to the library (``progress``) raised; the message names it. What was
+    finished before is kept (a map's store holds every finished combination)."""
 
 
 def _source_of(model: Any) -> tuple[Any, Any, tuple[Any, ...]]:
@@ -200,28 +213,63 @@ def response_map(
             fingerprint["paths"] = _paths_fingerprint(paths_t)
         keys.append(MapStore.key(fingerprint))
 
+    if progress is not None and not callable(progress):
+        raise TypeError(f"`progress` must be a callable progress(done, total, resumed) or None, got {progress!r}")
+    grid = np.linspace(lo, hi, omega_points)
     the_store = None
     if store is not None:
         the_store = store if isinstance(store, MapStore) else MapStore(store)
+        the_store.check_folder()  # a file or a broken link where map.parts should be: refused
         the_store.clear_orphans()  # temporaries of a write killed in an earlier run
     results: dict[int, CellResult] = {}
     if the_store is not None:
-        for flat, key in enumerate(keys):
-            data = the_store.load(key)
+        damaged: list[str] = []
+        for (flat, task), key in zip(tasks, keys):
+            data, damage = the_store.read(key)  # a special file in a part's place: refused
             if data is not None:
-                results[flat] = CellResult.from_dict(data, resumed=True)
+                try:
+                    cell = CellResult.from_dict(data, resumed=True)
+                    cell.check_against(task["values"], grid)
+                except (ValueError, TypeError) as exc:
+                    damage = str(exc)
+                else:
+                    results[flat] = cell
+            if damage is not None:
+                damaged.append(f"{key[:12]}…: {damage}")
+        remaining = len(tasks) - len(results)
+        if remaining:
+            the_store.check_writable(remaining)  # read-only: refused before any work
+        if damaged:
+            shown = "; ".join(damaged[:3]) + (f"; and {len(damaged) - 3} more" if len(damaged) > 3 else "")
+            warnings.warn(f"`map.parts` in {str(the_store.folder)!r}: {len(damaged)} damaged or foreign part(s) "
+                          f"computed again ({shown})", StoreWarning, stacklevel=2)
     todo = [(flat, task) for flat, task in tasks if flat not in results]
     total = len(tasks)
     resumed = len(results)
-    if progress is not None:
-        progress(resumed, total, resumed)
+
+    def report(done: int) -> None:
+        if progress is None:
+            return
+        try:
+            progress(done, total, resumed)
+        except Exception as exc:
+            raise CallbackError(
+                f"`progress` raised {type(exc).__name__}: {exc}; the map stopped there ({done} of {total} "
+                "combinations finished" + (", kept in map.parts" if the_store is not None else "") + ")"
+            ) from exc
+
+    report(resumed)
 
     def on_result(flat: int, data: dict[str, Any]) -> None:
         if the_store is not None:
-            the_store.save(keys[flat], data)
+            try:
+                the_store.save(keys[flat], data)
+            except WriteError as exc:
+                raise type(exc)(f"{exc}; the {len(results)} combination(s) finished before are kept in "
+                                f"{str(the_store.parts)!r}: make room and run again to resume",
+                                code=exc.errno, filename=exc.filename) from None
         results[flat] = CellResult.from_dict(data)
-        if progress is not None:
-            progress(len(results), total, resumed)
+        report(len(results))
 
     engine_used, workers_used = "none", 0  # everything read back: no engine ran
     if todo:
@@ -231,7 +279,6 @@ def response_map(
         runner.run(compute_cell, todo, on_result)
         engine_used, workers_used = runner.name, runner.workers
     cells = tuple(results[flat] for flat in range(total))
-    grid = np.linspace(lo, hi, omega_points)
     wall = time.perf_counter() - t_start
     computed = [c.timings.get("total", math.nan) for c in cells if not c.resumed]
     return ResponseMap(
@@ -243,4 +290,4 @@ def response_map(
     )
 
 
-__all__ = ["response_map", "DEFAULT_OMEGA_POINTS"]
+__all__ = ["response_map", "DEFAULT_OMEGA_POINTS", "StoreWarning", "CallbackError"]

@@ -74,6 +74,50 @@ def _spl(cell: "CellResult", size: int) -> np.ndarray:
     return np.full(size, np.nan) if cell.spl_max_stable_db is None else np.asarray(cell.spl_max_stable_db, dtype=float)
 
 
+def _is_real(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _is_real_or_none(x: Any) -> bool:
+    return x is None or _is_real(x)
+
+
+def _is_count(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool) and 0 <= x < 1 << 31
+
+
+def _is_str(x: Any) -> bool:
+    return isinstance(x, str)
+
+
+def _is_bool(x: Any) -> bool:
+    return isinstance(x, bool)
+
+
+_KIND_WORDS = {_is_real: "numbers", _is_real_or_none: "numbers or null", _is_count: "counts (integers >= 0)",
+               _is_str: "strings", _is_bool: "true/false"}
+
+
+def _column(data: dict[str, Any], name: str, ok: Any, size: int | None = None) -> list[Any]:
+    """``data[name]`` as a list of ``size`` items (any size when None) each passing ``ok``."""
+    col = data[name]
+    if not isinstance(col, list):
+        raise ValueError(f"a map part's `{name}` must be a list, got {type(col).__name__}")
+    if size is not None and len(col) != size:
+        raise ValueError(f"a map part's `{name}` has {len(col)} entries, `omega` {size}")
+    if not all(ok(x) for x in col):
+        bad = next(x for x in col if not ok(x))
+        raise ValueError(f"a map part's `{name}` must hold {_KIND_WORDS[ok]}, got {bad!r}"[:300])
+    return col
+
+
+def _field(data: dict[str, Any], name: str, kind: type, default: Any) -> Any:
+    value = data.get(name, default)
+    if not isinstance(value, kind):
+        raise ValueError(f"a map part's `{name}` must be a {kind.__name__}, got {type(value).__name__}")
+    return value
+
+
 def _float(x: Any) -> float | None:
     x = float(x)
     return None if math.isnan(x) else x
@@ -169,29 +213,84 @@ class CellResult:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], *, resumed: bool = False) -> "CellResult":
-        """The inverse of :meth:`to_dict` (``resumed`` marks a result read back from disk)."""
+        """The inverse of :meth:`to_dict` (``resumed`` marks a result read back from disk).
+
+        Every field is checked, since the dict may come from a damaged file: the grid columns
+        present, lists of one length of the right kind (numbers, None for NaN, strings, booleans),
+        the tables of the right shape.
+
+        Raises
+        ------
+        ValueError
+            Naming the first field that is missing or wrong (``a map part's `omega`: …``).
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"a map part must be a JSON object, got {type(data).__name__}")
         nan = float("nan")
+        missing = [k for k in ("values", *MAP_COLUMNS) if k not in data]
+        if missing:
+            raise ValueError(f"a map part lacks {', '.join(f'`{k}`' for k in missing)}")
+        values = data["values"]
+        if not isinstance(values, dict) or not all(isinstance(k, str) and _is_real(v) for k, v in values.items()):
+            raise ValueError("a map part's `values` must map names to numbers")
+        omega = _column(data, "omega", _is_real)
+        size = len(omega)
+        n_solutions = _column(data, "n_solutions", _is_count, size)
+        n_stable = _column(data, "n_stable", _is_count, size)
+        rms = _column(data, "rms_max_stable", _is_real_or_none, size)
+        rms_ac = _column(data, "rms_ac_max_stable", _is_real_or_none, size)
+        regime = _column(data, "regime_max_stable", _is_str, size)
+        periods = _column(data, "periods_stable", _is_str, size)
+        rattle = _column(data, "rattle", _is_bool, size)
         spl = data.get(SOUND_COLUMN)
+        if spl is not None:
+            spl = _column(data, SOUND_COLUMN, _is_real_or_none, size)
+        special_points = _field(data, "special_points", list, [])
+        attractors = _field(data, "attractors", list, [])
+        if not all(isinstance(x, dict) for x in (*special_points, *attractors)):
+            raise ValueError("a map part's `special_points` and `attractors` must be lists of tables")
+        intervals = _field(data, "intervals", dict, {})
+        for kind, runs in intervals.items():
+            if not (isinstance(runs, list) and all(isinstance(iv, list) and len(iv) == 2 and all(map(_is_real, iv))
+                                                   for iv in runs)):
+                raise ValueError(f"a map part's `intervals.{kind}` must be a list of [first, last] numbers")
+        timings = _field(data, "timings", dict, {})
+        if not all(_is_real(v) for v in timings.values()):
+            raise ValueError("a map part's `timings` must map stages to numbers of seconds")
+        status = _field(data, "status", str, "ok")
+        if status not in ("ok", "partial", "failed"):
+            raise ValueError(f"a map part's `status` must be ok, partial or failed, got {status!r}")
         return cls(
-            values={str(k): float(v) for k, v in data["values"].items()},
-            omega=np.asarray(data["omega"], dtype=float),
-            n_solutions=np.asarray(data["n_solutions"], dtype=int),
-            n_stable=np.asarray(data["n_stable"], dtype=int),
-            rms_max_stable=np.asarray([nan if x is None else x for x in data["rms_max_stable"]], dtype=float),
-            rms_ac_max_stable=np.asarray([nan if x is None else x for x in data["rms_ac_max_stable"]], dtype=float),
-            regime_max_stable=np.asarray(data["regime_max_stable"], dtype=object),
-            periods_stable=np.asarray(data["periods_stable"], dtype=object),
-            rattle=np.asarray(data["rattle"], dtype=bool),
-            special_points=list(data.get("special_points", [])),
-            intervals={k: [list(map(float, iv)) for iv in v] for k, v in data.get("intervals", {}).items()},
-            attractors=list(data.get("attractors", [])),
-            search=dict(data.get("search", {})),
-            status=str(data.get("status", "ok")),
-            message=str(data.get("message", "")),
-            timings={k: float(v) for k, v in data.get("timings", {}).items()},
+            values={k: float(v) for k, v in values.items()},
+            omega=np.asarray(omega, dtype=float),
+            n_solutions=np.asarray(n_solutions, dtype=int),
+            n_stable=np.asarray(n_stable, dtype=int),
+            rms_max_stable=np.asarray([nan if x is None else x for x in rms], dtype=float),
+            rms_ac_max_stable=np.asarray([nan if x is None else x for x in rms_ac], dtype=float),
+            regime_max_stable=np.asarray(regime, dtype=object),
+            periods_stable=np.asarray(periods, dtype=object),
+            rattle=np.asarray(rattle, dtype=bool),
+            special_points=list(special_points),
+            intervals={k: [[float(a), float(b)] for a, b in v] for k, v in intervals.items()},
+            attractors=list(attractors),
+            search=dict(_field(data, "search", dict, {})),
+            status=status,
+            message=_field(data, "message", str, ""),
+            timings={k: float(v) for k, v in timings.items()},
             resumed=resumed,
             spl_max_stable_db=None if spl is None else np.asarray([nan if x is None else x for x in spl], dtype=float),
         )
+
+    def check_against(self, values: dict[str, float], omega: np.ndarray) -> None:
+        """Raise ValueError unless this cell is of the combination ``values`` on the grid ``omega``
+        (a part read back must be the one its key names: same values, same grid, bit for bit)."""
+        if self.omega.shape != np.shape(omega):
+            raise ValueError(f"a map part's `omega` has {self.omega.size} frequencies, the map's grid "
+                             f"{np.size(omega)}")
+        if self.omega.tobytes() != np.asarray(omega, dtype=float).tobytes():
+            raise ValueError("a map part's `omega` is not the map's grid")
+        if set(self.values) != set(values) or any(self.values[k] != float(v) for k, v in values.items()):
+            raise ValueError(f"a map part's `values` {self.values} are not the combination's {values}")
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), allow_nan=False)

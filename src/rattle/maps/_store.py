@@ -11,26 +11,36 @@ settings, the rattle version; see :meth:`MapStore.key`): another command, config
 rattle version never reuses a part. Floats are written by ``json`` as their ``repr``: they read
 back bit for bit.
 
-A part that cannot be read (truncated, not JSON, another key inside: it should not happen, the
-writes are atomic) is treated as missing: the combination is computed again and the file
-replaced. Nothing here raises on a bad part.
+A part that cannot be read (truncated, not JSON, another key inside, a symbolic link, too large:
+it should not happen, the writes are atomic) is treated as missing: the combination is computed
+again and the file replaced (:meth:`MapStore.read` says what was wrong, for the one warning line
+of the run). What cannot be replaced is refused before any work, with a
+:class:`~rattle.errors.ConfigError` naming the path (:meth:`MapStore.check_folder`,
+:meth:`MapStore.read`, :meth:`MapStore.check_writable`): a folder, a named pipe or another special
+file in the place of a part (never opened: a FIFO would block), ``map.parts`` that is a file or a
+broken symbolic link, a read-only ``map.parts`` when combinations remain to be computed. A part
+that cannot be written (no space, no permission) raises :class:`rattle.files.WriteError`.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import logging
 import os
 import re
+import stat
+import tempfile
 import time
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
 from .._release import version as rattle_version
-from ..files import atomic_write_text
+from ..errors import ConfigError
+from ..files import WriteError, atomic_write_text, describe_os_error
 
 logger = logging.getLogger("rattle")
 
@@ -41,7 +51,13 @@ PARTS_FOLDER = "map.parts"
 #: Version of the part files' layout (part of every key: a new layout never reads an old part).
 STORE_FORMAT = 1
 
+#: Largest part read (bytes): a combination on 10 000 grid frequencies is ~2 MB.
+MAX_PART_BYTES = 64 << 20
+
 _KEY = re.compile(r"^[0-9a-f]{64}$")
+
+_SPECIAL = {stat.S_IFDIR: "a folder", stat.S_IFIFO: "a named pipe (FIFO)", stat.S_IFSOCK: "a socket",
+            stat.S_IFCHR: "a character device", stat.S_IFBLK: "a block device"}
 
 
 def _plain(value: Any, where: str = "fingerprint") -> Any:
@@ -133,31 +149,124 @@ class MapStore:
         if fingerprint is not None:
             doc["fingerprint"] = fingerprint
         text = json.dumps(doc, allow_nan=True, separators=(",", ":")) + "\n"
-        self.parts.mkdir(parents=True, exist_ok=True)
+        try:
+            self.parts.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise WriteError(f"cannot create the map's parts folder {str(self.parts)!r}: {describe_os_error(exc)}",
+                             code=exc.errno, filename=str(self.parts)) from None
         atomic_write_text(target, text)
         return target
 
-    def load(self, key: str) -> dict[str, Any] | None:
-        """The saved result of ``key``, or None when there is none or the part cannot be read
-        (a bad part is logged and treated as missing: it will be computed again)."""
+    def check_folder(self) -> None:
+        """Refuse (ConfigError) a ``map.parts`` that is not a folder: a file, a special file, a
+        broken symbolic link (a symbolic link to a folder is followed)."""
+        try:
+            st = os.stat(self.parts)
+        except FileNotFoundError:
+            if os.path.islink(self.parts):
+                raise ConfigError(
+                    f"the map's parts folder {str(self.parts)!r} is a broken symbolic link (to "
+                    f"{os.readlink(self.parts)!r}); remove it, or point it at a folder"
+                ) from None
+            return
+        except OSError as exc:
+            raise ConfigError(f"the map's parts folder {str(self.parts)!r} cannot be examined: "
+                              f"{describe_os_error(exc)}; give another -o folder") from None
+        if not stat.S_ISDIR(st.st_mode):
+            kind = _SPECIAL.get(stat.S_IFMT(st.st_mode), "a file")
+            raise ConfigError(
+                f"the map's parts folder {str(self.parts)!r} is {kind}, not a folder: a map keeps its finished "
+                "combinations there; move it away, or give another -o folder"
+            )
+
+    def check_writable(self, remaining: int) -> None:
+        """Refuse (ConfigError) a parts folder in which the ``remaining`` combinations could not be
+        stored (read-only, no permission), by creating and removing a temporary file there — before
+        any work. Creates the folder when it does not exist."""
+        try:
+            self.parts.mkdir(parents=True, exist_ok=True)
+            fd, name = tempfile.mkstemp(dir=self.parts, prefix=".probe.", suffix=".tmp")
+            os.close(fd)
+            os.unlink(name)
+        except OSError as exc:
+            code = exc.errno
+            if code in (errno.EROFS, errno.EACCES, errno.EPERM):
+                raise ConfigError(
+                    f"the map's parts folder {str(self.parts)!r} is not writable ({describe_os_error(exc)}) and "
+                    f"{remaining} combination(s) remain to be computed there; make it writable, or give another "
+                    "-o folder"
+                ) from None
+            raise WriteError(f"cannot write into the map's parts folder {str(self.parts)!r}: {describe_os_error(exc)}",
+                             code=code, filename=str(self.parts)) from None
+
+    def read(self, key: str) -> tuple[dict[str, Any] | None, str | None]:
+        """The saved result of ``key`` and what is wrong with its part: ``(result, None)``;
+        ``(None, None)`` when there is none; ``(None, reason)`` when the part is damaged or foreign
+        (to be computed again and replaced). Never blocks: the part is examined with ``lstat`` and
+        opened without following a symbolic link, without waiting for a writer.
+
+        Raises
+        ------
+        ConfigError
+            A folder, a named pipe or another special file in the part's place (it cannot be
+            replaced by the part computed again).
+        """
         target = self.path(key)
         try:
-            text = target.read_text(encoding="utf-8")
+            st = os.lstat(target)
         except FileNotFoundError:
-            return None
-        except (OSError, UnicodeDecodeError) as exc:
-            logger.warning("map part %s cannot be read (%s); computing it again", target, exc)
-            return None
+            return None, None
+        except OSError as exc:
+            return None, f"cannot be examined ({describe_os_error(exc)})"
+        if stat.S_ISLNK(st.st_mode):
+            return None, "is a symbolic link, not a part rattle wrote"
+        if not stat.S_ISREG(st.st_mode):
+            kind = _SPECIAL.get(stat.S_IFMT(st.st_mode), "not a file")
+            raise ConfigError(
+                f"map part {str(target)!r} is {kind}, not a file: it cannot be read or replaced; remove it (a map "
+                "part is a JSON file rattle writes), then run again"
+            )
+        if st.st_size > MAX_PART_BYTES:
+            return None, f"has {st.st_size} bytes, more than a part can hold ({MAX_PART_BYTES} bytes)"
+        flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
         try:
-            doc = json.loads(text)
-            ok = (isinstance(doc, dict) and doc.get("key") == key and doc.get("store_format") == STORE_FORMAT
-                  and isinstance(doc.get("result"), dict))
+            fd = os.open(target, flags)
+            try:
+                if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced since the lstat
+                    return None, "is not a file"
+                with os.fdopen(os.dup(fd), "rb") as fh:
+                    raw = fh.read(MAX_PART_BYTES + 1)
+            finally:
+                os.close(fd)
+        except FileNotFoundError:
+            return None, None
+        except OSError as exc:
+            return None, f"cannot be read ({describe_os_error(exc)})"
+        if len(raw) > MAX_PART_BYTES:
+            return None, f"holds more than {MAX_PART_BYTES} bytes"
+        try:
+            doc = json.loads(raw.decode("utf-8"))
+        except UnicodeDecodeError:
+            return None, "is not UTF-8 text"
         except (ValueError, RecursionError):
-            ok = False
-        if not ok:
-            logger.warning("map part %s is damaged or belongs to another key; computing it again", target)
-            return None
-        return doc["result"]
+            return None, "is not complete JSON (truncated or overwritten)"
+        if not isinstance(doc, dict):
+            return None, f"holds a JSON {type(doc).__name__}, not a part"
+        if doc.get("store_format") != STORE_FORMAT:
+            return None, f"has store format {doc.get('store_format')!r}, not {STORE_FORMAT}"
+        if doc.get("key") != key:
+            return None, "belongs to another combination (its key differs from its name)"
+        if not isinstance(doc.get("result"), dict):
+            return None, "has no result table"
+        return doc["result"], None
+
+    def load(self, key: str) -> dict[str, Any] | None:
+        """The saved result of ``key``, or None when there is none or the part cannot be read
+        (a bad part is logged and treated as missing: it will be computed again). See :meth:`read`."""
+        result, damage = self.read(key)
+        if damage is not None:
+            logger.warning("map part %s %s; computing it again", self.path(key), damage)
+        return result
 
     def finished(self) -> set[str]:
         """The keys with a part file (not opened: :meth:`load` checks each)."""
