@@ -25,6 +25,12 @@ and a refused input answer without loading the numerics. ``from rattle import X`
 
 from __future__ import annotations
 
+# First, before any slower import: in the command-line process (`rattle …`, `python -m rattle …`)
+# SIGINT/SIGTERM/SIGHUP exit 128 + n with one line from here on; a no-op for a library import.
+from ._signals import install_at_start as _install_at_start
+
+_install_at_start()
+
 import importlib
 from typing import TYPE_CHECKING, Any
 

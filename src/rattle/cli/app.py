@@ -14,15 +14,16 @@ until there is something to write.
 
 Interrupted runs leave nothing wrong: every command writes its files into a staging folder inside
 the output directory and moves them into place together at the end
-(:class:`rattle.io.OutputSet`); SIGTERM and SIGHUP are turned into the same clean exit path as
-Ctrl-C (an exception, so that every ``finally`` removes its temporary files and stops its worker
-processes).
+(:class:`rattle.io.OutputSet`); while a command runs, SIGINT, SIGTERM and SIGHUP raise
+:class:`Interrupted` (an exception, so that every ``finally`` removes its temporary files and
+stops its worker processes), and a further signal during that clean-up does not break it off
+(:mod:`rattle._signals`, which also answers the signals from the process's first millisecond,
+before click or numpy are imported).
 """
 
 from __future__ import annotations
 
 import contextlib
-import signal
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
@@ -31,6 +32,8 @@ from typing import Any
 
 import click
 
+from .. import _signals
+from .._signals import Interrupted
 from ..errors import ConfigError, ConvergenceError, RattleError
 from .commands import COMMANDS, common_options
 from .output import error, one_line, reset_verbose, warning
@@ -42,20 +45,12 @@ EXIT_NUMERICAL = 1
 EXIT_BAD_INPUT = 2
 
 _NoArgsIsHelpError: Any = getattr(click.exceptions, "NoArgsIsHelpError", ())
+_SIGINT = 2  # signal.SIGINT on every platform
 
 
 # --------------------------------------------------------------------------------------------
 # Signals and warnings
 # --------------------------------------------------------------------------------------------
-class Interrupted(KeyboardInterrupt):
-    """SIGTERM or SIGHUP received: raised in the main thread like Ctrl-C's KeyboardInterrupt, so
-    that the same ``finally`` blocks remove temporary files and stop worker processes."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
-
-
 class _Stopped(Exception):
     """An interruption carried through click's main loop (which would turn KeyboardInterrupt into
     a generic "Aborted!")."""
@@ -63,38 +58,6 @@ class _Stopped(Exception):
     def __init__(self, signum: int) -> None:
         super().__init__(signum)
         self.signum = signum
-
-
-def _raise_interrupted(signum: int, _frame: object) -> None:
-    raise Interrupted(signum)
-
-
-@contextlib.contextmanager
-def _signals_as_exceptions() -> Iterator[None]:
-    """SIGTERM and SIGHUP raise :class:`Interrupted` for the body (main thread only; the previous
-    handlers come back afterwards, which matters when the CLI runs inside another program)."""
-    installed: dict[int, Any] = {}
-    for name in ("SIGTERM", "SIGHUP"):
-        sig = getattr(signal, name, None)
-        if sig is None:
-            continue
-        try:
-            installed[sig] = signal.signal(sig, _raise_interrupted)
-        except ValueError:  # not the main thread: leave the signals alone
-            break
-    try:
-        yield
-    finally:
-        for sig, old in installed.items():
-            with contextlib.suppress(ValueError, TypeError):
-                signal.signal(sig, old)
-
-
-def _signal_name(signum: int) -> str:
-    try:
-        return signal.Signals(signum).name
-    except ValueError:  # pragma: no cover
-        return f"signal {signum}"
 
 
 #: Warning lines shown per run; the rest are counted and summarised in one line.
@@ -170,22 +133,23 @@ class RattleGroup(click.Group):
 
     def _run(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None, **extra: Any) -> int:
         try:
-            with _signals_as_exceptions(), _warnings_as_lines():
-                return self._invoke(args, prog_name, complete_var, **extra)
-        except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM/SIGHUP raised as Interrupted
-            signum = exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT)
-            error(f"interrupted by {_signal_name(signum)}; temporary files were removed and no output "
-                   "set was left half-written")
+            try:
+                with _signals.raising(), _warnings_as_lines():
+                    return self._invoke(args, prog_name, complete_var, **extra)
+            finally:
+                reset_verbose()
+        except KeyboardInterrupt as exc:  # a signal while the command ran (a later one is noted only)
+            signum = exc.signum if isinstance(exc, Interrupted) else int(_signals.interrupted_by() or _SIGINT)
+            error(_signals.message(signum))
+            _signals.mark_reported()
             return 128 + signum
-        finally:
-            reset_verbose()
 
     def invoke(self, ctx: click.Context) -> Any:
         # click turns KeyboardInterrupt into Abort (and prints a blank line); keep the signal
         try:
             return super().invoke(ctx)
         except KeyboardInterrupt as exc:
-            raise _Stopped(exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT)) from None
+            raise _Stopped(exc.signum if isinstance(exc, Interrupted) else _SIGINT) from None
 
     def _invoke(self, args: Sequence[str] | None, prog_name: str | None, complete_var: str | None,
                 **extra: Any) -> int:
@@ -206,7 +170,7 @@ class RattleGroup(click.Group):
         except click.Abort as exc:
             cause = exc.__cause__ or exc.__context__
             if isinstance(cause, KeyboardInterrupt):  # Ctrl-C while click itself was parsing
-                raise Interrupted(cause.signum if isinstance(cause, Interrupted) else int(signal.SIGINT)) from None
+                raise Interrupted(cause.signum if isinstance(cause, Interrupted) else _SIGINT) from None
             error("aborted")
             return EXIT_NUMERICAL
         except ConfigError as exc:
@@ -259,5 +223,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     ----------
     argv : sequence of str, optional
         Arguments without the program name; default ``sys.argv[1:]``.
+
+    In the command-line process (``rattle``, ``python -m rattle``: :mod:`rattle._signals`
+    installed its handlers at start), an interrupted run ends at once after its line: the
+    finalizers of what an interrupted library call left behind are not waited for (a Dask
+    client still connecting to a scheduler that never answered waits 20 s in its ``__del__``);
+    rattle's own temporary files and worker processes are gone already (its ``finally`` blocks).
     """
-    cli.main(args=list(argv) if argv is not None else None, prog_name="rattle")
+    code = cli.main(args=list(argv) if argv is not None else None, prog_name="rattle", standalone_mode=False)
+    if code >= 128 and _signals.interrupted_by() is not None and _signals.installed_at_start():
+        _signals.exit_now(code)
+    sys.exit(code)

@@ -1,0 +1,244 @@
+"""How the command line answers SIGINT, SIGTERM and SIGHUP, from its first millisecond.
+
+``rattle`` (the console script) and ``python -m rattle`` import this package before anything
+else of theirs; its ``__init__`` calls :func:`install_at_start`, which, in that process alone
+(:func:`is_command_line`: the interpreter's own command line says so), installs
+:func:`handle` for the three signals before click, numpy or any other slow import. Imported as a
+library (a notebook, pytest, a worker process) nothing is installed here.
+
+What a signal does, by phase (exit status 128 + the signal's number, one line on stderr
+``rattle: error: interrupted by SIGxxx; …``):
+
+- *at start and after the command* (mode ``"exit"``): the line is written and the process ends
+  at once — nothing has been created yet, or everything has been moved into place already;
+- *while a command runs* (:func:`raising`, mode ``"raise"``): the first signal raises
+  :class:`Interrupted` (a ``KeyboardInterrupt``) in the main thread, so that every ``finally``
+  removes its temporary files and stops its worker processes; the command line prints the line;
+- *a later signal* while that clean-up runs is noted and ignored (a Ctrl-C reaches the whole
+  process group, a supervisor may follow SIGINT with SIGTERM): the first one decides the exit
+  status, and the clean-up is not broken off half-way. Only a signal that comes more than
+  :data:`FORCE_AFTER` seconds into the clean-up (a user pressing Ctrl-C again at a clean-up
+  that hangs) ends the process at once.
+
+A signal whose disposition was "ignore" when the process started (``nohup``: SIGHUP; a
+background job of a non-interactive shell: SIGINT) stays ignored. A child forked before it set
+its own handlers (a worker process) is not the command line: SIGINT is ignored there (its
+parent decides), the other signals end it as their default action would.
+
+Imported here: ``os``, ``sys``, ``time`` and the C module ``_signal`` — not ``signal``, whose enums
+import ``enum``, ``functools`` and ``collections`` (10–20 ms on a busy machine, the very window
+this module closes), nor ``contextlib`` or ``typing``.
+"""
+
+from __future__ import annotations
+
+import _signal
+import os
+import sys
+import time
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:  # annotations only
+    from types import FrameType, TracebackType
+    from typing import Any
+
+__all__ = ["FORCE_AFTER", "HANDLED", "Interrupted", "install_at_start", "is_command_line", "installed_at_start",
+           "raising", "handle", "message", "mark_reported", "interrupted_by", "exit_now", "signal_name"]
+
+#: The signals handled, number → name (those the platform has).
+HANDLED: dict[int, str] = {getattr(_signal, name): name for name in ("SIGINT", "SIGTERM", "SIGHUP")
+                           if hasattr(_signal, name)}
+#: Seconds into the clean-up after which a further signal ends the process at once.
+FORCE_AFTER = 2.0
+
+_SIGINT = getattr(_signal, "SIGINT", 2)
+#: The module names ``python -m NAME`` runs the command line with.
+_MODULES = ("rattle", "rattle.__main__", "rattle.cli", "rattle.cli.main")
+#: The console scripts' names (pip's launchers on Windows add the suffixes).
+_SCRIPTS = ("rattle", "rattle.exe", "rattle-script.py")
+#: Interpreter options followed by a separate value.
+_WITH_VALUE = ("-X", "-W", "--check-hash-based-pycs")
+
+
+class Interrupted(KeyboardInterrupt):
+    """A signal received while a command runs: raised in the main thread like Ctrl-C's
+    ``KeyboardInterrupt``, so that the same ``finally`` blocks remove temporary files and stop
+    worker processes. ``signum`` is the signal's number."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _State:
+    owner: int | None = None        # the process that installed the handlers
+    at_start = False                # installed by install_at_start (the command-line process)
+    mode = "exit"                   # "exit" or "raise"
+    first: int | None = None        # the first signal received
+    first_at = 0.0                  # when (time.monotonic)
+    reported = False                # the interruption's line is on stderr
+
+
+def signal_name(signum: int) -> str:
+    """``SIGINT`` for 2 (``signal 99`` for a number without a name)."""
+    if signum in HANDLED:
+        return HANDLED[signum]
+    import signal  # the enum, for a signal this module does not handle
+
+    try:
+        return signal.Signals(signum).name
+    except ValueError:  # pragma: no cover
+        return f"signal {signum}"
+
+
+def message(signum: int, *, forced: bool = False) -> str:
+    """The interruption's error line without its ``rattle: error: `` prefix."""
+    if forced:
+        return (f"interrupted by {signal_name(signum)}; a further signal cut the clean-up short: a hidden staging "
+                "folder may be left in the output folder (the next run there removes it)")
+    return (f"interrupted by {signal_name(signum)}; temporary files were removed and no output set was left "
+            "half-written")
+
+
+def _write_line(text: str) -> None:
+    """``rattle: error: text`` on stderr, written with one system call (safe inside a handler,
+    whatever the stderr buffer was doing when the signal came)."""
+    try:
+        sys.stderr.flush()
+    except Exception:  # a write interrupted half-way ("reentrant call"), a closed stream
+        pass
+    try:
+        os.write(2, f"rattle: error: {text}\n".encode("utf-8", "replace"))
+    except OSError:  # pragma: no cover - stderr closed
+        pass
+    _State.reported = True
+
+
+def exit_now(code: int) -> None:
+    """End the process at once with ``code``: stdout and stderr flushed, no finalizers run (an
+    object an interrupted library call left behind — a Dask client still connecting — would
+    otherwise wait in its ``__del__``; what rattle created was removed in its ``finally``
+    blocks). The command line's use only."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except Exception:  # a closed or broken stream: nothing more to say
+            pass
+    os._exit(code)
+
+
+def handle(signum: int, _frame: FrameType | None) -> None:
+    """The handler of the handled signals (module docstring)."""
+    if os.getpid() != _State.owner:  # a forked child that has not set its own handlers yet
+        if signum != _SIGINT:
+            _signal.signal(signum, _signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+        return
+    first = _State.first
+    if first is None:
+        _State.first, _State.first_at = signum, time.monotonic()
+        if _State.mode == "raise":
+            raise Interrupted(signum)
+        if not _State.reported:
+            _write_line(message(signum))
+        exit_now(128 + signum)
+        return
+    # a later signal: the first one's clean-up runs (raise mode), or the command has ended
+    if _State.mode == "exit" or time.monotonic() - _State.first_at > FORCE_AFTER:
+        if not _State.reported:
+            _write_line(message(first, forced=_State.mode == "raise"))
+        exit_now(128 + first)
+
+
+def _install() -> dict[int, Any]:
+    """:func:`handle` for every handled signal not ignored; the handlers it replaced."""
+    previous: dict[int, Any] = {}
+    for sig in HANDLED:
+        old = _signal.getsignal(sig)
+        if old is None or (not callable(old) and old == _signal.SIG_IGN):  # set outside Python, or ignored (nohup)
+            continue
+        _signal.signal(sig, handle)
+        previous[sig] = old
+    _State.owner = os.getpid()
+    return previous
+
+
+def is_command_line(argv: list[str] | None = None) -> bool:
+    """Whether this process is ``rattle …`` or ``python -m rattle …``, from the interpreter's own
+    command line ``argv`` (default ``sys.orig_argv``), not from ``sys.argv`` (which a
+    multiprocessing child inherits from its parent)."""
+    if argv is None:
+        argv = list(getattr(sys, "orig_argv", None) or [])
+    args = argv[1:]
+    i = 0
+    while i < len(args):
+        arg = args[i]
+        if arg == "-m":
+            return i + 1 < len(args) and args[i + 1] in _MODULES
+        if arg.startswith("-m"):
+            return arg[2:] in _MODULES
+        if arg.startswith("-c") or arg == "-":
+            return False
+        if arg in _WITH_VALUE:
+            i += 2
+            continue
+        if arg.startswith("-"):
+            i += 1
+            continue
+        return os.path.basename(arg) in _SCRIPTS
+    return False
+
+
+def install_at_start() -> None:
+    """Install the handlers (mode ``"exit"``) when this process is the command line; a no-op
+    otherwise, and on a second call."""
+    if _State.at_start or not is_command_line():
+        return
+    try:
+        _install()
+    except (ValueError, OSError):  # pragma: no cover - not the main thread
+        return
+    _State.at_start = True
+
+
+def installed_at_start() -> bool:
+    """Whether :func:`install_at_start` installed the handlers in this process (it is the
+    command line)."""
+    return _State.at_start and _State.owner == os.getpid()
+
+
+class raising:  # noqa: N801 - used as a function: ``with raising():``
+    """For the body, the first handled signal raises :class:`Interrupted` and later ones are
+    noted (module docstring); afterwards the earlier handlers and mode come back (the command
+    line may run inside another program). Outside the main thread the body runs unprotected.
+
+    A class rather than a ``contextlib.contextmanager``: this module imports no ``contextlib``.
+    """
+
+    def __enter__(self) -> None:
+        self._mode = _State.mode
+        self._previous: dict[int, Any] = {}
+        _State.first, _State.reported, _State.mode = None, False, "raise"
+        try:
+            self._previous = _install()
+        except ValueError:  # not the main thread: leave the signals alone
+            _State.mode = self._mode
+
+    def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        for sig, old in self._previous.items():
+            try:
+                _signal.signal(sig, old)
+            except (ValueError, TypeError):  # pragma: no cover
+                pass
+        _State.mode = self._mode
+
+
+def mark_reported() -> None:
+    """The interruption's line has been written (a later signal does not write it again)."""
+    _State.reported = True
+
+
+def interrupted_by() -> int | None:
+    """The first signal received during the last :func:`raising` body (None if none)."""
+    return _State.first
