@@ -27,6 +27,9 @@ from __future__ import annotations
 
 import importlib.util
 import re
+import socket
+import struct
+import threading
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -74,6 +77,93 @@ def dask_available() -> bool:
     return importlib.util.find_spec("distributed") is not None
 
 
+#: The address schemes of Dask's communication layer.
+SCHEMES: tuple[str, ...] = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+#: Largest first message a scheduler sends (its handshake, a few hundred bytes): what announces
+#: more is not Dask.
+_MAX_HANDSHAKE = 1 << 24
+
+
+def _refuse(address: str, why: str) -> ConfigError:
+    return ConfigError(f"`--scheduler` {address!r} is not a Dask scheduler address: it {why}; use the address "
+                       "`dask scheduler` prints, e.g. tcp://127.0.0.1:8786, or leave --scheduler out to run on local "
+                       "processes")
+
+
+def _unanswered(address: str, timeout: float, why: str) -> ConfigError:
+    return ConfigError(f"`--scheduler` {address!r}: no Dask scheduler answered within {timeout:g} s ({why}); start "
+                       "one (`dask scheduler`, then `dask worker ADDRESS`) or give the address it prints, e.g. "
+                       "tcp://127.0.0.1:8786")
+
+
+def check_scheduler_address(address: str, timeout: float = CONNECT_TIMEOUT) -> str:
+    """Check that ``address`` is a Dask scheduler's, before a client is made: the form
+    (``[scheme://]host:port``, a scheme of :data:`SCHEMES`, a port 1 … 65535) at once, and for
+    ``tcp`` that a scheduler answers there within ``timeout`` seconds: the connection is made and
+    the scheduler's handshake — which a Dask scheduler sends first, unasked — is awaited. An
+    unroutable address, a closed port, a host that is not found, or a server of another protocol
+    (an HTTP server waits for a request and says nothing) are refused with one line; nothing here
+    waits longer than ``timeout`` (the name lookup included). Returns the address, stripped.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``--scheduler``, the address and what is wrong.
+    """
+    text = address.strip()
+    if not text or any(ord(c) < 32 or c.isspace() for c in text):
+        raise _refuse(address, "is blank or holds spaces or control characters")
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme not in SCHEMES:
+        raise _refuse(address, f"has the scheme {scheme!r}, which Dask does not know (it knows {', '.join(SCHEMES)})")
+    if scheme == "inproc":
+        return text
+    host, colon, port_text = rest.rpartition(":")
+    if host.startswith("[") and host.endswith("]"):
+        host = host[1:-1]
+    if not colon or not host or not port_text.isdigit() or not 1 <= int(port_text) <= 65535 or "/" in host:
+        raise _refuse(address, "is not of the form [scheme://]host:port with a port 1 … 65535")
+    if scheme != "tcp":  # TLS, websockets, UCX: the client's own timeout bounds the connection
+        return text
+    verdict: list[str | None] = []
+
+    def probe() -> None:
+        try:
+            with socket.create_connection((host, int(port_text)), timeout=timeout) as sock:
+                sock.settimeout(max(0.05, deadline - time.monotonic()))
+                head = b""
+                while len(head) < 8:
+                    chunk = sock.recv(8 - len(head))
+                    if not chunk:
+                        verdict.append("the server there closed the connection without a Dask handshake")
+                        return
+                    head += chunk
+            (size,) = struct.unpack("<Q", head)
+            ok = 8 <= size <= _MAX_HANDSHAKE
+            verdict.append(None if ok else "the server there answered, but not in Dask's protocol")
+        except socket.gaierror as exc:
+            verdict.append(f"the host cannot be found: {exc.strerror or exc}")
+        except ConnectionRefusedError:
+            verdict.append("connection refused: nothing listens at that port")
+        except TimeoutError:
+            verdict.append("no handshake: an unroutable or filtered address, or a server of another protocol "
+                           "such as HTTP")
+        except OSError as exc:
+            verdict.append(f"cannot be reached: {exc.strerror or exc}")
+
+    deadline = time.monotonic() + timeout
+    thread = threading.Thread(target=probe, name="rattle-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(timeout + 0.5)  # a name lookup has no timeout of its own: the thread is left behind
+    if not verdict:
+        raise _unanswered(address, timeout, "the host name was not resolved in time")
+    if verdict[0] is not None:
+        raise _unanswered(address, timeout, verdict[0])
+    return text
+
+
 def _key_text(key: Any) -> str:
     return re.sub(r"[^A-Za-z0-9_.=,+-]+", "_", str(key))[:120]
 
@@ -99,7 +189,7 @@ class DaskEngine:
     name = "dask"
 
     def __init__(self, scheduler: Any = None, workers: int | None = None, *,
-                 timeout: float = CONNECT_TIMEOUT) -> None:
+                 timeout: float | None = None) -> None:
         if not dask_available():
             raise ConfigError(f"`--scheduler` runs a map on Dask distributed, which is not installed: {_INSTALL}")
         requested = check_workers(workers)
@@ -116,7 +206,9 @@ class DaskEngine:
         if isinstance(scheduler, str) and not scheduler.strip():
             raise ConfigError("`--scheduler` must be a Dask scheduler address such as tcp://host:8786, got ''")
         self.scheduler = scheduler
-        self.timeout = float(timeout)
+        self.timeout = float(CONNECT_TIMEOUT if timeout is None else timeout)
+        if not (self.timeout > 0 and self.timeout < 3600):
+            raise ValueError(f"`timeout` must be a number of seconds in (0, 3600), got {timeout!r}")
         self.workers = requested if requested is not None else (cpu_count() if scheduler is None else 0)
         self.last_run: dict[str, Any] = {}
 
@@ -154,11 +246,14 @@ class DaskEngine:
 
             return client, release
         where = s if isinstance(s, str) else getattr(s, "scheduler_address", s)
+        if isinstance(s, str):
+            s = check_scheduler_address(s, self.timeout)  # refused at once, or within the timeout
         try:
             client = distributed.Client(s, timeout=self.timeout, set_as_default=False)
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, RuntimeError) as exc:
             raise ConfigError(
-                f"`--scheduler` {where!r}: no Dask scheduler answered within {self.timeout:g} s ({exc}); "
+                f"`--scheduler` {where!r}: no Dask scheduler answered within {self.timeout:g} s "
+                f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); "
                 "start one (`dask scheduler`, then `dask worker ADDRESS`) or give the address it prints, "
                 "e.g. tcp://127.0.0.1:8786"
             ) from None
