@@ -73,8 +73,6 @@ import math
 import warnings
 from typing import Any
 
-import numpy as np
-
 from ._validate import check_int, check_real, show
 
 #: Harmonics of the solution's base frequency, at most (see the module docstring).
@@ -262,6 +260,8 @@ def stiffest_frequency(model: Any) -> float:
 def damping_rate(model: Any) -> float:
     """c (1/s), the largest damping rate per inertia: C/I for the single equation, the spectral
     radius of M⁻¹C for a chain."""
+    import numpy as np  # here: the module stays importable without numpy (the command line's checks)
+
     C = model.system().damping
     return float(np.max(np.abs(np.linalg.eigvals(C)))) if C.size else 0.0
 

@@ -364,20 +364,35 @@ def check_period(period: int, harmonics: int, forced: int) -> int:
     return period
 
 
-def parse_at(text: str | None, omega_min: float, omega_max: float) -> list[float] | None:
-    """``--at W1,W2,…``: comma-separated frequencies within the analysis range (rad/s)."""
+def parse_at(text: str | None, omega_min: float | None = None, omega_max: float | None = None) -> list[float] | None:
+    """``--at W1,W2,…``: comma-separated frequencies (rad/s), at most
+    ``rattle._limits.MAX_DETAIL_FREQUENCIES`` of them; with ``omega_min``/``omega_max`` each
+    within the analysis range. Without the range (before the configuration is read) the list's
+    form and size are checked alone: no numpy is needed for that."""
     if text is None:
         return None
+    from .._limits import MAX_DETAIL_FREQUENCIES  # the library's bound (numpy is not imported for it)
+
     parts = [p.strip() for p in text.split(",")]
     if not parts or any(not p for p in parts):
         raise ConfigError(f"`--at` must be a comma-separated list of frequencies such as 0.8,1.4, got {text!r}")
+    if len(parts) > MAX_DETAIL_FREQUENCIES:
+        shown = text if len(text) <= 60 else text[:40] + "…" + text[-12:]
+        raise ConfigError(
+            f"`--at` must hold at most {MAX_DETAIL_FREQUENCIES} frequencies, got {len(parts)} ({shown!r}): each one is "
+            "a periodic-orbit search with simulations (seconds each); give fewer, or use `rattle sweep` for many "
+            "frequencies"
+        )
     values = []
     for part in parts:
         try:
             value = float(part)
         except ValueError:
             raise ConfigError(f"`--at` must hold numbers (rad/s), got {part!r} in {text!r}") from None
-        if not (math.isfinite(value) and omega_min <= value <= omega_max):
+        if not math.isfinite(value):
+            raise ConfigError(f"`--at` frequencies must be finite, got {part!r}; choose frequencies inside the "
+                              "analysis range")
+        if omega_min is not None and omega_max is not None and not omega_min <= value <= omega_max:
             raise ConfigError(
                 f"`--at` frequencies must be finite and within the analysis range {omega_min:g} … "
                 f"{omega_max:g} rad/s, got {part!r}; choose frequencies inside the range or widen it"

@@ -637,6 +637,8 @@ def compare_command(
     differences).
     """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
+    parse_at(at)  # the list's form and size: no numpy (the range is checked once the file is read)
+    measured_table = None
     if measured is not None:
         from ..files import check_input_file  # no numpy: refused at once
 
@@ -644,6 +646,8 @@ def compare_command(
             check_input_file(measured, what="measured data file")
         except ConfigError as exc:
             raise ConfigError(f"`--measured`: {exc}") from None
+        # every rule of the measured file that needs no configuration, before numpy is loaded
+        measured_table = _io().parse_measured_csv(measured)
     run_config = _io().load_config(config)
     if run_config.discontinuous:
         for given, option in ((at, "--at"), (measured, "--measured")):
@@ -662,8 +666,8 @@ def compare_command(
             "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max})
         return
     at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
-    measured_run = None if measured is None else _io().read_measured_csv(
-        measured, speed_order=getattr(run_config.model, "speed_order", None),
+    measured_run = None if measured_table is None else _io().read_measured_csv(
+        measured_table, speed_order=getattr(run_config.model, "speed_order", None),
         omega_range=(analysis.omega_min, analysis.omega_max), has_paths=bool(run_config.paths))
     t_start = time.perf_counter()
     from ..analysis import compare  # only now: all input has been validated

@@ -23,7 +23,8 @@ _LAZY: dict[str, str] = {
                      "rename_keys"], "._config"),
     **dict.fromkeys(["format_csv", "read_csv", "write_csv"], "..files"),
     **dict.fromkeys(["read_path_csv", "PATH_COLUMNS"], "._paths"),
-    **dict.fromkeys(["read_measured_csv", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS"], "._measured"),
+    **dict.fromkeys(["read_measured_csv", "parse_measured_csv", "MeasuredTable", "MEASURED_SPEED_COLUMNS",
+                     "MEASURED_VALUE_COLUMNS"], "._measured"),
     **dict.fromkeys(["MAX_CONFIG_BYTES", "read_bounded", "check_input_file"], "..files"),
     **dict.fromkeys(["environment", "metadata_document", "rattle_version", "to_jsonable", "write_metadata"],
                     "..files"),
@@ -46,7 +47,9 @@ if TYPE_CHECKING:
         load_config, model_to_toml_dict, rename_keys,
     )
     from ._paths import PATH_COLUMNS, read_path_csv
-    from ._measured import MEASURED_SPEED_COLUMNS, MEASURED_VALUE_COLUMNS, read_measured_csv
+    from ._measured import (
+        MEASURED_SPEED_COLUMNS, MEASURED_VALUE_COLUMNS, MeasuredTable, parse_measured_csv, read_measured_csv,
+    )
 
 __all__ = [
     # configuration
@@ -58,7 +61,7 @@ __all__ = [
     # sound path tables ([[paths]], SPEC §6)
     "read_path_csv", "PATH_COLUMNS",
     # measured run-ups (rattle compare --measured)
-    "read_measured_csv", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS",
+    "read_measured_csv", "parse_measured_csv", "MeasuredTable", "MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS",
     # metadata
     "write_metadata", "metadata_document", "to_jsonable", "rattle_version", "environment",
     # atomic writes, output sets, bounded reads

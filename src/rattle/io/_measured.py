@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +38,7 @@ from ..errors import ConfigError
 from ..files import csv_rows, read_bounded
 
 __all__ = ["MEASURED_SPEED_COLUMNS", "MEASURED_VALUE_COLUMNS", "MAX_MEASURED_BYTES", "MAX_MEASURED_ROWS",
-           "read_measured_csv"]
+           "MeasuredTable", "parse_measured_csv", "read_measured_csv"]
 
 #: Speed columns: exactly one of them.
 MEASURED_SPEED_COLUMNS = ("speed_rpm", "omega")
@@ -53,38 +54,58 @@ _RANGE_SLACK = 1e-9
 _UNITS = {"speed_rpm": "rpm", "omega": "rad/s"}
 
 
-def read_measured_csv(
-    file: str | os.PathLike[str],
-    *,
-    speed_order: float | None = None,
-    omega_range: tuple[float, float] | None = None,
-    has_paths: bool = False,
-    key: str = "--measured",
-) -> Any:
-    """Read a measured run-up into a :class:`rattle.results.MeasuredRun`.
+@dataclass(frozen=True)
+class MeasuredTable:
+    """A measured CSV file read and checked on its own (:func:`parse_measured_csv`): the rules
+    that need no configuration. Plain Python lists; neither numpy nor the results are loaded.
 
-    Parameters
+    Attributes
     ----------
-    file : str or os.PathLike
-        The CSV file (module docstring).
-    speed_order : float, optional
-        The model's engine order q_0 of Ω (``Chain.speed_order``); None: the model has no
-        engine, and ``speed_rpm`` is refused.
-    omega_range : (float, float), optional
-        The analysis range (rad/s); every measured speed must lie in it.
-    has_paths : bool, default False
-        Whether the configuration has ``[[paths]]`` (else ``spl_db`` is refused).
-    key : str, default "--measured"
-        The option's name in messages.
+    name : str
+        The file as given (for messages).
+    speed : str
+        The speed column: ``speed_rpm`` or ``omega``.
+    quantities : tuple of str
+        The measured quantity columns, in :data:`MEASURED_VALUE_COLUMNS` order.
+    columns : dict
+        Column name → its values (floats), one per row.
+    lines : tuple of int
+        The file's line of every row.
+    header_line : int
+        The line of the header.
+    key : str
+        The option's (or argument's) name in messages.
+    """
+
+    name: str
+    speed: str
+    quantities: tuple[str, ...]
+    columns: dict[str, list[float]]
+    lines: tuple[int, ...]
+    header_line: int
+    key: str = "--measured"
+
+    def fail(self, message: str) -> ConfigError:
+        return ConfigError(f"`{self.key}` ({self.name!r}) {message}")
+
+
+def parse_measured_csv(file: str | os.PathLike[str], *, key: str = "--measured") -> MeasuredTable:
+    """Read a measured CSV file and check every rule that needs no configuration (the file, its
+    header, every cell, speeds > 0 and strictly monotonic, ``acc_p2p`` > 0, the row count).
+
+    Imports neither numpy nor the results: the command line calls it before the configuration
+    is read, so that a refused file answers at once. :func:`read_measured_csv` takes its result.
 
     Raises
     ------
     ConfigError
-        Whatever breaks a rule of the module docstring; the message names ``key``, the file, the
-        line and column, the rule and the fix.
+        Naming ``key``, the file, the line and column, the rule and the fix.
     """
-    from ..results import MeasuredRun
-
+    if isinstance(file, MeasuredTable):
+        return file
+    if not isinstance(file, (str, os.PathLike)):
+        raise TypeError(f"`file` must be the path of a measured CSV file (str or os.PathLike), got {file!r} "
+                        f"({type(file).__name__})")
     name = os.fspath(file)
     where = f"`{key}` ({name!r})"
 
@@ -114,6 +135,7 @@ def read_measured_csv(
     if not rows:
         raise fail("is empty; it needs a header line such as speed_rpm,acc_p2p and one row per measured point")
     line, header = rows[0]
+    header_line = line
     if len(header) == 1 and any(sep in header[0] for sep in ";\t"):
         raise fail(f"line {line}: the header {header[0]!r} is not comma-separated; separate the columns with "
                    "commas (and use a point as the decimal separator)")
@@ -135,13 +157,6 @@ def read_measured_csv(
     if not quantities:
         raise fail(f"line {line}: the header {','.join(header)!r} has no measured quantity; add acc_p2p "
                    "(peak-to-peak acceleration of δ'') and/or spl_db (sound pressure level)")
-    if speed == "speed_rpm" and speed_order is None:
-        raise fail(f"line {line}, column `speed_rpm`: the configuration has no engine ([engine] or "
-                   "model.speed_order), so crankshaft rpm cannot be turned into Ω; give the column omega (rad/s) "
-                   "instead, or add an [engine]")
-    if "spl_db" in quantities and not has_paths:
-        raise fail(f"line {line}, column `spl_db`: the configuration has no [[paths]], so no sound pressure is "
-                   "computed to compare with; add [[paths]] (docs/sound.md) or remove the column")
     if len(rows) == 1:
         raise fail("has a header but no rows; add one row per measured point")
     if len(rows) - 1 > MAX_MEASURED_ROWS:
@@ -181,6 +196,50 @@ def read_measured_csv(
             if v <= 0:
                 raise fail(f"line {lines[i]}, column `acc_p2p`: must be > 0 (a peak-to-peak acceleration; the "
                            f"relative difference divides by it), got {v!r}; remove the row")
+    return MeasuredTable(name=name, speed=speed, quantities=tuple(quantities), columns=cols, lines=tuple(lines),
+                         header_line=header_line, key=key)
+
+
+def read_measured_csv(
+    file: str | os.PathLike[str] | MeasuredTable,
+    *,
+    speed_order: float | None = None,
+    omega_range: tuple[float, float] | None = None,
+    has_paths: bool = False,
+    key: str = "--measured",
+) -> Any:
+    """Read a measured run-up into a :class:`rattle.results.MeasuredRun`.
+
+    Parameters
+    ----------
+    file : str, os.PathLike or MeasuredTable
+        The CSV file (module docstring), or what :func:`parse_measured_csv` read from it.
+    speed_order : float, optional
+        The model's engine order q_0 of Ω (``Chain.speed_order``); None: the model has no
+        engine, and ``speed_rpm`` is refused.
+    omega_range : (float, float), optional
+        The analysis range (rad/s); every measured speed must lie in it.
+    has_paths : bool, default False
+        Whether the configuration has ``[[paths]]`` (else ``spl_db`` is refused).
+    key : str, default "--measured"
+        The option's name in messages (for a path; a MeasuredTable keeps its own).
+
+    Raises
+    ------
+    ConfigError
+        Whatever breaks a rule of the module docstring; the message names ``key``, the file, the
+        line and column, the rule and the fix.
+    """
+    table = parse_measured_csv(file, key=key)
+    fail, speed, line = table.fail, table.speed, table.header_line
+    if speed == "speed_rpm" and speed_order is None:
+        raise fail(f"line {line}, column `speed_rpm`: the configuration has no engine ([engine] or "
+                   "model.speed_order), so crankshaft rpm cannot be turned into Ω; give the column omega (rad/s) "
+                   "instead, or add an [engine]")
+    if "spl_db" in table.quantities and not has_paths:
+        raise fail(f"line {line}, column `spl_db`: the configuration has no [[paths]], so no sound pressure is "
+                   "computed to compare with; add [[paths]] (docs/sound.md) or remove the column")
+    s, lines, unit = table.columns[speed], table.lines, _UNITS[speed]
     factor = 1.0 if speed == "omega" else float(speed_order) * 2.0 * math.pi / 60.0  # type: ignore[arg-type]
     omega = [v * factor for v in s]
     if omega_range is not None:
@@ -191,9 +250,11 @@ def read_measured_csv(
                 option = "--rpm-min/--rpm-max" if speed == "speed_rpm" else "--omega-min/--omega-max"
                 raise fail(f"line {lines[i]}, column `{speed}`: {s[i]:.6g} {unit} lies outside the analysis range "
                            f"{shown}; widen the range ({option} or the configuration) or remove the rows outside it")
+    from ..results import MeasuredRun  # only now: every rule is checked (numpy and the numerics behind it)
+
     try:
-        return MeasuredRun(omega=omega, values={q: cols[q] for q in quantities},
-                           speed_rpm=s if speed == "speed_rpm" else None, source=Path(name).name,
+        return MeasuredRun(omega=omega, values={q: table.columns[q] for q in table.quantities},
+                           speed_rpm=s if speed == "speed_rpm" else None, source=Path(table.name).name,
                            lines=tuple(lines))
     except (TypeError, ValueError) as exc:
         raise fail(f"is refused: {exc}") from None
