@@ -298,8 +298,13 @@ def load_config(path: str | os.PathLike[str]) -> RunConfig:
     ConfigError
         If the file cannot be read, is not TOML, or breaks a rule of the schema (see the module
         docstring); the message names the key, the value, the rule and the fix.
+    TypeError
+        If ``path`` is not a path (None, a number …), naming it and showing the value.
     """
-    return config_from_dict(read_toml(path), source_name=os.fspath(path))
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"`path` must be the path of a TOML configuration file (a str or os.PathLike), got {path!r} "
+                        f"({type(path).__name__})")
+    return config_from_dict(read_toml(path), source_name=os.fsdecode(path))
 
 
 def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> RunConfig:

@@ -11,7 +11,8 @@ The CSV file has a header line naming the three columns ``frequency_hz``, ``magn
 starting with ``#`` and blank lines are skipped, spaces around fields are ignored. Refused, each
 with a :class:`~rattle.errors.ConfigError` naming the key (``paths[0].file``), the line and the
 rule: a missing or unreadable file, a missing, unknown or repeated column, a row with the wrong
-number of fields, a value that is not a finite number, a negative magnitude, frequencies that are
+number of fields, a value that is not a finite number, a magnitude below 0 or above 1e50 Pa per
+rad/s², a phase beyond ±10⁶ degrees (:meth:`rattle.model.SoundPath.value_rule`), frequencies that are
 not > 0 and strictly increasing, a table without rows; a source that names no element of the
 model or an inertia out of range.
 """
@@ -133,9 +134,10 @@ def read_path_csv(file: str | os.PathLike[str], source: str, *, key: str = "file
         if i and fi <= f[i - 1]:
             raise _fail(prefix, f"{where} line {lines[i]}: `frequency_hz` must be strictly increasing, got {fi!r} after "
                                 f"{f[i - 1]!r} (line {lines[i - 1]}); sort the rows and remove repeated frequencies")
-        if mi < 0:
-            raise _fail(prefix, f"{where} line {lines[i]}: `magnitude` must be >= 0 (a modulus, Pa per rad/s²), got "
-                                f"{mi!r}; put the sign into `phase_deg` (+180)")
+        for column, value in (("magnitude", mi), ("phase_deg", cols["phase_deg"][i])):
+            rule = SoundPath.value_rule(column, value)
+            if rule is not None:
+                raise _fail(prefix, f"{where} line {lines[i]}: {rule}")
     try:
         return SoundPath(source=source, frequency_hz=f, magnitude=mag, phase_deg=cols["phase_deg"],
                          name=Path(name).name)

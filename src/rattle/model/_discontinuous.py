@@ -46,7 +46,7 @@ from typing import ClassVar
 import numpy as np
 
 from .._typing import FloatArray
-from ._elastic import AbstractElastic, StageLaw, _check_real, _check_real_sequence
+from ._elastic import AbstractElastic, StageLaw, _check_real, _check_real_sequence, check_delta
 
 
 @dataclass(frozen=True, slots=True)
@@ -293,7 +293,9 @@ class NonsmoothLaw:
         return not (np.any(self._data.jumps > 0) or np.any(self._levels > 0))
 
     def force(self, delta: FloatArray | float) -> FloatArray:
-        """f(δ) (the right limit at a jump)."""
+        """f(δ) (the right limit at a jump); ``delta`` a number or an array of numbers (rad), else
+        TypeError naming it."""
+        delta = check_delta(delta)
         st = self._data
         j = np.searchsorted(st.breakpoints, delta, side="right")
         return st.slopes[j] * delta + st.offsets[j]

@@ -63,6 +63,29 @@ def _stages(breakpoints: tuple[float, ...], slopes: tuple[float, ...]) -> Stages
     return Stages(d, s, e)
 
 
+def check_delta(delta: Any, name: str = "delta") -> Any:
+    """``delta`` (rad) for a law's ``force``/``stiffness``: a real number or an array (or
+    sequence) of real numbers. A float or integer array and a number pass as they are (the hot
+    path of the numerics); a sequence becomes a float array. A string, a boolean, None or what
+    is not numbers is refused naming ``name`` and showing the value (TypeError)."""
+    if isinstance(delta, np.ndarray):
+        if delta.dtype.kind in "fiu":
+            return delta
+    elif isinstance(delta, (float, int, np.floating, np.integer)) and not isinstance(delta, (bool, np.bool_)):
+        return delta
+    what = "a deflection in rad: a number or an array of numbers"
+    shown = repr(delta) if len(repr(delta)) <= 80 else repr(delta)[:60] + "…"
+    if isinstance(delta, (str, bytes, bool, np.bool_)) or delta is None:
+        raise TypeError(f"`{name}` must be {what}, got {shown} ({type(delta).__name__})")
+    try:
+        raw = np.asarray(delta)
+    except (TypeError, ValueError):  # ragged nesting
+        raise TypeError(f"`{name}` must be {what}, got {shown}") from None
+    if raw.dtype.kind not in "fiu":  # booleans, strings, None or other objects among the values
+        raise TypeError(f"`{name}` must be {what}, got {shown} ({type(delta).__name__} of {raw.dtype})")
+    return raw.astype(float)
+
+
 class StageLaw:
     """A law f(δ) = s_j δ + e_j on stages d_j ≤ δ < d_{j+1}, read from its ``stages`` (breakpoints,
     slopes, offsets): the continuous laws here and the laws with jumps of
@@ -74,18 +97,21 @@ class StageLaw:
 
     def stage(self, delta: FloatArray | float) -> IntArray:
         """Index j of the stage holding δ (d_j ≤ δ < d_{j+1}); same shape as ``delta``."""
-        return np.searchsorted(self.stages.breakpoints, delta, side="right")
+        return np.searchsorted(self.stages.breakpoints, check_delta(delta), side="right")
 
     def force(self, delta: FloatArray | float) -> FloatArray:
-        """f(δ) = s_j δ + e_j, elementwise (the right limit at a breakpoint)."""
+        """f(δ) = s_j δ + e_j, elementwise (the right limit at a breakpoint); ``delta`` a number or
+        an array of numbers (rad), else TypeError naming it."""
+        delta = check_delta(delta)
         st = self.stages
         j = np.searchsorted(st.breakpoints, delta, side="right")
         return st.slopes[j] * delta + st.offsets[j]
 
     def stiffness(self, delta: FloatArray | float) -> FloatArray:
-        """∂f/∂δ = s_j, elementwise (right derivative at a breakpoint; a jump not included)."""
+        """∂f/∂δ = s_j, elementwise (right derivative at a breakpoint; a jump not included);
+        ``delta`` a number or an array of numbers (rad), else TypeError naming it."""
         st = self.stages
-        return st.slopes[np.searchsorted(st.breakpoints, delta, side="right")]
+        return st.slopes[np.searchsorted(st.breakpoints, check_delta(delta), side="right")]
 
 
 class AbstractElastic(StageLaw):
@@ -104,6 +130,7 @@ class AbstractElastic(StageLaw):
 
     def force_and_stiffness(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
         """f(δ) and ∂f/∂δ with one stage look-up."""
+        delta = check_delta(delta)
         st = self._stage_data
         j = np.searchsorted(st.breakpoints, delta, side="right")
         s = st.slopes[j]

@@ -19,15 +19,43 @@ from typing import Any
 
 import numpy as np
 
+from .._limits import MAX_MAGNITUDE
 from .._typing import FloatArray
 from .._validate import check_vector
 
-__all__ = ["SoundPath", "parse_source", "check_source"]
+__all__ = ["SoundPath", "parse_source", "check_source", "MAX_PATH_MAGNITUDE", "MAX_PHASE_DEG", "path_value_rule"]
 
 _INERTIA = re.compile(r"inertia:([0-9]+)")
 
 #: Largest number of rows of a path table.
 MAX_PATH_ROWS = 1_000_000
+#: Largest |H| (Pa per rad/s²) of a path table: the magnitude bound of every physical number
+#: (``rattle._limits.MAX_MAGNITUDE``), so that the pressure's harmonics, their squares and the
+#: level in dB stay finite (1e300 wrote ``inf`` into ``spl_db``).
+MAX_PATH_MAGNITUDE = MAX_MAGNITUDE
+#: Largest |phase| (degrees) of a path table: an unwrapped phase of a measured transfer runs
+#: through a few thousand turns at most (a 10 ms delay is 36 000° at 10 kHz); beyond 10⁶° (2 778
+#: turns) the phase is not known to a degree in double precision any more, let alone 1e300.
+MAX_PHASE_DEG = 1e6
+
+
+def path_value_rule(column: str, value: float, at: str = "") -> str | None:
+    """Why ``value`` (finite) is refused in ``column`` of a path table (``magnitude`` ≥ 0 and
+    ≤ :data:`MAX_PATH_MAGNITUDE`; ``phase_deg`` within ±:data:`MAX_PHASE_DEG`), or None; ``at``
+    follows the value shown (`` at row 3``)."""
+    if column == "magnitude":
+        if value < 0:
+            return (f"`magnitude` must be >= 0 (a modulus, Pa per rad/s²; put the sign in `phase_deg`, +180), "
+                    f"got {value!r}{at}")
+        if value > MAX_PATH_MAGNITUDE:
+            return (f"`magnitude` must be <= {MAX_PATH_MAGNITUDE:g} Pa per rad/s² (a physical transfer from "
+                    f"torsional acceleration to sound pressure; a larger one makes the sound pressure level "
+                    f"overflow to inf), got {value!r}{at}; check the column's unit")
+    if column == "phase_deg" and abs(value) > MAX_PHASE_DEG:
+        return (f"`phase_deg` must lie within ±{MAX_PHASE_DEG:g} degrees (an unwrapped phase of a few thousand "
+                f"turns at most; beyond, double precision does not hold it to a degree), got {value!r}{at}; give the "
+                "phase in degrees, wrapped or unwrapped")
+    return None
 
 
 def parse_source(source: str, name: str = "source") -> tuple[str, int | str]:
@@ -56,9 +84,10 @@ class SoundPath:
     frequency_hz : sequence of float, shape (R,)
         Frequencies (Hz), finite, > 0, strictly increasing; R ≥ 1.
     magnitude : sequence of float, shape (R,)
-        |H| (Pa per rad/s²), finite, ≥ 0.
+        |H| (Pa per rad/s²), finite, 0 … :data:`MAX_PATH_MAGNITUDE` (1e50).
     phase_deg : sequence of float, shape (R,)
-        arg H (degrees), finite; unwrapped before interpolation.
+        arg H (degrees), finite, within ±:data:`MAX_PHASE_DEG` (10⁶); unwrapped before
+        interpolation.
     name : str, optional
         A label for messages (e.g. the CSV file it was read from).
 
@@ -96,14 +125,23 @@ class SoundPath:
             i = int(steps[0])
             raise ValueError(f"`frequency_hz` must be strictly increasing, got {f[i]!r} then {f[i + 1]!r} "
                              f"at rows {i} and {i + 1}; sort the table and remove repeated frequencies")
-        neg = np.flatnonzero(mag < 0)
-        if neg.size:
-            raise ValueError(f"`magnitude` must be >= 0 (a modulus; put the sign in `phase_deg`), got "
-                             f"{mag[neg[0]]!r} at row {int(neg[0])}")
+        for column, values in (("magnitude", mag), ("phase_deg", ph)):
+            limit = MAX_PATH_MAGNITUDE if column == "magnitude" else MAX_PHASE_DEG
+            bad = np.flatnonzero((values < 0) | (values > limit)) if column == "magnitude" \
+                else np.flatnonzero(np.abs(values) > limit)
+            if bad.size:
+                row = int(bad[0])
+                raise ValueError(path_value_rule(column, float(values[row]), f" at row {row}"))
         object.__setattr__(self, "source", self.source.strip())
         object.__setattr__(self, "frequency_hz", f)
         object.__setattr__(self, "magnitude", mag)
         object.__setattr__(self, "phase_deg", ph)
+
+    @staticmethod
+    def value_rule(column: str, value: float, at: str = "") -> str | None:
+        """Why the finite ``value`` is refused in ``column`` (``magnitude``, ``phase_deg``) of a
+        path table, or None (:func:`path_value_rule`: the readers of path files use it per line)."""
+        return path_value_rule(column, value, at)
 
     @property
     def kind(self) -> str:

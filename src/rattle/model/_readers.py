@@ -34,12 +34,16 @@ def register_reader(reader: TableReader) -> None:
 
 
 def read_tables(path: str | Path) -> Any:
-    """The model tables of the TOML file at ``path``, read with the registered reader."""
+    """The model tables of the TOML file at ``path``, read with the registered reader; a
+    ``path`` that is not a path (None, a number …) is refused naming it (TypeError)."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"`path` must be the path of a TOML configuration file (a str or os.PathLike), got {path!r} "
+                        f"({type(path).__name__})")
     data = read_toml(path)
     if not _READER:
         raise RuntimeError("no reader of the model tables is registered: import rattle.model "
                            "(it loads rattle.model._tables, which registers its reader)")
-    return _READER[0](data, os.fspath(path))
+    return _READER[0](data, os.fsdecode(path))
 
 
 __all__ = ["TableReader", "read_tables", "register_reader"]

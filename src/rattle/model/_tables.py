@@ -640,6 +640,10 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
                 check.array(t[key], f"{where}.{key}")
         torques.append(check.build(Torque, {f: f"{where}.{f}" for f in _EXCITATION_TORQUES_KEYS}, **dict(t)))
 
+    if not torques and not has_engine:  # required, and not empty: an unforced chain's response is all zero
+        raise check.error("`excitation.torques` must hold at least one torque, got none (torques = []): without a "
+                          "torque the chain rests and every response is zero; add e.g. [[excitation.torques]] with "
+                          "inertia = 1, mean = 0.05, amplitudes = [0.06] (or an [engine])")
     names = {"inertias": "model.inertias", "links": "model.links", "elements": "model.elements",
              "torques": "excitation.torques", "speed_order": "model.speed_order"}
     engine = _engine(check, data, n, units) if has_engine else None
