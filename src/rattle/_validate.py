@@ -100,6 +100,9 @@ def check_range(omega: object, name: str = "omega") -> tuple[float, float]:
     """A frequency range (min, max) in rad/s: two finite numbers, 0 < min < max."""
     if isinstance(omega, (str, bytes)) or not hasattr(omega, "__iter__") or hasattr(omega, "items"):
         raise TypeError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got {omega!r}")
+    if isinstance(omega, (set, frozenset)):  # no order: which is min and which max would be chance
+        raise TypeError(f"`{name}` must be a pair (min, max) of frequencies in rad/s, got the set {omega!r}, which "
+                        "has no order; give a tuple such as (0.5, 0.8)")
     values = list(omega)  # type: ignore[call-overload]
     if len(values) != 2:
         raise ValueError(
