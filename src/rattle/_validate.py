@@ -198,3 +198,31 @@ def numerical_failures(func: _F) -> _F:
 
 __all__ = ["numerical_failures", "show", "check_real", "check_omega", "check_shooting", "check_vector", "check_range", "check_state", "as_float_array", "check_int", "check_bool", "check_choice",
            "check_instance"]
+
+
+#: Largest time history drawn from harmonic-balance coefficients, as samples × (2H + 1) numbers
+#: (the synthesis matrix of one array): 2**25 doubles are 256 MiB.
+MAX_HISTORY_CELLS = 1 << 25
+
+
+def check_history_size(samples: object, periods: object, harmonics: int, periods_name: str = "periods") -> tuple[int, int]:
+    """``samples`` (per period, an integer >= 2) and ``periods`` (an integer >= 1) of a time
+    history synthesised from ``harmonics`` harmonics, refused (ValueError/TypeError naming the
+    argument) before anything is allocated when samples · periods · (2H + 1) exceeds
+    :data:`MAX_HISTORY_CELLS`."""
+    import numpy as np
+
+    for name, value, low in (("samples", samples, 2), (periods_name, periods, 1)):
+        if _is_bool(value) or not isinstance(value, (int, np.integer)):
+            raise TypeError(f"`{name}` must be an integer, got {show(value)} ({type(value).__name__})")
+        if value < low:
+            raise ValueError(f"`{name}` must be an integer >= {low}, got {show(value)}")
+    n, p = int(samples), int(periods)  # type: ignore[arg-type]
+    cells = (n * p + 1) * (2 * max(int(harmonics), 0) + 1)
+    if cells > MAX_HISTORY_CELLS:
+        most = max(2, MAX_HISTORY_CELLS // ((2 * max(int(harmonics), 0) + 1) * p))
+        raise ValueError(
+            f"`samples` × `{periods_name}` = {show(n)} × {show(p)} time samples of {harmonics} harmonics would need "
+            f"{cells:.3g} numbers, more than the limit of {MAX_HISTORY_CELLS} (256 MiB); use `samples` <= {most}"
+        )
+    return n, p

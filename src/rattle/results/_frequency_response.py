@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
-from .._validate import as_float_array
+from .._validate import as_float_array, check_history_size
 from ..errors import Status
 from ..hb import resize_harmonics
 from ._columns import FRF_COLUMNS
@@ -319,8 +319,11 @@ class FrequencyResponse:
     def time_history(self, index: int, samples: int = 512, periods: int = 1) -> dict[str, FloatArray]:
         """Time history of point ``index`` over ``periods`` solution periods:
         dict with ``t``, ``delta``, ``velocity``, ``acceleration`` (arrays of length samples·periods + 1)."""
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
+            raise TypeError(f"`index` must be an integer, got {index!r}")
         if not -len(self) <= index < len(self):
             raise IndexError(f"`index` must be in [0, {len(self)}), got {index}")
+        samples, periods = check_history_size(samples, periods, self.coefficients.shape[-1] // 2)
         w = np.array([self.base_frequency(index)])
         Q = self.coefficients[index][None, :]
         T = 2 * np.pi / w[0]

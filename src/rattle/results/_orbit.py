@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._validate import check_history_size
+
 from .._typing import ComplexArray, FloatArray
 from ._columns import ORBIT_COLUMNS
 from ..measures import acceleration_batch, element_accelerations, evaluate_batch
@@ -262,6 +264,7 @@ class PeriodicOrbit:
         periods = sol.period if periods is None else periods
         if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 1:
             raise ValueError(f"`periods` must be an integer >= 1, got {periods!r}")
+        check_history_size(samples, periods, np.size(sol.coefficients) // 2)  # before allocating
         Tf = 2.0 * math.pi / self.omega
         t = np.linspace(0.0, periods * Tf, int(samples) * int(periods) + 1)
         w = np.array([sol.base_frequency])
