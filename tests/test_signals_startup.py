@@ -345,6 +345,26 @@ def test_the_first_signal_raises_and_later_ones_are_noted() -> None:
     assert {s: signal.getsignal(s) for s in before} == before  # the earlier handlers are back
 
 
+@pytest.mark.skipif(not hasattr(signal, "raise_signal"), reason="signal.raise_signal")
+def test_a_signal_swallowed_by_a_finalizer_is_delivered_again() -> None:
+    """Python ignores an exception raised in a ``__del__`` (or a weakref callback of the garbage
+    collector); the first signal's Interrupted raised there would be lost and the run go on."""
+
+    class Finalized:
+        def __del__(self) -> None:
+            signal.raise_signal(signal.SIGTERM)  # handled inside __del__: the exception is swallowed
+
+    hook = sys.unraisablehook
+    deadline = time.monotonic() + WAIT
+    with pytest.raises(_signals.Interrupted) as info:
+        with _signals.raising():
+            Finalized()
+            while time.monotonic() < deadline:  # the signal sent again is raised in this loop
+                pass
+    assert info.value.signum == signal.SIGTERM and time.monotonic() < deadline
+    assert sys.unraisablehook is hook
+
+
 def test_the_interruption_line() -> None:
     assert _signals.message(int(signal.SIGINT)) == (
         "interrupted by SIGINT; temporary files were removed and no output set was left half-written")

@@ -20,6 +20,11 @@ What a signal does, by phase (exit status 128 + the signal's number, one line on
   :data:`FORCE_AFTER` seconds into the clean-up (a user pressing Ctrl-C again at a clean-up
   that hangs) ends the process at once.
 
+Python swallows an exception raised while a finalizer runs (a ``__del__``, a weakref callback
+of the garbage collector): the first signal's :class:`Interrupted` raised there is sent again a
+moment later (:func:`_unraisable`, the ``sys.unraisablehook`` while a command runs), so that a
+signal that came at that instant still ends the run.
+
 A signal whose disposition was "ignore" when the process started (``nohup``: SIGHUP; a
 background job of a non-interactive shell: SIGINT) stays ignored. A child forked before it set
 its own handlers (a worker process) is not the command line: SIGINT is ignored there (its
@@ -50,6 +55,8 @@ HANDLED: dict[int, str] = {getattr(_signal, name): name for name in ("SIGINT", "
                            if hasattr(_signal, name)}
 #: Seconds into the clean-up after which a further signal ends the process at once.
 FORCE_AFTER = 2.0
+#: Seconds after which a signal swallowed by a finalizer is sent again (:func:`_unraisable`).
+_AGAIN_AFTER = 0.01
 
 _SIGINT = getattr(_signal, "SIGINT", 2)
 #: The module names ``python -m NAME`` runs the command line with.
@@ -77,6 +84,7 @@ class _State:
     first: int | None = None        # the first signal received
     first_at = 0.0                  # when (time.monotonic)
     reported = False                # the interruption's line is on stderr
+    hook: Any = sys.__unraisablehook__  # the unraisable hook :class:`raising` replaced
 
 
 def signal_name(signum: int) -> str:
@@ -207,6 +215,31 @@ def installed_at_start() -> bool:
     return _State.at_start and _State.owner == os.getpid()
 
 
+def _unraisable(unraisable: Any) -> None:
+    """``sys.unraisablehook`` while a command runs: the first signal's :class:`Interrupted`
+    raised while a finalizer ran (a ``__del__``, a weakref callback the garbage collector
+    called) is swallowed by Python ("Exception ignored in …") and the run would go on as if no
+    signal had come; it is delivered again instead, to be raised in the code that runs next.
+    Anything else goes to the hook that was there before."""
+    exc = unraisable.exc_value
+    if isinstance(exc, Interrupted) and _State.mode == "raise" and os.getpid() == _State.owner \
+            and _State.first == exc.signum:
+        _State.first = None
+        # Sent from a thread a moment later: sent from here, its handler would run inside this
+        # hook, which swallows it too. (Should it land in a finalizer again, it comes back here.)
+        import threading
+
+        threading.Thread(target=_send_again, args=(os.getpid(), exc.signum), name="rattle-signal-again",
+                         daemon=True).start()
+        return
+    _State.hook(unraisable)
+
+
+def _send_again(pid: int, signum: int) -> None:
+    time.sleep(_AGAIN_AFTER)
+    os.kill(pid, signum)
+
+
 class raising:  # noqa: N801 - used as a function: ``with raising():``
     """For the body, the first handled signal raises :class:`Interrupted` and later ones are
     noted (module docstring); afterwards the earlier handlers and mode come back (the command
@@ -218,11 +251,17 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
     def __enter__(self) -> None:
         self._mode = _State.mode
         self._previous: dict[int, Any] = {}
+        self._hook: Any = None
         _State.first, _State.reported, _State.mode = None, False, "raise"
         try:
             self._previous = _install()
         except ValueError:  # not the main thread: leave the signals alone
             _State.mode = self._mode
+            return
+        self._hook = sys.unraisablehook
+        if self._hook is not _unraisable:
+            _State.hook = self._hook
+        sys.unraisablehook = _unraisable
 
     def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
                  tb: TracebackType | None) -> None:
@@ -231,6 +270,8 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
                 _signal.signal(sig, old)
             except (ValueError, TypeError):  # pragma: no cover
                 pass
+        if self._hook is not None:
+            sys.unraisablehook = self._hook
         _State.mode = self._mode
 
 
