@@ -351,7 +351,7 @@ def test_python_examples_run(tmp_path, monkeypatch):
     with contextlib.redirect_stdout(out):
         for i, block in enumerate(blocks):
             exec(compile(block, f"docs/python.md block {i + 1}", "exec"), namespace)  # noqa: S102
-    assert tuple(read_csv(tmp_path / "frf.csv")) == FRF_COLUMNS
+    assert tuple(read_csv(tmp_path / "frf.csv")) == (*FRF_COLUMNS, "harmonics")  # SPEC §3 + §8
     for name in ("frf.png", "sweep.csv", "orbit.csv", "compare.png"):
         assert (tmp_path / name).is_file(), f"the example did not write {name}"
     assert "fold" in out.getvalue()

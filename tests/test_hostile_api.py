@@ -86,7 +86,7 @@ API_CASES = [
     # other arguments
     ("subharmonics string", lambda: fr(REF, subharmonics="yes"), TypeError, ["`subharmonics` must be True or False"]),
     ("max_period 9", lambda: fr(REF, max_period=9), ValueError, ["`max_period` must be an integer 1 … 8"]),
-    ("start unknown", lambda: fr(REF, start="middle"), ValueError, ["`start` must be 'low' or 'high'"]),
+    ("start unknown", lambda: fr(REF, start="middle"), ValueError, ["`start` must be one of 'low', 'high', 'both'"]),
     ("stability unknown", lambda: fr(REF, stability="floquet"), ValueError, ["`stability` must be 'monodromy' or 'hill'"]),
     ("newton as dict", lambda: fr(REF, newton={"residual_tol": 1e-9}), TypeError, ["`newton` must be a NewtonOptions"]),
     ("continuation as dict", lambda: fr(REF, continuation={}), TypeError, ["`continuation`"]),

@@ -35,7 +35,8 @@ class Status(enum.Enum):
     ``.message`` explains, ``.success`` tells whether the result is complete. A continuation run
     (``FrequencyResponse.status``, ``ContinuationStepper.status``) ends with ``SUCCESS``,
     ``RETURNED``, ``STOPPED`` (complete), ``MAX_STEPS``, ``MAX_TIME``, ``STEP_TOO_SMALL`` or
-    ``START_FAILED``; a Newton solve at a fixed parameter
+    ``START_FAILED``; a frequency response whose branches leave part of the range uncovered
+    with ``UNCOVERED``; a Newton solve at a fixed parameter
     (:class:`~rattle.continuation.NewtonResult`) with ``CONVERGED`` (complete), ``SINGULAR``,
     ``NON_FINITE`` or ``MAX_ITERATIONS``; a simulated steady state
     (:class:`~rattle.results.SteadyState`) with ``CONVERGED`` (the orbit polished by Newton
@@ -49,6 +50,7 @@ class Status(enum.Enum):
     STEP_TOO_SMALL = "the corrector failed even at the smallest allowed step"
     START_FAILED = "no periodic solution could be found at the start of the range"
     STOPPED = "the branch ended where it rejoined another branch"
+    UNCOVERED = "part of the frequency range is covered by no branch"
     CONVERGED = "Newton's method converged"
     SINGULAR = "singular Jacobian"
     NON_FINITE = "the residual became non-finite"

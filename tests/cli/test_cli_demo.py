@@ -32,7 +32,7 @@ def test_frf_subharmonics_writes_every_branch(tmp_path: Path) -> None:
     out = tmp_path / "out"
     assert sorted(p.name for p in out.iterdir()) == ["frf.csv", "frf.json", "frf.png"]
     cols = read_csv(out / "frf.csv")
-    assert list(cols) == list(FRF_COLUMNS)
+    assert list(cols) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
     branch = np.asarray(cols["branch"], dtype=int)
     period = np.asarray(cols["period"], dtype=int)
     assert len(np.unique(branch)) > 1
@@ -74,7 +74,7 @@ def test_demo_writes_every_file(demo: tuple[Path, Result]) -> None:
     for name in DEMO_FIGURES.values():
         assert (out / name).read_bytes()[:8] == PNG, name
     frf = read_csv(out / "frf.csv")
-    assert list(frf) == list(FRF_COLUMNS)
+    assert list(frf) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
     assert len(set(np.asarray(frf["branch"], dtype=int).tolist())) == 3
     sweep = read_csv(out / "sweep.csv")
     assert list(sweep) == list(SWEEP_COLUMNS)

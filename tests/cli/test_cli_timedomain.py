@@ -153,7 +153,7 @@ def test_compare_end_to_end(case: Path) -> None:
     assert result.exit_code == 0, result.stderr
     out = case / "out"
     assert sorted(p.name for p in out.iterdir()) == ["compare.json", "compare.png", "frf.csv", "sweep.csv"]
-    assert list(read_csv(out / "frf.csv")) == list(FRF_COLUMNS)
+    assert list(read_csv(out / "frf.csv")) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
     assert list(read_csv(out / "sweep.csv")) == list(SWEEP_COLUMNS)
     assert (out / "compare.png").read_bytes()[:8] == PNG
     meta = json.loads((out / "compare.json").read_text())

@@ -271,7 +271,7 @@ def test_frf_end_to_end_with_the_real_solver(tmp_path: Path) -> None:
     out = tmp_path / "out"
     assert sorted(p.name for p in out.iterdir()) == ["frf.csv", "frf.json", "frf.png"]
     frf = read_csv(out / "frf.csv")
-    assert list(frf) == list(FRF_COLUMNS)
+    assert list(frf) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
     assert frf["omega"].min() == pytest.approx(0.5) and frf["omega"].max() == pytest.approx(1.5)
     assert frf["stable"].dtype == bool
     meta = json.loads((out / "frf.json").read_text())

@@ -124,7 +124,7 @@ def test_options_validation(kwargs, match):
     (dict(omega=(0.0, 1.0)), r"`omega` must satisfy 0 < min < max"),
     (dict(omega=(0.1, float("nan"))), r"`omega` must be finite"),
     (dict(omega="0.1-3"), r"`omega` must be a pair"),
-    (dict(start="middle"), r"`start` must be 'low' or 'high'"),
+    (dict(start="middle"), r"`start` must be one of 'low', 'high', 'both'"),
     (dict(stability="eig"), r"`stability` must be"),
 ])
 def test_front_end_argument_validation(kwargs, match):
@@ -140,10 +140,34 @@ def test_unknown_keyword_raises():
 
 def test_frequency_response_stopped_by_a_failing_corrector_says_to_raise_the_harmonics(reference_model, monkeypatch):
     from rattle.analysis import _frequency_response as frf_module
+    from rattle.analysis import _harmonics as harmonics_module
 
     monkeypatch.setattr(frf_module, "HarmonicBalance", _NoSolutionAbove)
-    frf = frequency_response(reference_model, omega=(0.1, 3.0), harmonics=16, throw=False,
+    monkeypatch.setattr(harmonics_module, "HarmonicBalance", _NoSolutionAbove)
+    frf = frequency_response(reference_model, omega=(0.1, 3.0), harmonics=16, throw=False, adaptive=None,
                              continuation=ContinuationOptions(min_step=1e-4, max_step=0.05))
     assert frf.status is Status.STEP_TOO_SMALL
     assert "give more harmonics (e.g. 32)" in frf.message
     assert frf.omega.max() <= 0.5  # what was computed is kept
+    # the rest of the range is named: no start at the high end either (no solution above 0.5)
+    (gap,) = frf.settings["uncovered"]
+    assert 0.49 < gap[0] <= 0.5 and gap[1] == 3.0 and "not covered by any branch: Ω = 0.49" in frf.message
+
+
+def test_a_failing_corrector_raises_the_harmonics_on_that_stretch(reference_model, monkeypatch):
+    """With H adapting (the default), the branch goes on from the failure with 2H, 4H … up to
+    max_harmonics; a problem that has no solution there with any H still ends, naming it."""
+    from rattle.analysis import AdaptiveHarmonics
+    from rattle.analysis import _frequency_response as frf_module
+    from rattle.analysis import _harmonics as harmonics_module
+
+    monkeypatch.setattr(frf_module, "HarmonicBalance", _NoSolutionAbove)
+    monkeypatch.setattr(harmonics_module, "HarmonicBalance", _NoSolutionAbove)
+    frf = frequency_response(reference_model, omega=(0.1, 3.0), harmonics=16, throw=False,
+                             adaptive=AdaptiveHarmonics(max_harmonics=64),
+                             continuation=ContinuationOptions(min_step=1e-4, max_step=0.05))
+    assert frf.status is Status.STEP_TOO_SMALL
+    stretches = frf.settings["branches"][0]["stretches"]
+    assert [s["harmonics"] for s in stretches] == [16, 32, 64]
+    assert set(np.unique(frf.extra_columns["harmonics"]).tolist()) <= {16, 32, 64}
+    assert "with up to 64 harmonics" in frf.message

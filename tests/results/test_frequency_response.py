@@ -73,7 +73,7 @@ def test_regime_of_asymmetric_law():
 def test_csv_round_trip_in_spec_column_order(reference_frf, tmp_path):
     path = reference_frf.to_csv(tmp_path / "frf.csv")
     header = path.read_text().splitlines()[0]
-    assert header == ",".join(FRF_COLUMNS)
+    assert header == ",".join((*FRF_COLUMNS, "harmonics"))  # SPEC §3 + §8
     data = read_csv(path)
     np.testing.assert_array_equal(data["omega"], reference_frf.omega)
     np.testing.assert_array_equal(data["rms"], reference_frf.rms)

@@ -8,7 +8,7 @@ from ._friction_response import friction_response
 from ._friction_subharmonics import friction_subharmonics
 from ._nonsmooth import RegularisationOptions, nonsmooth_response, nonsmooth_subharmonics
 from ._nonsmooth_orbit import nonsmooth_orbit
-from ._harmonics import adaptive_frequency_response, truncation_error
+from ._harmonics import AdaptiveHarmonics, adaptive_frequency_response, truncation_error
 from ._orbit import periodic_orbit
 from ._regimes import confirm_with_sweep, label_regions
 from ._steady import SteadyStateOptions, steady_state
@@ -18,5 +18,5 @@ __all__ = [
     "load_case", "Case", "frequency_response", "start_solution", "assemble", "time_sweep", "periodic_orbit", "compare",
     "steady_state", "SteadyStateOptions", "nonsmooth_response", "nonsmooth_subharmonics", "RegularisationOptions",
     "nonsmooth_orbit", "friction_response", "friction_subharmonics", "friction_orbit",
-    "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response",
+    "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response", "AdaptiveHarmonics",
 ]

@@ -268,6 +268,7 @@ def assemble(
         settings=dict(settings or {}),
         timings=timings,
         element_columns=element_cols,
+        extra_columns={"harmonics": np.full(P, hb.basis.harmonics, dtype=int)},  # H of each row (SPEC §8)
     )
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import asdict, replace
 from typing import Literal
 
 import numpy as np
@@ -19,6 +19,7 @@ from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..stability import stability_method
 from ._assemble import assemble, monitor_of
+from ._harmonics import AdaptiveHarmonics, follow_branch
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
 
 logger = logging.getLogger("rattle")
@@ -90,7 +91,8 @@ def frequency_response(
     samples: int | None = None,
     hb: HBOptions | None = None,
     period: int = 1,
-    start: Literal["low", "high"] = "low",
+    start: Literal["low", "high", "both"] = "low",
+    adaptive: AdaptiveHarmonics | None = AdaptiveHarmonics(),
     stability: StabilityMethod = "monodromy",
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
@@ -121,8 +123,17 @@ def frequency_response(
     ``"monodromy"`` the exact monodromy of the piecewise-linear linearisation about the HB
     orbit, or ``"hill"`` Hill's method), stability changes labelled.
 
-    If the run ends before the far end of the range, ``throw=True`` raises ConvergenceError
-    with the points computed so far in ``.partial``; ``throw=False`` returns them with the status.
+    ``harmonics`` is the starting H: with ``adaptive`` (default :class:`AdaptiveHarmonics`) H is
+    doubled on a stretch where its truncation error estimate exceeds the tolerance or where the
+    corrector fails even at the smallest step, and lowered again where the estimate allows; the
+    column ``harmonics`` (``extra_columns``) gives H per row. ``adaptive=None`` keeps H fixed.
+
+    Coverage: a branch that turns back and leaves the range at the side it started from, or
+    that ends early, does not cover the range; the branch through the other end is then
+    followed too (``start="both"`` always follows both and keeps the second where it is another
+    branch). What no branch covers is listed in ``settings["uncovered"]`` ([[Ω_lo, Ω_hi], …]) and
+    the status is ``UNCOVERED``: ``throw=True`` raises ConvergenceError with the points computed
+    in ``.partial``; ``throw=False`` returns them with the status.
 
     ``confirm_tori`` (default True): every ``torus`` region (an unstable stretch between two
     Neimark–Sacker points; only chains have them) is confirmed by one simulation from the
@@ -138,7 +149,8 @@ def frequency_response(
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     check_analysable_model(model)
     lo, hi = _limits.check_frequency_range(model, *check_range(omega))
-    _validate.check_choice(start, "start", ("low", "high"))
+    _validate.check_choice(start, "start", ("low", "high", "both"))
+    _validate.check_instance(adaptive, "adaptive", AdaptiveHarmonics, "an AdaptiveHarmonics (or None: H fixed)")
     stability = stability_method(stability)  # a name becomes its method object (rattle.stability)
     period = _limits.check_period(period)
     subharmonics = _validate.check_bool(subharmonics, "subharmonics")
@@ -155,7 +167,7 @@ def frequency_response(
     confirm_tori = _validate.check_bool(confirm_tori, "confirm_tori")
     result = _frequency_response(
         model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,
-        sweep=sweep, seeds=seeds, throw=throw, callback=callback,
+        sweep=sweep, seeds=seeds, throw=throw, callback=callback, adaptive=adaptive,
     )
     if confirm_tori and any(r.kind == "torus" for r in result.regions):
         from ._tori import confirm_tori as _confirm  # time domain: only when there is a torus
@@ -172,53 +184,74 @@ def _frequency_response(
     run: RunSettings,
     *,
     period: int = 1,
-    start: Literal["low", "high"] = "low",
+    start: Literal["low", "high", "both"] = "low",
     subharmonics: bool = False,
     max_period: int = 4,
     sweep: object | None = None,
     seeds: Sequence[tuple[float, int, FloatArray]] = (),
     throw: bool = True,
     callback: Callable[[BranchPoint], None] | None = None,
+    adaptive: AdaptiveHarmonics | None = None,
 ) -> FrequencyResponse:
     """frequency_response() after its arguments are checked: every option comes in ``run``."""
     lo, hi = omega_range
-    cont_opts, newton_opts, hb_opts, stability = run.continuation, run.newton, run.hb, run.stability
-    harmonics = hb_opts.harmonics
+    harmonics = run.hb.harmonics
     t_start = time.perf_counter()
-    hb = HarmonicBalance(model, hb_opts, period=period)
-    omega0 = lo if start == "low" else hi
-    try:
-        q0, how = start_solution(hb, omega0, newton_opts, continuation=cont_opts)
-    except ConvergenceError:
-        if throw:
-            raise
-        q0, how = hb.linear_solution(omega0), "failed"
-    stepper = ContinuationStepper(hb, q0, omega0, (lo, hi), cont_opts, newton_opts, monitor=monitor_of(hb))
-    while (pt := stepper.step()) is not None:
-        if callback is not None:
-            callback(pt)
+    first_end = "high" if start == "high" else "low"
+    primary, status, message = _branch_from_end(model, run, first_end, omega_range, period=period, adaptive=adaptive,
+                                                callback=callback, branch_id=0)
+    branches = [primary]
+    covered = [_extent(primary)]
+    other_end = "low" if first_end == "high" else "high"
+    budget_spent = status in (Status.MAX_STEPS, Status.MAX_TIME)  # the user's limit: not spent again
+    if start == "both" or (_uncovered(omega_range, covered) and not budget_spent):
+        second, status2, message2 = _branch_from_end(model, run, other_end, omega_range, period=period,
+                                                     adaptive=adaptive, callback=callback, branch_id=1)
+        same = (len(primary) and len(second) and _reaches(primary, other_end, omega_range)
+                and _reaches(second, first_end, omega_range))
+        if len(second) and not same:  # another branch (the one through the other end)
+            branches.append(second)
+            covered.append(_extent(second))
+            message = f"{message}; from the {other_end} end: {message2}"
+    uncovered = _uncovered(omega_range, covered)
+    if uncovered:
+        # A range not covered is never success: a branch that returned (or a later one that was
+        # complete) leaves the status UNCOVERED; a failure keeps its own status and reason.
+        if status.success:
+            status = Status.UNCOVERED
+        message = (f"{message}; not covered by any branch: "
+                   + ", ".join(f"Ω = {a:.6g} … {b:.6g}" for a, b in uncovered))
+    elif not status.success or status is Status.RETURNED:
+        status = Status.SUCCESS  # the branches through the two ends cover the range together
     t_cont = time.perf_counter()
-    points = stepper.points
-    status = stepper.status or Status.START_FAILED
-    message = stepper.message
-    if status is Status.STEP_TOO_SMALL:
+    if uncovered and any(b.settings.get("end_status") == Status.STEP_TOO_SMALL.name for b in branches):
         # Where the corrector fails even at the smallest step, the truncated problem usually has
         # no solution there: an orbit through stiff stages (a gear mesh stiffer than the rest of
         # the chain) needs more harmonics than the range's low end can be resolved with.
-        message += (f"; with {harmonics} harmonics the truncated problem may have no solution beyond this "
-                    f"point (impacts on a stiff stage need many harmonics): give more harmonics "
-                    f"(e.g. {min(2 * harmonics, _limits.MAX_HARMONICS)}) or start the range elsewhere")
-    logger.info("continuation: %d points, %s (%s)", len(points), status.name, message)
-    result = assemble(
-        model, hb, points, stability=stability, newton=newton_opts, status=status, message=message,
-        settings={
-            "omega": [lo, hi], **run.record(), "period": period,
-            "start": start, "start_solution": how, "rejected_steps": stepper.rejected,
-            "rejected_by_monitor": stepper.monitor_rejected,
-            "origin": f"continuation from the {start} end of the range",
-        },
-        timings={"continuation": t_cont - t_start},
-    )
+        if adaptive is None:
+            message += (f"; with {harmonics} harmonics the truncated problem may have no solution beyond this "
+                        f"point (impacts on a stiff stage need many harmonics): give more harmonics "
+                        f"(e.g. {min(2 * harmonics, _limits.MAX_HARMONICS)}), let them adapt (the default) "
+                        "or start the range elsewhere")
+        else:
+            top = max(int(s["harmonics"]) for b in branches for s in b.settings.get("stretches", [])) \
+                if any(b.settings.get("stretches") for b in branches) else harmonics
+            message += (f"; the corrector failed even at the smallest step with up to {top} harmonics: the "
+                        "truncated problem may have no solution there (impacts on a stiff stage need many "
+                        "harmonics, a chaotic motion has no periodic branch to follow): give a larger "
+                        "`max_harmonics` (AdaptiveHarmonics), or start the range elsewhere")
+    logger.info("continuation: %d points, %s (%s)", sum(len(b) for b in branches), status.name, message)
+    settings = {
+        "omega": [lo, hi], **run.record(), "period": period, "start": start,
+        "start_solution": primary.settings.get("start_solution"),
+        "rejected_steps": sum(int(b.settings.get("rejected_steps", 0)) for b in branches),
+        "rejected_by_monitor": sum(int(b.settings.get("rejected_by_monitor", 0)) for b in branches),
+        "origin": f"continuation from the {first_end} end of the range",
+        "uncovered": [[a, b] for a, b in uncovered],
+        "adaptive_harmonics": None if adaptive is None else asdict(adaptive),
+    }
+    result = FrequencyResponse.concatenate(branches, status=status, message=message, settings=settings,
+                                           timings={**primary.timings, "continuation": t_cont - t_start})
     if subharmonics and status.success:
         if isinstance(max_period, bool) or not isinstance(max_period, int) or max_period < 1:
             raise ValueError(f"`max_period` must be an integer >= 1, got {max_period!r}")
@@ -227,7 +260,10 @@ def _frequency_response(
         t_sub = time.perf_counter()
         from ._branches import seed_from_state, seeded_branches, sweep_seeds
 
-        extra = period_doubling_branches(result, (lo, hi), max_period=max_period, run=run)
+        extra: list[FrequencyResponse] = []
+        for primary_b in branches:
+            extra += period_doubling_branches(primary_b, (lo, hi), max_period=max_period, run=run,
+                                              first_branch=len(branches) + len(extra))
         seed_list = []
         for k, seed in enumerate(seeds):
             try:
@@ -243,14 +279,15 @@ def _frequency_response(
         if sweep is not None:
             seed_list += sweep_seeds(known, sweep, harmonics_per_period=harmonics, run=run)
         if seed_list:
-            extra += seeded_branches(known, seed_list, (lo, hi), run=run, first_branch=1 + len(extra))
+            extra += seeded_branches(known, seed_list, (lo, hi), run=run, first_branch=len(branches) + len(extra))
         timings = dict(result.timings)
         timings["subharmonics"] = time.perf_counter() - t_sub
         settings = dict(result.settings, subharmonics=True, max_period=max_period,
-                        branches=[_branch_record(result), *(_branch_record(b) for b in extra)])
+                        branches=[*(_branch_record(b) for b in branches), *(_branch_record(b) for b in extra)])
         result = FrequencyResponse.concatenate([result, *extra], settings=settings, timings=timings)
     else:
-        result = replace(result, settings=dict(result.settings, subharmonics=False, branches=[_branch_record(result)]))
+        result = replace(result, settings=dict(result.settings, subharmonics=False,
+                                               branches=[_branch_record(b) for b in branches]))
     if len(result):
         from ._regimes import confirm_with_sweep, label_regions
 
@@ -263,10 +300,96 @@ def _frequency_response(
     return result
 
 
+def _branch_from_end(model: Model, run: RunSettings, end: str, omega_range: tuple[float, float], *, period: int,
+                     adaptive: AdaptiveHarmonics | None, callback: Callable[[BranchPoint], None] | None,
+                     branch_id: int) -> tuple[FrequencyResponse, Status, str]:
+    """The branch through the start solution at the ``end`` ("low"/"high") of the range, followed
+    into it (H per stretch with ``adaptive``), assembled with its stability, special points and
+    the column ``harmonics``: (result, status, message). RETURNED when it leaves the range at
+    the side it started from; an empty result (START_FAILED) when no start solution is found."""
+    lo, hi = omega_range
+    omega0 = lo if end == "low" else hi
+    hb = HarmonicBalance(model, run.hb, period=period)
+    try:
+        q0, how = start_solution(hb, omega0, run.newton, continuation=run.continuation)
+    except ConvergenceError as exc:
+        empty = assemble(model, hb, [], stability=run.stability, newton=run.newton, status=Status.START_FAILED,
+                         message=str(exc), branch_id=branch_id,
+                         settings={"start_solution": "failed", "end_status": Status.START_FAILED.name})
+        return empty, Status.START_FAILED, str(exc)
+    stretches = follow_branch(model, run, q0, omega0, omega_range, period=period, adaptive=adaptive,
+                              callback=callback)
+    last = stretches[-1].stepper
+    status = last.status or Status.START_FAILED
+    points = [pt for st in stretches for pt in st.points]
+    if status is Status.SUCCESS and points and points[-1].p == omega0 and len(points) > 1:
+        status = Status.RETURNED  # a restarted stretch (tangent start) cannot tell: the branch can
+    message = last.message if status is not Status.RETURNED or last.message != Status.SUCCESS.message \
+        else Status.RETURNED.message
+    if status is Status.RETURNED:
+        message = Status.RETURNED.message
+    parts = []
+    for st in stretches:
+        if not st.points:
+            continue
+        part = assemble(model, st.hb, st.points, stability=run.stability, newton=run.newton, branch_id=branch_id,  # type: ignore[arg-type]
+                        status=status, message=message, settings={})
+        parts.append(part)
+    rejected = sum(st.stepper.rejected for st in stretches)
+    by_monitor = sum(st.stepper.monitor_rejected for st in stretches)
+    settings = {"start_solution": how, "rejected_steps": rejected, "rejected_by_monitor": by_monitor,
+                "end_status": status.name, **run.record(),
+                "stretches": [{"harmonics": st.hb.basis.harmonics, "points": len(st.points),  # type: ignore[attr-defined]
+                               "omega": [st.points[0].p, st.points[-1].p] if st.points else None,
+                               "ended": st.ended or status.name.lower()} for st in stretches],
+                "origin": f"continuation from the {end} end of the range"}
+    if not parts:
+        empty = assemble(model, hb, [], stability=run.stability, newton=run.newton, status=status, message=message,
+                         branch_id=branch_id, settings=settings)
+        return empty, status, message
+    branch = FrequencyResponse.concatenate(parts, status=status, message=message, settings=settings)
+    return branch, status, message
+
+
+def _extent(branch: FrequencyResponse) -> tuple[float, float] | None:
+    """The Ω interval a connected branch covers (None when empty)."""
+    return (float(branch.omega.min()), float(branch.omega.max())) if len(branch) else None
+
+
+def _reaches(branch: FrequencyResponse, end: str, omega_range: tuple[float, float]) -> bool:
+    lo, hi = omega_range
+    ext = _extent(branch)
+    tol = 1e-9 * hi
+    return ext is not None and (ext[0] <= lo + tol if end == "low" else ext[1] >= hi - tol)
+
+
+def _uncovered(omega_range: tuple[float, float], covered: Sequence[tuple[float, float] | None]) -> list[tuple[float, float]]:
+    """The parts of ``omega_range`` outside every interval of ``covered`` (to 1e-9 relative)."""
+    lo, hi = omega_range
+    tol = 1e-9 * hi
+    gaps = [(lo, hi)]
+    for iv in covered:
+        if iv is None:
+            continue
+        a, b = iv
+        nxt = []
+        for g0, g1 in gaps:
+            if b < g0 - tol or a > g1 + tol:
+                nxt.append((g0, g1))
+                continue
+            if a > g0 + tol:
+                nxt.append((g0, a))
+            if b < g1 - tol:
+                nxt.append((b, g1))
+        gaps = nxt
+    return [(a, b) for a, b in gaps if b - a > tol]
+
+
 def _branch_record(branch: FrequencyResponse) -> dict:
     """The settings one branch was computed with (``assemble``'s ``settings``), tagged with its id."""
     b = int(branch.branch[0]) if len(branch) else 0
-    keep = ("harmonics", "samples", "samples_given", "stability", "newton", "continuation", "origin")
+    keep = ("harmonics", "samples", "samples_given", "stability", "newton", "continuation", "origin", "stretches",
+            "end_status")
     return {"branch": b, "period": int(branch.period[0]) if len(branch) else None,
             **{k: branch.settings[k] for k in keep if k in branch.settings}}
 

@@ -107,7 +107,8 @@ _quiet_option = click.option(
 # --------------------------------------------------------------------------------------------
 def compute_frf(
     model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], t_start: float,
-    *, subharmonics: bool = False, names: Sequence[str] = FRF_FILES,
+    *, subharmonics: bool = False, names: Sequence[str] = FRF_FILES, start: str = "low",
+    fixed_harmonics: bool = False,
 ) -> Any:
     """The frequency response; on a numerical failure the points computed before it are
     written (frf.csv, frf.json, frf.png, as the command's whole set ``names``: files of an
@@ -115,7 +116,11 @@ def compute_frf(
     naming the files."""
     from ..analysis import frequency_response  # only now: all input has been validated
 
-    extra = {"subharmonics": True} if subharmonics else {}
+    extra: dict[str, Any] = {"subharmonics": True} if subharmonics else {}
+    if start != "low":
+        extra["start"] = start
+    if fixed_harmonics:
+        extra["adaptive"] = None
     logger.info("computing the frequency response over %g … %g rad/s with %d harmonics",
                 analysis.omega_min, analysis.omega_max, analysis.harmonics)
     try:
@@ -143,7 +148,7 @@ def compute_frf(
 
 def run_frf(
     model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False,
-    paths: Sequence[Any] = (),
+    paths: Sequence[Any] = (), start: str = "low", fixed_harmonics: bool = False,
 ) -> None:
     """Compute the frequency response, write the three files and print the summary.
 
@@ -160,6 +165,10 @@ def run_frf(
         Also follow the period-doubled branches (every branch goes into the files).
     paths : sequence of SoundPath, default ()
         The configuration's ``[[paths]]``: when given, frf.csv gets the column ``spl_db``.
+    start : {"low", "high", "both"}, default "low"
+        The end the branch is started from (``frequency_response(start=...)``).
+    fixed_harmonics : bool, default False
+        Keep H fixed (``frequency_response(adaptive=None)``).
 
     Raises
     ------
@@ -168,7 +177,8 @@ def run_frf(
         when the error carries them in ``.partial``.
     """
     t_start = time.perf_counter()
-    result = compute_frf(model, analysis, output, sections, t_start, subharmonics=subharmonics)
+    result = compute_frf(model, analysis, output, sections, t_start, subharmonics=subharmonics, start=start,
+                         fixed_harmonics=fixed_harmonics)
     if paths:  # SPEC §6: the sound pressure level at the receiver, per point
         result = result.with_sound(tuple(paths))
     written = write_frf(result, output, sections, t_start)
@@ -259,9 +269,16 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
 @click.option("--subharmonics", is_flag=True, default=False,
               help="Also follow the sub-harmonic (period-doubled) branches born at every period-doubling "
                    "point; all branches go into frf.csv (columns branch, period) and frf.png.")
+@click.option("--start", type=click.Choice(["low", "high", "both"]), default="low", show_default=True,
+              help="Where the branch is started: the low or the high end of the range (a branch that does not "
+                   "cover the range is followed from the other end too), or both ends always.")
+@click.option("--fixed-harmonics", is_flag=True, default=False,
+              help="Keep H = --harmonics on the whole range (by default H is raised where the truncation "
+                   "error or a failing corrector demands it, up to 128, and lowered again where it allows).")
 def frf_command(
     config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
-    rpm_min: float | None, rpm_max: float | None, subharmonics: bool,
+    rpm_min: float | None, rpm_max: float | None, subharmonics: bool, start: str = "low",
+    fixed_harmonics: bool = False,
 ) -> None:
     """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
 
@@ -279,13 +296,14 @@ def frf_command(
         omega_max=w_max,
     )
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
-               "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None}
+               "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None,
+               "start": None if start == "low" else start, "fixed_harmonics": True if fixed_harmonics else None}
     if run_config.discontinuous:
         run_nonsmooth_frf(run_config, analysis, output, sections("frf", config, run_config, analysis, options),
                           subharmonics=subharmonics)
         return
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
-            subharmonics=subharmonics, paths=run_config.paths)
+            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics)
 
 
 # --------------------------------------------------------------------------------------------

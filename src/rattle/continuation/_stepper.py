@@ -208,6 +208,9 @@ class ContinuationStepper:
             self._finish(Status.MAX_TIME, f"{Status.MAX_TIME.message} ({opts.max_time} s, last {self.symbol} = {self.points[-1].p:.6g})")
             return None
         lo, hi = self.p_range
+        turns: list[float] = []  # the turns of the trials rejected in a row for turning too much
+        ds_first = self._ds  # the step tried first (before any halving)
+        kink = False
         while True:
             ds = self._ds
             y_pred, normal = self.predictor.predict(self._y, self._t, ds, self._y_prev)
@@ -216,7 +219,14 @@ class ContinuationStepper:
             at_floor = ds <= opts.min_step * 1.0000001
             if corr is not None and t_new is not None:
                 turn = math.acos(min(1.0, float(t_new @ self._t)))
-                if turn <= opts.max_turn or at_floor:
+                # A kink of the branch (a contact switching on or off: the tangent jumps there) turns
+                # the tangent by the same angle however short the step; on a smooth branch the turn
+                # shrinks with the step. A turn that two halvings of the step in a row each left at
+                # more than 3/4 of itself is a kink: taken in one step (the monitor below still
+                # checks the segment: no zero of a test function is stepped over).
+                kink = turn > opts.max_turn and len(turns) >= 2 and turn >= 0.75 * turns[-1] \
+                    and turns[-1] >= 0.75 * turns[-2]
+                if turn <= opts.max_turn or at_floor or kink:
                     reading = self._read(corr.y, t_new)
                     if reading is None or self._reading is None:
                         verdict = None
@@ -230,6 +240,10 @@ class ContinuationStepper:
                         break
                     self.monitor_rejected += 1
             self.rejected += 1
+            if corr is not None and t_new is not None and turn > opts.max_turn:
+                turns.append(turn)
+            else:
+                turns.clear()
             if at_floor:
                 _, p = corr_.unscale(self._y)
                 self._finish(
@@ -267,6 +281,8 @@ class ContinuationStepper:
         # Step control from the iteration count and the tangent's turn.
         f_it = opts.target_iterations / max(corr.iterations, 1)
         f_turn = opts.target_turn / max(turn, 1e-12)
+        if kink:  # the turn was the kink's, not the branch's curvature: go on with the step tried first
+            ds, f_turn = ds_first, 2.0
         factor = min(max(min(f_it, f_turn), 0.5), 2.0)
         if verdict is not None:
             factor = min(factor, max(verdict.factor, 0.25))

@@ -87,8 +87,20 @@ def branch_label(frf: "FrequencyResponse", branch: int) -> str:
 
 
 def _harmonics_text(frf: "FrequencyResponse") -> str:
+    """``H = 32``, or ``H = 32–128`` where H adapted along the branches (the rows' ``harmonics``)."""
+    text = getattr(frf, "harmonics_text", None)
+    if callable(text):
+        return f"H = {text()}"
     h = frf.settings.get("harmonics", frf.harmonics) if isinstance(frf.settings, dict) else frf.harmonics
     return f"H = {h}"
+
+
+def draw_uncovered(frf: "FrequencyResponse", ax: Any) -> None:
+    """Shade the parts of the range no branch covers (``frf.uncovered``), labelled ``not covered``."""
+    gaps = getattr(frf, "uncovered", None) or []
+    scale = speed_axis(frf)[0]
+    for k, (a, b) in enumerate(gaps):
+        ax.axvspan(a * scale, b * scale, color="0.85", zorder=0, label="not covered (no branch found)" if k == 0 else None)
 
 
 def draw_branches(
@@ -342,6 +354,7 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
                 shown: Sequence[Any], legend: str, *, element: int = 0, label: str = "") -> None:
     """One frequency-response panel: column ``key`` (``quantity`` of element ``element``)."""
     colors = draw_branches(frf, ax, key)
+    draw_uncovered(frf, ax)
     if special_points:
         draw_special_points(frf, ax, key)
     if linear and quantity in ("mean", "rms", "rms_ac"):
@@ -360,5 +373,6 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
 
 __all__ = [
     "frequency_response_plot", "column", "speed_axis", "draw_branches", "draw_special_points", "draw_regions", "place_legend",
+    "draw_uncovered",
     "branch_colors", "branch_label", "true_runs", "SPECIAL_POINT_STYLES", "QUANTITY_LABELS",
 ]

@@ -180,19 +180,25 @@ class FrequencyResponse:
         )
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The SPEC columns in order, as a dict of arrays; for a chain also, per element NAME,
-        ``NAME_mean … NAME_regime`` (SPEC §5, :data:`ELEMENT_COLUMNS`); with an engine
-        (SPEC §6) ``speed_rpm``; then the extra columns (``spl_db``)."""
+        """The SPEC columns in order, as a dict of arrays; ``harmonics`` (H of each row, SPEC §8);
+        for a chain also, per element NAME, ``NAME_mean … NAME_regime`` (SPEC §5,
+        :data:`ELEMENT_COLUMNS`); with an engine (SPEC §6) ``speed_rpm``; then the other extra
+        columns (``spl_db``)."""
         rpm = self.speed_rpm
         speed = {} if rpm is None else {"speed_rpm": rpm}
-        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **self.element_columns, **speed,
-                **self.extra_columns}
+        extra = dict(self.extra_columns)
+        harmonics = {} if "harmonics" not in extra else {"harmonics": extra.pop("harmonics")}
+        return {**{name: getattr(self, name) for name in FRF_COLUMNS}, **harmonics, **self.element_columns, **speed,
+                **extra}
 
     @property
     def column_names(self) -> list[str]:
-        """Names of :meth:`columns` in file order."""
+        """Names of :meth:`columns` in file order: the SPEC §3 columns, ``harmonics`` (H of each
+        row, SPEC §8), the element columns, ``speed_rpm``, the other extra columns."""
         speed = [] if getattr(self.model, "speed_order", None) is None else ["speed_rpm"]
-        return [*FRF_COLUMNS, *self.element_columns, *speed, *self.extra_columns]
+        harmonics = ["harmonics"] if "harmonics" in self.extra_columns else []
+        return [*FRF_COLUMNS, *harmonics, *self.element_columns, *speed,
+                *(k for k in self.extra_columns if k != "harmonics")]
 
     @property
     def speed_rpm(self) -> FloatArray | None:
@@ -217,14 +223,20 @@ class FrequencyResponse:
         """A few lines for the terminal."""
         lines = [
             f"{len(self)} solution points over Ω = {self.omega.min():.4g} … {self.omega.max():.4g} "
-            f"(H = {self.settings.get('harmonics', self.harmonics)} harmonics per forcing period), {int(np.sum(~self.stable))} unstable",
+            f"(H = {self.harmonics_text()} harmonics per forcing period), {int(np.sum(~self.stable))} unstable",
             f"status: {self.status.name.lower()} — {self.message or self.status.message}",
         ]
+        order = getattr(self.model, "speed_order", None)
+        gaps = self.uncovered
+        if gaps:
+            lines.append("not covered (no branch found there): " + ", ".join(
+                f"Ω = {a:.5g} … {b:.5g}" + ("" if order is None else
+                                            f" ({a * 60.0 / (2.0 * np.pi * order):.5g} … {b * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
+                for a, b in gaps))
         if len(np.unique(self.branch)) > 1:
             lines.append("branches: " + ", ".join(
                 f"{b} (period {int(self.period[self.branch == b][0])}, Ω = {self.omega[self.branch == b].min():.4g}…{self.omega[self.branch == b].max():.4g})"
                 for b in np.unique(self.branch)))
-        order = getattr(self.model, "speed_order", None)
         if order is not None:
             rpm = self.speed_rpm
             lines.append(f"engine speed {rpm.min():.5g} … {rpm.max():.5g} rpm (Ω = {order:g} × crankshaft speed)")
@@ -242,13 +254,33 @@ class FrequencyResponse:
             lines.append("time: " + ", ".join(f"{k} {v:.3g} s" for k, v in self.timings.items()))
         return "\n".join(lines)
 
+    @property
+    def uncovered(self) -> list[tuple[float, float]]:
+        """The parts (Ω_lo, Ω_hi) of the analysed range that no branch covers (SPEC §8; empty
+        when the branches cover all of it)."""
+        return [(float(a), float(b)) for a, b in self.settings.get("uncovered", []) or []]
+
+    def harmonics_text(self) -> str:
+        """The harmonic count(s) of the rows: ``32``, or ``32–128`` where H adapted along the branch."""
+        col = self.extra_columns.get("harmonics")
+        if col is None or not len(col):
+            return str(self.settings.get("harmonics", self.harmonics))
+        lo, hi = int(np.min(col)), int(np.max(col))
+        return str(lo) if lo == hi else f"{lo}–{hi}"
+
     def metadata(self) -> dict[str, Any]:
-        """Settings, timings, status and special points, JSON-serialisable."""
+        """Settings, timings, status, the uncovered parts of the range (``uncovered``, Ω and, with
+        an engine, ``uncovered_rpm``) and special points, JSON-serialisable."""
+        order = getattr(self.model, "speed_order", None)
+        gaps = self.uncovered
+        rpm = {} if order is None else {"uncovered_rpm": [[a * 60.0 / (2.0 * np.pi * order),
+                                                         b * 60.0 / (2.0 * np.pi * order)] for a, b in gaps]}
         return {
             "settings": self.settings,
             "timings": self.timings,
             "status": self.status.name.lower(),
             "message": self.message or self.status.message,
+            "uncovered": [[a, b] for a, b in gaps], **rpm,
             "points": len(self),
             "regions": [g.to_dict() for g in self.regions],
             "special_points": [
