@@ -233,9 +233,6 @@ def test_nul_in_a_path_table_name_is_refused(tmp_path: Path, command: str) -> No
     assert_bad_input(result, "NUL byte", "path table")
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError, reason=(
-    "click.Path converts the argument with os.stat, which raises ValueError on a NUL byte; the fix is in "
-    "the front door (cli/commands.py or cli/app.py, another engineer's): see the issue 28 report"))
 @pytest.mark.parametrize("args", [["frf", "ca\x00se.toml"], ["compare", "case.toml", "--measured", "ru\x00n.csv"]],
                          ids=["CONFIG", "--measured"])
 def test_nul_in_a_path_argument_is_refused(tmp_path: Path, no_solver: None, args: list[str]) -> None:

@@ -275,6 +275,28 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
         _State.mode = self._mode
 
 
+def report(signum: int) -> None:
+    """Write the interruption's line for ``signum`` once, with the handled signals blocked while
+    it is written and marked: a further signal then (the handlers back in exit mode) ends the
+    process without writing it again, and cannot end it before it is written."""
+    mask = None
+    try:
+        mask = _signal.pthread_sigmask(_signal.SIG_BLOCK, HANDLED)
+    except (AttributeError, OSError, ValueError):  # pragma: no cover - no pthread_sigmask here
+        pass
+    try:
+        if not _State.reported:
+            try:  # through sys.stderr (what a caller capturing it sees); no handler runs meanwhile
+                sys.stderr.write(f"rattle: error: {message(signum)}\n")
+                sys.stderr.flush()
+                _State.reported = True
+            except Exception:  # a closed or broken stream
+                _write_line(message(signum))
+    finally:
+        if mask is not None:
+            _signal.pthread_sigmask(_signal.SIG_SETMASK, mask)
+
+
 def mark_reported() -> None:
     """The interruption's line has been written (a later signal does not write it again)."""
     _State.reported = True

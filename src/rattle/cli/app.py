@@ -140,8 +140,7 @@ class RattleGroup(click.Group):
                 reset_verbose()
         except KeyboardInterrupt as exc:  # a signal while the command ran (a later one is noted only)
             signum = exc.signum if isinstance(exc, Interrupted) else int(_signals.interrupted_by() or _SIGINT)
-            error(_signals.message(signum))
-            _signals.mark_reported()
+            _signals.report(signum)  # once, whatever a further signal does meanwhile
             return 128 + signum
 
     def invoke(self, ctx: click.Context) -> Any:
@@ -193,6 +192,10 @@ class RattleGroup(click.Group):
             if type(exc).__name__ == "LinAlgError":  # numpy.linalg's, without importing numpy here
                 error(f"numerical failure: {one_line(exc)} (a singular or non-finite linear system)")
                 return EXIT_NUMERICAL
+            if isinstance(exc, ValueError) and "embedded null byte" in str(exc):  # click's os.stat of a path
+                error("a path argument contains a NUL byte (\\x00), which no file name can hold; check how the "
+                      "command line was built")
+                return EXIT_BAD_INPUT
             # The library validates its arguments with ValueError/TypeError naming the argument
             # (a combination the CLI's own checks did not anticipate): bad input, not a crash.
             if "`" not in str(exc):
