@@ -140,7 +140,7 @@ def test_unknown_keyword_raises():
 
 def test_frequency_response_stopped_by_a_failing_corrector_says_to_raise_the_harmonics(reference_model, monkeypatch):
     from rattle.analysis import _frequency_response as frf_module
-    from rattle.analysis import _harmonics as harmonics_module
+    from rattle.analysis import _stretches as harmonics_module
 
     monkeypatch.setattr(frf_module, "HarmonicBalance", _NoSolutionAbove)
     monkeypatch.setattr(harmonics_module, "HarmonicBalance", _NoSolutionAbove)
@@ -159,7 +159,7 @@ def test_a_failing_corrector_raises_the_harmonics_on_that_stretch(reference_mode
     max_harmonics; a problem that has no solution there with any H still ends, naming it."""
     from rattle.analysis import AdaptiveHarmonics
     from rattle.analysis import _frequency_response as frf_module
-    from rattle.analysis import _harmonics as harmonics_module
+    from rattle.analysis import _stretches as harmonics_module
 
     monkeypatch.setattr(frf_module, "HarmonicBalance", _NoSolutionAbove)
     monkeypatch.setattr(harmonics_module, "HarmonicBalance", _NoSolutionAbove)

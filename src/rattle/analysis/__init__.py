@@ -8,7 +8,8 @@ from ._friction_response import friction_response
 from ._friction_subharmonics import friction_subharmonics
 from ._nonsmooth import RegularisationOptions, nonsmooth_response, nonsmooth_subharmonics
 from ._nonsmooth_orbit import nonsmooth_orbit
-from ._harmonics import AdaptiveHarmonics, adaptive_frequency_response, truncation_error
+from ._harmonics import adaptive_frequency_response, truncation_error
+from ._stretches import AdaptiveHarmonics
 from ._orbit import periodic_orbit
 from ._regimes import confirm_with_sweep, label_regions
 from ._steady import SteadyStateOptions, steady_state

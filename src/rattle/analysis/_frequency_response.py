@@ -19,7 +19,7 @@ from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..stability import stability_method
 from ._assemble import assemble, monitor_of
-from ._harmonics import AdaptiveHarmonics, follow_branch
+from ._stretches import AdaptiveHarmonics, follow_branch
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
 
 logger = logging.getLogger("rattle")
