@@ -28,7 +28,6 @@ from ..hb import HarmonicBalance, resize_harmonics
 from ..model import Model
 
 
-# ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True, slots=True)
 class AdaptiveHarmonics:
     """Harmonics raised and lowered along a branch, stretch by stretch (the default of
