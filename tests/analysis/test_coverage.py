@@ -63,8 +63,9 @@ def test_a_branch_that_returns_is_followed_from_the_other_end():
     assert ends == ["RETURNED", "SUCCESS"]
     assert frf.omega[frf.branch == 0].max() == pytest.approx(0.698, abs=2e-3)
     assert frf.omega[frf.branch == 1].min() == pytest.approx(0.3) and frf.omega[frf.branch == 1].max() == pytest.approx(2.0)
-    # start="high" finds the covering branch first; "both" keeps the returning one too
-    high = rattle.frequency_response(model, omega=(0.3, 2.0), start="high")
+    # start="high" finds the covering branch first (and, without the sweep check, only it);
+    # "both" keeps the returning one too
+    high = rattle.frequency_response(model, omega=(0.3, 2.0), start="high", check=None)
     assert high.status is Status.SUCCESS and len(np.unique(high.branch)) == 1
     both = rattle.frequency_response(model, omega=(0.3, 2.0), start="both")
     assert len(np.unique(both.branch)) == 2
@@ -102,3 +103,25 @@ def test_kinks_of_the_branch_cost_one_step():
     found = sorted((s.kind, round(s.omega, 4)) for s in frf.special_points)
     assert found == sorted([("fold", 0.6534), ("fold", 0.6983), ("period_doubling", 0.726), ("period_doubling", 0.678),
                             ("neimark_sacker", 0.6115), ("neimark_sacker", 0.5819)])
+
+
+def test_an_attractor_the_start_misses_is_continued_from_the_sweep():
+    """Started at the high end, the continuation follows the branch that covers the range and
+    misses the one a run-up from 0.3 settles on (stable, returning at Ω = 0.698). The default
+    exact up/down sweep finds its motion unexplained and continues it as a branch; without the
+    check it is missing."""
+    from rattle.analysis import SweepCheck
+
+    model = Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=Backlash(b=1.0),
+                  excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
+    frf = rattle.frequency_response(model, omega=(0.3, 2.0), start="high")
+    assert len(np.unique(frf.branch)) == 2
+    missed = frf.branch == 1
+    assert frf.omega[missed].min() == pytest.approx(0.3) and frf.omega[missed].max() == pytest.approx(0.698, abs=2e-3)
+    assert frf.stable[missed].any()
+    check = frf.settings["sweep_check"]
+    assert check["seeded"] and check["seeded"][0][0] == pytest.approx(0.3)
+    without = rattle.frequency_response(model, omega=(0.3, 2.0), start="high", check=None)
+    assert len(np.unique(without.branch)) == 1 and without.settings["sweep_check"] is None
+    with pytest.raises(ValueError, match="`points`"):
+        SweepCheck(points=1)

@@ -10,6 +10,7 @@ from ._nonsmooth import RegularisationOptions, nonsmooth_response, nonsmooth_sub
 from ._nonsmooth_orbit import nonsmooth_orbit
 from ._harmonics import adaptive_frequency_response, truncation_error
 from ._stretches import AdaptiveHarmonics
+from ._sweep_check import SweepCheck
 from ._orbit import periodic_orbit
 from ._regimes import confirm_with_sweep, label_regions
 from ._steady import SteadyStateOptions, steady_state
@@ -20,4 +21,5 @@ __all__ = [
     "steady_state", "SteadyStateOptions", "nonsmooth_response", "nonsmooth_subharmonics", "RegularisationOptions",
     "nonsmooth_orbit", "friction_response", "friction_subharmonics", "friction_orbit",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response", "AdaptiveHarmonics",
+    "SweepCheck",
 ]

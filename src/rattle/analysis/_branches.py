@@ -301,7 +301,7 @@ def branch_from_seed(
                     settings=run.record(hb_opts, period=period, origin=f"seed at Ω = {omega:.6g}"))
 
 
-def _explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rtol: float) -> bool:
+def explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rtol: float) -> bool:
     """Whether a stable stretch of a period-``period`` branch crosses Ω with that rms."""
     for b in np.unique(frf.branch[frf.period == period]):
         rows = np.nonzero(frf.branch == b)[0]
@@ -334,7 +334,7 @@ def sweep_seeds(frf: FrequencyResponse, sweep: object, *, harmonics_per_period: 
         if n < 2:
             continue
         rms = float(np.asarray(sweep.rms)[j])  # type: ignore[attr-defined]
-        if _explained(frf, n, float(w), rms, rtol):
+        if explained(frf, n, float(w), rms, rtol):
             continue
         if any(abs(s[0] - w) <= step + 1e-12 and s[1] == n for s in seeds):
             continue  # one seed per stretch of unexplained motion
@@ -381,7 +381,7 @@ def seeded_branches(
     for w, n, q in seeds:
         known = FrequencyResponse.concatenate([frf, *out]) if out else frf
         rms = float(np.sqrt(q[0] ** 2 + 0.5 * np.sum(q[1:] ** 2)))
-        if _explained(known, n, w, rms, 1e-3):
+        if explained(known, n, w, rms, 1e-3):
             continue
         H = (q.size - 1) // 2
         branch = branch_from_seed(frf.model, w, q, n, omega_range, H, continuation=continuation, newton=newton,
@@ -392,4 +392,4 @@ def seeded_branches(
     return out
 
 
-__all__ += ["branch_from_seed", "sweep_seeds", "seed_from_state", "seeded_branches"]
+__all__ += ["branch_from_seed", "sweep_seeds", "seed_from_state", "seeded_branches", "explained"]

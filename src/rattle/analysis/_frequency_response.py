@@ -6,7 +6,7 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from ..results import FrequencyResponse
 from ..stability import stability_method
 from ._assemble import assemble, monitor_of
 from ._stretches import AdaptiveHarmonics, follow_branch
+from ._sweep_check import SweepCheck, missed_branches
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
 
 logger = logging.getLogger("rattle")
@@ -93,6 +94,7 @@ def frequency_response(
     period: int = 1,
     start: Literal["low", "high", "both"] = "low",
     adaptive: AdaptiveHarmonics | None = AdaptiveHarmonics(),
+    check: SweepCheck | None = SweepCheck(),
     stability: StabilityMethod = "monodromy",
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
@@ -128,6 +130,11 @@ def frequency_response(
     corrector fails even at the smallest step, and lowered again where the estimate allows; the
     column ``harmonics`` (``extra_columns``) gives H per row. ``adaptive=None`` keeps H fixed.
 
+    ``check`` (default :class:`SweepCheck`): an exact up/down sweep over the range (24
+    frequencies each way); every period-1 motion it settles on that no stable computed stretch
+    explains (Ω and rms within 1 %) is continued as a branch of its own (``check=None`` skips it;
+    ``settings["sweep_check"]`` records what it saw).
+
     Coverage: a branch that turns back and leaves the range at the side it started from, or
     that ends early, does not cover the range; the branch through the other end is then
     followed too (``start="both"`` always follows both and keeps the second where it is another
@@ -151,6 +158,7 @@ def frequency_response(
     lo, hi = _limits.check_frequency_range(model, *check_range(omega))
     _validate.check_choice(start, "start", ("low", "high", "both"))
     _validate.check_instance(adaptive, "adaptive", AdaptiveHarmonics, "an AdaptiveHarmonics (or None: H fixed)")
+    _validate.check_instance(check, "check", SweepCheck, "a SweepCheck (or None: no sweep check)")
     stability = stability_method(stability)  # a name becomes its method object (rattle.stability)
     period = _limits.check_period(period)
     subharmonics = _validate.check_bool(subharmonics, "subharmonics")
@@ -167,7 +175,7 @@ def frequency_response(
     confirm_tori = _validate.check_bool(confirm_tori, "confirm_tori")
     result = _frequency_response(
         model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,
-        sweep=sweep, seeds=seeds, throw=throw, callback=callback, adaptive=adaptive,
+        sweep=sweep, seeds=seeds, throw=throw, callback=callback, adaptive=adaptive, check=check,
     )
     if confirm_tori and any(r.kind == "torus" for r in result.regions):
         from ._tori import confirm_tori as _confirm  # time domain: only when there is a torus
@@ -192,6 +200,7 @@ def _frequency_response(
     throw: bool = True,
     callback: Callable[[BranchPoint], None] | None = None,
     adaptive: AdaptiveHarmonics | None = None,
+    check: SweepCheck | None = None,
 ) -> FrequencyResponse:
     """frequency_response() after its arguments are checked: every option comes in ``run``."""
     lo, hi = omega_range
@@ -224,6 +233,16 @@ def _frequency_response(
     elif not status.success or status is Status.RETURNED:
         status = Status.SUCCESS  # the branches through the two ends cover the range together
     t_cont = time.perf_counter()
+    checked: dict[str, Any] | None = None
+    if check is not None and period == 1 and status.success and any(len(b) for b in branches):
+        # attractors a run-up or run-down settles on that no branch explains: continued as branches
+        known = FrequencyResponse.concatenate(branches)
+        try:
+            missed, checked = missed_branches(known, omega_range, run, check, first_branch=len(branches))
+        except (ValueError, ConvergenceError) as exc:  # a model the simulation refuses (its time step)
+            missed, checked = [], {"skipped": str(exc)}
+        branches += missed
+        checked["time"] = time.perf_counter() - t_cont
     if uncovered and any(b.settings.get("end_status") == Status.STEP_TOO_SMALL.name for b in branches):
         # Where the corrector fails even at the smallest step, the truncated problem usually has
         # no solution there: an orbit through stiff stages (a gear mesh stiffer than the rest of
@@ -249,6 +268,7 @@ def _frequency_response(
         "origin": f"continuation from the {first_end} end of the range",
         "uncovered": [[a, b] for a, b in uncovered],
         "adaptive_harmonics": None if adaptive is None else asdict(adaptive),
+        "sweep_check": checked,
     }
     result = FrequencyResponse.concatenate(branches, status=status, message=message, settings=settings,
                                            timings={**primary.timings, "continuation": t_cont - t_start})

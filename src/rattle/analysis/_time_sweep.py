@@ -39,8 +39,6 @@ from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_mod
 from ..results._sweep import SweepResult
 from ..results._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED
 from ..timeint._shooting import FLOW_FAILURES
-
-from ._frequency_response import check_range
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
 logger = logging.getLogger("rattle")
@@ -386,10 +384,10 @@ def time_sweep(
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     if isinstance(model, (NonsmoothSystem, FrictionSystem)):
-        lo, hi = _limits.check_frequency_range(_Bounds(model), *check_range(omega), simulate=True)
+        lo, hi = _limits.check_frequency_range(_Bounds(model), *_validate.check_range(omega, "omega"), simulate=True)
     else:
         check_analysable_model(model)
-        lo, hi = _limits.check_frequency_range(model, *check_range(omega), simulate=True)
+        lo, hi = _limits.check_frequency_range(model, *_validate.check_range(omega, "omega"), simulate=True)
     points = _limits.check_points(points)
     if not isinstance(direction, str) or direction not in DIRECTIONS:
         raise ValueError(
