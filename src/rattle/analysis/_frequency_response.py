@@ -130,7 +130,7 @@ def frequency_response(
     corrector fails even at the smallest step, and lowered again where the estimate allows; the
     column ``harmonics`` (``extra_columns``) gives H per row. ``adaptive=None`` keeps H fixed.
 
-    ``check`` (default :class:`SweepCheck`): an exact up/down sweep over the range (24
+    ``check`` (default :class:`SweepCheck`): an exact up/down sweep over the range (16
     frequencies each way); every period-1 motion it settles on that no stable computed stretch
     explains (Ω and rms within 1 %) is continued as a branch of its own (``check=None`` skips it;
     ``settings["sweep_check"]`` records what it saw).

@@ -37,13 +37,13 @@ from ._settings import RunSettings
 @dataclass(frozen=True, slots=True)
 class SweepCheck:
     """The exact up/down sweep that checks a frequency response for attractors its branches
-    miss (module docstring): ``points`` frequencies each way (default 24), an attractor is
+    miss (module docstring): ``points`` frequencies each way (default 16), an attractor is
     explained when a stable stretch of a computed branch crosses its Ω with an rms within
     ``rtol`` (default 1 %) of it, at most ``max_branches`` new branches (default 4); a motion
     not settled on a period-1 orbit within ``max_periods`` forcing periods (default 200) is not
     one of them (a non-periodic motion, or a sub-harmonic: ``subharmonics=True``)."""
 
-    points: int = 24
+    points: int = 16
     rtol: float = 1e-2
     max_branches: int = 4
     max_periods: int = 200
