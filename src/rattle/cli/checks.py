@@ -333,7 +333,10 @@ def check_scheduler(scheduler: str | None) -> str | None:
     if importlib.util.find_spec("distributed") is None:
         raise ConfigError(f"`--scheduler` {scheduler!r} needs Dask distributed, which is not installed: "
                           "pip install 'rattle[dask]', or leave --scheduler out to run on local processes")
-    return scheduler.strip()
+    # its form before any numerics load (the engine waits for the scheduler's handshake)
+    from ..engines import check_scheduler_address
+
+    return check_scheduler_address(scheduler, probe=False)
 
 
 def check_omega(omega: float, option: str = "--omega", model: Model | None = None) -> float:

@@ -37,7 +37,7 @@ from ._serial import SerialEngine
 __all__ = [
     "Engine", "EngineError", "TaskError", "SerialEngine", "ProcessEngine", "DaskEngine", "make_engine",
     "ENGINES", "die_with_parent", "cpu_count", "MAX_RETRIES", "WORKER_ENVIRONMENT", "ResultCallback",
-    "ProgressCallback", "Task", "local_cluster", "WORKER_CONFIG",
+    "ProgressCallback", "Task", "local_cluster", "WORKER_CONFIG", "check_scheduler_address",
 ]
 
 #: The engine names :func:`make_engine` knows.
@@ -45,7 +45,7 @@ ENGINES: tuple[str, ...] = ("serial", "processes", "dask")
 
 
 def __getattr__(name: str) -> Any:
-    if name in ("DaskEngine", "local_cluster", "WORKER_CONFIG"):  # keep `import rattle.engines` minimal
+    if name in ("DaskEngine", "local_cluster", "WORKER_CONFIG", "check_scheduler_address"):  # keep `import rattle.engines` minimal
         from . import _dask
 
         return getattr(_dask, name)

@@ -96,11 +96,12 @@ def _unanswered(address: str, timeout: float, why: str) -> ConfigError:
                        "tcp://127.0.0.1:8786")
 
 
-def check_scheduler_address(address: str, timeout: float = CONNECT_TIMEOUT) -> str:
+def check_scheduler_address(address: str, timeout: float | None = None, *, probe: bool = True) -> str:
     """Check that ``address`` is a Dask scheduler's, before a client is made: the form
     (``[scheme://]host:port``, a scheme of :data:`SCHEMES`, a port 1 … 65535) at once, and for
     ``tcp`` that a scheduler answers there within ``timeout`` seconds: the connection is made and
-    the scheduler's handshake — which a Dask scheduler sends first, unasked — is awaited. An
+    the scheduler's handshake — which a Dask scheduler sends first, unasked — is awaited
+    (``timeout`` default :data:`CONNECT_TIMEOUT`; ``probe=False``: the form only). An
     unroutable address, a closed port, a host that is not found, or a server of another protocol
     (an HTTP server waits for a request and says nothing) are refused with one line; nothing here
     waits longer than ``timeout`` (the name lookup included). Returns the address, stripped.
@@ -110,6 +111,7 @@ def check_scheduler_address(address: str, timeout: float = CONNECT_TIMEOUT) -> s
     ConfigError
         Naming ``--scheduler``, the address and what is wrong.
     """
+    timeout = CONNECT_TIMEOUT if timeout is None else float(timeout)  # the module's, read now
     text = address.strip()
     if not text or any(ord(c) < 32 or c.isspace() for c in text):
         raise _refuse(address, "is blank or holds spaces or control characters")
@@ -125,7 +127,7 @@ def check_scheduler_address(address: str, timeout: float = CONNECT_TIMEOUT) -> s
         host = host[1:-1]
     if not colon or not host or not port_text.isdigit() or not 1 <= int(port_text) <= 65535 or "/" in host:
         raise _refuse(address, "is not of the form [scheme://]host:port with a port 1 … 65535")
-    if scheme != "tcp":  # TLS, websockets, UCX: the client's own timeout bounds the connection
+    if scheme != "tcp" or not probe:  # TLS, websockets, UCX: the client's own timeout bounds the connection
         return text
     verdict: list[str | None] = []
 
