@@ -142,6 +142,15 @@ class RattleGroup(click.Group):
             signum = exc.signum if isinstance(exc, Interrupted) else int(_signals.interrupted_by() or _SIGINT)
             _signals.report(signum)  # once, whatever a further signal does meanwhile
             return 128 + signum
+        except Exception:
+            # The interruption raised inside code that turns it into another error: a C extension's
+            # module initialisation interrupted while it was being imported ("ImportError:
+            # initialization failed"), a library that wraps what it catches. The signal decides.
+            signum = _signals.interrupted_by()
+            if signum is None:
+                raise
+            _signals.report(int(signum))
+            return 128 + int(signum)
 
     def invoke(self, ctx: click.Context) -> Any:
         # click turns KeyboardInterrupt into Abort (and prints a blank line); keep the signal
