@@ -89,6 +89,10 @@ PROBLEM_MAX_SAMPLES = 32 * PROBLEM_MAX_HARMONICS
 MAX_NEWTON_ITERATIONS = 1000
 #: Longest period searched or followed, as a multiple of the forcing period (SPEC §1).
 MAX_PERIOD = 8
+#: Most forcing periods one recorded exact integration (``propagate``) may span: every stage
+#: segment is kept, so a span of 1e9 time units would fill the memory before it ended. Steady
+#: states and sweeps integrate a period at a time and record a few; ``advance`` records nothing.
+MAX_RECORDED_PERIODS = 100_000
 #: Frequencies per direction of a time-domain sweep, at most.
 MAX_SWEEP_POINTS = 100_000
 #: Budget of accepted continuation points, at most.
@@ -144,6 +148,23 @@ def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1) 
             f"lower `{name}` or the period"
         )
     return h
+
+
+def check_interval(t0: object, t1: object, omega: object) -> tuple[float, float]:
+    """``t0`` ≤ ``t1``, both finite, spanning at most :data:`MAX_RECORDED_PERIODS` forcing periods
+    2π/``omega`` (a recorded exact integration keeps every segment); returns them as floats."""
+    a, b = float(t0), float(t1)  # type: ignore[arg-type]
+    if not (math.isfinite(a) and math.isfinite(b) and b >= a):
+        raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+    w = float(omega)  # type: ignore[arg-type]
+    periods = (b - a) * w / (2.0 * math.pi) if math.isfinite(w) and w > 0.0 else 0.0
+    if periods > MAX_RECORDED_PERIODS:
+        raise ValueError(
+            f"`t1` - `t0` = {b - a:.6g} spans {periods:.3g} forcing periods at omega = {w:g}; a recorded exact "
+            f"integration keeps every stage segment and takes at most {MAX_RECORDED_PERIODS} periods: integrate "
+            "in parts, or use advance() (no record) or steady_state() for a long settling"
+        )
+    return a, b
 
 
 def check_samples(value: object, harmonics: int, name: str = "samples", *, period: int = 1) -> int | None:
@@ -377,9 +398,9 @@ def warn_clearance(b: float, name: str = "b", stacklevel: int = 3) -> None:
 
 
 __all__ = [
-    "MAX_HARMONICS", "MAX_EFFECTIVE_HARMONICS", "MAX_SAMPLES", "MAX_PERIOD", "MAX_SWEEP_POINTS",
+    "MAX_HARMONICS", "MAX_EFFECTIVE_HARMONICS", "MAX_SAMPLES", "MAX_PERIOD", "MAX_RECORDED_PERIODS", "MAX_SWEEP_POINTS",
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
-    "CLEARANCE_WARNING", "check_harmonics", "check_samples", "check_period", "check_points",
+    "CLEARANCE_WARNING", "check_harmonics", "check_interval", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
     "check_scales", "warn_clearance", "stiffest_frequency", "simulation_rate", "damping_rate",
 ]

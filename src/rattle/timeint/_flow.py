@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from .._limits import check_interval
 from .._typing import FloatArray, IntArray
 from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError
@@ -372,9 +373,7 @@ class SystemIntegrator:
         crossings, final state and sensitivity ∂z(t1)/∂z(t0)."""
         z = check_system_state(z0, self.system.n)
         omega = check_omega(omega)
-        t0, t1 = float(t0), float(t1)
-        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
-            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        t0, t1 = check_interval(t0, t1, omega)
         flow = self.stages(omega)
         rec: dict[str, list] = {k: [] for k in ("ts", "st", "zs", "seg", "ct", "ce", "cd", "cb")}
         z1, M = self._march(flow, z, t0, t1, rec)

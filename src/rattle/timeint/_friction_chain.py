@@ -80,6 +80,7 @@ from types import SimpleNamespace
 import numpy as np
 from scipy.optimize import brentq
 
+from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_omega, check_shooting
 from ..errors import ConvergenceError
@@ -430,9 +431,7 @@ class FrictionIntegrator:
         sensitivity ∂z(t1)/∂z(t0)."""
         z = check_system_state(z0, self.n)
         omega = check_omega(omega)
-        t0, t1 = float(t0), float(t1)
-        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
-            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        t0, t1 = check_interval(t0, t1, omega)
         rec: dict[str, list] = {k: [] for k in ("ts", "st", "sk", "lk", "seg", "et", "ee", "ek", "ev")}
         z1, M = self._march(z, t0, t1, omega, rec)
         ts = np.asarray(rec["ts"], dtype=float)

@@ -37,6 +37,7 @@ import math
 
 import numpy as np
 
+from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_state
 from ..errors import ConvergenceError
@@ -173,9 +174,7 @@ class ExactIntegrator:
         Returns the :class:`Trajectory`: its segments, final state and sensitivity ∂x(t1)/∂x0.
         """
         x0 = check_state(x0)
-        t0, t1 = float(t0), float(t1)
-        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
-            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        t0, t1 = check_interval(t0, t1, omega)
         sol = self.solutions(omega)
         starts: list[float] = []
         stages: list[int] = []

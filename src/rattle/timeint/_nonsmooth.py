@@ -53,6 +53,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from .._limits import check_interval
 from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_shooting, check_state
 from ..errors import ConvergenceError
@@ -394,9 +395,7 @@ class NonsmoothIntegrator:
         ``omega``: the :class:`NonsmoothTrajectory` with its sensitivity ∂x(t1)/∂x(t0)."""
         x0 = check_state(x0)
         omega = check_omega(omega)
-        t0, t1 = float(t0), float(t1)
-        if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
-            raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
+        t0, t1 = check_interval(t0, t1, omega)
         sol = self.solutions(omega)
         rec: dict[str, list] = {k: [] for k in ("t", "kind", "stage", "sign", "x", "h", "et", "ek")}
         d, v, M = self._march(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
