@@ -84,6 +84,8 @@ def test_a_range_not_covered_exits_1_naming_the_intervals(tmp_path):
     assert ra == pytest.approx(1275.8, abs=0.1) and rb == pytest.approx(b * 60 / (4 * math.pi))
     assert f"not covered (no branch found there): Ω = {a:.5g} … {b:.5g} ({ra:.5g} … {rb:.5g} rpm)" in result.output
     assert meta["status"] == "step_too_small"
+    # not labelled "unstable" there: no branch is known there at all
+    assert not [r for r in meta["regions"] if r["omega_max"] > a + 1e-9 and r["omega_min"] < b - 1e-9]
 
 
 def test_kinks_of_the_branch_cost_one_step():

@@ -183,12 +183,24 @@ def label_regions(frf: FrequencyResponse, min_gap: float = 1e-4) -> tuple[Region
     covered = _union([iv for b in np.unique(frf.branch) for iv in stable_intervals(frf, int(b))])
     lo_all, hi_all = float(frf.omega.min()), float(frf.omega.max())
     tol = 1e-6 * (hi_all - lo_all)
+    # the parts of the range no branch covers are not "unstable": no branch is known there at all
+    # (frf.uncovered, named in the summary and shaded in the plot)
+    blank = [(float(x), float(y)) for x, y in (frf.settings.get("uncovered") or [])]
     edge = lo_all
     for a, b in covered + [(hi_all, hi_all)]:
-        if a - edge > min_gap * (hi_all - lo_all):
-            regions.append(_gap_region(frf, edge, a, tol))
+        for x, y in _outside(edge, a, blank):
+            if y - x > min_gap * (hi_all - lo_all):
+                regions.append(_gap_region(frf, x, y, tol))
         edge = max(edge, b)
     return tuple(sorted(regions, key=lambda r: (r.omega_min, r.kind)))
+
+
+def _outside(lo: float, hi: float, blanks: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The parts of (lo, hi) outside every interval of ``blanks``."""
+    parts = [(lo, hi)]
+    for x, y in blanks:
+        parts = [piece for a, b in parts for piece in ((a, min(b, x)), (max(a, y), b)) if piece[1] > piece[0]]
+    return parts
 
 
 def _periods_text(periods: list[int]) -> str:
