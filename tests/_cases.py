@@ -1,8 +1,12 @@
 """Cases shared by the tests: the reference clutch and the torque converter's preloaded spring as
-TOML, the chain with a lock-up clutch, the clutch-and-gear chain with friction per stage."""
+TOML, the chain with a lock-up clutch, the clutch-and-gear chain with friction per stage; and the
+state at t = 0 of a harmonic-balance row, the start of exact shooting from it."""
 
 from __future__ import annotations
 
+import numpy as np
+
+from rattle.hb import FourierBasis
 from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Preload, Torque
 
 
@@ -82,3 +86,22 @@ amplitudes = [0.03]
 
 [analysis]
 {lines}"""
+
+
+def hb_state0(frf, i):
+    """(δ(0), δ'(0)) of row i of a single equation's frequency response: a start for exact shooting."""
+    q = frf.coefficients[i]
+    H = frf.harmonics
+    w = frf.omega[i] / frf.period[i]
+    k = np.arange(1, H + 1)
+    return np.array([q[0] + q[1: H + 1].sum(), np.sum(k * w * q[H + 1:])])
+
+
+def hb_chain_state0(frf, i):
+    """(x(0), x'(0)) of row i of a chain's frequency response: a start for exact shooting."""
+    n = frf.model.system().n
+    H = frf.harmonics
+    Q = frf.coefficients[i].reshape(n, 2 * H + 1)
+    basis = FourierBasis(H, 4 * (2 * H + 1))
+    w = float(frf.omega[i] / frf.period[i])
+    return np.array([basis.evaluate(r, w, 0.0, derivative=k) for k in (0, 1) for r in Q], dtype=float)

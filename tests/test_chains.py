@@ -16,6 +16,7 @@ from rattle.model.library import REFERENCE_B
 from rattle.timeint import SystemIntegrator, shoot_system_orbit
 
 import _exact_branch as xb
+from _cases import hb_chain_state0
 
 
 def two_inertia(I1: float, I2: float) -> Chain:
@@ -54,16 +55,6 @@ def driveline() -> Chain:
         torques=(Torque(inertia=1, mean=0.05, amplitudes=(0.03, 0.015), phases=(0.0, 0.5)),
                  Torque(inertia=3, mean=-0.05)),
     )
-
-
-def _state(frf, model, i):
-    """(x(0), x'(0)) of row i's HB orbit: a start guess for exact shooting."""
-    n = model.system().n
-    H = frf.harmonics
-    Q = frf.coefficients[i].reshape(n, 2 * H + 1)
-    basis = rattle.hb.FourierBasis(H, 4 * (2 * H + 1))
-    w = float(frf.omega[i] / frf.period[i])
-    return np.array([basis.evaluate(r, w, 0.0, derivative=k) for k in (0, 1) for r in Q], dtype=float)
 
 
 def _points(frf):
@@ -131,7 +122,7 @@ def test_driveline_special_points(omega, start, kinds):
     (the reference follows the branch HB starts on: from the HB orbit at the same end)."""
     model = driveline()
     frf = rattle.frequency_response(model, omega=omega, harmonics=16, start=start, confirm_tori=False)
-    exact = xb.exact_special_points(model, omega, x0=_state(frf, model, 0), start=start, **REFERENCE_STEPS).special
+    exact = xb.exact_special_points(model, omega, x0=hb_chain_state0(frf, 0), start=start, **REFERENCE_STEPS).special
     assert {k for k, _ in exact} == kinds
     _match(exact, _points(frf), 1e-4)
 
@@ -154,7 +145,7 @@ def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega)
         w = float(frf.omega[i])
         if special.size and np.min(np.abs(special - w)) < 5e-3:
             continue
-        z0 = _state(frf, model, i)
+        z0 = hb_chain_state0(frf, i)
         orbit = shoot_system_orbit(system, w, z0, integrator=integ)
         assert orbit.converged
         assert np.max(np.abs(orbit.state0 - z0)) <= 1e-2 * model.length_scale()  # the same orbit

@@ -15,17 +15,8 @@ import rattle
 from rattle.cli.main import cli
 from rattle.errors import Status
 from rattle.model import Backlash, Chain, Element, Excitation, Link, Model, Torque, Unilateral
-from rattle.timeint import ExactIntegrator, shoot_periodic_orbit
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-
-
-def _hb_state0(frf, i):
-    q = frf.coefficients[i]
-    H = frf.harmonics
-    w = frf.omega[i] / frf.period[i]
-    k = np.arange(1, H + 1)
-    return np.array([q[0] + q[1: H + 1].sum(), np.sum(k * w * q[H + 1:])])
 
 
 def test_harmonics_are_raised_where_the_truncation_demands_it():

@@ -19,6 +19,8 @@ import rattle
 from rattle.model import Chain, Element, Excitation, Link, Model, Piecewise, Torque, Unilateral
 from rattle.timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
 
+from _cases import hb_chain_state0, hb_state0  # tests/ is on sys.path through its conftest
+
 
 @pytest.mark.parametrize("side, gap", [("positive", 0.1), ("negative", 0.1), ("positive", 0.0)])
 def test_the_law_is_the_one_sided_piecewise_law(side, gap):
@@ -71,14 +73,6 @@ def test_the_configuration_refuses_naming_the_key(tmp_path, elastic, mean, words
         assert word in str(info.value)
 
 
-def _hb_state0(frf, i):
-    q = frf.coefficients[i]
-    H = frf.harmonics
-    w = frf.omega[i] / frf.period[i]
-    k = np.arange(1, H + 1)
-    return np.array([q[0] + q[1: H + 1].sum(), np.sum(k * w * q[H + 1:])])
-
-
 def test_the_single_equation_agrees_with_exact_shooting():
     """A stop 2° beyond the rest position, the mean load pressing toward it, the forcing strong
     enough to lift off and hit: the frequency response covers the range and every sampled row's
@@ -97,7 +91,7 @@ def test_the_single_equation_agrees_with_exact_shooting():
     rows = np.flatnonzero(frf.stable & (frf.period == 1))
     checked = 0
     for i in rows[:: max(1, rows.size // 25)]:
-        orbit = shoot_periodic_orbit(model, frf.omega[i], _hb_state0(frf, i), integrator=integ)
+        orbit = shoot_periodic_orbit(model, frf.omega[i], hb_state0(frf, i), integrator=integ)
         assert orbit.converged
         assert abs(frf.rms[i] - orbit.rms) <= 1e-3 * orbit.rms, (frf.omega[i], frf.rms[i], orbit.rms)
         assert orbit.stable
@@ -116,16 +110,6 @@ def _two_dof() -> Chain:
     )
 
 
-def _chain_state(frf, chain, i):
-    """(x(0), x'(0)) of row i's HB orbit."""
-    n = chain.system().n
-    H = frf.harmonics
-    Q = frf.coefficients[i].reshape(n, 2 * H + 1)
-    basis = rattle.hb.FourierBasis(H, 4 * (2 * H + 1))
-    w = float(frf.omega[i] / frf.period[i])
-    return np.array([basis.evaluate(r, w, 0.0, derivative=k) for k in (0, 1) for r in Q], dtype=float)
-
-
 def test_a_chain_with_a_unilateral_stop_agrees_with_exact_shooting():
     """Both doors of the exact check on every sampled stable row: the stop's rms within 0.1 % and
     the same stability; the stop is hit on some of them."""
@@ -140,7 +124,7 @@ def test_a_chain_with_a_unilateral_stop_agrees_with_exact_shooting():
         w = float(frf.omega[i])
         if special.size and np.min(np.abs(special - w)) < 5e-3:
             continue
-        orbit = shoot_system_orbit(system, w, _chain_state(frf, chain, i))
+        orbit = shoot_system_orbit(system, w, hb_chain_state0(frf, i))
         assert orbit.converged
         exact = orbit.measures.element("stop")["rms"]
         assert frf.element("stop")["rms"][i] == pytest.approx(exact, rel=1e-3), w

@@ -188,9 +188,13 @@ def _impacts(state: Any) -> bool:
 
 def _coefficients(model: Any, state: Any, hb: HarmonicBalance) -> FloatArray:
     """HB coefficients (coordinate-major) of a settled periodic motion's exact trajectory."""
-    T = state.period * 2.0 * math.pi / state.omega
-    t = hb.basis.times(T)
-    traj = state.trajectory
+    return trajectory_coefficients(state.trajectory, state.period * 2.0 * math.pi / state.omega, hb)
+
+
+def trajectory_coefficients(traj: Any, period: float, hb: HarmonicBalance) -> FloatArray:
+    """HB coefficients (coordinate-major) of the exact periodic trajectory ``traj`` of period
+    ``period`` (s), sampled on ``hb``'s grid: every coordinate of a chain, δ of the single equation."""
+    t = hb.basis.times(period)
     if isinstance(traj, SystemTrajectory):
         x = traj.sample(t).x  # (N, n)
         return hb.basis.analyze(np.asarray(x).T).reshape(-1)

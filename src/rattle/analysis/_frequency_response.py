@@ -344,10 +344,7 @@ def _branch_from_end(model: Model, run: RunSettings, end: str, omega_range: tupl
     points = [pt for st in stretches for pt in st.points]
     if status is Status.SUCCESS and points and points[-1].p == omega0 and len(points) > 1:
         status = Status.RETURNED  # a restarted stretch (tangent start) cannot tell: the branch can
-    message = last.message if status is not Status.RETURNED or last.message != Status.SUCCESS.message \
-        else Status.RETURNED.message
-    if status is Status.RETURNED:
-        message = Status.RETURNED.message
+    message = Status.RETURNED.message if status is Status.RETURNED else last.message
     parts = []
     for st in stretches:
         if not st.points:

@@ -24,12 +24,10 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from .. import _validate
-from .._typing import FloatArray
 from ..hb import HarmonicBalance
 from ..results import FrequencyResponse
+from ._attractors import trajectory_coefficients
 from ._branches import branch_from_seed, explained
 from ._settings import RunSettings
 
@@ -55,15 +53,6 @@ class SweepCheck:
         rtol = _validate.check_real(self.rtol, "rtol")
         if not 0.0 < rtol < 1.0:
             raise ValueError(f"`rtol` must be in (0, 1), got {self.rtol!r}")
-
-
-def _coefficients(model: Any, trajectory: Any, omega: float, hb: HarmonicBalance) -> FloatArray:
-    """HB coefficients (coordinate-major) of the exact period-1 orbit ``trajectory``."""
-    t = hb.basis.times(2.0 * math.pi / omega)
-    sample = trajectory.sample(t)
-    if hasattr(sample, "x"):  # a chain: every coordinate
-        return hb.basis.analyze(np.asarray(sample.x).T).reshape(-1)
-    return hb.basis.analyze(np.asarray(sample.delta))
 
 
 def missed_branches(frf: FrequencyResponse, omega_range: tuple[float, float], run: RunSettings, check: SweepCheck,
@@ -96,7 +85,7 @@ def missed_branches(frf: FrequencyResponse, omega_range: tuple[float, float], ru
         record["unexplained"].append([w, rms])
         if len(out) >= check.max_branches:
             continue
-        q = _coefficients(model, traj, w, hb)
+        q = trajectory_coefficients(traj, 2.0 * math.pi / w, hb)
         branch = branch_from_seed(model, w, q, 1, (lo, hi), H, run=run, branch_id=first_branch + len(out))
         if branch is not None and len(branch) and explained(FrequencyResponse.concatenate([frf, *out, branch]), 1, w,
                                                             rms, check.rtol):
