@@ -79,10 +79,14 @@ class Stretch:
     the stepper that produced them (status, message, rejected steps), and why it ended
     (``ended``: "" for the last stretch, else "raised" or "lowered")."""
 
-    hb: HarmonicBalance
     points: list[BranchPoint]
     stepper: ContinuationStepper
     ended: str = ""
+
+    @property
+    def hb(self) -> HarmonicBalance:
+        """The stretch's harmonic-balance problem (the stepper's)."""
+        return self.stepper.problem  # type: ignore[return-value]
 
 
 def _rms(q: FloatArray, coordinates: int) -> tuple[float, float]:
@@ -158,7 +162,7 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
         if pt is None:
             failed = stepper.status is Status.STEP_TOO_SMALL
             if adaptive is None or not failed or 2 * H > top or not stepper.points:
-                stretches.append(Stretch(stepper.problem, stepper.points, stepper))  # type: ignore[arg-type]
+                stretches.append(Stretch(stepper.points, stepper))
                 return stretches
             # the corrector fails even at the smallest step: go on from the last point with 2H
             found = None
@@ -167,9 +171,9 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
                 if found is not None:
                     break
             if found is None:
-                stretches.append(Stretch(stepper.problem, stepper.points, stepper))  # type: ignore[arg-type]
+                stretches.append(Stretch(stepper.points, stepper))
                 return stretches
-            stretches.append(Stretch(stepper.problem, stepper.points, stepper, "raised"))  # type: ignore[arg-type]
+            stretches.append(Stretch(stepper.points, stepper, "raised"))
             H *= 2
             raised_at = found[1]
             stepper = stepper_for(H, *found)
@@ -209,7 +213,7 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
                 if start is None:  # no 2H solution to go on from: keep H here
                     missed = 0
                     continue
-                stretches.append(Stretch(stepper.problem, keep, stepper, "raised"))  # type: ignore[arg-type]
+                stretches.append(Stretch(keep, stepper, "raised"))
                 H *= 2
                 raised_at = start[1]
                 stepper = stepper_for(H, *start)
@@ -221,7 +225,7 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
             # (a stretch that needed 2H a moment ago would need it again): try H/2
             coarse = solve_with(H // 2, pt)
             if coarse is not None and _change(rms, _rms(coarse[0], n_coord)) < adaptive.tolerance / 8.0:
-                stretches.append(Stretch(stepper.problem, list(stepper.points), stepper, "lowered"))  # type: ignore[arg-type]
+                stretches.append(Stretch(list(stepper.points), stepper, "lowered"))
                 H //= 2
                 stepper = stepper_for(H, *coarse)
                 good, quiet = 0, 0
