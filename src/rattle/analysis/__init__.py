@@ -1,11 +1,12 @@
 """Front ends: one call from a model to a result."""
 
-from ._case import Case, load_case
+from ._case import Case, load_case, method_options
 from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
 from ._friction_orbit import friction_orbit
 from ._friction_response import friction_response
 from ._friction_subharmonics import friction_subharmonics
+from ._exact_branch import ShootingOptions
 from ._nonsmooth import RegularisationOptions, nonsmooth_response, nonsmooth_subharmonics
 from ._nonsmooth_orbit import nonsmooth_orbit
 from ._harmonics import adaptive_frequency_response, truncation_error
@@ -21,5 +22,5 @@ __all__ = [
     "steady_state", "SteadyStateOptions", "nonsmooth_response", "nonsmooth_subharmonics", "RegularisationOptions",
     "nonsmooth_orbit", "friction_response", "friction_subharmonics", "friction_orbit",
     "label_regions", "confirm_with_sweep", "truncation_error", "adaptive_frequency_response", "AdaptiveHarmonics",
-    "SweepCheck",
+    "SweepCheck", "ShootingOptions", "method_options",
 ]

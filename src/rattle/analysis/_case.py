@@ -16,6 +16,7 @@ from ..io import AnalysisSettings, RunConfig, load_config
 from ..model import FrictionSystem, Model, NonsmoothSystem
 from ._compare import compare
 from ._frequency_response import frequency_response
+from ._exact_branch import ShootingOptions
 from ._nonsmooth import RegularisationOptions, nonsmooth_response
 from ._nonsmooth_orbit import nonsmooth_orbit
 from ._orbit import periodic_orbit
@@ -32,6 +33,12 @@ def regularisation_options(analysis: AnalysisSettings) -> RegularisationOptions:
         kw["held"] = True
     return RegularisationOptions(harmonics=analysis.harmonics, regularisation=analysis.regularisation,
                                  refine=analysis.refine or None, **kw)
+
+
+def method_options(analysis: AnalysisSettings) -> ShootingOptions | RegularisationOptions:
+    """The method of a discontinuous law's ``[analysis] method`` (SPEC §8): ``"shooting"`` (the
+    default) :class:`ShootingOptions`, ``"hb"`` :func:`regularisation_options`."""
+    return regularisation_options(analysis) if analysis.method == "hb" else ShootingOptions()
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,7 +86,7 @@ class Case:
         ``newton``, ``subharmonics`` override; ``subharmonics=True`` follows the period-2 branches
         of a one-equation law)."""
         if self.discontinuous:
-            kw: dict[str, Any] = {"omega": self.analysis.omega, "options": self.regularisation_options(), **options}
+            kw: dict[str, Any] = {"omega": self.analysis.omega, "options": method_options(self.analysis), **options}
             return nonsmooth_response(self.model, **kw)  # type: ignore[arg-type]
         return frequency_response(self.model, **self._with_analysis(options, "omega"))
 

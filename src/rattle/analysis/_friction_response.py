@@ -76,6 +76,7 @@ from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
+from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
 from ._held_limit import held_limit
 from ._regularisation import (
     RegularisationLimit,
@@ -403,6 +404,8 @@ def friction_response(
     module docstring)."""
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    if isinstance(options, ShootingOptions):
+        return shooting_friction_response(system, omega, options, continuation=continuation, newton=newton)
     lo, hi = check_range(omega)
     opts = chain_options(system) if options is None else options
     if not isinstance(opts, RegularisationOptions):
@@ -420,6 +423,63 @@ def friction_response(
     points = stepper.run()
     return check_branch(system, make, points, opts, FrictionIntegrator(system),
                         status=stepper.status or Status.SUCCESS, message=stepper.message)
+
+
+def shooting_friction_response(
+    system: FrictionSystem,
+    omega: tuple[float, float],
+    options: ShootingOptions | None = None,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    subharmonics: bool = False,
+) -> FrictionResponse:
+    """The chain's period-1 branch over ``omega`` by exact shooting continuation
+    (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit of the chain,
+    the special points located and labelled; ``followed`` "exact shooting", the HB columns nan).
+    A second branch followed down from Ω_max, where the first left frequencies uncovered, is the
+    first of ``branches``; with ``subharmonics`` the period-2 branches born at the located period
+    doublings follow."""
+    if not isinstance(system, FrictionSystem):
+        raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    lo, hi = check_range(omega)
+    opts = ShootingOptions() if options is None else options
+    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton)
+    parts = [exact_friction_response(system, b, number=k) for k, b in enumerate(found)]
+    primary, extra = parts[0], list(parts[1:])
+    if subharmonics and len(primary):
+        from ._friction_subharmonics import period_two_orbit  # the seed (that module builds on this one)
+
+        integ = FrictionIntegrator(system)
+        for b in subharmonic_branches(system, primary, (lo, hi), opts, continuation, newton,
+                                      lambda w, z: period_two_orbit(system, integ, w, z)):
+            extra.append(exact_friction_response(system, b, number=len(extra) + 1, period=2))
+    return dataclasses.replace(primary, branches=tuple(extra)) if extra else primary
+
+
+def exact_friction_response(system: FrictionSystem, branch: ExactBranch, *, number: int,
+                            period: int = 1) -> FrictionResponse:
+    """The :class:`FrictionResponse` of an exact branch of the chain: every row an exact orbit."""
+    n, m, P = system.n, system.m, len(branch.rows)
+    rows = [exact_measures(r.trajectory, r.omega, period) for r in branch.rows]
+    if rows:
+        mean, rms, stick, states, pattern, mult = (np.array([r[k] for r in rows]) for k in range(6))
+    else:
+        mean = rms = stick = np.zeros((0, m))
+        states, pattern, mult = np.zeros((0, 2 * n)), np.zeros((0, 2 * m), dtype=np.int64), np.zeros((0, 2 * n), complex)
+    omegas = branch.omega
+    rpm = system.speed_rpm(omegas)
+    return FrictionResponse(
+        omega=omegas, rpm=None if rpm is None else np.asarray(rpm, dtype=float), element_names=system.element_names,
+        rms=rms, rms_hb=np.full((P, m), np.nan), mean=mean, stick_fraction=stick, matched=np.ones(P, dtype=bool),
+        match_distance=np.full(P, np.nan), stable=np.abs(mult).max(axis=1) < 1.0 + UNIT_TOL if P else np.zeros(0, bool),
+        stable_hb=np.zeros(P, dtype=bool), multipliers=mult, multipliers_hb=np.full((P, 2 * n), np.nan + 0j),
+        status=branch.status, message=branch.message, regularisation=math.nan, harmonics=0,
+        limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0), limit_harmonics=np.zeros(0, dtype=int),
+        limit_rms=np.zeros((0, m)), limit_richardson=np.zeros((0, m)), limit_linear=np.zeros(0, dtype=bool),
+        limit_multipliers=np.zeros((0, 2 * n), dtype=complex), pattern=pattern, period=period, branch=number,
+        origin=branch.origin, states=states, followed="exact shooting",
+        labels=np.array([r.label for r in branch.rows], dtype=object))
 
 
 def period_gap(traj: FrictionTrajectory, omega: float) -> float:

@@ -68,7 +68,8 @@ from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
 from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
-from ._friction_response import friction_response
+from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
+from ._friction_response import friction_response, shooting_friction_response
 from ._friction_subharmonics import friction_subharmonics
 from ._period_two import branches_at_doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import (
@@ -230,20 +231,26 @@ def balance_factory(system: NonsmoothSystem, period: int = 1) -> Callable[[float
 def nonsmooth_response(
     system: NonsmoothSystem | FrictionSystem,
     omega: tuple[float, float],
-    options: RegularisationOptions | None = None,
+    options: ShootingOptions | RegularisationOptions | None = None,
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
 ) -> NonsmoothResponse | FrictionResponse:
-    """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min (module docstring), with
-    the settings ``options`` (:class:`RegularisationOptions`); with ``subharmonics`` also the
+    """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min. The method follows from
+    ``options``: None or a :class:`ShootingOptions`, exact shooting continuation (the default,
+    :func:`shooting_response`: every row an exact orbit, special points located); a
+    :class:`RegularisationOptions`, the regularised harmonic balance with every row checked by
+    exact shooting (module docstring); with ``subharmonics`` also the
     period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
     ``branches``. A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
     :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`),
     with ``subharmonics`` also to :func:`~rattle.analysis.friction_subharmonics`."""
     if not isinstance(subharmonics, bool):
         raise TypeError(f"`subharmonics` must be True or False, got {subharmonics!r}")
+    if options is None or isinstance(options, ShootingOptions):  # the default: exact shooting continuation
+        return shooting_response(system, omega, options, continuation=continuation, newton=newton,
+                                 subharmonics=subharmonics)
     if isinstance(system, FrictionSystem):
         chain = friction_response(system, omega, options, continuation=continuation, newton=newton)
         if subharmonics:
@@ -273,6 +280,63 @@ def nonsmooth_response(
         branches = nonsmooth_subharmonics(system, primary, (lo, hi), opts, continuation=continuation, newton=newton)
         primary = dataclasses.replace(primary, branches=branches)
     return primary
+
+
+def shooting_response(
+    system: NonsmoothSystem | FrictionSystem,
+    omega: tuple[float, float],
+    options: ShootingOptions | None = None,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    subharmonics: bool = False,
+) -> NonsmoothResponse | FrictionResponse:
+    """The period-1 branch over ``omega`` by exact shooting continuation
+    (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit, the special
+    points located and labelled; ``followed`` "exact shooting", the HB columns nan). A second
+    branch followed down from Ω_max, where the first left frequencies uncovered, is the first of
+    ``branches``; with ``subharmonics`` the period-2 branches born at the located period doublings
+    follow (numbered on)."""
+    lo, hi = check_range(omega)
+    opts = ShootingOptions() if options is None else options
+    if isinstance(system, FrictionSystem):
+        return shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
+                                          subharmonics=subharmonics)
+    if not isinstance(system, NonsmoothSystem):
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+                        f"friction, Chain.friction_system()), got {system!r}")
+    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton)
+    parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
+    primary = parts[0]
+    extra = list(parts[1:])
+    if subharmonics and len(primary):
+        integ = NonsmoothIntegrator(system)
+        for b in subharmonic_branches(system, primary, (lo, hi), opts, continuation, newton,
+                                      lambda w, q: _period_two_orbit(system, integ, w, q)):
+            extra.append(_exact_response(b, number=len(extra) + 1, period=2))
+    return dataclasses.replace(primary, branches=tuple(extra)) if extra else primary
+
+
+def _exact_response(branch: ExactBranch, *, number: int, period: int = 1) -> NonsmoothResponse:
+    """The :class:`NonsmoothResponse` of an exact branch: every row an exact orbit."""
+    rows: dict[str, list] = {k: [] for k in _ROW_KEYS}
+    nan2 = np.full(2, np.nan + 0j)
+    for r in branch.rows:
+        traj = r.trajectory
+        mean, rms = traj.mean_and_rms()
+        orbit = NonsmoothOrbit(state0=r.q, omega=r.omega, period=period, monodromy=r.M,
+                               multipliers=monodromy_multipliers(r.M), converged=True, iterations=0, residual=0.0,
+                               trajectory=traj, mean=mean, rms=rms)
+        rows["omega"].append(r.omega)
+        rows["rms_hb"].append(math.nan)
+        rows["mult_hb"].append(nan2)
+        rows["matched"].append(True)
+        _add_row(rows, orbit, nan2)
+    return _response(rows, status=branch.status, message=branch.message, regularisation=math.nan, harmonics=0,
+                     period=period, branch=number, origin=branch.origin, followed="exact shooting",
+                     labels=np.array([r.label for r in branch.rows], dtype=object),
+                     limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0), limit_rms=np.zeros(0),
+                     limit_richardson=np.zeros(0), limit_linear=np.zeros(0, dtype=bool))
 
 
 _ROW_KEYS = ("omega", "rms_hb", "rms", "stable", "mult", "mult_hb", "stick", "matched", "mean", "p2p", "acc_p2p",
@@ -560,4 +624,5 @@ def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: Non
                      limit_richardson=np.zeros(0), limit_linear=np.zeros(0, dtype=bool))
 
 
-__all__ = ["NonsmoothResponse", "RegularisationOptions", "nonsmooth_response", "nonsmooth_subharmonics"]
+__all__ = ["NonsmoothResponse", "RegularisationOptions", "ShootingOptions", "nonsmooth_response",
+           "nonsmooth_subharmonics", "shooting_response"]

@@ -231,13 +231,16 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
         are written first, and the error names the files (exit status 1, as the smooth frf).
     """
     t_start = time.perf_counter()
-    from ..analysis import nonsmooth_response  # only now: all input has been validated
-    from ..analysis._case import regularisation_options
+    from ..analysis import method_options, nonsmooth_response  # only now: all input has been validated
 
-    options = regularisation_options(analysis)
-    logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised harmonic "
-                "balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
-                analysis.omega_max, options.harmonics, options.regularisation)
+    options = method_options(analysis)
+    if analysis.method == "hb":
+        logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised "
+                    "harmonic balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
+                    analysis.omega_max, options.harmonics, options.regularisation)
+    else:
+        logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s by exact shooting "
+                    "continuation", analysis.omega_min, analysis.omega_max)
     result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics)
     timings = {"nonsmooth_response": time.perf_counter() - t_start}
     chain = getattr(run_config, "chain_friction", False)  # a FrictionResponse, one column set per element

@@ -238,6 +238,20 @@ def write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: floa
 # --------------------------------------------------------------------------------------------
 # rattle frf on a discontinuous law (preload, friction)
 # --------------------------------------------------------------------------------------------
+def _shooting_settings(options: Any, chain: bool) -> dict[str, Any]:
+    """The ``frf.json`` settings of an exact shooting continuation (``options``, a ShootingOptions)."""
+    return {
+        "method": "exact shooting continuation: pseudo-arclength in (z(0), Ω) on the exact event-driven period map"
+                  + (" of the chain" if chain else "") + " (Filippov sticking and locking, saltation monodromy), "
+                  "special points located on the branch (rattle.analysis.nonsmooth_response)",
+        "settle_periods": options.settle_periods, "hops": list(options.hops), "locate": options.locate,
+    }
+
+
+def _is_shooting(options: Any) -> bool:
+    return type(options).__name__ == "ShootingOptions"
+
+
 def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str, float]) -> dict[str, Any]:
     """The ``frf.json`` sections of a :class:`rattle.results.NonsmoothResponse`: the settings of the
     regularised harmonic balance (``options``, a ``RegularisationOptions``), the equation solved,
@@ -251,7 +265,7 @@ def nonsmooth_metadata(result: Any, system: Any, options: Any, timings: dict[str
     stick = np.asarray(result.stick_time, dtype=float)
     labels = result.bifurcation
     return {
-        "settings": {
+        "settings": _shooting_settings(options, False) if _is_shooting(options) else {
             "method": "regularised harmonic balance continued over Ω, every point checked by exact event-driven "
                       "shooting (rattle.analysis.nonsmooth_response)",
             "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
@@ -332,8 +346,7 @@ def _branch_lines(result: Any, subharmonics: bool) -> list[str]:
         m = np.asarray(b.matched, dtype=bool)
         worst = _largest(b.rms_error, m)
         how = (f"{int(np.count_nonzero(m))} matched by exact shooting over {b.period} periods"
-               if b.followed == "harmonic balance" else
-               "followed by exact shooting alone (the regularised HB has no period-2 orbit next to the exact one)")
+               if b.followed == "harmonic balance" else "every row an exact orbit (exact shooting continuation)")
         lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
                      f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {how}; stable over Ω = {_stable_spans(b)}"
                      + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
@@ -350,18 +363,21 @@ def nonsmooth_summary(result: Any, options: Any, subharmonics: bool = False) -> 
 
     n = len(result)
     matched = np.asarray(result.matched, dtype=bool)
+    unstable = int(np.count_nonzero(~np.asarray(result.stable, dtype=bool)))
+    how = (f"(exact shooting continuation: every row an exact orbit); {unstable} unstable" if _is_shooting(options)
+           else f"(regularised harmonic balance, H = {options.harmonics}, ε = {options.regularisation:g}); "
+                f"{int(np.count_nonzero(matched))} matched by exact shooting, {unstable} unstable")
     lines = [
-        f"{n} points over Ω = {np.min(result.omega):.4g} … {np.max(result.omega):.4g} (regularised harmonic balance, "
-        f"H = {options.harmonics}, ε = {options.regularisation:g}); {int(np.count_nonzero(matched))} matched by exact "
-        f"shooting, {int(np.count_nonzero(~np.asarray(result.stable, dtype=bool)))} unstable"
-        if n else "no points",
+        f"{n} points over Ω = {np.min(result.omega):.4g} … {np.max(result.omega):.4g} {how}" if n else "no points",
         f"status: {result.status.name.lower()} — {result.message or result.status.message}",
     ]
     err = np.abs(np.asarray(result.rms_error, dtype=float)[matched])
     err = err[np.isfinite(err)]
-    if err.size:
-        lines.append(f"rms of the HB against the exact orbit: median error {np.median(err):.2g}, largest "
-                     f"{np.max(err):.2g} (at Ω = {result.omega[matched][np.nanargmax(np.abs(result.rms_error[matched]))]:.5g})")
+    if err.size or matched.any():
+        if err.size:
+            lines.append(f"rms of the HB against the exact orbit: median error {np.median(err):.2g}, largest "
+                         f"{np.max(err):.2g} (at Ω = "
+                         f"{result.omega[matched][np.nanargmax(np.abs(result.rms_error[matched]))]:.5g})")
         refined = int(np.size(result.limit_index))
         best = _largest(getattr(result, "hb_error", None), matched)
         if refined and best is not None:
@@ -375,10 +391,14 @@ def nonsmooth_summary(result: Any, options: Any, subharmonics: bool = False) -> 
         i = int(np.nanargmax(np.where(matched, result.rms, np.nan)))
         lines.append(f"largest exact rms {result.rms[i]:.5g} rad at Ω = {result.omega[i]:.5g} ({result.regime[i]})")
     labels = result.bifurcation
-    changes = [f"{labels[i]} before Ω = {result.omega[i]:.5g}" for i in range(n) if labels[i]]
+    if getattr(result, "labels", None) is not None:  # located on the exact branch
+        changes = [f"{labels[i]} at Ω = {result.omega[i]:.7g}" for i in range(n) if labels[i]]
+        head = "special points (located; grazing: a crossing or a stick phase appears or vanishes): "
+    else:
+        changes = [f"{labels[i]} before Ω = {result.omega[i]:.5g}" for i in range(n) if labels[i]]
+        head = "bifurcations (between rows; grazing: a crossing or a stick phase appears or vanishes): "
     if changes:
-        lines.append("bifurcations (between rows; grazing: a crossing or a stick phase appears or vanishes): "
-                     + ", ".join(changes))
+        lines.append(head + ", ".join(changes))
     lines.extend(_branch_lines(result, subharmonics))
     return "\n".join(lines)
 
@@ -407,7 +427,7 @@ def friction_metadata(result: Any, system: Any, options: Any, timings: dict[str,
                  "sticking_rows": int(np.count_nonzero(matched & (stick[:, e] > 0)))}
                 for e, (name, law) in enumerate(zip(system.element_names, system.laws))]
     return {
-        "settings": {
+        "settings": _shooting_settings(options, True) if _is_shooting(options) else {
             "method": "regularised harmonic balance of the chain continued over Ω, every point checked by exact "
                       "event-driven shooting with Filippov sticking and saltation monodromy "
                       "(rattle.analysis.nonsmooth_response)",

@@ -9,6 +9,9 @@ A configuration file holds the model tables and the run's own tables::
                          regularisation        a discontinuous law's ε, optional (default 0.01; 0.001 for a
                                                chain with friction on its elements)
                          refine                a discontinuous law's refinement, optional (default 0.005)
+                         method                a discontinuous law's method: "shooting" (exact shooting
+                                               continuation, the default) or "hb" (the regularised
+                                               harmonic balance checked by exact shooting)
                          limit_harmonics       the refinement's largest H, optional (default 256; a chain
                                                with friction or jumps on its elements: its harmonics)
     [[paths]]            the sound paths (SPEC §6, :mod:`._paths`)
@@ -122,6 +125,10 @@ class AnalysisSettings:
         For a chain with friction or torque jumps on its elements: narrow the steps of an element
         held part of the period to their limit (``RegularisationOptions(held=True)``); None
         otherwise.
+    method : str or None
+        For a discontinuous law (SPEC §8): ``"shooting"`` (exact shooting continuation, the
+        default) or ``"hb"`` (the regularised harmonic balance, every row checked by exact
+        shooting); None for a continuous law.
     """
 
     omega_min: float = DEFAULT_OMEGA[0]
@@ -131,6 +138,7 @@ class AnalysisSettings:
     refine: float | None = None
     limit_harmonics: int | None = None
     held_limit: bool | None = None
+    method: str | None = None
 
     def __post_init__(self) -> None:
         omega_min = _limits.check_magnitude(self.omega_min, "omega_min")
@@ -165,6 +173,8 @@ class AnalysisSettings:
                     f"limit) must satisfy 0 <= refine < 1, got {tol!r}; use 0.005 (0.5 %), or 0 to turn it off"
                 )
             object.__setattr__(self, "refine", tol)
+        if self.method is not None and self.method not in METHODS:
+            raise ValueError(f"`method` must be one of {', '.join(repr(m) for m in METHODS)}, got {self.method!r}")
         if self.limit_harmonics is not None:
             lim = _limits.check_harmonics(self.limit_harmonics, "limit_harmonics")
             object.__setattr__(self, "limit_harmonics", int(lim))
@@ -189,6 +199,8 @@ class AnalysisSettings:
             out["limit_harmonics"] = self.limit_harmonics
         if self.held_limit is not None:
             out["held_limit"] = self.held_limit
+        if self.method is not None:
+            out["method"] = self.method
         return out
 
 
@@ -265,7 +277,9 @@ class RunConfig:
 # --------------------------------------------------------------------------------------------
 # Schema of [analysis] (the model tables: rattle.model._tables)
 # --------------------------------------------------------------------------------------------
-_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine", "limit_harmonics", "held_limit")
+_ANALYSIS_KEYS = ("omega", "harmonics", "regularisation", "refine", "limit_harmonics", "held_limit", "method")
+#: ``analysis.method`` of a discontinuous law (SPEC §8), the default first.
+METHODS = ("shooting", "hb")
 _EXAMPLES.update({
     "analysis": "[analysis] with omega = [0.1, 3.0], harmonics = 32",
     "analysis.omega": "omega = [0.1, 3.0]",
@@ -274,6 +288,7 @@ _EXAMPLES.update({
     "analysis.refine": "refine = 0.005",
     "analysis.limit_harmonics": "limit_harmonics = 64",
     "analysis.held_limit": "held_limit = true",
+    "analysis.method": 'method = "shooting"',
 })
 
 
@@ -527,13 +542,28 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not isinstance(held_limit, bool):
             raise check.error(f"`analysis.held_limit` must be true or false, got {_show(held_limit)}; "
                               f"write e.g. {_example('analysis.held_limit')}")
+    method = METHODS[0] if discontinuous else None
+    if "method" in table:
+        if not discontinuous:
+            raise check.error(
+                f"`analysis.method` = {_show(table['method'])} applies only to a discontinuous law "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
+                "a `model.elements[k].preload` > 0), which exact shooting or the regularised harmonic balance "
+                "solves; this law is continuous and solved by harmonic balance: remove `analysis.method`"
+            )
+        method = table["method"]
+        if method not in METHODS:
+            raise check.error(f"`analysis.method` must be \"shooting\" (exact shooting continuation, the default) or "
+                              f"\"hb\" (the regularised harmonic balance), got {_show(method)}; "
+                              f"write e.g. {_example('analysis.method')}")
     return check.build(
         AnalysisSettings,
         {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics",
          "regularisation": "analysis.regularisation", "refine": "analysis.refine",
-         "limit_harmonics": "analysis.limit_harmonics", "held_limit": "analysis.held_limit"},
+         "limit_harmonics": "analysis.limit_harmonics", "held_limit": "analysis.held_limit",
+         "method": "analysis.method"},
         omega_min=omega[0], omega_max=omega[1], harmonics=harmonics, regularisation=regularisation, refine=refine,
-        limit_harmonics=limit_harmonics, held_limit=held_limit,
+        limit_harmonics=limit_harmonics, held_limit=held_limit, method=method,
     )
 
 

@@ -36,8 +36,9 @@ def friction_response_plot(response: FrictionResponse) -> tuple[Any, PlotAxes]:
     labels = response.bifurcation
     for e, name in enumerate(response.element_names):
         c = colours[e % len(colours)]
-        ax.plot(w, response.rms_hb[:, e], "--", color=c, lw=0.9, alpha=0.8,
-                label=f"{name}: HB (ε = {response.regularisation:g}, H = {response.harmonics})")
+        if np.any(np.isfinite(response.rms_hb[:, e])):  # none when followed by exact shooting
+            ax.plot(w, response.rms_hb[:, e], "--", color=c, lw=0.9, alpha=0.8,
+                    label=f"{name}: HB (ε = {response.regularisation:g}, H = {response.harmonics})")
         ax.plot(w, np.where(matched & response.stable, response.rms[:, e], np.nan), "-", color=c, lw=1.6,
                 label=f"{name}: exact, stable")
         unst = matched & ~response.stable

@@ -69,8 +69,9 @@ def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]
 
     fig, (ax, ax_s) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": (3, 1)})
     w = response.omega
-    ax.plot(w, response.rms_hb, "-", color="0.6", lw=0.8,
-            label=f"regularised HB (ε = {response.regularisation:g}, H = {response.harmonics})")
+    if np.any(np.isfinite(response.rms_hb)):  # none when followed by exact shooting
+        ax.plot(w, response.rms_hb, "-", color="0.6", lw=0.8,
+                label=f"regularised HB (ε = {response.regularisation:g}, H = {response.harmonics})")
     matched = response.matched
     for stable, style, text in ((True, "-", "exact orbit, stable"), (False, "--", "exact orbit, unstable")):
         y = np.where(matched & (response.stable == stable), response.rms, np.nan)

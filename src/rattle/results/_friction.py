@@ -73,7 +73,9 @@ class FrictionResponse:
     element's HB rms there (nan: the ladder failed), ``held_status`` (k,) ``"converged"``,
     ``"stalled"``, ``"floor"`` or ``"failed"``, ``held_scale`` (k,) the held steps' width relative
     to the chain's at the last rung. The HB's ε → 0 estimate of a held element
-    (:attr:`rms_hb_estimate`) is then that rms."""
+    (:attr:`rms_hb_estimate`) is then that rms. ``labels`` (P,): the special points located on an
+    exact branch (exact shooting continuation), "" elsewhere; None: named between rows
+    (:attr:`bifurcation`)."""
 
     omega: FloatArray
     rpm: FloatArray | None
@@ -110,6 +112,7 @@ class FrictionResponse:
     held_rms: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
     held_status: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=object))
     held_scale: FloatArray = field(default_factory=lambda: np.zeros(0))
+    labels: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.omega.size)
@@ -215,6 +218,17 @@ class FrictionResponse:
         out = np.full(len(self), "", dtype=object)
         pat = self.pattern
         m = len(self.element_names)
+        if self.labels is not None:  # located on the exact branch: the labels; structure changes between rows
+            out[:] = self.labels
+            if pat is not None:
+                for i in range(1, len(self)):
+                    if out[i] or out[i - 1]:
+                        continue
+                    if np.any(pat[i, :m] != pat[i - 1, :m]):
+                        out[i] = "grazing_sliding"
+                    elif np.any(pat[i, m:] != pat[i - 1, m:]):
+                        out[i] = "grazing"
+            return out
         prev = None
         for i in np.flatnonzero(self.matched):
             if prev is not None:
@@ -280,7 +294,9 @@ class FrictionResponse:
             return float(x) if math.isfinite(x) else None
 
         return {
-            "method": "regularised harmonic balance, checked by exact event-driven shooting (Filippov sticking, "
+            "method": "exact shooting continuation on the event-driven period map (Filippov sticking, saltation "
+                      "monodromy)" if self.followed == "exact shooting" else
+                      "regularised harmonic balance, checked by exact event-driven shooting (Filippov sticking, "
                       "saltation monodromy)",
             "regularisation": self.regularisation, "harmonics": self.harmonics,
             "elements": list(self.element_names), "rows": len(self), "matched": matched,
@@ -371,9 +387,14 @@ class FrictionResponse:
                  f"Ω = {self.omega.min():.5g} … {self.omega.max():.5g} rad/s" if P else "no rows"]
         if self.rpm is not None and P:
             lines.append(f"engine speed {self.rpm.min():.5g} … {self.rpm.max():.5g} rpm")
-        lines.append(f"regularised HB ε = {self.regularisation:g}, H = {self.harmonics}; exact orbit matched on "
-                     f"{md['matched']} of {P} rows")
-        if md["matched"]:
+        shooting = self.followed == "exact shooting"
+        if shooting:
+            lines.append(f"exact shooting continuation: every row an exact orbit; {int(np.sum(~self.stable))} of {P} "
+                         "unstable")
+        else:
+            lines.append(f"regularised HB ε = {self.regularisation:g}, H = {self.harmonics}; exact orbit matched on "
+                         f"{md['matched']} of {P} rows")
+        if md["matched"] and not shooting:
             lines.append(f"HB rms vs exact (largest over the elements): within 0.5 % on {md['within_0_5_percent']} "
                          f"of {md['matched']} matched rows, max {100 * (md['max_rms_error'] or 0):.3g} %, median "
                          f"{100 * (md['median_rms_error'] or 0):.3g} %")
@@ -405,8 +426,9 @@ class FrictionResponse:
                 lines.append(f"{name} sticks on {int(np.sum(st > 0))} rows (Ω {w.min():.4g} … {w.max():.4g}, "
                              f"up to {st.max():.0%} of the period)")
         labels = self.bifurcation
+        where = "at" if self.labels is not None else "near"  # located on an exact branch, or between rows
         for i in np.flatnonzero(labels != ""):
-            lines.append(f"{labels[i].replace('_', ' ')} near Ω = {self.omega[i]:.5g}")
+            lines.append(f"{labels[i].replace('_', ' ')} {where} Ω = {self.omega[i]:.7g}")
         if not self.status.success:
             lines.append(f"continuation: {self.message}")
         return "\n".join(lines)

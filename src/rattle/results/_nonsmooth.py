@@ -60,7 +60,9 @@ class NonsmoothResponse:
     the primary's rows first. ``followed``: how the branch was continued, ``"harmonic balance"``
     (the regularised HB, every row checked by exact shooting) or ``"exact shooting"`` (a
     sub-harmonic branch the regularised HB has no orbit for: every row an exact orbit, ``matched``
-    true, the HB's columns nan)."""
+    true, the HB's columns nan). ``labels`` (P,): the special points located on an exact branch
+    (:func:`rattle.analysis.nonsmooth_response` by exact shooting), "" elsewhere; None: the
+    stability changes between rows are named from their multipliers (:attr:`bifurcation`)."""
 
     omega: FloatArray
     rms_hb: FloatArray
@@ -92,6 +94,7 @@ class NonsmoothResponse:
     states: FloatArray | None = None
     branches: tuple[NonsmoothResponse, ...] = ()
     followed: str = "harmonic balance"
+    labels: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         for name in ("sticks", "crossings"):  # not given: unknown (-1) on every row
@@ -147,6 +150,14 @@ class NonsmoothResponse:
         phase appears or vanishes (the number of held phases per period, :attr:`sticks`, changes)
         and ``grazing`` where a pair of breakpoint crossings does (:attr:`crossings`)."""
         out = np.full(len(self), "", dtype=object)
+        if self.labels is not None:  # located on the exact branch: the labels; structure changes between rows
+            out[:] = self.labels
+            for i in range(1, len(self)):
+                if not out[i] and not out[i - 1] and self.sticks[i] != self.sticks[i - 1]:
+                    out[i] = "grazing_sliding"
+                elif not out[i] and not out[i - 1] and self.crossings[i] != self.crossings[i - 1]:
+                    out[i] = "grazing"
+            return out
         prev = None
         for i in np.flatnonzero(self.matched):
             if prev is not None:

@@ -222,6 +222,16 @@ class FrictionTrajectory:
                 out.append((float(a), float(b)))
         return out
 
+    def event_structure(self) -> tuple[int, ...]:
+        """The switching pattern: for every element its stick or lock phases, then its breakpoint
+        crossings, over the trajectory (2m counts, element-major)."""
+        out: list[int] = []
+        for e in range(self.stuck.shape[1]):
+            mine = self.event_elements == e
+            out.append(int(np.sum(mine & np.isin(self.event_kinds, (STICK, LOCK)))))
+            out.append(int(np.sum(mine & (self.event_kinds == CROSSING))))
+        return tuple(out)
+
     def crossed_breakpoints(self, element: int) -> FloatArray:
         """The breakpoints ``element`` crossed."""
         sel = (self.event_kinds == CROSSING) & (self.event_elements == element)

@@ -309,6 +309,12 @@ class NonsmoothTrajectory:
             a_lo, a_hi = min(a_lo, *vals_a), max(a_hi, *vals_a)
         return d_lo, d_hi, a_lo, a_hi
 
+    def event_structure(self) -> tuple[int, ...]:
+        """The switching pattern: the stick or lock phases, then the breakpoint crossings, over the
+        trajectory (2 counts, as :meth:`FrictionTrajectory.event_structure` for one element)."""
+        kinds = self.event_kind
+        return (sum(k in ("stick", "lock") for k in kinds), sum(k == "crossing" for k in kinds))
+
     @property
     def crossed_breakpoints(self) -> FloatArray:
         """The breakpoints the trajectory crossed or locked on (sorted, unique)."""
@@ -317,6 +323,10 @@ class NonsmoothTrajectory:
         hit = [float(bp[min(a, b)]) for a, b in pairwise(st) if a != b]
         hit += [float(bp[j]) for j, k in zip(st, kd) if k == LOCK]
         return np.unique(np.asarray(hit, dtype=float))
+
+
+#: Frequencies whose stage solutions :meth:`NonsmoothIntegrator.solutions` keeps.
+SOLUTION_CACHE = 4
 
 
 class NonsmoothIntegrator:
@@ -332,7 +342,7 @@ class NonsmoothIntegrator:
         self.system = system
         self.options = options
         self._search = _Search(options.samples_per_scale, options.max_events)
-        self._cache: tuple[float, StageSolutions] | None = None
+        self._cache: dict[float, StageSolutions] = {}
         st = system.law.stages
         self._d = st.breakpoints.tolist()
         self._s = st.slopes.tolist()
@@ -341,11 +351,15 @@ class NonsmoothIntegrator:
         self._r = system.law.friction_levels.tolist()
 
     def solutions(self, omega: float) -> StageSolutions:
-        """The closed-form solutions of every mode at ``omega`` (the last one cached)."""
-        if self._cache is not None and self._cache[0] == omega:
-            return self._cache[1]
+        """The closed-form solutions of every mode at ``omega`` (the last :data:`SOLUTION_CACHE`
+        frequencies cached: a shooting continuation evaluates the period map at Ω and at Ω + h)."""
+        sol = self._cache.get(omega)
+        if sol is not None:
+            return sol
         sol = _mode_solutions(self.system, omega, self.options.samples_per_scale)
-        self._cache = (float(omega), sol)
+        if len(self._cache) >= SOLUTION_CACHE:
+            del self._cache[next(iter(self._cache))]
+        self._cache[float(omega)] = sol
         return sol
 
     def velocity_scale(self, omega: float) -> float:

@@ -26,7 +26,9 @@ def bracketed_newton(
         lo, hi = b, a
     else:
         lo, hi = a, b
-    x = a - fa * (b - a) / (fb - fa)  # regula falsi start: good for a transversal crossing
+    # regula falsi start (good for a transversal crossing); the midpoint where the two ends agree
+    # (a bracket of two equal round-off values: no secant)
+    x = 0.5 * (a + b) if fb == fa else a - fa * (b - a) / (fb - fa)
     dx_old = dx = abs(b - a)
     for _ in range(200):
         f, df = fun(x)

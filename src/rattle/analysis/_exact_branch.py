@@ -1,0 +1,472 @@
+"""Exact shooting continuation: the branch of periodic orbits of a discontinuous law, every row an
+exact orbit.
+
+For a law with torque jumps (a preload) or Coulomb friction, on the single equation
+(:class:`~rattle.model.NonsmoothSystem`) or on a chain (:class:`~rattle.model.FrictionSystem`),
+the periodic orbits of period T = p·2π/Ω are the zeros of the scaled period-map defect
+
+    R(z(0), Ω) = (φ_T(z(0); Ω) − z(0)) / s        (:class:`~rattle.timeint.ShootingProblem`),
+
+φ_T the exact event-driven flow (crossings located to round-off, stick/slip/lock by Filippov) and
+∂R/∂z(0) = (M − I)/s with M the exact monodromy (stage transition matrices and saltation
+matrices). The branch is continued by pseudo-arclength in (z(0), Ω) on the one stepper
+(:class:`~rattle.continuation.ContinuationStepper`): every row is an exact orbit, its rms, measures,
+stick time and Floquet multipliers exact by construction (no regularisation, no truncation).
+
+**Start.** At the first frequency the exact flow is simulated ``settle_periods`` forcing periods
+from rest (transients decay) and the period map's fixed point is found by Newton from there;
+where that fails, from ``settle_periods`` more.
+
+**Grazing.** Where the orbit grazes a switching surface (a crossing of a jump or a stop at zero
+speed, the start or end of a stick or lock phase) the period map is continuous but its derivative
+blows up (the saltation matrix carries 1/v), and the corrector fails ever closer to the grazing
+point: the stepper ends with its step at the floor. The branch then goes on along the orbits of
+the other event structure: at Ω (1 ± h) next to the last point, h = ``hops`` in turn, the period
+map's fixed point is sought by Newton from the last orbit; one that differs from it by at most
+:data:`HOP_DISTANCE` (scaled state) and has another event structure is on the branch's other
+side. The branch is continued from it away from the grazing (Ω increasing from Ω (1 + h),
+decreasing from Ω (1 − h)); a continuation that stalls again within :data:`MIN_PIECE` points is
+the wrong arm (the same side of the grazing), and the next candidate is tried. So a
+discontinuity-induced fold (the two arms on one side of the grazing: the branch turns there) and
+a persisting branch (the arms on either side) are both followed.
+
+**Special points located.** Between two consecutive rows whose count of multipliers outside the
+unit circle (|μ| > 1 + :data:`UNIT_TOL`) differs, the point where the critical multiplier's
+modulus crosses 1 is located on the branch by Brent's method along the secant
+(:func:`~rattle.continuation.locate_on_segment`, each trial point corrected onto the branch): to
+``xtol`` in scaled arc length, far inside 1e-4 in Ω. It is labelled by how the multipliers left
+the unit circle (:func:`~rattle.stability.classify_loss`: ``fold``, ``period_doubling``,
+``neimark_sacker``) when they do so continuously, and by what happened to the event structure when
+they jump there (a discontinuity-induced bifurcation): ``grazing_sliding`` where a stick or lock
+phase appears or vanishes, ``grazing`` where a pair of crossings does.
+
+**Coverage.** A branch followed from Ω_min that turns back and leaves the range at Ω_min, or ends
+early, leaves the frequencies above it uncovered: the branch through Ω_max is then followed down
+from there (a second branch) until it reaches the frequencies covered.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._typing import ComplexArray, FloatArray
+from ..continuation import (
+    ArclengthCorrector,
+    BranchPoint,
+    ContinuationOptions,
+    ContinuationStepper,
+    NewtonOptions,
+    locate_on_segment,
+    solve_fixed,
+)
+from .._threads import one_blas_thread
+from ..errors import Status
+from ..model import FrictionSystem, NonsmoothSystem
+from ..stability import classify_loss
+from ..timeint import ShootingProblem
+
+#: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
+#: gives a neutral multiplier 1 (a family of orbits).
+UNIT_TOL = 1e-8
+#: A hop past a grazing lands on the branch's other side only within this scaled distance of the
+#: last orbit (the state moves like the square root of the distance to the grazing).
+HOP_DISTANCE = 0.05
+#: A piece continued from a hop that stalls again within this many points is the wrong arm.
+MIN_PIECE = 5
+#: A piece whose last CRAWL_POINTS steps were all within CRAWL_FACTOR × the stepper's smallest
+#: step is approaching a grazing (the corrector converges only ever closer to it): it ends there
+#: and the grazing is hopped (module docstring).
+CRAWL_POINTS = 4
+CRAWL_FACTOR = 8.0
+CRAWLING = "crawling towards a grazing"
+#: Multipliers that move by less than this across a located point left the unit circle
+#: continuously (a smooth bifurcation); a larger jump is the event structure's.
+CONTINUOUS_JUMP = 1e-3
+
+
+@dataclass(frozen=True, slots=True)
+class ShootingOptions:
+    """Exact shooting continuation (SPEC §8 ``method = "shooting"``), the default method for laws
+    with jumps or friction.
+
+    ``settle_periods`` forcing periods of exact simulation before the first shooting at a start;
+    ``hops`` the relative frequency offsets tried in turn past a grazing (module docstring);
+    ``max_pieces`` the most pieces (grazings passed) per branch; ``locate`` the stability
+    changes on the branch (module docstring); ``xtol`` the location's tolerance in scaled arc
+    length."""
+
+    settle_periods: int = 40
+    hops: tuple[float, ...] = (1e-5, 1e-4, 1e-3, 1e-2)
+    max_pieces: int = 64
+    locate: bool = True
+    xtol: float = 1e-10
+
+    def __post_init__(self) -> None:
+        if isinstance(self.settle_periods, bool) or not isinstance(self.settle_periods, int) or self.settle_periods < 0:
+            raise ValueError(f"`settle_periods` must be an integer >= 0, got {self.settle_periods!r}")
+        hops = tuple(self.hops)
+        if not hops or not all(isinstance(h, (int, float)) and not isinstance(h, bool) and 0 < h < 0.5 for h in hops):
+            raise ValueError(f"`hops` must be relative offsets in (0, 0.5), got {self.hops!r}")
+        object.__setattr__(self, "hops", tuple(float(h) for h in hops))
+        if isinstance(self.max_pieces, bool) or not isinstance(self.max_pieces, int) or self.max_pieces < 1:
+            raise ValueError(f"`max_pieces` must be an integer >= 1, got {self.max_pieces!r}")
+        if not isinstance(self.locate, bool):
+            raise TypeError(f"`locate` must be True or False, got {self.locate!r}")
+        if not (isinstance(self.xtol, (int, float)) and 0 < self.xtol < 1e-2):
+            raise ValueError(f"`xtol` must be in (0, 0.01), got {self.xtol!r}")
+
+
+@dataclass(slots=True)
+class ExactRow:
+    """One row of an exact branch: the state z(0) ``q``, ``omega``, the monodromy ``M``, its
+    event ``structure``, the ``label`` of a special point located there ("" none) and the
+    ``trajectory`` of one period."""
+
+    q: FloatArray
+    omega: float
+    M: FloatArray
+    structure: tuple[int, ...]
+    label: str = ""
+    trajectory: Any = None
+
+    @property
+    def multipliers(self) -> ComplexArray:
+        mu = np.linalg.eigvals(self.M)
+        return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+    @property
+    def unstable_count(self) -> int:
+        return int(np.sum(np.abs(np.linalg.eigvals(self.M)) > 1.0 + UNIT_TOL))
+
+
+@dataclass(slots=True)
+class ExactBranch:
+    """The rows of one continued exact branch (in continuation order), how it ended (``status``,
+    ``message``), the ``pieces`` it was followed in (rows per piece: grazings passed between
+    them) and ``origin`` (where it was started)."""
+
+    rows: list[ExactRow] = field(default_factory=list)
+    status: Status = Status.SUCCESS
+    message: str = ""
+    pieces: list[int] = field(default_factory=list)
+    origin: str = ""
+
+    @property
+    def omega(self) -> FloatArray:
+        return np.array([r.omega for r in self.rows], dtype=float)
+
+
+def _row(problem: ShootingProblem, q: FloatArray, omega: float) -> ExactRow:
+    """The row of the orbit through (q, Ω): one recorded period of the exact flow (its monodromy,
+    event structure and trajectory)."""
+    q = np.asarray(q, dtype=float).copy()
+    traj = problem.integrator.propagate(q, 0.0, problem.orbit_period(omega), omega)
+    return ExactRow(q, float(omega), np.asarray(traj.sensitivity, dtype=float), traj.event_structure(),
+                    trajectory=traj)
+
+
+def _structure(problem: ShootingProblem, q: FloatArray, omega: float) -> tuple[int, ...]:
+    """The event structure of the orbit through q (stick/lock phases and crossings per element)."""
+    try:
+        return problem.integrator.propagate(np.asarray(q, dtype=float), 0.0, problem.orbit_period(omega),
+                                            omega).event_structure()
+    except Exception:  # noqa: BLE001 - no structure where the flow cannot be followed
+        return (-1,)
+
+
+def start_state(problem: ShootingProblem, omega: float, options: ShootingOptions, newton: NewtonOptions,
+                guess: FloatArray | None = None) -> FloatArray | None:
+    """The exact periodic orbit's z(0) at ``omega`` (module docstring, start): from ``guess`` (else
+    rest) settled ``settle_periods`` forcing periods by the exact flow, then Newton on the period
+    map; where that fails, settled as long again. None when no orbit was found."""
+    z = np.zeros(problem.size) if guess is None else np.asarray(guess, dtype=float).copy()
+    T1 = 2.0 * math.pi / omega
+    integ = problem.integrator
+    for _ in range(2):
+        try:
+            for _k in range(options.settle_periods):
+                z = np.asarray(integ.propagate(z, 0.0, T1, omega).state1, dtype=float)
+        except Exception:  # noqa: BLE001 - a flow that cannot be followed gives no start
+            return None
+        res = solve_fixed(problem, z, omega, newton)
+        if res.converged:
+            return res.q
+    return None
+
+
+def _tangent(problem: ShootingProblem, corrector: ArclengthCorrector, q: FloatArray, omega: float,
+             direction: float) -> FloatArray | None:
+    """The branch's unit tangent (scaled) at (q, Ω), oriented so that Ω moves by ``direction``."""
+    R, Rq, Rp = problem.residual_jacobian(q, omega)
+    if not np.all(np.isfinite(Rq)):
+        return None
+    reference = np.zeros(problem.size + 1)
+    reference[-1] = direction
+    return corrector.tangent(Rq, Rp, reference)
+
+
+class _Follower:
+    """Follows one exact branch in pieces (module docstring)."""
+
+    def __init__(self, problem: ShootingProblem, omega: tuple[float, float], options: ShootingOptions,
+                 continuation: ContinuationOptions, newton: NewtonOptions) -> None:
+        self.problem = problem
+        self.lo, self.hi = omega
+        self.options = options
+        self.continuation = continuation
+        self.newton = newton
+        self.corrector = ArclengthCorrector(problem, newton)
+
+    def _piece(self, q: FloatArray, w: float, direction: float,
+               stop: Any = None) -> ContinuationStepper | None:
+        lo, hi = self.lo, self.hi
+        if w <= lo and direction < 0 or w >= hi and direction > 0:
+            return None
+        tangent = None
+        if lo < w < hi:
+            tangent = _tangent(self.problem, self.corrector, q, w, direction)
+            if tangent is None:
+                return None
+        floor = CRAWL_FACTOR * self.continuation.min_step
+        crawl = [0]
+
+        def halt(pt: BranchPoint) -> str | None:
+            crawl[0] = crawl[0] + 1 if pt.step <= floor else 0
+            if crawl[0] >= CRAWL_POINTS:
+                return CRAWLING
+            return None if stop is None else stop(pt)
+
+        stepper = ContinuationStepper(self.problem, q, w, (lo, hi), options=self.continuation, newton=self.newton,
+                                      tangent=tangent, stop=halt)
+        stepper.run()
+        if stepper.status is Status.STOPPED and stepper.message == CRAWLING:
+            stepper.status = Status.STEP_TOO_SMALL  # a grazing approached: hop it
+            stepper.message = (f"{Status.STEP_TOO_SMALL.message}: the steps fell to the floor near "
+                               f"Ω = {stepper.points[-1].p:.6g} (a grazing)")
+        return stepper
+
+    def _hops(self, last: BranchPoint, structure: tuple[int, ...]) -> list[tuple[FloatArray, float, float]]:
+        """Candidates past a grazing: (z(0), Ω, direction) of nearby orbits of another structure."""
+        s = self.problem.length_scale
+        out = []
+        for h in self.options.hops:
+            for d in (1.0, -1.0):
+                w = last.p * (1.0 + d * h)
+                if not self.lo <= w <= self.hi:
+                    continue
+                res = solve_fixed(self.problem, last.q, w, self.newton)
+                if not res.converged or float(np.max(np.abs((res.q - last.q) / s))) > HOP_DISTANCE:
+                    continue
+                if _structure(self.problem, res.q, w) == structure:
+                    continue
+                out.append((res.q, w, d))
+            if out:
+                break
+        return out
+
+    def follow(self, q0: FloatArray, w0: float, direction: float, stop: Any = None) -> ExactBranch:
+        branch = ExactBranch()
+        q, w, d = q0, w0, direction
+        pending: list[tuple[FloatArray, float, float]] = []
+        while True:
+            stepper = self._piece(q, w, d, stop)
+            pts = [] if stepper is None else stepper.points
+            stalled = stepper is not None and stepper.status is Status.STEP_TOO_SMALL
+            if pending and (not pts or stalled and len(pts) < MIN_PIECE):
+                q, w, d = pending.pop(0)  # the wrong arm: try the next candidate
+                continue
+            if pts:
+                branch.pieces.append(len(pts))
+                rows = [_row(self.problem, p.q, p.p) for p in pts]
+                if branch.rows and rows:
+                    rows[0].label = "grazing_sliding" if _held_changed(branch.rows[-1], rows[0]) else "grazing"
+                branch.rows.extend(rows)
+            if stepper is None:
+                branch.status, branch.message = Status.START_FAILED, f"no exact branch could be continued from Ω = {w:.6g}"
+                return branch
+            branch.status, branch.message = stepper.status or Status.SUCCESS, stepper.message
+            if not stalled or len(branch.pieces) >= self.options.max_pieces:
+                return branch
+            last = pts[-1]
+            candidates = self._hops(last, branch.rows[-1].structure)
+            if not candidates:
+                branch.message += " (a grazing: no orbit of another event structure was found next to it)"
+                return branch
+            q, w, d = candidates[0]
+            pending = candidates[1:]
+
+    def locate(self, branch: ExactBranch) -> None:
+        """Insert the located special points between rows of different stability (module docstring)."""
+        rows = branch.rows
+        out: list[ExactRow] = []
+        piece_end = np.cumsum(branch.pieces) if branch.pieces else np.array([len(rows)])
+        s = self.problem.length_scale
+        eye = np.eye(self.problem.size)
+        for i, row in enumerate(rows):
+            if i and i not in piece_end:
+                a = rows[i - 1]
+                ca, cb = a.unstable_count, row.unstable_count
+                if ca != cb:
+                    k = min(ca, cb)
+
+                    def test(q: FloatArray, p: float, corr: Any, dvec: Any, k: int = k) -> float:
+                        M = corr.Rq * s[:, None] + eye
+                        return float(np.sort(np.abs(np.linalg.eigvals(M)))[::-1][k]) - 1.0
+
+                    pt = locate_on_segment(self.corrector, a.q, a.omega, row.q, row.omega, test,
+                                           xtol=self.options.xtol)
+                    if pt is not None:
+                        located = _row(self.problem, pt.q, pt.p)
+                        located.label = _label(a, row)
+                        out.append(located)
+            out.append(row)
+        branch.rows = out
+
+
+def _held_changed(a: ExactRow, b: ExactRow) -> bool:
+    """The number of stick or lock phases differs between the two rows' structures."""
+    return a.structure[0::2] != b.structure[0::2]
+
+
+def _label(a: ExactRow, b: ExactRow) -> str:
+    """The name of the stability change between rows a and b (module docstring)."""
+    mu_a, mu_b = a.multipliers, b.multipliers
+    jump = float(np.max(np.abs(np.sort(np.abs(mu_a)) - np.sort(np.abs(mu_b)))))
+    if a.structure != b.structure and jump > CONTINUOUS_JUMP:
+        return "grazing_sliding" if _held_changed(a, b) else "grazing"
+    return classify_loss(mu_a, mu_b)
+
+
+def exact_branches(
+    system: NonsmoothSystem | FrictionSystem,
+    omega: tuple[float, float],
+    options: ShootingOptions | None = None,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    period: int = 1,
+) -> list[ExactBranch]:
+    """The branch of period ``period`` (1: period-1 orbits) over ``omega`` = (Ω_min, Ω_max) followed from Ω_min by exact shooting
+    continuation, and, where it leaves frequencies above it uncovered, the branch through Ω_max
+    followed down (module docstring). Every row an exact orbit; special points located and
+    labelled."""
+    opts = ShootingOptions() if options is None else options
+    if not isinstance(opts, ShootingOptions):
+        raise TypeError(f"`options` must be a ShootingOptions, got {opts!r}")
+    with one_blas_thread():
+        return _exact_branches(system, omega, opts, continuation, newton, period)
+
+
+def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float, float], opts: ShootingOptions,
+                    continuation: ContinuationOptions | None, newton: NewtonOptions | None,
+                    period: int) -> list[ExactBranch]:
+    lo, hi = omega
+    problem = ShootingProblem(system, period=period)
+    newton = newton or NewtonOptions()
+    cont = continuation or ContinuationOptions()
+    follower = _Follower(problem, (lo, hi), opts, cont, newton)
+    q0 = start_state(problem, lo, opts, newton)
+    if q0 is None:
+        return [ExactBranch(status=Status.START_FAILED, origin=f"Ω = {lo:.6g}",
+                            message=f"no exact periodic orbit was found at Ω = {lo:.6g} (the flow settled "
+                                    f"{2 * opts.settle_periods} periods, then Newton on the period map)")]
+    first = follower.follow(q0, lo, 1.0)
+    first.origin = f"Ω = {lo:.6g}"
+    out = [first]
+    top = float(first.omega.max()) if first.rows else lo
+    if top < hi * (1.0 - 1e-9):
+        q1 = start_state(problem, hi, opts, newton)
+        if q1 is not None:
+            def covered(pt: BranchPoint) -> str | None:
+                return "reached the frequencies already covered" if pt.p < top else None
+
+            second = follower.follow(q1, hi, -1.0, stop=covered)
+            second.origin = f"Ω = {hi:.6g}"
+            if second.rows:
+                out.append(second)
+    if opts.locate:
+        for b in out:
+            follower.locate(b)
+    return out
+
+
+
+
+#: A period-p orbit whose one-period map returns within this scaled distance is a period-1 orbit
+#: run p times: the sub-harmonic branch rejoined a period-1 branch.
+REJOIN_TOL = 1e-7
+
+
+def subharmonic_branches(
+    system: NonsmoothSystem | FrictionSystem,
+    primary: Any,
+    omega: tuple[float, float],
+    options: ShootingOptions,
+    continuation: ContinuationOptions | None,
+    newton: NewtonOptions | None,
+    seed: Any,
+) -> list[ExactBranch]:
+    """The period-2 branches born at the period doublings located on the exact ``primary``
+    branch (a response with ``omega``, ``states``, ``bifurcation``), each followed by exact
+    shooting continuation over two forcing periods both ways from its seed until it rejoins a
+    period-1 orbit (its one-period map returns within :data:`REJOIN_TOL`) or leaves the range.
+    ``seed(Ω, z(0))`` gives an exact period-2 orbit (``state0``, ``omega``) next to the period-1
+    orbit through z(0) at Ω, or None; it is tried at the rows either side of the located point.
+    A doubling at an end of a branch already found starts none."""
+    lo, hi = omega
+    newton = newton or NewtonOptions()
+    cont = continuation or ContinuationOptions()
+    out: list[ExactBranch] = []
+    with one_blas_thread():
+        problem = ShootingProblem(system, period=2)
+        once = ShootingProblem(system, period=1, integrator=problem.integrator)
+        follower = _Follower(problem, (lo, hi), options, cont, newton)
+        labels = primary.bifurcation
+        for i in np.flatnonzero(labels == "period_doubling"):
+            w_pd = float(primary.omega[i])
+            if any(abs(w_pd - float(b.omega[j])) <= 1e-3 * w_pd for b in out if b.rows for j in (0, -1)):
+                continue
+            orbit = None
+            for j in (i + 1, i - 1):
+                if 0 <= j < len(primary) and np.all(np.isfinite(primary.states[j])):
+                    orbit = seed(float(primary.omega[j]), primary.states[j])
+                    if orbit is not None:
+                        break
+            if orbit is None:
+                continue
+
+            def rejoined(pt: BranchPoint, prev: dict = {}) -> str | None:  # noqa: B006 - per side, reset below
+                r = once.residual(pt.q, pt.p)
+                if not np.all(np.isfinite(r)):
+                    return None
+                # the one-period defect vanishes at the doubling and flips sign past it (the branch
+                # would go on along its own copy shifted by one forcing period: a closed loop)
+                flipped = "defect" in prev and float(r @ prev["defect"]) < 0.0
+                prev["defect"] = r
+                if flipped or float(np.max(np.abs(r))) < REJOIN_TOL:
+                    return f"the period-2 branch rejoined a period-1 branch near Ω = {pt.p:.6g}"
+                return None
+
+            sides = []
+            for d in (-1.0, 1.0):
+                state: dict = {}
+                sides.append(follower.follow(np.asarray(orbit.state0, dtype=float), float(orbit.omega), d,
+                                             stop=lambda pt, state=state: rejoined(pt, state)))
+            down, up = sides
+            branch = ExactBranch(origin=f"period doubling at Ω = {w_pd:.6g}")
+            branch.rows = list(reversed(down.rows[1:])) + up.rows
+            branch.pieces = [len(branch.rows)]
+            branch.status = Status.SUCCESS
+            branch.message = "; ".join(m for m in (down.message, up.message) if m)
+            if options.locate:
+                follower.locate(branch)
+            if len(branch.rows) >= 2:
+                out.append(branch)
+    return out
+
+
+__all__ = ["ExactBranch", "ExactRow", "ShootingOptions", "exact_branches", "start_state", "subharmonic_branches"]
