@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
+from _filippov import chain_reference as _reference  # tests/ is on sys.path through its conftest
 
 from rattle.model import (
     Backlash,
@@ -96,95 +96,6 @@ def test_without_friction_it_is_the_smooth_chain(grounded):
     assert np.allclose(b.state1, a.state1, rtol=0, atol=1e-12)
     assert np.allclose(b.sensitivity, a.sensitivity, rtol=0, atol=1e-9)
 
-
-def _reference(fs: FrictionSystem, z0, t1, omega):
-    """An independent integration of the Filippov system by scipy (DOP853, rtol 1e-12) with
-    terminal events at every breakpoint, velocity zero and stick band edge; only constant friction
-    levels (the mode logic written out again, one element at a time)."""
-    sysm = fs.system
-    n, m = sysm.n, sysm.m
-    A = sysm.element_rows
-    B = sysm.element_columns
-    r = np.array([fs.friction_levels(e)[0] for e in range(m)])
-    assert all(np.all(fs.friction_levels(e) == r[e]) for e in range(m))
-
-    def y_of(t, z, sigma):
-        x, v = z[:n], z[n:]
-        d = A @ x
-        f = np.array([el.law.force(d[e]) for e, el in enumerate(sysm.elements)])
-        g = f + np.where(sigma != 0, sigma * r, 0.0)
-        return sysm.forcing(t, omega) - sysm.damping @ v - sysm.stiffness @ x - B @ g
-
-    def lam(S, y):
-        AS, BS = A[S], B[:, S]
-        return np.linalg.solve(AS @ BS, AS @ y)
-
-    def rhs(t, z, S, sigma):
-        y = y_of(t, z, sigma)
-        if S:
-            y = y - B[:, S] @ lam(S, y)
-        return np.concatenate((z[n:], y))
-
-    def settle(t, z, S, sigma):
-        S = sorted(S)
-        for e in S:
-            sigma[e] = 0  # a stuck element's torque is λ, not σ r
-        while S:
-            lm = lam(S, y_of(t, z, sigma))
-            worst = np.argmax(np.abs(lm) - r[S])
-            if abs(lm[worst]) - r[S][worst] <= 1e-12 * r[S][worst]:
-                break
-            e = S.pop(int(worst))
-            sigma[e] = 1 if lm[worst] > 0 else -1
-        for e in S:
-            sigma[e] = 0
-        return S, sigma
-
-    t, z = 0.0, np.asarray(z0, float).copy()
-    sigma = np.zeros(m)
-    for e in range(m):
-        if r[e] > 0:
-            sigma[e] = np.sign(A[e] @ z[n:])
-    S: list[int] = []
-    while t < t1:
-        evs = []
-        for e, el in enumerate(sysm.elements):
-            for dbp in el.breakpoints:
-                ev = (lambda tt, zz, *_, e=e, dbp=dbp: A[e] @ zz[:n] - dbp)
-                ev.terminal = True
-                evs.append(("bp", e, ev))
-            if r[e] > 0 and e not in S:
-                ev = (lambda tt, zz, *_, e=e: A[e] @ zz[n:])
-                ev.terminal = True
-                ev.direction = -sigma[e]  # leaving σ's side only (it starts at rest after a release)
-                evs.append(("v0", e, ev))
-        for j, e in enumerate(S):
-            def band(tt, zz, *_, j=j, e=e, S=tuple(S), sg=sigma.copy()):  # noqa: B008 - bound now
-                return abs(lam(list(S), y_of(tt, zz, sg))[j]) - r[e]
-            band.terminal = True
-            band.direction = 1
-            evs.append(("band", e, band))
-        sol = solve_ivp(rhs, (t, t1), z, method="DOP853", rtol=1e-12, atol=1e-15, args=(list(S), sigma.copy()),
-                        events=[e[2] for e in evs], max_step=2 * math.pi / omega / 64)  # a held state's torque
-        # still changes with F(t): steps no longer than the forcing allows, or a band exit is stepped over
-        t, z = float(sol.t[-1]), sol.y[:, -1].copy()
-        if sol.status != 1:
-            break
-        hit = min((abs(float(te[-1]) - t), i) for i, te in enumerate(sol.t_events) if te.size)
-        kind, e, _ = evs[hit[1]]
-        if kind == "v0":
-            z[n:] -= A[e] * (A[e] @ z[n:]) / (A[e] @ A[e])
-            S, sigma = settle(t, z, S + [e], sigma)
-        elif kind == "band":
-            lm = lam(S, y_of(t, z, sigma))[S.index(e)]
-            S = [k for k in S if k != e]
-            sigma[e] = 1 if lm > 0 else -1
-        # a breakpoint: nothing changes in the mode (constant friction levels); restart past the kink
-        t_next = t + 1e-13 * max(1.0, t)
-        if t_next < t1:
-            z = z + (t_next - t) * rhs(t, z, S, sigma)
-            t = t_next
-    return z
 
 
 @pytest.mark.parametrize("levels,omega", [((0.03, None), 0.45), ((0.03, 0.01), 0.9), ((0.06, 0.02), 0.3)])

@@ -30,6 +30,7 @@ omega = [1.2, 1.23]
 harmonics = 32
 regularisation = 0.02
 refine = 0
+method = "hb"
 """
 
 

@@ -179,6 +179,7 @@ amplitudes = [0.1]
 omega = [1.315, 1.34]
 harmonics = 32
 regularisation = 0.01
+method = "hb"
 """
 
 

@@ -36,6 +36,7 @@ phases = [0.3]
 [analysis]
 omega = [1.2, 1.25]
 harmonics = 32
+method = "hb"            # the regularised harmonic balance, every row checked (the default is exact shooting)
 """
 
 
@@ -66,7 +67,8 @@ def test_frf_json_holds_the_settings_and_the_measured_error(frf_run):
     err = np.abs(np.asarray(table["rms_error"], dtype=float)[matched])
     assert meta["command"] == "frf" and meta["status"] == "success" and meta["version"]
     assert meta["settings"]["harmonics"] == 32 and meta["settings"]["regularisation"] == 0.01
-    assert meta["analysis"] == {"omega": [1.2, 1.25], "harmonics": 32, "regularisation": 0.01, "refine": 0.005}
+    assert meta["analysis"] == {"omega": [1.2, 1.25], "harmonics": 32, "regularisation": 0.01, "refine": 0.005,
+                                "method": "hb"}
     assert meta["settings"]["refine"] == 0.005
     assert meta["points"] == len(table["omega"]) and meta["matched"] == int(matched.sum()) > 0
     assert meta["rms_error_max"] == pytest.approx(float(np.max(err)), rel=1e-12)
@@ -189,7 +191,7 @@ def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkey
 
 #: The torque converter's preloaded spring (examples/torque_converter_preload.toml) around its
 #: period doublings at Ω ≈ 0.545 and 0.562.
-TORQUE_CONVERTER = preload_spring_toml((0.53, 0.575), 64, friction=None)
+TORQUE_CONVERTER = preload_spring_toml((0.53, 0.575), 64, friction=None) + 'method = "hb"\n'
 
 
 def test_frf_subharmonics_writes_the_period_two_branch_with_the_primary(tmp_path):

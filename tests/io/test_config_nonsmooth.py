@@ -93,7 +93,8 @@ def test_analysis_defaults_of_a_discontinuous_law_are_the_front_end_defaults():
     assert cfg.analysis.refine == RegularisationOptions().refine == 0.005
     cfg = config_from_dict(_base({"type": "preload", "preload": 0.05}, harmonics=48, regularisation=0.003))
     assert (cfg.analysis.harmonics, cfg.analysis.regularisation) == (48, 0.003)
-    assert cfg.analysis.to_dict() == {"omega": [0.8, 1.6], "harmonics": 48, "regularisation": 0.003, "refine": 0.005}
+    assert cfg.analysis.to_dict() == {"omega": [0.8, 1.6], "harmonics": 48, "regularisation": 0.003, "refine": 0.005,
+                                      "method": "shooting"}  # the default method of a discontinuous law (SPEC §8)
     assert config_from_dict(cfg.to_dict()).analysis == cfg.analysis
     # a continuous law keeps its defaults and has no regularisation
     smooth = config_from_dict(_base({"type": "linear"}))

@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 import pytest
+from _filippov import single_reference as _reference  # tests/ is on sys.path through its conftest
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from rattle.errors import ConvergenceError
 from rattle.model import Clutch, Excitation, Linear, Model, Piecewise, reference_case
@@ -35,85 +35,6 @@ from rattle.timeint._nonsmooth import (
 # ---------------------------------------------------------------------------------------------
 # Independent reference
 # ---------------------------------------------------------------------------------------------
-def _surface(d):
-    def event(t, x):
-        return x[0] - d
-
-    return event
-
-
-def _velocity_zero():
-    def event(t, x):
-        return x[1]
-
-    return event
-
-
-def _reference(system: NonsmoothSystem, x0, t1: float, omega: float):
-    """Mode by mode with DOP853 (rtol 1e-12, atol 1e-14) and terminal events; returns the final
-    state and the solver's (t, δ, δ') samples."""
-    st, r = system.law.stages, system.law.friction_levels
-    bp, s, e = st.breakpoints, st.slopes, st.offsets
-    k, c = system.k, system.c
-
-    def F(t):
-        return system.excitation(t, omega)
-
-    t, (d, v) = 0.0, x0
-    j = int(np.searchsorted(bp, d, side="right"))
-    sg = 0 if r[j] == 0 else int(np.sign(v))
-    stick = False
-    ts, xs = [], []
-    while True:
-        if stick:
-            fd = k * (s[j] * d + e[j])
-            lo, hi = fd - k * r[j], fd + k * r[j]
-            grid = np.linspace(t, t1, max(2, int((t1 - t) * 400)))
-            out = np.flatnonzero((F(grid[1:]) > hi) | (F(grid[1:]) < lo))
-            if not out.size:
-                return np.array([d, 0.0]), np.concatenate(ts), np.hstack(xs)
-            i = out[0]
-            up = F(grid[i + 1]) > hi
-            t = brentq(lambda q, hi=hi, lo=lo, up=up: (F(q) - hi) if up else (lo - F(q)), grid[i], grid[i + 1],
-                       xtol=1e-15, rtol=1e-15)
-            v, sg, stick = 0.0, (1 if up else -1), False
-            continue
-        jj, ss = j, sg
-
-        def rhs(tt, x, jj=jj, ss=ss):
-            return [x[1], F(tt) - c * x[1] - k * (s[jj] * x[0] + e[jj] + r[jj] * ss)]
-
-        events = []
-        for bound, direction, comp in ((jj - 1, -1, 0), (jj, 1, 0)):
-            if 0 <= bound < len(bp):
-                ev = _surface(bp[bound])
-                ev.terminal, ev.direction = True, direction
-                events.append((ev, "up" if direction > 0 else "down"))
-        if ss != 0:
-            ev = _velocity_zero()
-            ev.terminal, ev.direction = True, -ss
-            events.append((ev, "stop"))
-        sol = solve_ivp(rhs, (t, t1), [d, v], method="DOP853", rtol=1e-12, atol=1e-14,
-                        events=[ev for ev, _ in events], dense_output=True)
-        ts.append(sol.t)
-        xs.append(sol.y)
-        if sol.status == 0:
-            return sol.y[:, -1], np.concatenate(ts), np.hstack(xs)
-        t, n = min((te[0], n) for n, te in enumerate(sol.t_events) if len(te))
-        d, v = sol.sol(t)
-        what = events[n][1]
-        if what == "stop":
-            v = 0.0
-            R = F(t) - k * (s[jj] * d + e[jj])
-            if abs(R) <= k * r[jj]:
-                stick = True
-            else:
-                sg = 1 if R > 0 else -1
-        else:
-            d = bp[jj] if what == "up" else bp[jj - 1]
-            j = jj + 1 if what == "up" else jj - 1
-            sg = 0 if r[j] == 0 else (1 if v > 0 else -1)
-
 
 def _system(elastic, friction=None, c=0.05, mean=0.05, amps=(0.03,), phases=None) -> NonsmoothSystem:
     return NonsmoothSystem(damping=c, stiffness=1.0, law=NonsmoothLaw(elastic=elastic, friction=friction),
