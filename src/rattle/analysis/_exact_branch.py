@@ -179,14 +179,42 @@ def _structure(problem: ShootingProblem, q: FloatArray, omega: float) -> tuple[i
 
 
 def start_state(problem: ShootingProblem, omega: float, options: ShootingOptions, newton: NewtonOptions,
-                guess: FloatArray | None = None) -> FloatArray | None:
+                guess: FloatArray | None = None, continuation: ContinuationOptions | None = None,
+                bounds: tuple[float, float] | None = None) -> FloatArray | None:
+    """The exact periodic orbit's z(0) at ``omega``: :func:`settled_start` there, else from a
+    neighbouring frequency Ω (1 ± δ), δ = 1 %, 3 %, 10 % (within ``bounds``), continued along its
+    branch to ``omega`` (an unstable orbit that neither the settled flow nor Newton from the
+    attractor reaches at ``omega`` is reached along the branch). None when none is found."""
+    q = settled_start(problem, omega, options, newton, guess)
+    if q is not None:
+        return q
+    lo, hi = bounds if bounds is not None else (0.0, math.inf)
+    cont = continuation or ContinuationOptions()
+    for delta in (0.01, 0.03, 0.1):
+        for sign in (1.0, -1.0):
+            w1 = omega * (1.0 + sign * delta)
+            if not lo <= w1 <= hi:
+                continue
+            q1 = settled_start(problem, w1, options, newton, guess)
+            if q1 is None:
+                continue
+            rng = (min(omega, w1), max(omega, w1))
+            stepper = ContinuationStepper(problem, q1, w1, rng, options=cont, newton=newton)
+            pts = stepper.run()
+            if pts and stepper.status in (Status.SUCCESS, Status.RETURNED) and pts[-1].p == omega:
+                return pts[-1].q
+    return None
+
+
+def settled_start(problem: ShootingProblem, omega: float, options: ShootingOptions, newton: NewtonOptions,
+                  guess: FloatArray | None = None) -> FloatArray | None:
     """The exact periodic orbit's z(0) at ``omega`` (module docstring, start): from ``guess`` (else
     rest) settled ``settle_periods`` forcing periods by the exact flow, then Newton on the period
     map; where that fails, settled as long again. None when no orbit was found."""
     z = np.zeros(problem.size) if guess is None else np.asarray(guess, dtype=float).copy()
     T1 = 2.0 * math.pi / omega
     integ = problem.integrator
-    for _ in range(2):
+    for _ in range(START_TRIES):
         try:
             for _k in range(options.settle_periods):
                 z = np.asarray(integ.propagate(z, 0.0, T1, omega).state1, dtype=float)
@@ -195,6 +223,40 @@ def start_state(problem: ShootingProblem, omega: float, options: ShootingOptions
         res = solve_fixed(problem, z, omega, newton)
         if res.converged:
             return res.q
+        q = damped_newton(problem, z, omega, newton)
+        if q is not None:
+            return q
+    return None
+
+
+#: Settled starts tried (each ``settle_periods`` later than the last: another point of the attractor).
+START_TRIES = 3
+
+
+def damped_newton(problem: ShootingProblem, q: FloatArray, omega: float, newton: NewtonOptions,
+                  iterations: int = 60) -> FloatArray | None:
+    """Newton on the period map at fixed Ω with the step halved until the scaled residual
+    decreases (an unstable orbit, which the settled flow does not approach, from a state of the
+    attractor); None when it stalls. Converged as :func:`~rattle.continuation.solve_fixed`."""
+    q = np.asarray(q, dtype=float).copy()
+    r, dq = problem.newton_step(q, omega)
+    res = float(np.max(np.abs(r)))
+    for _ in range(iterations):
+        if not math.isfinite(res) or dq is None:
+            return None
+        if res <= newton.residual_tol and float(np.max(np.abs(dq) / problem.length_scale)) <= newton.step_tol:
+            return q + dq
+        step = 1.0
+        for _h in range(30):
+            trial = q + step * dq
+            r_t, dq_t = problem.newton_step(trial, omega)
+            res_t = float(np.max(np.abs(r_t)))
+            if math.isfinite(res_t) and res_t < res:
+                break
+            step *= 0.5
+        else:
+            return None
+        q, r, dq, res = trial, r_t, dq_t, res_t
     return None
 
 
@@ -369,7 +431,7 @@ def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float
     newton = newton or NewtonOptions()
     cont = continuation or ContinuationOptions()
     follower = _Follower(problem, (lo, hi), opts, cont, newton)
-    q0 = start_state(problem, lo, opts, newton)
+    q0 = start_state(problem, lo, opts, newton, continuation=cont, bounds=(lo, hi))
     if q0 is None:
         return [ExactBranch(status=Status.START_FAILED, origin=f"Ω = {lo:.6g}",
                             message=f"no exact periodic orbit was found at Ω = {lo:.6g} (the flow settled "
@@ -379,7 +441,7 @@ def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float
     out = [first]
     top = float(first.omega.max()) if first.rows else lo
     if top < hi * (1.0 - 1e-9):
-        q1 = start_state(problem, hi, opts, newton)
+        q1 = start_state(problem, hi, opts, newton, continuation=cont, bounds=(lo, hi))
         if q1 is not None:
             def covered(pt: BranchPoint) -> str | None:
                 return "reached the frequencies already covered" if pt.p < top else None

@@ -1,0 +1,190 @@
+"""Exact shooting continuation, the default method for laws with jumps or friction
+(:mod:`rattle.analysis._exact_branch`): every row an exact orbit of an independent integration,
+special points located and labelled, a start anywhere in a range, the CLI's default.
+
+References: the independent Filippov integrations of tests/_filippov.py (scipy DOP853, rtol 1e-12,
+the mode logic written out again) — not the project's integrators.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _filippov import chain_reference, single_reference  # tests/ is on sys.path through its conftest
+
+import rattle
+from rattle.analysis import RegularisationOptions, ShootingOptions, nonsmooth_response
+from rattle.analysis._exact_branch import start_state
+from rattle.continuation import NewtonOptions
+from rattle.model import (
+    Backlash, Chain, Clutch, Element, Excitation, Friction, FrictionSystem, Link, NonsmoothLaw, NonsmoothSystem,
+    Preload, Torque,
+)
+from rattle.results import FrictionResponse, NonsmoothResponse
+from rattle.timeint import ShootingProblem
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _random_single(seed: int) -> tuple[NonsmoothSystem, tuple[float, float]]:
+    """A preload (with a clearance on odd seeds) and friction on two of three seeds, forcing with a
+    second harmonic; a 10 % range around a random Ω."""
+    rng = np.random.default_rng(seed)
+    b = [0.0, 0.05][seed % 2]
+    fr = None if seed % 3 == 0 else Friction(levels=tuple(rng.uniform(0.0, 0.01, 3 if b else 2)))
+    law = NonsmoothLaw(elastic=Preload(preload=rng.uniform(0.005, 0.03), clearance=b, slope=rng.uniform(0.6, 1.4)),
+                       friction=fr)
+    system = NonsmoothSystem(damping=rng.uniform(0.03, 0.1), stiffness=1.0, law=law,
+                             excitation=Excitation(mean=rng.uniform(-0.02, 0.05),
+                                                   amplitudes=(rng.uniform(0.03, 0.1), rng.uniform(0.0, 0.02)),
+                                                   phases=(0.0, rng.uniform(0.0, 6.0))))
+    w = rng.uniform(0.4, 1.6)
+    return system, (w, 1.1 * w)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_every_row_is_an_exact_orbit_of_the_independent_integration(seed):
+    """Random preload/friction laws: five rows spread over the branch, each integrated over its
+    period by the independent reference from the row's z(0), come back to z(0) (the orbit is
+    periodic to the reference's accuracy) and follow the row's trajectory at the reference's own
+    output times to 1e-7 of the length scale: the same orbit, so the same rms (the rms is the
+    trajectory's exact integral)."""
+    system, omega = _random_single(seed)
+    frf = nonsmooth_response(system, omega)
+    assert isinstance(frf, NonsmoothResponse) and frf.followed == "exact shooting"
+    assert frf.status.success, frf.message
+    assert np.all(np.isnan(frf.rms_hb)) and np.all(frf.matched)
+    L = system.length_scale()
+    for i in np.unique(np.linspace(0, len(frf) - 1, 5).astype(int)):
+        w, z0 = float(frf.omega[i]), frf.states[i]
+        T = 2.0 * math.pi / w
+        z1, ts, xs = single_reference(system, tuple(z0), T, w)
+        assert abs(z1[0] - z0[0]) <= 1e-7 * L
+        assert abs(z1[1] - z0[1]) <= 1e-7 * L * max(w, 1.0)
+        traj = rattle.timeint.NonsmoothIntegrator(system).propagate(z0, 0.0, T, w)
+        d = traj.sample(ts)[0]
+        assert np.max(np.abs(d - xs[0])) <= 1e-7 * L
+        assert frf.rms[i] == pytest.approx(traj.mean_and_rms()[1], rel=1e-12)
+
+
+def _chain_case() -> FrictionSystem:
+    chain = Chain(
+        inertias=(1.0, 0.5, 2.0),
+        links=(Link(between=(2, 3), stiffness=0.6, damping=0.03), Link(between=(3, 0), stiffness=0.4, damping=0.04)),
+        elements=(
+            Element(name="clutch", between=(1, 2), stiffness=1.5, law=Clutch(alpha=0.2, b=0.05),
+                    friction=Friction(levels=0.02)),
+            Element(name="gear", between=(2, 3), stiffness=2.0, law=Backlash(b=0.02)),
+        ),
+        torques=(Torque(inertia=1, mean=0.02, amplitudes=(0.25,), phases=(0.0,)),),
+    )
+    return chain.friction_system()
+
+
+def test_a_chain_with_friction_rows_are_exact_orbits_of_the_independent_integration():
+    fs = _chain_case()
+    frf = nonsmooth_response(fs, (0.6, 0.66))
+    assert isinstance(frf, FrictionResponse) and frf.followed == "exact shooting" and frf.status.success
+    L = fs.length_scale()
+    for i in (0, len(frf) // 2, len(frf) - 1):
+        w, z0 = float(frf.omega[i]), frf.states[i]
+        z1 = chain_reference(fs, z0, 2.0 * math.pi / w, w)
+        assert np.max(np.abs(z1[: fs.n] - z0[: fs.n])) <= 1e-7 * L
+        assert np.max(np.abs(z1[fs.n:] - z0[fs.n:])) <= 1e-7 * L * fs.frequency_scale()
+
+
+def test_the_torque_converter_special_points_are_located_and_named():
+    """examples/torque_converter_preload.toml: the special points the regularised HB placed between
+    rows (its header) are located on the exact branch; at a smooth one (fold, period doubling) the
+    critical multiplier is on the unit circle to 1e-6; the jump at the lower fold is a grazing
+    (the exact branch turns where a pair of crossings of the jump vanishes)."""
+    case = rattle.load_case(EXAMPLES / "torque_converter_preload.toml")
+    frf = nonsmooth_response(case.model, case.analysis.omega)
+    assert frf.status.success and frf.labels is not None
+    found = [(str(frf.bifurcation[i]), float(frf.omega[i]), i) for i in np.flatnonzero(frf.bifurcation != "")]
+    kinds = [k for k, _, _ in found]
+    assert kinds.count("period_doubling") == 4 and kinds.count("fold") == 3 and "grazing" in kinds
+    between = {"period_doubling": [(0.541, 0.547), (0.559, 0.564), (0.745, 0.752), (0.862, 0.868)],
+               "fold": [(0.6244, 0.6248), (1.0192, 1.0196), (1.0247, 1.0251)]}
+    for kind, spans in between.items():
+        at = sorted(w for k, w, _ in found if k == kind)
+        assert all(lo <= w <= hi for w, (lo, hi) in zip(at, spans)), (kind, at)
+    for kind, _w, i in found:
+        if kind in ("fold", "period_doubling"):
+            target = 1.0 if kind == "fold" else -1.0
+            mu = np.asarray(frf.multipliers[i])
+            assert np.min(np.abs(mu - target)) <= 1e-6
+    # the stability on either side of every located smooth point differs
+    stable = np.asarray(frf.stable, dtype=bool)
+    for kind, _w, i in found:
+        if kind in ("fold", "period_doubling") and 0 < i < len(frf) - 1:
+            assert stable[i - 1] != stable[i + 1]
+
+
+@pytest.mark.parametrize("name", ["torque_converter_preload.toml", "clutch_friction.toml"])
+def test_a_start_at_every_frequency_of_a_grid_succeeds(name):
+    """The exact start (settled, then Newton on the period map) at 20 frequencies over each
+    example's range."""
+    case = rattle.load_case(EXAMPLES / name)
+    problem = ShootingProblem(case.model)
+    lo, hi = case.analysis.omega
+    for w in np.linspace(lo, hi, 20):
+        q = start_state(problem, float(w), ShootingOptions(), NewtonOptions())
+        assert q is not None, w
+        assert float(np.max(np.abs(problem.residual(q, float(w))))) <= 1e-9
+
+
+def test_a_chain_start_at_every_frequency_of_a_grid_succeeds():
+    case = rattle.load_case(EXAMPLES / "chain_lockup_clutch.toml")
+    problem = ShootingProblem(case.model)
+    lo, hi = case.analysis.omega
+    for w in np.linspace(lo, hi, 20):
+        q = start_state(problem, float(w), ShootingOptions(), NewtonOptions())
+        assert q is not None, w
+
+
+def test_shooting_and_the_regularised_hb_agree_where_both_apply():
+    """The same branch by both methods: at every matched HB row, Newton on the period map from
+    the shooting branch's state interpolated to that Ω converges to the HB row's exact orbit."""
+    from rattle.analysis._exact_branch import damped_newton
+
+    system, omega = _random_single(4)
+    shot = nonsmooth_response(system, omega)
+    hb = nonsmooth_response(system, omega, RegularisationOptions(harmonics=64, refine=None))
+    problem = ShootingProblem(system)
+    ok = np.flatnonzero(hb.matched)
+    assert ok.size
+    for i in ok[:: max(1, ok.size // 5)]:
+        w = float(hb.omega[i])
+        guess = np.array([np.interp(w, shot.omega, shot.states[:, k]) for k in range(2)])
+        q = damped_newton(problem, guess, w, NewtonOptions())
+        assert q is not None
+        assert np.max(np.abs(q - hb.states[i]) / problem.length_scale) <= 1e-8
+
+
+def test_options_are_validated():
+    with pytest.raises(ValueError, match="settle_periods"):
+        ShootingOptions(settle_periods=-1)
+    with pytest.raises(ValueError, match="hops"):
+        ShootingOptions(hops=(0.7,))
+    with pytest.raises(TypeError, match="locate"):
+        ShootingOptions(locate=1)  # type: ignore[arg-type]
+
+
+def test_the_cli_default_for_a_preload_is_exact_shooting(tmp_path):
+    from _cases import preload_spring_toml  # tests/ is on sys.path through its conftest
+    from click.testing import CliRunner
+
+    from rattle.cli.main import cli
+
+    (tmp_path / "case.toml").write_text(preload_spring_toml((0.53, 0.575), 64, friction=None))
+    result = CliRunner().invoke(cli, ["frf", str(tmp_path / "case.toml"), "-o", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    meta = json.loads((tmp_path / "out" / "frf.json").read_text())
+    assert meta["settings"]["method"].startswith("exact shooting continuation")
+    assert meta["analysis"]["method"] == "shooting"
+    assert "exact shooting continuation" in result.output
