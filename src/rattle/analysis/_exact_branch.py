@@ -83,6 +83,10 @@ MIN_PIECE = 5
 CRAWL_POINTS = 4
 CRAWL_FACTOR = 8.0
 CRAWLING = "crawling towards a grazing"
+#: A hop's grazing point is sought this many points back along the arm hopped onto.
+GRAZE_POINTS = 40
+#: Relative frequency steps to a restart past a stall that no hop passes (:meth:`_Follower._restart`).
+RESTART_STEPS = (0.005, 0.02, 0.05)
 #: Multipliers that move by less than this across a located point left the unit circle
 #: continuously (a smooth bifurcation); a larger jump is the event structure's.
 CONTINUOUS_JUMP = 1e-3
@@ -147,13 +151,15 @@ class ExactRow:
 class ExactBranch:
     """The rows of one continued exact branch (in continuation order), how it ended (``status``,
     ``message``), the ``pieces`` it was followed in (rows per piece: grazings passed between
-    them) and ``origin`` (where it was started)."""
+    them), ``origin`` (where it was started) and the ``bridges``: the Ω intervals between a stall
+    and the hop past its grazing (the branch is continuous across them)."""
 
     rows: list[ExactRow] = field(default_factory=list)
     status: Status = Status.SUCCESS
     message: str = ""
     pieces: list[int] = field(default_factory=list)
     origin: str = ""
+    bridges: list[tuple[float, float]] = field(default_factory=list)
 
     @property
     def omega(self) -> FloatArray:
@@ -311,29 +317,38 @@ class _Follower:
                                f"Ω = {stepper.points[-1].p:.6g} (a grazing)")
         return stepper
 
-    def _hops(self, last: BranchPoint, structure: tuple[int, ...]) -> list[tuple[FloatArray, float, float]]:
-        """Candidates past a grazing: (z(0), Ω, direction) of nearby orbits of another structure."""
+    def _hops(self, last: BranchPoint, structure: tuple[int, ...],
+              recent: float) -> list[tuple[FloatArray, float, float]]:
+        """Candidates past a grazing: (z(0), Ω, direction) of nearby orbits of another structure;
+        failing those, the nearest orbit of the same structure a step ahead in the direction of
+        travel since the Ω ``recent`` a few points back (the steps fell to the floor where the
+        branch still goes on: a natural step over)."""
         s = self.problem.length_scale
-        out = []
+        out: list[tuple[FloatArray, float, float]] = []
+        ahead: list[tuple[FloatArray, float, float]] = []
+        travel = 1.0 if last.p >= recent else -1.0
         for h in self.options.hops:
             for d in (1.0, -1.0):
                 w = last.p * (1.0 + d * h)
                 if not self.lo <= w <= self.hi:
                     continue
                 res = solve_fixed(self.problem, last.q, w, self.newton)
-                if not res.converged or float(np.max(np.abs((res.q - last.q) / s))) > HOP_DISTANCE:
+                q = res.q if res.converged else damped_newton(self.problem, last.q, w, self.newton)
+                if q is None or float(np.max(np.abs((q - last.q) / s))) > HOP_DISTANCE:
                     continue
-                if _structure(self.problem, res.q, w) == structure:
-                    continue
-                out.append((res.q, w, d))
+                if _structure(self.problem, q, w) != structure:
+                    out.append((q, w, d))
+                elif d == travel and not ahead:
+                    ahead.append((q, w, d))
             if out:
                 break
-        return out
+        return out or ahead
 
     def follow(self, q0: FloatArray, w0: float, direction: float, stop: Any = None) -> ExactBranch:
         branch = ExactBranch()
         q, w, d = q0, w0, direction
         pending: list[tuple[FloatArray, float, float]] = []
+        hopped = False
         while True:
             stepper = self._piece(q, w, d, stop)
             pts = [] if stepper is None else stepper.points
@@ -342,10 +357,13 @@ class _Follower:
                 q, w, d = pending.pop(0)  # the wrong arm: try the next candidate
                 continue
             if pts:
-                branch.pieces.append(len(pts))
                 rows = [_row(self.problem, p.q, p.p) for p in pts]
-                if branch.rows and rows:
+                if branch.rows and rows and hopped:
+                    graze = self._graze(pts[0], d, rows[0].structure)
+                    if graze is not None:
+                        rows.insert(0, graze)
                     rows[0].label = "grazing_sliding" if _held_changed(branch.rows[-1], rows[0]) else "grazing"
+                branch.pieces.append(len(rows))
                 branch.rows.extend(rows)
             if stepper is None:
                 branch.status, branch.message = Status.START_FAILED, f"no exact branch could be continued from Ω = {w:.6g}"
@@ -354,12 +372,70 @@ class _Follower:
             if not stalled or len(branch.pieces) >= self.options.max_pieces:
                 return branch
             last = pts[-1]
-            candidates = self._hops(last, branch.rows[-1].structure)
+            recent = pts[max(0, len(pts) - 8)].p
+            candidates = self._hops(last, branch.rows[-1].structure, recent)
             if not candidates:
-                branch.message += " (a grazing: no orbit of another event structure was found next to it)"
-                return branch
+                travel = 1.0 if last.p >= recent else -1.0
+                restarted = self._restart(branch, last.p, travel, stop)
+                if restarted is None:
+                    branch.message += " (a grazing: no orbit of another event structure was found next to it)"
+                    return branch
+                candidates = [restarted]
+                hopped = False
+            else:
+                hopped = True
+                # the arms meet at the grazing between the stall and the hop: the branch is continuous there
+                branch.bridges.append((min(last.p, candidates[0][1]), max(last.p, candidates[0][1])))
             q, w, d = candidates[0]
             pending = candidates[1:]
+
+    def _graze(self, start: BranchPoint, direction: float, structure: tuple[int, ...]) -> ExactRow | None:
+        """The grazing point a hop passed, on the arm hopped onto: that arm followed back (against
+        ``direction``) from its first point while its event structure stays ``structure``; the last
+        such point (the arm ends there, or its structure changes: the grazing, to the stepper's
+        resolution). None when the arm cannot be followed back."""
+        seen: list[BranchPoint] = []
+
+        def same(pt: BranchPoint) -> str | None:
+            if _structure(self.problem, pt.q, pt.p) != structure:
+                return "the structure changed"
+            seen.append(pt)
+            return "far enough" if len(seen) > GRAZE_POINTS else None
+
+        stepper = self._piece(start.q, start.p, -direction, same)
+        if stepper is None or len(seen) < 2 or len(seen) > GRAZE_POINTS:
+            return None
+        return _row(self.problem, seen[-1].q, seen[-1].p)
+
+    def _restart(self, branch: ExactBranch, w_stall: float, travel: float,
+                 stop: Any) -> tuple[FloatArray, float, float] | None:
+        """Past a stall with no orbit next to it: the exact start (settled, then shot) a step
+        :data:`RESTART_STEPS` further in the direction of travel, where this branch has no rows yet;
+        the stretch back to the stall is followed from there (a piece of its own). Returns the
+        restart (z(0), Ω, direction) to go on from, or None."""
+        covered = (min(r.omega for r in branch.rows), max(r.omega for r in branch.rows))
+        for step in RESTART_STEPS:
+            w = w_stall * (1.0 + travel * step)
+            if not self.lo <= w <= self.hi or covered[0] <= w <= covered[1]:
+                continue
+            q = start_state(self.problem, w, self.options, self.newton, continuation=self.continuation,
+                            bounds=(self.lo, self.hi))
+            if q is None:
+                continue
+            if stop is not None and stop(BranchPoint(q, w, 0, 0.0, np.zeros(q.size + 1), 0.0)):
+                return None
+
+            def back(pt: BranchPoint, w_stall: float = w_stall) -> str | None:
+                return "reached the stall" if (pt.p - w_stall) * travel <= 0 else None
+
+            stepper = self._piece(q, w, -travel, back)
+            if stepper is not None and stepper.points:
+                rows = [_row(self.problem, p.q, p.p) for p in reversed(stepper.points)]
+                if rows:
+                    branch.pieces.append(len(rows))
+                    branch.rows.extend(rows)
+            return q, w, travel
+        return None
 
     def locate(self, branch: ExactBranch) -> None:
         """Insert the located special points between rows of different stability (module docstring)."""
@@ -368,6 +444,8 @@ class _Follower:
         piece_end = np.cumsum(branch.pieces) if branch.pieces else np.array([len(rows)])
         s = self.problem.length_scale
         eye = np.eye(self.problem.size)
+        sizes = list(branch.pieces) if branch.pieces else [len(rows)]
+        piece_of = np.searchsorted(piece_end, np.arange(len(rows)), side="right")
         for i, row in enumerate(rows):
             if i and i not in piece_end:
                 a = rows[i - 1]
@@ -385,8 +463,11 @@ class _Follower:
                         located = _row(self.problem, pt.q, pt.p)
                         located.label = _label(a, row)
                         out.append(located)
+                        sizes[int(piece_of[i])] += 1
             out.append(row)
         branch.rows = out
+        if branch.pieces:
+            branch.pieces = sizes
 
 
 def _held_changed(a: ExactRow, b: ExactRow) -> bool:
@@ -453,7 +534,37 @@ def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float
     if opts.locate:
         for b in out:
             follower.locate(b)
+    _coverage(out, lo, hi)
     return out
+
+
+def _coverage(branches: list[ExactBranch], lo: float, hi: float) -> None:
+    """A primary branch that ended early (a stall) while the branches together cover the range is a
+    success: its status says so, its message keeps why it ended; else the uncovered frequencies are
+    named in its message."""
+    spans: list[tuple[float, float]] = []
+    for b in branches:
+        k = 0
+        for size in b.pieces or [len(b.rows)]:
+            om = [r.omega for r in b.rows[k:k + size]]
+            k += size
+            if om:
+                spans.append((min(om), max(om)))
+        spans.extend(b.bridges)
+    spans.sort()
+    gaps, reach = [], lo
+    for a, c in spans:
+        if a > reach * (1.0 + 1e-9):
+            gaps.append((reach, a))
+        reach = max(reach, c)
+    if reach < hi * (1.0 - 1e-9):
+        gaps.append((reach, hi))
+    first = branches[0]
+    if not gaps and not first.status.success and first.status is not Status.START_FAILED:
+        first.message = f"{first.message}; the range is covered with the branch followed from the other end"
+        first.status = Status.SUCCESS
+    elif gaps:
+        first.message += "; not covered: " + ", ".join(f"Ω = {a:.6g} … {c:.6g}" for a, c in gaps)
 
 
 

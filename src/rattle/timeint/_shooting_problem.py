@@ -50,6 +50,9 @@ from ._shooting import FLOW_FAILURES
 #: Relative step of the forward difference in Ω of a discontinuous law's period map.
 OMEGA_STEP = math.sqrt(np.finfo(float).eps)
 
+#: Scaled distance within which a discontinuous law's ∂φ_T/∂Ω is taken again (:meth:`ShootingProblem._omega_derivative`).
+REUSE_DISTANCE = 1e-4
+
 Shootable = System | NonsmoothSystem | FrictionSystem
 
 
@@ -107,6 +110,7 @@ class ShootingProblem:
         self._omega_s = omega_s
         self._scale = np.concatenate((np.full(n, L), np.full(n, L * omega_s)))
         self._eye = np.eye(2 * n)
+        self._last_zw: tuple[FloatArray, float, FloatArray] | None = None
 
     # --- the ContinuationProblem protocol ------------------------------------------------------
     @property
@@ -165,13 +169,28 @@ class ShootingProblem:
         else:
             try:
                 z1, M = self.period_map(q, omega)
-                h = OMEGA_STEP * omega
-                zh, _ = self.period_map(q, omega + h)
+                zw = self._omega_derivative(q, omega, z1)
             except FLOW_FAILURES:  # the flow cannot be followed from q: no residual (a failed corrector step)
                 nan = np.full(2 * self.n, np.nan)
                 return nan, np.full((2 * self.n, 2 * self.n), np.nan), nan
-            zw = (zh - z1) / h
         return (z1 - q) / s, (M - self._eye) / s[:, None], zw / s
+
+    def _omega_derivative(self, q: FloatArray, omega: float, z1: FloatArray) -> FloatArray:
+        """∂φ_T/∂Ω by the forward difference (module docstring); within :data:`REUSE_DISTANCE` (scaled,
+        in q and in Ω) of the point where it was last taken, that value again: a corrector's
+        iterations move the point by less, and the column enters only the Jacobian (the chord
+        method in Ω: the residual, hence every branch point, stays exact)."""
+        last = self._last_zw
+        if last is not None:
+            q0, w0, zw0 = last
+            if abs(omega - w0) <= REUSE_DISTANCE * self._omega_s and \
+                    float(np.max(np.abs(q - q0) / self._scale)) <= REUSE_DISTANCE:
+                return zw0
+        h = OMEGA_STEP * omega
+        zh, _ = self.period_map(q, omega + h)
+        zw = (zh - z1) / h
+        self._last_zw = (q.copy(), float(omega), zw)
+        return zw
 
     def newton_step(self, q: FloatArray, omega: float) -> tuple[FloatArray, FloatArray | None]:
         """R(q, Ω) and the Newton increment −(M − I)⁻¹ (φ_T(q) − q) (None if M − I is singular):
