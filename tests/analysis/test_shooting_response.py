@@ -188,3 +188,14 @@ def test_the_cli_default_for_a_preload_is_exact_shooting(tmp_path):
     assert meta["settings"]["method"].startswith("exact shooting continuation")
     assert meta["analysis"]["method"] == "shooting"
     assert "exact shooting continuation" in result.output
+
+
+def test_progress_reports_the_share_of_the_range_reached():
+    system, omega = _random_single(1)
+    seen: list[tuple[int, int]] = []
+    frf = nonsmooth_response(system, omega, progress=lambda done, total: seen.append((done, total)))
+    assert frf.status.success and seen
+    done = [d for d, _ in seen]
+    assert all(t == 1000 for _, t in seen) and done == sorted(done) and done[-1] >= 900
+    with pytest.raises(TypeError, match="progress"):
+        nonsmooth_response(system, omega, progress=3)  # type: ignore[arg-type]

@@ -281,8 +281,10 @@ class _Follower:
     """Follows one exact branch in pieces (module docstring)."""
 
     def __init__(self, problem: ShootingProblem, omega: tuple[float, float], options: ShootingOptions,
-                 continuation: ContinuationOptions, newton: NewtonOptions) -> None:
+                 continuation: ContinuationOptions, newton: NewtonOptions, progress: Any = None) -> None:
         self.problem = problem
+        self.progress = progress
+        self._reach = (math.inf, -math.inf)
         self.lo, self.hi = omega
         self.options = options
         self.continuation = continuation
@@ -304,6 +306,8 @@ class _Follower:
 
         def halt(pt: BranchPoint) -> str | None:
             crawl[0] = crawl[0] + 1 if pt.step <= floor else 0
+            if self.progress is not None:
+                self._report(pt.p)
             if crawl[0] >= CRAWL_POINTS:
                 return CRAWLING
             return None if stop is None else stop(pt)
@@ -316,6 +320,12 @@ class _Follower:
             stepper.message = (f"{Status.STEP_TOO_SMALL.message}: the steps fell to the floor near "
                                f"Ω = {stepper.points[-1].p:.6g} (a grazing)")
         return stepper
+
+    def _report(self, omega: float) -> None:
+        """``progress(done, total)``: the share of the range reached so far, in thousandths."""
+        a, b = min(self._reach[0], omega), max(self._reach[1], omega)
+        self._reach = (a, b)
+        self.progress(int(round(1000 * (b - a) / (self.hi - self.lo))), 1000)
 
     def _hops(self, last: BranchPoint, structure: tuple[int, ...],
               recent: float) -> list[tuple[FloatArray, float, float]]:
@@ -492,26 +502,30 @@ def exact_branches(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     period: int = 1,
+    progress: Any = None,
 ) -> list[ExactBranch]:
     """The branch of period ``period`` (1: period-1 orbits) over ``omega`` = (Ω_min, Ω_max) followed from Ω_min by exact shooting
     continuation, and, where it leaves frequencies above it uncovered, the branch through Ω_max
     followed down (module docstring). Every row an exact orbit; special points located and
-    labelled."""
+    labelled. ``progress(done, total)``, if given, is called at every accepted point with the share
+    of the range reached (in thousandths; the library draws nothing itself)."""
     opts = ShootingOptions() if options is None else options
     if not isinstance(opts, ShootingOptions):
         raise TypeError(f"`options` must be a ShootingOptions, got {opts!r}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"`progress` must be a callable progress(done, total) or None, got {progress!r}")
     with one_blas_thread():
-        return _exact_branches(system, omega, opts, continuation, newton, period)
+        return _exact_branches(system, omega, opts, continuation, newton, period, progress)
 
 
 def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float, float], opts: ShootingOptions,
                     continuation: ContinuationOptions | None, newton: NewtonOptions | None,
-                    period: int) -> list[ExactBranch]:
+                    period: int, progress: Any = None) -> list[ExactBranch]:
     lo, hi = omega
     problem = ShootingProblem(system, period=period)
     newton = newton or NewtonOptions()
     cont = continuation or ContinuationOptions()
-    follower = _Follower(problem, (lo, hi), opts, cont, newton)
+    follower = _Follower(problem, (lo, hi), opts, cont, newton, progress)
     q0 = start_state(problem, lo, opts, newton, continuation=cont, bounds=(lo, hi))
     if q0 is None:
         return [ExactBranch(status=Status.START_FAILED, origin=f"Ω = {lo:.6g}",

@@ -433,6 +433,7 @@ def shooting_friction_response(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
+    progress: Callable[[int, int], None] | None = None,
 ) -> FrictionResponse:
     """The chain's period-1 branch over ``omega`` by exact shooting continuation
     (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit of the chain,
@@ -444,7 +445,7 @@ def shooting_friction_response(
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
-    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton)
+    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
     parts = [exact_friction_response(system, b, number=k) for k, b in enumerate(found)]
     primary, extra = parts[0], list(parts[1:])
     if subharmonics and len(primary):

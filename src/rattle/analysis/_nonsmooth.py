@@ -236,6 +236,7 @@ def nonsmooth_response(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
+    progress: Callable[[int, int], None] | None = None,
 ) -> NonsmoothResponse | FrictionResponse:
     """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min. The method follows from
     ``options``: None or a :class:`ShootingOptions`, exact shooting continuation (the default,
@@ -250,7 +251,7 @@ def nonsmooth_response(
         raise TypeError(f"`subharmonics` must be True or False, got {subharmonics!r}")
     if options is None or isinstance(options, ShootingOptions):  # the default: exact shooting continuation
         return shooting_response(system, omega, options, continuation=continuation, newton=newton,
-                                 subharmonics=subharmonics)
+                                 subharmonics=subharmonics, progress=progress)
     if isinstance(system, FrictionSystem):
         chain = friction_response(system, omega, options, continuation=continuation, newton=newton)
         if subharmonics:
@@ -290,22 +291,24 @@ def shooting_response(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
+    progress: Callable[[int, int], None] | None = None,
 ) -> NonsmoothResponse | FrictionResponse:
     """The period-1 branch over ``omega`` by exact shooting continuation
     (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit, the special
     points located and labelled; ``followed`` "exact shooting", the HB columns nan). A second
     branch followed down from Ω_max, where the first left frequencies uncovered, is the first of
     ``branches``; with ``subharmonics`` the period-2 branches born at the located period doublings
-    follow (numbered on)."""
+    follow (numbered on). ``progress(done, total)``: called with the share of the range reached
+    (the CLI draws a bar; the library draws nothing)."""
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
     if isinstance(system, FrictionSystem):
         return shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
-                                          subharmonics=subharmonics)
+                                          subharmonics=subharmonics, progress=progress)
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
                         f"friction, Chain.friction_system()), got {system!r}")
-    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton)
+    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
     parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
     primary = parts[0]
     extra = list(parts[1:])

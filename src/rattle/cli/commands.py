@@ -241,7 +241,15 @@ def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path,
     else:
         logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s by exact shooting "
                     "continuation", analysis.omega_min, analysis.omega_max)
-    result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics)
+    if analysis.method == "hb":
+        result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics)
+    else:  # a bar of the range reached on a terminal (the runs of a chain take tens of seconds)
+        bar = ProgressBar("exact shooting continuation", enabled=True, unit="‰")
+        try:
+            result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics,
+                                        progress=bar)
+        finally:
+            bar.close()
     timings = {"nonsmooth_response": time.perf_counter() - t_start}
     chain = getattr(run_config, "chain_friction", False)  # a FrictionResponse, one column set per element
     meta = (friction_metadata if chain else nonsmooth_metadata)(result, run_config.model, options, timings)
