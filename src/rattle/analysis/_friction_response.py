@@ -76,7 +76,7 @@ from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
-from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
+from ._exact_branch import ExactBranch, ShootingOptions, exact_branches
 from ._held_limit import held_limit
 from ._regularisation import (
     RegularisationLimit,
@@ -432,30 +432,20 @@ def shooting_friction_response(
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
-    subharmonics: bool = False,
     progress: Callable[[int, int], None] | None = None,
 ) -> FrictionResponse:
     """The chain's period-1 branch over ``omega`` by exact shooting continuation
     (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit of the chain,
     the special points located and labelled; ``followed`` "exact shooting", the HB columns nan).
     A second branch followed down from Ω_max, where the first left frequencies uncovered, is the
-    first of ``branches``; with ``subharmonics`` the period-2 branches born at the located period
-    doublings follow."""
+    first of ``branches`` (the sub-harmonic ones: :func:`rattle.analysis.nonsmooth_response`)."""
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
     found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
     parts = [exact_friction_response(system, b, number=k) for k, b in enumerate(found)]
-    primary, extra = parts[0], list(parts[1:])
-    if subharmonics and len(primary):
-        from ._friction_subharmonics import period_two_orbit  # the seed (that module builds on this one)
-
-        integ = FrictionIntegrator(system)
-        for b in subharmonic_branches(system, primary, (lo, hi), opts, continuation, newton,
-                                      lambda w, z: period_two_orbit(system, integ, w, z)):
-            extra.append(exact_friction_response(system, b, number=len(extra) + 1, period=2))
-    return dataclasses.replace(primary, branches=tuple(extra)) if extra else primary
+    return dataclasses.replace(parts[0], branches=tuple(parts[1:])) if len(parts) > 1 else parts[0]
 
 
 def exact_friction_response(system: FrictionSystem, branch: ExactBranch, *, number: int,

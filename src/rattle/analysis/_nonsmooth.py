@@ -66,11 +66,11 @@ from ..hb import HBOptions, RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
-from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
+from ..timeint import FrictionIntegrator, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
 from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
 from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
-from ._friction_response import friction_response, shooting_friction_response
-from ._friction_subharmonics import friction_subharmonics
+from ._friction_response import exact_friction_response, friction_response, shooting_friction_response
+from ._friction_subharmonics import friction_subharmonics, period_two_orbit
 from ._period_two import branches_at_doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import (
     RegularisationLimit,
@@ -302,22 +302,29 @@ def shooting_response(
     (the CLI draws a bar; the library draws nothing)."""
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
+    primary: NonsmoothResponse | FrictionResponse
     if isinstance(system, FrictionSystem):
-        return shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
-                                          subharmonics=subharmonics, progress=progress)
-    if not isinstance(system, NonsmoothSystem):
+        primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
+                                             progress=progress)
+        chain_integ = FrictionIntegrator(system)
+        seed = lambda w, z: period_two_orbit(system, chain_integ, w, z)  # noqa: E731
+        build = lambda b, k: exact_friction_response(system, b, number=k, period=2)  # noqa: E731
+    elif isinstance(system, NonsmoothSystem):
+        found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
+        parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
+        primary = dataclasses.replace(parts[0], branches=tuple(parts[1:])) if len(parts) > 1 else parts[0]
+        integ = NonsmoothIntegrator(system)
+        seed = lambda w, z: _period_two_orbit(system, integ, w, z)  # noqa: E731
+        build = lambda b, k: _exact_response(b, number=k, period=2)  # noqa: E731
+    else:
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
                         f"friction, Chain.friction_system()), got {system!r}")
-    found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
-    parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
-    primary = parts[0]
-    extra = list(parts[1:])
-    if subharmonics and len(primary):
-        integ = NonsmoothIntegrator(system)
-        for b in subharmonic_branches(system, primary, (lo, hi), opts, continuation, newton,
-                                      lambda w, q: _period_two_orbit(system, integ, w, q)):
-            extra.append(_exact_response(b, number=len(extra) + 1, period=2))
-    return dataclasses.replace(primary, branches=tuple(extra)) if extra else primary
+    if not subharmonics or not len(primary):
+        return primary
+    extra = list(primary.branches)
+    for b in subharmonic_branches(system, primary, (lo, hi), opts, continuation, newton, seed):
+        extra.append(build(b, len(extra) + 1))
+    return dataclasses.replace(primary, branches=tuple(extra))
 
 
 def _exact_response(branch: ExactBranch, *, number: int, period: int = 1) -> NonsmoothResponse:
