@@ -375,10 +375,34 @@ def check_scales(model: Any, prefix: str = "") -> None:
     force = abs(ex.mean) + sum(abs(a) for a in ex.amplitudes)
     bound(force, "the force scale |mean| + Σ|amplitudes|", "`excitation.mean` and `excitation.amplitudes`",
           allow_zero=True)
-    slopes = [float(s) for s in model.elastic.stages.slopes if s > 0]
-    length = force / (model.k * min(slopes))
+    st = model.elastic.stages
+    length = quasi_static_deflection(st.slopes, st.breakpoints, force, model.k)
     bound(length, "the deflection scale (force scale)/(K/I)",
           f"`excitation.mean`, `excitation.amplitudes` and `{p}stiffness` / `{p}inertia`", allow_zero=True)
+
+
+def quasi_static_deflection(slopes: Any, breakpoints: Any, force: float, k: float) -> float:
+    """The largest quasi-static deflection that a force amplitude ``force`` gives on a law of
+    stage ``slopes`` (≥ 0, relative to ``k``) between ``breakpoints``:
+
+        A = min(F / (k s_min),  w + F / (k s_out)),
+
+    s_min the softest positive slope, s_out the softer positive slope of the two outer stages,
+    w = max(breakpoints) − min(breakpoints) the width of the inner stages: an inner stage holds no
+    more than its width, however soft. (F / (k s_min) alone grows without bound as an inner
+    slope — a clutch's α — tends to 0, though the motion tends to the backlash limit's.)"""
+    slopes = [float(s) for s in slopes]
+    bps = [float(b) for b in breakpoints]
+
+    def over(s: float) -> float:  # F / (k s), inf where k s underflows to 0
+        ks = k * s
+        return force / ks if ks > 0 else math.inf
+
+    out = over(min(s for s in slopes if s > 0)) if any(s > 0 for s in slopes) else math.inf
+    outer = [s for s in (slopes[0], slopes[-1]) if s > 0] if slopes else []
+    if outer and bps:
+        out = min(out, (max(bps) - min(bps)) + over(min(outer)))
+    return out
 
 
 def warn_clearance(b: float, name: str = "b", stacklevel: int = 3) -> None:
@@ -402,5 +426,5 @@ __all__ = [
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
     "CLEARANCE_WARNING", "check_harmonics", "check_interval", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
-    "check_scales", "warn_clearance", "stiffest_frequency", "simulation_rate", "damping_rate",
+    "check_scales", "quasi_static_deflection", "warn_clearance", "stiffest_frequency", "simulation_rate", "damping_rate",
 ]
