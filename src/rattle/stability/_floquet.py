@@ -30,6 +30,7 @@ through ``scipy.linalg.expm`` instead.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -482,12 +483,29 @@ def neimark_sacker_function(mu: ComplexArray) -> FloatArray:
     (it overflows to ±inf only where ψ_ns itself exceeds 1.8 · 10³⁰⁸, as the determinant would).
     """
     mu = np.asarray(mu, dtype=complex)
-    i, j = np.triu_indices(mu.shape[-1], 1)
+    i, j = _pairs(mu.shape[-1])
     t = mu[..., i] * mu[..., j] - 1.0
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        magnitude = np.exp(np.sum(np.log(np.abs(t)), axis=-1))
-        out = np.where(np.cos(np.sum(np.angle(t), axis=-1)) < 0.0, -magnitude, magnitude)
-    return np.where(np.all(np.isfinite(t), axis=-1), out, np.nan)
+        magnitude = np.exp(np.log(np.abs(t)).sum(axis=-1))
+        negative = np.cos(np.angle(t).sum(axis=-1)) < 0.0
+    return np.where(np.isfinite(t).all(axis=-1), np.where(negative, -magnitude, magnitude), np.nan)
+
+
+@functools.lru_cache(maxsize=64)
+def _pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs i < j of k multipliers (cached: the monitor asks for the same k each time)."""
+    return np.triu_indices(k, 1)
+
+
+def _eigenvalues(M: FloatArray) -> ComplexArray:
+    """Eigenvalues of (..., k, k) matrices, unsorted (NaN for a matrix with a non-finite entry)."""
+    finite = np.isfinite(M).all(axis=(-2, -1))
+    if np.all(finite):
+        return np.linalg.eigvals(M).astype(complex, copy=False)
+    mu = np.full(M.shape[:-1], np.nan, dtype=complex)
+    if np.any(finite):
+        mu[finite] = np.linalg.eigvals(M[finite])
+    return mu
 
 
 def floquet_test_functions(M: FloatArray) -> FloatArray:
@@ -513,7 +531,7 @@ def floquet_test_functions(M: FloatArray) -> FloatArray:
     eye = np.eye(k)
     with np.errstate(over="ignore", invalid="ignore"):
         parts = [np.linalg.det(M - eye), np.linalg.det(M + eye)]
-    parts.append(neimark_sacker_function(multipliers_from_monodromy(M)))
+    parts.append(neimark_sacker_function(_eigenvalues(M)))
     return np.stack(parts, axis=-1)
 
 
