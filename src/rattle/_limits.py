@@ -407,16 +407,31 @@ def check_scales(model: Any, prefix: str = "") -> None:
           f"`excitation.mean`, `excitation.amplitudes` and `{p}stiffness` / `{p}inertia`", allow_zero=True)
 
 
+#: A scale may exceed the motion it stands for by this factor before the tighter bound replaces
+#: it (:func:`bounded_scale`): within an order of magnitude the continuation's scaled tolerances
+#: serve (the reference clutch with α = 1e-3, its scale 80 times its orbit, gives α = 0's answer),
+#: 10⁹ times they do not; below the factor every law keeps the scale it was solved with.
+SCALE_SLACK = 10.0
+
+
+def bounded_scale(estimate: float, bound: float) -> float:
+    """``estimate`` (the quasi-static amplitude on the softest stages), or ``bound`` (an upper
+    bound of the motion, :func:`quasi_static_deflection`) where the estimate exceeds it more than
+    :data:`SCALE_SLACK` times."""
+    return estimate if estimate <= SCALE_SLACK * bound else bound
+
+
 def quasi_static_deflection(slopes: Any, breakpoints: Any, force: float, k: float) -> float:
-    """The largest quasi-static deflection that a force amplitude ``force`` gives on a law of
-    stage ``slopes`` (≥ 0, relative to ``k``) between ``breakpoints``:
+    """The quasi-static deflection scale that a force amplitude ``force`` gives on a law of
+    stage ``slopes`` (≥ 0, relative to ``k``) between ``breakpoints``: F / (k s_min), s_min the
+    softest positive slope — unless it exceeds ten times (:func:`bounded_scale`) the bound
 
-        A = min(F / (k s_min),  w + F / (k s_out)),
+        A = w + F / (k s_out),
 
-    s_min the softest positive slope, s_out the softer positive slope of the two outer stages,
-    w = max(breakpoints) − min(breakpoints) the width of the inner stages: an inner stage holds no
-    more than its width, however soft. (F / (k s_min) alone grows without bound as an inner
-    slope — a clutch's α — tends to 0, though the motion tends to the backlash limit's.)"""
+    s_out the softer positive slope of the two outer stages, w = max(breakpoints) −
+    min(breakpoints) the width of the inner stages: an inner stage holds no more than its width,
+    however soft. (F / (k s_min) alone grows without bound as an inner slope — a clutch's α —
+    tends to 0, though the motion tends to the backlash limit's.)"""
     slopes = [float(s) for s in slopes]
     bps = [float(b) for b in breakpoints]
 
@@ -427,7 +442,7 @@ def quasi_static_deflection(slopes: Any, breakpoints: Any, force: float, k: floa
     out = over(min(s for s in slopes if s > 0)) if any(s > 0 for s in slopes) else math.inf
     outer = [s for s in (slopes[0], slopes[-1]) if s > 0] if slopes else []
     if outer and bps:
-        out = min(out, (max(bps) - min(bps)) + over(min(outer)))
+        out = bounded_scale(out, (max(bps) - min(bps)) + over(min(outer)))
     return out
 
 
@@ -452,5 +467,5 @@ __all__ = [
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
     "CLEARANCE_WARNING", "check_harmonics", "check_interval", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
-    "check_scales", "quasi_static_deflection", "warn_clearance", "max_harmonics_for", "stiffest_frequency", "simulation_rate", "damping_rate",
+    "check_scales", "quasi_static_deflection", "bounded_scale", "SCALE_SLACK", "warn_clearance", "max_harmonics_for", "stiffest_frequency", "simulation_rate", "damping_rate",
 ]

@@ -132,16 +132,16 @@ class Model:
         """A characteristic angle L (rad) for scaling: the static deflection, the breakpoints and
         the quasi-static dynamic amplitude, whichever is largest.
 
-        The quasi-static amplitude of the forcing amplitude F_a on the law is at most
+        The quasi-static amplitude of the forcing amplitude F_a on the law is F_a / (k s_min), s_min
+        the softest positive slope, unless it exceeds ten times the bound
 
-            A = min(F_a / (k s_min),  w + F_a / (k s_out)),
+            A = w + F_a / (k s_out),
 
-        s_min the softest positive slope, s_out the softer positive slope of the two outer stages
-        and w the width of the inner stages (the span of the breakpoints; ``_limits.
-        quasi_static_deflection``): an inner stage holds no more than its width, however soft. The
-        second bound keeps L the size of the motion when an inner stage is nearly flat (a clutch of
-        α = 1e-9 would otherwise give L = F_a / (k α), 10⁹ times the orbit, and the continuation's
-        scaled tolerances would see no orbit at all).
+        s_out the softer positive slope of the two outer stages and w the width of the inner stages
+        (the span of the breakpoints; ``_limits.quasi_static_deflection``): an inner stage holds no
+        more than its width, however soft. The bound keeps L the size of the motion when an inner
+        stage is nearly flat (a clutch of α = 1e-9 would otherwise give L = F_a / (k α), 10⁹ times
+        the orbit, and the continuation's scaled tolerances would see no orbit at all).
         """
         st = self.elastic.stages
         dyn = quasi_static_deflection(st.slopes, st.breakpoints, self.excitation.amplitude_scale, self.k)

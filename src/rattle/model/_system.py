@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._limits import bounded_scale
 from .._typing import FloatArray
 from ._drag import SpeedLoad
 from ._elastic import AbstractElastic
@@ -283,12 +284,13 @@ class System:
         """A characteristic deflection (rad): the static deflection, the breakpoints and the
         quasi-static dynamic amplitude, whichever is largest.
 
-        The quasi-static amplitude of the forcing amplitudes F_a is at most the smaller of
-        max|K_soft⁻¹ F_a| (every element on its softest positive stage) and
+        The quasi-static amplitude of the forcing amplitudes F_a is max|K_soft⁻¹ F_a| (every
+        element on its softest positive stage), unless it exceeds ten times the bound
         w + max|K_out⁻¹ F_a| (every element on the softer positive one of its two outer stages;
-        w the widest span of an element's breakpoints): an inner stage holds no more than its
-        width, however soft (see :meth:`rattle.model.Model.length_scale`, the same bound for the
-        single equation: a nearly flat inner stage would otherwise make L many times the motion).
+        w the widest span of an element's breakpoints; ``_limits.bounded_scale``): an inner stage
+        holds no more than its width, however soft (see :meth:`rattle.model.Model.length_scale`,
+        the same rule for the single equation: a nearly flat inner stage would otherwise make L
+        many times the motion).
         """
         xs = self.static_equilibrium()
         if self.load is not None:  # the static deflection under the largest drag of the table
@@ -309,7 +311,7 @@ class System:
         if span > 0 and all(j is not None for j in outer):
             bound = span + quasi_static(tuple(int(j) for j in outer))  # type: ignore[arg-type]
             if bound > span:  # a singular outer combination (0) bounds nothing
-                dyn = min(dyn, bound)
+                dyn = bounded_scale(dyn, bound)
         return max(float(np.max(np.abs(xs))) if xs.size else 0.0, bp, dyn, 1e-300)
 
 
