@@ -7,7 +7,9 @@ Run:  python benchmarks/bench_floquet.py  [--repeat 7]
   does), and time per call of the continuation's ``FloquetMonitor`` (two orbits per call);
 * n = 2, 3: hand-built grounded chains with two clearance elements, at H = 32, on orbits whose
   deflections cross breakpoints of both elements — time per orbit of the batched monodromy,
-  and per call of the monitor-equivalent evaluation (two orbits, ψ_fold, ψ_pd, ψ_ns).
+  and per call of the monitor-equivalent evaluation (two orbits, ψ_fold, ψ_pd, ψ_ns);
+* ψ_ns for n = 3, 10, 30, 60 (``--neimark-sacker-only``): from the multipliers, as evaluated, against
+  the determinant of the bialternate product it replaced (up to n = 30: n = 60 takes over a minute).
 
 Figures are best-of-``--repeat`` CPU times (the machine is shared); run with OMP_NUM_THREADS=1.
 Before/after for n = 1: ``--against <older tree>/src`` times the older package interleaved with
@@ -165,6 +167,31 @@ def single_element(repeat: int, orbits: str | None, against: str | None) -> None
               f"(median {1e6 * np.median(t['monitor']):6.1f})")
 
 
+def neimark_sacker(repeat: int, sizes: tuple[int, ...] = (3, 10, 30, 60), determinant_up_to: int = 30) -> None:
+    """ψ_ns = Π_{i<j}(μ_i μ_j − 1) of a (2n × 2n) monodromy as ``floquet_test_functions`` evaluates
+    it (from the multipliers, O(n³)) against the LU determinant of the bialternate product
+    det(M ⊙ M − I) it replaced (O(n⁶): k(k−1)/2 = 7140 rows for n = 60, 410 MB, over a minute),
+    on monodromy-like matrices (spectral radius ~ 1), and their relative difference."""
+    from rattle.stability import floquet_test_functions, second_compound
+
+    rng = np.random.default_rng(0)
+    for n in sizes:
+        k = 2 * n
+        M = rng.standard_normal((k, k)) * 0.9 / np.sqrt(k)
+        t_new = best(lambda M=M: floquet_test_functions(M), repeat)
+        line = f"n={n:3d} (2n = {k:3d}): floquet_test_functions (psi_ns from the multipliers) {1e3 * t_new:8.3f} ms"
+        if n <= determinant_up_to:
+            def det(M=M):
+                B = second_compound(M)
+                return np.linalg.det(B - np.eye(B.shape[-1]))
+
+            t_old = best(det, max(1, repeat if n < 20 else 1))
+            old = det()
+            diff = abs(floquet_test_functions(M)[2] - old) / abs(old)
+            line += f"; psi_ns = det(M ⊙ M − I) alone {1e3 * t_old:10.3f} ms; relative difference {diff:.1e}"
+        print(line)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
@@ -173,11 +200,16 @@ def main(argv=None) -> int:
                         "figures are timed interleaved with this tree's, in the same process")
     parser.add_argument("--orbits", help="a .npz file keeping the reference FRF's orbits (computed and saved "
                         "when absent), so that runs on two trees time the same orbits")
+    parser.add_argument("--neimark-sacker-only", action="store_true", help="only the ψ_ns timings (n = 3 … 60)")
     args = parser.parse_args(argv)
+    if args.neimark_sacker_only:
+        neimark_sacker(args.repeat)
+        return 0
     single_element(args.repeat, args.orbits, args.against)
     if not args.single_only:
         for n in (2, 3):
             n_dof(n, args.repeat)
+        neimark_sacker(args.repeat)
     return 0
 
 

@@ -129,9 +129,24 @@ _H_REASON = (
 )
 
 
-def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1) -> int:
+def max_harmonics_for(coordinates: int, period: int = 1) -> int:
+    """The largest H of a period-``period`` branch of a system of n = ``coordinates`` coordinates:
+    its n coordinates share the single equation's effective harmonics,
+
+        n · p · H ≤ MAX_EFFECTIVE_HARMONICS (512),
+
+    and at most ``MAX_HARMONICS``. The harmonic balance has n·(2pH + 1) unknowns and a dense
+    Jacobian, and each special point is located again with 2H: n·p·H ≤ 512 keeps that problem
+    within the single equation's largest, ~2,050 unknowns (measured on one core: a solve of 2,049
+    unknowns 0.6 s and 34 MB, of 4,097 3.9 s and 134 MB; a continuation point needs several).
+    Nothing changes for one or two coordinates; a chain of 60 inertias gets H ≤ 8, of 30 H ≤ 17."""
+    return max(1, min(MAX_HARMONICS, MAX_EFFECTIVE_HARMONICS // (max(1, coordinates) * max(1, period))))
+
+
+def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1, coordinates: int = 1) -> int:
     """``harmonics`` H: an integer 1 … ``MAX_HARMONICS``; with ``period`` p > 1 also
-    H·p ≤ ``MAX_EFFECTIVE_HARMONICS`` (a period-p branch needs p·H harmonics of Ω)."""
+    H·p ≤ ``MAX_EFFECTIVE_HARMONICS`` (a period-p branch needs p·H harmonics of Ω); with n =
+    ``coordinates`` > 1 (a chain) also n·p·H ≤ ``MAX_EFFECTIVE_HARMONICS`` (:func:`max_harmonics_for`)."""
     h = check_int(name, value, -(10**30))
     if h < 1:
         raise ValueError(f"`{name}` must be an integer >= 1, got {show(h)}; use e.g. 32")
@@ -146,6 +161,17 @@ def check_harmonics(value: object, name: str = "harmonics", *, period: int = 1) 
             f"a period-{period} branch carries {period}·H harmonics of the forcing frequency and "
             f"{period}·H = {h * period} exceeds {MAX_EFFECTIVE_HARMONICS} ({_H_REASON}); "
             f"lower `{name}` or the period"
+        )
+    top = max_harmonics_for(coordinates, period)
+    if coordinates > 1 and h > top:
+        raise ValueError(
+            f"`{name}` must be <= {top} for a system of {coordinates} coordinates (a chain's inertias, one fewer when "
+            "it is free)"
+            + (f" on branches of period {period}" if period > 1 else "") + f", got {show(h)}: its coordinates share the "
+            f"{MAX_EFFECTIVE_HARMONICS} effective harmonics of one problem (n·p·H = {coordinates * period * h} > "
+            f"{MAX_EFFECTIVE_HARMONICS}), as the harmonic balance has n·(2H + 1) unknowns and a dense Jacobian and each "
+            f"special point is located again with 2H (a solve of 4,097 unknowns takes ~4 s and 134 MB); lower `{name}` "
+            f"to {top} or less, or model fewer inertias"
         )
     return h
 
@@ -375,10 +401,49 @@ def check_scales(model: Any, prefix: str = "") -> None:
     force = abs(ex.mean) + sum(abs(a) for a in ex.amplitudes)
     bound(force, "the force scale |mean| + Σ|amplitudes|", "`excitation.mean` and `excitation.amplitudes`",
           allow_zero=True)
-    slopes = [float(s) for s in model.elastic.stages.slopes if s > 0]
-    length = force / (model.k * min(slopes))
+    st = model.elastic.stages
+    length = quasi_static_deflection(st.slopes, st.breakpoints, force, model.k)
     bound(length, "the deflection scale (force scale)/(K/I)",
           f"`excitation.mean`, `excitation.amplitudes` and `{p}stiffness` / `{p}inertia`", allow_zero=True)
+
+
+#: A scale may exceed the motion it stands for by this factor before the tighter bound replaces
+#: it (:func:`bounded_scale`): within an order of magnitude the continuation's scaled tolerances
+#: serve (the reference clutch with α = 1e-3, its scale 80 times its orbit, gives α = 0's answer),
+#: 10⁹ times they do not; below the factor every law keeps the scale it was solved with.
+SCALE_SLACK = 10.0
+
+
+def bounded_scale(estimate: float, bound: float) -> float:
+    """``estimate`` (the quasi-static amplitude on the softest stages), or ``bound`` (an upper
+    bound of the motion, :func:`quasi_static_deflection`) where the estimate exceeds it more than
+    :data:`SCALE_SLACK` times."""
+    return estimate if estimate <= SCALE_SLACK * bound else bound
+
+
+def quasi_static_deflection(slopes: Any, breakpoints: Any, force: float, k: float) -> float:
+    """The quasi-static deflection scale that a force amplitude ``force`` gives on a law of
+    stage ``slopes`` (≥ 0, relative to ``k``) between ``breakpoints``: F / (k s_min), s_min the
+    softest positive slope — unless it exceeds ten times (:func:`bounded_scale`) the bound
+
+        A = w + F / (k s_out),
+
+    s_out the softer positive slope of the two outer stages, w = max(breakpoints) −
+    min(breakpoints) the width of the inner stages: an inner stage holds no more than its width,
+    however soft. (F / (k s_min) alone grows without bound as an inner slope — a clutch's α —
+    tends to 0, though the motion tends to the backlash limit's.)"""
+    slopes = [float(s) for s in slopes]
+    bps = [float(b) for b in breakpoints]
+
+    def over(s: float) -> float:  # F / (k s), inf where k s underflows to 0
+        ks = k * s
+        return force / ks if ks > 0 else math.inf
+
+    out = over(min(s for s in slopes if s > 0)) if any(s > 0 for s in slopes) else math.inf
+    outer = [s for s in (slopes[0], slopes[-1]) if s > 0] if slopes else []
+    if outer and bps:
+        out = bounded_scale(out, (max(bps) - min(bps)) + over(min(outer)))
+    return out
 
 
 def warn_clearance(b: float, name: str = "b", stacklevel: int = 3) -> None:
@@ -402,5 +467,5 @@ __all__ = [
     "MAX_CONTINUATION_POINTS", "MAX_WORKERS", "MIN_OMEGA_RATIO", "MAX_OMEGA_RATIO", "MAX_MAGNITUDE",
     "CLEARANCE_WARNING", "check_harmonics", "check_interval", "check_samples", "check_period", "check_points",
     "check_max_points", "check_workers", "check_hb_settings", "check_callback", "check_magnitude", "check_frequency", "check_frequency_range",
-    "check_scales", "warn_clearance", "stiffest_frequency", "simulation_rate", "damping_rate",
+    "check_scales", "quasi_static_deflection", "bounded_scale", "SCALE_SLACK", "warn_clearance", "max_harmonics_for", "stiffest_frequency", "simulation_rate", "damping_rate",
 ]

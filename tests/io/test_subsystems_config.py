@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import math
+import warnings
 
 import numpy as np
 
@@ -204,7 +205,7 @@ _DEL = object()
     (GEARS, "model.gear_pair.inertias", [0.0, 6e-3], ["`model.gear_pair.inertias[0]` must be > 0"]),
     (GEARS, "model.gear_pair.mesh_stiffness", -2e8, ["`model.gear_pair.mesh_stiffness` must be > 0"]),
     (GEARS, "model.gear_pair.mesh_damping_ratio", 0.0, ["`model.gear_pair.mesh_damping_ratio` must be > 0"]),
-    (GEARS, "model.gear_pair.backlash_um", 0.0, ["`model.gear_pair.backlash_um` must be > 0"]),
+    (GEARS, "model.gear_pair.backlash_um", 0.0, ["`model.gear_pair.backlash_um` (converted to m) must be > 0"]),
     (GEARS, "model.gear_pair.backlash", 6e-5, ["`model.gear_pair.backlash` and `model.gear_pair.backlash_um`"]),
     (GEARS, "model.gear_pair.mesh_stifness", 1.0, ["`model.gear_pair.mesh_stifness` is not a known key",
                                                    "did you mean `mesh_stiffness`"]),
@@ -290,3 +291,111 @@ def test_loose_gear_drag_by_speed_enters_its_relative_coordinate_with_a_plus_sig
     both["drag"] = {"speed_rpm": [600.0], "torque": [0.02]}
     with pytest.raises(ConfigError, match="`model.loose_gear.drag_torque` and \\[drag\\] are both given"):
         config_from_dict(both)
+
+
+# --- unit traps: lengths in mm and µm, an implausible backlash, warnings as one plain line ------------
+@pytest.mark.parametrize("text, where", [(GEARS, "model.gear_pair"), (LOOSE, "model.loose_gear")])
+def test_lengths_in_mm_and_um_are_the_same_model(text, where):
+    """``backlash``/``base_radii`` in m, ``KEY_mm`` or ``KEY_um``: the same chain (the divisions are
+    correctly rounded, so 0.06 mm and 60 µm are both 6e-05 m exactly as written)."""
+    shape = where.split(".")[1]
+    ref = config_from_dict(_data(text)).model
+    for backlash, radii in ((("backlash_mm", 0.06 if shape == "gear_pair" else 0.1), ("base_radii_mm", [30.0, 40.0])),
+                            (("backlash", 6e-5 if shape == "gear_pair" else 1e-4), ("base_radii_um", [3e4, 4e4]))):
+        data = _data(text)
+        table = data["model"][shape]
+        del table["backlash_um"], table["base_radii"]
+        table[backlash[0]], table[radii[0]] = backlash[1], radii[1]
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # plausible: no warning
+            model = config_from_dict(data).model
+        assert model.elements == ref.elements and model.inertias == ref.inertias
+
+
+@pytest.mark.parametrize("path, value, fragments", [
+    ("model.gear_pair.backlash_mm", 0.06, ["`model.gear_pair.backlash_um` and `model.gear_pair.backlash_mm` are both "
+                                           "given: one length in µm and in mm"]),
+    ("model.gear_pair.base_radii_mm", [30.0, 40.0], ["`model.gear_pair.base_radii` and "
+                                                     "`model.gear_pair.base_radii_mm` are both given"]),
+    ("model.gear_pair.mesh_stiffness_mm", 1.0, ["`model.gear_pair.mesh_stiffness_mm` is not a known key",
+                                                "`mesh_stiffness` is not a length", "backlash_mm"]),
+    ("model.gear_pair.backlash_nm", 1.0, ["`model.gear_pair.backlash_nm` is not a known key",
+                                          "lengths also as KEY_mm or KEY_um"]),
+    ("model.gear_pair.backlash_deg", 1.0, ["`model.gear_pair.backlash_deg` is not a known key: `backlash` is not an "
+                                           "angle, so it has no value in degrees"]),
+])
+def test_length_keys_are_refused_naming_the_key_and_rule(path, value, fragments):
+    with pytest.raises(ConfigError) as info:
+        config_from_dict(_set(_data(GEARS), path, value), source_name="case.toml")
+    for fragment in fragments:
+        assert fragment in str(info.value), (fragment, str(info.value))
+
+
+def test_a_length_suffix_on_an_angle_is_refused():
+    """A spline's backlash and a chain element's half-gap are angles: ``_mm`` names that."""
+    data = _data(DAMPER)
+    spline = data["model"]["elements"][1]
+    del spline["backlash_deg"]
+    spline["backlash_mm"] = 0.1
+    with pytest.raises(ConfigError, match=r"`model.elements\[1\].backlash_mm` is not a known key: `backlash` is not a "
+                                          r"length, so it has no value in mm"):
+        config_from_dict(data)
+
+
+@pytest.mark.parametrize("key, value, fragments", [
+    # 0.12 m meant as mm: 4 × the smaller base radius (0.03 m); the derived half-gap (2 rad) is not warned again
+    ("backlash", 0.12, ["`model.gear_pair.backlash` = 0.12 m", "0.1 × the smaller base radius (0.03 m)",
+                        "if 0.12 was meant in mm, write `model.gear_pair.backlash_mm` = 0.12"]),
+    # 60 µm written as mm: 0.06 m, twice the bound
+    ("backlash_mm", 60.0, ["`model.gear_pair.backlash_mm` = 60 mm (0.06 m)",
+                           "if 60 was meant in µm, write `model.gear_pair.backlash_um` = 60"]),
+])
+def test_an_implausible_backlash_warns_once_naming_the_key_and_the_likely_unit(key, value, fragments):
+    data = _data(GEARS)
+    del data["model"]["gear_pair"]["backlash_um"]
+    data["model"]["gear_pair"][key] = value
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        config_from_dict(data, source_name="case.toml")
+    assert len(caught) == 1, [str(w.message) for w in caught]
+    message = str(caught[0].message)
+    assert message.startswith("case.toml: ")
+    for fragment in fragments:
+        assert fragment in message, (fragment, message)
+    # at the threshold (a tenth of the smaller base radius, 3 mm) nothing; just above it, the warning
+    for backlash, count in ((3e-3, 0), (3.001e-3, 1)):
+        data["model"]["gear_pair"] = {**data["model"]["gear_pair"], key: backlash / (1e-3 if key == "backlash_mm" else 1)}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            config_from_dict(data)
+        assert len(caught) == count
+
+
+def test_the_builders_warn_once_naming_the_argument():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        gear_pair(base_radii=[0.03, 0.04], inertias=[5e-3, 6e-3], mesh_stiffness=2e8, mesh_damping_ratio=0.05,
+                  backlash=0.12)
+        loose_gear(base_radii=[0.03, 0.04], inertia=2e-4, mesh_stiffness=2e8, mesh_damping_ratio=0.05,
+                   backlash=0.2, drive_acceleration=[400.0])
+    assert [str(w.message)[:30] for w in caught] == ["`backlash` = 0.12 m of play al", "`backlash` = 0.2 m of play alo"]
+    assert "pass backlash = 0.00012 (m) instead" in str(caught[0].message)
+    assert all(w.filename == __file__ for w in caught)  # the caller's line, not the builder's
+
+
+def test_the_command_line_shows_the_warning_as_one_plain_line(tmp_path):
+    """``rattle: warning: <message>``: the key and the likely unit, no internal file location."""
+    path = tmp_path / "gears.toml"
+    path.write_text(GEARS.replace("backlash_um = 60.0", "backlash = 0.12").replace("omega = [3000.0, 12000.0]",
+                                                                                      "omega = [11000.0, 12000.0]")
+                    .replace("harmonics = 8", "harmonics = 2"), encoding="utf-8")
+    try:
+        runner = CliRunner(mix_stderr=False)  # type: ignore[call-arg]
+    except TypeError:
+        runner = CliRunner()
+    result = runner.invoke(cli, ["frf", str(path), "-o", str(tmp_path / "out"), "--fixed-harmonics"],
+                           catch_exceptions=False)
+    warned = [line for line in result.stderr.splitlines() if "warning:" in line]
+    assert len(warned) == 1, result.stderr
+    assert warned[0].startswith(f"rattle: warning: {path}: `model.gear_pair.backlash` = 0.12 m")
+    assert ".py" not in result.stderr and "rattle/" not in result.stderr.replace(str(tmp_path), "")

@@ -64,3 +64,48 @@ def test_clearance_threshold_is_pi_over_two() -> None:
         Backlash(b=math.pi / 2)
     with pytest.warns(UserWarning, match=r"`b` = 1.6 rad is 92°"):
         Clutch(alpha=0.5, b=1.6)
+
+
+def _long_chain(n: int, harmonics: int) -> dict:
+    """A free chain of n inertias (n − 1 coordinates) with a clutch at one end, as a parsed file."""
+    return {"model": {"inertias": [1.0] + [0.5] * (n - 1),
+                      "links": [{"between": [i, i + 1], "damping": 0.05, **({"stiffness": 20.0} if i > 1 else {})}
+                                for i in range(1, n)],
+                      "elements": [{"name": "clutch", "between": [1, 2], "stiffness": 1.0, "type": "clutch",
+                                    "alpha": 0.25, "b": 0.1}]},
+            "excitation": {"torques": [{"inertia": 1, "mean": 0.05, "amplitudes": [0.03]},
+                                       {"inertia": n, "mean": -0.05}]},
+            "analysis": {"omega": [0.3, 2.0], "harmonics": harmonics}}
+
+
+def test_a_chains_coordinates_share_the_effective_harmonics() -> None:
+    """n·p·H ≤ 512: one or two coordinates keep H ≤ 256; a free chain of 60 inertias (59
+    coordinates) gets H ≤ 8, refused up-front naming the key and the limit (file, API, CLI exit 2)."""
+    import rattle
+    from rattle.errors import ConfigError
+    from rattle.io import config_from_dict
+
+    assert [_limits.max_harmonics_for(n) for n in (1, 2, 3, 30, 59)] == [256, 256, 170, 17, 8]
+    assert _limits.max_harmonics_for(30, period=2) == 8
+    assert config_from_dict(_long_chain(60, 8)).analysis.harmonics == 8
+    with pytest.raises(ConfigError, match=r"`analysis.harmonics` must be <= 8 for a system of 59 coordinates"):
+        config_from_dict(_long_chain(60, 9))
+    model = config_from_dict(_long_chain(60, 8)).model
+    with pytest.raises(ValueError, match=r"`harmonics` must be <= 8 for a system of 59 coordinates .*, got 32"):
+        rattle.frequency_response(model, omega=(0.3, 2.0), harmonics=32)
+
+
+def test_a_too_long_chain_for_its_harmonics_exits_2_writing_nothing(tmp_path) -> None:
+    from click.testing import CliRunner
+
+    from rattle.cli.main import cli
+    from rattle.io import dumps_toml
+
+    (tmp_path / "chain.toml").write_text(dumps_toml(_long_chain(60, 16)), encoding="utf-8")
+    try:
+        runner = CliRunner(mix_stderr=False)  # type: ignore[call-arg]
+    except TypeError:
+        runner = CliRunner()
+    result = runner.invoke(cli, ["frf", str(tmp_path / "chain.toml"), "-o", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.stderr
+    assert "`analysis.harmonics` must be <= 8" in result.stderr and not (tmp_path / "out").exists()

@@ -217,6 +217,63 @@ def test_test_functions_are_products_of_multiplier_expressions(rng):
     assert abs(psi[2]) < 1e-14 and abs(psi[0]) > 0.1 and abs(psi[1]) > 0.1
 
 
+def _psi_ns_determinant(M):
+    """ψ_ns as it was computed before: the LU determinant of M ⊙ M − I (O(k⁶))."""
+    B = second_compound(M)
+    return np.linalg.det(B - np.eye(B.shape[-1]))
+
+
+def _factor_scale(M):
+    """S = Π_{i<j} (|μ_i||μ_j| + 1): the size of ψ_ns's factors, the scale of its round-off."""
+    a = np.abs(np.linalg.eigvals(M))
+    i, j = np.triu_indices(M.shape[-1], 1)
+    return np.prod(a[..., i] * a[..., j] + 1.0, axis=-1)
+
+
+def test_neimark_sacker_function_from_multipliers_equals_the_bialternate_determinant(rng):
+    """ψ_ns from the multipliers (O(k³)) against det(M ⊙ M − I) (O(k⁶)) on random monodromies:
+    the same values up to round-off on the scale S of its factors, hence the same signs, and the
+    same zeros (a complex pair on the unit circle, a neutral saddle), changing sign together."""
+    for k in (4, 6, 8, 12):
+        M = rng.standard_normal((300, k, k)) * rng.uniform(0.3, 1.5, (300, 1, 1)) / np.sqrt(k)
+        new, old = floquet_test_functions(M)[:, 2], _psi_ns_determinant(M)
+        S = _factor_scale(M)
+        # both are backward stable: measured max |new − old| / S = 9e-16 (k = 4 … 12, 300 draws each);
+        # 1e-14 leaves a factor 10. Where |ψ_ns| exceeds twice that the signs must agree.
+        assert np.all(np.abs(new - old) <= 1e-14 * S)
+        clear = np.abs(old) > 2e-14 * S
+        assert clear.mean() > 0.8 and np.all(np.sign(new[clear]) == np.sign(old[clear]))
+    # zeros: a pair r e^{±iθ} in a random basis, through r = 1; a neutral saddle (μ, 1/μ)
+    theta = 0.9
+    R = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    for k in (4, 8):
+        V = rng.standard_normal((k, k))
+        rest = np.diag(rng.uniform(-0.8, 0.8, k - 2))
+        signs = []
+        for r in (0.999, 1.0, 1.001):
+            M = V @ scipy.linalg.block_diag(r * R, rest) @ np.linalg.inv(V)
+            new, old, S = floquet_test_functions(M)[2], _psi_ns_determinant(M), _factor_scale(M)
+            if r == 1.0:
+                assert abs(new) <= 1e-11 * S and abs(old) <= 1e-11 * S
+            else:
+                assert abs(new) > 1e-6 * S and np.sign(new) == np.sign(old)
+                signs.append(np.sign(new))
+        assert signs[0] == -signs[1]
+        saddle = V @ np.diag([2.5, 0.4, *rng.uniform(-0.8, 0.8, k - 2)]) @ np.linalg.inv(V)
+        assert abs(floquet_test_functions(saddle)[2]) <= 1e-11 * _factor_scale(saddle)
+    # a pair meeting the real axis away from the circle (b c through 0, |μ| ≈ 0.83): no zero, one sign
+    for k in (4, 6):
+        V = rng.standard_normal((k, k))
+        rest = np.diag(rng.uniform(-0.5, 0.5, k - 2))
+        vals = []
+        for bc in np.linspace(-1e-3, 1e-3, 21):
+            M = V @ scipy.linalg.block_diag([[0.83, 1.0], [bc, 0.83]], rest) @ np.linalg.inv(V)
+            vals.append((floquet_test_functions(M)[2], _psi_ns_determinant(M)))
+        vals = np.array(vals)
+        assert len({*np.sign(vals[:, 0])}) == 1 and np.all(np.sign(vals[:, 0]) == np.sign(vals[:, 1]))
+        np.testing.assert_allclose(vals[:, 0], vals[:, 1], rtol=1e-12)
+
+
 def test_classification_and_torus_ratio_of_synthetic_multipliers():
     theta = 2 * np.pi * 0.137
     pair = lambda r: [r * np.exp(1j * theta), r * np.exp(-1j * theta)]  # noqa: E731

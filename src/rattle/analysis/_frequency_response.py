@@ -172,6 +172,9 @@ def frequency_response(
     _validate.check_instance(newton, "newton", NewtonOptions, "a NewtonOptions")
     _limits.check_callback(callback)
     run = RunSettings.make(resolve_hb(harmonics, samples, hb), newton, continuation, stability)
+    # a chain's coordinates share the effective harmonics of one problem (n·p·H ≤ 512)
+    _limits.check_harmonics(run.hb.harmonics, "harmonics" if hb is None else "hb.harmonics", period=period,
+                            coordinates=model.system().n)
     confirm_tori = _validate.check_bool(confirm_tori, "confirm_tori")
     result = _frequency_response(
         model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,

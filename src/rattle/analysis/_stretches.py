@@ -40,7 +40,8 @@ class AdaptiveHarmonics:
     the stretch since the last point that passed is followed again with 2H; where the corrector
     fails even at the smallest step, the branch goes on from its last point with 2H (an orbit
     through a stiff stage needs more harmonics than the rest of the range). Both stop at
-    ``max_harmonics`` (times the branch's period at most :data:`rattle._limits.MAX_EFFECTIVE_HARMONICS`).
+    ``max_harmonics`` (times the branch's period, times the n coordinates of a chain, at most
+    :data:`rattle._limits.MAX_EFFECTIVE_HARMONICS`: :func:`rattle._limits.max_harmonics_for`).
     With ``lower``, where e < ``tolerance``/16 above the starting H, the point is solved with H/2
     and the branch goes on with H/2 when that changes its rms by less than ``tolerance``/2.
 
@@ -122,7 +123,8 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
 
     lo, hi = omega_range
     H0 = run.hb.harmonics
-    top = min(adaptive.max_harmonics, _limits.MAX_EFFECTIVE_HARMONICS // period) if adaptive else H0
+    # the coordinates share the effective harmonics of one problem (n·p·H ≤ 512, _limits.max_harmonics_for)
+    top = min(adaptive.max_harmonics, _limits.max_harmonics_for(q0.size // (2 * H0 + 1), period)) if adaptive else H0
 
     def stepper_for(H: int, q: FloatArray, w: float, tangent: FloatArray | None) -> ContinuationStepper:
         hb = HarmonicBalance(model, run.for_harmonics(H), period=period)

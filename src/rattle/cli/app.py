@@ -27,7 +27,6 @@ import contextlib
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
-from pathlib import Path
 from typing import Any
 
 import click
@@ -67,9 +66,9 @@ MAX_WARNINGS = 8
 @contextlib.contextmanager
 def _warnings_as_lines() -> Iterator[None]:
     """Every warning raised during the body reaches the user as one ``rattle: warning: …`` line:
-    rattle's own warnings (their message names the key in backticks) as they are; others (numpy's
-    "overflow encountered in …") with where they arose (the rattle module and line), what kind
-    they are, and what they mean for the run. Each distinct warning once; at most
+    rattle's own warnings (UserWarning, or a message naming a key in backticks) as they are; others
+    (numpy's "overflow encountered in …") with what kind they are and what they mean for the run —
+    never with the file and line they arose at. Each distinct warning once; at most
     ``MAX_WARNINGS`` lines."""
     seen: set[tuple[Any, ...]] = set()
     hidden = 0
@@ -77,7 +76,7 @@ def _warnings_as_lines() -> Iterator[None]:
     def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
              file: Any = None, line: str | None = None) -> None:
         nonlocal hidden
-        key = (category, str(message), filename, lineno)
+        key = (category, " ".join(str(message).split()))
         if key in seen:
             return
         seen.add(key)
@@ -85,11 +84,11 @@ def _warnings_as_lines() -> Iterator[None]:
             hidden += 1
             return
         text = " ".join(str(message).split())
-        if "`" in text:  # one of ours: already says what and why
+        if "`" in text or issubclass(category, UserWarning):  # one of ours: already says what and why
             warning(text)
             return
-        where = _where(filename, lineno)
-        warning(f"{text} ({category.__name__} at {where}); the run went on, but check the results "
+        # never the file and line it arose at: an internal location says nothing to the user
+        warning(f"{text} ({category.__name__}); the run went on, but check the results "
                  "at the frequencies where this happened")
 
     with warnings.catch_warnings():
@@ -99,16 +98,6 @@ def _warnings_as_lines() -> Iterator[None]:
         finally:
             if hidden:
                 warning(f"{hidden} further warning(s) not shown")
-
-
-def _where(filename: str, lineno: int) -> str:
-    """``rattle/measures.py:141`` for a file of the package; the file name otherwise."""
-    parts = Path(filename).parts
-    if "rattle" in parts:
-        i = len(parts) - 1 - parts[::-1].index("rattle")
-        return "/".join(parts[i:]) + f":{lineno}"
-    return f"{Path(filename).name}:{lineno}"
-
 
 
 class RattleGroup(click.Group):

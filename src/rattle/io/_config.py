@@ -450,6 +450,12 @@ def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonic
             f"`{name}` must be >= {needed}, the number of excitation harmonics "
             f"({where}), got {harmonics}; raise `{name}`"
         )
+    system = getattr(model, "system", None)
+    if callable(system):  # a chain's coordinates share the effective harmonics of one problem
+        try:
+            _limits.check_harmonics(harmonics, name, coordinates=int(system().n))
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
 
 
 def check_analysis(

@@ -2,7 +2,7 @@
 reader of their configuration tables."""
 
 from ._analysable import check_analysable_model
-from ._builders import GearPair, LooseGear, clutch_damper, gear_pair, hub_spline, loose_gear
+from ._builders import MAX_BACKLASH_RATIO, GearPair, LooseGear, clutch_damper, gear_pair, hub_spline, loose_gear
 from ._chain import Chain, Element, Link, Torque
 from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw, PiecewiseJump, Preload
 from ._drag import Drag, SpeedLoad
@@ -26,5 +26,5 @@ __all__ = [
     "firing_orders", "engine_speed", "forcing_frequency", "base_order", "engine_torque",
     "SoundPath", "Drag", "SpeedLoad",
     "AbstractJumpLaw", "Preload", "PiecewiseJump", "Friction", "NonsmoothLaw", "NonsmoothSystem", "FrictionSystem",
-    "clutch_damper", "hub_spline", "gear_pair", "loose_gear", "GearPair", "LooseGear",
+    "clutch_damper", "hub_spline", "gear_pair", "loose_gear", "GearPair", "LooseGear", "MAX_BACKLASH_RATIO",
 ]

@@ -16,13 +16,16 @@ Each builder states its physics and returns the objects every analysis already s
   (:class:`LooseGear`).
 
 Angles are in rad, stiffnesses in N m/rad (N/m for a mesh), lengths in m: the configuration
-reader (:mod:`._table_shapes`) converts degrees and micrometres before calling these.
+reader (:mod:`._table_shapes`) converts degrees, millimetres and micrometres before calling these.
+A mesh backlash above a tenth of the smaller base radius is warned about
+(:func:`backlash_warning`: a length in mm written as m).
 Every refusal is a ``ValueError``/``TypeError`` naming the argument in backticks.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -32,7 +35,8 @@ import numpy as np
 from ._chain import Chain, Element, Link, Torque
 from ._elastic import Backlash, Piecewise, _check_real, _check_real_sequence
 
-__all__ = ["GearPair", "LooseGear", "clutch_damper", "gear_pair", "hub_spline", "loose_gear"]
+__all__ = ["GearPair", "LooseGear", "MAX_BACKLASH_RATIO", "backlash_warning", "clutch_damper", "gear_pair", "hub_spline",
+           "loose_gear"]
 
 
 #: The smallest non-zero free play of a damper (rad): 1e-12 rad (6e-11 degrees) is no free play.
@@ -160,6 +164,42 @@ def hub_spline(*, backlash: float, stiffness: float, name: str = "spline",
     return Element(name=name, between=between, stiffness=k, law=Backlash(b=total / 2.0))
 
 
+#: A gear mesh's backlash (total play along the line of action) above this fraction of the smaller
+#: base radius is implausible, and warned about (:func:`backlash_warning`): real meshes have
+#: 0.01 … 0.5 mm on base radii of 10 … 200 mm (b_los / r ≈ 1e-4 … 0.02), and at r/10 the half-gap is
+#: already ≥ 1/20 rad (2.9°) of either gear; a unit slip (mm written as m: × 1000) lands far above.
+MAX_BACKLASH_RATIO = 0.1
+
+#: The length units a backlash may be written in, largest first (a value in one, mistaken for the
+#: next, is 1000 times too large): name, factor to m, the key suffix of a case file.
+_LENGTHS = (("m", 1.0, ""), ("mm", 1e-3, "_mm"), ("µm", 1e-6, "_um"))
+
+
+def backlash_warning(backlash: float, base_radii: Sequence[float], *, key: str = "backlash", unit: str = "m",
+                     in_file: bool = False) -> str | None:
+    """The warning for a gear mesh's total play ``backlash`` (m) above :data:`MAX_BACKLASH_RATIO`
+    times the smaller base radius — b_los > 0.1 · min(r1, r2), implausible for a gear mesh — naming
+    ``key`` as written in ``unit`` (``"m"``, ``"mm"`` or ``"µm"``) and the likely unit: the next
+    smaller one (mm for m, µm for mm), with the key or value that says it (``in_file``: the case
+    file's ``KEY_mm``/``KEY_um``; else the value in m to pass). None when plausible."""
+    r = min(float(v) for v in base_radii)
+    if not backlash > MAX_BACKLASH_RATIO * r:
+        return None
+    names = [u[0] for u in _LENGTHS]
+    i = names.index(unit)
+    written = backlash / _LENGTHS[i][1]
+    in_m = "" if unit == "m" else f" ({backlash:.4g} m)"
+    text = (f"`{key}` = {written:g} {unit}{in_m} of play along the line of action is more than {MAX_BACKLASH_RATIO:g} × "
+            f"the smaller base radius ({r:g} m): implausible for a gear mesh, whose backlash is some 0.01 … 0.5 mm")
+    if i + 1 == len(_LENGTHS):
+        return text + "; check the value"
+    likely, factor, suffix = _LENGTHS[i + 1]
+    base = key[: -len(_LENGTHS[i][2])] if _LENGTHS[i][2] else key
+    fix = (f"write `{base}{suffix}` = {written:g} instead" if in_file
+           else f"pass {key} = {written * factor:g} (m) instead")
+    return f"{text}; if {written:g} was meant in {likely}, {fix}"
+
+
 def _mesh(base_radii: object, mesh_stiffness: object, mesh_damping_ratio: object,
           backlash: object) -> tuple[float, float, float, float, float]:
     if isinstance(base_radii, (str, bytes)) or not hasattr(base_radii, "__len__") or len(base_radii) != 2:  # type: ignore[arg-type]
@@ -172,6 +212,20 @@ def _mesh(base_radii: object, mesh_stiffness: object, mesh_damping_ratio: object
         raise ValueError(f"`mesh_damping_ratio` must be > 0 (typical gear meshes: 0.03 … 0.1), got {zeta!r}")
     b_los = _positive("backlash", backlash)
     return r1, r2, km, zeta, b_los
+
+
+def _mesh_law(half_gap: float, backlash: float, base_radii: tuple[float, float]) -> Backlash:
+    """The mesh's backlash law of half-gap ``half_gap`` (rad), with one warning when the play
+    ``backlash`` (m) is implausible for the gear geometry (:func:`backlash_warning`): the half-gap
+    is then not warned about again as an angle (:class:`~rattle.model.Backlash` warns beyond π/2
+    rad, which b_los > π r implies)."""
+    message = backlash_warning(backlash, base_radii)
+    if message is None:
+        return Backlash(b=half_gap)
+    warnings.warn(message, UserWarning, stacklevel=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return Backlash(b=half_gap)
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,7 +327,7 @@ def gear_pair(*, base_radii: Sequence[float], inertias: Sequence[float], mesh_st
         out_torques.append(Torque(inertia=tq.inertia, mean=tq.mean * s, amplitudes=tuple(a * s for a in tq.amplitudes),
                                   phases=tq.phases))
     chain = Chain(inertias=(J1, J2r), links=tuple(out_links),
-                  elements=(Element(name=name, between=(1, 2), stiffness=K, law=Backlash(b=b)),),
+                  elements=(Element(name=name, between=(1, 2), stiffness=K, law=_mesh_law(b, b_los, (r1, r2))),),
                   torques=tuple(out_torques), speed_order=speed_order)
     return GearPair(chain=chain, ratio=ratio, base_radii=(r1, r2), reflected_inertia=J2r, stiffness=K, damping=c,
                     half_gap=b)
@@ -354,7 +408,7 @@ def loose_gear(*, base_radii: Sequence[float], inertia: float, mesh_stiffness: f
     c = 2.0 * zeta * math.sqrt(K * J2)
     b = b_los / (2.0 * r2)
     chain = Chain(inertias=(J2,), links=(Link(between=(1, 0), damping=c),),
-                  elements=(Element(name=name, between=(1, 0), stiffness=K, law=Backlash(b=b)),),
+                  elements=(Element(name=name, between=(1, 0), stiffness=K, law=_mesh_law(b, b_los, (r1, r2))),),
                   torques=(Torque(inertia=1, mean=td, amplitudes=tuple(J2 * ratio * a for a in acc),
                                   phases=phases),),
                   speed_order=speed_order)

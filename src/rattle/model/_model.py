@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._limits import check_scales
+from .._limits import check_scales, quasi_static_deflection
 from ._elastic import AbstractElastic, _check_real
 from ._excitation import Excitation
 from ._readers import read_tables
@@ -103,7 +103,8 @@ class Model:
         for j, (s, e) in enumerate(zip(st.slopes, st.offsets)):
             lo, hi = edges[j], edges[j + 1]
             if s > 0:
-                x = (target - e) / s
+                with np.errstate(over="ignore"):  # a nearly flat stage (α = 5e-324): x = ±inf, not on it
+                    x = (target - e) / s
                 if lo <= x <= hi:
                     return float(x)
             elif abs(target - e) <= 1e-15 * max(1.0, abs(target)):
@@ -129,10 +130,21 @@ class Model:
 
     def length_scale(self) -> float:
         """A characteristic angle L (rad) for scaling: the static deflection, the breakpoints and
-        the quasi-static dynamic amplitude, whichever is largest."""
+        the quasi-static dynamic amplitude, whichever is largest.
+
+        The quasi-static amplitude of the forcing amplitude F_a on the law is F_a / (k s_min), s_min
+        the softest positive slope, unless it exceeds ten times the bound
+
+            A = w + F_a / (k s_out),
+
+        s_out the softer positive slope of the two outer stages and w the width of the inner stages
+        (the span of the breakpoints; ``_limits.quasi_static_deflection``): an inner stage holds no
+        more than its width, however soft. The bound keeps L the size of the motion when an inner
+        stage is nearly flat (a clutch of α = 1e-9 would otherwise give L = F_a / (k α), 10⁹ times
+        the orbit, and the continuation's scaled tolerances would see no orbit at all).
+        """
         st = self.elastic.stages
-        s_pos = st.slopes[st.slopes > 0]
-        dyn = self.excitation.amplitude_scale / (self.k * float(np.min(s_pos)))
+        dyn = quasi_static_deflection(st.slopes, st.breakpoints, self.excitation.amplitude_scale, self.k)
         bp = float(np.max(np.abs(st.breakpoints))) if st.breakpoints.size else 0.0
         return max(abs(self.static_equilibrium()), bp, dyn, 1e-300)
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._limits import bounded_scale
 from .._typing import FloatArray
 from ._drag import SpeedLoad
 from ._elastic import AbstractElastic
@@ -281,18 +282,36 @@ class System:
 
     def length_scale(self) -> float:
         """A characteristic deflection (rad): the static deflection, the breakpoints and the
-        quasi-static dynamic amplitude on the softest positive stages, whichever is largest."""
+        quasi-static dynamic amplitude, whichever is largest.
+
+        The quasi-static amplitude of the forcing amplitudes F_a is max|K_soft⁻¹ F_a| (every
+        element on its softest positive stage), unless it exceeds ten times the bound
+        w + max|K_out⁻¹ F_a| (every element on the softer positive one of its two outer stages;
+        w the widest span of an element's breakpoints; ``_limits.bounded_scale``): an inner stage
+        holds no more than its width, however soft (see :meth:`rattle.model.Model.length_scale`,
+        the same rule for the single equation: a nearly flat inner stage would otherwise make L
+        many times the motion).
+        """
         xs = self.static_equilibrium()
         if self.load is not None:  # the static deflection under the largest drag of the table
             xs = max((self.static_equilibrium(float(w)) for w in self.load.nodes), key=lambda x: float(np.max(np.abs(x))))
         bp = max((float(np.max(np.abs(e.breakpoints))) for e in self.elements if e.breakpoints.size), default=0.0)
-        softest = tuple(int(np.argmin(np.where(e.slopes > 0, e.slopes, np.inf))) for e in self.elements)
-        Ks = self.stage_stiffness(softest)
         amp = np.sum(np.hypot(self.cos, self.sin), axis=0)
-        try:
-            dyn = float(np.max(np.abs(np.linalg.solve(Ks, amp)))) if np.any(amp) else 0.0
-        except np.linalg.LinAlgError:
-            dyn = 0.0
+
+        def quasi_static(stages: tuple[int, ...]) -> float:
+            try:
+                return float(np.max(np.abs(np.linalg.solve(self.stage_stiffness(stages), amp)))) if np.any(amp) else 0.0
+            except np.linalg.LinAlgError:
+                return 0.0
+
+        dyn = quasi_static(tuple(int(np.argmin(np.where(e.slopes > 0, e.slopes, np.inf))) for e in self.elements))
+        outer = [min((j for j in (0, len(e.slopes) - 1) if e.slopes[j] > 0), key=lambda j: e.slopes[j], default=None)
+                 for e in self.elements]
+        span = max((float(np.ptp(e.breakpoints)) for e in self.elements if e.breakpoints.size), default=0.0)
+        if span > 0 and all(j is not None for j in outer):
+            bound = span + quasi_static(tuple(int(j) for j in outer))  # type: ignore[arg-type]
+            if bound > span:  # a singular outer combination (0) bounds nothing
+                dyn = bounded_scale(dyn, bound)
         return max(float(np.max(np.abs(xs))) if xs.size else 0.0, bp, dyn, 1e-300)
 
 

@@ -2,8 +2,9 @@
 
 :class:`_Checker` validates the structure and the TOML types of one configuration (unknown and
 missing keys with the nearest known key, numbers, arrays, integers, sub-tables) and re-raises the
-model dataclasses' errors with the key the user wrote (:func:`rename_keys`); :func:`_in_radians`
-turns the ``KEY_deg`` keys into radians once, remembering what the user wrote. The readers of the
+model dataclasses' errors with the key the user wrote (:func:`rename_keys`); :func:`_in_base_units`
+turns the unit-suffixed keys (``KEY_deg``, and ``KEY_mm``/``KEY_um`` for lengths) into rad and m once,
+remembering what the user wrote. The readers of the
 model tables (:mod:`._tables`, SPEC §2, §5, §6), of the data-sheet shapes (:mod:`._table_shapes`)
 and of the ``[analysis]`` table (:mod:`rattle.io`) share it; it knows no table of its own except
 the hint lines ``_EXAMPLES`` they extend.
@@ -29,6 +30,12 @@ _T = TypeVar("_T")
 #: Keys holding angles (rad) that may be given in degrees as ``KEY_deg``: in ``[model.elastic]``
 #: and every ``[[model.elements]]``.
 ANGLE_KEYS = ("b", "breakpoints", "gap")
+
+#: The unit suffixes a key may carry (:func:`_in_base_units`): suffix → (the base unit of the key
+#: without it, the suffix's unit, the factor dividing the written value; 0 for degrees, converted by
+#: ``math.radians``). Angles as ``KEY_deg``; lengths, where a table has them (a gear pair's
+#: ``backlash`` and ``base_radii``), as ``KEY_mm`` or ``KEY_um``.
+UNIT_SUFFIXES = {"_deg": ("rad", "degrees", 0.0), "_mm": ("m", "mm", 1e3), "_um": ("m", "µm", 1e6)}
 
 # Example lines for "add e.g. ..." hints: the SPEC §2 example file.
 _EXAMPLES = {
@@ -137,12 +144,18 @@ class _Checker:
 
     def __init__(self, source_name: str) -> None:
         self.source_name = source_name
-        #: full rad key -> the ``_deg`` key the user wrote (``model.elastic.b`` -> ``model.elastic.b_deg``)
-        self.degree_keys: dict[str, str] = {}
+        #: full key in its base unit -> (the suffixed key the user wrote, the base unit)
+        #: (``model.elastic.b`` -> (``model.elastic.b_deg``, ``rad``)), :func:`_in_base_units`
+        self.user_keys: dict[str, tuple[str, str]] = {}
+        #: table -> {key in its base unit: the suffixed key written there}
+        self.converted_keys: dict[str, dict[str, str]] = {}
+        #: keys a reader derived from others it has judged itself (a gear pair's mesh element): the
+        #: model dataclasses' plausibility warnings about them are not repeated (:meth:`build`)
+        self.derived_keys: set[str] = set()
 
     def error(self, message: str) -> ConfigError:
-        for rad, deg in self.degree_keys.items():  # name the key the user wrote
-            message = message.replace(f"`{rad}`", f"`{deg}` (converted to rad)").replace(f"`{rad}[", f"`{deg}[")
+        for key, (written, unit) in self.user_keys.items():  # name the key the user wrote
+            message = message.replace(f"`{key}`", f"`{written}` (converted to {unit})").replace(f"`{key}[", f"`{written}[")
         return ConfigError(f"{self.source_name}: {message}")
 
     # --- structure ---------------------------------------------------------------------------
@@ -242,7 +255,10 @@ class _Checker:
                 warnings.simplefilter("always")
                 result = factory(**kwargs)
             for w in caught:
-                warnings.warn(f"{self.source_name}: {rename_keys(str(w.message), names)}", w.category, stacklevel=3)
+                text = rename_keys(str(w.message), names)
+                if any(f"`{key}`" in text or f"`{key}[" in text for key in self.derived_keys):
+                    continue  # judged by the reader that derived it, naming the user's key
+                warnings.warn(f"{self.source_name}: {text}", w.category, stacklevel=3)
             return result
         except (ValueError, TypeError) as exc:
             message = str(exc)
@@ -252,32 +268,46 @@ class _Checker:
             raise self.error(renamed) from exc
 
 
-def _in_radians(check: _Checker, table: Mapping[str, Any], where: str, known: Sequence[str],
-                angles: Sequence[str] = ANGLE_KEYS) -> dict[str, Any]:
-    """``table`` with every ``KEY_deg`` (``KEY`` one of ``angles``, in degrees) replaced by ``KEY`` in rad."""
+def _in_base_units(check: _Checker, table: Mapping[str, Any], where: str, known: Sequence[str],
+                   angles: Sequence[str] = ANGLE_KEYS, lengths: Sequence[str] = ()) -> dict[str, Any]:
+    """``table`` with every unit-suffixed key (:data:`UNIT_SUFFIXES`) replaced by its twin in the
+    base unit: ``KEY_deg`` (KEY one of ``angles``) by ``KEY`` in rad, ``KEY_mm`` and ``KEY_um`` (KEY
+    one of ``lengths``) by ``KEY`` in m — remembering what the user wrote for the messages. A suffix
+    on a key of another kind, or two forms of one key, is refused naming both."""
     out = dict(table)
     for key in table:
-        if not (isinstance(key, str) and key.endswith("_deg")):
+        suffix = next((x for x in UNIT_SUFFIXES if isinstance(key, str) and key.endswith(x)), None)
+        if suffix is None:
             continue
-        twin = key[: -len("_deg")]
-        if twin not in angles:
-            why = (f"`{twin}` is not an angle" if twin in known else f"`{where}.{twin}` is not a known key")
+        base, unit, factor = UNIT_SUFFIXES[suffix]
+        kind, allowed = ("an angle", angles) if base == "rad" else ("a length", lengths)
+        twin = key[: -len(suffix)]
+        if twin not in allowed:
+            why = (f"`{twin}` is not {kind}" if twin in known else f"`{where}.{twin}` is not a known key")
+            same = [a + x for x, (b, _, _) in UNIT_SUFFIXES.items() if b == base for a in allowed]
             raise check.error(
-                f"`{where}.{key}` is not a known key: {why}, so it has no value in degrees (the `_deg` keys here "
-                f"are {_join([a + '_deg' for a in angles])}); remove it or correct its spelling"
+                f"`{where}.{key}` is not a known key: {why}, so it has no value in {unit} (the `{suffix}`-style keys "
+                f"here are {_join(same)}); remove it or correct its spelling"
             )
-        if twin in table:
-            raise check.error(
-                f"`{where}.{twin}` and `{where}.{key}` are both given: one angle in rad and in degrees; "
-                f"keep one of them"
-            )
+        earlier = check.converted_keys.get(where, {}).get(twin)  # KEY_mm and KEY_um both
+        if twin in table or earlier is not None:
+            other, other_unit = (twin, base) if twin in table else (earlier, UNIT_SUFFIXES[earlier[len(twin):]][1])
+            raise check.error(f"`{where}.{other}` and `{where}.{key}` are both given: one {kind.split()[-1]} in "
+                              f"{other_unit} and in {unit}; keep one of them")
         value = table[key]
         if isinstance(value, (list, tuple)):
             check.array(value, f"{where}.{key}")
-            out[twin] = [math.radians(float(v)) for v in value]
+            out[twin] = [_convert(float(v), suffix, factor) for v in value]
         else:
             check.number(value, f"{where}.{key}")
-            out[twin] = math.radians(float(value))
+            out[twin] = _convert(float(value), suffix, factor)
         del out[key]
-        check.degree_keys[f"{where}.{twin}"] = f"{where}.{key}"
+        check.converted_keys.setdefault(where, {})[twin] = key
+        check.user_keys[f"{where}.{twin}"] = (f"{where}.{key}", base)
     return out
+
+
+def _convert(value: float, suffix: str, factor: float) -> float:
+    """A value written with ``suffix`` in its base unit: degrees × π/180 (``math.radians``), mm and µm
+    divided by 1e3, 1e6 (a correctly rounded division: 60 µm → 6e-05 exactly as written)."""
+    return math.radians(value) if suffix == "_deg" else value / factor

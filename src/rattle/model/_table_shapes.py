@@ -18,7 +18,8 @@ handed on as the SPEC §5 tables the reader already knows::
         → type = "backlash", b = backlash / 2
 
     [model.gear_pair]                  base_radii, inertias, mesh_stiffness (N/m), mesh_damping_ratio,
-                                       backlash (m, total, along the line of action) or backlash_um, name
+                                       backlash (m, total, along the line of action; or backlash_mm,
+                                       backlash_um; base_radii_mm …), name
         → [model] inertias = [J1, J2 (r1/r2)²], the mesh damping link and the mesh element on gear 1's
           side; torques on inertia 2 ([[excitation.torques]], [engine], [drag]) × r1/r2
 
@@ -40,9 +41,9 @@ import warnings
 from collections.abc import Mapping
 from typing import Any
 
-from ._builders import clutch_damper, gear_pair, hub_spline, loose_gear
+from ._builders import backlash_warning, clutch_damper, gear_pair, hub_spline, loose_gear
 from ._elastic import ELASTIC_LAWS
-from ._table_checks import _Checker, _in_radians, _show, rename_keys
+from ._table_checks import UNIT_SUFFIXES, _Checker, _in_base_units, _show, rename_keys
 
 __all__ = ["SUBSYSTEM_TYPES", "expand_subsystems"]
 
@@ -85,9 +86,10 @@ def _keys(check: _Checker, table: Mapping[str, Any], where: str, allowed: tuple[
         if key not in allowed:
             from ._table_checks import _did_you_mean
 
+            lengths = ", lengths also as KEY_mm or KEY_um" if "backlash" in allowed and kind != "spline" else ""
             raise check.error(
                 f"`{where}.{key}` is not a known key: {what} allows only {', '.join(allowed)} (angles also as "
-                f"KEY_deg); {_did_you_mean(str(key), allowed)}remove it or correct its spelling"
+                f"KEY_deg{lengths}); {_did_you_mean(str(key), allowed)}remove it or correct its spelling"
             )
     for key in required:
         if key not in table:
@@ -115,7 +117,7 @@ def _damper(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]
     t = dict(t)
     for key in ("drive_stiffness", "coast_stiffness"):
         _per_degree(check, t, where, key)
-    t = _in_radians(check, t, where, _DAMPER_KEYS, angles=("drive_angles", "coast_angles", "free_play"))
+    t = _in_base_units(check, t, where, _DAMPER_KEYS, angles=("drive_angles", "coast_angles", "free_play"))
     _keys(check, t, where, _DAMPER_KEYS, ("between", "drive_stiffness", "coast_stiffness"),
           'type = "damper" ([[model.elements]])', "damper")
     for key in ("drive_stiffness", "drive_angles", "coast_stiffness", "coast_angles"):
@@ -157,7 +159,7 @@ def _damper_friction_count(check: _Checker, t: Mapping[str, Any], where: str, n:
 
 
 def _spline(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]:
-    t = _in_radians(check, t, where, _SPLINE_KEYS, angles=("backlash",))
+    t = _in_base_units(check, t, where, _SPLINE_KEYS, angles=("backlash",))
     _keys(check, t, where, _SPLINE_KEYS, ("between", "stiffness", "backlash"), 'type = "spline" ([[model.elements]])', "spline")
     check.number(t["stiffness"], f"{where}.stiffness")
     check.number(t["backlash"], f"{where}.backlash")
@@ -168,17 +170,23 @@ def _spline(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]
             **({"friction": t["friction"]} if "friction" in t else {})}
 
 
-def _backlash_m(check: _Checker, t: dict[str, Any], where: str) -> dict[str, str]:
-    """``backlash_um`` (µm) → ``backlash`` (m); the names for the messages."""
-    names = {"backlash": f"{where}.backlash"}
-    if "backlash_um" in t:
-        if "backlash" in t:
-            raise check.error(f"`{where}.backlash` and `{where}.backlash_um` are both given: one backlash in m and "
-                              "in µm; keep one of them")
-        check.number(t["backlash_um"], f"{where}.backlash_um")
-        t["backlash"] = float(t.pop("backlash_um")) / 1e6  # correctly rounded: 60 µm → 6e-05 exactly as written
-        names["backlash"] = f"{where}.backlash_um"
-    return names
+def _mesh_lengths(check: _Checker, t: Mapping[str, Any], where: str, known: tuple[str, ...],
+                  angles: tuple[str, ...] = ()) -> dict[str, Any]:
+    """A gear table with its lengths in m (``backlash``, ``base_radii``: also as ``KEY_mm``, ``KEY_um``)
+    and its angles in rad."""
+    return _in_base_units(check, t, where, known, angles=angles, lengths=("backlash", "base_radii"))
+
+
+def _judge_backlash(check: _Checker, where: str, backlash: float, base_radii: Any, element: str) -> None:
+    """One warning, naming the key the user wrote and the likely unit, when the backlash is
+    implausible for the gear geometry (:func:`~rattle.model._builders.backlash_warning`); the mesh
+    element derived from it (``element``, its half-gap ``b``) is then not judged again as an angle."""
+    written = check.converted_keys.get(where, {}).get("backlash", "backlash")
+    unit = UNIT_SUFFIXES[written[len("backlash"):]][1] if written != "backlash" else "m"
+    message = backlash_warning(backlash, base_radii, key=f"{where}.{written}", unit=unit, in_file=True)
+    if message is not None:
+        warnings.warn(f"{check.source_name}: {message}", UserWarning, stacklevel=5)
+    check.derived_keys.add(f"{element}.b")
 
 
 def _name(check: _Checker, t: Mapping[str, Any], where: str) -> str:
@@ -218,8 +226,7 @@ def _gear_pair(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]
     _whole_model(check, model_t, "gear_pair", "the gear pair is the whole chain (its two gears are inertias 1 and 2)",
                  "its radii are in m, its mesh stiffness in N/m")
     t = check.table(model_t, "gear_pair", where)
-    t = dict(t)
-    names = _backlash_m(check, t, where)
+    t = _mesh_lengths(check, t, where, _GEAR_KEYS)
     _keys(check, t, where, _GEAR_KEYS, ("base_radii", "inertias", "mesh_stiffness", "mesh_damping_ratio",
                                         "backlash"), "[model.gear_pair]", "gear_pair")
     for key in ("base_radii", "inertias"):
@@ -227,10 +234,10 @@ def _gear_pair(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any]
     for key in ("mesh_stiffness", "mesh_damping_ratio", "backlash"):
         check.number(t[key], f"{where}.{key}")
     name = _name(check, t, where)
-    names = {**{k: f"{where}.{k}" for k in _GEAR_KEYS}, **names}
-    pair = _build(check, gear_pair, names, base_radii=t["base_radii"], inertias=t["inertias"],
-                  mesh_stiffness=t["mesh_stiffness"], mesh_damping_ratio=t["mesh_damping_ratio"],
-                  backlash=t["backlash"], name=name)
+    pair = _build(check, gear_pair, {k: f"{where}.{k}" for k in _GEAR_KEYS}, base_radii=t["base_radii"],
+                  inertias=t["inertias"], mesh_stiffness=t["mesh_stiffness"],
+                  mesh_damping_ratio=t["mesh_damping_ratio"], backlash=t["backlash"], name=name)
+    _judge_backlash(check, where, float(t["backlash"]), pair.base_radii, "model.elements[0]")
     element = {"name": name, "between": [1, 2], "stiffness": pair.stiffness, "type": "backlash", "b": pair.half_gap}
     out = dict(data)
     out["model"] = {"units": model_t["units"], "inertias": list(pair.chain.inertias),
@@ -274,8 +281,7 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
             raise check.error(f"`{where}.drag_torque` and [drag] are both given: give the loose gear's drag once "
                               "(a constant `drag_torque`, or [drag] by speed)")
         t["drag_torque"] = 0.0
-    names = _backlash_m(check, t, where)
-    t = _in_radians(check, t, where, _LOOSE_KEYS, angles=("drive_phases",))
+    t = _mesh_lengths(check, t, where, _LOOSE_KEYS, angles=("drive_phases",))
     _keys(check, t, where, _LOOSE_KEYS, ("base_radii", "inertia", "mesh_stiffness", "mesh_damping_ratio",
                                          "backlash", "drag_torque", "speed_rpm", "orders", "drive_acceleration"),
           "[model.loose_gear]", "loose_gear")
@@ -288,12 +294,13 @@ def _loose_gear(check: _Checker, data: dict[str, Any], model_t: Mapping[str, Any
         raise check.error(f"`{where}.drive_acceleration` must have one entry per order of `{where}.orders` "
                           f"({len(t['orders'])}), got {len(t['drive_acceleration'])}")
     name = _name(check, t, where)
-    names = {**{k: f"{where}.{k}" for k in _LOOSE_KEYS}, **names}
-    gear = _build(check, loose_gear, names, base_radii=t["base_radii"], inertia=t["inertia"],
+    gear = _build(check, loose_gear, {k: f"{where}.{k}" for k in _LOOSE_KEYS}, base_radii=t["base_radii"],
+                  inertia=t["inertia"],
                   mesh_stiffness=t["mesh_stiffness"], mesh_damping_ratio=t["mesh_damping_ratio"],
                   backlash=t["backlash"], drive_acceleration=t["drive_acceleration"],
                   drive_phases=t.get("drive_phases"), drag_torque=t["drag_torque"],
                   name=name)
+    _judge_backlash(check, where, float(t["backlash"]), gear.base_radii, "model.elements[0]")
     tq = gear.chain.torques[0]
     out = dict(data)
     out["model"] = {"units": "SI", "inertias": list(gear.chain.inertias),
@@ -325,13 +332,16 @@ def _refuse_discontinuous_in_chain(check: _Checker, model_t: Mapping[str, Any]) 
             )
 
 
-def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>") -> Mapping[str, Any]:
+def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>",
+                      check: _Checker | None = None) -> Mapping[str, Any]:
     """``data`` with every sub-system shape rewritten into ordinary tables; ``data`` itself (the same
-    object) when it has none. Raises ConfigError naming the key the user wrote."""
+    object) when it has none. Raises ConfigError naming the key the user wrote. ``check``: the
+    reader's checker, which then remembers the keys written with a unit suffix and the keys
+    derived here (for the reader's messages)."""
     model_t = data.get("model") if isinstance(data, Mapping) else None
     if not isinstance(model_t, Mapping):
         return data
-    check = _Checker(source_name)
+    check = _Checker(source_name) if check is None else check
     _refuse_discontinuous_in_chain(check, model_t)
     elastic = model_t.get("elastic")
     if isinstance(elastic, Mapping) and elastic.get("type") in SUBSYSTEM_TYPES:

@@ -68,7 +68,7 @@ from ._table_checks import (
     _Checker,
     _did_you_mean,
     _example,
-    _in_radians,
+    _in_base_units,
     _join,
     _kind,
     _show,
@@ -190,7 +190,7 @@ def model_tables(data: Mapping[str, Any], source_name: str = "<dict>") -> ModelT
     check = _Checker(source_name)
     if not isinstance(data, Mapping):
         raise check.error(f"the configuration must be a table of tables, got {_kind(data)}")
-    data = expand_subsystems(data, source_name)  # damper, spline, gear pair shapes → the ordinary tables
+    data = expand_subsystems(data, source_name, check)  # damper, spline, gear pair shapes → the ordinary tables
 
     # Structure of every table first, so that a misspelt key is reported before its values.
     check.keys(data, "", _TOP_KEYS, required=("model",) if "engine" in data else ("model", "excitation"))
@@ -397,11 +397,11 @@ def _model_in_radians(check: _Checker, model_t: Mapping[str, Any]) -> dict[str, 
     out = {k: v for k, v in model_t.items() if k != "units"}
     laws = sorted({p for law in ELASTIC_LAWS.values() for p in _law_params(law)} | {"type"})
     if isinstance(out.get("elastic"), Mapping):  # also the preload's clearance (clearance_deg)
-        out["elastic"] = _in_radians(check, out["elastic"], "model.elastic", [*laws, *_MODEL_ELASTIC_KEYS],
+        out["elastic"] = _in_base_units(check, out["elastic"], "model.elastic", [*laws, *_MODEL_ELASTIC_KEYS],
                                      angles=(*ANGLE_KEYS, "clearance"))
     elements = out.get("elements")
     if isinstance(elements, (list, tuple)) and all(isinstance(t, Mapping) for t in elements):
-        out["elements"] = [_in_radians(check, t, f"model.elements[{k}]",
+        out["elements"] = [_in_base_units(check, t, f"model.elements[{k}]",
                                        [*_MODEL_ELEMENTS_KEYS, "friction", *laws, *_MODEL_ELASTIC_KEYS],
                                        angles=(*ANGLE_KEYS, "clearance"))
                            for k, t in enumerate(elements)]
@@ -431,7 +431,7 @@ def _engine(check: _Checker, data: Mapping[str, Any], n: int, units: str) -> Eng
             f"`engine` needs `model.units` = \"SI\" (got {json.dumps(units)}): its speeds are in rpm and its "
             "torques in N m; add units = \"SI\" to [model] and give the model in SI units"
         )
-    t = _in_radians(check, t, "engine", _ENGINE_KEYS, angles=("phases",))
+    t = _in_base_units(check, t, "engine", _ENGINE_KEYS, angles=("phases",))
     check.keys(t, "engine", _ENGINE_KEYS, required=("inertia", "speed_rpm", "orders", "amplitudes"))
     check.integer(t["inertia"], "engine.inertia")
     if not 1 <= t["inertia"] <= n:

@@ -3,8 +3,8 @@
 from ._classify import COMPLEX_TOL, UNIT_CIRCLE_TOL, classify_loss, critical_distance, is_stable, torus_ratio
 from ._floquet import (
     TEST_FUNCTIONS, crossing_times, crossing_times_batch, element_monodromy_batch, floquet_test_functions, monodromy,
-    monodromy_and_crossings_batch, monodromy_batch, multipliers_from_monodromy, second_compound, stage_transition,
-    system_monodromy_batch,
+    monodromy_and_crossings_batch, monodromy_batch, multipliers_from_monodromy, neimark_sacker_function, second_compound,
+    stage_transition, system_monodromy_batch,
 )
 from ._hill import hill_exponents, hill_multipliers
 from ._methods import STABILITY_METHODS, AbstractStabilityMethod, Hill, Monodromy, floquet_monitor, stability_method
@@ -19,7 +19,7 @@ from ._regularised import (
 __all__ = [
     "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
     "monodromy_and_crossings_batch", "element_monodromy_batch", "system_monodromy_batch",
-    "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "TEST_FUNCTIONS",
+    "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "neimark_sacker_function", "TEST_FUNCTIONS",
     "hill_exponents", "hill_multipliers", "FloquetMonitor", "hb_system",
     "AbstractStabilityMethod", "Monodromy", "Hill", "STABILITY_METHODS", "stability_method", "floquet_monitor",
     "is_stable", "classify_loss", "torus_ratio", "critical_distance", "UNIT_CIRCLE_TOL", "COMPLEX_TOL",

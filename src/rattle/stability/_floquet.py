@@ -30,6 +30,7 @@ through ``scipy.linalg.expm`` instead.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -458,6 +459,55 @@ def second_compound(M: FloatArray) -> FloatArray:
 TEST_FUNCTIONS = ("fold", "period_doubling", "neimark_sacker")
 
 
+def neimark_sacker_function(mu: ComplexArray) -> FloatArray:
+    """ψ_ns = det(M ⊙ M − I) = Π_{i<j} (μ_i μ_j − 1) from the multipliers μ (..., k) of real
+    monodromies (complex ones in exactly conjugate pairs, as LAPACK and
+    :func:`multipliers_from_monodromy` give them), in O(k²) after the O(k³) eigenvalues — instead
+    of the O(k⁶) determinant of the k(k−1)/2-square bialternate product (:func:`second_compound`,
+    2.6 · 10⁸ entries for a 60-inertia chain, k = 120).
+
+    The bialternate product's eigenvalues are the μ_i μ_j (i < j), so the two are the same
+    polynomial in M's entries; both are backward stable: this one is ψ_ns of M + E with
+    |E| ~ eps |M| (the eigenvalues'), the determinant ψ_ns of M ⊙ M + E'. Where a complex pair
+    meets the real axis its members' errors grow to ~ sqrt(eps), but they are opposite and every
+    symmetric product (μ_1 μ_2 − 1, (μ_1 μ_j − 1)(μ_2 μ_j − 1)) keeps an error ~ eps, so ψ_ns stays
+    smooth enough for the monitor's difference quotient (``_monitor``).
+
+    The factors t = μ_i μ_j − 1 are real (μ_i, μ_j both real, or μ_j = μ̄_i) or come in conjugate
+    pairs (product |t|² > 0), so the product is real and its phase Σ arg t a multiple of π (up to
+    round-off ~ k² eps, far below π/2):
+
+        ψ_ns = sign(cos Σ arg t) · exp(Σ log |t|),
+
+    a zero factor giving 0, a non-finite μ NaN, and the magnitude without intermediate overflow
+    (it overflows to ±inf only where ψ_ns itself exceeds 1.8 · 10³⁰⁸, as the determinant would).
+    """
+    mu = np.asarray(mu, dtype=complex)
+    i, j = _pairs(mu.shape[-1])
+    t = mu[..., i] * mu[..., j] - 1.0
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        magnitude = np.exp(np.log(np.abs(t)).sum(axis=-1))
+        negative = np.cos(np.angle(t).sum(axis=-1)) < 0.0
+    return np.where(np.isfinite(t).all(axis=-1), np.where(negative, -magnitude, magnitude), np.nan)
+
+
+@functools.lru_cache(maxsize=64)
+def _pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs i < j of k multipliers (cached: the monitor asks for the same k each time)."""
+    return np.triu_indices(k, 1)
+
+
+def _eigenvalues(M: FloatArray) -> ComplexArray:
+    """Eigenvalues of (..., k, k) matrices, unsorted (NaN for a matrix with a non-finite entry)."""
+    finite = np.isfinite(M).all(axis=(-2, -1))
+    if np.all(finite):
+        return np.linalg.eigvals(M).astype(complex, copy=False)
+    mu = np.full(M.shape[:-1], np.nan, dtype=complex)
+    if np.any(finite):
+        mu[finite] = np.linalg.eigvals(M[finite])
+    return mu
+
+
 def floquet_test_functions(M: FloatArray) -> FloatArray:
     """Floquet test functions of monodromies (..., 2n, 2n), shape (..., 2) for n = 1, (..., 3) else:
 
@@ -467,7 +517,9 @@ def floquet_test_functions(M: FloatArray) -> FloatArray:
     zero at a fold (μ = 1), a period doubling (μ = −1) and a Neimark–Sacker point (μ = e^{±iθ}:
     μ μ̄ = 1) — ψ_ns also vanishes at a neutral saddle (real μ_i μ_j = 1), which
     :func:`~rattle.stability.classify_loss` tells apart. For n = 1, det M = e^{−cT} < 1 and no
-    pair reaches the circle: only ψ_fold, ψ_pd.
+    pair reaches the circle: only ψ_fold, ψ_pd. ψ_fold and ψ_pd are LU determinants (O(n³));
+    ψ_ns is evaluated from the multipliers (:func:`neimark_sacker_function`, O(n³) for the
+    eigenvalues), not as the determinant of the bialternate product (O(n⁶)).
     """
     M = np.asarray(M, dtype=float)
     k = M.shape[-1]
@@ -479,14 +531,13 @@ def floquet_test_functions(M: FloatArray) -> FloatArray:
     eye = np.eye(k)
     with np.errstate(over="ignore", invalid="ignore"):
         parts = [np.linalg.det(M - eye), np.linalg.det(M + eye)]
-        if k > 2:
-            B = second_compound(M)
-            parts.append(np.linalg.det(B - np.eye(B.shape[-1])))
+    parts.append(neimark_sacker_function(_eigenvalues(M)))
     return np.stack(parts, axis=-1)
 
 
 __all__ = [
     "stage_transition", "crossing_times", "crossing_times_batch", "monodromy", "monodromy_batch",
     "monodromy_and_crossings_batch", "element_monodromy_batch", "system_monodromy_batch",
-    "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "TEST_FUNCTIONS", "EIG_CONDITION_LIMIT",
+    "multipliers_from_monodromy", "second_compound", "floquet_test_functions", "neimark_sacker_function", "TEST_FUNCTIONS",
+    "EIG_CONDITION_LIMIT",
 ]
