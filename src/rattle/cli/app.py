@@ -24,6 +24,7 @@ before click or numpy are imported).
 from __future__ import annotations
 
 import contextlib
+import gc
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
@@ -228,6 +229,21 @@ for _command in COMMANDS:
     cli.add_command(_command)
 
 
+#: The young generation's threshold of the command-line process (Python's default: 700).
+GC_THRESHOLD0 = 10_000
+
+
+def _collect_rarely() -> None:
+    """The cyclic garbage collector of the command-line process, tuned for a short run that
+    imports much (numpy, scipy, numba, matplotlib: some 10⁶ long-lived objects) and allocates
+    few cycles: a young collection every 10,000 allocations instead of 700, so that the imports
+    do not pay some 400 collections and three full ones (0.3 s of CPU in ``rattle frf``, 0.1 s
+    with this). Cycles are still collected; the library's own processes are left as they are."""
+    threshold0, threshold1, threshold2 = gc.get_threshold()
+    if threshold0:  # 0: the collector was switched off on purpose; leave it so
+        gc.set_threshold(max(threshold0, GC_THRESHOLD0), threshold1, threshold2)
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     """Console entry point ``rattle`` (and ``python -m rattle``); exits with status 0, 1 or 2.
 
@@ -242,7 +258,12 @@ def main(argv: Sequence[str] | None = None) -> None:
     client still connecting to a scheduler that never answered waits 20 s in its ``__del__``);
     rattle's own temporary files and worker processes are gone already (its ``finally`` blocks).
     """
+    _collect_rarely()
     code = cli.main(args=list(argv) if argv is not None else None, prog_name="rattle", standalone_mode=False)
+    # Everything alive now lives until the process ends: the interpreter's exit need not search
+    # it for garbage cycles (0.45 s of CPU after `rattle frf` with numba, scipy and matplotlib
+    # loaded, 0.04 s with this). Finalizers, atexit and the streams' flush run as before.
+    gc.freeze()
     if code >= 128 and _signals.interrupted_by() is not None and _signals.installed_at_start():
         _signals.exit_now(code)
     sys.exit(code)
