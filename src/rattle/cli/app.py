@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import os
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
@@ -229,6 +230,27 @@ for _command in COMMANDS:
     cli.add_command(_command)
 
 
+#: The environment variables that set the BLAS/OpenMP thread pools (numpy's and scipy's OpenBLAS,
+#: MKL, OpenMP), read once when the library loads.
+BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def single_threaded_blas() -> bool:
+    """One BLAS/OpenMP thread for the command-line process (and the processes it starts), unless
+    the environment already chooses (any of :data:`BLAS_THREAD_VARIABLES` set: all left as they
+    are) or numpy is loaded already (too late to matter; the caller's environment is left alone).
+
+    rattle's dense problems are small (2(2H + 1) rows: 130 at H = 32): a thread pool hands them
+    out and spins waiting for them for longer than they take. Measured (benchmarks/bench_threads.py,
+    2 cores): the reference FRF with Hill's method at H = 32 takes 7.4 s CPU with one thread and
+    43 s with two (59 s wall); ``rattle frf`` on the reference case 2.06 s against 2.20 s.
+    Returns whether it set them."""
+    if "numpy" in sys.modules or any(var in os.environ for var in BLAS_THREAD_VARIABLES):
+        return False
+    os.environ.update(dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
+    return True
+
+
 #: The young generation's threshold of the command-line process (Python's default: 700).
 GC_THRESHOLD0 = 10_000
 
@@ -258,6 +280,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     client still connecting to a scheduler that never answered waits 20 s in its ``__del__``);
     rattle's own temporary files and worker processes are gone already (its ``finally`` blocks).
     """
+    single_threaded_blas()
     _collect_rarely()
     code = cli.main(args=list(argv) if argv is not None else None, prog_name="rattle", standalone_mode=False)
     # Everything alive now lives until the process ends: the interpreter's exit need not search
