@@ -1,8 +1,8 @@
 """The command line's PNG, drawn once (``rattle.cli.output.write_png``), is byte for byte the file
-``Figure.savefig(format="png", dpi=150)`` writes: a constrained-layout figure (frf, sweep, orbit,
-compare), one laid out by ``tight_layout`` at drawing time, one without a layout, a multi-panel
-one; and with a matplotlibrc that changes the picture (tight bounding box, transparent) it is
-savefig's own file."""
+``Figure.savefig(format="png", dpi=150)`` writes: a constrained-layout figure (frf; the sweep
+and orbit plots in test_plotting.py, with its fixtures), one laid out by ``tight_layout`` at
+drawing time, one without a layout, multi-panel ones; and with a matplotlibrc that changes the
+picture (tight bounding box, transparent, a coloured background) it is savefig's own file."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ def _close_figures():
     plt.close("all")
 
 
-def _both(make) -> tuple[bytes, bytes]:
+def both(make) -> tuple[bytes, bytes]:
     a, b = io.BytesIO(), io.BytesIO()
     fig = make()
     fig.savefig(a, format="png", dpi=FIGURE_DPI)
@@ -49,28 +49,18 @@ def _lines(layout):
 
 @pytest.mark.parametrize("layout", ["constrained", None, "none"])
 def test_a_figure_is_the_file_savefig_writes(layout) -> None:
-    a, b = _both(_lines(layout))
+    a, b = both(_lines(layout))
     assert a[:8] == b"\x89PNG\r\n\x1a\n" and a == b
 
 
 def test_the_reference_frf_plot_is_the_file_savefig_writes(reference_frf) -> None:
-    a, b = _both(lambda: reference_frf.plot()[0])
+    a, b = both(lambda: reference_frf.plot()[0])
     assert a == b
-
-
-def test_the_sweep_and_orbit_plots_are_the_files_savefig_writes(reference_model, reference_frf) -> None:
-    import rattle
-
-    sweep = rattle.time_sweep(reference_model, omega=(0.5, 1.0), points=12, direction="up")
-    orbit = rattle.periodic_orbit(reference_model, 0.8)
-    for make in (lambda: sweep.plot()[0], lambda: orbit.plot()[0]):
-        a, b = _both(make)
-        assert a == b
 
 
 @pytest.mark.parametrize("rc", [{"savefig.bbox": "tight"}, {"savefig.transparent": True},
                                 {"savefig.facecolor": "yellow"}])
 def test_settings_that_change_the_picture_are_savefigs(rc) -> None:
     with matplotlib.rc_context(rc):
-        a, b = _both(_lines("constrained"))
+        a, b = both(_lines("constrained"))
     assert a == b
