@@ -236,9 +236,10 @@ BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THR
 
 
 def single_threaded_blas() -> bool:
-    """One BLAS/OpenMP thread for the command-line process (and the processes it starts), unless
-    the environment already chooses (any of :data:`BLAS_THREAD_VARIABLES` set: all left as they
-    are) or numpy is loaded already (too late to matter; the caller's environment is left alone).
+    """One BLAS/OpenMP thread for the command-line process and the processes it starts (called by
+    :func:`main` there only), unless the environment already chooses (any of
+    :data:`BLAS_THREAD_VARIABLES` set: all left as they are) or numpy is loaded already (too late
+    to matter; the environment is left alone).
 
     rattle's dense problems are small (2(2H + 1) rows: 130 at H = 32): a thread pool hands them
     out and spins waiting for them for longer than they take. Measured (benchmarks/bench_threads.py,
@@ -260,7 +261,8 @@ def _collect_rarely() -> None:
     imports much (numpy, scipy, numba, matplotlib: some 10⁶ long-lived objects) and allocates
     few cycles: a young collection every 10,000 allocations instead of 700, so that the imports
     do not pay some 400 collections and three full ones (0.3 s of CPU in ``rattle frf``, 0.1 s
-    with this). Cycles are still collected; the library's own processes are left as they are."""
+    with this). Cycles are still collected. Called by :func:`main` in the command-line process
+    only: a program that imports rattle keeps its own settings."""
     threshold0, threshold1, threshold2 = gc.get_threshold()
     if threshold0:  # 0: the collector was switched off on purpose; leave it so
         gc.set_threshold(max(threshold0, GC_THRESHOLD0), threshold1, threshold2)
@@ -280,13 +282,17 @@ def main(argv: Sequence[str] | None = None) -> None:
     client still connecting to a scheduler that never answered waits 20 s in its ``__del__``);
     rattle's own temporary files and worker processes are gone already (its ``finally`` blocks).
     """
-    single_threaded_blas()
-    _collect_rarely()
+    command_line = _signals.installed_at_start()  # not main() called inside another program
+    if command_line:
+        single_threaded_blas()
+        _collect_rarely()
     code = cli.main(args=list(argv) if argv is not None else None, prog_name="rattle", standalone_mode=False)
-    # Everything alive now lives until the process ends: the interpreter's exit need not search
-    # it for garbage cycles (0.45 s of CPU after `rattle frf` with numba, scipy and matplotlib
-    # loaded, 0.04 s with this). Finalizers, atexit and the streams' flush run as before.
-    gc.freeze()
+    if command_line:
+        # Everything alive now lives until the process ends: the interpreter's exit need not
+        # search it for garbage cycles (0.45 s of CPU after `rattle frf` with numba, scipy and
+        # matplotlib loaded, 0.04 s with this). Finalizers, atexit and the streams' flush run as
+        # before.
+        gc.freeze()
     if code >= 128 and _signals.interrupted_by() is not None and _signals.installed_at_start():
         _signals.exit_now(code)
     sys.exit(code)
