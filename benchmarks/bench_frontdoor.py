@@ -17,6 +17,10 @@ Run:  python benchmarks/bench_frontdoor.py  [--repeat 5] [--stops 3]
     has exited and both workers are gone is measured (``--stops`` times; min, median, max),
     against the 1 s target. Then the same with SIGTERM.
 
+(c) ``rattle frf`` on the reference case: the whole command's CPU against its computation's
+    (``rattle.frequency_response`` in a warm process), target ≤ 2 — ``bench_command.py``'s table
+    (``--ratio-repeat`` runs each; that script alone also compares with another tree).
+
 The machine is shared: the best of several runs is the figure that measures the code, not the
 load.
 """
@@ -210,16 +214,27 @@ def sweep_stop(stops: int) -> bool:
     return ok
 
 
+def command_ratio(repeat: int) -> bool:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import bench_command
+
+    print(f"\n(c) rattle frf on the reference case: command / computation CPU (target ≤ {bench_command.TARGET:g}), "
+          f"best (median) of {repeat} runs\n")
+    return bench_command.report({"this tree": SRC}, bench_command.ROOT / "examples" / "reference_clutch.toml", repeat)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5, help="runs per command; the best counts")
     parser.add_argument("--stops", type=int, default=3, help="parallel sweeps stopped per signal")
+    parser.add_argument("--ratio-repeat", type=int, default=3, help="runs of (c), the command/computation ratio")
     args = parser.parse_args()
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores, load average {load:.2f}\n")
     ok = front_door(args.repeat)
     if sys.platform.startswith("linux"):
         ok &= sweep_stop(args.stops)
+    ok &= command_ratio(args.ratio_repeat)
     print("\nall targets met" if ok else "\nsome targets missed (see MISSED; a loaded machine inflates the times)")
 
 

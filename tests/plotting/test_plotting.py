@@ -250,3 +250,16 @@ def test_plot_axes_is_a_dict_with_a_primary() -> None:
     with pytest.raises(ValueError, match="`panels`"):
         PlotAxes({})
     assert "PlotAxes(['top', 'bottom'], primary='bottom')" == repr(axes)
+
+
+def test_sweep_and_orbit_png_are_the_files_savefig_writes(sweep, orbit) -> None:
+    """The command line's PNG drawn once is byte for byte savefig's (see test_png_once.py)."""
+    import io
+
+    from rattle.cli.output import FIGURE_DPI, write_png
+
+    for result in (sweep, orbit):
+        a, b = io.BytesIO(), io.BytesIO()
+        result.plot()[0].savefig(a, format="png", dpi=FIGURE_DPI)
+        write_png(result.plot()[0], b, FIGURE_DPI)
+        assert a.getvalue()[:8] == b"\x89PNG\r\n\x1a\n" and a.getvalue() == b.getvalue()
