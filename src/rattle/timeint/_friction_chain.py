@@ -78,6 +78,7 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .._limits import check_interval
 from .._typing import FloatArray
@@ -113,8 +114,6 @@ def _brent(fun, a: float, b: float, fa: float, fb: float) -> float:  # type: ign
         return b
     if (fa > 0.0) == (fb > 0.0):  # a sign change within round-off: the end nearer zero
         return a if abs(fa) < abs(fb) else b
-    from scipy.optimize import brentq  # here: scipy.optimize costs ~0.15 s to import, and smooth laws never call this
-
     return float(brentq(fun, a, b, xtol=4.0 * _EPS * max(abs(b), 1e-300), rtol=4.0 * _EPS, maxiter=200))
 
 

@@ -26,6 +26,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.integrate._ivp.ivp import METHODS as _IVP_METHODS
 
 from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
@@ -185,9 +187,6 @@ def integrate_general(
     t0, t1 = float(t0), float(t1)
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
         raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
-    from scipy.integrate import solve_ivp  # here: scipy.integrate (and scipy.optimize with it) costs
-    from scipy.integrate._ivp.ivp import METHODS as _IVP_METHODS  # ~0.15 s to import, for this reference only
-
     if method not in _IVP_METHODS:
         raise ValueError(f"`method` must be one of {', '.join(_IVP_METHODS)}, got {method!r}")
     for name, value in (("rtol", rtol), ("atol", atol), ("max_step", max_step)):
