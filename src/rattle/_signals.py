@@ -84,6 +84,7 @@ class _State:
     first: int | None = None        # the first signal received
     first_at = 0.0                  # when (time.monotonic)
     reported = False                # the interruption's line is on stderr
+    reporting = False               # report() is writing it now
     hook: Any = sys.__unraisablehook__  # the unraisable hook :class:`raising` replaced
 
 
@@ -111,15 +112,20 @@ def message(signum: int, *, forced: bool = False) -> str:
 def _write_line(text: str) -> None:
     """``rattle: error: text`` on stderr, written with one system call (safe inside a handler,
     whatever the stderr buffer was doing when the signal came)."""
+    outer = _State.reporting
+    _State.reporting = True  # a handler run nested in here (a pending signal) returns: one line
     try:
-        sys.stderr.flush()
-    except Exception:  # a write interrupted half-way ("reentrant call"), a closed stream
-        pass
-    try:
-        os.write(2, f"rattle: error: {text}\n".encode("utf-8", "replace"))
-    except OSError:  # pragma: no cover - stderr closed
-        pass
-    _State.reported = True
+        try:
+            sys.stderr.flush()
+        except Exception:  # a write interrupted half-way ("reentrant call"), a closed stream
+            pass
+        try:
+            os.write(2, f"rattle: error: {text}\n".encode("utf-8", "replace"))
+        except OSError:  # pragma: no cover - stderr closed
+            pass
+        _State.reported = True
+    finally:
+        _State.reporting = outer
 
 
 def exit_now(code: int) -> None:
@@ -152,6 +158,8 @@ def handle(signum: int, _frame: FrameType | None) -> None:
         exit_now(128 + signum)
         return
     # a later signal: the first one's clean-up runs (raise mode), or the command has ended
+    if _State.reporting:  # the line is being written (this handler runs nested inside report()):
+        return  # it is written once, and the command ends right after
     if _State.mode == "exit" or time.monotonic() - _State.first_at > FORCE_AFTER:
         if not _State.reported:
             _write_line(message(first, forced=_State.mode == "raise"))
@@ -286,12 +294,17 @@ def report(signum: int) -> None:
         pass
     try:
         if not _State.reported:
-            try:  # through sys.stderr (what a caller capturing it sees); no handler runs meanwhile
+            # A signal that arrived just before the mask was set has its Python handler pending: it
+            # may run inside the write below (at a flush); ``reporting`` tells it to return.
+            _State.reporting = True
+            try:  # through sys.stderr (what a caller capturing it sees)
                 sys.stderr.write(f"rattle: error: {message(signum)}\n")
                 sys.stderr.flush()
                 _State.reported = True
             except Exception:  # a closed or broken stream
                 _write_line(message(signum))
+            finally:
+                _State.reporting = False
     finally:
         if mask is not None:
             _signal.pthread_sigmask(_signal.SIG_SETMASK, mask)
