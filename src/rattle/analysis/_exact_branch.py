@@ -67,7 +67,7 @@ from .._threads import one_blas_thread
 from ..errors import Status
 from ..model import FrictionSystem, NonsmoothSystem
 from ..stability import classify_loss
-from ..timeint import ShootingProblem
+from ..timeint import ShootingProblem, monodromy_multipliers
 
 #: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
 #: gives a neutral multiplier 1 (a family of orbits).
@@ -126,25 +126,21 @@ class ShootingOptions:
 
 @dataclass(slots=True)
 class ExactRow:
-    """One row of an exact branch: the state z(0) ``q``, ``omega``, the monodromy ``M``, its
-    event ``structure``, the ``label`` of a special point located there ("" none) and the
-    ``trajectory`` of one period."""
+    """One row of an exact branch: the state z(0) ``q``, ``omega``, the monodromy ``M`` and its
+    ``multipliers`` (largest modulus first, computed once), its event ``structure``, the
+    ``label`` of a special point located there ("" none) and the ``trajectory`` of one period."""
 
     q: FloatArray
     omega: float
     M: FloatArray
+    multipliers: ComplexArray
     structure: tuple[int, ...]
     label: str = ""
     trajectory: Any = None
 
     @property
-    def multipliers(self) -> ComplexArray:
-        mu = np.linalg.eigvals(self.M)
-        return mu[np.argsort(-np.abs(mu), kind="stable")]
-
-    @property
     def unstable_count(self) -> int:
-        return int(np.sum(np.abs(np.linalg.eigvals(self.M)) > 1.0 + UNIT_TOL))
+        return int(np.sum(np.abs(self.multipliers) > 1.0 + UNIT_TOL))
 
 
 @dataclass(slots=True)
@@ -171,8 +167,8 @@ def _row(problem: ShootingProblem, q: FloatArray, omega: float) -> ExactRow:
     event structure and trajectory)."""
     q = np.asarray(q, dtype=float).copy()
     traj = problem.integrator.propagate(q, 0.0, problem.orbit_period(omega), omega)
-    return ExactRow(q, float(omega), np.asarray(traj.sensitivity, dtype=float), traj.event_structure(),
-                    trajectory=traj)
+    M = np.asarray(traj.sensitivity, dtype=float)
+    return ExactRow(q, float(omega), M, monodromy_multipliers(M), traj.event_structure(), trajectory=traj)
 
 
 def _structure(problem: ShootingProblem, q: FloatArray, omega: float) -> tuple[int, ...]:

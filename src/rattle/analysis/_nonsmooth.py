@@ -66,8 +66,10 @@ from ..hb import HBOptions, RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionResponse, NonsmoothResponse
 from ..stability import regularised_multipliers
-from ..timeint import FrictionIntegrator, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit
-from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
+from ..timeint import (
+    FLOW_FAILURES, FrictionIntegrator, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
+    shoot_nonsmooth_orbit,
+)
 from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
 from ._friction_response import exact_friction_response, friction_response, shooting_friction_response
 from ._friction_subharmonics import friction_subharmonics, period_two_orbit
@@ -335,7 +337,7 @@ def _exact_response(branch: ExactBranch, *, number: int, period: int = 1) -> Non
         traj = r.trajectory
         mean, rms = traj.mean_and_rms()
         orbit = NonsmoothOrbit(state0=r.q, omega=r.omega, period=period, monodromy=r.M,
-                               multipliers=monodromy_multipliers(r.M), converged=True, iterations=0, residual=0.0,
+                               multipliers=r.multipliers, converged=True, iterations=0, residual=0.0,
                                trajectory=traj, mean=mean, rms=rms)
         rows["omega"].append(r.omega)
         rows["rms_hb"].append(math.nan)

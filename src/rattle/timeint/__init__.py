@@ -11,7 +11,7 @@ from typing import Any
 from ._exact import ExactIntegrator, ExactMeasures, StageSolutions, StateSamples, Trajectory
 from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory
 from ._general import GeneralSolution, integrate_general
-from ._shooting import ShootingOrbit, shoot_periodic_orbit
+from ._shooting import FLOW_FAILURES, ShootingOrbit, monodromy_multipliers, shoot_periodic_orbit
 from ._shooting_problem import ShootingProblem
 from ._system_shooting import SystemOrbit, shoot_system_orbit
 
@@ -21,7 +21,7 @@ from ._nonsmooth import (
 )
 __all__ = [
     "ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
-    "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem",
+    "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem", "monodromy_multipliers", "FLOW_FAILURES",
     "integrate_general", "GeneralSolution",
     "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
     "NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
