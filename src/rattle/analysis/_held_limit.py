@@ -39,7 +39,7 @@ from .._typing import FloatArray
 from ..continuation import NewtonOptions
 from ..errors import ConvergenceError
 from ..hb import HBOptions, RegularisedSystemBalance
-from ..hb._regularised_system import MAX_SAMPLES
+from ..hb import MAX_SAMPLES
 
 #: Statuses of :class:`HeldLimit`.
 HELD_STATUSES = ("converged", "stalled", "floor")

@@ -44,9 +44,7 @@ from ..errors import ConvergenceError
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..measures import system_measures_batch
 from ..model import Model, check_analysable_model
-from ..results import FrequencyResponse
-from ..results._orbit import OrbitSolution, PeriodicOrbit
-from ..results._steady import SteadyState
+from ..results import FrequencyResponse, OrbitSolution, PeriodicOrbit, SteadyState
 from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, stability_method
 from ..timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
 from ..timeint._flow import check_system_state

@@ -29,7 +29,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..results import FrequencyResponse
-from ..results._frequency_response import Region
+from ..results import Region
 from ..timeint._shooting import _newton_shooting, _state_scale
 from ..timeint._system_shooting import _newton_system, system_state_scale
 from ._steady import SteadyStateOptions, make_integrator, steady_state

@@ -6,11 +6,12 @@ and continued by :class:`rattle.continuation.ContinuationStepper`."""
 from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions, default_samples
 from ._regularised import RegularisedBalance, RegularisedForce
-from ._regularised_system import RegularisedSystemBalance
+from ._kernels import irfft, rfft
+from ._regularised_system import MAX_SAMPLES, RegularisedSystemBalance
 from ._residual import HarmonicBalance
 
 __all__ = ["FourierBasis", "resize_harmonics", "HarmonicBalance", "HBOptions", "default_samples",
-           "RegularisedBalance", "RegularisedForce", "RegularisedSystemBalance"]
+           "RegularisedBalance", "RegularisedForce", "RegularisedSystemBalance", "MAX_SAMPLES", "rfft", "irfft"]
 
 #: Names whose home moved to :mod:`rattle.continuation` (Newton at a fixed parameter is the same
 #: for every continuation problem): still importable from here, resolved when first used, so that

@@ -2,7 +2,7 @@
 
 A configuration file holds the model tables and the run's own tables::
 
-    [model], [excitation], [engine], [drag]    the model: read by :func:`rattle.model._tables.model_tables`
+    [model], [excitation], [engine], [drag]    the model: read by :func:`rattle.model.model_tables`
                                                (schema, units, angles in degrees, data-sheet shapes)
     [analysis]           omega                 [min, max] in rad/s, optional (default [0.1, 3.0])
                          harmonics             integer 1 … 256, optional (default 32)
@@ -51,9 +51,8 @@ from .. import _limits
 from ..errors import ConfigError
 from ..files import read_toml
 from ..model import Model, Preload, check_analysable_model, forcing_frequency
-from ..model._friction_system import FrictionSystem
-from ..model._nonsmooth_system import NonsmoothSystem
-from ..model._table_checks import (
+from ..model import FrictionSystem, NonsmoothSystem, model_tables
+from .._table_checks import (
     _EXAMPLES,
     _Checker,
     _example,
@@ -61,7 +60,6 @@ from ..model._table_checks import (
     _show,
     rename_keys,
 )
-from ..model._tables import model_tables
 
 __all__ = [
     "DEFAULT_HARMONICS",

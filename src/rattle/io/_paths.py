@@ -148,7 +148,7 @@ def read_path_csv(file: str | os.PathLike[str], source: str, *, key: str = "file
 def paths_from_config(value: Any, model: Any, base_dir: str | os.PathLike[str], prefix: str = "") -> tuple[Any, ...]:
     """The ``[[paths]]`` array of tables as SoundPath objects, files relative to ``base_dir``,
     sources checked against ``model``."""
-    from ..model._paths import check_source
+    from ..model import check_source
 
     if isinstance(value, Mapping) or not isinstance(value, list) or not all(isinstance(t, Mapping) for t in value):
         raise _fail(prefix, f"`paths` must be an array of tables, written [[paths]] with source = \"…\" and file = "

@@ -14,9 +14,9 @@ from ._elastic import (
 from ._excitation import Excitation
 from ._model import Model
 from ._nonsmooth_system import NonsmoothSystem
-from ._paths import SoundPath
+from ._paths import SoundPath, check_source, parse_source
 from ._system import ReducedElement, System
-from . import _tables  # noqa: F401  (loaded here: registers the reader of Model.from_toml and Chain.from_toml)
+from ._tables import ModelTables, model_tables  # (loaded here: registers the reader of Model.from_toml and Chain.from_toml)
 from .library import backlash_case, reference_case
 
 __all__ = [
@@ -24,7 +24,7 @@ __all__ = [
     "ELASTIC_LAWS",
     "Excitation", "Model", "System", "ReducedElement", "Chain", "Link", "Element", "Torque", "check_analysable_model", "reference_case", "backlash_case",
     "firing_orders", "engine_speed", "forcing_frequency", "base_order", "engine_torque",
-    "SoundPath", "Drag", "SpeedLoad",
+    "SoundPath", "check_source", "parse_source", "model_tables", "ModelTables", "Drag", "SpeedLoad",
     "AbstractJumpLaw", "Preload", "PiecewiseJump", "Friction", "NonsmoothLaw", "NonsmoothSystem", "FrictionSystem",
     "clutch_damper", "hub_spline", "gear_pair", "loose_gear", "GearPair", "LooseGear", "MAX_BACKLASH_RATIO",
 ]

@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from ..files._read import read_toml
+from ..files import read_toml
 
 #: reader(data, source_name) -> the model tables of ``data`` (``source_name`` names the file in errors).
 TableReader = Callable[[Mapping[str, Any], str], Any]

@@ -43,7 +43,7 @@ from typing import Any
 
 from ._builders import backlash_warning, clutch_damper, gear_pair, hub_spline, loose_gear
 from ._elastic import ELASTIC_LAWS
-from ._table_checks import UNIT_SUFFIXES, _Checker, _in_base_units, _show, rename_keys
+from .._table_checks import UNIT_SUFFIXES, _Checker, _in_base_units, _show, rename_keys
 
 __all__ = ["SUBSYSTEM_TYPES", "expand_subsystems"]
 
@@ -84,7 +84,7 @@ def _keys(check: _Checker, table: Mapping[str, Any], where: str, allowed: tuple[
           required: tuple[str, ...], what: str, kind: str) -> None:
     for key in table:
         if key not in allowed:
-            from ._table_checks import _did_you_mean
+            from .._table_checks import _did_you_mean
 
             lengths = ", lengths also as KEY_mm or KEY_um" if "backlash" in allowed and kind != "spline" else ""
             raise check.error(
@@ -361,7 +361,7 @@ def expand_subsystems(data: Mapping[str, Any], source_name: str = "<dict>",
     for k, t in enumerate(elements if isinstance(elements, list) else []):
         kind = t.get("type") if isinstance(t, Mapping) else None
         if isinstance(kind, str) and kind not in ELASTIC_LAWS and kind != "preload" and kind not in SUBSYSTEM_TYPES:
-            from ._table_checks import _did_you_mean
+            from .._table_checks import _did_you_mean
 
             types = [*ELASTIC_LAWS, "preload", *SUBSYSTEM_TYPES]
             hint = _did_you_mean(kind, types).replace("`", '"')

@@ -62,7 +62,7 @@ from ._friction_system import FrictionSystem
 from ._model import Model
 from ._nonsmooth_system import NonsmoothSystem
 from ._readers import register_reader
-from ._table_checks import (
+from .._table_checks import (
     _EXAMPLES,
     ANGLE_KEYS,
     _Checker,

@@ -18,12 +18,12 @@ from ._sound import (
     UNCOVERED_WARNING, SoundPressure, a_weighting_db, check_sound_paths, coefficient_sound_pressure,
     linear_sound_pressure, motion_sound_pressure, sound_pressure,
 )
-from ._steady import SteadyState
-from ._sweep import SweepResult
+from ._steady import METHODS as STEADY_METHODS, SteadyState
+from ._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SweepResult
 
 __all__ = [
     "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
-    "SweepResult", "SteadyState", "PeriodicOrbit", "OrbitSolution", "Comparison",
+    "SweepResult", "FAILED_PERIOD", "SWEEP_FAILED", "SWEEP_ELEMENT_COLUMNS", "SteadyState", "STEADY_METHODS", "PeriodicOrbit", "OrbitSolution", "Comparison",
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
     "coefficient_sound_pressure", "check_sound_paths", "UNCOVERED_WARNING",

@@ -53,7 +53,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from .._validate import as_float_array
 from ..model import SoundPath, check_analysable_model
-from ..model._paths import check_source, parse_source
+from ..model import check_source, parse_source
 
 __all__ = ["SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "P_REF",
            "UNCOVERED_WARNING", "motion_sound_pressure", "coefficient_sound_pressure", "record_harmonics",

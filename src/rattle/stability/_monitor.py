@@ -31,7 +31,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..continuation import MonitorReading
 from ..hb import HarmonicBalance
-from ..hb import _kernels as fft
+from .. import hb as fft  # its compiled rfft/irfft
 from ..model import System
 from ._classify import critical_distance
 from ._floquet import (

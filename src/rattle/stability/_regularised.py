@@ -39,7 +39,7 @@ import scipy.linalg
 
 from .._typing import ComplexArray, FloatArray
 from ..hb import RegularisedBalance, RegularisedSystemBalance
-from ..timeint._shooting import monodromy_multipliers
+from ..timeint import monodromy_multipliers
 
 
 def _shifted(q: FloatArray, H: int, phase: float) -> FloatArray:

@@ -23,7 +23,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from ..errors import ConfigError
+from .errors import ConfigError
 
 _T = TypeVar("_T")
 
