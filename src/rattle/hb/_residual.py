@@ -25,6 +25,7 @@ b = [K/I]); it runs through the same code and gives the same numbers as the scal
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -71,11 +72,20 @@ def _jacobian_gather_tables(H: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def product_tables(H: int, k: int) -> tuple[FloatArray, np.ndarray, np.ndarray]:
-    """Buffer X (k, 4L+1) and the gather tables of :func:`product_jacobians` for k signals."""
+    """Buffer X (k, 4L+1) and the gather tables of :func:`product_jacobians` for k signals: a fresh
+    buffer each call, the (read-only) tables shared by every problem of the same H and k."""
+    j1, j2 = _shifted_tables(H, k)
+    return np.zeros((k, 4 * (4 * H + 1) + 1)), j1, j2
+
+
+@functools.lru_cache(maxsize=32)
+def _shifted_tables(H: int, k: int) -> tuple[np.ndarray, np.ndarray]:
     j1, j2 = _jacobian_gather_tables(H)
-    size = 4 * (4 * H + 1) + 1
-    shift = (size * np.arange(k))[:, None, None]
-    return np.zeros((k, size)), j1[None] + shift, j2[None] + shift
+    shift = ((4 * (4 * H + 1) + 1) * np.arange(k))[:, None, None]
+    j1, j2 = j1[None] + shift, j2[None] + shift
+    j1.flags.writeable = False
+    j2.flags.writeable = False
+    return j1, j2
 
 
 def product_jacobians(spec: np.ndarray, samples: int, tables: tuple[FloatArray, np.ndarray, np.ndarray]) -> FloatArray:
