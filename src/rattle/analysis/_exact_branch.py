@@ -75,6 +75,10 @@ UNIT_TOL = 1e-8
 #: A hop past a grazing lands on the branch's other side only within this scaled distance of the
 #: last orbit (the state moves like the square root of the distance to the grazing).
 HOP_DISTANCE = 0.05
+#: ... and only to an orbit whose every element's rms is within this relative distance of the last
+#: orbit's: across a grazing the orbit changes continuously (the new crossings or stick phases are
+#: small), so a hop of h ≤ 1e-2 in Ω moves the rms by far less.
+HOP_RMS = 0.05
 #: A piece continued from a hop that stalls again within this many points is the wrong arm.
 MIN_PIECE = 5
 #: A piece whose last CRAWL_POINTS steps were all within CRAWL_FACTOR × the stepper's smallest
@@ -87,6 +91,12 @@ CRAWLING = "crawling towards a grazing"
 GRAZE_POINTS = 40
 #: Relative frequency steps to a restart past a stall that no hop passes (:meth:`_Follower._restart`).
 RESTART_STEPS = (0.005, 0.02, 0.05)
+#: A restart past a stall whose orbit's rms is within this relative distance of the stall's is the
+#: same branch (followed back to the stall); a larger jump is another branch (:meth:`_Follower._restart`).
+RESTART_RMS = 0.1
+#: A branch followed from a restart onto another branch ends where its state comes within this
+#: scaled distance of the orbit interpolated between two rows of the branch it started from.
+JOIN_DISTANCE = 1e-2
 #: Multipliers that move by less than this across a located point left the unit circle
 #: continuously (a smooth bifurcation); a larger jump is the event structure's.
 CONTINUOUS_JUMP = 1e-3
@@ -169,6 +179,14 @@ def _row(problem: ShootingProblem, q: FloatArray, omega: float) -> ExactRow:
     traj = problem.integrator.propagate(q, 0.0, problem.orbit_period(omega), omega)
     M = np.asarray(traj.sensitivity, dtype=float)
     return ExactRow(q, float(omega), M, monodromy_multipliers(M), traj.event_structure(), trajectory=traj)
+
+
+def _row_rms(row: ExactRow) -> FloatArray:
+    """Every element's rms over the row's recorded period (the trajectory's own quadrature)."""
+    traj = row.trajectory
+    if hasattr(traj, "element_mean_and_rms"):  # a chain's trajectory: one rms per element
+        return np.atleast_1d(np.asarray(traj.element_mean_and_rms()[1], dtype=float))
+    return np.atleast_1d(float(traj.mean_and_rms()[1]))
 
 
 def _structure(problem: ShootingProblem, q: FloatArray, omega: float) -> tuple[int, ...]:
@@ -323,13 +341,15 @@ class _Follower:
         self._reach = (a, b)
         self.progress(int(round(1000 * (b - a) / (self.hi - self.lo))), 1000)
 
-    def _hops(self, last: BranchPoint, structure: tuple[int, ...],
+    def _hops(self, last: BranchPoint, last_row: ExactRow,
               recent: float) -> list[tuple[FloatArray, float, float]]:
         """Candidates past a grazing: (z(0), Ω, direction) of nearby orbits of another structure;
         failing those, the nearest orbit of the same structure a step ahead in the direction of
         travel since the Ω ``recent`` a few points back (the steps fell to the floor where the
         branch still goes on: a natural step over)."""
         s = self.problem.length_scale
+        structure = last_row.structure
+        rms_last = _row_rms(last_row)
         out: list[tuple[FloatArray, float, float]] = []
         ahead: list[tuple[FloatArray, float, float]] = []
         travel = 1.0 if last.p >= recent else -1.0
@@ -342,7 +362,16 @@ class _Follower:
                 q = res.q if res.converged else damped_newton(self.problem, last.q, w, self.newton)
                 if q is None or float(np.max(np.abs((q - last.q) / s))) > HOP_DISTANCE:
                     continue
-                if _structure(self.problem, q, w) != structure:
+                try:
+                    row = _row(self.problem, q, w)
+                except Exception:  # noqa: BLE001 - no orbit where the flow cannot be followed
+                    continue
+                # the orbit itself next to the last one, not only its state at t = 0: an orbit of
+                # another branch can pass close to z(0) with a far larger motion (measured: a
+                # preload with stage friction hopped from rms 0.128 onto a resonance orbit of 0.40)
+                if not np.all(np.abs(_row_rms(row) - rms_last) <= HOP_RMS * np.abs(rms_last)):
+                    continue
+                if row.structure != structure:
                     out.append((q, w, d))
                 elif d == travel and not ahead:
                     ahead.append((q, w, d))
@@ -379,7 +408,7 @@ class _Follower:
                 return branch
             last = pts[-1]
             recent = pts[max(0, len(pts) - 8)].p
-            candidates = self._hops(last, branch.rows[-1].structure, recent)
+            candidates = self._hops(last, branch.rows[-1], recent)
             if not candidates:
                 travel = 1.0 if last.p >= recent else -1.0
                 restarted = self._restart(branch, last.p, travel, stop)
@@ -434,7 +463,15 @@ class _Follower:
             def back(pt: BranchPoint, w_stall: float = w_stall) -> str | None:
                 return "reached the stall" if (pt.p - w_stall) * travel <= 0 else None
 
-            stepper = self._piece(q, w, -travel, back)
+            restart_rms = _row_rms(_row(self.problem, q, w))
+            stall_rms = _row_rms(branch.rows[-1])
+            if np.all(np.abs(restart_rms - stall_rms) <= RESTART_RMS * np.abs(stall_rms)):
+                stepper = self._piece(q, w, -travel, back)
+            else:
+                # another branch (the stall's branch turned back at a grazing we could not pass, or
+                # ended): followed back past the stall's frequency — over its own folds — until it
+                # leaves the range or joins the rows of this branch, so none of it is skipped
+                stepper = self._piece(q, w, -travel, lambda pt, rows=list(branch.rows): _joins(self.problem, pt, rows, w))
             if stepper is not None and stepper.points:
                 rows = [_row(self.problem, p.q, p.p) for p in reversed(stepper.points)]
                 if rows:
@@ -474,6 +511,20 @@ class _Follower:
         branch.rows = out
         if branch.pieces:
             branch.pieces = sizes
+
+
+def _joins(problem: ShootingProblem, pt: BranchPoint, rows: list[ExactRow], w0: float) -> str | None:
+    """"joined the branch" when the point's state is within :data:`JOIN_DISTANCE` (scaled) of the
+    orbit interpolated between two consecutive ``rows`` around its Ω (never at the start ``w0``)."""
+    if abs(pt.p - w0) <= 1e-9 * w0:
+        return None
+    s = problem.length_scale
+    for a, c in zip(rows, rows[1:]):
+        if min(a.omega, c.omega) <= pt.p <= max(a.omega, c.omega):
+            t = 0.0 if a.omega == c.omega else (pt.p - a.omega) / (c.omega - a.omega)
+            if float(np.max(np.abs(pt.q - ((1.0 - t) * a.q + t * c.q)) / s)) <= JOIN_DISTANCE:
+                return "joined the branch"
+    return None
 
 
 def _held_changed(a: ExactRow, b: ExactRow) -> bool:
