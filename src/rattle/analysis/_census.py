@@ -191,8 +191,8 @@ class _ExactSearch(_Search):
     the event-driven integrators); an unexplained periodic attractor of period n is continued by
     exact shooting continuation through its orbit (:func:`~._exact_branch.branch_through`), its
     rows solved on the grid exactly (:func:`exact_solutions_on_grid`). The harmonic-balance
-    starts (section 3 there) do not apply: the period-2 branches born at period doublings come
-    with the response, the rest from the simulations."""
+    starts (section 3 there) become simulations (:meth:`hb_subharmonics`); the period-2
+    branches born at period doublings come with the response."""
 
     def __init__(self, system: NonsmoothSystem | FrictionSystem, response: Any, grid: FloatArray, run: RunSettings,
                  options: AttractorSearch, solutions: list[GridSolution], shooting: ShootingOptions) -> None:
@@ -256,7 +256,33 @@ class _ExactSearch(_Search):
             record["note"] = "continued branch does not pass through the simulated orbit"
 
     def hb_subharmonics(self) -> None:
-        return None  # no harmonic balance on the exact flow (class docstring)
+        """The exact flow's counterpart of the harmonic-balance starts (section 3 of
+        :mod:`._attractors`): at the same ``hb_points`` grid frequencies, exact simulations from
+        the most energetic stable period-1 orbit there displaced in (x, x'/Ω) by A (cos φ, sin φ)
+        along every coordinate, A = ½, 1 and 2 × max(the orbit's half peak-to-peak, the length
+        scale), φ = 0, 2π/3, 4π/3 (deterministic): a sub-harmonic or an isola born in a
+        saddle-node pair has a basin beside the primary orbit, which these reach where the bands'
+        multi-start (one frequency per band) does not."""
+        if not self.opts.hb_periods or self.opts.hb_points == 0:
+            return
+        N, P = self.grid.size, self.opts.hb_points
+        L = float(self.system.length_scale())
+        for j in sorted({int(min(N - 1, (k + 0.5) * N // P)) for k in range(P)}):
+            w = float(self.grid[j])
+            base = [s for s in self.by_index.get(j, []) if s.period == 1 and s.stable]
+            if not base:
+                continue
+            s1 = max(base, key=lambda s: s.rms)
+            x1 = np.asarray(s1.section[0], dtype=float)
+            n = x1.size // 2
+            amp = max(0.5 * s1.p2p, L)
+            for r in (0.5, 1.0, 2.0):
+                for phi in (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0):
+                    x0 = x1.copy()
+                    x0[:n] += r * amp * math.cos(phi)
+                    x0[n:] += r * amp * w * math.sin(phi)
+                    self.counts["hb_starts"] += 1
+                    self.simulate(j, x0, f"sub-harmonic start at Ω = {w:.6g}")
 
 
 def find_exact_attractors(system: NonsmoothSystem | FrictionSystem, response: Any, grid: FloatArray,
