@@ -16,7 +16,6 @@ exact simulation (:func:`rattle.analysis.attractor_census`). Checked here:
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +23,7 @@ import pytest
 
 from _cases import preload_spring_toml
 from _cli_helpers import invoke, write_config
-from rattle.analysis import AttractorSearch, RunSettings, attractor_census, steady_state
-from rattle.analysis import SteadyStateOptions
+from rattle.analysis import AttractorSearch, RunSettings, SteadyStateOptions, attractor_census, steady_state
 from rattle.hb import HBOptions
 from rattle.io import config_from_dict, load_config, read_csv
 
