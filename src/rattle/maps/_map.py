@@ -140,12 +140,19 @@ def response_map(
     wherever nothing stable is known and a multi-start per band; every new periodic attractor
     continued as a branch). Summarised per grid frequency as SPEC §7's ``map.csv`` columns.
 
+    A law with a torque jump or friction (a NonsmoothSystem, or a chain with them: a
+    FrictionSystem) is mapped on the exact flow (:func:`rattle.analysis.attractor_census`): the
+    exact shooting continuation of ``rattle frf`` with its period-2 branches, every branch solved
+    exactly on the grid, the search by exact simulation; give it as its Case or RunConfig (or
+    with ``tables``). Its ``[analysis] method = "hb"`` and sound ``paths`` are refused
+    (ConfigError).
+
     Every combination's model is built and validated first: a name that resolves to nothing,
     or a value the model refuses, raises :class:`~rattle.errors.ConfigError` before any work.
 
     Parameters
     ----------
-    model : Model, Chain, or a Case (:func:`rattle.load_case`)
+    model : Model, Chain, or a Case (:func:`rattle.load_case`) or RunConfig
         The base model; a Case also gives the default range (its ``analysis.omega``) and harmonics.
     omega : (float, float), optional
         Frequency range (default: the case's, else (0.1, 3.0)).
