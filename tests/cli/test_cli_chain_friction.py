@@ -50,12 +50,12 @@ method = "hb"            # the regularised harmonic balance, every row checked (
 """
 
 
-@pytest.mark.parametrize("args", [["map", "--vary", "mean=0.04,0.05"]])
-def test_map_refuses_a_chain_with_friction_and_writes_nothing(tmp_path, args):
+def test_map_refuses_the_regularised_method_on_a_chain_with_friction_and_writes_nothing(tmp_path):
+    """CHAIN asks for the regularised HB (``method = "hb"``): ``rattle map`` solves a chain with
+    friction by exact shooting and refuses it naming the key (exit 2, nothing written)."""
     config = write_config(tmp_path, CHAIN)
-    result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
-    assert_bad_input(result, "`model.elements[0].friction`", "a chain with Coulomb friction on its elements",
-                     f"not supported by `rattle {args[0]}` yet", "use `rattle frf`", "or `rattle orbit`")
+    result = invoke(["map", str(config), "--vary", "mean=0.04,0.05", "-o", "out"], tmp_path)
+    assert_bad_input(result, '`analysis.method` = "hb"', "by exact shooting")
     assert not (tmp_path / "out").exists()
 
 
@@ -294,8 +294,8 @@ PRELOAD_CHAIN = CHAIN.replace('type = "clutch"\nalpha = 0.25\nb = 0.1\nfriction 
 
 def test_a_preload_element_is_solved_by_orbit_and_named_where_refused(tmp_path):
     """``rattle orbit`` on the chain with a preloaded element: the exact orbit (rms that of Newton
-    shooting from rest to 1e-9), orbit.json naming the jump law; ``rattle map`` refuses it naming
-    both keys; the default ε of a chain with a jump is 0.01."""
+    shooting from rest to 1e-9), orbit.json naming the jump law; ``rattle map`` refuses its
+    ``method = "hb"``; the default ε of a chain with a jump is 0.01."""
     from rattle.timeint import shoot_friction_orbit
 
     assert PRELOAD_CHAIN != CHAIN
@@ -308,5 +308,5 @@ def test_a_preload_element_is_solved_by_orbit_and_named_where_refused(tmp_path):
     exact = shoot_friction_orbit(load_config(config).model, 0.9, np.zeros(4))
     assert exact.converged and abs(float(exact.rms[0]) - meta["orbit"]["elements"][0]["rms"]) <= 1e-9
     result = invoke(["map", str(config), "--vary", "mean=0.04,0.05", "-o", "map"], tmp_path)
-    assert_bad_input(result, "`model.elements[0].preload` and `model.elements[0].friction`")
+    assert_bad_input(result, '`analysis.method` = "hb"')  # the map solves it by exact shooting only
     assert not (tmp_path / "map").exists()

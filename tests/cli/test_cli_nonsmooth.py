@@ -97,12 +97,12 @@ def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
     assert math.isfinite(float(table["mu1_abs"][i])) and float(table["stick_time"][i]) == 0.0
 
 
-@pytest.mark.parametrize("args", [["map", "--vary", "damping=0.04,0.05"]])  # sweep, compare: test_cli_nonsmooth_sweep.py
-def test_commands_that_cannot_solve_the_law_refuse_it_and_write_nothing(tmp_path, args):
+def test_map_refuses_the_regularised_method_and_writes_nothing(tmp_path):
+    """``rattle map`` solves a discontinuous law by exact shooting: PRELOAD asks for the
+    regularised HB (``method = "hb"``), which is refused naming the key (exit 2)."""
     config = write_config(tmp_path, PRELOAD)
-    result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
-    assert_bad_input(result, "`model.elastic.preload` and `model.elastic.friction`",
-                     f"not supported by `rattle {args[0]}` yet", "use `rattle frf`")
+    result = invoke(["map", str(config), "--vary", "damping=0.04,0.05", "-o", "out"], tmp_path)
+    assert_bad_input(result, '`analysis.method` = "hb"', "by exact shooting", 'remove `method = "hb"`')
     assert not (tmp_path / "out").exists()
 
 

@@ -2,8 +2,8 @@
 single equation) and a chain with friction on its elements are swept by their exact event-driven
 integrators and written as the usual set (sweep.csv, sweep.json, sweep.png); compare sets the
 regularised HB's response (checked by exact shooting) beside that sweep (frf.csv, sweep.csv,
-compare.json, compare.png). ``--at`` and ``--measured`` of compare, and ``rattle map``, are refused
-(exit 2, nothing written)."""
+compare.json, compare.png). ``--at`` and ``--measured`` of compare are refused (exit 2, nothing
+written)."""
 
 from __future__ import annotations
 
@@ -103,13 +103,10 @@ def test_compare_of_a_chain_with_friction_writes_the_set(tmp_path):
 @pytest.mark.parametrize("args, fragment", [
     (["compare", "--at", "0.6"], "`--at` is not supported for a discontinuous law"),
     (["compare", "--measured", "run.csv"], "`--measured` is not supported for a discontinuous law"),
-    (["map", "--vary", "mean=0.04,0.05"], "not supported by `rattle map` yet"),
 ])
 def test_the_options_and_commands_that_remain_refused_exit_2_and_write_nothing(tmp_path, text, keys, args, fragment):
     config = write_config(tmp_path, text)
     (tmp_path / "run.csv").write_text("omega,acc_p2p\n0.6,0.1\n0.65,0.1\n", encoding="utf-8")
     result = invoke([args[0], str(config), *args[1:], "-o", "out"], tmp_path)
     assert_bad_input(result, keys, fragment)
-    if args[0] == "map":
-        assert "`rattle sweep`" in result.stderr
     assert not (tmp_path / "out").exists()

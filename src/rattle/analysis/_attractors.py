@@ -464,14 +464,18 @@ class _Search:
 
 
     # --- 2. multi-start ---------------------------------------------------------------------
+    def rest(self, w: float) -> FloatArray:
+        """The coordinates (n,) of the static equilibrium at Ω = w: the rings' centre."""
+        return np.asarray(self.system.static_equilibrium(w), dtype=float)
+
     def multistart(self) -> None:
         B, K = self.opts.bands, self.opts.starts
         if B == 0 or K == 0:
             return
-        n = self.system.n
         for b, j in enumerate(self.band_indices()):
             w = float(self.grid[j])
-            x_eq = np.asarray(self.system.static_equilibrium(w), dtype=float)
+            x_eq = self.rest(w)
+            n = x_eq.size
             known = self.by_index.get(j, [])
             amp = max([0.5 * s.p2p for s in known], default=0.0)
             amp = max(amp, float(self.system.length_scale()))
@@ -495,7 +499,11 @@ def find_attractors(frf: FrequencyResponse, grid: FloatArray, run: RunSettings,
     options = options or AttractorSearch()
     if solutions is None:
         solutions = solutions_on_grid(frf, grid, run)
-    search = _Search(frf, grid, run, options, solutions)
+    return run_search(_Search(frf, grid, run, options, solutions), options)
+
+
+def run_search(search: _Search, options: AttractorSearch) -> Census:
+    """The stages of the search (module docstring) in order, and its census."""
     if options.from_unstable:
         search.unstable_runs()
         search.unstable_stretches()

@@ -657,7 +657,7 @@ def subharmonic_branches(
     out: list[ExactBranch] = []
     with one_blas_thread():
         problem = ShootingProblem(system, period=2)
-        once = ShootingProblem(system, period=1, integrator=problem.integrator)
+        shorter = [ShootingProblem(system, period=1, integrator=problem.integrator)]
         follower = _Follower(problem, (lo, hi), options, cont, newton)
         labels = primary.bifurcation
         for i in np.flatnonzero(labels == "period_doubling"):
@@ -673,34 +673,138 @@ def subharmonic_branches(
             if orbit is None:
                 continue
 
-            def rejoined(pt: BranchPoint, prev: dict = {}) -> str | None:  # noqa: B006 - per side, reset below
-                r = once.residual(pt.q, pt.p)
-                if not np.all(np.isfinite(r)):
-                    return None
-                # the one-period defect vanishes at the doubling and flips sign past it (the branch
-                # would go on along its own copy shifted by one forcing period: a closed loop)
-                flipped = "defect" in prev and float(r @ prev["defect"]) < 0.0
-                prev["defect"] = r
-                if flipped or float(np.max(np.abs(r))) < REJOIN_TOL:
-                    return f"the period-2 branch rejoined a period-1 branch near Ω = {pt.p:.6g}"
-                return None
-
-            sides = []
-            for d in (-1.0, 1.0):
-                state: dict = {}
-                sides.append(follower.follow(np.asarray(orbit.state0, dtype=float), float(orbit.omega), d,
-                                             stop=lambda pt, state=state: rejoined(pt, state)))
-            down, up = sides
-            branch = ExactBranch(origin=f"period doubling at Ω = {w_pd:.6g}")
-            branch.rows = list(reversed(down.rows[1:])) + up.rows
-            branch.pieces = [len(branch.rows)]
-            branch.status = Status.SUCCESS
-            branch.message = "; ".join(m for m in (down.message, up.message) if m)
-            if options.locate:
-                follower.locate(branch)
+            branch = _both_ways(follower, shorter, np.asarray(orbit.state0, dtype=float), float(orbit.omega),
+                                f"period doubling at Ω = {w_pd:.6g}", options.locate)
             if len(branch.rows) >= 2:
                 out.append(branch)
     return out
 
 
-__all__ = ["ExactBranch", "ExactRow", "ShootingOptions", "exact_branches", "start_state", "subharmonic_branches"]
+def _rejoin_stop(shorter: list[ShootingProblem], period: int) -> Any:
+    """The stop of one side of a branch of period p ≥ 2: it has rejoined an orbit of a period d
+    dividing p (``shorter``: the period-d problems) when the d-period map's scaled defect falls
+    below :data:`REJOIN_TOL`, or, for d = p/2, flips sign (past the period doubling the branch
+    would go on along its own copy shifted by d forcing periods: a closed loop)."""
+    prev: dict[int, FloatArray] = {}
+
+    def rejoined(pt: BranchPoint) -> str | None:
+        for k, once in enumerate(shorter):
+            r = once.residual(pt.q, pt.p)
+            if not np.all(np.isfinite(r)):
+                continue
+            # the sign flip marks a period doubling of the period-d orbit (d = p/2) only
+            flipped = 2 * once.period == period and k in prev and float(r @ prev[k]) < 0.0
+            prev[k] = r
+            if flipped or float(np.max(np.abs(r))) < REJOIN_TOL:
+                return f"the period-{period} branch rejoined a period-{once.period} branch near Ω = {pt.p:.6g}"
+        return None
+
+    return rejoined
+
+
+#: A branch followed from an orbit has closed on itself (an isola) when it crosses the orbit's
+#: frequency again within this scaled distance of one of the orbit's section points (the
+#: continuation's chords put the interpolated state off the branch by (step)² × curvature).
+CLOSE_TOL = 1e-2
+CLOSED = "the branch closed on itself (an isola)"
+#: ... after it has left the start: moved this far in Ω (relative), or 0.1 (scaled) in state.
+LEAVE_OMEGA = 1e-3
+
+
+def _close_stop(problem: ShootingProblem, z0: FloatArray, w0: float, inner: Any) -> Any:
+    """``inner`` (a stop or None), and the stop of a branch that comes back to its start: where
+    it crosses Ω = ``w0`` again after leaving it, the state interpolated there lies within
+    :data:`CLOSE_TOL` (scaled) of a section point z(m 2π/Ω), m = 0 … p − 1, of the orbit through
+    ``z0`` (the same orbit, or it shifted by m forcing periods: the loop is traced from there on
+    again)."""
+    s = problem.length_scale
+    T = 2.0 * math.pi / w0
+    points = [np.asarray(z0, dtype=float)]
+    try:
+        for m in range(1, problem.period):
+            points.append(np.asarray(problem.integrator.propagate(points[-1], (m - 1) * T, m * T, w0).state1,
+                                     dtype=float))
+    except Exception:  # noqa: BLE001 - the start itself is enough to recognise the loop
+        pass
+    state: dict[str, Any] = {"prev": None, "left": False}
+
+    def closed(pt: BranchPoint) -> str | None:
+        reason = None if inner is None else inner(pt)
+        if reason:
+            return reason
+        prev, state["prev"] = state["prev"], pt
+        if abs(pt.p - w0) > LEAVE_OMEGA * w0 or min(float(np.max(np.abs((pt.q - z) / s))) for z in points) > 0.1:
+            state["left"] = True
+        if prev is None or not state["left"] or (prev.p - w0) * (pt.p - w0) > 0.0:
+            return None
+        t = 0.0 if pt.p == prev.p else (w0 - prev.p) / (pt.p - prev.p)
+        z = (1.0 - t) * prev.q + t * pt.q
+        if min(float(np.max(np.abs((z - zm) / s))) for zm in points) <= CLOSE_TOL:
+            return CLOSED
+        return None
+
+    return closed
+
+
+def _both_ways(follower: _Follower, shorter: list[ShootingProblem], z0: FloatArray, w0: float, origin: str,
+               locate: bool, close: bool = False) -> ExactBranch:
+    """The branch through the orbit z(0) = ``z0`` at ``w0`` followed down and up in Ω (each side
+    stopped where it rejoins a shorter period, :func:`_rejoin_stop`; with ``close`` also where it
+    comes back to its start, :func:`_close_stop`: an isola is then followed once, down from
+    ``w0`` round to it), joined in order of the continuation (down reversed, then up); its
+    special points located with ``locate``."""
+    period = follower.problem.period
+
+    def stop() -> Any:
+        inner = _rejoin_stop(shorter, period) if shorter else None
+        return _close_stop(follower.problem, z0, w0, inner) if close else inner
+
+    down = follower.follow(z0, w0, -1.0, stop=stop())
+    if close and down.message == CLOSED:
+        up = ExactBranch(rows=down.rows[:1])
+    else:
+        up = follower.follow(z0, w0, 1.0, stop=stop())
+    branch = ExactBranch(origin=origin)
+    branch.rows = list(reversed(down.rows[1:])) + up.rows
+    branch.pieces = [len(branch.rows)]
+    branch.status = Status.SUCCESS
+    branch.message = "; ".join(m for m in (down.message, up.message) if m)
+    if locate:
+        follower.locate(branch)
+    return branch
+
+
+def branch_through(
+    system: NonsmoothSystem | FrictionSystem,
+    state: FloatArray,
+    omega0: float,
+    period: int,
+    omega: tuple[float, float],
+    options: ShootingOptions | None = None,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    origin: str = "",
+) -> ExactBranch:
+    """The exact branch of period ``period`` (T = p 2π/Ω) through the orbit z(0) = ``state`` at
+    ``omega0`` (an attractor found by simulation, say), followed both ways within ``omega`` =
+    (Ω_min, Ω_max) by exact shooting continuation (module docstring: grazings hopped, special
+    points located). A branch of period p ≥ 2 ends where it rejoins an orbit of a period d
+    dividing p: the d-period map's defect R_d(z(0), Ω) = (φ_{d 2π/Ω}(z(0)) − z(0)) / s falls
+    below :data:`REJOIN_TOL` (or flips sign, d = p/2); a branch that comes back to the orbit (an
+    isola) is followed once round (:data:`CLOSE_TOL`)."""
+    opts = ShootingOptions() if options is None else options
+    if not isinstance(opts, ShootingOptions):
+        raise TypeError(f"`options` must be a ShootingOptions, got {opts!r}")
+    lo, hi = omega
+    with one_blas_thread():
+        problem = ShootingProblem(system, period=period)
+        shorter = [ShootingProblem(system, period=d, integrator=problem.integrator)
+                   for d in range(1, period) if period % d == 0]
+        follower = _Follower(problem, (lo, hi), opts, continuation or ContinuationOptions(), newton or NewtonOptions())
+        return _both_ways(follower, shorter, np.asarray(state, dtype=float), float(omega0), origin, opts.locate,
+                          close=True)
+
+
+__all__ = ["ExactBranch", "ExactRow", "ShootingOptions", "branch_through", "exact_branches", "start_state",
+           "subharmonic_branches"]

@@ -199,23 +199,6 @@ def _law_keys(run_config: Any) -> str:
     return " and ".join(keys) or "`model.elastic`"
 
 
-def refuse_discontinuous(run_config: Any, command: str) -> None:
-    """Exit 2 (nothing written) when ``rattle COMMAND`` cannot solve the configuration's law yet."""
-    if getattr(run_config, "chain_friction", False):
-        raise ConfigError(
-            f"{_law_keys(run_config)}: a chain with Coulomb friction on its elements is not supported by "
-            f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance of the chain checked by "
-            "exact shooting with Filippov sticking), `rattle sweep` (the exact time-domain sweep) or `rattle orbit` "
-            "(one orbit at a frequency), or remove the friction"
-        )
-    if run_config.discontinuous:
-        raise ConfigError(
-            f"{_law_keys(run_config)}: a discontinuous law (a torque jump or friction) is not supported by "
-            f"`rattle {command}` yet; use `rattle frf` (the regularised harmonic balance checked by exact "
-            "shooting), `rattle sweep` (the exact time-domain sweep) or `rattle orbit`"
-        )
-
-
 def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path, sections: dict[str, Any],
                       subharmonics: bool = False) -> None:
     """``rattle frf`` on a discontinuous law, or a chain with friction on its elements:
@@ -776,8 +759,9 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
 @click.argument("config", type=click.Path(path_type=Path))
 @_output_option
 @click.option("--vary", "vary", type=str, multiple=True, metavar="NAME=START:STOP:COUNT",
-              help="A varied parameter: a short name (alpha, b, damping, mean, amplitude) or a dotted key of the "
-                   "configuration (model.elastic.alpha, excitation.amplitudes.1, model.elements.clutch.b), "
+              help="A varied parameter: a short name (alpha, b, damping, mean, amplitude, preload, friction) or a "
+                   "dotted key of the configuration (model.elastic.alpha, excitation.amplitudes.1, "
+                   "model.elements.clutch.b, model.elastic.friction.2), "
                    "COUNT values from START to STOP, or NAME=v1,v2,v3. Repeat for more parameters.")
 @click.option("--omega-points", "omega_points", type=int, default=146, show_default=True, metavar="N",
               help="Frequencies of the map's grid over the analysis range.")
@@ -813,12 +797,17 @@ def map_command(
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
     run_config = _io().load_config(config)
-    refuse_discontinuous(run_config, "map")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
-        run_config.analysis, run_config.model, labels=labels, harmonics=harmonics, omega_min=w_min, omega_max=w_max
+        run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
+        omega_max=w_max,
     )
-    tables = _io().model_to_toml_dict(run_config.model, analysis)
+    if run_config.discontinuous:  # a jump or friction: the file's tables (the law's continuous part is there)
+        import dataclasses
+
+        tables = dataclasses.replace(run_config, analysis=analysis).to_dict()
+    else:
+        tables = _io().model_to_toml_dict(run_config.model, analysis)
     params = parameters(tables, parsed)
     build_all(tables, params)  # every combination's model, before any work
     t_start = time.perf_counter()

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from .._lazy import lazy_exports
 
 _LAZY: dict[str, str] = {
-    "AttractorSearch": "..analysis._attractors",
+    "AttractorSearch": "..analysis",
     **dict.fromkeys(["response_map", "DEFAULT_OMEGA_POINTS", "StoreWarning", "CallbackError"], "._map"),
     **dict.fromkeys(["map_report", "common_intervals", "format_intervals"], "._report"),
     **dict.fromkeys(["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"],
@@ -33,7 +33,7 @@ __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "Respo
 
 
 if TYPE_CHECKING:
-    from ..analysis._attractors import AttractorSearch
+    from ..analysis import AttractorSearch
     from ._map import DEFAULT_OMEGA_POINTS, CallbackError, StoreWarning, response_map
     from ._report import common_intervals, format_intervals, map_report
     from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap

@@ -6,16 +6,18 @@ give the same bits). It
 
 1. takes the combination's model (built and validated from its configuration tables, with
    :func:`rattle.io.config_from_dict`, once, before any work: :func:`rattle.maps.response_map`);
-2. computes its frequency response with sub-harmonic branch switching
-   (:func:`~rattle.analysis.frequency_response`, ``subharmonics=True``) — a response that stops
-   early keeps what it computed (status ``partial``);
-3. solves every branch exactly at the grid frequencies (:mod:`rattle.analysis._grid`);
-4. searches the attractors the branches do not explain and continues each new one as a branch
-   (:mod:`rattle.analysis._attractors`);
-5. summarises each grid frequency per SPEC §7 (:func:`summarise`) and the combination's
+2. finds every branch on the grid and the attractors they miss
+   (:func:`rattle.analysis.attractor_census`): for a smooth law the frequency response with
+   sub-harmonic branch switching (harmonic balance), every branch solved again at the grid
+   frequencies, and the attractor search; for a discontinuous law (a torque jump or friction) the
+   exact shooting continuation of ``rattle frf`` with the period-2 branches born at its period
+   doublings, every branch solved exactly at the grid frequencies, and the attractor search on
+   the exact flow — a response that stops early keeps what it computed (status ``partial``);
+3. summarises each grid frequency per SPEC §7 (:func:`summarise`) and the combination's
    intervals and special points;
-6. with sound paths (``task["paths"]``), the largest sound pressure level over the stable
-   periodic solutions at each grid frequency (:func:`sound_levels`).
+4. with sound paths (``task["paths"]``), the largest sound pressure level over the stable
+   periodic solutions at each grid frequency (:func:`sound_levels`; smooth laws: the levels come
+   from the harmonic-balance series of the solutions).
 """
 
 from __future__ import annotations
@@ -26,12 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis._attractors import AttractorSearch, Census, find_attractors
-from ..analysis._frequency_response import _frequency_response
-from ..analysis._grid import solutions_on_grid
-from ..analysis._settings import RunSettings
+from ..analysis import AttractorSearch, Census, RunSettings, attractor_census, special_points
 from ..errors import RattleError
-from ..results import UNCOVERED_WARNING, FrequencyResponse, coefficient_sound_pressure
+from ..results import UNCOVERED_WARNING, coefficient_sound_pressure
 from ._result import INTERVAL_KINDS, CellResult, grid_runs
 
 
@@ -103,15 +102,6 @@ def sound_levels(model: Any, census: Census, grid: np.ndarray, paths: tuple[Any,
     return spl, note
 
 
-def _special_points(parts: list[FrequencyResponse]) -> list[dict[str, Any]]:
-    out = []
-    for frf in parts:
-        for sp in frf.special_points:
-            out.append({"kind": sp.kind, "omega": float(sp.omega), "branch": int(sp.branch),
-                        "period": int(frf.period[sp.index]), "rms": float(frf.rms[sp.index])})
-    return out
-
-
 def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     """One combination (``task``: ``model`` — built from its configuration tables with the varied
     values set —, ``values`` by NAME, ``omega`` (lo, hi), ``omega_points``, ``run`` the RunSettings,
@@ -128,23 +118,12 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     values = dict(task["values"])
     model = task["model"]
     paths = tuple(task.get("paths") or ())
-    timings: dict[str, float] = {}
-    status, message = "ok", ""
     try:
-        frf = _frequency_response(model, (lo, hi), run, subharmonics=True, max_period=int(task["max_period"]),
-                                  throw=False)
+        found = attractor_census(model, grid, run, search, max_period=int(task["max_period"]))
     except RattleError as exc:  # nothing computed: the cell says why
         return _failed(values, grid, f"{type(exc).__name__}: {exc}", time.perf_counter() - t0, bool(paths))
-    if not frf.status.success:
-        status, message = "partial", frf.message
-    t1 = time.perf_counter()
-    timings["frequency_response"] = t1 - t0
-    solutions = solutions_on_grid(frf, grid, run)
-    t2 = time.perf_counter()
-    timings["grid"] = t2 - t1
-    census = find_attractors(frf, grid, run, search, solutions)
+    census, message, timings = found.census, found.message, dict(found.timings)
     t3 = time.perf_counter()
-    timings["search"] = t3 - t2
     summary = summarise(census, grid)
     if census.counts.get("not_continued"):
         message = "; ".join(x for x in (message, (
@@ -158,12 +137,12 @@ def compute_cell(task: dict[str, Any]) -> dict[str, Any]:
     timings["total"] = time.perf_counter() - t0
     intervals = summary.pop("intervals")
     cell = CellResult(
-        values=values, omega=grid, **summary, special_points=_special_points([frf, *census.branches]),
+        values=values, omega=grid, **summary, special_points=special_points(found.parts),
         intervals=intervals, attractors=census.found,
         search={**census.counts, "bands": search.bands, "starts": search.starts,
                 "from_unstable": search.from_unstable, "max_branches": search.max_branches,
-                "max_periods": search.max_periods, "branches_of_response": int(len(np.unique(frf.branch)))},
-        status=status, message=message, timings=timings,
+                "max_periods": search.max_periods, "branches_of_response": found.branches},
+        status=found.status, message=message, timings=timings,
     )
     return cell.to_dict()
 

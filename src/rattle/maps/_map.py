@@ -24,12 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import check_int
-from ..errors import RattleError
+from .._validate import check_int, check_range
+from ..analysis import DEFAULT_HARMONICS, AttractorSearch, RunSettings, StabilityMethod, resolve_hb
+from ..errors import ConfigError, RattleError
 from ..files import WriteError
-from ..analysis._attractors import AttractorSearch
-from ..analysis._frequency_response import check_range
-from ..analysis._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
 from ..continuation import ContinuationOptions, NewtonOptions
 from ..hb import HBOptions
 from ._cell import compute_cell
@@ -51,15 +49,23 @@ class CallbackError(RattleError, RuntimeError):
     finished before is kept (a map's store holds every finished combination)."""
 
 
-def _source_of(model: Any) -> tuple[Any, Any, tuple[Any, ...]]:
-    """The model, the analysis settings and the sound paths of a Model/Chain, a Case or a
-    RunConfig (None, (): none)."""
+def _source_of(model: Any) -> tuple[Any, Any, tuple[Any, ...], Any]:
+    """The model, the analysis settings, the sound paths and the resolved file (a RunConfig) of a
+    Model/Chain, a Case or a RunConfig (None, (), None: none)."""
     from ..io import RunConfig
 
     config = model if isinstance(model, RunConfig) else getattr(model, "config", None)
     if config is not None:  # a Case (load_case) or a RunConfig: the resolved file
-        return config.model, config.analysis, tuple(getattr(config, "paths", ()) or ())
-    return model, None, ()
+        return config.model, config.analysis, tuple(getattr(config, "paths", ()) or ()), config
+    return model, None, (), None
+
+
+def _discontinuous(model: Any) -> bool:
+    """A law with a torque jump or friction (a NonsmoothSystem, a FrictionSystem): solved by exact
+    shooting (:func:`rattle.analysis.attractor_census`)."""
+    from ..model import FrictionSystem, NonsmoothSystem
+
+    return isinstance(model, (NonsmoothSystem, FrictionSystem))
 
 
 def _paths_fingerprint(paths: tuple[Any, ...]) -> list[dict[str, Any]]:
@@ -76,12 +82,21 @@ def _paths_fingerprint(paths: tuple[Any, ...]) -> list[dict[str, Any]]:
     return out
 
 
-def _tables_of(model: Any, lo: float, hi: float, harmonics: int) -> dict[str, Any]:
+def _tables_of(model: Any, config: Any, lo: float, hi: float, harmonics: int) -> dict[str, Any]:
     """The configuration tables of ``model`` with the run's range and harmonics as its
     ``[analysis]``: every combination's model is then validated against the range it is run on
-    (an engine's chain writes its speed order and the range in rad/s)."""
+    (an engine's chain writes its speed order and the range in rad/s). A discontinuous law's
+    tables come from its file (``config``, a RunConfig: the law's continuous part lives there)."""
+    import dataclasses
+
     from ..io import AnalysisSettings, model_to_toml_dict
 
+    if _discontinuous(model):
+        if config is None:
+            raise TypeError("`model`: a law with a torque jump or friction is mapped from its file: give its Case "
+                            "(rattle.load_case(path)) or RunConfig (rattle.io.load_config(path)), or its `tables`")
+        analysis = dataclasses.replace(config.analysis, omega_min=lo, omega_max=hi, harmonics=harmonics)
+        return dataclasses.replace(config, analysis=analysis).to_dict()
     return model_to_toml_dict(model, AnalysisSettings(omega_min=lo, omega_max=hi, harmonics=harmonics))
 
 
@@ -125,12 +140,19 @@ def response_map(
     wherever nothing stable is known and a multi-start per band; every new periodic attractor
     continued as a branch). Summarised per grid frequency as SPEC §7's ``map.csv`` columns.
 
+    A law with a torque jump or friction (a NonsmoothSystem, or a chain with them: a
+    FrictionSystem) is mapped on the exact flow (:func:`rattle.analysis.attractor_census`): the
+    exact shooting continuation of ``rattle frf`` with its period-2 branches, every branch solved
+    exactly on the grid, the search by exact simulation; give it as its Case or RunConfig (or
+    with ``tables``). Its ``[analysis] method = "hb"`` and sound ``paths`` are refused
+    (ConfigError).
+
     Every combination's model is built and validated first: a name that resolves to nothing,
     or a value the model refuses, raises :class:`~rattle.errors.ConfigError` before any work.
 
     Parameters
     ----------
-    model : Model, Chain, or a Case (:func:`rattle.load_case`)
+    model : Model, Chain, or a Case (:func:`rattle.load_case`) or RunConfig
         The base model; a Case also gives the default range (its ``analysis.omega``) and harmonics.
     omega : (float, float), optional
         Frequency range (default: the case's, else (0.1, 3.0)).
@@ -166,7 +188,7 @@ def response_map(
     from ._vary import apply, build_all, combinations, parameters
 
     t_start = time.perf_counter()
-    model, analysis, config_paths = _source_of(model)
+    model, analysis, config_paths, config = _source_of(model)
     paths_t: tuple[Any, ...] = config_paths if paths is None else tuple(paths)
     if omega is None:
         omega = analysis.omega if analysis is not None else (0.1, 3.0)
@@ -183,11 +205,22 @@ def response_map(
         raise TypeError(f"`search` must be an AttractorSearch or None, got {search!r}")
     # the tables to vary: the caller's (a parsed file, validated with its own [analysis]), or
     # the model's with the run's range and harmonics
-    base = dict(tables) if tables is not None else _tables_of(model, lo, hi, hb_opts.harmonics)
+    base = dict(tables) if tables is not None else _tables_of(model, config, lo, hi, hb_opts.harmonics)
     params = parameters(base, vary)
     models = build_all(base, params)  # every combination's model, validated before any work
     orders = {getattr(m, "speed_order", None) for m in models}
     speed_order = orders.pop() if len(orders) == 1 else None  # rpm only when one order holds for all
+    if any(_discontinuous(m) for m in models) and (base.get("analysis") or {}).get("method") == "hb":
+        raise ConfigError(
+            '`analysis.method` = "hb": a map solves a law with a torque jump or friction by exact shooting '
+            '(the default method, "shooting": every branch row an exact orbit, as `rattle frf` computes it); '
+            'remove `method = "hb"` from [analysis] (or set it to "shooting")')
+    if paths_t and any(_discontinuous(m) for m in models):
+        raise ConfigError(
+            "`paths`: the sound levels of a map are not computed for a law with a torque jump or friction yet "
+            "(they need the harmonic-balance series of every stable solution, and its branches are exact orbits); "
+            "map it without paths (`paths=()`, or remove the [[paths]] tables) and take the levels of single "
+            "orbits from `rattle frf`")
     if paths_t:  # every source must exist in every combination's model
         from ..results import check_sound_paths
 

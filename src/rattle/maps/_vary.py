@@ -10,7 +10,13 @@ short name      single equation (SPEC §2)          chain (SPEC §5): resolved w
 ``damping``     ``model.damping``                  the one link with a damping (the one > 0)
 ``mean``        ``excitation.mean``                the one torque with a mean ≠ 0
 ``amplitude``   ``excitation.amplitudes.1``        the one torque with a first harmonic ≠ 0
+``preload``     ``model.elastic.preload``          the one element with a ``preload``
+``friction``    ``model.elastic.friction.1``       the one element with a ``friction`` level
 ==============  =================================  ==========================================
+
+``friction`` names the friction level of a law that has one (``friction = 0.02``); a law with a
+level per stage is varied level by level (``model.elastic.friction.2``). The stage angles of a
+piecewise law are its ``model.elastic.breakpoints.K``.
 
 In a dotted key, list positions count from 1 (``excitation.amplitudes.1`` is F_p1, the first
 harmonic; ``model.elements.2.b`` the second element's clearance), and an element may be named
@@ -53,6 +59,8 @@ SHORT_NAMES: dict[str, str] = {
     "damping": "model.damping",
     "mean": "excitation.mean",
     "amplitude": "excitation.amplitudes.1",
+    "preload": "model.elastic.preload",
+    "friction": "model.elastic.friction",
 }
 #: Values one parameter may take (a grid of more is a typo: 1e6 values would be 1e6 frequency
 #: responses).
@@ -307,6 +315,9 @@ def _short_on_chain(tables: Mapping[str, Any], name: str) -> str:
         cands = [f"excitation.torques.{i + 1}.mean" for i, t in enumerate(torques)
                  if _is_number(t.get("mean")) and float(t["mean"]) != 0.0]
         what, probe = "torques with a mean ≠ 0", "excitation.torques.1.mean"
+    elif name in ("preload", "friction"):
+        cands = [f"model.elements.{i + 1}.{name}" for i, e in enumerate(elements) if e.get(name) is not None]
+        what, probe = f"elements with a `{name}`", f"model.elements.1.{name}"
     else:  # amplitude
         cands = [f"excitation.torques.{i + 1}.amplitudes.1" for i, t in enumerate(torques)
                  if t.get("amplitudes") and _is_number(t["amplitudes"][0]) and float(t["amplitudes"][0]) != 0.0]
@@ -351,6 +362,8 @@ def resolve(tables: Mapping[str, Any], name: str) -> str:
         raise _err(f"{name!r}: the analysis settings are not design parameters: "
                    f"{_NOT_PARAMETERS['omega']}, and --harmonics for the harmonics")
     path, value = _walk(tables, key, name)
+    if name in SHORT_NAMES and isinstance(value, (list, tuple)) and len(value) == 1:
+        path, value = [*path, "1"], value[0]  # `friction`: the one level of a law that has one
     field = _not_parameter(path)
     if field is not None:
         raise _err(f"{name!r}: `{'.'.join(path)}` cannot be varied: {_NOT_PARAMETERS[field]}")
