@@ -78,6 +78,7 @@ def test_a_law_with_jumps_is_shot_exactly_by_default() -> None:
     assert isinstance(frf, FrequencyResponse) and isinstance(frf.check, NonsmoothCheck)
     assert frf.check.followed == "exact shooting" and frf.status.success and len(frf) >= 2
     np.testing.assert_array_equal(frf.rms, frf.check.rms)
+    np.testing.assert_allclose(frf.check.stick_fraction, frf.check.stick_time * frf.omega / (2 * np.pi), rtol=1e-15)
     np.testing.assert_allclose(frf.rms_ac**2 + frf.mean**2, frf.rms**2, rtol=1e-12)
     assert np.all(frf.branch == 0) and np.all(frf.period == 1) and frf.coefficients.shape == (len(frf), 0)
     assert frf.settings["method"].startswith("exact shooting") and frf.settings["subharmonics"] is False
@@ -88,6 +89,16 @@ def test_a_law_with_jumps_is_shot_exactly_by_default() -> None:
     with pytest.raises(ValueError, match="no Fourier coefficients"):
         frf.time_history(0)
     assert frf.select(0).check is not None and len(frf.select(0)) == len(frf)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = frf.plot()  # the panels follow from the columns: the exact-check group's
+    assert set(axes) == {"rms", "stick"}
+    plt.close(fig)
+    with pytest.raises(TypeError, match="leave them at their defaults"):
+        frf.plot(quantity="p2p")
 
 
 def test_the_harmonic_balance_arguments_are_refused_for_a_law_with_jumps() -> None:

@@ -468,11 +468,6 @@ class FrequencyResponse:
         HB rms with the stability changes and the stick fraction
         (:func:`rattle.plotting.nonsmooth_response_plot`, per element for a chain
         :func:`rattle.plotting.friction_response_plot`)."""
-        if self.check is not None:
-            if ax is not None or kwargs:
-                raise TypeError("`ax` and keyword options are not taken by the plot of a law with jumps or friction")
-            return plot_with("friction_response_plot" if isinstance(self.check, FrictionCheck)
-                             else "nonsmooth_response_plot", self.check)
         return plot_with("frequency_response_plot", self, ax=ax, **kwargs)
 
 

@@ -121,6 +121,12 @@ class FrictionCheck:
 
     # --- derived columns ----------------------------------------------------------------------
     @property
+    def stick_time(self) -> FloatArray:
+        """(P, m): the time each element sticks per orbit period, stick_fraction · p·2π/Ω: the
+        single equation's name (:attr:`NonsmoothCheck.stick_time`) for the same measure."""
+        return self.stick_fraction * (2.0 * np.pi * self.period / self.omega)[:, None]
+
+    @property
     def element_rms_error(self) -> FloatArray:
         """rms_hb / rms − 1 per row and element (P, m); nan where not matched."""
         with np.errstate(invalid="ignore", divide="ignore"):

@@ -111,6 +111,12 @@ class NonsmoothCheck:
         return int(self.omega.size)
 
     @property
+    def stick_fraction(self) -> FloatArray:
+        """The share of the orbit's period p·2π/Ω that δ sticks or locks, stick_time / (p·2π/Ω):
+        the chain's name (:attr:`FrictionCheck.stick_fraction`) for the same measure."""
+        return self.stick_time * self.omega / (2.0 * np.pi * self.period)
+
+    @property
     def rms_error(self) -> FloatArray:
         """rms_hb / rms − 1: the regularisation's (and truncation's) effect on the rms, row by row."""
         return self.rms_hb / self.rms - 1.0
