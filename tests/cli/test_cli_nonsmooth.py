@@ -243,3 +243,14 @@ def test_orbit_period_two_writes_the_period_doubled_orbit(tmp_path):
     result = invoke(["orbit", str(config), "--omega", "0.7", "--period", "2", "-o", "out2"], tmp_path)
     assert result.exit_code == 1 and "no periodic orbit of period 2" in result.stderr
     assert not (tmp_path / "out2").exists()
+
+
+@pytest.mark.parametrize("option", [["--start", "high"], ["--fixed-harmonics"]])
+def test_harmonic_balance_options_are_refused_for_a_jump_law(tmp_path, option):
+    """``rattle frf`` is one path for every law: an option of the harmonic balance of a continuous
+    law is refused by the one front end (exit 2, the argument named, nothing written), not ignored."""
+    config = write_config(tmp_path, PRELOAD)
+    result = invoke(["frf", str(config), *option, "-o", "out"], tmp_path)
+    assert result.exit_code == 2, (result.stdout, result.stderr)
+    assert "must be left at the default for a law with jumps or friction" in result.stderr
+    assert not (tmp_path / "out").exists()
