@@ -54,6 +54,6 @@ def test_load_case_runs_the_discontinuous_front_ends_on_the_file_settings(tmp_pa
     held = np.asarray(sweep.extra_columns["stick_fraction"])
     assert held.shape == (4,) and np.all((held >= 0) & (held <= 1))
     both = case.compare(points=4)
-    assert both.frf.harmonics == 32 and both.frf.regularisation == 0.02 and len(both.sweep.omega) == 8
+    assert both.frf.check.harmonics == 32 and both.frf.check.regularisation == 0.02 and len(both.sweep.omega) == 8
     with pytest.raises(ConfigError, match="load_case"):
         rattle.Model.from_toml(path)
