@@ -88,6 +88,9 @@ def test_a_law_with_jumps_is_shot_exactly_by_default() -> None:
     assert header == frf.check.column_names() and "stick_time" in header
     with pytest.raises(ValueError, match="no Fourier coefficients"):
         frf.time_history(0)
+    with pytest.raises(ValueError, match="a law with jumps or friction has none"):
+        frf.linear_response()
+    assert "exact shooting" in repr(frf)
     assert frf.select(0).check is not None and len(frf.select(0)) == len(frf)
     import matplotlib
 

@@ -215,7 +215,8 @@ class FrequencyResponse:
     def __repr__(self) -> str:
         return (
             f"FrequencyResponse({len(self)} points, {len(np.unique(self.branch))} branch(es), "
-            f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}, H = {self.harmonics}, "
+            f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}, "
+            f"{'exact shooting' if self.check is not None and self.check.followed == 'exact shooting' else f'H = {self.harmonics}'}, "
             f"{int(np.sum(~self.stable))} unstable, special points: "
             f"{', '.join(f'{s.kind}@{s.omega:.4g}' for s in self.special_points) or 'none'}; "
             f"status: {self.status.name})"
@@ -433,7 +434,10 @@ class FrequencyResponse:
 
     def linear_response(self, omega: FloatArray | None = None, points: int = 600, *, element: int = 0) -> LinearResponse:
         """The linear system's (f = δ) closed-form response on element ``element``, by default
-        on a uniform grid."""
+        on a uniform grid (a :class:`~rattle.model.Model` or :class:`~rattle.model.Chain`'s)."""
+        if self.check is not None:
+            raise ValueError("the linear response is that of a Model or Chain; a law with jumps or friction has "
+                             "none here: use rattle.linear_frequency_response(model, omega) on its continuous model")
         if omega is None:
             omega = np.linspace(self.omega.min(), self.omega.max(), points)
         return linear_frequency_response(self.model, omega, element)
