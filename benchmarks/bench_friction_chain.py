@@ -50,7 +50,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from _cases import clutch_gear_chain, lockup_chain
 
-from rattle.analysis import RegularisationOptions, friction_response
+from rattle.analysis import RegularisationOptions
+from rattle.analysis._friction_response import friction_response  # the builder under rattle.frequency_response
 from rattle.model import Chain
 
 

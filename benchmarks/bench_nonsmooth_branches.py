@@ -64,7 +64,8 @@ import time
 import numpy as np
 
 import rattle.analysis._nonsmooth as _ns
-from rattle.analysis import RegularisationOptions, nonsmooth_response
+from rattle.analysis import RegularisationOptions
+from rattle.analysis._nonsmooth import nonsmooth_response  # the builder under rattle.frequency_response
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
 
 LAWS = [(0.05, 0.0), (0.05, 0.02), (0.2, 0.05)]

@@ -40,11 +40,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rattle.analysis import friction_subharmonics, nonsmooth_response, nonsmooth_subharmonics
+from rattle.analysis._friction_subharmonics import friction_subharmonics
+from rattle.analysis._nonsmooth import nonsmooth_response, nonsmooth_subharmonics  # the builders under rattle.frequency_response
 from rattle.analysis._case import regularisation_options
 from rattle.io import load_config
 from rattle.model import FrictionSystem
-from rattle.plotting._nonsmooth import _held_runs
+from rattle.results import held_runs as _held_runs
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 DEFAULT = ("torque_converter_preload.toml", "clutch_friction.toml", "chain_clutch_friction.toml")

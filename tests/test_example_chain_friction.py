@@ -26,7 +26,8 @@ def test_the_example_is_a_chain_with_friction_per_stage():
 
 
 def test_the_example_as_stated_on_its_period_doubling_range():
-    from rattle.analysis import RegularisationOptions, nonsmooth_response
+    from rattle.analysis import RegularisationOptions
+    from rattle.analysis._nonsmooth import nonsmooth_response
 
     cfg = load_config(EXAMPLES / NAME)
     omega = (0.4, 0.5)

@@ -39,7 +39,7 @@ def test_the_example_is_a_chain_with_a_preloaded_clutch_and_a_gear():
 
 
 def test_the_example_slips_then_locks_as_stated():
-    from rattle.analysis import friction_response
+    from rattle.analysis._friction_response import friction_response
     from rattle.analysis._case import regularisation_options
 
     cfg = load_config(EXAMPLES / NAME)

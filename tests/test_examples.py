@@ -99,7 +99,8 @@ def _stated_changes(path: Path) -> list[tuple[str, float, float]]:
 def test_discontinuous_examples_as_stated(name, omega, stick):
     """The stability changes an example with a preload or friction states lie where it says (on a
     part of its range, at its own harmonics and regularisation), and it sticks where it says."""
-    from rattle.analysis import RegularisationOptions, nonsmooth_response
+    from rattle.analysis import RegularisationOptions
+    from rattle.analysis._nonsmooth import nonsmooth_response
 
     cfg = load_config(EXAMPLES / name)
     assert cfg.discontinuous

@@ -24,12 +24,14 @@ import math
 import numpy as np
 import pytest
 
-from rattle.analysis import RegularisationOptions, friction_response, nonsmooth_response
+from rattle.analysis import RegularisationOptions, frequency_response
+from rattle.analysis._friction_response import friction_response
+from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._friction_response import _start, friction_balance_factory
 from rattle.analysis._regularisation import regularisation_limit
 from rattle.continuation import ContinuationOptions
 from rattle.model import Chain, FrictionSystem
-from rattle.results import FrictionResponse
+from rattle.results import FrequencyResponse, FrictionCheck
 from rattle.timeint import shoot_friction_orbit, shoot_system_orbit
 
 from _cases import clutch_gear_chain, lockup_chain  # tests/ is on sys.path through its conftest
@@ -44,19 +46,19 @@ def _chain(levels: tuple[float, ...] | None, amplitude: float, speed_order: floa
 
 
 @pytest.fixture(scope="module")
-def sticking() -> FrictionResponse:
+def sticking() -> FrictionCheck:
     fs = _chain(STICK, 0.1).friction_system()
     return friction_response(fs, (1.25, 1.35), RegularisationOptions(harmonics=32, limit_harmonics=64),
                              continuation=WIDE)
 
 
 @pytest.fixture(scope="module")
-def slipping() -> FrictionResponse:
+def slipping() -> FrictionCheck:
     fs = _chain(SLIP, 0.2, speed_order=2.0).friction_system()
     return friction_response(fs, (1.28, 1.3), RegularisationOptions(harmonics=32), continuation=WIDE)
 
 
-def test_sticking_rows_match_the_exact_orbit_at_the_regularisation_limit(sticking: FrictionResponse) -> None:
+def test_sticking_rows_match_the_exact_orbit_at_the_regularisation_limit(sticking: FrictionCheck) -> None:
     r = sticking
     assert len(r) >= 5 and r.status.success
     assert np.all(r.matched)
@@ -77,7 +79,7 @@ def test_sticking_rows_match_the_exact_orbit_at_the_regularisation_limit(stickin
     assert np.any(r.bifurcation != "")
 
 
-def test_slipping_rows_match_the_exact_orbit_at_eps(slipping: FrictionResponse) -> None:
+def test_slipping_rows_match_the_exact_orbit_at_eps(slipping: FrictionCheck) -> None:
     r = slipping
     assert len(r) >= 3 and np.all(r.matched)
     assert np.all(r.stick_fraction == 0.0)
@@ -127,8 +129,8 @@ def test_chain_ladder_records_every_element() -> None:
     np.testing.assert_allclose(ext, b - 2.5e-3 * (b - a) / (2.5e-3 - 5e-3))
 
 
-def test_columns_csv_and_json(sticking: FrictionResponse, slipping: FrictionResponse, tmp_path) -> None:  # type: ignore[no-untyped-def]
-    path = sticking.to_csv(tmp_path / "friction.csv")
+def test_columns_csv_and_json(sticking: FrictionCheck, slipping: FrictionCheck, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    path = FrequencyResponse.from_check(sticking, model=None, settings={}, timings={}).to_csv(tmp_path / "friction.csv")
     with open(path, newline="") as fh:
         rows = list(csv.reader(fh))
     header = rows[0]
@@ -149,25 +151,29 @@ def test_columns_csv_and_json(sticking: FrictionResponse, slipping: FrictionResp
     assert "clutch sticks" in text and "matched on" in text
 
 
-def test_plot(sticking: FrictionResponse) -> None:
+def test_plot(sticking: FrictionCheck) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = sticking.plot()
+    from rattle.plotting import friction_response_plot
+
+    fig, axes = friction_response_plot(sticking)
     assert len(axes["rms"].lines) >= 4 and axes["rms"].patches  # the stick range is shaded
     plt.close(fig)
 
 
-def test_nonsmooth_response_dispatches_a_friction_system(slipping: FrictionResponse) -> None:
+def test_nonsmooth_response_dispatches_a_friction_system(slipping: FrictionCheck) -> None:
     fs = _chain(SLIP, 0.2, speed_order=2.0).friction_system()
-    r = nonsmooth_response(fs, (1.28, 1.3), RegularisationOptions(harmonics=32), continuation=WIDE)
-    assert isinstance(r, FrictionResponse)
-    np.testing.assert_allclose(r.rms, slipping.rms, rtol=1e-12)
+    r = frequency_response(fs, (1.28, 1.3), options=RegularisationOptions(harmonics=32), continuation=WIDE)
+    assert isinstance(r, FrequencyResponse) and isinstance(r.check, FrictionCheck)
+    np.testing.assert_allclose(r.check.rms, slipping.rms, rtol=1e-12)
+    np.testing.assert_allclose(r.rms, slipping.rms[:, 0], rtol=1e-12)  # the SPEC columns: the first element's
+    assert r.column_names == slipping.column_names() and len(r) == len(slipping)
 
 
-def test_regularised_stability_reads_the_hb_orbit(slipping: FrictionResponse) -> None:
+def test_regularised_stability_reads_the_hb_orbit(slipping: FrictionCheck) -> None:
     """``stability="regularised"``: the HB multipliers are the regularised chain's monodromy along
     the HB orbit (not the exact flow). On the slipping branch (friction reverses twice a period) the
     largest moduli agree with the exact orbit's to 1e-5 (measured 9e-7: the regularisation's and the
@@ -199,7 +205,7 @@ def test_bad_arguments_are_refused() -> None:
         RegularisationOptions(harmonics=0)
 
 
-def test_bifurcation_labels_follow_stability_and_switching_pattern(sticking: FrictionResponse) -> None:
+def test_bifurcation_labels_follow_stability_and_switching_pattern(sticking: FrictionCheck) -> None:
     """Every change of stability between matched rows carries its kind; every change of an
     element's stick phases or crossings without one is a grazing label; nothing else is labelled."""
     r = sticking

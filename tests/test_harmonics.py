@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rattle.analysis import adaptive_frequency_response, truncation_error
+from rattle.analysis import truncation_error
+from rattle.analysis._harmonics import adaptive_frequency_response
 from rattle.timeint import ExactIntegrator, shoot_periodic_orbit
 from test_crossval import _hb_state0
 

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import rattle.analysis._nonsmooth as ns
-from rattle.analysis import RegularisationOptions, nonsmooth_response
+from rattle.analysis import RegularisationOptions
+from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
 
 OPTIONS = RegularisationOptions(harmonics=128, regularisation=0.01, refine=0.005)

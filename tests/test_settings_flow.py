@@ -14,7 +14,7 @@ import rattle
 from rattle import ContinuationOptions, HBOptions, NewtonOptions
 from rattle.analysis import _assemble as frf_module
 from rattle.stability import _methods as methods_module  # Hill.multipliers, used by every analysis
-from rattle.analysis import adaptive_frequency_response
+from rattle.analysis._harmonics import adaptive_frequency_response
 from rattle.continuation import ContinuationStepper
 from rattle.hb import HarmonicBalance
 from _cases import clutch_toml  # tests/_cases.py (tests/ is on sys.path through its conftest)

@@ -43,8 +43,8 @@ def _version() -> str:
 #: Public name → the sub-module that defines it (the one registry of the lazy re-exports).
 _LAZY: dict[str, str] = {
     **dict.fromkeys(
-        ["SteadyStateOptions", "compare", "frequency_response", "load_case", "periodic_orbit", "steady_state",
-         "time_sweep"],
+        ["RegularisationOptions", "ShootingOptions", "SteadyStateOptions", "compare", "frequency_response",
+         "load_case", "periodic_orbit", "steady_state", "time_sweep"],
         ".analysis",
     ),
     **dict.fromkeys(
@@ -68,6 +68,7 @@ _LAZY: dict[str, str] = {
         ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
     ),
     **dict.fromkeys(["SoundPath", "Drag"], ".model"),
+    **dict.fromkeys(["NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction"], ".model"),
     **dict.fromkeys(["clutch_damper", "hub_spline", "gear_pair", "loose_gear"], ".model"),
     **dict.fromkeys(["SoundPressure", "linear_sound_pressure", "sound_pressure"], ".results"),
 }
@@ -91,8 +92,10 @@ __all__ = [
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
     "shoot_periodic_orbit", "periodic_orbit", "PeriodicOrbit", "OrbitSolution", "compare", "Comparison",
     "response_map", "ResponseMap", "AttractorSearch",
-    # options and method objects
-    "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
+    # laws with torque jumps or friction (one equation; a Chain's elements take them too)
+    "NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction",
+    # options and method objects (ShootingOptions, RegularisationOptions: the method for jumps or friction)
+    "ShootingOptions", "RegularisationOptions", "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     # extension points: problems, the stepper, the integrators
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
     "SystemIntegrator",
@@ -124,7 +127,8 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     __version__: str
     from .analysis import (
-        SteadyStateOptions, compare, frequency_response, load_case, periodic_orbit, steady_state, time_sweep,
+        RegularisationOptions, ShootingOptions, SteadyStateOptions, compare, frequency_response, load_case,
+        periodic_orbit, steady_state, time_sweep,
     )
     from .continuation import ContinuationOptions, ContinuationProblem, ContinuationStepper, NewtonOptions
     from .errors import ConfigError, ConvergenceError, RattleError, Status
@@ -142,5 +146,6 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .stability import Hill, Monodromy
     from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit
     from .model import Drag, SoundPath
+    from .model import Friction, NonsmoothLaw, NonsmoothSystem, PiecewiseJump, Preload
     from .model import clutch_damper, gear_pair, hub_spline, loose_gear
     from .results import SoundPressure, linear_sound_pressure, sound_pressure

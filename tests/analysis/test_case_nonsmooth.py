@@ -10,7 +10,7 @@ import pytest
 import rattle
 from rattle.errors import ConfigError
 from rattle.model import NonsmoothSystem
-from rattle.results import NonsmoothOrbitResult, NonsmoothResponse
+from rattle.results import FrequencyResponse, NonsmoothCheck, NonsmoothOrbitResult
 
 CASE = """
 [model]
@@ -42,8 +42,9 @@ def test_load_case_runs_the_discontinuous_front_ends_on_the_file_settings(tmp_pa
     opts = case.regularisation_options()
     assert (opts.harmonics, opts.regularisation, opts.refine) == (32, 0.02, None)
     frf = case.frequency_response()
-    assert isinstance(frf, NonsmoothResponse) and frf.harmonics == 32 and frf.regularisation == 0.02
-    assert frf.omega[0] == 1.2 and frf.omega[-1] == pytest.approx(1.23) and frf.limit_index.size == 0
+    assert isinstance(frf, FrequencyResponse) and isinstance(frf.check, NonsmoothCheck)
+    assert frf.check.harmonics == 32 and frf.check.regularisation == 0.02
+    assert frf.omega[0] == 1.2 and frf.omega[-1] == pytest.approx(1.23) and frf.check.limit_index.size == 0
     orbit = case.periodic_orbit(1.21)
     assert isinstance(orbit, NonsmoothOrbitResult) and orbit.converged
     i = int(np.argmin(np.abs(frf.omega - 1.21)))
@@ -53,6 +54,6 @@ def test_load_case_runs_the_discontinuous_front_ends_on_the_file_settings(tmp_pa
     held = np.asarray(sweep.extra_columns["stick_fraction"])
     assert held.shape == (4,) and np.all((held >= 0) & (held <= 1))
     both = case.compare(points=4)
-    assert both.frf.harmonics == 32 and both.frf.regularisation == 0.02 and len(both.sweep.omega) == 8
+    assert both.frf.check.harmonics == 32 and both.frf.check.regularisation == 0.02 and len(both.sweep.omega) == 8
     with pytest.raises(ConfigError, match="load_case"):
         rattle.Model.from_toml(path)

@@ -18,7 +18,9 @@ import pytest
 
 from _cases import clutch_gear_chain
 from _cli_helpers import invoke, write_config
-from rattle.analysis import RegularisationOptions, friction_subharmonics, nonsmooth_response
+from rattle.analysis import RegularisationOptions
+from rattle.analysis._friction_subharmonics import friction_subharmonics
+from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._friction_response import period_gap
 from rattle.continuation import ContinuationOptions
 from rattle.io import read_csv
@@ -130,7 +132,7 @@ def test_without_a_regularised_period_two_orbit_the_branch_is_followed_exactly(r
 
 def test_arguments_are_checked():
     system = _chain().friction_system()
-    with pytest.raises(TypeError, match="`primary` must be the FrictionResponse"):
+    with pytest.raises(TypeError, match="`primary` must be the FrictionCheck"):
         friction_subharmonics(system, None, RANGE)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="`system` must be a rattle.model.FrictionSystem"):
         friction_subharmonics(None, None, RANGE)  # type: ignore[arg-type]

@@ -15,7 +15,7 @@ from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Pr
 from rattle.results import (
     NONSMOOTH_ORBIT_COLUMNS,
     NonsmoothOrbitResult,
-    NonsmoothResponse,
+    NonsmoothCheck,
 )
 from rattle.timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
 
@@ -251,13 +251,15 @@ def test_the_branch_plot_shades_where_the_exact_orbit_sticks() -> None:
     stick = np.array([0.0, 1.0, 2.0, 0.0, 0.5, np.nan])
     matched = np.array([True, True, True, True, True, False])
     mu = np.tile([0.5 + 0j, 0.0 + 0j], (6, 1))
-    res = NonsmoothResponse(
+    res = NonsmoothCheck(
         omega=w, rms_hb=np.linspace(0.1, 0.2, 6), mean=np.zeros(6), rms=np.linspace(0.1, 0.2, 6), rms_ac=nan,
         p2p=nan, acc_p2p=nan, regime=np.full(6, "single_sided", dtype=object), stable=np.ones(6, dtype=bool),
         multipliers=mu, multipliers_hb=mu, stick_time=stick, matched=matched, status=Status.SUCCESS, message="",
         regularisation=0.01, harmonics=64, limit_index=np.zeros(0, dtype=int), limit_eps=np.zeros(0),
         limit_rms=np.zeros(0), limit_richardson=np.zeros(0), limit_linear=np.zeros(0, dtype=bool))
-    _fig, ax = res.plot()
+    from rattle.plotting import nonsmooth_response_plot
+
+    _fig, ax = nonsmooth_response_plot(res)
     spans = sorted(_span(p) for p in ax["rms"].patches)
     np.testing.assert_allclose(spans, [(0.6, 0.7), (0.9, 0.9)])
     np.testing.assert_allclose(ax["stick"].get_lines()[0].get_ydata(), np.where(matched, stick / (2 * np.pi / w), np.nan))

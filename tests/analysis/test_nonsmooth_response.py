@@ -6,7 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rattle.analysis import RegularisationOptions, nonsmooth_response
+from rattle.analysis import RegularisationOptions
+from rattle.analysis._nonsmooth import nonsmooth_response
+from rattle.results import FrequencyResponse
 from rattle.continuation import solve_fixed
 from rattle.hb import HBOptions, RegularisedBalance
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
@@ -88,7 +90,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
     assert np.allclose(res.rms_ac**2 + res.mean**2, res.rms**2, rtol=1e-12)
     assert set(res.regime) <= {"no_impact", "single_sided", "double_sided"}
     assert not any(res.bifurcation)  # stable throughout
-    path = res.to_csv(tmp_path / "frf.csv")
+    path = FrequencyResponse.from_check(res, model=system, settings={}, timings={}).to_csv(tmp_path / "frf.csv")
     cols = read_csv(path)
     assert list(cols) == list(NONSMOOTH_COLUMNS) and len(cols["omega"]) == len(res)
     np.testing.assert_allclose(cols["rms"], res.rms, rtol=1e-15)
@@ -117,7 +119,7 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
 
 def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
     res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
-    fig, ax = res.plot()
+    fig, ax = FrequencyResponse.from_check(res, model=None, settings={}, timings={}).plot()
     assert set(ax) == {"rms", "stick"}
     exact = [ln for ln in ax["rms"].get_lines() if ln.get_label() == "exact orbit, stable"][0]
     np.testing.assert_allclose(exact.get_ydata(), np.where(res.matched & res.stable, res.rms, np.nan))

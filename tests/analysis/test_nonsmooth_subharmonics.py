@@ -11,7 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from rattle.analysis import RegularisationOptions, nonsmooth_response, nonsmooth_subharmonics
+from rattle.analysis import RegularisationOptions
+from rattle.analysis._nonsmooth import nonsmooth_response, nonsmooth_subharmonics
 from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
 from rattle.timeint import NonsmoothIntegrator
 
@@ -122,7 +123,7 @@ def test_the_hb_of_period_two_is_within_half_a_percent_where_matched(response):
 def test_subharmonics_arguments_are_checked():
     with pytest.raises(TypeError, match="`subharmonics` must be True or False"):
         nonsmooth_response(_system(), RANGE, OPTIONS, subharmonics="yes")
-    with pytest.raises(TypeError, match="`primary` must be the NonsmoothResponse"):
+    with pytest.raises(TypeError, match="`primary` must be the NonsmoothCheck"):
         nonsmooth_subharmonics(_system(), None, RANGE, OPTIONS)
 
 

@@ -17,14 +17,15 @@ import pytest
 from _filippov import chain_reference, single_reference  # tests/ is on sys.path through its conftest
 
 import rattle
-from rattle.analysis import RegularisationOptions, ShootingOptions, nonsmooth_response
+from rattle.analysis import RegularisationOptions, ShootingOptions
+from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._exact_branch import start_state
 from rattle.continuation import NewtonOptions
 from rattle.model import (
     Backlash, Chain, Clutch, Element, Excitation, Friction, FrictionSystem, Link, NonsmoothLaw, NonsmoothSystem,
     Preload, Torque,
 )
-from rattle.results import FrictionResponse, NonsmoothResponse
+from rattle.results import FrictionCheck, NonsmoothCheck
 from rattle.timeint import ShootingProblem
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -55,7 +56,7 @@ def test_every_row_is_an_exact_orbit_of_the_independent_integration(seed):
     trajectory's exact integral)."""
     system, omega = _random_single(seed)
     frf = nonsmooth_response(system, omega)
-    assert isinstance(frf, NonsmoothResponse) and frf.followed == "exact shooting"
+    assert isinstance(frf, NonsmoothCheck) and frf.followed == "exact shooting"
     assert frf.status.success, frf.message
     assert np.all(np.isnan(frf.rms_hb)) and np.all(frf.matched)
     L = system.length_scale()
@@ -88,7 +89,7 @@ def _chain_case() -> FrictionSystem:
 def test_a_chain_with_friction_rows_are_exact_orbits_of_the_independent_integration():
     fs = _chain_case()
     frf = nonsmooth_response(fs, (0.6, 0.66))
-    assert isinstance(frf, FrictionResponse) and frf.followed == "exact shooting" and frf.status.success
+    assert isinstance(frf, FrictionCheck) and frf.followed == "exact shooting" and frf.status.success
     L = fs.length_scale()
     for i in (0, len(frf) // 2, len(frf) - 1):
         w, z0 = float(frf.omega[i]), frf.states[i]

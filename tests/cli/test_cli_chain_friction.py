@@ -1,5 +1,5 @@
 """``rattle`` on a chain with Coulomb friction on its elements (``[[model.elements]] friction``):
-``rattle frf`` writes the chain's non-smooth response (a FrictionResponse) as one set, ``rattle
+``rattle frf`` writes the chain's non-smooth response (a FrequencyResponse with a FrictionCheck) as one set, ``rattle
 orbit`` one exact orbit with the regularised HB's beside it (a FrictionOrbitResult); map refuses
 it (exit 2, nothing written) and says that frf and orbit solve it (``rattle sweep`` and ``rattle
 compare`` on it: test_cli_nonsmooth_sweep.py)."""
@@ -173,7 +173,7 @@ def test_frf_json_holds_the_settings_the_elements_and_the_measured_error(frf_run
     assert meta["points"] == len(table["omega"]) and meta["matched"] == int(matched.sum()) == len(table["omega"])
     assert meta["max_rms_error"] == pytest.approx(float(np.max(err)), rel=1e-12)
     assert meta["config"]["model"]["elements"][0]["friction"] == 0.02
-    assert meta["timings"]["cli_wall_time"] > 0 and "nonsmooth_response" in meta["timings"]
+    assert meta["timings"]["cli_wall_time"] > 0 and "frequency_response" in meta["timings"]
 
 
 def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
@@ -197,15 +197,15 @@ def test_frf_exact_rms_is_the_independent_exact_orbit(frf_run):
 def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkeypatch):
     import dataclasses
 
-    import rattle.analysis
+    import rattle.analysis._nonsmooth as module
     from rattle.errors import Status
 
-    real = rattle.analysis.nonsmooth_response
+    real = module.nonsmooth_response  # the builder under rattle.frequency_response
 
     def stopped(*args, **kwargs):
         return dataclasses.replace(real(*args, **kwargs), status=Status.MAX_STEPS, message="")
 
-    monkeypatch.setattr(rattle.analysis, "nonsmooth_response", stopped)
+    monkeypatch.setattr(module, "nonsmooth_response", stopped)
     config = write_config(tmp_path, SLIPPING.replace("omega = [0.8, 0.82]", "omega = [0.8, 0.805]"))
     result = invoke(["frf", str(config), "-o", "out"], tmp_path)
     assert result.exit_code == 1, (result.stdout, result.stderr)

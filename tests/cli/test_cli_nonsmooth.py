@@ -74,7 +74,7 @@ def test_frf_json_holds_the_settings_and_the_measured_error(frf_run):
     assert meta["rms_error_max"] == pytest.approx(float(np.max(err)), rel=1e-12)
     assert meta["system"]["law"]["friction"] == {"levels": [0.02]}
     assert meta["config"]["model"]["elastic"]["preload"] == 0.05
-    assert meta["timings"]["cli_wall_time"] > 0 and "nonsmooth_response" in meta["timings"]
+    assert meta["timings"]["cli_wall_time"] > 0 and "frequency_response" in meta["timings"]
     assert meta["bifurcations"] == []
 
 
@@ -171,15 +171,15 @@ def test_an_incomplete_continuation_writes_its_rows_and_exits_1(tmp_path, monkey
     """As the smooth frf: the rows computed are written as the set, then exit status 1 naming them."""
     import dataclasses
 
-    import rattle.analysis
+    import rattle.analysis._nonsmooth as module
     from rattle.errors import Status
 
-    real = rattle.analysis.nonsmooth_response
+    real = module.nonsmooth_response  # the builder under rattle.frequency_response
 
     def stopped(*args, **kwargs):
         return dataclasses.replace(real(*args, **kwargs), status=Status.MAX_STEPS, message="")
 
-    monkeypatch.setattr(rattle.analysis, "nonsmooth_response", stopped)
+    monkeypatch.setattr(module, "nonsmooth_response", stopped)
     config = write_config(tmp_path, PRELOAD.replace("omega = [1.2, 1.25]", "omega = [1.2, 1.21]"))
     result = invoke(["frf", str(config), "-o", "out"], tmp_path)
     assert result.exit_code == 1, (result.stdout, result.stderr)
@@ -243,3 +243,14 @@ def test_orbit_period_two_writes_the_period_doubled_orbit(tmp_path):
     result = invoke(["orbit", str(config), "--omega", "0.7", "--period", "2", "-o", "out2"], tmp_path)
     assert result.exit_code == 1 and "no periodic orbit of period 2" in result.stderr
     assert not (tmp_path / "out2").exists()
+
+
+@pytest.mark.parametrize("option", [["--start", "high"], ["--fixed-harmonics"]])
+def test_harmonic_balance_options_are_refused_for_a_jump_law(tmp_path, option):
+    """``rattle frf`` is one path for every law: an option of the harmonic balance of a continuous
+    law is refused by the one front end (exit 2, the argument named, nothing written), not ignored."""
+    config = write_config(tmp_path, PRELOAD)
+    result = invoke(["frf", str(config), *option, "-o", "out"], tmp_path)
+    assert result.exit_code == 2, (result.stdout, result.stderr)
+    assert "must be left at the default for a law with jumps or friction" in result.stderr
+    assert not (tmp_path / "out").exists()

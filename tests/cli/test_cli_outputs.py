@@ -24,6 +24,11 @@ from _fake_result import FakeResponse
 OLD = {"frf.csv": "old csv\n", "frf.json": "{\"old\": true}\n", "frf.png": "old png"}
 
 
+def _case_arguments(model: Any, analysis: Any, options: Any = None) -> dict[str, Any]:
+    """``rattle.analysis.case_arguments`` of a continuous law (the fakes stand in for one)."""
+    return {"omega": analysis.omega, "harmonics": analysis.harmonics, **(options or {})}
+
+
 @pytest.fixture
 def fake_solver(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
     state: dict[str, Any] = {"raise": None, "result": FakeResponse(), "warn": None}
@@ -38,6 +43,7 @@ def fake_solver(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
 
     module = types.ModuleType("rattle.analysis")
     module.frequency_response = frequency_response  # type: ignore[attr-defined]
+    module.case_arguments = _case_arguments  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "rattle.analysis", module)
     return state
 

@@ -194,12 +194,18 @@ def FakeResponse(n: int = 3) -> _FakeResponse:  # noqa: N802 - stands for the cl
     return _FakeResponse(n, settings={"harmonics": np.int64(32)}, timings={"continuation": 0.5})
 
 
+def _case_arguments(model: Any, analysis: Any, options: Any = None) -> dict[str, Any]:
+    """``rattle.analysis.case_arguments`` of a continuous law (the fakes stand in for one)."""
+    return {"omega": analysis.omega, "harmonics": analysis.harmonics, **(options or {})}
+
+
 @pytest.fixture
 def fake_solver(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
     """Replace rattle.analysis by a module whose frequency_response does what ``state`` says."""
     state: dict[str, Any] = {"calls": [], "raise": None, "result": FakeResponse()}
 
-    def frequency_response(model: Any, omega: tuple[float, float] = (0.1, 3.0), harmonics: int = 32, *, throw: bool = True) -> _FakeResponse:
+    def frequency_response(model: Any, omega: tuple[float, float] = (0.1, 3.0), harmonics: int = 32, *, throw: bool = True,
+                           progress: Any = None) -> _FakeResponse:
         state["calls"].append({"model": model, "omega": omega, "harmonics": harmonics, "throw": throw})
         if state["raise"] is not None:
             raise state["raise"]
@@ -207,6 +213,7 @@ def fake_solver(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
 
     module = types.ModuleType("rattle.analysis")
     module.frequency_response = frequency_response  # type: ignore[attr-defined]
+    module.case_arguments = _case_arguments  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "rattle.analysis", module)
     return state
 

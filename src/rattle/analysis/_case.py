@@ -17,7 +17,7 @@ from ..model import FrictionSystem, Model, NonsmoothSystem
 from ._compare import compare
 from ._frequency_response import frequency_response
 from ._exact_branch import ShootingOptions
-from ._nonsmooth import RegularisationOptions, nonsmooth_response
+from ._nonsmooth import RegularisationOptions
 from ._nonsmooth_orbit import nonsmooth_orbit
 from ._orbit import periodic_orbit
 from ._time_sweep import time_sweep
@@ -39,6 +39,20 @@ def method_options(analysis: AnalysisSettings) -> ShootingOptions | Regularisati
     """The method of a discontinuous law's ``[analysis] method`` (SPEC §8): ``"shooting"`` (the
     default) :class:`ShootingOptions`, ``"hb"`` :func:`regularisation_options`."""
     return regularisation_options(analysis) if analysis.method == "hb" else ShootingOptions()
+
+
+def case_arguments(model: Any, analysis: AnalysisSettings, options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The keywords of :func:`rattle.frequency_response` for ``model`` with a case file's
+    ``[analysis]``: its range ``omega``, and for a continuous law its ``harmonics``, for a law with
+    jumps or friction (``model.discontinuous``) its method (:func:`method_options`); ``options``
+    (keywords given) override them."""
+    options = dict(options or {})
+    kw: dict[str, Any] = {"omega": analysis.omega}
+    if getattr(model, "discontinuous", False):
+        kw["options"] = method_options(analysis)
+    elif "hb" not in options:  # the harmonic count given inside hb= replaces the file's
+        kw["harmonics"] = analysis.harmonics
+    return {**kw, **options}
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,15 +94,11 @@ class Case:
         (``subharmonics=True``, ``omega=…``, ``hb=HBOptions(…)``, ``newton=…``, …) are passed on
         and override the file; an unknown keyword raises TypeError.
 
-        For a discontinuous law, or a chain with friction on its elements:
-        :func:`rattle.analysis.nonsmooth_response` over the file's range with
-        :meth:`regularisation_options` (keywords ``omega``, ``options``, ``continuation``,
-        ``newton``, ``subharmonics`` override; ``subharmonics=True`` follows the period-2 branches
-        of a one-equation law)."""
-        if self.discontinuous:
-            kw: dict[str, Any] = {"omega": self.analysis.omega, "options": method_options(self.analysis), **options}
-            return nonsmooth_response(self.model, **kw)  # type: ignore[arg-type]
-        return frequency_response(self.model, **self._with_analysis(options, "omega"))
+        For a discontinuous law, or a chain with friction on its elements, the file's method
+        (:func:`method_options`: ``[analysis] method``) instead of its harmonics (keywords
+        ``omega``, ``options``, ``continuation``, ``newton``, ``subharmonics``, ``throw``,
+        ``progress`` override)."""
+        return frequency_response(self.model, **case_arguments(self.model, self.analysis, options))
 
     def periodic_orbit(self, omega: float, **options: Any) -> Any:
         """:func:`rattle.periodic_orbit` at ``omega`` with the file's harmonics, the primary branch
@@ -140,4 +150,4 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     return Case(load_config(path))
 
 
-__all__ = ["Case", "load_case"]
+__all__ = ["Case", "load_case", "case_arguments", "method_options", "regularisation_options"]

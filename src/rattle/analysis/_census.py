@@ -10,7 +10,7 @@ branches miss, for every law.
   (:func:`~rattle.analysis._attractors.find_attractors`);
 * a discontinuous law (a torque jump or friction: :class:`~rattle.model.NonsmoothSystem`, or a
   chain with friction, :class:`~rattle.model.FrictionSystem`): the exact shooting continuation
-  that ``rattle frf`` runs at its defaults (:func:`~rattle.analysis.nonsmooth_response` with
+  that ``rattle frf`` runs at its defaults (:func:`~rattle.analysis.frequency_response` with
   :class:`~rattle.analysis.ShootingOptions`, the period-2 branches born at its period doublings
   too), every branch solved exactly at the grid frequencies (:func:`exact_solutions_on_grid`:
   Newton on the period map R(z(0), Ω_j) = (φ_T(z(0); Ω_j) − z(0)) / s at the fixed Ω_j from the
@@ -20,8 +20,8 @@ branches miss, for every law.
 
 The responses of the two kinds are read through the small accessors below (``omega``, the first
 element's ``rms``, ``stable``, ``period``, ``branch``, the special points), the attributes common
-to :class:`~rattle.results.FrequencyResponse`, :class:`~rattle.results.NonsmoothResponse` and
-:class:`~rattle.results.FrictionResponse`.
+to :class:`~rattle.results.FrequencyResponse`, :class:`~rattle.results.NonsmoothCheck` and
+:class:`~rattle.results.FrictionCheck` (the exact-check groups of a discontinuous law's response).
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ from ._steady import _FrictionFlow, _NonsmoothFlow, friction_measures, make_inte
 # ---------------------------------------------------------------------------------------------
 def response_parts(response: Any) -> list[Any]:
     """The branches of a response, each a result of its own: a FrequencyResponse is one table
-    (its ``branch`` column tells them apart); a Nonsmooth/FrictionResponse carries its other
+    (its ``branch`` column tells them apart); a Nonsmooth/FrictionCheck carries its other
     branches in ``branches``."""
     if isinstance(response, FrequencyResponse):
         return [response]
@@ -289,8 +289,8 @@ def find_exact_attractors(system: NonsmoothSystem | FrictionSystem, response: An
                           run: RunSettings, options: AttractorSearch | None = None,
                           solutions: list[GridSolution] | None = None,
                           shooting: ShootingOptions | None = None) -> Census:
-    """The attractors on ``grid`` that the exact branches of ``response`` (a NonsmoothResponse or
-    FrictionResponse of ``system``) do not explain, found by exact simulation and continued by
+    """The attractors on ``grid`` that the exact branches of ``response`` (a NonsmoothCheck or
+    FrictionCheck of ``system``) do not explain, found by exact simulation and continued by
     exact shooting (:class:`_ExactSearch`), with every branch's solutions on the grid."""
     options = options or AttractorSearch()
     if solutions is None:

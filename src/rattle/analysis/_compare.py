@@ -279,7 +279,8 @@ def _compare_discontinuous(
     callback: Callable[[int, int], None] | None,
 ) -> Comparison:
     """:func:`compare` on a discontinuous law: its response and its exact sweep, side by side."""
-    from ._nonsmooth import nonsmooth_response
+    from ._exact_branch import ShootingOptions
+    from ._nonsmooth import method_settings, nonsmooth_response
 
     lo, hi = _limits.check_frequency_range(_Bounds(model), *check_range(omega), simulate=True)
     _limits.check_points(points)
@@ -291,14 +292,18 @@ def _compare_discontinuous(
         raise ValueError("`at` is not supported for a discontinuous law: its comparison has no detailed orbits "
                          "(use nonsmooth_orbit at a frequency); leave `at` None")
     t0 = time.perf_counter()
-    frf = nonsmooth_response(model, (lo, hi), regularisation, continuation=continuation, newton=newton)
+    check = nonsmooth_response(model, (lo, hi), regularisation, continuation=continuation, newton=newton)
     t1 = time.perf_counter()
+    frf = FrequencyResponse.from_check(
+        check, model=model, timings={"frequency_response": t1 - t0},
+        settings={**method_settings(regularisation or ShootingOptions(), isinstance(model, FrictionSystem)),
+                  "subharmonics": False})
     sweep = time_sweep(model, omega=(lo, hi), points=points, direction="both", options=options,
                        workers=workers, callback=callback)
     t2 = time.perf_counter()
     return Comparison(
         model=model, frf=frf, sweep=sweep, at=(), reasons=(), orbits=(), simulations=(),  # type: ignore[arg-type]
-        settings={"omega": [lo, hi], "harmonics": frf.harmonics, "regularisation": frf.regularisation,
+        settings={"omega": [lo, hi], "harmonics": check.harmonics, "regularisation": check.regularisation,
                   "points": points, "at": None, "workers": workers},
         timings={"frequency_response": t1 - t0, "sweep": t2 - t1, "total": t2 - t0},
     )

@@ -19,6 +19,9 @@ from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse
 from ..stability import stability_method
 from ._assemble import assemble, monitor_of
+from ._exact_branch import ShootingOptions
+from ._nonsmooth import discontinuous_response
+from ._regularisation import RegularisationOptions
 from ._stretches import AdaptiveHarmonics, follow_branch
 from ._sweep_check import SweepCheck, missed_branches
 from ._settings import DEFAULT_HARMONICS, RunSettings, StabilityMethod, resolve_hb
@@ -89,6 +92,7 @@ def frequency_response(
     omega: tuple[float, float] = (0.1, 3.0),
     harmonics: int = DEFAULT_HARMONICS,
     *,
+    options: ShootingOptions | RegularisationOptions | None = None,
     samples: int | None = None,
     hb: HBOptions | None = None,
     period: int = 1,
@@ -105,8 +109,27 @@ def frequency_response(
     throw: bool = True,
     callback: Callable[[BranchPoint], None] | None = None,
     confirm_tori: bool = True,
+    progress: Callable[[int, int], None] | None = None,
 ) -> FrequencyResponse:
-    """Non-linear frequency response of ``model`` over ``omega`` = (Ω_min, Ω_max) rad/s.
+    """Non-linear frequency response of ``model`` over ``omega`` = (Ω_min, Ω_max) rad/s, for
+    every law.
+
+    The method follows from the law. A continuous law (the model's ``discontinuous`` false):
+    harmonic balance, below. A law with torque jumps or friction (a
+    :class:`~rattle.model.NonsmoothSystem`, a :class:`~rattle.model.FrictionSystem`, or a
+    :class:`~rattle.model.Chain` with friction or jumps on an element, solved on its
+    ``friction_system()``): ``options`` chooses the method (SPEC §8) — None or a
+    :class:`~rattle.analysis.ShootingOptions`, exact shooting continuation on the event-driven
+    period map (the default: every row an exact orbit, special points located); a
+    :class:`~rattle.analysis.RegularisationOptions`, the regularised harmonic balance with every
+    row checked by exact shooting (its ``harmonics`` and ε). The result's ``check`` holds the
+    exact-check columns; ``omega``, ``options``, ``continuation``, ``newton``, ``subharmonics``
+    (the period-2 branches born at the period doublings, rows of their own ``branch`` and
+    ``period``), ``throw`` and ``progress`` apply; the harmonic-balance arguments (``harmonics``,
+    ``samples``, ``hb``, ``period``, ``start``, ``adaptive``, ``check``, ``stability``,
+    ``max_period``, ``sweep``, ``seeds``, ``callback``, ``confirm_tori``) must be left at their
+    defaults. ``progress(done, total)``: called with the share (‰) of the range reached (the CLI
+    draws a bar; the library draws nothing).
 
     With ``subharmonics=True`` every period-doubling point found is followed onto the branch
     of doubled period (branch switching), recursively up to solutions of period
@@ -153,6 +176,26 @@ def frequency_response(
     ``rattle.analysis._settings``), NewtonOptions, ContinuationOptions and stability method;
     ``result.settings["branches"]`` records what each branch actually used.
     """
+    _limits.check_callback(progress, "progress")
+    if getattr(model, "discontinuous", False):  # a law with jumps or friction: exact shooting or regularised HB
+        given = {name: value for name, value, default in (
+            ("harmonics", harmonics, DEFAULT_HARMONICS), ("samples", samples, None), ("hb", hb, None),
+            ("period", period, 1), ("start", start, "low"), ("adaptive", adaptive, AdaptiveHarmonics()),
+            ("check", check, SweepCheck()), ("stability", stability, "monodromy"), ("max_period", max_period, 4),
+            ("sweep", sweep, None), ("seeds", tuple(seeds), ()), ("callback", callback, None),
+            ("confirm_tori", confirm_tori, True)) if not _same(value, default)}
+        if given:
+            raise TypeError(
+                f"{', '.join(f'`{k}`' for k in given)} must be left at the default for a law with jumps or friction "
+                "(they set the harmonic balance of a continuous law); choose its method with `options`: "
+                "ShootingOptions() (exact shooting continuation, the default) or "
+                "RegularisationOptions(harmonics=…, regularisation=…)")
+        return discontinuous_response(model, omega, options, continuation=continuation, newton=newton,
+                                      subharmonics=_validate.check_bool(subharmonics, "subharmonics"),
+                                      throw=_validate.check_bool(throw, "throw"), progress=progress)
+    if options is not None:
+        raise TypeError(f"`options` chooses the method of a law with jumps or friction; this law is continuous "
+                        f"(solved by harmonic balance: `harmonics`, `hb`, …), so leave `options` None, got {options!r}")
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     check_analysable_model(model)
     lo, hi = _limits.check_frequency_range(model, *check_range(omega))
@@ -176,6 +219,8 @@ def frequency_response(
     _limits.check_harmonics(run.hb.harmonics, "harmonics" if hb is None else "hb.harmonics", period=period,
                             coordinates=model.system().n)
     confirm_tori = _validate.check_bool(confirm_tori, "confirm_tori")
+    if progress is not None:  # the share of the range reached, as the exact shooting continuation reports it
+        callback = _reporting(progress, lo, hi, callback)
     result = _frequency_response(
         model, (lo, hi), run, period=period, start=start, subharmonics=subharmonics, max_period=max_period,
         sweep=sweep, seeds=seeds, throw=throw, callback=callback, adaptive=adaptive, check=check,
@@ -187,6 +232,32 @@ def frequency_response(
         result = replace(result, regions=_confirm(result), timings={
             **result.timings, "torus_simulations": time.perf_counter() - t0})
     return result
+
+
+def _same(value: object, default: object) -> bool:
+    """``value`` is ``default`` (equal, of the same type: 32 and 32.0 differ from what a user meant
+    only in type, and an option object equal to the default's is the default)."""
+    try:
+        return type(value) is type(default) and bool(value == default)
+    except (TypeError, ValueError):  # an array or an object that does not compare
+        return False
+
+
+def _reporting(progress: Callable[[int, int], None], lo: float, hi: float,
+               callback: Callable[[BranchPoint], None] | None) -> Callable[[BranchPoint], None]:
+    """A ``callback`` that also calls ``progress(done, 1000)`` with the share (‰) of [lo, hi]
+    reached by the points so far."""
+    reached = [0]
+
+    def report(point: BranchPoint) -> None:
+        done = int(1000 * min(max((point.omega - lo) / (hi - lo), 0.0), 1.0))
+        if done > reached[0]:
+            reached[0] = done
+            progress(done, 1000)
+        if callback is not None:
+            callback(point)
+
+    return report
 
 
 def _frequency_response(

@@ -6,7 +6,7 @@ For x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t)
 1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedSystemBalance`, smooth steps
    of relative width ε, H harmonics) at Ω: started from the linearised chain's steady state at
    wide steps (ε = 0.1, else 0.3) and narrowed to the requested ε by homotopy, with the fallbacks
-   of :func:`~rattle.analysis.friction_response`'s start (damped Newton; the spectrum of the exact
+   of :func:`~rattle.analysis._friction_response.friction_response`'s start (damped Newton; the spectrum of the exact
    orbit reached by simulation);
 2. the exact orbit: Newton shooting on the event-driven flow
    (:func:`~rattle.timeint.shoot_friction_orbit`: every element's sticking exact, Filippov; the

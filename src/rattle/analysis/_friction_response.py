@@ -71,7 +71,7 @@ from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptio
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedSystemBalance
 from ..model import FrictionSystem
-from ..results import FrictionResponse
+from ..results import FrictionCheck
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint._friction_chain import CROSSING, LOCK, STICK
@@ -395,7 +395,7 @@ def friction_response(
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
-) -> FrictionResponse:
+) -> FrictionCheck:
     """The period-1 branch of the chain with friction ``system`` over ``omega`` = (Ω_min, Ω_max),
     from Ω_min (module docstring), with the settings ``options`` (None: :func:`chain_options`)
     (:class:`~rattle.analysis.RegularisationOptions`: ``harmonics`` H, ``regularisation`` ε,
@@ -433,12 +433,12 @@ def shooting_friction_response(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
-) -> FrictionResponse:
+) -> FrictionCheck:
     """The chain's period-1 branch over ``omega`` by exact shooting continuation
     (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit of the chain,
     the special points located and labelled; ``followed`` "exact shooting", the HB columns nan).
     A second branch followed down from Ω_max, where the first left frequencies uncovered, is the
-    first of ``branches`` (the sub-harmonic ones: :func:`rattle.analysis.nonsmooth_response`)."""
+    first of ``branches`` (the sub-harmonic ones: :func:`rattle.analysis._nonsmooth.shooting_response`)."""
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
@@ -449,8 +449,8 @@ def shooting_friction_response(
 
 
 def exact_friction_response(system: FrictionSystem, branch: ExactBranch, *, number: int,
-                            period: int = 1) -> FrictionResponse:
-    """The :class:`FrictionResponse` of an exact branch of the chain: every row an exact orbit."""
+                            period: int = 1) -> FrictionCheck:
+    """The :class:`FrictionCheck` of an exact branch of the chain: every row an exact orbit."""
     n, m, P = system.n, system.m, len(branch.rows)
     rows = [exact_measures(r.trajectory, r.omega, period) for r in branch.rows]
     if rows:
@@ -460,7 +460,7 @@ def exact_friction_response(system: FrictionSystem, branch: ExactBranch, *, numb
         states, pattern, mult = np.zeros((0, 2 * n)), np.zeros((0, 2 * m), dtype=np.int64), np.zeros((0, 2 * n), complex)
     omegas = branch.omega
     rpm = system.speed_rpm(omegas)
-    return FrictionResponse(
+    return FrictionCheck(
         omega=omegas, rpm=None if rpm is None else np.asarray(rpm, dtype=float), element_names=system.element_names,
         rms=rms, rms_hb=np.full((P, m), np.nan), mean=mean, stick_fraction=stick, matched=np.ones(P, dtype=bool),
         match_distance=np.full(P, np.nan), stable=np.abs(mult).max(axis=1) < 1.0 + UNIT_TOL if P else np.zeros(0, bool),
@@ -506,7 +506,7 @@ REPEAT_TOL = 1e-6
 
 def check_branch(system: FrictionSystem, make: Callable[[float, int], RegularisedSystemBalance],
                  points: list, opts: RegularisationOptions, integ: FrictionIntegrator, *,  # type: ignore[type-arg]
-                 status: Status, message: str, branch: int = 0, origin: str = "") -> FrictionResponse:
+                 status: Status, message: str, branch: int = 0, origin: str = "") -> FrictionCheck:
     """The rows of a continued HB branch ``points`` (:class:`~rattle.continuation.ContinuationPoint`
     of ``make(ε, H)``'s problem, whose period p forcing periods is the orbits'), each checked by exact
     shooting over p periods and refined at its regularisation's limit (module docstring, steps 2
@@ -679,7 +679,7 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
                 held_scale.append(math.nan)
     omegas = np.array([float(p.omega) for p in points])
     rpm = system.speed_rpm(omegas)
-    return FrictionResponse(
+    return FrictionCheck(
         omega=omegas, rpm=None if rpm is None else np.asarray(rpm, dtype=float), element_names=system.element_names,
         rms=rms, rms_hb=rms_hb, mean=mean, stick_fraction=stick, matched=matched, match_distance=dist_all,
         stable=stable, stable_hb=stable_hb, multipliers=mult, multipliers_hb=mult_hb,
@@ -695,4 +695,4 @@ def check_branch(system: FrictionSystem, make: Callable[[float, int], Regularise
     )
 
 
-__all__ = ["FrictionResponse", "check_branch", "exact_measures", "period_gap", "friction_balance_factory", "friction_response"]
+__all__ = ["FrictionCheck", "check_branch", "exact_measures", "period_gap", "friction_balance_factory", "friction_response"]

@@ -41,7 +41,7 @@ from .._validate import check_range
 from ..continuation import ContinuationOptions, NewtonOptions
 from ..errors import Status
 from ..model import FrictionSystem
-from ..results import FrictionResponse
+from ..results import FrictionCheck
 from ..timeint import FrictionIntegrator, FrictionOrbit, shoot_friction_orbit
 from ..timeint._shooting import FLOW_FAILURES
 from ._friction_response import (
@@ -103,13 +103,13 @@ def _period_two_start(make2, orbit: FrictionOrbit, omega: float, eps: float, H2:
 
 def friction_subharmonics(
     system: FrictionSystem,
-    primary: FrictionResponse,
+    primary: FrictionCheck,
     omega: tuple[float, float],
     options: RegularisationOptions | None = None,
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
-) -> tuple[FrictionResponse, ...]:
+) -> tuple[FrictionCheck, ...]:
     """The period-2 branches born at the period doublings of the chain's period-1 branch
     ``primary`` (:func:`~rattle.analysis._friction_response.friction_response` of ``system`` with
     the same ``options``; None: :func:`~rattle.analysis._friction_response.chain_options`) within
@@ -120,8 +120,8 @@ def friction_subharmonics(
     orbit is found next to it starts none either."""
     if not isinstance(system, FrictionSystem):
         raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
-    if not isinstance(primary, FrictionResponse):
-        raise TypeError(f"`primary` must be the FrictionResponse of `system`, got {primary!r}")
+    if not isinstance(primary, FrictionCheck):
+        raise TypeError(f"`primary` must be the FrictionCheck of `system`, got {primary!r}")
     lo, hi = check_range(omega)
     opts = chain_options(system) if options is None else options
     if not isinstance(opts, RegularisationOptions):
@@ -136,7 +136,7 @@ def friction_subharmonics(
     def seed(i: int) -> FrictionOrbit | None:
         return None if states is None else period_two_orbit(system, integ, float(primary.omega[i]), states[i])
 
-    def from_seed(w0: float, orbit: FrictionOrbit, number: int, origin: str) -> FrictionResponse | None:
+    def from_seed(w0: float, orbit: FrictionOrbit, number: int, origin: str) -> FrictionCheck | None:
         q2 = _period_two_start(make2, orbit, w0, opts.regularisation, H2, newton)
         if q2 is None:
             return None
@@ -147,14 +147,14 @@ def friction_subharmonics(
         return check_branch(system, make2, points, opts2, integ, status=status, message=message, branch=number,
                             origin=origin)
 
-    def exact(w0: float, orbit: FrictionOrbit, grid: FloatArray, number: int, origin: str) -> FrictionResponse:
+    def exact(w0: float, orbit: FrictionOrbit, grid: FloatArray, number: int, origin: str) -> FrictionCheck:
         return _exact_branch(system, integ, orbit, w0, grid, opts, branch=number, origin=origin)
 
     return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
 def _exact_branch(system: FrictionSystem, integ: FrictionIntegrator, seed: FrictionOrbit, omega: float,
-                  grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> FrictionResponse:
+                  grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> FrictionCheck:
     """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
     ``grid`` each way by Newton shooting over two periods from the orbit at the previous frequency
     (:func:`~._period_two.follow_exactly`), until the shooting fails, its orbit repeats after one
@@ -184,7 +184,7 @@ def _exact_branch(system: FrictionSystem, integ: FrictionIntegrator, seed: Frict
     rpm = system.speed_rpm(omegas)
     message = "followed by exact shooting alone (the regularised HB of period 2 has no orbit next to the exact one " \
               "there); " + "; ".join(ends)
-    return FrictionResponse(
+    return FrictionCheck(
         omega=omegas, rpm=None if rpm is None else np.asarray(rpm, dtype=float), element_names=system.element_names,
         rms=rms, rms_hb=nan_m, mean=mean, stick_fraction=stick, matched=np.ones(P, dtype=bool),
         match_distance=np.full(P, np.nan), stable=stable, stable_hb=np.zeros(P, dtype=bool), multipliers=mult,

@@ -54,7 +54,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -63,8 +65,8 @@ from .._validate import check_range
 from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
-from ..model import FrictionSystem, NonsmoothSystem
-from ..results import FrictionResponse, NonsmoothResponse
+from ..model import Chain, FrictionSystem, NonsmoothSystem
+from ..results import FrequencyResponse, FrictionCheck, NonsmoothCheck
 from ..stability import regularised_multipliers
 from ..timeint import (
     FLOW_FAILURES, FrictionIntegrator, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
@@ -239,16 +241,18 @@ def nonsmooth_response(
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
     progress: Callable[[int, int], None] | None = None,
-) -> NonsmoothResponse | FrictionResponse:
-    """The period-1 branch over ``omega`` = (Ω_min, Ω_max), from Ω_min. The method follows from
-    ``options``: None or a :class:`ShootingOptions`, exact shooting continuation (the default,
+) -> NonsmoothCheck | FrictionCheck:
+    """The exact-check group (:class:`~rattle.results.NonsmoothCheck`, a chain's
+    :class:`~rattle.results.FrictionCheck`) of the period-1 branch over ``omega`` = (Ω_min, Ω_max),
+    from Ω_min: the builder under :func:`rattle.frequency_response` (:func:`discontinuous_response`
+    makes it a :class:`~rattle.results.FrequencyResponse`). The method follows from ``options``: None or a :class:`ShootingOptions`, exact shooting continuation (the default,
     :func:`shooting_response`: every row an exact orbit, special points located); a
     :class:`RegularisationOptions`, the regularised harmonic balance with every row checked by
     exact shooting (module docstring); with ``subharmonics`` also the
     period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
     ``branches``. A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
-    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionResponse`),
-    with ``subharmonics`` also to :func:`~rattle.analysis.friction_subharmonics`."""
+    :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionCheck`),
+    with ``subharmonics`` also to :func:`~rattle.analysis._friction_subharmonics.friction_subharmonics`."""
     if not isinstance(subharmonics, bool):
         raise TypeError(f"`subharmonics` must be True or False, got {subharmonics!r}")
     if options is None or isinstance(options, ShootingOptions):  # the default: exact shooting continuation
@@ -285,6 +289,65 @@ def nonsmooth_response(
     return primary
 
 
+def method_settings(options: ShootingOptions | RegularisationOptions, chain: bool) -> dict[str, Any]:
+    """The ``frf.json`` settings of the method ``options`` (``chain``: a chain with friction or jumps
+    on its elements): what was solved and how, and the options' values."""
+    if isinstance(options, ShootingOptions):
+        return {
+            "method": "exact shooting continuation: pseudo-arclength in (z(0), Ω) on the exact event-driven period "
+                      "map" + (" of the chain" if chain else "") + " (Filippov sticking and locking, saltation "
+                      "monodromy), special points located on the branch (rattle.frequency_response)",
+            "settle_periods": options.settle_periods, "hops": list(options.hops), "locate": options.locate,
+        }
+    out = {
+        "method": ("regularised harmonic balance of the chain continued over Ω, every point checked by exact "
+                   "event-driven shooting with Filippov sticking and saltation monodromy (rattle.frequency_response)")
+        if chain else ("regularised harmonic balance continued over Ω, every point checked by exact event-driven "
+                       "shooting (rattle.frequency_response)"),
+        "harmonics": options.harmonics, "regularisation": options.regularisation, "match": options.match,
+        "limit": options.limit, "refine": options.refine, "limit_eps": options.limit_eps,
+        "limit_harmonics": options.limit_harmonics,
+    }
+    if chain:
+        out.update(held=options.held, held_harmonics=options.held_harmonics)
+    return out
+
+
+def discontinuous_response(
+    model: Any,
+    omega: tuple[float, float],
+    options: ShootingOptions | RegularisationOptions | None = None,
+    *,
+    continuation: ContinuationOptions | None = None,
+    newton: NewtonOptions | None = None,
+    subharmonics: bool = False,
+    throw: bool = True,
+    progress: Callable[[int, int], None] | None = None,
+) -> FrequencyResponse:
+    """:func:`rattle.analysis.frequency_response` of a law with jumps or friction: the
+    :class:`~rattle.results.FrequencyResponse` of :func:`nonsmooth_response` (its exact-check
+    group in ``check``, every branch's rows, the method's settings and the time taken). A
+    :class:`~rattle.model.Chain` is solved on its ``friction_system()``. With ``throw`` a run that
+    did not cover the range raises :class:`~rattle.errors.ConvergenceError` with the result in
+    ``.partial``."""
+    system = model.friction_system() if isinstance(model, Chain) else model
+    if options is not None and not isinstance(options, (ShootingOptions, RegularisationOptions)):
+        raise TypeError(f"`options` must be None, a ShootingOptions (exact shooting continuation) or a "
+                        f"RegularisationOptions (the regularised harmonic balance), got {options!r}")
+    t0 = time.perf_counter()
+    check = nonsmooth_response(system, omega, options, continuation=continuation, newton=newton,
+                               subharmonics=subharmonics, progress=progress)
+    chain = isinstance(system, FrictionSystem)
+    opts = options if options is not None else ShootingOptions()
+    settings = {**method_settings(opts, chain), "subharmonics": subharmonics}
+    result = FrequencyResponse.from_check(check, model=system, settings=settings,
+                                          timings={"frequency_response": time.perf_counter() - t0})
+    if throw and not result.status.success:
+        raise ConvergenceError(f"frequency response incomplete: {result.message or result.status.message}",
+                               partial=result)
+    return result
+
+
 def shooting_response(
     system: NonsmoothSystem | FrictionSystem,
     omega: tuple[float, float],
@@ -294,7 +357,7 @@ def shooting_response(
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
     progress: Callable[[int, int], None] | None = None,
-) -> NonsmoothResponse | FrictionResponse:
+) -> NonsmoothCheck | FrictionCheck:
     """The period-1 branch over ``omega`` by exact shooting continuation
     (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit, the special
     points located and labelled; ``followed`` "exact shooting", the HB columns nan). A second
@@ -304,7 +367,7 @@ def shooting_response(
     (the CLI draws a bar; the library draws nothing)."""
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
-    primary: NonsmoothResponse | FrictionResponse
+    primary: NonsmoothCheck | FrictionCheck
     if isinstance(system, FrictionSystem):
         primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
                                              progress=progress)
@@ -329,8 +392,8 @@ def shooting_response(
     return dataclasses.replace(primary, branches=tuple(extra))
 
 
-def _exact_response(branch: ExactBranch, *, number: int, period: int = 1) -> NonsmoothResponse:
-    """The :class:`NonsmoothResponse` of an exact branch: every row an exact orbit."""
+def _exact_response(branch: ExactBranch, *, number: int, period: int = 1) -> NonsmoothCheck:
+    """The :class:`NonsmoothCheck` of an exact branch: every row an exact orbit."""
     rows: dict[str, list] = {k: [] for k in _ROW_KEYS}
     nan2 = np.full(2, np.nan + 0j)
     for r in branch.rows:
@@ -383,10 +446,10 @@ def _add_row(rows: dict[str, list], orbit: NonsmoothOrbit | None, mu_hb: np.ndar
     rows["stable"].append(bool(np.all(np.abs(mu_hb) < 1.0)))
 
 
-def _response(rows: dict[str, list], **fields: object) -> NonsmoothResponse:
-    """The :class:`NonsmoothResponse` of the collected ``rows`` and the other ``fields``."""
+def _response(rows: dict[str, list], **fields: object) -> NonsmoothCheck:
+    """The :class:`NonsmoothCheck` of the collected ``rows`` and the other ``fields``."""
     rms, mean = np.array(rows["rms"], dtype=float), np.array(rows["mean"], dtype=float)
-    return NonsmoothResponse(
+    return NonsmoothCheck(
         omega=np.array(rows["omega"], dtype=float), rms_hb=np.array(rows["rms_hb"], dtype=float), mean=mean, rms=rms,
         rms_ac=np.sqrt(np.maximum(rms**2 - mean**2, 0.0)), p2p=np.array(rows["p2p"], dtype=float),
         acc_p2p=np.array(rows["acc_p2p"], dtype=float), regime=np.array(rows["regime"], dtype=object),
@@ -400,7 +463,7 @@ def _response(rows: dict[str, list], **fields: object) -> NonsmoothResponse:
 
 def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], RegularisedBalance],
                   opts: RegularisationOptions, points: list[BranchPoint], status: Status, message: str, *,
-                  branch: int = 0, origin: str = "") -> NonsmoothResponse:
+                  branch: int = 0, origin: str = "") -> NonsmoothCheck:
     """Steps 2–4 of the module docstring on the continued ``points`` of one branch (of the period
     p of ``make``'s problems: the exact orbits are shot over p forcing periods)."""
     harmonics, regularisation, match = opts.harmonics, opts.regularisation, opts.match
@@ -545,13 +608,13 @@ def _period_two_start(make2: Callable[[float, int], RegularisedBalance], orbit: 
 
 def nonsmooth_subharmonics(
     system: NonsmoothSystem,
-    primary: NonsmoothResponse,
+    primary: NonsmoothCheck,
     omega: tuple[float, float],
     options: RegularisationOptions | None = None,
     *,
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
-) -> tuple[NonsmoothResponse, ...]:
+) -> tuple[NonsmoothCheck, ...]:
     """The period-2 branches born at the period doublings of the period-1 branch ``primary``
     (:func:`nonsmooth_response` of ``system`` with the same ``options``) within ``omega``.
 
@@ -571,8 +634,8 @@ def nonsmooth_subharmonics(
     returned branches are what was found, numbered 1, 2, … in order of Ω."""
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation), got {system!r}")
-    if not isinstance(primary, NonsmoothResponse):
-        raise TypeError(f"`primary` must be the NonsmoothResponse of `system`, got {primary!r}")
+    if not isinstance(primary, NonsmoothCheck):
+        raise TypeError(f"`primary` must be the NonsmoothCheck of `system`, got {primary!r}")
     lo, hi = check_range(omega)
     opts = RegularisationOptions() if options is None else options
     if not isinstance(opts, RegularisationOptions):
@@ -584,7 +647,7 @@ def nonsmooth_subharmonics(
     def seed(i: int) -> NonsmoothOrbit | None:
         return _period_two_orbit(system, integ, float(primary.omega[i]), primary.states[i])
 
-    def from_seed(w0: float, orbit: NonsmoothOrbit, number: int, origin: str) -> NonsmoothResponse | None:
+    def from_seed(w0: float, orbit: NonsmoothOrbit, number: int, origin: str) -> NonsmoothCheck | None:
         q2 = _period_two_start(make2, orbit, w0, opts.regularisation, H2, newton)
         if q2 is None:
             return None
@@ -594,14 +657,14 @@ def nonsmooth_subharmonics(
             return None
         return _check_branch(system, make2, opts, points, status, message, branch=number, origin=origin)
 
-    def exact(w0: float, orbit: NonsmoothOrbit, grid: FloatArray, number: int, origin: str) -> NonsmoothResponse:
+    def exact(w0: float, orbit: NonsmoothOrbit, grid: FloatArray, number: int, origin: str) -> NonsmoothCheck:
         return _exact_branch(system, integ, orbit, w0, grid, opts, branch=number, origin=origin)
 
     return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
 def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: NonsmoothOrbit, omega: float,
-                  grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> NonsmoothResponse:
+                  grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> NonsmoothCheck:
     """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
     ``grid`` each way by Newton shooting over two periods from the orbit at the previous
     frequency (natural continuation), until the shooting fails, its orbit repeats after one
@@ -636,5 +699,5 @@ def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: Non
                      limit_richardson=np.zeros(0), limit_linear=np.zeros(0, dtype=bool))
 
 
-__all__ = ["NonsmoothResponse", "RegularisationOptions", "ShootingOptions", "nonsmooth_response",
-           "nonsmooth_subharmonics", "shooting_response"]
+__all__ = ["NonsmoothCheck", "RegularisationOptions", "ShootingOptions", "discontinuous_response", "method_settings",
+           "nonsmooth_response", "nonsmooth_subharmonics", "shooting_response"]

@@ -6,7 +6,7 @@ For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.Nonsm
    relative width ε, H harmonics) is solved at Ω from rest where the steps are wide (ε = 0.1) and
    narrowed to the requested ε by the homotopy of
    :func:`~rattle.analysis._regularisation.regularisation_limit` — the start of
-   :func:`~rattle.analysis.nonsmooth_response`, at one Ω;
+   :func:`rattle.frequency_response` (a law with jumps or friction), at one Ω;
 2. the exact orbit: Newton shooting on the event-driven flow
    (:func:`~rattle.timeint.shoot_nonsmooth_orbit`: crossings, sticking and locking exact, the
    monodromy with saltation matrices) from the HB orbit's state (δ, δ') at t = 0, or from ``x0``

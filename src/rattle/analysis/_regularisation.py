@@ -205,7 +205,8 @@ def regularisation_limit(
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class RegularisationOptions:
-    """Settings of :func:`nonsmooth_response`.
+    """Settings of the regularised harmonic balance of a law with jumps or friction
+    (:func:`rattle.frequency_response` with ``options=RegularisationOptions(...)``).
 
     ``harmonics`` H and ``regularisation`` ε of the HB (relative widths of the smooth steps);
     ``match``: the largest departure of the exact orbit's δ(t) from the HB's, relative to the HB

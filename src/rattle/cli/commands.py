@@ -26,8 +26,7 @@ from .checks import (
 )
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
-    friction_metadata, friction_summary, map_csv_writer, map_json_writer, map_summary, metadata_writer,
-    nonsmooth_metadata, nonsmooth_summary, one_line, save_figure, save_plot, sections, set_verbose, warning,
+    map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections, set_verbose, warning,
     write_frf, write_set,
 )
 
@@ -36,7 +35,7 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
     from ..model import Model
 
 __all__ = [
-    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_frf", "run_nonsmooth_orbit",
+    "DEFAULT_OUTPUT", "COMMANDS", "common_options", "compute_frf", "run_frf", "run_nonsmooth_orbit",
     "run_friction_orbit", "run_discontinuous_compare",
     "frf_command", "sweep_command", "orbit_command", "compare_command", "map_command", "demo_command",
 ]
@@ -114,17 +113,23 @@ def compute_frf(
     written (frf.csv, frf.json, frf.png, as the command's whole set ``names``: files of an
     earlier run that the partial set does not replace are removed) and the error re-raised
     naming the files."""
-    from ..analysis import frequency_response  # only now: all input has been validated
+    from ..analysis import case_arguments, frequency_response  # only now: all input has been validated
 
     extra: dict[str, Any] = {"subharmonics": True} if subharmonics else {}
     if start != "low":
         extra["start"] = start
     if fixed_harmonics:
         extra["adaptive"] = None
-    logger.info("computing the frequency response over %g … %g rad/s with %d harmonics",
-                analysis.omega_min, analysis.omega_max, analysis.harmonics)
+    arguments = case_arguments(model, analysis, extra)  # the law's method: harmonics, or [analysis] method
+    logger.info("computing the frequency response over %g … %g rad/s%s", analysis.omega_min, analysis.omega_max,
+                f" with {analysis.harmonics} harmonics" if "harmonics" in arguments else
+                f" ({type(arguments['options']).__name__})" if "options" in arguments else "")
+    bar = ProgressBar("frequency response", enabled=True, unit="‰")  # a bar of the range reached, on a terminal
     try:
-        return frequency_response(model, omega=analysis.omega, harmonics=analysis.harmonics, throw=True, **extra)
+        try:
+            return frequency_response(model, throw=True, progress=bar, **arguments)
+        finally:
+            bar.close()
     except (ConvergenceError, ArithmeticError) as exc:
         partial = getattr(exc, "partial", None)
         if partial is None or not len(partial):
@@ -199,58 +204,6 @@ def _law_keys(run_config: Any) -> str:
     return " and ".join(keys) or "`model.elastic`"
 
 
-def run_nonsmooth_frf(run_config: Any, analysis: AnalysisSettings, output: Path, sections: dict[str, Any],
-                      subharmonics: bool = False) -> None:
-    """``rattle frf`` on a discontinuous law, or a chain with friction on its elements:
-    :func:`rattle.analysis.nonsmooth_response` (a NonsmoothResponse, or a FrictionResponse for the
-    chain) with the file's ``[analysis]`` (harmonics, regularisation, refine), written as one set
-    frf.csv, frf.json, frf.png; with ``subharmonics`` the period-2 branches born at its period
-    doublings too.
-
-    Raises
-    ------
-    ConvergenceError
-        When the continuation did not cover the range (status not a success): the rows computed
-        are written first, and the error names the files (exit status 1, as the smooth frf).
-    """
-    t_start = time.perf_counter()
-    from ..analysis import method_options, nonsmooth_response  # only now: all input has been validated
-
-    options = method_options(analysis)
-    if analysis.method == "hb":
-        logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s: regularised "
-                    "harmonic balance (H = %d, ε = %g), every point checked by exact shooting", analysis.omega_min,
-                    analysis.omega_max, options.harmonics, options.regularisation)
-    else:
-        logger.info("computing the frequency response of a discontinuous law over %g … %g rad/s by exact shooting "
-                    "continuation", analysis.omega_min, analysis.omega_max)
-    if analysis.method == "hb":
-        result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics)
-    else:  # a bar of the range reached on a terminal (the runs of a chain take tens of seconds)
-        bar = ProgressBar("exact shooting continuation", enabled=True, unit="‰")
-        try:
-            result = nonsmooth_response(run_config.model, analysis.omega, options, subharmonics=subharmonics,
-                                        progress=bar)
-        finally:
-            bar.close()
-    timings = {"nonsmooth_response": time.perf_counter() - t_start}
-    chain = getattr(run_config, "chain_friction", False)  # a FrictionResponse, one column set per element
-    meta = (friction_metadata if chain else nonsmooth_metadata)(result, run_config.model, options, timings)
-    written = write_set(output, FRF_FILES, [
-        ("frf.csv", result.to_csv),
-        ("frf.json", metadata_writer(meta, sections, t_start)),
-        ("frf.png", lambda path: save_plot(result, path)),
-    ])
-    summary = (friction_summary if chain else nonsmooth_summary)(result, options, subharmonics)
-    echo_written(summary, written, output)
-    if not result.status.success:
-        raise ConvergenceError(
-            f"frequency response incomplete: {result.message or result.status.message}; the points computed "
-            f"before the failure were written to {', '.join(str(output / name) for name in written)}",
-            partial=result,
-        )
-
-
 @click.command("frf", short_help="Frequency response of the model in a configuration file.")
 @common_options
 @click.argument("config", type=click.Path(path_type=Path))
@@ -292,10 +245,6 @@ def frf_command(
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None,
                "start": None if start == "low" else start, "fixed_harmonics": True if fixed_harmonics else None}
-    if run_config.discontinuous:
-        run_nonsmooth_frf(run_config, analysis, output, sections("frf", config, run_config, analysis, options),
-                          subharmonics=subharmonics)
-        return
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
             subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics)
 

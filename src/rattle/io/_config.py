@@ -82,7 +82,7 @@ __all__ = [
 DEFAULT_OMEGA: tuple[float, float] = (0.1, 3.0)
 #: Default number of harmonics ``analysis.harmonics``: the SPEC §2 example.
 DEFAULT_HARMONICS: int = 32
-#: Defaults for a discontinuous law (a preload or friction: ``rattle.analysis.nonsmooth_response``):
+#: Defaults for a discontinuous law (a preload or friction: ``rattle.frequency_response``):
 #: ``analysis.regularisation`` ε and ``analysis.harmonics`` (those of ``RegularisationOptions``).
 DEFAULT_REGULARISATION: float = 0.01
 #: ``analysis.regularisation`` for a chain with friction on its elements: its velocity width ε L ω_n
@@ -211,9 +211,9 @@ class RunConfig:
     model : Model, Chain, NonsmoothSystem or FrictionSystem
         The ``[model]`` and ``[excitation]`` tables: a :class:`~rattle.model.NonsmoothSystem` when
         ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or a ``friction`` level > 0; only
-        ``rattle frf``, ``rattle orbit`` and :func:`rattle.analysis.nonsmooth_response` solve it), a
+        ``rattle frf``, ``rattle orbit`` and :func:`rattle.frequency_response` solve it), a
         :class:`~rattle.model.FrictionSystem` for a chain with a ``friction`` level > 0 on some
-        ``[[model.elements]]`` (only ``rattle frf``, ``rattle orbit``, ``nonsmooth_response`` and
+        ``[[model.elements]]`` (only ``rattle frf``, ``rattle orbit``, ``frequency_response`` and
         ``nonsmooth_orbit``), else a Model or a
         Chain.
     analysis : AnalysisSettings

@@ -98,7 +98,7 @@ class Element:
     :class:`~rattle.model.Friction`).
 
     A chain with friction or a torque jump on any element is solved on
-    :meth:`Chain.friction_system` (:func:`rattle.analysis.nonsmooth_response`, the exact flow of
+    :meth:`Chain.friction_system` (:func:`rattle.frequency_response`, the exact flow of
     :class:`rattle.timeint.FrictionIntegrator`); the smooth analyses refuse it."""
 
     name: str
@@ -429,14 +429,14 @@ class Chain:
             raise ValueError(
                 f"the chain has Coulomb friction on element(s) {names}: the smooth analyses (frf, sweep, "
                 "compare, map, orbit) do not hold a torque that jumps at zero relative speed; solve it with "
-                "rattle.analysis.nonsmooth_response(chain.friction_system(), ...)"
+                "rattle.frequency_response(chain, ...)"
             )
         if self.has_jumps:
             names = ", ".join(e.name for e in self.elements if e.has_jumps)
             raise ValueError(
                 f"the chain has a torque jump (preload) in the law of element(s) {names}: the smooth analyses "
                 "(frf, sweep, compare, map, orbit) need a continuous law; solve it with "
-                "rattle.analysis.nonsmooth_response(chain.friction_system(), ...)"
+                "rattle.frequency_response(chain, ...)"
             )
         return self._system
 

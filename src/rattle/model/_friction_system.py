@@ -98,6 +98,12 @@ class FrictionSystem:
         return self.laws[e].stages.jumps
 
     @property
+    def discontinuous(self) -> bool:
+        """True: the elements' laws may jump or have friction (the front ends solve the chain
+        exactly, or regularised and checked exactly)."""
+        return True
+
+    @property
     def has_friction(self) -> bool:
         return any(bool(np.any(law.friction_levels > 0)) for law in self.laws)
 

@@ -152,6 +152,12 @@ class Model:
         """A characteristic force per inertia for residual scaling: |F_m| + Σ |F_pn|."""
         return max(abs(self.excitation.mean) + self.excitation.amplitude_scale, 1e-300)
 
+    @property
+    def discontinuous(self) -> bool:
+        """False: a Model's law is continuous (a law with jumps or friction is a
+        :class:`~rattle.model.NonsmoothSystem`); the front ends choose their method by this."""
+        return False
+
     def system(self) -> System:
         """The equations of motion as the numerics see them: the n = m = 1
         :class:`~rattle.model.System` with C = [[C/I]], K = [[0]], a = [1], b = [K/I]."""

@@ -55,6 +55,12 @@ class NonsmoothSystem:
         law = NonsmoothLaw(elastic=model.elastic if elastic is None else elastic, friction=friction)
         return cls(damping=model.c, stiffness=model.k, law=law, excitation=model.excitation)
 
+    @property
+    def discontinuous(self) -> bool:
+        """True: the law jumps or has friction (the front ends solve it exactly, or regularised and
+        checked exactly)."""
+        return True
+
     # The equation's coefficients under the names the exact integrator's stage solutions read.
     @property
     def c(self) -> float:

@@ -16,7 +16,8 @@ from ._frf import (
 from ._friction import friction_response_plot
 from ._friction_orbit import friction_orbit_plot
 from ._map import map_plot_names, plot_map
-from ._nonsmooth import held_runs, nonsmooth_orbit_plot, nonsmooth_response_plot
+from ..results import held_runs
+from ._nonsmooth import nonsmooth_orbit_plot, nonsmooth_response_plot
 from ._orbit import amplitude_spectrum, orbit_plot
 from ._sweep import PERIOD_COLORS, period_label, sweep_plot
 

@@ -225,7 +225,7 @@ def _discontinuous_plot(comparison: "Comparison", fig: Any, title: str | None) -
 
     from ._sweep import _draw_sweep
 
-    frf, sweep = comparison.frf, comparison.sweep
+    frf, sweep = comparison.frf.check, comparison.sweep  # the exact-check group: HB and exact side by side
     names = tuple(getattr(frf, "element_names", ()) or ())
     m = max(1, len(names))
     if fig is None:

@@ -288,10 +288,24 @@ def frequency_response_plot(
     (figure, PlotAxes)
         One panel ``response`` (the given ``ax`` when there is one). A chain drawn without
         ``ax``: one panel per clearance element, keyed by its name, sharing Ω; the primary is
-        the first element's.
+        the first element's. A law with jumps or friction (``frf.check`` set): the panels of its
+        exact-check group — :func:`nonsmooth_response_plot` (one equation: ``rms``, ``stick``)
+        or :func:`friction_response_plot` (a chain: per element, and the stick fractions); the
+        options above apply to the harmonic-balance plot only and must be left at their defaults.
     """
     import matplotlib.pyplot as plt
 
+    if getattr(frf, "check", None) is not None:  # the panels follow from the columns the result has
+        if ax is not None or (quantity, linear, special_points, regions, legend, title) != (
+                "rms", True, True, True, "outside", None):
+            raise TypeError("`ax`, `quantity`, `linear`, `special_points`, `regions`, `legend` and `title` apply to "
+                            "the harmonic-balance plot; a law with jumps or friction draws its exact-check panels: "
+                            "leave them at their defaults")
+        from ._friction import friction_response_plot
+        from ._nonsmooth import nonsmooth_response_plot
+
+        draw = friction_response_plot if hasattr(frf.check, "element_names") else nonsmooth_response_plot
+        return draw(frf.check)
     ax = unwrap(ax)
     if quantity not in QUANTITY_LABELS:
         raise ValueError(f"`quantity` must be a numeric SPEC column ({', '.join(QUANTITY_LABELS)}), got {quantity!r}")

@@ -16,15 +16,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._axes import PlotAxes
-from ._nonsmooth import STICK_COLOUR, held_runs
+from ..results import held_runs
+from ._nonsmooth import STICK_COLOUR
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..results import FrictionResponse
+    from ..results import FrictionCheck
 
 _MARKERS = {"fold": "o", "period_doubling": "s", "neimark_sacker": "D"}
 
 
-def friction_response_plot(response: FrictionResponse) -> tuple[Any, PlotAxes]:
+def friction_response_plot(response: FrictionCheck) -> tuple[Any, PlotAxes]:
     """Draw ``response`` (module docstring); returns (figure, PlotAxes with panels ``rms`` (the
     primary) and ``stick``)."""
     import matplotlib.pyplot as plt

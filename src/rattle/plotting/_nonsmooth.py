@@ -20,10 +20,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..results import held_runs
 from ._axes import PlotAxes
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..results import NonsmoothOrbitResult, NonsmoothResponse
+    from ..results import NonsmoothOrbitResult, NonsmoothCheck
 
 #: Colours of the sub-harmonic branches, in order (the period-1 branch is tab:blue).
 _BRANCH_COLOURS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
@@ -36,33 +37,7 @@ LOCK_COLOUR = "tab:orange"
 _SHADE_ALPHA = 0.25
 
 
-def held_runs(omega: np.ndarray, held: np.ndarray) -> list[tuple[float, float]]:
-    """The Ω-ranges (min, max) of the consecutive runs of rows where ``held`` is true.
-
-    Parameters
-    ----------
-    omega : ndarray, shape (P,)
-        The forcing frequency Ω of every row, in branch order.
-    held : ndarray of bool, shape (P,)
-        The rows to gather (e.g. where the exact orbit sticks or locks).
-
-    Returns
-    -------
-    list of (float, float)
-        One ``(min Ω, max Ω)`` per run of consecutive true rows, in row order; empty when none.
-    """
-    runs: list[tuple[float, float]] = []
-    idx = np.flatnonzero(held)
-    if idx.size == 0:
-        return runs
-    breaks = np.flatnonzero(np.diff(idx) > 1)
-    for part in np.split(idx, breaks + 1):
-        w = omega[part]
-        runs.append((float(np.min(w)), float(np.max(w))))
-    return runs
-
-
-def nonsmooth_response_plot(response: NonsmoothResponse) -> tuple[Any, PlotAxes]:
+def nonsmooth_response_plot(response: NonsmoothCheck) -> tuple[Any, PlotAxes]:
     """Draw ``response`` (module docstring); returns (figure, PlotAxes with panels ``rms`` and
     ``stick``)."""
     import matplotlib.pyplot as plt
@@ -168,4 +143,4 @@ def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tu
     return fig, PlotAxes({"delta": ax_d, "velocity": ax_v, "phase": ax_p})
 
 
-__all__ = ["LOCK_COLOUR", "STICK_COLOUR", "held_runs", "nonsmooth_orbit_plot", "nonsmooth_response_plot"]
+__all__ = ["LOCK_COLOUR", "STICK_COLOUR", "nonsmooth_orbit_plot", "nonsmooth_response_plot"]

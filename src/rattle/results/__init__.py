@@ -7,11 +7,12 @@ them when loaded.
 
 from ._columns import FRF_COLUMNS, ORBIT_COLUMNS, SWEEP_COLUMNS
 from ._comparison import Comparison
-from ._friction import FRICTION_ELEMENT_COLUMNS, FRICTION_TAIL_COLUMNS, FrictionResponse
+from ._check import held_runs
+from ._friction import FRICTION_ELEMENT_COLUMNS, FRICTION_TAIL_COLUMNS, FrictionCheck
 from ._friction_orbit import FRICTION_ORBIT_ELEMENT_COLUMNS, FrictionOrbitResult, HeldLimitRecord
 from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, compare_measured
-from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothResponse
+from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothCheck
 from ._nonsmooth_orbit import NONSMOOTH_ORBIT_COLUMNS, NonsmoothOrbitResult
 from ._orbit import OrbitSolution, PeriodicOrbit
 from ._sound import (
@@ -28,6 +29,7 @@ __all__ = [
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",
     "coefficient_sound_pressure", "check_sound_paths", "UNCOVERED_WARNING",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
-    "NonsmoothResponse", "NONSMOOTH_COLUMNS", "FrictionResponse", "FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS",
+    "NonsmoothCheck", "NONSMOOTH_COLUMNS", "FrictionCheck", "FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS",
+    "held_runs",
     "NonsmoothOrbitResult", "NONSMOOTH_ORBIT_COLUMNS", "FrictionOrbitResult", "FRICTION_ORBIT_ELEMENT_COLUMNS", "HeldLimitRecord",
 ]

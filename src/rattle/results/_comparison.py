@@ -48,8 +48,8 @@ class Comparison:
         Provenance.
 
     A discontinuous law (:class:`~rattle.model.NonsmoothSystem`, or a chain with friction:
-    :class:`~rattle.model.FrictionSystem`): ``frf`` is its :class:`NonsmoothResponse` or
-    :class:`FrictionResponse` (exact rms per row, ``stable``, ``matched``), ``at``, ``orbits`` and
+    :class:`~rattle.model.FrictionSystem`): ``frf`` is its :class:`NonsmoothCheck` or
+    :class:`FrictionCheck` (exact rms per row, ``stable``, ``matched``), ``at``, ``orbits`` and
     ``simulations`` are empty, and :meth:`agreement` sets the sweep's settled period-1 rows against
     the response's exact rms.
     """
@@ -76,9 +76,9 @@ class Comparison:
 
     @property
     def discontinuous(self) -> bool:
-        """True when ``frf`` is the response of a discontinuous law (no ``branch`` column: a
-        :class:`NonsmoothResponse` or :class:`FrictionResponse`)."""
-        return not isinstance(self.frf, FrequencyResponse)
+        """True when ``frf`` is the response of a discontinuous law (it carries an exact-check
+        group, :class:`NonsmoothCheck` or :class:`FrictionCheck`, in ``check``)."""
+        return self.frf.check is not None
 
     def agreement(self) -> dict[str, Any]:
         """The sweep's settled period-1 rows against the response's exact rms (first element of a
@@ -88,7 +88,7 @@ class Comparison:
         (those with such a stretch), ``median`` and ``largest`` relative difference
         |rms_sweep − rms_response| / rms_sweep (None when none compared; they include the
         interpolation between the response's rows) and ``without`` (the Ω of the rows without)."""
-        frf, sweep = self.frf, self.sweep
+        frf, sweep = self.frf.check, self.sweep
         w = np.asarray(frf.omega, dtype=float)
         r = np.asarray(frf.rms, dtype=float)
         r = r[:, 0] if r.ndim == 2 else r
@@ -114,7 +114,7 @@ class Comparison:
 
     def _frf_lines(self) -> list[str]:
         """A discontinuous law's response in a few lines."""
-        frf = self.frf
+        frf = self.frf.check
         stable = np.asarray(frf.stable, dtype=bool) & np.asarray(frf.matched, dtype=bool)
         return [
             f"regularised harmonic balance (H = {frf.harmonics}, ε = {frf.regularisation:g}) checked by exact "
@@ -149,7 +149,7 @@ class Comparison:
         """Settings, timings and the examined frequencies, JSON-serialisable (a discontinuous
         law: the response's counts and the :meth:`agreement` instead of the orbits)."""
         if self.discontinuous:
-            frf = self.frf
+            frf = self.frf.check
             stable = np.asarray(frf.stable, dtype=bool) & np.asarray(frf.matched, dtype=bool)
             response = {"harmonics": frf.harmonics, "regularisation": frf.regularisation, "rows": len(frf),
                         "matched": int(np.sum(frf.matched)), "stable": int(np.sum(stable)),

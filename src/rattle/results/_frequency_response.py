@@ -14,6 +14,8 @@ from .._validate import as_float_array, check_history_size
 from ..errors import Status
 from ..hb import resize_harmonics
 from ._columns import FRF_COLUMNS
+from ._friction import FrictionCheck
+from ._nonsmooth import NonsmoothCheck
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model, check_analysable_model
 from ._plotter import plot_with
@@ -161,6 +163,46 @@ class FrequencyResponse:
     element_columns: dict[str, np.ndarray] = field(default_factory=dict)
     #: Further per-row columns written after the element columns (``spl_db``: :meth:`with_sound`).
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
+    #: The exact-check column group of a law with jumps or friction (None for a continuous law).
+    check: NonsmoothCheck | FrictionCheck | None = None
+
+    @classmethod
+    def from_check(cls, check: NonsmoothCheck | FrictionCheck, *, model: Any, settings: dict[str, Any],
+                   timings: dict[str, float]) -> "FrequencyResponse":
+        """The response of a law with jumps or friction from its exact-check group ``check`` (the
+        primary branch, its sub-harmonic branches in ``check.branches``): one row per row of each,
+        the primary's first; ``model`` the system solved (a :class:`~rattle.model.NonsmoothSystem`
+        or :class:`~rattle.model.FrictionSystem`), ``settings`` the method's (JSON-able: written to
+        ``frf.json``; ``subharmonics`` and ``refine`` read by :meth:`summary`)."""
+        parts = (check, *check.branches)
+
+        def cat(get: Any, dtype: Any = float) -> np.ndarray:
+            return np.concatenate([np.asarray(get(p), dtype=dtype) for p in parts])
+
+        chain = isinstance(check, FrictionCheck)  # a chain: the SPEC columns describe its first element (SPEC §5)
+        first = (lambda a: np.asarray(a, dtype=float).reshape(len(a), -1)[:, 0]) if chain else (lambda a: a)
+        mean, rms = cat(lambda p: first(p.mean)), cat(lambda p: first(p.rms))
+        omega = cat(lambda p: p.omega)
+        P = omega.size
+        bif = cat(lambda p: p.bifurcation, object)
+        multipliers = cat(lambda p: p.multipliers, complex)
+        branch = cat(lambda p: np.full(len(p), p.branch), np.int64)
+        located = cat(lambda p: np.full(len(p), p.labels is not None), bool)
+        special = tuple(SpecialPoint(str(bif[i]), int(i), float(omega[i]), int(branch[i]), multipliers[i],
+                                     located=bool(located[i]))
+                        for i in range(P) if bif[i] in ("fold", "period_doubling", "neimark_sacker"))
+        nan = np.full(P, np.nan)
+        return cls(
+            model=model, harmonics=int(check.harmonics), branch=branch,
+            period=cat(lambda p: np.full(len(p), p.period), np.int64), omega=omega, mean=mean, rms=rms,
+            rms_ac=np.sqrt(np.maximum(rms**2 - mean**2, 0.0)),
+            p2p=nan.copy() if chain else cat(lambda p: p.p2p), acc_p2p=nan.copy() if chain else cat(lambda p: p.acc_p2p),
+            delta_min=nan.copy(), delta_max=nan.copy(),
+            regime=np.full(P, "", dtype=object) if chain else cat(lambda p: p.regime, object),
+            stable=cat(lambda p: p.stable, bool), bifurcation=bif, iterations=np.zeros(P, dtype=np.int64),
+            residual=nan.copy(), coefficients=np.zeros((P, 0)), multipliers=multipliers, special_points=special,
+            status=check.status, message=check.message, settings=dict(settings), timings=dict(timings), check=check,
+        )
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -173,7 +215,8 @@ class FrequencyResponse:
     def __repr__(self) -> str:
         return (
             f"FrequencyResponse({len(self)} points, {len(np.unique(self.branch))} branch(es), "
-            f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}, H = {self.harmonics}, "
+            f"Ω = {self.omega.min():.4g}…{self.omega.max():.4g}, "
+            f"{'exact shooting' if self.check is not None and self.check.followed == 'exact shooting' else f'H = {self.harmonics}'}, "
             f"{int(np.sum(~self.stable))} unstable, special points: "
             f"{', '.join(f'{s.kind}@{s.omega:.4g}' for s in self.special_points) or 'none'}; "
             f"status: {self.status.name})"
@@ -183,7 +226,10 @@ class FrequencyResponse:
         """The SPEC columns in order, as a dict of arrays; ``harmonics`` (H of each row, SPEC §8);
         for a chain also, per element NAME, ``NAME_mean … NAME_regime`` (SPEC §5,
         :data:`ELEMENT_COLUMNS`); with an engine (SPEC §6) ``speed_rpm``; then the other extra
-        columns (``spl_db``)."""
+        columns (``spl_db``). With an exact-check group (a law with jumps or friction): its
+        columns (:meth:`NonsmoothCheck.columns`, :meth:`FrictionCheck.columns`), every branch's."""
+        if self.check is not None:
+            return self.check.all_columns()
         rpm = self.speed_rpm
         speed = {} if rpm is None else {"speed_rpm": rpm}
         extra = dict(self.extra_columns)
@@ -194,7 +240,10 @@ class FrequencyResponse:
     @property
     def column_names(self) -> list[str]:
         """Names of :meth:`columns` in file order: the SPEC §3 columns, ``harmonics`` (H of each
-        row, SPEC §8), the element columns, ``speed_rpm``, the other extra columns."""
+        row, SPEC §8), the element columns, ``speed_rpm``, the other extra columns; with an
+        exact-check group, its columns."""
+        if self.check is not None:
+            return self.check.column_names()
         speed = [] if getattr(self.model, "speed_order", None) is None else ["speed_rpm"]
         harmonics = ["harmonics"] if "harmonics" in self.extra_columns else []
         return [*FRF_COLUMNS, *harmonics, *self.element_columns, *speed,
@@ -220,7 +269,10 @@ class FrequencyResponse:
         return {c: self.element_columns[f"{name}_{c}"] for c in ELEMENT_COLUMNS}
 
     def summary(self) -> str:
-        """A few lines for the terminal."""
+        """A few lines for the terminal (with an exact-check group, its
+        :meth:`~NonsmoothCheck.frf_summary`)."""
+        if self.check is not None:
+            return self.check.frf_summary(self.settings)
         lines = [
             f"{len(self)} solution points over Ω = {self.omega.min():.4g} … {self.omega.max():.4g} "
             f"(H = {self.harmonics_text()} harmonics per forcing period), {int(np.sum(~self.stable))} unstable",
@@ -270,7 +322,10 @@ class FrequencyResponse:
 
     def metadata(self) -> dict[str, Any]:
         """Settings, timings, status, the uncovered parts of the range (``uncovered``, Ω and, with
-        an engine, ``uncovered_rpm``) and special points, JSON-serialisable."""
+        an engine, ``uncovered_rpm``) and special points, JSON-serialisable; with an exact-check
+        group, its :meth:`~NonsmoothCheck.frf_metadata`."""
+        if self.check is not None:
+            return self.check.frf_metadata(self.model, self.settings, self.timings)
         order = getattr(self.model, "speed_order", None)
         gaps = self.uncovered
         rpm = {} if order is None else {"uncovered_rpm": [[a * 60.0 / (2.0 * np.pi * order),
@@ -298,6 +353,9 @@ class FrequencyResponse:
         coefficients are padded to the largest harmonic count, special points re-indexed."""
         if not parts:
             raise ValueError("`parts` must hold at least one FrequencyResponse")
+        if any(p.check is not None for p in parts):
+            raise ValueError("`parts` must be responses of a continuous law: a law with jumps or friction holds "
+                             "all its branches in one response already")
         model = parts[0].model
         H = max(p.harmonics for p in parts)
 
@@ -340,6 +398,9 @@ class FrequencyResponse:
         )
         fields["element_columns"] = {k: v[rows] for k, v in self.element_columns.items()}
         fields["extra_columns"] = {k: v[rows] for k, v in self.extra_columns.items()}
+        if self.check is not None:  # that branch's own check group
+            fields["check"] = replace(next(c for c in (self.check, *self.check.branches) if c.branch == branch),
+                                      branches=())
         return type(self)(model=self.model, harmonics=self.harmonics, special_points=special, status=self.status,
                           message=self.message, settings=self.settings, timings=self.timings, **fields)
 
@@ -353,6 +414,10 @@ class FrequencyResponse:
         dict with ``t``, ``delta``, ``velocity``, ``acceleration`` (arrays of length samples·periods + 1)."""
         if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
             raise TypeError(f"`index` must be an integer, got {index!r}")
+        if self.check is not None:
+            raise ValueError("a law with jumps or friction has no Fourier coefficients (its orbits are exact "
+                             "trajectories): use rattle.analysis.nonsmooth_orbit(system, omega) for one orbit's "
+                             "time history")
         if not -len(self) <= index < len(self):
             raise IndexError(f"`index` must be in [0, {len(self)}), got {index}")
         samples, periods = check_history_size(samples, periods, self.coefficients.shape[-1] // 2)
@@ -369,7 +434,10 @@ class FrequencyResponse:
 
     def linear_response(self, omega: FloatArray | None = None, points: int = 600, *, element: int = 0) -> LinearResponse:
         """The linear system's (f = δ) closed-form response on element ``element``, by default
-        on a uniform grid."""
+        on a uniform grid (a :class:`~rattle.model.Model` or :class:`~rattle.model.Chain`'s)."""
+        if self.check is not None:
+            raise ValueError("the linear response is that of a Model or Chain; a law with jumps or friction has "
+                             "none here: use rattle.linear_frequency_response(model, omega) on its continuous model")
         if omega is None:
             omega = np.linspace(self.omega.min(), self.omega.max(), points)
         return linear_frequency_response(self.model, omega, element)
@@ -379,6 +447,9 @@ class FrequencyResponse:
         objects; :func:`rattle.results.sound_pressure`): ``spl_db`` (sound pressure level at the
         receiver, dB re 20 µPa), ``spl_dba`` (A-weighted, dB(A)) and ``spl_linear_db`` (the linear
         system's level at the same Ω)."""
+        if self.check is not None:
+            raise ValueError("`paths`: the sound pressure needs the Fourier coefficients of a harmonic-balance "
+                             "response; a law with jumps or friction has none")
         sp = sound_pressure(self, paths)
         with warnings.catch_warnings():  # the same harmonics: warned about once, above
             warnings.simplefilter("ignore")
@@ -397,7 +468,10 @@ class FrequencyResponse:
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """rms vs Ω (stable solid, unstable dashed, bifurcations marked, linear overlaid);
         returns (figure, :class:`rattle.plotting.PlotAxes`). See
-        :func:`rattle.plotting.frequency_response_plot`."""
+        :func:`rattle.plotting.frequency_response_plot`. With an exact-check group: the exact and
+        HB rms with the stability changes and the stick fraction
+        (:func:`rattle.plotting.nonsmooth_response_plot`, per element for a chain
+        :func:`rattle.plotting.friction_response_plot`)."""
         return plot_with("frequency_response_plot", self, ax=ax, **kwargs)
 
 

@@ -1,4 +1,7 @@
-"""The frequency response of a chain with Coulomb friction: rows of a continued branch.
+"""The exact-check column group of a chain with Coulomb friction or jumps on its elements.
+
+A :class:`~rattle.results.FrequencyResponse` of such a chain carries one :class:`FrictionCheck` in
+``check``: the rows of its continued branch (and, in ``branches``, its sub-harmonic ones).
 
 Each row is a point of the chain's regularised harmonic balance
 (:mod:`rattle.analysis._friction_response`) and, where exact Newton shooting on the event-driven
@@ -18,7 +21,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,9 +28,9 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
 from ..stability import classify_loss
-from ._plotter import plot_with
+from ._check import branch_lines, branch_metadata
 
-#: The per-element columns of :meth:`FrictionResponse.columns`, NAME_ prefixed, in this order.
+#: The per-element columns of :meth:`FrictionCheck.columns`, NAME_ prefixed, in this order.
 FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated",
                             "rms_hb_held")
 #: The columns closing each row.
@@ -37,7 +39,7 @@ FRICTION_TAIL_COLUMNS = ("matched", "stable", "stable_hb", "mu_abs", "mu_hb_abs"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class FrictionResponse:
+class FrictionCheck:
     """Rows of a continued branch of a chain with friction (P rows, m elements, n coordinates).
 
     ``omega`` (P,); ``rpm`` (P,) the crankshaft speed, None without an engine order;
@@ -59,7 +61,7 @@ class FrictionResponse:
     and breakpoint crossings (m … 2m−1) per period of every element, −1 where not matched.
 
     ``period`` p: the orbits repeat after p forcing periods (1: the primary branch; 2: a
-    sub-harmonic branch born at a period doubling, :func:`rattle.analysis.friction_subharmonics`);
+    sub-harmonic branch born at a period doubling, :func:`rattle.analysis._friction_subharmonics.friction_subharmonics`);
     ``branch`` its number (0 the primary), ``origin`` where it was born; ``states`` (P, 2n) the
     exact orbit's z(0) = (x, x') (nan where not matched). The primary branch carries the
     sub-harmonic ones in ``branches`` (empty unless asked for); :meth:`to_csv` writes them all, the
@@ -106,7 +108,7 @@ class FrictionResponse:
     branch: int = 0
     origin: str = ""
     states: FloatArray | None = None
-    branches: tuple[FrictionResponse, ...] = ()
+    branches: tuple[FrictionCheck, ...] = ()
     followed: str = "harmonic balance"
     held_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     held_rms: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
@@ -118,6 +120,12 @@ class FrictionResponse:
         return int(self.omega.size)
 
     # --- derived columns ----------------------------------------------------------------------
+    @property
+    def stick_time(self) -> FloatArray:
+        """(P, m): the time each element sticks per orbit period, stick_fraction · p·2π/Ω: the
+        single equation's name (:attr:`NonsmoothCheck.stick_time`) for the same measure."""
+        return self.stick_fraction * (2.0 * np.pi * self.period / self.omega)[:, None]
+
     @property
     def element_rms_error(self) -> FloatArray:
         """rms_hb / rms − 1 per row and element (P, m); nan where not matched."""
@@ -278,13 +286,6 @@ class FrictionResponse:
         parts = [self.columns()] + [b.columns() for b in self.branches]
         return {k: np.concatenate([np.asarray(p[k]) for p in parts]) for k in parts[0]}
 
-    def to_csv(self, path: str | Path) -> Path:
-        """Write :meth:`all_columns` (this branch, then its sub-harmonic ones) to ``path`` atomically."""
-        from ..files import write_csv
-
-        write_csv(path, self.all_columns(), self.column_names())
-        return Path(path)
-
     def metadata(self) -> dict[str, Any]:
         """A JSON-able summary of the run: settings, counts and the measured HB error."""
         matched = int(np.sum(self.matched))
@@ -433,11 +434,45 @@ class FrictionResponse:
             lines.append(f"continuation: {self.message}")
         return "\n".join(lines)
 
-    def plot(self) -> tuple:
-        """rms vs Ω per element (exact solid, HB dashed, unstable marked, stick ranges shaded) and
-        the stick fractions; returns (figure, PlotAxes). See
-        :func:`rattle.plotting.friction_response_plot`."""
-        return plot_with("friction_response_plot", self)
+    def frf_metadata(self, system: Any, settings: dict[str, Any], timings: dict[str, float]) -> dict[str, Any]:
+        """The ``frf.json`` sections (:meth:`FrequencyResponse.metadata`): the method's
+        ``settings``, the elements of ``system`` (law, friction level per stage relative to the
+        element's stiffness, the matched rows where it sticks), status and message, the rows, this
+        group's own counts and measured HB error (:meth:`metadata`), the sub-harmonic branches and
+        ``timings``."""
+        own = {k: v for k, v in self.metadata().items() if k not in ("method", "regularisation", "harmonics",
+                                                                      "status", "message")}
+        matched = np.asarray(self.matched, dtype=bool)
+        stick = np.nan_to_num(np.asarray(self.stick_fraction, dtype=float).reshape(len(self), -1))
+        elements = [{"name": name, "law": law.elastic.to_dict(),
+                     "friction": [float(r) for r in system.friction_levels(e)],
+                     "sticking_rows": int(np.count_nonzero(matched & (stick[:, e] > 0)))}
+                    for e, (name, law) in enumerate(zip(system.element_names, system.laws))]
+        return {
+            "settings": dict(settings),
+            "system": {"coordinates": int(system.n), "elements": elements},
+            "status": self.status.name.lower(),
+            "message": self.message or self.status.message,
+            "points": len(self),
+            **own,
+            "branches": [branch_metadata(b) for b in self.branches],
+            "timings": dict(timings),
+        }
+
+    def frf_summary(self, settings: dict[str, Any]) -> str:
+        """What ``rattle frf`` prints (:meth:`FrequencyResponse.summary`): :meth:`summary`, the
+        continuation's status, every element's largest exact rms, and the sub-harmonic branches
+        (``settings["subharmonics"]``: whether they were asked for)."""
+        lines = [self.summary(), f"status: {self.status.name.lower()} — {self.message or self.status.message}"]
+        matched = np.asarray(self.matched, dtype=bool)
+        rms = np.asarray(self.rms, dtype=float).reshape(len(self), -1)
+        for e, name in enumerate(self.element_names):
+            col = np.where(matched, rms[:, e], np.nan)
+            if np.any(np.isfinite(col)):
+                j = int(np.nanargmax(col))
+                lines.append(f"{name}: largest exact rms {col[j]:.5g} rad at Ω = {self.omega[j]:.5g}")
+        lines.extend(branch_lines(self, bool(settings.get("subharmonics"))))
+        return "\n".join(lines)
 
 
-__all__ = ["FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS", "FrictionResponse"]
+__all__ = ["FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS", "FrictionCheck"]

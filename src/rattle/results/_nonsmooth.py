@@ -1,4 +1,8 @@
-"""The frequency response of a discontinuous law (preload, friction): rows of a continued branch.
+"""The exact-check column group of a discontinuous law's (preload, friction) frequency response.
+
+A :class:`~rattle.results.FrequencyResponse` of a single equation with jumps or friction carries
+one :class:`NonsmoothCheck` in ``check``: the rows of its continued branch (and, in ``branches``,
+its sub-harmonic ones) with what the exact check measured.
 
 Each row is a point of the regularised harmonic balance (:mod:`rattle.analysis._nonsmooth`) and,
 where exact Newton shooting on the event-driven flow found the same orbit (``matched``), that exact
@@ -16,23 +20,23 @@ period doubling, a complex pair a Neimark–Sacker point): the change lies betwe
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
 from ..stability import classify_loss
-from ._plotter import plot_with
+from ._check import branch_lines, branch_metadata, largest
 
-#: The columns of :meth:`NonsmoothResponse.columns`: the SPEC §3 ones, then the extension.
+#: The columns of :meth:`NonsmoothCheck.columns`: the SPEC §3 ones, then the extension.
 NONSMOOTH_COLUMNS = ("branch", "period", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "regime", "stable", "bifurcation",
                      "rms_hb", "rms_error", "matched", "stick_time", "mu1_abs", "mu2_abs", "mu1_hb_abs", "mu2_hb_abs", "eps_limit", "rms_hb_limit",
                      "rms_hb_extrapolated", "rms_error_limit", "sticks", "crossings")
 
 
 @dataclass(frozen=True, slots=True)
-class NonsmoothResponse:
+class NonsmoothCheck:
     """Rows of a continued branch (arrays of length P) and how the run ended.
 
     ``omega``; ``rms_hb`` of the regularised HB orbit; from the exact orbit (nan where not
@@ -53,7 +57,7 @@ class NonsmoothResponse:
     :attr:`hb_error` is the error of the HB's ε → 0 estimate on every row.
 
     ``period`` p: the orbits repeat after p forcing periods (1: the primary branch; 2: a
-    sub-harmonic branch born at a period doubling, :func:`rattle.analysis.nonsmooth_subharmonics`);
+    sub-harmonic branch born at a period doubling, :func:`rattle.analysis._nonsmooth.nonsmooth_subharmonics`);
     ``branch`` its number (0 the primary), ``origin`` where it was born; ``states`` (P, 2) the
     exact orbit's (δ, δ') at t = 0 (nan where not matched). The primary branch carries the
     sub-harmonic ones in ``branches`` (empty unless asked for); :meth:`to_csv` writes them all,
@@ -61,7 +65,7 @@ class NonsmoothResponse:
     (the regularised HB, every row checked by exact shooting) or ``"exact shooting"`` (a
     sub-harmonic branch the regularised HB has no orbit for: every row an exact orbit, ``matched``
     true, the HB's columns nan). ``labels`` (P,): the special points located on an exact branch
-    (:func:`rattle.analysis.nonsmooth_response` by exact shooting), "" elsewhere; None: the
+    (:func:`rattle.frequency_response` by exact shooting), "" elsewhere; None: the
     stability changes between rows are named from their multipliers (:attr:`bifurcation`)."""
 
     omega: FloatArray
@@ -92,7 +96,7 @@ class NonsmoothResponse:
     branch: int = 0
     origin: str = ""
     states: FloatArray | None = None
-    branches: tuple[NonsmoothResponse, ...] = ()
+    branches: tuple[NonsmoothCheck, ...] = ()
     followed: str = "harmonic balance"
     labels: np.ndarray | None = None
 
@@ -105,6 +109,12 @@ class NonsmoothResponse:
 
     def __len__(self) -> int:
         return int(self.omega.size)
+
+    @property
+    def stick_fraction(self) -> FloatArray:
+        """The share of the orbit's period p·2π/Ω that δ sticks or locks, stick_time / (p·2π/Ω):
+        the chain's name (:attr:`FrictionCheck.stick_fraction`) for the same measure."""
+        return self.stick_time * self.omega / (2.0 * np.pi * self.period)
 
     @property
     def rms_error(self) -> FloatArray:
@@ -187,22 +197,93 @@ class NonsmoothResponse:
             "sticks": self.sticks, "crossings": self.crossings,
         }
 
-    def plot(self) -> tuple:
-        """The exact and HB rms vs Ω with the stability changes, and the stick fraction; returns
-        (figure, PlotAxes). See :func:`rattle.plotting.nonsmooth_response_plot`."""
-        return plot_with("nonsmooth_response_plot", self)
+    def column_names(self) -> list[str]:
+        """:data:`NONSMOOTH_COLUMNS`: the names of :meth:`columns` in file order."""
+        return list(NONSMOOTH_COLUMNS)
 
     def all_columns(self) -> dict[str, np.ndarray]:
         """:meth:`columns` of this branch followed by those of each of :attr:`branches`."""
         parts = [self.columns()] + [b.columns() for b in self.branches]
         return {k: np.concatenate([np.asarray(p[k]) for p in parts]) for k in NONSMOOTH_COLUMNS}
 
-    def to_csv(self, path: str | Path) -> Path:
-        """Write :meth:`all_columns` (this branch, then its sub-harmonic ones) to ``path`` atomically."""
-        from ..files import write_csv
+    def frf_metadata(self, system: Any, settings: dict[str, Any], timings: dict[str, float]) -> dict[str, Any]:
+        """The ``frf.json`` sections (:meth:`FrequencyResponse.metadata`): the method's
+        ``settings``, the equation solved (``system``), status and message, the rows (all, matched
+        by exact shooting, sticking), the largest and median |rms_error| over the matched rows, the
+        stability changes, the sub-harmonic branches and ``timings``."""
+        matched = np.asarray(self.matched, dtype=bool)
+        err = np.abs(np.asarray(self.rms_error, dtype=float)[matched])
+        err = err[np.isfinite(err)]
+        stick = np.asarray(self.stick_time, dtype=float)
+        labels = self.bifurcation
+        return {
+            "settings": dict(settings),
+            "system": {"damping": system.damping, "stiffness": system.stiffness, "law": system.law.to_dict(),
+                       "excitation": system.excitation.to_dict()},
+            "status": self.status.name.lower(),
+            "message": self.message or self.status.message,
+            "points": len(self),
+            "matched": int(np.count_nonzero(matched)),
+            "sticking": int(np.count_nonzero(matched & (np.nan_to_num(stick) > 0))),
+            "unstable": int(np.count_nonzero(~np.asarray(self.stable, dtype=bool))),
+            "rms_error_max": float(np.max(err)) if err.size else None,
+            "rms_error_median": float(np.median(err)) if err.size else None,
+            "refined": int(np.size(self.limit_index)),
+            "hb_error_max": largest(self.hb_error, matched),
+            "bifurcations": [{"kind": str(labels[i]), "index": int(i), "omega": float(self.omega[i])}
+                             for i in range(len(self)) if labels[i]],
+            "branches": [branch_metadata(b) for b in self.branches],
+            "timings": dict(timings),
+        }
 
-        write_csv(path, self.all_columns(), list(NONSMOOTH_COLUMNS))
-        return Path(path)
+    def frf_summary(self, settings: dict[str, Any]) -> str:
+        """What ``rattle frf`` prints (:meth:`FrequencyResponse.summary`): the rows, how they were
+        found, the HB's error against the exact orbits, sticking, the largest exact rms, the
+        special points and the sub-harmonic branches (``settings["subharmonics"]``: whether they
+        were asked for; ``settings["refine"]``: the refinement tolerance)."""
+        n = len(self)
+        matched = np.asarray(self.matched, dtype=bool)
+        unstable = int(np.count_nonzero(~np.asarray(self.stable, dtype=bool)))
+        how = (f"(exact shooting continuation: every row an exact orbit); {unstable} unstable"
+               if self.followed == "exact shooting"
+               else f"(regularised harmonic balance, H = {self.harmonics}, ε = {self.regularisation:g}); "
+                    f"{int(np.count_nonzero(matched))} matched by exact shooting, {unstable} unstable")
+        lines = [
+            f"{n} points over Ω = {np.min(self.omega):.4g} … {np.max(self.omega):.4g} {how}" if n else "no points",
+            f"status: {self.status.name.lower()} — {self.message or self.status.message}",
+        ]
+        err = np.abs(np.asarray(self.rms_error, dtype=float)[matched])
+        err = err[np.isfinite(err)]
+        if err.size or matched.any():
+            if err.size:
+                lines.append(f"rms of the HB against the exact orbit: median error {np.median(err):.2g}, largest "
+                             f"{np.max(err):.2g} (at Ω = "
+                             f"{self.omega[matched][np.nanargmax(np.abs(self.rms_error[matched]))]:.5g})")
+            refined = int(np.size(self.limit_index))
+            best = largest(self.hb_error, matched)
+            if refined and best is not None:
+                lines.append(f"regularisation continued towards its limit at {refined} row(s) (those off by more "
+                             f"than {settings.get('refine') or 0:g} and any asked for): largest error at the smallest "
+                             f"ε {best:.2g}")
+            stick = np.nan_to_num(np.asarray(self.stick_time, dtype=float)[matched])
+            if np.any(stick > 0):
+                period = 2.0 * np.pi / np.asarray(self.omega, dtype=float)[matched]
+                lines.append(f"sticks at {int(np.count_nonzero(stick > 0))} of the matched points (at most "
+                             f"{np.max(stick / period):.0%} of the period)")
+            i = int(np.nanargmax(np.where(matched, self.rms, np.nan)))
+            lines.append(f"largest exact rms {self.rms[i]:.5g} rad at Ω = {self.omega[i]:.5g} ({self.regime[i]})")
+        labels = self.bifurcation
+        if self.labels is not None:  # located on the exact branch
+            changes = [f"{labels[i]} at Ω = {self.omega[i]:.7g}" for i in range(n) if labels[i]]
+            head = "special points (located; grazing: a crossing or a stick phase appears or vanishes): "
+        else:
+            changes = [f"{labels[i]} before Ω = {self.omega[i]:.5g}" for i in range(n) if labels[i]]
+            head = "bifurcations (between rows; grazing: a crossing or a stick phase appears or vanishes): "
+        if changes:
+            lines.append(head + ", ".join(changes))
+        lines.extend(branch_lines(self, bool(settings.get("subharmonics"))))
+        return "\n".join(lines)
 
 
-__all__ = ["NONSMOOTH_COLUMNS", "NonsmoothResponse"]
+
+__all__ = ["NONSMOOTH_COLUMNS", "NonsmoothCheck"]

@@ -183,7 +183,7 @@ class NonsmoothOrbitResult:
     @property
     def matched(self) -> bool:
         """The exact orbit is the HB orbit's (``hb_distance`` ≤ ``match``), as in
-        :class:`NonsmoothResponse`: otherwise the shooting found another orbit and ``rms_error``
+        :class:`NonsmoothCheck`: otherwise the shooting found another orbit and ``rms_error``
         compares two different orbits."""
         return bool(self.hb_distance <= self.match)
 
