@@ -4,11 +4,13 @@
 An analysis on top of :mod:`rattle.timeint`: it runs the exact integrators and Newton shooting
 there and returns a :class:`~rattle.results.SteadyState` (whose ``status`` tells how it ended).
 
-One settling loop serves both: the single equation runs on :class:`ExactIntegrator` (state
-(δ, δ'), its fast scalar path), a chain on :class:`SystemIntegrator` (state z = (x, x') of its
-n coordinates; the scaled norm below then takes every coordinate by the System's length scale
-and every velocity by that times ν, :func:`system_state_scale`); shooting is
-:func:`_newton_shooting` or :func:`_newton_system` on the same exact flows.
+One settling loop serves every system, on its exact integrator (:func:`make_integrator`): the
+single equation on :class:`ExactIntegrator` (state (δ, δ'), its fast scalar path), a chain on
+:class:`SystemIntegrator` (state z = (x, x') of its n coordinates; the scaled norm below then
+takes every coordinate by the System's length scale and every velocity by that times ν,
+:func:`~rattle.timeint.state_scale`), the discontinuous laws on :class:`NonsmoothIntegrator`
+and :class:`FrictionIntegrator`; shooting is :meth:`ShootingProblem.solve` on the same exact
+flows.
 
 The state is integrated exactly (:class:`ExactIntegrator`) one forcing period T = 2π/Ω at a time,
 from t = 0 to T (F is T-periodic, so every period starts at forcing phase 0). The states at the
@@ -66,11 +68,9 @@ from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check
 from ..results._steady import METHODS, SteadyState
 from ..timeint import (
     ExactIntegrator, ExactMeasures, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator, NonsmoothTrajectory,
-    SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory,
+    ShootingProblem, Shot, SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory, built_for,
+    check_system_state, make_integrator, state_scale,
 )
-from ..timeint._flow import check_system_state
-from ..timeint._shooting import _newton_shooting, _Shot, _state_scale
-from ..timeint._system_shooting import _newton_system, _SystemShot, system_state_scale
 
 _TWO_PI = 2.0 * math.pi
 _LINEAR_CHECK = 0.1  # relative mismatch allowed between the simulation and the linearisation
@@ -158,63 +158,8 @@ class SteadyStateOptions:
 
 
 # ---------------------------------------------------------------------------------------------
-# The flow being settled: one equation (ExactIntegrator, 2 states) or a System (2n states)
+# The flow being settled: the exact integrator of any system, state z = (x, x')
 # ---------------------------------------------------------------------------------------------
-class _ModelFlow:
-    """The single equation on :class:`ExactIntegrator` (the fast path: scalar hot loop)."""
-
-    def __init__(self, model: Model, integ: ExactIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        self.dim = 2
-        self.scale = _state_scale(model, omega)
-
-    def advance(self, x: FloatArray, T: float) -> FloatArray:
-        d, v = self.integ._advance(float(x[0]), float(x[1]), 0.0, T, self.omega)
-        return np.array([d, v])
-
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _Shot:
-        return _newton_shooting(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
-
-    def propagate(self, x: FloatArray, T: float) -> Trajectory:
-        return self.integ.propagate(x, 0.0, T, self.omega)
-
-    @staticmethod
-    def section(traj: Trajectory, t: FloatArray) -> FloatArray:
-        s = traj.sample(t)
-        return np.column_stack((s.delta, s.velocity))
-
-    @staticmethod
-    def measures(traj: Trajectory) -> ExactMeasures:
-        return traj.measures()
-
-
-class _SystemFlow:
-    """A :class:`~rattle.model.System` on :class:`SystemIntegrator` (z = (x, x'), 2n states)."""
-
-    def __init__(self, system: System, integ: SystemIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        self.dim = 2 * system.n
-        self.scale = system_state_scale(system, omega)
-
-    def advance(self, x: FloatArray, T: float) -> FloatArray:
-        return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]
-
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _SystemShot:
-        return _newton_system(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
-
-    def propagate(self, x: FloatArray, T: float) -> SystemTrajectory:
-        return self.integ.propagate(x, 0.0, T, self.omega)
-
-    @staticmethod
-    def section(traj: SystemTrajectory, t: FloatArray) -> FloatArray:
-        x, v = traj.derivatives(np.asarray(t, dtype=float), 1)
-        return np.concatenate((x, v), axis=-1)
-
-    @staticmethod
-    def measures(traj: SystemTrajectory) -> SystemMeasures:
-        return traj.measures()
-
-
 class _Failed:
     """A shooting solve whose flow could not be followed (an event budget exceeded): never
     accepted (residual ∞)."""
@@ -226,71 +171,55 @@ class _Failed:
         self.x, self.evaluations = x, evaluations
 
 
-class _NonsmoothFlow:
-    """The single equation with a discontinuous law (:class:`~rattle.model.NonsmoothSystem`) on
-    :class:`NonsmoothIntegrator`: state (δ, δ'), scaled by (L, L ν) as
-    :func:`~rattle.timeint.shoot_nonsmooth_orbit` scales its residual; the period map's
-    sensitivity carries the saltation matrices (a stick or lock phase contributes an exact zero
-    multiplier), so the acceptance tests of the acceleration hold unchanged."""
+class _Flow:
+    """The exact flow of ``system`` on its integrator (:func:`make_integrator`): the period map
+    without records, Newton shooting (:meth:`ShootingProblem.solve`), the recorded trajectory,
+    its section states and its measures. States z = (x, x') (2n,; (δ, δ') for the single
+    equations), scaled by :func:`~rattle.timeint.state_scale`, (L, L ν), as the shooting scales
+    its residual; a discontinuous law's period map carries the saltation matrices (a stick or
+    lock phase contributes an exact zero multiplier), so the acceptance tests of the
+    acceleration hold unchanged."""
 
-    def __init__(self, system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        self.dim = 2
-        self.scale = np.array([system.length_scale(), integ.velocity_scale(omega)])
+    def __init__(self, system: Model | System | NonsmoothSystem | FrictionSystem, integ: Any, omega: float) -> None:
+        self.system, self.integ, self.omega = system, integ, omega
+        self.scale = state_scale(system, omega)
+        self.dim = self.scale.size
 
     def advance(self, x: FloatArray, T: float) -> FloatArray:
-        return self.integ.propagate(x, 0.0, T, self.omega).state1
+        return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]
 
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _Shot | _Failed:
+    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> Shot | _Failed:
         try:
-            return _newton_shooting(self.integ, self.omega, x, n, tol, iterations, self.scale,  # type: ignore[arg-type]
-                                    _MAX_HALVINGS)
-        except ConvergenceError:  # a trial state the event-driven flow cannot follow: no orbit
+            return ShootingProblem(self.system, period=n, integrator=self.integ).solve(
+                x, self.omega, tol=tol, max_iterations=iterations, max_halvings=_MAX_HALVINGS, scale=self.scale)
+        except ConvergenceError:  # a state the event-driven flow cannot follow: no orbit
             return _Failed(np.asarray(x, dtype=float).copy())
 
-    def propagate(self, x: FloatArray, T: float) -> NonsmoothTrajectory:
+    def propagate(self, x: FloatArray, T: float) -> Any:
         return self.integ.propagate(x, 0.0, T, self.omega)
 
     @staticmethod
-    def section(traj: NonsmoothTrajectory, t: FloatArray) -> FloatArray:
-        d, v, _ = traj.sample(np.asarray(t, dtype=float))
-        return np.column_stack((d, v))
+    def section(traj: Any, t: FloatArray) -> FloatArray:
+        """The states z(t) (len(t), 2n) on a trajectory of any of the integrators."""
+        t = np.asarray(t, dtype=float)
+        if isinstance(traj, Trajectory):
+            s = traj.sample(t)
+            return np.column_stack((s.delta, s.velocity))
+        if isinstance(traj, SystemTrajectory):
+            x, v = traj.derivatives(t, 1)
+            return np.concatenate((x, v), axis=-1)
+        if isinstance(traj, NonsmoothTrajectory):
+            d, v, _ = traj.sample(t)
+            return np.column_stack((d, v))
+        return traj.sample(t)[0]
 
     @staticmethod
-    def measures(traj: NonsmoothTrajectory) -> ExactMeasures:
-        return nonsmooth_measures(traj)
-
-
-class _FrictionFlow:
-    """A chain with friction (:class:`~rattle.model.FrictionSystem`) on
-    :class:`FrictionIntegrator`: z = (x, x'), 2n states, scaled by L and L max(Ω, ω_n) as
-    :func:`~rattle.timeint.shoot_friction_orbit` scales its residual (saltation monodromy)."""
-
-    def __init__(self, system: FrictionSystem, integ: FrictionIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        n = system.n
-        self.dim = 2 * n
-        self.scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
-
-    def advance(self, x: FloatArray, T: float) -> FloatArray:
-        return self.integ.advance(x, 0.0, T, self.omega)[0]
-
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _SystemShot | _Failed:
-        try:
-            return _newton_system(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
-        except ConvergenceError:
-            return _Failed(np.asarray(x, dtype=float).copy())
-
-    def propagate(self, x: FloatArray, T: float) -> FrictionTrajectory:
-        return self.integ.propagate(x, 0.0, T, self.omega)
-
-    @staticmethod
-    def section(traj: FrictionTrajectory, t: FloatArray) -> FloatArray:
-        return traj.sample(np.asarray(t, dtype=float))[0]
-
-    @staticmethod
-    def measures(traj: FrictionTrajectory) -> SystemMeasures:
-        return friction_measures(traj)
+    def measures(traj: Any) -> ExactMeasures | SystemMeasures:
+        if isinstance(traj, NonsmoothTrajectory):
+            return nonsmooth_measures(traj)
+        if isinstance(traj, FrictionTrajectory):
+            return friction_measures(traj)
+        return traj.measures()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -397,9 +326,6 @@ def stick_fraction(traj: NonsmoothTrajectory | FrictionTrajectory) -> float | Fl
     return float(traj.stick_time / T)
 
 
-_Flow = _ModelFlow | _SystemFlow | _NonsmoothFlow | _FrictionFlow
-
-
 def _proper_divisors(n: int) -> list[int]:
     return [m for m in range(1, n) if n % m == 0]
 
@@ -408,7 +334,7 @@ def _proper_divisors(n: int) -> list[int]:
 class _Candidate:
     """A stable orbit found by shooting, waiting for the simulation to come close."""
 
-    shot: _Shot | _SystemShot
+    shot: Shot
     period: int
     cycle: FloatArray  # (n, dim) unscaled section points
     created: int
@@ -434,7 +360,7 @@ class _Settler:
         self.shooting_periods = 0
         # acceleration state
         self.candidate: _Candidate | None = None
-        self.pending: tuple[int, FloatArray, _Shot, int] | None = None
+        self.pending: tuple[int, FloatArray, Shot, int] | None = None
         self.next_attempt = 1
         self.failures = 0
 
@@ -450,13 +376,13 @@ class _Settler:
         self.d[i, 1 : n + 1] = np.max(np.abs(self.P[i] - self.P[i - n : i][::-1]), axis=1)
         self.i = i
 
-    def shoot(self, x: FloatArray, n: int) -> _Shot | _SystemShot:
+    def shoot(self, x: FloatArray, n: int) -> Shot:
         opts = self.opts
         shot = self.flow.shoot(x, n, opts.shooting_tolerance, opts.shooting_iterations)
         self.shooting_periods += shot.evaluations * n
         return shot
 
-    def cycle_points(self, shot: _Shot | _SystemShot, n: int) -> FloatArray:
+    def cycle_points(self, shot: Shot, n: int) -> FloatArray:
         if n == 1:
             return shot.x[None, :].copy()
         return self.flow.section(shot.trajectory, np.arange(n) * self.T)
@@ -481,7 +407,7 @@ class _Settler:
                 return n
         return 0
 
-    def stable_orbit(self, x: FloatArray, n: int) -> tuple[_Shot | _SystemShot, int] | None:
+    def stable_orbit(self, x: FloatArray, n: int) -> tuple[Shot, int] | None:
         """Newton shooting with period n from x; the orbit (with its minimal period) if it
         converged and is stable, else None."""
         shot = self.shoot(x, n)
@@ -550,7 +476,7 @@ class _Settler:
         k = self.opts.section_points
         return self.X[max(0, self.i + 1 - k) : self.i + 1].copy()
 
-    def from_shot(self, shot: _Shot | _SystemShot, n: int) -> SteadyState:
+    def from_shot(self, shot: Shot, n: int) -> SteadyState:
         traj = shot.trajectory
         return SteadyState(
             omega=self.omega, period=n, status=Status.CONVERGED, periods=self.i,
@@ -640,48 +566,18 @@ def static_state(model: Model | Chain | System | NonsmoothSystem | FrictionSyste
     return np.concatenate((system.static_equilibrium(omega), np.zeros(system.n)))
 
 
-def make_integrator(
-    model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
-) -> ExactIntegrator | SystemIntegrator | NonsmoothIntegrator | FrictionIntegrator:
-    """The exact integrator :func:`steady_state` uses for ``model``: :class:`ExactIntegrator`
-    for the single equation (its fast scalar path), :class:`SystemIntegrator` of the System
-    for a chain, :class:`NonsmoothIntegrator` or :class:`FrictionIntegrator` for the
-    discontinuous laws (reuse it across calls to share its cache)."""
-    if isinstance(model, Model):
-        return ExactIntegrator(model)
-    if isinstance(model, NonsmoothSystem):
-        return NonsmoothIntegrator(model)
-    if isinstance(model, FrictionSystem):
-        return FrictionIntegrator(model)
-    return SystemIntegrator(model.system() if isinstance(model, Chain) else model)
-
-
-def _checked_integrator(integrator: object, cls: type, target: object, owner: str, what: str, noun: str) -> Any:
-    """``integrator``, or a new ``cls(target)`` when None: refused (TypeError) when not a ``cls``
-    (``what`` says which, e.g. "a SystemIntegrator for a chain"), and (ValueError) when its
-    ``owner`` attribute is another ``noun`` than ``target``."""
-    integ = cls(target) if integrator is None else integrator
-    if not isinstance(integ, cls):
-        raise TypeError(f"`integrator` must be {what}, got {integrator!r}")
-    built_for = getattr(integ, owner)
-    if built_for is not target and built_for != target:
-        raise ValueError(f"`integrator` was built for a different {noun} than `model`")
+def _checked_integrator(integrator: object, system: Model | System | NonsmoothSystem | FrictionSystem) -> Any:
+    """``integrator``, or :func:`make_integrator` of ``system`` when None: refused (TypeError)
+    when not the exact integrator of ``system``'s kind, (ValueError) when built for another
+    system."""
+    integ = make_integrator(system) if integrator is None else integrator
+    if not built_for(integ, system):
+        kind = type(make_integrator(system)).__name__ if integrator is not None else ""
+        if not isinstance(integ, type(make_integrator(system))):
+            raise TypeError(f"`integrator` must be a {kind} for a {type(system).__name__}, got {integrator!r}")
+        raise ValueError(f"`integrator` was built for a different {'model' if isinstance(system, Model) else 'system'} "
+                         "than `model`")
     return integ
-
-
-def _discontinuous_flow(
-    model: NonsmoothSystem | FrictionSystem, omega: float, x0: object, integrator: object,
-) -> tuple[_NonsmoothFlow | _FrictionFlow, FloatArray, tuple[str, ...]]:
-    """The flow, start state and element names of a discontinuous law."""
-    if isinstance(model, NonsmoothSystem):
-        x = check_state(x0) if x0 is not None else static_state(model)
-        integ = _checked_integrator(integrator, NonsmoothIntegrator, model, "system",
-                                    "a NonsmoothIntegrator for a NonsmoothSystem", "system")
-        return _NonsmoothFlow(model, integ, omega), x, ()
-    x = check_system_state(x0, model.n, "x0") if x0 is not None else static_state(model, omega)
-    finteg = _checked_integrator(integrator, FrictionIntegrator, model, "fsys",
-                                 "a FrictionIntegrator for a FrictionSystem", "system")
-    return _FrictionFlow(model, finteg, omega), x, model.element_names
 
 
 @numerical_failures
@@ -739,33 +635,23 @@ def steady_state(
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
         raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
-    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+    if isinstance(model, (System, NonsmoothSystem, FrictionSystem)):
         from .._validate import check_omega
 
         omega = check_omega(omega)
-        dflow, x, dnames = _discontinuous_flow(model, omega, x0, integrator)
-        return _Settler(dflow, omega, x.copy(), opts, dnames).run()
-    if isinstance(model, System):
-        from .._validate import check_omega
-
-        omega = check_omega(omega)
-        system = model
+        system: Model | System | NonsmoothSystem | FrictionSystem = model
     else:
         check_analysable_model(model)
         omega = _limits.check_frequency(model, omega)
-        system = None if isinstance(model, Model) else model.system()
-    if system is None:
-        x = check_state(x0) if x0 is not None else static_state(model)
-        integ = _checked_integrator(integrator, ExactIntegrator, model, "model", "an ExactIntegrator for a Model",
-                                    "model")
-        flow: _ModelFlow | _SystemFlow = _ModelFlow(model, integ, omega)  # type: ignore[arg-type]
+        system = model if isinstance(model, Model) else model.system()
+    if isinstance(system, (Model, NonsmoothSystem)):
+        x = check_state(x0) if x0 is not None else static_state(system)
         names: tuple[str, ...] = ()
     else:
-        x = check_system_state(x0, system.n, "x0") if x0 is not None else static_state(system, omega)
-        sinteg = _checked_integrator(integrator, SystemIntegrator, system, "system", "a SystemIntegrator for a chain",
-                                     "system")
-        flow = _SystemFlow(system, sinteg, omega)
-        names = tuple(e.name for e in system.elements)
+        n = system.n
+        x = check_system_state(x0, n, "x0") if x0 is not None else static_state(system, omega)
+        names = system.element_names if isinstance(system, FrictionSystem) else tuple(e.name for e in system.elements)
+    flow = _Flow(system, _checked_integrator(integrator, system), omega)
     return _Settler(flow, omega, x.copy(), opts, names).run()
 
 

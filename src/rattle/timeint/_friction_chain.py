@@ -82,16 +82,14 @@ from scipy.optimize import brentq
 
 from .._limits import check_interval
 from .._typing import FloatArray
-from .._validate import check_omega, check_shooting
+from .._validate import check_omega
 from ..errors import ConvergenceError
 from ..model import FrictionSystem, System
 from ..model._system import ReducedElement
 from ._events import first_exit
 from ._flow import check_system_state
 from ._nonsmooth import NonsmoothOptions
-from ._shooting import ShotOrbit, monodromy_multipliers
 from ._stage_flow import Segment, StageSolution, SystemStages
-from ._system_shooting import _newton_system
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
@@ -454,8 +452,10 @@ class FrictionIntegrator:
             locked=np.asarray(rec["lk"], dtype=bool).reshape(-1, self.m),
         )
 
-    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float) -> tuple[FloatArray, FloatArray]:
-        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path)."""
+    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[FloatArray, FloatArray]:
+        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path; the
+        ``sensitivity`` is there for the common signature: M is always computed)."""
         return self._march(np.asarray(z0, dtype=float).copy(), float(t0), float(t1), float(omega), None)
 
     def _march(self, z: FloatArray, t0: float, t1: float, omega: float,
@@ -827,105 +827,4 @@ class FrictionIntegrator:
         return None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class FrictionOrbit(ShotOrbit):
-    """A periodic orbit of a chain with friction by Newton shooting on the exact period map:
-    ``state0`` z(0) (2n,), ``monodromy`` (with saltation matrices), ``multipliers``,
-    ``trajectory`` over one period, every element's ``mean`` and ``rms`` (m,) and
-    ``stick_fraction`` (m,: the fraction of the period it sticks)."""
-
-    trajectory: FrictionTrajectory
-    mean: FloatArray
-    rms: FloatArray
-    stick_fraction: FloatArray
-
-
-def _newton_held(integ: FrictionIntegrator, omega: float, z: FloatArray, T: float, hold: dict[int, float],
-                 scale: FloatArray, tol: float, max_iterations: int) -> tuple[FloatArray, float, int]:
-    """Gauss–Newton on [φ(z0) − z0; a_e·x0 − d_e (e held)] = 0 with the Jacobian [[M − I]; [a_e, 0]]
-    (least squares: M − I is singular along the family of orbits the holds pick one of)."""
-    n = integ.n
-    rows = np.zeros((len(hold), 2 * n))
-    target = np.zeros(len(hold))
-    for k, (e, d) in enumerate(hold.items()):
-        rows[k, :n] = integ.A[e]
-        target[k] = d
-    L = float(scale[0])
-
-    def residual(zz: FloatArray) -> tuple[FloatArray, FloatArray] | None:
-        try:
-            z1, M = integ.advance(zz, 0.0, T, omega)
-        except ConvergenceError:
-            return None
-        return np.concatenate(((z1 - zz) / scale, (rows @ zz - target) / L)), M
-
-    out = residual(z)
-    if out is None:
-        return z, math.inf, 0
-    r, M = out
-    res = float(np.max(np.abs(r)))
-    it = 0
-    while res > tol and it < max_iterations:
-        it += 1
-        J = np.vstack(((M - np.eye(2 * n)) / scale[:, None], rows / L))
-        dz = np.linalg.lstsq(J, -r, rcond=None)[0]
-        step = 1.0
-        for _ in range(31):
-            out = residual(z + step * dz)
-            if out is not None and float(np.max(np.abs(out[0]))) < res:
-                break
-            step *= 0.5
-        else:
-            break
-        z = z + step * dz
-        r, M = out  # type: ignore[misc]
-        res = float(np.max(np.abs(r)))
-    return z, res, it
-
-
-def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *, period: int = 1,
-                         tol: float = 1e-12, max_iterations: int = 50,
-                         integrator: FrictionIntegrator | None = None,
-                         hold: dict[int, float] | None = None) -> FrictionOrbit:
-    """Periodic orbit of the chain with friction by Newton shooting: r(z0) = φ(z0; 0 → T) − z0 = 0
-    with the Jacobian M − I (M the exact monodromy with saltation matrices), steps halved until
-    the scaled residual decreases. Scales: L for positions, L max(Ω, ω_n) for velocities. A
-    failed solve is returned with ``converged`` False.
-
-    ``hold`` {element: deflection}: elements that stick the whole period. Their orbits form a
-    family (the stuck deflection is free within the friction band; a multiplier 1, M − I
-    singular); the one whose held deflection is the given one is found, by Gauss–Newton on the
-    shooting equations with a_e·x0 = d_e added. The start is moved onto the holds: δ_e = d_e and
-    δ_e' = 0."""
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a FrictionSystem, got {system!r}")
-    omega = check_omega(omega)
-    check_shooting(period, tol, max_iterations)
-    integ = FrictionIntegrator(system) if integrator is None else integrator
-    if integ.fsys is not system:
-        raise ValueError("`integrator` was built for a different system than `system`")
-    z = check_system_state(z0, system.n).copy()
-    n = system.n
-    scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
-    T = period * 2.0 * math.pi / omega
-    if hold:
-        held = {int(e): float(d) for e, d in hold.items()}
-        for e, d in held.items():
-            if not 0 <= e < system.m:
-                raise ValueError(f"`hold` names element {e}; the system has elements 0 … {system.m - 1}")
-            a = integ.A[e]
-            z[:n] += a * ((d - float(a @ z[:n])) / float(a @ a))
-            z[n:] -= a * (float(a @ z[n:]) / float(a @ a))
-        z, res, it = _newton_held(integ, omega, z, T, held, scale, float(tol), int(max_iterations))
-        traj: FrictionTrajectory = integ.propagate(z, 0.0, T, omega)
-    else:  # Newton on φ(z0) − z0 with M − I (the shooting core shared with the smooth chain's)
-        shot = _newton_system(integ, omega, z, int(period), float(tol), int(max_iterations), scale, max_halvings=30)
-        z, res, it = shot.x, shot.residual, shot.iterations
-        traj = shot.trajectory  # type: ignore[assignment]
-    mean, rms = traj.element_mean_and_rms()
-    return FrictionOrbit(state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
-                         multipliers=monodromy_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,
-                         residual=res, trajectory=traj, mean=mean, rms=rms, stick_fraction=traj.stick_time() / T)
-
-
-__all__ = ["EVENT_NAMES", "FrictionIntegrator", "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit"]
+__all__ = ["EVENT_NAMES", "FrictionIntegrator", "FrictionTrajectory"]

@@ -55,13 +55,12 @@ import numpy as np
 
 from .._limits import check_interval
 from .._typing import FloatArray, IntArray
-from .._validate import check_omega, check_shooting, check_state
+from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model._elastic import Stages
 from ..model._nonsmooth_system import NonsmoothSystem
 from ._integrator import ExactIntegrator, _Segment
 from ._roots import bracketed_newton
-from ._shooting import ShotOrbit, _newton_shooting
 from ._stage_solutions import StageSolutions
 
 _EPS = float(np.finfo(float).eps)
@@ -422,6 +421,13 @@ class NonsmoothIntegrator:
             homogeneous=np.asarray(rec["h"], dtype=float).reshape(-1, 2),
             event_time=np.asarray(rec["et"], dtype=float), event_kind=tuple(rec["ek"]), solutions=sol)
 
+    def advance(self, x0: FloatArray, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
+        """The state (δ, δ') at ``t1`` and ∂x(t1)/∂x(t0) (None when ``sensitivity`` is False): the
+        period map of a shooting."""
+        traj = self.propagate(x0, t0, t1, omega)
+        return traj.state1, (traj.sensitivity if sensitivity else None)
+
     # --- the march ---------------------------------------------------------------------------
     def _march(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
                rec: dict[str, list]) -> tuple[float, float, tuple[float, float, float, float]]:
@@ -679,56 +685,4 @@ class NonsmoothIntegrator:
         return None, False
 
 
-# ---------------------------------------------------------------------------------------------
-# Periodic orbits
-# ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class NonsmoothOrbit(ShotOrbit):
-    """A periodic orbit of the discontinuous equation found by Newton shooting on the exact period
-    map: ``state0`` (δ, δ') at t = 0, ``omega``, ``period`` p (T = p 2π/Ω), ``monodromy`` M (with
-    the saltation matrices), ``multipliers`` (eigenvalues of M, largest modulus first),
-    ``converged``, ``iterations``, ``residual`` (scaled ‖φ(x0) − x0‖∞), ``trajectory`` over one
-    period, ``mean`` and ``rms`` of δ."""
-
-    trajectory: NonsmoothTrajectory
-    mean: float
-    rms: float
-
-    @property
-    def regime(self) -> str:
-        """``no_impact``, ``single_sided`` or ``double_sided`` from the breakpoints crossed or
-        locked on (a jump at δ = 0 is on neither side: crossing only it is ``single_sided``)."""
-        crossed = self.trajectory.crossed_breakpoints
-        if crossed.size == 0:
-            return "no_impact"
-        if np.all(crossed >= 0.0) or np.all(crossed <= 0.0):
-            return "single_sided"
-        return "double_sided"
-
-
-def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray | tuple[float, float], *,
-                          period: int = 1, tol: float = 1e-12, max_iterations: int = 50,
-                          integrator: NonsmoothIntegrator | None = None) -> NonsmoothOrbit:
-    """Periodic orbit of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) by Newton shooting: r(x0) =
-    φ(x0; 0 → T) − x0 = 0 with the Jacobian M − I, M the exact monodromy (stage transition and
-    saltation matrices). The residual is scaled by (L, L ν) (:meth:`NonsmoothIntegrator.velocity_scale`).
-    A failed solve is returned with ``converged`` False."""
-    if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
-    omega = check_omega(omega)
-    check_shooting(period, tol, max_iterations)
-    integ = NonsmoothIntegrator(system) if integrator is None else integrator
-    if integ.system != system:
-        raise ValueError("`integrator` was built for a different system than `system`")
-    L = system.length_scale()
-    scale = np.array([L, integ.velocity_scale(omega)])
-    shot = _newton_shooting(integ, omega, check_state(x0), int(period), float(tol), int(max_iterations), scale)  # type: ignore[arg-type]
-    traj: NonsmoothTrajectory = shot.trajectory  # type: ignore[assignment]
-    mean, rms = traj.mean_and_rms()
-    return NonsmoothOrbit(state0=shot.x, omega=omega, period=int(period), monodromy=traj.sensitivity,
-                          multipliers=shot.multipliers(), converged=shot.residual <= tol, iterations=shot.iterations,
-                          residual=shot.residual, trajectory=traj, mean=mean, rms=rms)
-
-
-__all__ = ["NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory",
-           "shoot_nonsmooth_orbit"]
+__all__ = ["NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothTrajectory"]
