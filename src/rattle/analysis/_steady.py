@@ -68,7 +68,7 @@ from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check
 from ..results._steady import METHODS, SteadyState
 from ..timeint import (
     ExactIntegrator, ExactMeasures, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator, NonsmoothTrajectory,
-    ShootingProblem, Shot, SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory, built_for,
+    ExactTrajectory, ShootingProblem, Shot, SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory, built_for,
     check_system_state, make_integrator, state_scale,
 )
 
@@ -199,19 +199,9 @@ class _Flow:
         return self.integ.propagate(x, 0.0, T, self.omega)
 
     @staticmethod
-    def section(traj: Any, t: FloatArray) -> FloatArray:
+    def section(traj: ExactTrajectory, t: FloatArray) -> FloatArray:
         """The states z(t) (len(t), 2n) on a trajectory of any of the integrators."""
-        t = np.asarray(t, dtype=float)
-        if isinstance(traj, Trajectory):
-            s = traj.sample(t)
-            return np.column_stack((s.delta, s.velocity))
-        if isinstance(traj, SystemTrajectory):
-            x, v = traj.derivatives(t, 1)
-            return np.concatenate((x, v), axis=-1)
-        if isinstance(traj, NonsmoothTrajectory):
-            d, v, _ = traj.sample(t)
-            return np.column_stack((d, v))
-        return traj.sample(t)[0]
+        return traj.states(np.asarray(t, dtype=float))
 
     @staticmethod
     def measures(traj: Any) -> ExactMeasures | SystemMeasures:

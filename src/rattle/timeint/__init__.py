@@ -8,7 +8,7 @@ The steady state of a simulation with period detection is an analysis built on t
 
 from typing import Any
 
-from ._exact import ExactIntegrator, ExactMeasures, StageSolutions, StateSamples, Trajectory
+from ._exact import ExactIntegrator, ExactMeasures, ExactTrajectory, StageSolutions, StateSamples, Trajectory
 from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory, check_system_state
 from ._general import GeneralSolution, integrate_general
 from ._friction_chain import FrictionIntegrator, FrictionTrajectory
@@ -22,7 +22,7 @@ from ._shooting import (
 )
 
 __all__ = [
-    "ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
+    "ExactIntegrator", "ExactTrajectory", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
     "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem", "monodromy_multipliers", "FLOW_FAILURES",
     "Shot", "ShotOrbit", "state_scale", "make_integrator", "built_for", "check_system_state",
     "integrate_general", "GeneralSolution",

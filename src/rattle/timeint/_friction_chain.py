@@ -87,6 +87,7 @@ from ..errors import ConvergenceError
 from ..model import FrictionSystem, System
 from ..model._system import ReducedElement
 from ._events import first_exit
+from ._trajectory import ExactTrajectory
 from ._flow import check_system_state
 from ._nonsmooth import NonsmoothOptions
 from ._stage_flow import Segment, StageSolution, SystemStages
@@ -115,8 +116,8 @@ def _brent(fun, a: float, b: float, fa: float, fb: float) -> float:  # type: ign
     return float(brentq(fun, a, b, xtol=4.0 * _EPS * max(abs(b), 1e-300), rtol=4.0 * _EPS, maxiter=200))
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class FrictionTrajectory:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FrictionTrajectory(ExactTrajectory):
     """The exact motion from ``t0`` to ``t1``: ``state0``, ``state1`` (2n,) and the sensitivity
     ∂z(t1)/∂z(t0) (stage transitions and saltation matrices); per segment its start time
     ``t_start`` (and ``t_end``), the element ``stages`` (k, m), the ``stuck`` flags (k, m: held
@@ -126,14 +127,6 @@ class FrictionTrajectory:
     breakpoint crossed, locked on or left)."""
 
     system: FrictionSystem
-    omega: float
-    t0: float
-    t1: float
-    state0: FloatArray
-    state1: FloatArray
-    sensitivity: FloatArray
-    t_start: FloatArray
-    t_end: FloatArray
     stages: np.ndarray
     stuck: np.ndarray
     segments: tuple[Segment, ...]
@@ -143,9 +136,9 @@ class FrictionTrajectory:
     event_values: FloatArray
     locked: np.ndarray | None = None
 
-    def segment_index(self, t: FloatArray | float) -> np.ndarray:
-        t = np.asarray(t, dtype=float)
-        return np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """z = (x, x') at times ``t``, shape t.shape + (2n,)."""
+        return self.sample(t)[0]
 
     def sample(self, t: FloatArray | float) -> tuple[FloatArray, FloatArray]:
         """z = (x, x') and z' = (x', x'') at times ``t``: shapes t.shape + (2n,) each."""

@@ -60,6 +60,7 @@ from ..errors import ConvergenceError
 from ..model._elastic import Stages
 from ..model._nonsmooth_system import NonsmoothSystem
 from ._integrator import ExactIntegrator, _Segment
+from ._trajectory import ExactTrajectory
 from ._roots import bracketed_newton
 from ._stage_solutions import StageSolutions
 
@@ -135,7 +136,7 @@ def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: in
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class NonsmoothTrajectory:
+class NonsmoothTrajectory(ExactTrajectory):
     """An exact trajectory from ``t0`` to ``t1``: segments i from ``t_start[i]`` to ``t_end[i]``
     of ``kind[i]`` (0 slip, 1 stick, 2 lock) on ``stage[i]`` with friction sign ``sign[i]``
     (slip only), start state ``x_start[i]`` and homogeneous part ``homogeneous[i]`` (slip);
@@ -144,14 +145,6 @@ class NonsmoothTrajectory:
     ``stick``, ``unstick``, ``lock``, ``unlock``)."""
 
     system: NonsmoothSystem
-    omega: float
-    t0: float
-    t1: float
-    state0: FloatArray
-    state1: FloatArray
-    sensitivity: FloatArray
-    t_start: FloatArray
-    t_end: FloatArray
     kind: IntArray
     stage: IntArray
     sign: IntArray
@@ -161,15 +154,17 @@ class NonsmoothTrajectory:
     event_kind: tuple[str, ...]
     solutions: StageSolutions = field(repr=False)
 
-    def _segment_of(self, t: FloatArray) -> IntArray:
-        return np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """(δ, δ') at times ``t``, shape t.shape + (2,)."""
+        d, v, _ = self.sample(np.asarray(t, dtype=float))
+        return np.stack((d, v), axis=-1)
 
     def sample(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """δ, δ' and δ'' at times ``t`` in [t0, t1] (arrays of t's shape); δ'' on a stick or lock
         is 0, at a switching time the value of the segment starting there."""
         t = np.asarray(t, dtype=float)
         flat = t.ravel()
-        idx = self._segment_of(flat)
+        idx = self.segment_index(flat)
         d, v, a = np.empty_like(flat), np.zeros_like(flat), np.zeros_like(flat)
         sol = self.solutions
         for i in np.unique(idx):
