@@ -124,8 +124,6 @@ PRIVATE_TARGETS_ALLOWED: tuple[str, ...] = (
     "rattle.timeint",
     "rattle.model._nonsmooth_system",
     "rattle.model._friction_system",
-    "rattle.model._system",
-    "rattle.model._stage_matrix",
     "rattle.continuation",
     "rattle.analysis",
 )
@@ -150,7 +148,8 @@ PRIVATE_IMPORTS_ALLOWED: frozenset[tuple[str, str]] = frozenset({
     ("rattle.model._readers", "rattle.files._read"),
     ("rattle.results._sound", "rattle.model._paths"),  # check_source, parse_source
     ("rattle.stability._monitor", "rattle.hb._kernels"),
-    ("rattle.timeint._nonsmooth", "rattle.model._elastic"),
+    ("rattle.stability._floquet", "rattle.model._stage_matrix"),  # stage_transition (exported by rattle.model now)
+    ("rattle.stability._kernels", "rattle.model._stage_matrix"),
 })
 
 

@@ -48,8 +48,7 @@ from ..results import FrequencyResponse
 from ..results._orbit import OrbitSolution, PeriodicOrbit
 from ..results._steady import SteadyState
 from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, stability_method
-from ..timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
-from ..timeint._flow import check_system_state
+from ..timeint import ExactIntegrator, check_system_state, shoot_periodic_orbit, shoot_system_orbit
 from ._frequency_response import check_range, frequency_response
 from ._settings import DEFAULT_HARMONICS, StabilityMethod, check_stability, resolve_hb
 from ._steady import SteadyStateOptions, make_integrator, steady_state

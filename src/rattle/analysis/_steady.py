@@ -67,9 +67,9 @@ from ..errors import ConvergenceError
 from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check_analysable_model
 from ..results._steady import METHODS, SteadyState
 from ..timeint import (
-    ExactIntegrator, ExactMeasures, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator, NonsmoothTrajectory,
-    ExactTrajectory, ShootingProblem, Shot, SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory, built_for,
-    check_system_state, make_integrator, state_scale,
+    ExactIntegrator, ExactMeasures, ExactTrajectory, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator,
+    NonsmoothTrajectory, ShootingProblem, Shot, SystemIntegrator, SystemMeasures, built_for, check_system_state,
+    make_integrator, state_scale,
 )
 
 _TWO_PI = 2.0 * math.pi

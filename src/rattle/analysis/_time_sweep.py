@@ -38,7 +38,7 @@ from ..errors import ConfigError, RattleError
 from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
 from ..results._sweep import SweepResult
 from ..results._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED
-from ..timeint._shooting import FLOW_FAILURES
+from ..timeint import FLOW_FAILURES
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
 logger = logging.getLogger("rattle")

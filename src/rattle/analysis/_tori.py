@@ -123,8 +123,9 @@ def simulate_torus(frf: FrequencyResponse, region: Region, options: SteadyStateO
     z_hb = _state_at_zero(frf.coefficients[row], n, W, p)
     integ = make_integrator(model)
     target = model if system is None else integ.system
+    scale = state_scale(target, W)
     shot = ShootingProblem(target, period=p, integrator=integ).solve(
-        z_hb, W, tol=1e-12, max_iterations=20, max_halvings=12, scale=state_scale(target, W))
+        z_hb, W, tol=1e-12, max_iterations=20, max_halvings=12, scale=scale)
     converged = shot.residual <= 1e-10
     z_star = shot.x if converged else z_hb
     M = shot.trajectory.sensitivity

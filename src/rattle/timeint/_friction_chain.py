@@ -84,8 +84,7 @@ from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_omega
 from ..errors import ConvergenceError
-from ..model import FrictionSystem, System
-from ..model._system import ReducedElement
+from ..model import FrictionSystem, ReducedElement, System
 from ._events import first_exit
 from ._trajectory import ExactTrajectory
 from ._flow import check_system_state

@@ -41,8 +41,7 @@ from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_state
 from ..errors import ConvergenceError
-from ..model import Model
-from ..model._stage_matrix import transition_scalar
+from ..model import Model, transition_scalar
 from ._roots import bracketed_newton
 from ._stage_solutions import StageSolutions
 from ._trajectory import Trajectory

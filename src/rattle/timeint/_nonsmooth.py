@@ -57,8 +57,7 @@ from .._limits import check_interval
 from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
-from ..model._elastic import Stages
-from ..model._nonsmooth_system import NonsmoothSystem
+from ..model import NonsmoothSystem, Stages
 from ._integrator import ExactIntegrator, _Segment
 from ._trajectory import ExactTrajectory
 from ._roots import bracketed_newton

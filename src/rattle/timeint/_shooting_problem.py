@@ -60,7 +60,6 @@ from ._flow import SystemIntegrator
 from ._friction_chain import FrictionIntegrator
 from ._integrator import ExactIntegrator
 from ._nonsmooth import NonsmoothIntegrator
-from ._trajectory import Trajectory
 
 #: What an exact flow or its shooting raises when it cannot follow the motion (the event budget
 #: of a chatter, a loop of stuck elements, a singular step; numpy's LinAlgError is a ValueError):
