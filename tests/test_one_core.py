@@ -90,7 +90,8 @@ def test_the_shooters_and_the_settling_loop_call_the_one_loop() -> None:
              and node.name == "_Flow"]
     assert len(flows) == 1 and "solve" in _calls(next(f for f in flows[0].body if getattr(f, "name", "") == "shoot"))
     others = {(mod, f.name): f for mod, f in _functions()
-              if (mod, f.name) in {("rattle.analysis._exact_branch", "damped_newton"), ("rattle.analysis._tori", "simulate_torus")}}
+              if (mod, f.name) in {("rattle.analysis._exact_branch", "damped_newton"),
+                                   ("rattle.analysis._tori", "simulate_torus")}}
     assert len(others) == 2
     for key, f in others.items():
         assert "solve" in _calls(f), key

@@ -67,7 +67,7 @@ into a stick φ⁺ is the sliding field, nᵀφ⁺ = 0, and nᵀ S = 0: the δ_e
 At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. A crossing of a jump has
 φ⁺ ≠ φ⁻ (the stages on each side) and S ≠ I. Between events the sensitivity is the mode's
 exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the Floquet multipliers of
-:func:`shoot_friction_orbit`. Not resolved: a tangential touch of a switching surface (grazing: the
+:func:`~rattle.timeint.shoot_friction_orbit`. Not resolved: a tangential touch of a switching surface (grazing: the
 map is not differentiable there) and stuck sets closing a loop.
 """
 

@@ -40,7 +40,7 @@ the δ-crossings by the crossing search of :class:`~rattle.timeint.ExactIntegrat
 
 Between events the sensitivity is the stage transition matrix exp(A τ), A = [[0, 1], [−k s_j, −c]],
 so ∂x(t1)/∂x(t0) = Π (exp(A τ) and S) is exact, and so are the Floquet multipliers of
-:func:`shoot_nonsmooth_orbit`. Grazing (a tangential touch of a switching surface) is not
+:func:`~rattle.timeint.shoot_nonsmooth_orbit`. Grazing (a tangential touch of a switching surface) is not
 resolved: the map is not differentiable there.
 """
 

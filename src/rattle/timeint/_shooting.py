@@ -79,7 +79,9 @@ def _regime(crossed: FloatArray, strict: bool = True) -> str:
     (``strict`` False: a breakpoint at δ = 0 is on neither side)."""
     if crossed.size == 0:
         return "no_impact"
-    if (np.all(crossed > 0.0) or np.all(crossed < 0.0)) if strict else (np.all(crossed >= 0.0) or np.all(crossed <= 0.0)):
+    one_side = (np.all(crossed > 0.0) or np.all(crossed < 0.0)) if strict else \
+        (np.all(crossed >= 0.0) or np.all(crossed <= 0.0))
+    if one_side:
         return "single_sided"
     return "double_sided"
 

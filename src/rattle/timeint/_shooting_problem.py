@@ -1,7 +1,8 @@
 """Periodic orbits by shooting, as a continuation problem in the forcing frequency.
 
 For any of rattle's equations of motion — the single equation (a :class:`~rattle.model.Model`), a
-smooth :class:`~rattle.model.System`, the single equation with a discontinuous law (:class:`~rattle.model.NonsmoothSystem`) or a chain with
+smooth :class:`~rattle.model.System`, the single equation with a discontinuous law
+(:class:`~rattle.model.NonsmoothSystem`) or a chain with
 torque jumps and Coulomb friction on its elements (:class:`~rattle.model.FrictionSystem`) — a
 periodic orbit of period T = p·2π/Ω is a fixed point of the exact period map
 z(0) ↦ φ_T(z(0); Ω), z = (x, x'). With the unknowns q = z(0) (2n numbers) and the parameter Ω
@@ -18,7 +19,7 @@ M the exact monodromy: the product of the stage (or mode) transition matrices ex
 for the discontinuous laws, the saltation matrices of the crossings of a jump and of the stick,
 slip and lock transitions (:mod:`._friction_chain`). ∂φ_T/∂Ω is exact for a smooth System
 (:meth:`SystemTrajectory.omega_derivative`, ``fixed="phase"``: T = p·2π/Ω moves with Ω); for the
-discontinuous laws it is the forward difference (φ_T(q; Ω + h) − φ_T(q; Ω)) / h with
+discontinuous laws (and a Model) it is the forward difference (φ_T(q; Ω + h) − φ_T(q; Ω)) / h with
 h = √ε_mach · Ω, relative error O(h) ≈ 1e-8 — it enters only the corrector's Jacobian and the
 tangent, so the branch points (R = 0) are exact whatever its error, and Newton's rate is
 unchanged to that order.
@@ -98,7 +99,8 @@ def make_integrator(system: Shootable | Chain) -> Any:
     for kind, integ, _ in _INTEGRATORS:
         if isinstance(system, kind):
             return integ(system)
-    raise TypeError(f"`system` must be a rattle Model, Chain, System, NonsmoothSystem or FrictionSystem, got {system!r}")
+    raise TypeError("`system` must be a rattle Model, Chain, System, NonsmoothSystem or FrictionSystem, "
+                    f"got {system!r}")
 
 
 def built_for(integrator: object, system: Shootable) -> bool:
