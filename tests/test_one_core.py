@@ -3,7 +3,8 @@
 - one Newton loop on the period map (:meth:`rattle.timeint.ShootingProblem.solve`): no other
   function of the package both runs a period map and halves a step;
 - one trajectory type: every exact integrator's trajectory is an
-  :class:`~rattle.timeint.ExactTrajectory` and declares none of its shared fields again;
+  :class:`~rattle.timeint.ExactTrajectory`, declares none of its shared fields again and answers
+  ``states(t)`` and ``measures()`` (the settling loop reads nothing else);
 - one ``make_integrator``: no other function picks an integrator class by the kind of system;
 - at most two public classes named ``*Integrator`` (the flow and its scalar kernel).
 """
@@ -104,7 +105,8 @@ def test_one_trajectory_type() -> None:
     for cls in (timeint.Trajectory, timeint.SystemTrajectory, timeint.NonsmoothTrajectory, timeint.FrictionTrajectory):
         assert issubclass(cls, timeint.ExactTrajectory), cls
         assert not shared & set(cls.__dict__.get("__annotations__", {})), (cls, shared & set(cls.__annotations__))
-        assert "segment_index" not in cls.__dict__ and "states" in cls.__dict__, cls
+        assert "segment_index" not in cls.__dict__, cls
+        assert "states" in cls.__dict__ and "measures" in cls.__dict__, cls
 
 
 def test_one_make_integrator() -> None:

@@ -184,14 +184,18 @@ class _Flow:
         self.system, self.integ, self.omega = system, integ, omega
         self.scale = state_scale(system, omega)
         self.dim = self.scale.size
+        self._problems: dict[int, ShootingProblem] = {}  # by period multiple
 
     def advance(self, x: FloatArray, T: float) -> FloatArray:
         return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]
 
     def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> Shot | _Failed:
+        problem = self._problems.get(n)
+        if problem is None:
+            problem = self._problems[n] = ShootingProblem(self.system, period=n, integrator=self.integ)
         try:
-            return ShootingProblem(self.system, period=n, integrator=self.integ).solve(
-                x, self.omega, tol=tol, max_iterations=iterations, max_halvings=_MAX_HALVINGS, scale=self.scale)
+            return problem.solve(x, self.omega, tol=tol, max_iterations=iterations, max_halvings=_MAX_HALVINGS,
+                                 scale=self.scale)
         except ConvergenceError:  # a state the event-driven flow cannot follow: no orbit
             return _Failed(np.asarray(x, dtype=float).copy())
 
@@ -204,107 +208,8 @@ class _Flow:
         return traj.states(np.asarray(t, dtype=float))
 
     @staticmethod
-    def measures(traj: Any) -> ExactMeasures | SystemMeasures:
-        if isinstance(traj, NonsmoothTrajectory):
-            return nonsmooth_measures(traj)
-        if isinstance(traj, FrictionTrajectory):
-            return friction_measures(traj)
+    def measures(traj: ExactTrajectory) -> ExactMeasures | SystemMeasures:
         return traj.measures()
-
-
-# ---------------------------------------------------------------------------------------------
-# Measures of the exact non-smooth trajectories
-# ---------------------------------------------------------------------------------------------
-_EXTREMA_PER_SCALE = 40  # grid points per time scale bracketing the extrema of a segment
-
-
-def nonsmooth_measures(traj: NonsmoothTrajectory) -> ExactMeasures:
-    """The measures of δ over a :class:`~rattle.timeint.NonsmoothTrajectory`: mean and rms by
-    its own quadrature (:meth:`mean_and_rms`, Gauss–Legendre inside the segments), rms about the
-    mean likewise, the extremes of δ and δ'' by :meth:`extremes` (δ'' jumps at a switching: both
-    one-sided values count, a stick or lock contributes δ'' = 0)."""
-    T = traj.t1 - traj.t0
-    if not T > 0.0:
-        raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
-    mean, rms = traj.mean_and_rms()
-    ms_ac = traj.integrate(lambda t, d, v, a: (d - mean) ** 2) / T
-    dmin, dmax, amin, amax = traj.extremes()
-    return ExactMeasures(mean=mean, rms=rms, rms_ac=math.sqrt(max(ms_ac, 0.0)), delta_min=dmin, delta_max=dmax,
-                         p2p=dmax - dmin, acc_min=amin, acc_max=amax, acc_p2p=amax - amin)
-
-
-def _root(fun, a: float, b: float) -> float:  # type: ignore[no-untyped-def]
-    """A root of the scalar ``fun`` bracketed on [a, b] by grid samples (the scalar evaluation
-    may differ from them in round-off: then the end nearer zero)."""
-    from scipy.optimize import brentq
-
-    fa, fb = fun(a), fun(b)
-    if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
-        return a if abs(fa) <= abs(fb) else b
-    return float(brentq(fun, a, b, xtol=4.0 * np.finfo(float).eps * max(abs(b), 1e-300), maxiter=200))
-
-
-def friction_measures(traj: FrictionTrajectory) -> SystemMeasures:
-    """The measures of every element's deflection δ_e = a_e·x over a
-    :class:`~rattle.timeint.FrictionTrajectory`: mean and rms by its own quadrature
-    (:meth:`element_mean_and_rms`), rms about the mean likewise; the extremes on every segment
-    (the motion is analytic there) from a grid of 40 points per time scale that includes both
-    segment ends — so δ_e'' counts its one-sided values at every switching — refined where δ_e'
-    changes sign (δ extremes, by Brent's method on the segment's exact solution) and at the grid
-    extrema of δ_e'' and in the first and last cell of every segment (bounded Brent
-    minimisation)."""
-    from scipy.optimize import minimize_scalar
-
-    T = traj.t1 - traj.t0
-    if not T > 0.0:
-        raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
-    fsys = traj.system
-    A = fsys.system.element_rows
-    n, m = fsys.n, A.shape[0]
-    mean, rms = traj.element_mean_and_rms()
-    ms_ac = traj.integrate(lambda z: (z[:, :n] @ A.T - mean) ** 2) / T
-    dmin, dmax = np.full(m, np.inf), np.full(m, -np.inf)
-    amin, amax = np.full(m, np.inf), np.full(m, -np.inf)
-    k_seg = len(traj.segments)
-    for i, seg in enumerate(traj.segments):
-        length = float(traj.t_end[i] - traj.t_start[i])
-        if length < 0.0 or (length == 0.0 and k_seg > 1):
-            continue
-        scale = float(seg.sol.time_scale)
-        if not math.isfinite(scale) or scale <= 0.0:
-            scale = max(T, 1.0)
-        cells = max(2, math.ceil(length / (scale / _EXTREMA_PER_SCALE)))
-        tg = np.linspace(0.0, length, cells + 1)
-        z, zd = seg.state(tg)
-        d, v, a = z[:, :n] @ A.T, z[:, n:] @ A.T, zd[:, n:] @ A.T
-        dmin, dmax = np.minimum(dmin, d.min(axis=0)), np.maximum(dmax, d.max(axis=0))
-        amin, amax = np.minimum(amin, a.min(axis=0)), np.maximum(amax, a.max(axis=0))
-        if length == 0.0:
-            continue
-        for e in range(m):
-            ve, ae = v[:, e], a[:, e]
-            for q in np.flatnonzero((ve[:-1] > 0.0) != (ve[1:] > 0.0)).tolist():
-                tq = _root(lambda x, e=e: seg.element_point(x, e)[1], float(tg[q]), float(tg[q + 1]))
-                val = seg.element_point(tq, e)[0]
-                dmin[e], dmax[e] = min(dmin[e], val), max(dmax[e], val)
-            da = np.diff(ae)
-            if not np.any(da):
-                continue
-            # an interior grid extremum, and both ways the first and the last cell (an extremum
-            # next to a segment end leaves no sign change of the grid differences)
-            brackets = [(float(tg[q - 1]), float(tg[q + 1]), 1.0 if da[q - 1] < 0.0 else -1.0)
-                        for q in (np.flatnonzero(da[:-1] * da[1:] < 0.0) + 1).tolist()]
-            for lo_c, hi_c in ((tg[0], tg[1]), (tg[-2], tg[-1])):
-                brackets += [(float(lo_c), float(hi_c), 1.0), (float(lo_c), float(hi_c), -1.0)]
-            for lo_c, hi_c, sign in brackets:  # sign +1: a minimum of δ_e'', −1: a maximum
-                res = minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
-                                      bounds=(lo_c, hi_c), method="bounded",
-                                      options={"xatol": 1e-12 * max(length, 1.0)})
-                val = seg.element_point(float(res.x), e)[2]
-                amin[e], amax[e] = min(amin[e], val), max(amax[e], val)
-    return SystemMeasures(names=fsys.element_names, mean=mean, rms=rms, rms_ac=np.sqrt(np.maximum(ms_ac, 0.0)),
-                          delta_min=dmin, delta_max=dmax, p2p=dmax - dmin, acc_min=amin, acc_max=amax,
-                          acc_p2p=amax - amin)
 
 
 def stick_fraction(traj: NonsmoothTrajectory | FrictionTrajectory) -> float | FloatArray:
@@ -646,4 +551,4 @@ def steady_state(
 
 
 __all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS", "static_state", "make_integrator",
-           "nonsmooth_measures", "friction_measures", "stick_fraction"]
+           "stick_fraction"]

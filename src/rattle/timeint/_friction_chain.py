@@ -78,7 +78,7 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from .._limits import check_interval
 from .._typing import FloatArray
@@ -87,13 +87,14 @@ from ..errors import ConvergenceError
 from ..model import FrictionSystem, ReducedElement, System
 from ._events import first_exit
 from ._trajectory import ExactTrajectory
-from ._flow import check_system_state
+from ._flow import SystemMeasures, check_system_state
 from ._nonsmooth import NonsmoothOptions
 from ._stage_flow import Segment, StageSolution, SystemStages
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(16)
+_EXTREMA_PER_SCALE = 40  # grid points per time scale bracketing the extrema of a segment (measures)
 
 #: Event kinds of a :class:`FrictionTrajectory` (``lock``/``unlock``: an element held at a jump of
 #: its law, ``event_values`` the breakpoint).
@@ -138,6 +139,67 @@ class FrictionTrajectory(ExactTrajectory):
     def states(self, t: FloatArray | float) -> FloatArray:
         """z = (x, x') at times ``t``, shape t.shape + (2n,)."""
         return self.sample(t)[0]
+
+    def measures(self) -> SystemMeasures:
+        """The measures of every element's deflection δ_e = a_e·x over the
+        trajectory: mean and rms by its own quadrature
+        (:meth:`element_mean_and_rms`), rms about the mean likewise; the extremes on every segment
+        (the motion is analytic there) from a grid of 40 points per time scale that includes both
+        segment ends — so δ_e'' counts its one-sided values at every switching — refined where δ_e'
+        changes sign (δ extremes, by Brent's method on the segment's exact solution) and at the grid
+        extrema of δ_e'' and in the first and last cell of every segment (bounded Brent
+        minimisation)."""
+        T = self.t1 - self.t0
+        if not T > 0.0:
+            raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
+        fsys = self.system
+        A = fsys.system.element_rows
+        n, m = fsys.n, A.shape[0]
+        mean, rms = self.element_mean_and_rms()
+        ms_ac = self.integrate(lambda z: (z[:, :n] @ A.T - mean) ** 2) / T
+        dmin, dmax = np.full(m, np.inf), np.full(m, -np.inf)
+        amin, amax = np.full(m, np.inf), np.full(m, -np.inf)
+        k_seg = len(self.segments)
+        for i, seg in enumerate(self.segments):
+            length = float(self.t_end[i] - self.t_start[i])
+            if length < 0.0 or (length == 0.0 and k_seg > 1):
+                continue
+            scale = float(seg.sol.time_scale)
+            if not math.isfinite(scale) or scale <= 0.0:
+                scale = max(T, 1.0)
+            cells = max(2, math.ceil(length / (scale / _EXTREMA_PER_SCALE)))
+            tg = np.linspace(0.0, length, cells + 1)
+            z, zd = seg.state(tg)
+            d, v, a = z[:, :n] @ A.T, z[:, n:] @ A.T, zd[:, n:] @ A.T
+            dmin, dmax = np.minimum(dmin, d.min(axis=0)), np.maximum(dmax, d.max(axis=0))
+            amin, amax = np.minimum(amin, a.min(axis=0)), np.maximum(amax, a.max(axis=0))
+            if length == 0.0:
+                continue
+            for e in range(m):
+                ve, ae = v[:, e], a[:, e]
+                for q in np.flatnonzero((ve[:-1] > 0.0) != (ve[1:] > 0.0)).tolist():
+                    tq = _brent(lambda x, e=e: seg.element_point(x, e)[1], float(tg[q]), float(tg[q + 1]),
+                                0.0, 0.0)
+                    val = seg.element_point(tq, e)[0]
+                    dmin[e], dmax[e] = min(dmin[e], val), max(dmax[e], val)
+                da = np.diff(ae)
+                if not np.any(da):
+                    continue
+                # an interior grid extremum, and both ways the first and the last cell (an extremum
+                # next to a segment end leaves no sign change of the grid differences)
+                brackets = [(float(tg[q - 1]), float(tg[q + 1]), 1.0 if da[q - 1] < 0.0 else -1.0)
+                            for q in (np.flatnonzero(da[:-1] * da[1:] < 0.0) + 1).tolist()]
+                for lo_c, hi_c in ((tg[0], tg[1]), (tg[-2], tg[-1])):
+                    brackets += [(float(lo_c), float(hi_c), 1.0), (float(lo_c), float(hi_c), -1.0)]
+                for lo_c, hi_c, sign in brackets:  # sign +1: a minimum of δ_e'', −1: a maximum
+                    res = minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
+                                          bounds=(lo_c, hi_c), method="bounded",
+                                          options={"xatol": 1e-12 * max(length, 1.0)})
+                    val = seg.element_point(float(res.x), e)[2]
+                    amin[e], amax[e] = min(amin[e], val), max(amax[e], val)
+        return SystemMeasures(names=fsys.element_names, mean=mean, rms=rms, rms_ac=np.sqrt(np.maximum(ms_ac, 0.0)),
+                              delta_min=dmin, delta_max=dmax, p2p=dmax - dmin, acc_min=amin, acc_max=amax,
+                              acc_p2p=amax - amin)
 
     def sample(self, t: FloatArray | float) -> tuple[FloatArray, FloatArray]:
         """z = (x, x') and z' = (x', x'') at times ``t``: shapes t.shape + (2n,) each."""

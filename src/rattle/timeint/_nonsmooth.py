@@ -59,7 +59,7 @@ from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import NonsmoothSystem, Stages
 from ._integrator import ExactIntegrator, _Segment
-from ._trajectory import ExactTrajectory
+from ._trajectory import ExactMeasures, ExactTrajectory
 from ._roots import bracketed_newton
 from ._stage_solutions import StageSolutions
 
@@ -157,6 +157,20 @@ class NonsmoothTrajectory(ExactTrajectory):
         """(δ, δ') at times ``t``, shape t.shape + (2,)."""
         d, v, _ = self.sample(np.asarray(t, dtype=float))
         return np.stack((d, v), axis=-1)
+
+    def measures(self) -> ExactMeasures:
+        """The measures of δ (SPEC §1) over the trajectory: mean and rms by its own quadrature
+        (:meth:`mean_and_rms`, Gauss–Legendre inside the segments), rms about the
+        mean likewise, the extremes of δ and δ'' by :meth:`extremes` (δ'' jumps at a switching: both
+        one-sided values count, a stick or lock contributes δ'' = 0)."""
+        T = self.t1 - self.t0
+        if not T > 0.0:
+            raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
+        mean, rms = self.mean_and_rms()
+        ms_ac = self.integrate(lambda t, d, v, a: (d - mean) ** 2) / T
+        dmin, dmax, amin, amax = self.extremes()
+        return ExactMeasures(mean=mean, rms=rms, rms_ac=math.sqrt(max(ms_ac, 0.0)), delta_min=dmin, delta_max=dmax,
+                             p2p=dmax - dmin, acc_min=amin, acc_max=amax, acc_p2p=amax - amin)
 
     def sample(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """δ, δ' and δ'' at times ``t`` in [t0, t1] (arrays of t's shape); δ'' on a stick or lock

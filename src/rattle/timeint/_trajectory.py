@@ -58,7 +58,7 @@ class ExactTrajectory:
     mode) of the law, analytic inside. The law-specific records (stages, events, stick and lock
     flags, the exact segment solutions) are the extras of :class:`Trajectory`,
     :class:`~rattle.timeint.SystemTrajectory`, :class:`~rattle.timeint.NonsmoothTrajectory` and
-    :class:`~rattle.timeint.FrictionTrajectory`, which all answer :meth:`states`."""
+    :class:`~rattle.timeint.FrictionTrajectory`, which all answer :meth:`states` and :meth:`measures`."""
 
     omega: float
     t0: float
@@ -90,6 +90,12 @@ class ExactTrajectory:
     def states(self, t: FloatArray | float) -> FloatArray:
         """The states z(t) = (x, x'), shape t.shape + (2n,) (each kind of trajectory evaluates
         its own exact segments)."""
+        raise NotImplementedError
+
+    def measures(self) -> object:
+        """The response measures over [t0, t1] (SPEC §1), exact to round-off: an
+        :class:`ExactMeasures` of δ for the single equations, a
+        :class:`~rattle.timeint.SystemMeasures` of every element for a chain."""
         raise NotImplementedError
 
 
