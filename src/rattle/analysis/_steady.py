@@ -69,7 +69,7 @@ from ..results._steady import METHODS, SteadyState
 from ..timeint import (
     ExactIntegrator, ExactMeasures, ExactTrajectory, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator,
     NonsmoothTrajectory, ShootingProblem, Shot, SystemIntegrator, SystemMeasures, built_for, check_system_state,
-    make_integrator, state_scale,
+    make_integrator,
 )
 
 _TWO_PI = 2.0 * math.pi
@@ -182,9 +182,10 @@ class _Flow:
 
     def __init__(self, system: Model | System | NonsmoothSystem | FrictionSystem, integ: Any, omega: float) -> None:
         self.system, self.integ, self.omega = system, integ, omega
-        self.scale = state_scale(system, omega)
+        # one ShootingProblem per period multiple; the first gives the scales
+        self._problems: dict[int, ShootingProblem] = {1: ShootingProblem(system, period=1, integrator=integ)}
+        self.scale = self._problems[1].state_scale(omega)
         self.dim = self.scale.size
-        self._problems: dict[int, ShootingProblem] = {}  # by period multiple
 
     def advance(self, x: FloatArray, T: float) -> FloatArray:
         return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]

@@ -88,9 +88,9 @@ def _regime(crossed: FloatArray, strict: bool = True) -> str:
 
 def _solve(system: Any, integ: Any, omega: float, x: FloatArray, period: int, tol: float, max_iterations: int,
            max_halvings: int = _MAX_HALVINGS, **kw: Any) -> Shot:
-    return ShootingProblem(system, period=int(period), integrator=integ).solve(
-        x, omega, tol=float(tol), max_iterations=int(max_iterations), max_halvings=max_halvings,
-        scale=state_scale(system, omega), **kw)
+    problem = ShootingProblem(system, period=int(period), integrator=integ)
+    return problem.solve(x, omega, tol=float(tol), max_iterations=int(max_iterations), max_halvings=max_halvings,
+                         scale=problem.state_scale(omega), **kw)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -182,6 +182,7 @@ class ShootingProblem:
         self._records = isinstance(integ, (ExactIntegrator, NonsmoothIntegrator))
         n, L, omega_s = _scales(system)
         self.n = n
+        self._L = L
         self._omega_s = omega_s
         self._scale = np.concatenate((np.full(n, L), np.full(n, L * omega_s)))
         self._eye = np.eye(2 * n)
@@ -207,6 +208,10 @@ class ShootingProblem:
     def force_scale(self) -> float:
         """1: the residual is already scaled by s."""
         return 1.0
+
+    def state_scale(self, omega: float) -> FloatArray:
+        """:func:`state_scale` of the system at Ω: (L, L ν), ν = max(Ω, ω_s) (2n,)."""
+        return np.concatenate((np.full(self.n, self._L), np.full(self.n, self._L * max(float(omega), self._omega_s))))
 
     def orbit_period(self, omega: float) -> float:
         """T = p·2π/Ω (s)."""
