@@ -42,7 +42,7 @@ from rattle.hb import HBOptions
 from rattle.maps._cell import summarise
 from rattle.model import Clutch
 from rattle.timeint import shoot_periodic_orbit
-from rattle.timeint._system_shooting import shoot_system_orbit
+from rattle.timeint import shoot_system_orbit
 
 
 def cell(model, grid, run):

@@ -28,7 +28,7 @@ from rattle.hb._regularised import RegularisedBalance
 from rattle.model import Excitation
 from rattle.model._discontinuous import Friction, NonsmoothLaw, Preload
 from rattle.model._nonsmooth_system import NonsmoothSystem
-from rattle.timeint._nonsmooth import NonsmoothIntegrator, shoot_nonsmooth_orbit
+from rattle.timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
 
 C, FM, FP, PHASE = 0.05, 0.01, 0.3, 0.3
 CASES = [  # (T_p, r, Ω)

@@ -25,11 +25,7 @@ from rattle.model._discontinuous import (
 )
 from rattle.model._nonsmooth_system import NonsmoothSystem
 from rattle.timeint import ExactIntegrator
-from rattle.timeint._nonsmooth import (
-    NonsmoothIntegrator,
-    NonsmoothOptions,
-    shoot_nonsmooth_orbit,
-)
+from rattle.timeint import NonsmoothIntegrator, NonsmoothOptions, shoot_nonsmooth_orbit
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 """Front ends: one call from a model to a result."""
 
 from ._attractors import AttractorSearch, Census
-from ._case import Case, case_arguments, load_case, method_options
+from ._case import Case, case_arguments, load_case, method_options, regularisation_options
 from ._census import CellCensus, attractor_census, special_points
 from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
@@ -23,7 +23,7 @@ __all__ = [
     "steady_state", "SteadyStateOptions", "RegularisationOptions",
     "nonsmooth_orbit", "friction_orbit",
     "label_regions", "confirm_with_sweep", "truncation_error", "AdaptiveHarmonics",
-    "SweepCheck", "ShootingOptions", "method_options", "case_arguments",
+    "SweepCheck", "ShootingOptions", "method_options", "regularisation_options", "case_arguments",
     # one combination of a response map (rattle.maps): every branch on its grid, every attractor
     "AttractorSearch", "Census", "CellCensus", "attractor_census", "special_points",
     "RunSettings", "DEFAULT_HARMONICS", "StabilityMethod", "resolve_hb",

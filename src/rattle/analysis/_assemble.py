@@ -17,15 +17,15 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..continuation import ArclengthCorrector, BranchPoint
-from ..continuation._detect import LocatedPoint, locate_on_segment
+from ..continuation import LocatedPoint, locate_on_segment
 from ..errors import Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions
 from ..measures import Measures, system_measures_batch
 from ..model import Model
 from ..results import FrequencyResponse, SpecialPoint
-from ..results._frequency_response import element_columns_from
+from ..results import element_columns_from
 from ..stability import FloquetMonitor, classify_loss, stability_method, torus_ratio
-from ..stability._classify import UNIT_CIRCLE_TOL
+from ..stability import UNIT_CIRCLE_TOL
 from ._settings import StabilityMethod, scaled_hb
 
 

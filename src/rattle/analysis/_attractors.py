@@ -43,7 +43,7 @@ Where the simulations start (the budget, :class:`AttractorSearch`):
 
 A simulated periodic attractor of period n is *explained* when a stable known solution of
 period n at the same Ω passes through its section state (scaled max-norm, ``match``, on the
-scales of :func:`~rattle.timeint.system_state_scale`); a non-periodic one is recorded at its
+scales of :func:`~rattle.timeint.state_scale`); a non-periodic one is recorded at its
 grid frequency. Every unexplained periodic attractor is continued (at most ``max_branches``
 new branches per response), and its branch's solutions join the grid.
 
@@ -68,7 +68,7 @@ from .._typing import FloatArray
 from ..hb import HarmonicBalance
 from ..results import FrequencyResponse
 from ..timeint import SystemTrajectory
-from ..timeint._system_shooting import system_state_scale
+from ..timeint import state_scale
 from ._branches import branch_from_seed, is_shorter_period
 from ._grid import GridSolution, section_states, solutions_on_grid
 from ._settings import RunSettings
@@ -226,7 +226,7 @@ class _Search:
         return [s for s in self.by_index.get(j, []) if s.stable]
 
     def scale(self, j: int) -> FloatArray:
-        return system_state_scale(self.system, float(self.grid[j]))
+        return state_scale(self.system, float(self.grid[j]))
 
     def passes(self, j: int, n: int, point: FloatArray, stable_only: bool) -> bool:
         """Whether a known solution of period n at grid index j (a stable one, with
@@ -376,8 +376,7 @@ class _Search:
     def closes_exactly(self, w: float, x0: FloatArray, period: int) -> bool:
         """Whether exact shooting from x0 closes a period-``period`` orbit through x0 (within
         ``match``, scaled): the harmonic-balance solution is a true orbit."""
-        from ..timeint import shoot_periodic_orbit
-        from ..timeint._system_shooting import shoot_system_orbit
+        from ..timeint import shoot_periodic_orbit, shoot_system_orbit
 
         if self.model is self.system or not hasattr(self.model, "elastic"):
             orbit = shoot_system_orbit(self.system, w, x0, period=period)
@@ -385,7 +384,7 @@ class _Search:
             orbit = shoot_periodic_orbit(self.model, w, x0, period=period, integrator=self.integ)
         if not orbit.converged:
             return False
-        sc = system_state_scale(self.system, w)
+        sc = state_scale(self.system, w)
         return float(np.max(np.abs(np.asarray(orbit.state0) - x0) / sc)) < self.opts.match
 
     def hb_subharmonics(self) -> None:

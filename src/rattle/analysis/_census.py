@@ -39,12 +39,12 @@ from ..continuation import NewtonOptions, solve_fixed
 from ..errors import Status
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrequencyResponse, SteadyState
-from ..timeint import FLOW_FAILURES, ShootingProblem
+from ..timeint import FLOW_FAILURES, ShootingProblem, make_integrator
 from ._attractors import AttractorSearch, Census, _Search, find_attractors, run_search
 from ._exact_branch import ExactBranch, ExactRow, ShootingOptions, _row, branch_through
 from ._grid import GridSolution, _crossings, solutions_on_grid
 from ._settings import RunSettings
-from ._steady import _FrictionFlow, _NonsmoothFlow, friction_measures, make_integrator, nonsmooth_measures, static_state
+from ._steady import static_state
 
 
 # ---------------------------------------------------------------------------------------------
@@ -113,10 +113,8 @@ def _orbit_state(system: NonsmoothSystem | FrictionSystem, row: ExactRow, period
     search sees, computed by the same functions."""
     traj = row.trajectory
     t = np.arange(period) * (2.0 * math.pi / row.omega)
-    if isinstance(system, FrictionSystem):
-        measures, cycle, names = friction_measures(traj), _FrictionFlow.section(traj, t), system.element_names
-    else:
-        measures, cycle, names = nonsmooth_measures(traj), _NonsmoothFlow.section(traj, t), ()
+    measures, cycle = traj.measures(), traj.states(t)
+    names = system.element_names if isinstance(system, FrictionSystem) else ()
     return SteadyState(omega=float(row.omega), period=int(period), status=Status.CONVERGED, periods=0,
                        shooting_periods=0, state0=row.q, final_state=row.q, cycle=cycle, poincare=cycle[:1],
                        trajectory=traj, measures=measures, multipliers=row.multipliers, residual=0.0,

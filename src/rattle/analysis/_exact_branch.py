@@ -67,7 +67,7 @@ from .._threads import one_blas_thread
 from ..errors import Status
 from ..model import FrictionSystem, NonsmoothSystem
 from ..stability import classify_loss
-from ..timeint import ShootingProblem, monodromy_multipliers
+from ..timeint import FLOW_FAILURES, ShootingProblem, monodromy_multipliers
 
 #: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
 #: gives a neutral multiplier 1 (a family of orbits).
@@ -256,28 +256,15 @@ START_TRIES = 3
 def damped_newton(problem: ShootingProblem, q: FloatArray, omega: float, newton: NewtonOptions,
                   iterations: int = 60) -> FloatArray | None:
     """Newton on the period map at fixed Ω with the step halved until the scaled residual
-    decreases (an unstable orbit, which the settled flow does not approach, from a state of the
-    attractor); None when it stalls. Converged as :func:`~rattle.continuation.solve_fixed`."""
-    q = np.asarray(q, dtype=float).copy()
-    r, dq = problem.newton_step(q, omega)
-    res = float(np.max(np.abs(r)))
-    for _ in range(iterations):
-        if not math.isfinite(res) or dq is None:
-            return None
-        if res <= newton.residual_tol and float(np.max(np.abs(dq) / problem.length_scale)) <= newton.step_tol:
-            return q + dq
-        step = 1.0
-        for _h in range(30):
-            trial = q + step * dq
-            r_t, dq_t = problem.newton_step(trial, omega)
-            res_t = float(np.max(np.abs(r_t)))
-            if math.isfinite(res_t) and res_t < res:
-                break
-            step *= 0.5
-        else:
-            return None
-        q, r, dq, res = trial, r_t, dq_t, res_t
-    return None
+    decreases (:meth:`ShootingProblem.solve`: an unstable orbit, which the settled flow does not
+    approach, from a state of the attractor); None when it stalls. Converged as
+    :func:`~rattle.continuation.solve_fixed` (residual and step within the tolerances)."""
+    try:
+        shot = problem.solve(q, omega, tol=newton.residual_tol, step_tol=newton.step_tol, max_iterations=iterations,
+                             max_halvings=29, least_squares=False, record=False)
+    except FLOW_FAILURES:  # the flow cannot be followed from q
+        return None
+    return shot.x if shot.converged else None
 
 
 def _tangent(problem: ShootingProblem, corrector: ArclengthCorrector, q: FloatArray, omega: float,

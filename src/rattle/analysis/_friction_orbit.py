@@ -48,8 +48,7 @@ from ..hb import RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionOrbitResult, HeldLimitRecord
 from ..stability import regularised_system_multipliers
-from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
-from ..timeint._shooting import FLOW_FAILURES
+from ..timeint import FLOW_FAILURES, FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ._friction_response import (
     REPEAT_TOL,
     _departures,

@@ -74,8 +74,7 @@ from ..model import FrictionSystem
 from ..results import FrictionCheck
 from ..stability import regularised_system_multipliers
 from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
-from ..timeint._friction_chain import CROSSING, LOCK, STICK
-from ..timeint._shooting import FLOW_FAILURES, monodromy_multipliers
+from ..timeint import CROSSING, FLOW_FAILURES, LOCK, STICK, monodromy_multipliers
 from ._exact_branch import ExactBranch, ShootingOptions, exact_branches
 from ._held_limit import held_limit
 from ._regularisation import (

@@ -42,8 +42,7 @@ from ..continuation import ContinuationOptions, NewtonOptions
 from ..errors import Status
 from ..model import FrictionSystem
 from ..results import FrictionCheck
-from ..timeint import FrictionIntegrator, FrictionOrbit, shoot_friction_orbit
-from ..timeint._shooting import FLOW_FAILURES
+from ..timeint import FLOW_FAILURES, FrictionIntegrator, FrictionOrbit, shoot_friction_orbit
 from ._friction_response import (
     REPEAT_TOL,
     UNIT_TOL,

@@ -28,7 +28,7 @@ from ..continuation import solve_fixed
 from ..hb import HarmonicBalance
 from ..measures import system_measures_batch
 from ..results import FrequencyResponse
-from ..stability._classify import UNIT_CIRCLE_TOL
+from ..stability import UNIT_CIRCLE_TOL
 from ._settings import RunSettings
 
 

@@ -69,8 +69,8 @@ from ..model import Chain, FrictionSystem, NonsmoothSystem
 from ..results import FrequencyResponse, FrictionCheck, NonsmoothCheck
 from ..stability import regularised_multipliers
 from ..timeint import (
-    FLOW_FAILURES, FrictionIntegrator, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
-    shoot_nonsmooth_orbit,
+    FLOW_FAILURES, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
+    make_integrator, shoot_nonsmooth_orbit,
 )
 from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
 from ._friction_response import exact_friction_response, friction_response, shooting_friction_response
@@ -371,14 +371,14 @@ def shooting_response(
     if isinstance(system, FrictionSystem):
         primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
                                              progress=progress)
-        chain_integ = FrictionIntegrator(system)
+        chain_integ = make_integrator(system)
         seed = lambda w, z: period_two_orbit(system, chain_integ, w, z)  # noqa: E731
         build = lambda b, k: exact_friction_response(system, b, number=k, period=2)  # noqa: E731
     elif isinstance(system, NonsmoothSystem):
         found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
         parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
         primary = dataclasses.replace(parts[0], branches=tuple(parts[1:])) if len(parts) > 1 else parts[0]
-        integ = NonsmoothIntegrator(system)
+        integ = make_integrator(system)
         seed = lambda w, z: _period_two_orbit(system, integ, w, z)  # noqa: E731
         build = lambda b, k: _exact_response(b, number=k, period=2)  # noqa: E731
     else:

@@ -37,8 +37,7 @@ from ..errors import ConvergenceError
 from ..hb import RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionOrbitResult, NonsmoothOrbitResult
-from ..timeint import NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
-from ..timeint._shooting import FLOW_FAILURES
+from ..timeint import FLOW_FAILURES, NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
 from ._nonsmooth import RegularisationOptions, balance_factory
 from ._regularisation import regularisation_limit
 

@@ -46,8 +46,7 @@ from ..measures import system_measures_batch
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, OrbitSolution, PeriodicOrbit, SteadyState
 from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, stability_method
-from ..timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
-from ..timeint._flow import check_system_state
+from ..timeint import ExactIntegrator, check_system_state, shoot_periodic_orbit, shoot_system_orbit
 from ._frequency_response import check_range, frequency_response
 from ._settings import DEFAULT_HARMONICS, StabilityMethod, check_stability, resolve_hb
 from ._steady import SteadyStateOptions, make_integrator, steady_state

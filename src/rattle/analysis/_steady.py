@@ -4,11 +4,13 @@
 An analysis on top of :mod:`rattle.timeint`: it runs the exact integrators and Newton shooting
 there and returns a :class:`~rattle.results.SteadyState` (whose ``status`` tells how it ended).
 
-One settling loop serves both: the single equation runs on :class:`ExactIntegrator` (state
-(δ, δ'), its fast scalar path), a chain on :class:`SystemIntegrator` (state z = (x, x') of its
-n coordinates; the scaled norm below then takes every coordinate by the System's length scale
-and every velocity by that times ν, :func:`system_state_scale`); shooting is
-:func:`_newton_shooting` or :func:`_newton_system` on the same exact flows.
+One settling loop serves every system, on its exact integrator (:func:`make_integrator`): the
+single equation on :class:`ExactIntegrator` (state (δ, δ'), its fast scalar path), a chain on
+:class:`SystemIntegrator` (state z = (x, x') of its n coordinates; the scaled norm below then
+takes every coordinate by the System's length scale and every velocity by that times ν,
+:func:`~rattle.timeint.state_scale`), the discontinuous laws on :class:`NonsmoothIntegrator`
+and :class:`FrictionIntegrator`; shooting is :meth:`ShootingProblem.solve` on the same exact
+flows.
 
 The state is integrated exactly (:class:`ExactIntegrator`) one forcing period T = 2π/Ω at a time,
 from t = 0 to T (F is T-periodic, so every period starts at forcing phase 0). The states at the
@@ -63,14 +65,12 @@ from .._validate import check_int, check_positive, check_state, numerical_failur
 from ..errors import Status
 from ..errors import ConvergenceError
 from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check_analysable_model
-from ..results._steady import METHODS, SteadyState
+from ..results import STEADY_METHODS as METHODS, SteadyState
 from ..timeint import (
-    ExactIntegrator, ExactMeasures, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator, NonsmoothTrajectory,
-    SystemIntegrator, SystemMeasures, SystemTrajectory, Trajectory,
+    ExactIntegrator, ExactMeasures, ExactTrajectory, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator,
+    NonsmoothTrajectory, ShootingProblem, Shot, SystemIntegrator, SystemMeasures, built_for, check_system_state,
+    make_integrator,
 )
-from ..timeint._flow import check_system_state
-from ..timeint._shooting import _newton_shooting, _Shot, _state_scale
-from ..timeint._system_shooting import _newton_system, _SystemShot, system_state_scale
 
 _TWO_PI = 2.0 * math.pi
 _LINEAR_CHECK = 0.1  # relative mismatch allowed between the simulation and the linearisation
@@ -158,63 +158,8 @@ class SteadyStateOptions:
 
 
 # ---------------------------------------------------------------------------------------------
-# The flow being settled: one equation (ExactIntegrator, 2 states) or a System (2n states)
+# The flow being settled: the exact integrator of any system, state z = (x, x')
 # ---------------------------------------------------------------------------------------------
-class _ModelFlow:
-    """The single equation on :class:`ExactIntegrator` (the fast path: scalar hot loop)."""
-
-    def __init__(self, model: Model, integ: ExactIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        self.dim = 2
-        self.scale = _state_scale(model, omega)
-
-    def advance(self, x: FloatArray, T: float) -> FloatArray:
-        d, v = self.integ._advance(float(x[0]), float(x[1]), 0.0, T, self.omega)
-        return np.array([d, v])
-
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _Shot:
-        return _newton_shooting(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
-
-    def propagate(self, x: FloatArray, T: float) -> Trajectory:
-        return self.integ.propagate(x, 0.0, T, self.omega)
-
-    @staticmethod
-    def section(traj: Trajectory, t: FloatArray) -> FloatArray:
-        s = traj.sample(t)
-        return np.column_stack((s.delta, s.velocity))
-
-    @staticmethod
-    def measures(traj: Trajectory) -> ExactMeasures:
-        return traj.measures()
-
-
-class _SystemFlow:
-    """A :class:`~rattle.model.System` on :class:`SystemIntegrator` (z = (x, x'), 2n states)."""
-
-    def __init__(self, system: System, integ: SystemIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        self.dim = 2 * system.n
-        self.scale = system_state_scale(system, omega)
-
-    def advance(self, x: FloatArray, T: float) -> FloatArray:
-        return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]
-
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _SystemShot:
-        return _newton_system(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
-
-    def propagate(self, x: FloatArray, T: float) -> SystemTrajectory:
-        return self.integ.propagate(x, 0.0, T, self.omega)
-
-    @staticmethod
-    def section(traj: SystemTrajectory, t: FloatArray) -> FloatArray:
-        x, v = traj.derivatives(np.asarray(t, dtype=float), 1)
-        return np.concatenate((x, v), axis=-1)
-
-    @staticmethod
-    def measures(traj: SystemTrajectory) -> SystemMeasures:
-        return traj.measures()
-
-
 class _Failed:
     """A shooting solve whose flow could not be followed (an event budget exceeded): never
     accepted (residual ∞)."""
@@ -226,166 +171,46 @@ class _Failed:
         self.x, self.evaluations = x, evaluations
 
 
-class _NonsmoothFlow:
-    """The single equation with a discontinuous law (:class:`~rattle.model.NonsmoothSystem`) on
-    :class:`NonsmoothIntegrator`: state (δ, δ'), scaled by (L, L ν) as
-    :func:`~rattle.timeint.shoot_nonsmooth_orbit` scales its residual; the period map's
-    sensitivity carries the saltation matrices (a stick or lock phase contributes an exact zero
-    multiplier), so the acceptance tests of the acceleration hold unchanged."""
+class _Flow:
+    """The exact flow of ``system`` on its integrator (:func:`make_integrator`): the period map
+    without records, Newton shooting (:meth:`ShootingProblem.solve`), the recorded trajectory,
+    its section states and its measures. States z = (x, x') (2n,; (δ, δ') for the single
+    equations), scaled by :func:`~rattle.timeint.state_scale`, (L, L ν), as the shooting scales
+    its residual; a discontinuous law's period map carries the saltation matrices (a stick or
+    lock phase contributes an exact zero multiplier), so the acceptance tests of the
+    acceleration hold unchanged."""
 
-    def __init__(self, system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        self.dim = 2
-        self.scale = np.array([system.length_scale(), integ.velocity_scale(omega)])
+    def __init__(self, system: Model | System | NonsmoothSystem | FrictionSystem, integ: Any, omega: float) -> None:
+        self.system, self.integ, self.omega = system, integ, omega
+        # one ShootingProblem per period multiple; the first gives the scales
+        self._problems: dict[int, ShootingProblem] = {1: ShootingProblem(system, period=1, integrator=integ)}
+        self.scale = self._problems[1].state_scale(omega)
+        self.dim = self.scale.size
 
     def advance(self, x: FloatArray, T: float) -> FloatArray:
-        return self.integ.propagate(x, 0.0, T, self.omega).state1
+        return self.integ.advance(x, 0.0, T, self.omega, sensitivity=False)[0]
 
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _Shot | _Failed:
+    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> Shot | _Failed:
+        problem = self._problems.get(n)
+        if problem is None:
+            problem = self._problems[n] = ShootingProblem(self.system, period=n, integrator=self.integ)
         try:
-            return _newton_shooting(self.integ, self.omega, x, n, tol, iterations, self.scale,  # type: ignore[arg-type]
-                                    _MAX_HALVINGS)
-        except ConvergenceError:  # a trial state the event-driven flow cannot follow: no orbit
+            return problem.solve(x, self.omega, tol=tol, max_iterations=iterations, max_halvings=_MAX_HALVINGS,
+                                 scale=self.scale)
+        except ConvergenceError:  # a state the event-driven flow cannot follow: no orbit
             return _Failed(np.asarray(x, dtype=float).copy())
 
-    def propagate(self, x: FloatArray, T: float) -> NonsmoothTrajectory:
+    def propagate(self, x: FloatArray, T: float) -> Any:
         return self.integ.propagate(x, 0.0, T, self.omega)
 
     @staticmethod
-    def section(traj: NonsmoothTrajectory, t: FloatArray) -> FloatArray:
-        d, v, _ = traj.sample(np.asarray(t, dtype=float))
-        return np.column_stack((d, v))
+    def section(traj: ExactTrajectory, t: FloatArray) -> FloatArray:
+        """The states z(t) (len(t), 2n) on a trajectory of any of the integrators."""
+        return traj.states(np.asarray(t, dtype=float))
 
     @staticmethod
-    def measures(traj: NonsmoothTrajectory) -> ExactMeasures:
-        return nonsmooth_measures(traj)
-
-
-class _FrictionFlow:
-    """A chain with friction (:class:`~rattle.model.FrictionSystem`) on
-    :class:`FrictionIntegrator`: z = (x, x'), 2n states, scaled by L and L max(Ω, ω_n) as
-    :func:`~rattle.timeint.shoot_friction_orbit` scales its residual (saltation monodromy)."""
-
-    def __init__(self, system: FrictionSystem, integ: FrictionIntegrator, omega: float) -> None:
-        self.integ, self.omega = integ, omega
-        n = system.n
-        self.dim = 2 * n
-        self.scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
-
-    def advance(self, x: FloatArray, T: float) -> FloatArray:
-        return self.integ.advance(x, 0.0, T, self.omega)[0]
-
-    def shoot(self, x: FloatArray, n: int, tol: float, iterations: int) -> _SystemShot | _Failed:
-        try:
-            return _newton_system(self.integ, self.omega, x, n, tol, iterations, self.scale, _MAX_HALVINGS)
-        except ConvergenceError:
-            return _Failed(np.asarray(x, dtype=float).copy())
-
-    def propagate(self, x: FloatArray, T: float) -> FrictionTrajectory:
-        return self.integ.propagate(x, 0.0, T, self.omega)
-
-    @staticmethod
-    def section(traj: FrictionTrajectory, t: FloatArray) -> FloatArray:
-        return traj.sample(np.asarray(t, dtype=float))[0]
-
-    @staticmethod
-    def measures(traj: FrictionTrajectory) -> SystemMeasures:
-        return friction_measures(traj)
-
-
-# ---------------------------------------------------------------------------------------------
-# Measures of the exact non-smooth trajectories
-# ---------------------------------------------------------------------------------------------
-_EXTREMA_PER_SCALE = 40  # grid points per time scale bracketing the extrema of a segment
-
-
-def nonsmooth_measures(traj: NonsmoothTrajectory) -> ExactMeasures:
-    """The measures of δ over a :class:`~rattle.timeint.NonsmoothTrajectory`: mean and rms by
-    its own quadrature (:meth:`mean_and_rms`, Gauss–Legendre inside the segments), rms about the
-    mean likewise, the extremes of δ and δ'' by :meth:`extremes` (δ'' jumps at a switching: both
-    one-sided values count, a stick or lock contributes δ'' = 0)."""
-    T = traj.t1 - traj.t0
-    if not T > 0.0:
-        raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
-    mean, rms = traj.mean_and_rms()
-    ms_ac = traj.integrate(lambda t, d, v, a: (d - mean) ** 2) / T
-    dmin, dmax, amin, amax = traj.extremes()
-    return ExactMeasures(mean=mean, rms=rms, rms_ac=math.sqrt(max(ms_ac, 0.0)), delta_min=dmin, delta_max=dmax,
-                         p2p=dmax - dmin, acc_min=amin, acc_max=amax, acc_p2p=amax - amin)
-
-
-def _root(fun, a: float, b: float) -> float:  # type: ignore[no-untyped-def]
-    """A root of the scalar ``fun`` bracketed on [a, b] by grid samples (the scalar evaluation
-    may differ from them in round-off: then the end nearer zero)."""
-    from scipy.optimize import brentq
-
-    fa, fb = fun(a), fun(b)
-    if fa == 0.0 or fb == 0.0 or (fa > 0.0) == (fb > 0.0):
-        return a if abs(fa) <= abs(fb) else b
-    return float(brentq(fun, a, b, xtol=4.0 * np.finfo(float).eps * max(abs(b), 1e-300), maxiter=200))
-
-
-def friction_measures(traj: FrictionTrajectory) -> SystemMeasures:
-    """The measures of every element's deflection δ_e = a_e·x over a
-    :class:`~rattle.timeint.FrictionTrajectory`: mean and rms by its own quadrature
-    (:meth:`element_mean_and_rms`), rms about the mean likewise; the extremes on every segment
-    (the motion is analytic there) from a grid of 40 points per time scale that includes both
-    segment ends — so δ_e'' counts its one-sided values at every switching — refined where δ_e'
-    changes sign (δ extremes, by Brent's method on the segment's exact solution) and at the grid
-    extrema of δ_e'' and in the first and last cell of every segment (bounded Brent
-    minimisation)."""
-    from scipy.optimize import minimize_scalar
-
-    T = traj.t1 - traj.t0
-    if not T > 0.0:
-        raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
-    fsys = traj.system
-    A = fsys.system.element_rows
-    n, m = fsys.n, A.shape[0]
-    mean, rms = traj.element_mean_and_rms()
-    ms_ac = traj.integrate(lambda z: (z[:, :n] @ A.T - mean) ** 2) / T
-    dmin, dmax = np.full(m, np.inf), np.full(m, -np.inf)
-    amin, amax = np.full(m, np.inf), np.full(m, -np.inf)
-    k_seg = len(traj.segments)
-    for i, seg in enumerate(traj.segments):
-        length = float(traj.t_end[i] - traj.t_start[i])
-        if length < 0.0 or (length == 0.0 and k_seg > 1):
-            continue
-        scale = float(seg.sol.time_scale)
-        if not math.isfinite(scale) or scale <= 0.0:
-            scale = max(T, 1.0)
-        cells = max(2, math.ceil(length / (scale / _EXTREMA_PER_SCALE)))
-        tg = np.linspace(0.0, length, cells + 1)
-        z, zd = seg.state(tg)
-        d, v, a = z[:, :n] @ A.T, z[:, n:] @ A.T, zd[:, n:] @ A.T
-        dmin, dmax = np.minimum(dmin, d.min(axis=0)), np.maximum(dmax, d.max(axis=0))
-        amin, amax = np.minimum(amin, a.min(axis=0)), np.maximum(amax, a.max(axis=0))
-        if length == 0.0:
-            continue
-        for e in range(m):
-            ve, ae = v[:, e], a[:, e]
-            for q in np.flatnonzero((ve[:-1] > 0.0) != (ve[1:] > 0.0)).tolist():
-                tq = _root(lambda x, e=e: seg.element_point(x, e)[1], float(tg[q]), float(tg[q + 1]))
-                val = seg.element_point(tq, e)[0]
-                dmin[e], dmax[e] = min(dmin[e], val), max(dmax[e], val)
-            da = np.diff(ae)
-            if not np.any(da):
-                continue
-            # an interior grid extremum, and both ways the first and the last cell (an extremum
-            # next to a segment end leaves no sign change of the grid differences)
-            brackets = [(float(tg[q - 1]), float(tg[q + 1]), 1.0 if da[q - 1] < 0.0 else -1.0)
-                        for q in (np.flatnonzero(da[:-1] * da[1:] < 0.0) + 1).tolist()]
-            for lo_c, hi_c in ((tg[0], tg[1]), (tg[-2], tg[-1])):
-                brackets += [(float(lo_c), float(hi_c), 1.0), (float(lo_c), float(hi_c), -1.0)]
-            for lo_c, hi_c, sign in brackets:  # sign +1: a minimum of δ_e'', −1: a maximum
-                res = minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
-                                      bounds=(lo_c, hi_c), method="bounded",
-                                      options={"xatol": 1e-12 * max(length, 1.0)})
-                val = seg.element_point(float(res.x), e)[2]
-                amin[e], amax[e] = min(amin[e], val), max(amax[e], val)
-    return SystemMeasures(names=fsys.element_names, mean=mean, rms=rms, rms_ac=np.sqrt(np.maximum(ms_ac, 0.0)),
-                          delta_min=dmin, delta_max=dmax, p2p=dmax - dmin, acc_min=amin, acc_max=amax,
-                          acc_p2p=amax - amin)
+    def measures(traj: ExactTrajectory) -> ExactMeasures | SystemMeasures:
+        return traj.measures()
 
 
 def stick_fraction(traj: NonsmoothTrajectory | FrictionTrajectory) -> float | FloatArray:
@@ -397,9 +222,6 @@ def stick_fraction(traj: NonsmoothTrajectory | FrictionTrajectory) -> float | Fl
     return float(traj.stick_time / T)
 
 
-_Flow = _ModelFlow | _SystemFlow | _NonsmoothFlow | _FrictionFlow
-
-
 def _proper_divisors(n: int) -> list[int]:
     return [m for m in range(1, n) if n % m == 0]
 
@@ -408,7 +230,7 @@ def _proper_divisors(n: int) -> list[int]:
 class _Candidate:
     """A stable orbit found by shooting, waiting for the simulation to come close."""
 
-    shot: _Shot | _SystemShot
+    shot: Shot
     period: int
     cycle: FloatArray  # (n, dim) unscaled section points
     created: int
@@ -434,7 +256,7 @@ class _Settler:
         self.shooting_periods = 0
         # acceleration state
         self.candidate: _Candidate | None = None
-        self.pending: tuple[int, FloatArray, _Shot, int] | None = None
+        self.pending: tuple[int, FloatArray, Shot, int] | None = None
         self.next_attempt = 1
         self.failures = 0
 
@@ -450,13 +272,13 @@ class _Settler:
         self.d[i, 1 : n + 1] = np.max(np.abs(self.P[i] - self.P[i - n : i][::-1]), axis=1)
         self.i = i
 
-    def shoot(self, x: FloatArray, n: int) -> _Shot | _SystemShot:
+    def shoot(self, x: FloatArray, n: int) -> Shot:
         opts = self.opts
         shot = self.flow.shoot(x, n, opts.shooting_tolerance, opts.shooting_iterations)
         self.shooting_periods += shot.evaluations * n
         return shot
 
-    def cycle_points(self, shot: _Shot | _SystemShot, n: int) -> FloatArray:
+    def cycle_points(self, shot: Shot, n: int) -> FloatArray:
         if n == 1:
             return shot.x[None, :].copy()
         return self.flow.section(shot.trajectory, np.arange(n) * self.T)
@@ -481,7 +303,7 @@ class _Settler:
                 return n
         return 0
 
-    def stable_orbit(self, x: FloatArray, n: int) -> tuple[_Shot | _SystemShot, int] | None:
+    def stable_orbit(self, x: FloatArray, n: int) -> tuple[Shot, int] | None:
         """Newton shooting with period n from x; the orbit (with its minimal period) if it
         converged and is stable, else None."""
         shot = self.shoot(x, n)
@@ -550,7 +372,7 @@ class _Settler:
         k = self.opts.section_points
         return self.X[max(0, self.i + 1 - k) : self.i + 1].copy()
 
-    def from_shot(self, shot: _Shot | _SystemShot, n: int) -> SteadyState:
+    def from_shot(self, shot: Shot, n: int) -> SteadyState:
         traj = shot.trajectory
         return SteadyState(
             omega=self.omega, period=n, status=Status.CONVERGED, periods=self.i,
@@ -640,48 +462,18 @@ def static_state(model: Model | Chain | System | NonsmoothSystem | FrictionSyste
     return np.concatenate((system.static_equilibrium(omega), np.zeros(system.n)))
 
 
-def make_integrator(
-    model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
-) -> ExactIntegrator | SystemIntegrator | NonsmoothIntegrator | FrictionIntegrator:
-    """The exact integrator :func:`steady_state` uses for ``model``: :class:`ExactIntegrator`
-    for the single equation (its fast scalar path), :class:`SystemIntegrator` of the System
-    for a chain, :class:`NonsmoothIntegrator` or :class:`FrictionIntegrator` for the
-    discontinuous laws (reuse it across calls to share its cache)."""
-    if isinstance(model, Model):
-        return ExactIntegrator(model)
-    if isinstance(model, NonsmoothSystem):
-        return NonsmoothIntegrator(model)
-    if isinstance(model, FrictionSystem):
-        return FrictionIntegrator(model)
-    return SystemIntegrator(model.system() if isinstance(model, Chain) else model)
-
-
-def _checked_integrator(integrator: object, cls: type, target: object, owner: str, what: str, noun: str) -> Any:
-    """``integrator``, or a new ``cls(target)`` when None: refused (TypeError) when not a ``cls``
-    (``what`` says which, e.g. "a SystemIntegrator for a chain"), and (ValueError) when its
-    ``owner`` attribute is another ``noun`` than ``target``."""
-    integ = cls(target) if integrator is None else integrator
-    if not isinstance(integ, cls):
-        raise TypeError(f"`integrator` must be {what}, got {integrator!r}")
-    built_for = getattr(integ, owner)
-    if built_for is not target and built_for != target:
-        raise ValueError(f"`integrator` was built for a different {noun} than `model`")
+def _checked_integrator(integrator: object, system: Model | System | NonsmoothSystem | FrictionSystem) -> Any:
+    """``integrator``, or :func:`make_integrator` of ``system`` when None: refused (TypeError)
+    when not the exact integrator of ``system``'s kind, (ValueError) when built for another
+    system."""
+    integ = make_integrator(system) if integrator is None else integrator
+    if not built_for(integ, system):
+        kind = type(make_integrator(system)).__name__ if integrator is not None else ""
+        if not isinstance(integ, type(make_integrator(system))):
+            raise TypeError(f"`integrator` must be a {kind} for a {type(system).__name__}, got {integrator!r}")
+        raise ValueError(f"`integrator` was built for a different {'model' if isinstance(system, Model) else 'system'} "
+                         "than `model`")
     return integ
-
-
-def _discontinuous_flow(
-    model: NonsmoothSystem | FrictionSystem, omega: float, x0: object, integrator: object,
-) -> tuple[_NonsmoothFlow | _FrictionFlow, FloatArray, tuple[str, ...]]:
-    """The flow, start state and element names of a discontinuous law."""
-    if isinstance(model, NonsmoothSystem):
-        x = check_state(x0) if x0 is not None else static_state(model)
-        integ = _checked_integrator(integrator, NonsmoothIntegrator, model, "system",
-                                    "a NonsmoothIntegrator for a NonsmoothSystem", "system")
-        return _NonsmoothFlow(model, integ, omega), x, ()
-    x = check_system_state(x0, model.n, "x0") if x0 is not None else static_state(model, omega)
-    finteg = _checked_integrator(integrator, FrictionIntegrator, model, "fsys",
-                                 "a FrictionIntegrator for a FrictionSystem", "system")
-    return _FrictionFlow(model, finteg, omega), x, model.element_names
 
 
 @numerical_failures
@@ -739,35 +531,25 @@ def steady_state(
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
         raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
-    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+    if isinstance(model, (System, NonsmoothSystem, FrictionSystem)):
         from .._validate import check_omega
 
         omega = check_omega(omega)
-        dflow, x, dnames = _discontinuous_flow(model, omega, x0, integrator)
-        return _Settler(dflow, omega, x.copy(), opts, dnames).run()
-    if isinstance(model, System):
-        from .._validate import check_omega
-
-        omega = check_omega(omega)
-        system = model
+        system: Model | System | NonsmoothSystem | FrictionSystem = model
     else:
         check_analysable_model(model)
         omega = _limits.check_frequency(model, omega)
-        system = None if isinstance(model, Model) else model.system()
-    if system is None:
-        x = check_state(x0) if x0 is not None else static_state(model)
-        integ = _checked_integrator(integrator, ExactIntegrator, model, "model", "an ExactIntegrator for a Model",
-                                    "model")
-        flow: _ModelFlow | _SystemFlow = _ModelFlow(model, integ, omega)  # type: ignore[arg-type]
+        system = model if isinstance(model, Model) else model.system()
+    if isinstance(system, (Model, NonsmoothSystem)):
+        x = check_state(x0) if x0 is not None else static_state(system)
         names: tuple[str, ...] = ()
     else:
-        x = check_system_state(x0, system.n, "x0") if x0 is not None else static_state(system, omega)
-        sinteg = _checked_integrator(integrator, SystemIntegrator, system, "system", "a SystemIntegrator for a chain",
-                                     "system")
-        flow = _SystemFlow(system, sinteg, omega)
-        names = tuple(e.name for e in system.elements)
+        n = system.n
+        x = check_system_state(x0, n, "x0") if x0 is not None else static_state(system, omega)
+        names = system.element_names if isinstance(system, FrictionSystem) else tuple(e.name for e in system.elements)
+    flow = _Flow(system, _checked_integrator(integrator, system), omega)
     return _Settler(flow, omega, x.copy(), opts, names).run()
 
 
 __all__ = ["SteadyStateOptions", "SteadyState", "steady_state", "METHODS", "static_state", "make_integrator",
-           "nonsmooth_measures", "friction_measures", "stick_fraction"]
+           "stick_fraction"]

@@ -30,8 +30,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..results import FrequencyResponse
 from ..results import Region
-from ..timeint._shooting import _newton_shooting, _state_scale
-from ..timeint._system_shooting import _newton_system, system_state_scale
+from ..timeint import ShootingProblem, state_scale
 from ._steady import SteadyStateOptions, make_integrator, steady_state
 
 #: Settling options of the confirmation run: 600 periods to settle (the unstable orbit is left in
@@ -123,12 +122,10 @@ def simulate_torus(frf: FrequencyResponse, region: Region, options: SteadyStateO
     n = 1 if system is None else system.n
     z_hb = _state_at_zero(frf.coefficients[row], n, W, p)
     integ = make_integrator(model)
-    if system is None:
-        scale = _state_scale(model, W)
-        shot = _newton_shooting(integ, W, z_hb, p, 1e-12, 20, scale)
-    else:
-        scale = system_state_scale(system, W)
-        shot = _newton_system(integ, W, z_hb, p, 1e-12, 20, scale)  # type: ignore[arg-type]
+    target = model if system is None else integ.system
+    scale = state_scale(target, W)
+    shot = ShootingProblem(target, period=p, integrator=integ).solve(
+        z_hb, W, tol=1e-12, max_iterations=20, max_halvings=12, scale=scale)
     converged = shot.residual <= 1e-10
     z_star = shot.x if converged else z_hb
     M = shot.trajectory.sensitivity

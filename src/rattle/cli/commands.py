@@ -505,7 +505,7 @@ def _nonsmooth_orbit_settings(run_config: Any, omega: float, period: int, harmon
     _nonsmooth_orbit_options(run_config, period, omega_min, omega_max)
     analysis = override_analysis(run_config.analysis, run_config.bounds_model, harmonics=harmonics)
     check_omega(omega, model=run_config.bounds_model)
-    from ..analysis._case import regularisation_options
+    from ..analysis import regularisation_options
 
     return analysis, regularisation_options(analysis)
 
@@ -678,7 +678,7 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
     down sweep, written as frf.csv (the response's columns), sweep.csv, compare.json, compare.png."""
     t_start = time.perf_counter()
     from ..analysis import compare  # only now: all input has been validated
-    from ..analysis._case import regularisation_options
+    from ..analysis import regularisation_options
 
     reg = regularisation_options(analysis)
     logger.info("comparing the response of a discontinuous law (regularised harmonic balance, H = %d, ε = %g, checked "

@@ -16,6 +16,7 @@ from ._model import Model
 from ._nonsmooth_system import NonsmoothSystem
 from ._paths import SoundPath, check_source, parse_source
 from ._system import ReducedElement, System
+from ._stage_matrix import StageConstants, stage_constants, stage_transition, transition_entries, transition_scalar
 from ._tables import ModelTables, model_tables  # (loaded here: registers the reader of Model.from_toml and Chain.from_toml)
 from .library import backlash_case, reference_case
 
@@ -27,4 +28,5 @@ __all__ = [
     "SoundPath", "check_source", "parse_source", "model_tables", "ModelTables", "Drag", "SpeedLoad",
     "AbstractJumpLaw", "Preload", "PiecewiseJump", "Friction", "NonsmoothLaw", "NonsmoothSystem", "FrictionSystem",
     "clutch_damper", "hub_spline", "gear_pair", "loose_gear", "GearPair", "LooseGear", "MAX_BACKLASH_RATIO",
+    "StageConstants", "stage_constants", "stage_transition", "transition_entries", "transition_scalar",
 ]

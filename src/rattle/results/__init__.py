@@ -10,7 +10,7 @@ from ._comparison import Comparison
 from ._check import held_runs
 from ._friction import FRICTION_ELEMENT_COLUMNS, FRICTION_TAIL_COLUMNS, FrictionCheck
 from ._friction_orbit import FRICTION_ORBIT_ELEMENT_COLUMNS, FrictionOrbitResult, HeldLimitRecord
-from ._frequency_response import FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
+from ._frequency_response import element_columns_from, FrequencyResponse, LinearResponse, Region, SpecialPoint, linear_frequency_response
 from ._measured import MEASURED_QUANTITIES, MeasuredComparison, MeasuredRun, compare_measured
 from ._nonsmooth import NONSMOOTH_COLUMNS, NonsmoothCheck
 from ._nonsmooth_orbit import NONSMOOTH_ORBIT_COLUMNS, NonsmoothOrbitResult
@@ -23,7 +23,7 @@ from ._steady import METHODS as STEADY_METHODS, SteadyState
 from ._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SweepResult
 
 __all__ = [
-    "FrequencyResponse", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
+    "FrequencyResponse", "element_columns_from", "SpecialPoint", "Region", "LinearResponse", "linear_frequency_response",
     "SweepResult", "FAILED_PERIOD", "SWEEP_FAILED", "SWEEP_ELEMENT_COLUMNS", "SteadyState", "STEADY_METHODS", "PeriodicOrbit", "OrbitSolution", "Comparison",
     "FRF_COLUMNS", "SWEEP_COLUMNS", "ORBIT_COLUMNS",
     "SoundPressure", "sound_pressure", "linear_sound_pressure", "a_weighting_db", "motion_sound_pressure",

@@ -39,7 +39,7 @@ import scipy.linalg
 from .._typing import ComplexArray, FloatArray
 from ..hb import FourierBasis
 from ..model import System
-from ..model._stage_matrix import stage_transition  # the one closed form of exp(A τ) (re-exported)
+from ..model import stage_transition  # the one closed form of exp(A τ) (re-exported)
 from . import _kernels
 
 #: A stage combination whose eigenvector matrix has a condition number above this goes through

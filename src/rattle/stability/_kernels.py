@@ -24,7 +24,7 @@ try:  # numba is a dependency; the array code stays the fallback (and the refere
 except ImportError:  # pragma: no cover - exercised only without numba
     numba = None
 
-from ..model._stage_matrix import stage_constants, transition_scalar
+from ..model import stage_constants, transition_scalar
 
 AVAILABLE = numba is not None
 

@@ -8,24 +8,28 @@ The steady state of a simulation with period detection is an analysis built on t
 
 from typing import Any
 
-from ._exact import ExactIntegrator, ExactMeasures, StageSolutions, StateSamples, Trajectory
-from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory
+from ._exact import ExactIntegrator, ExactMeasures, ExactTrajectory, StageSolutions, StateSamples, Trajectory
+from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory, check_system_state
 from ._general import GeneralSolution, integrate_general
-from ._shooting import FLOW_FAILURES, ShootingOrbit, monodromy_multipliers, shoot_periodic_orbit
-from ._shooting_problem import ShootingProblem
-from ._system_shooting import SystemOrbit, shoot_system_orbit
-
-from ._friction_chain import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
-from ._nonsmooth import (
-    NonsmoothIntegrator, NonsmoothOptions, NonsmoothOrbit, NonsmoothTrajectory, shoot_nonsmooth_orbit,
+from ._friction_chain import CROSSING, LOCK, STICK, FrictionIntegrator, FrictionTrajectory
+from ._nonsmooth import NonsmoothIntegrator, NonsmoothOptions, NonsmoothTrajectory
+from ._shooting_problem import (
+    FLOW_FAILURES, ShootingProblem, Shot, built_for, make_integrator, monodromy_multipliers, state_scale,
 )
+from ._shooting import (
+    FrictionOrbit, NonsmoothOrbit, ShootingOrbit, ShotOrbit, SystemOrbit, shoot_friction_orbit, shoot_nonsmooth_orbit,
+    shoot_periodic_orbit, shoot_system_orbit,
+)
+
 __all__ = [
-    "ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
+    "ExactIntegrator", "ExactTrajectory", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
     "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem", "monodromy_multipliers", "FLOW_FAILURES",
+    "Shot", "ShotOrbit", "state_scale", "make_integrator", "built_for", "check_system_state",
     "integrate_general", "GeneralSolution",
     "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
     "NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
     "FrictionIntegrator", "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit",
+    "CROSSING", "LOCK", "STICK",  # the segment kinds of a FrictionTrajectory
 ]
 
 #: Names that moved out of ``rattle.timeint`` (the steady state is an analysis, its result a

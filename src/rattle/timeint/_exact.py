@@ -13,6 +13,6 @@ This module gathers them under their old names (the N-coordinate counterparts ar
 
 from ._integrator import ExactIntegrator
 from ._stage_solutions import StageSolutions
-from ._trajectory import ExactMeasures, StateSamples, Trajectory
+from ._trajectory import ExactMeasures, ExactTrajectory, StateSamples, Trajectory
 
-__all__ = ["ExactIntegrator", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions"]
+__all__ = ["ExactIntegrator", "ExactTrajectory", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions"]

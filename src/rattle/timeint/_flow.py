@@ -28,6 +28,7 @@ from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError
 from ..model import System
 from ._events import first_exit, vector_bracketed_newton
+from ._trajectory import ExactTrajectory
 from ._stage_flow import Segment, SystemStages
 
 _EPS = float(np.finfo(float).eps)
@@ -105,7 +106,7 @@ class SystemMeasures:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class SystemTrajectory:
+class SystemTrajectory(ExactTrajectory):
     """An exact trajectory of a :class:`~rattle.model.System` from ``t0`` to ``t1``.
 
     Segment i runs from ``t_start[i]`` to ``t_end[i]`` on the stage combination ``stages[i]``
@@ -117,14 +118,6 @@ class SystemTrajectory:
     """
 
     system: System
-    omega: float
-    t0: float
-    t1: float
-    state0: FloatArray
-    state1: FloatArray
-    sensitivity: FloatArray
-    t_start: FloatArray
-    t_end: FloatArray
     stages: IntArray
     z_start: FloatArray
     crossing_times: FloatArray
@@ -133,22 +126,10 @@ class SystemTrajectory:
     crossing_breakpoints: FloatArray
     segments: tuple[Segment, ...] = field(repr=False, compare=False)
 
-    @property
-    def n_segments(self) -> int:
-        return int(self.t_start.size)
-
-    def segment_index(self, t: FloatArray | float) -> IntArray:
-        """Index of the segment holding each time (the later one at a crossing)."""
-        idx = np.searchsorted(self.t_start, t, side="right") - 1
-        return np.clip(idx, 0, self.n_segments - 1)
-
-    def _check_times(self, t: FloatArray) -> None:
-        span = max(abs(self.t0), abs(self.t1), self.t1 - self.t0)
-        if t.size and (np.min(t) < self.t0 - 4 * _EPS * span or np.max(t) > self.t1 + 4 * _EPS * span):
-            raise ValueError(
-                f"`t` must lie within the trajectory's interval [{self.t0!r}, {self.t1!r}], got values "
-                f"in [{float(np.min(t))!r}, {float(np.max(t))!r}]"
-            )
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """z = (x, x') at times ``t``, shape t.shape + (2n,)."""
+        x, v = self.derivatives(np.asarray(t, dtype=float), 1)
+        return np.concatenate((x, v), axis=-1)
 
     def _segment_derivatives(self, i: int, taus: FloatArray, order: int) -> list[FloatArray]:
         """[x, x', …, x^(order)] at local times ``taus`` of segment i, each (N, n); beyond the
@@ -170,7 +151,7 @@ class SystemTrajectory:
         if not 0 <= int(order) <= 4:
             raise ValueError(f"`order` must be 0 … 4, got {order!r}")
         t = np.asarray(t, dtype=float)
-        self._check_times(t)
+        self.check_times(t)
         n = self.system.n
         flat = t.reshape(-1)
         seg = self.segment_index(flat) if segment is None else np.broadcast_to(segment, t.shape).reshape(-1)

@@ -67,7 +67,7 @@ into a stick φ⁺ is the sliding field, nᵀφ⁺ = 0, and nᵀ S = 0: the δ_e
 At a release φ⁺ = φ⁻ (λ_e = ±r_ej makes the two fields equal), S = I. A crossing of a jump has
 φ⁺ ≠ φ⁻ (the stages on each side) and S ≠ I. Between events the sensitivity is the mode's
 exp(A τ). So ∂z(t1)/∂z(t0) = Π (exp(A τ), S) is exact, and so are the Floquet multipliers of
-:func:`shoot_friction_orbit`. Not resolved: a tangential touch of a switching surface (grazing: the
+:func:`~rattle.timeint.shoot_friction_orbit`. Not resolved: a tangential touch of a switching surface (grazing: the
 map is not differentiable there) and stuck sets closing a loop.
 """
 
@@ -78,24 +78,23 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from .._limits import check_interval
 from .._typing import FloatArray
-from .._validate import check_omega, check_shooting
+from .._validate import check_omega
 from ..errors import ConvergenceError
-from ..model import FrictionSystem, System
-from ..model._system import ReducedElement
+from ..model import FrictionSystem, ReducedElement, System
 from ._events import first_exit
-from ._flow import check_system_state
+from ._trajectory import ExactTrajectory
+from ._flow import SystemMeasures, check_system_state
 from ._nonsmooth import NonsmoothOptions
-from ._shooting import ShotOrbit, monodromy_multipliers
 from ._stage_flow import Segment, StageSolution, SystemStages
-from ._system_shooting import _newton_system
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(16)
+_EXTREMA_PER_SCALE = 40  # grid points per time scale bracketing the extrema of a segment (measures)
 
 #: Event kinds of a :class:`FrictionTrajectory` (``lock``/``unlock``: an element held at a jump of
 #: its law, ``event_values`` the breakpoint).
@@ -117,8 +116,8 @@ def _brent(fun, a: float, b: float, fa: float, fb: float) -> float:  # type: ign
     return float(brentq(fun, a, b, xtol=4.0 * _EPS * max(abs(b), 1e-300), rtol=4.0 * _EPS, maxiter=200))
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class FrictionTrajectory:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FrictionTrajectory(ExactTrajectory):
     """The exact motion from ``t0`` to ``t1``: ``state0``, ``state1`` (2n,) and the sensitivity
     ∂z(t1)/∂z(t0) (stage transitions and saltation matrices); per segment its start time
     ``t_start`` (and ``t_end``), the element ``stages`` (k, m), the ``stuck`` flags (k, m: held
@@ -128,14 +127,6 @@ class FrictionTrajectory:
     breakpoint crossed, locked on or left)."""
 
     system: FrictionSystem
-    omega: float
-    t0: float
-    t1: float
-    state0: FloatArray
-    state1: FloatArray
-    sensitivity: FloatArray
-    t_start: FloatArray
-    t_end: FloatArray
     stages: np.ndarray
     stuck: np.ndarray
     segments: tuple[Segment, ...]
@@ -145,9 +136,70 @@ class FrictionTrajectory:
     event_values: FloatArray
     locked: np.ndarray | None = None
 
-    def segment_index(self, t: FloatArray | float) -> np.ndarray:
-        t = np.asarray(t, dtype=float)
-        return np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """z = (x, x') at times ``t``, shape t.shape + (2n,)."""
+        return self.sample(t)[0]
+
+    def measures(self) -> SystemMeasures:
+        """The measures of every element's deflection δ_e = a_e·x over the
+        trajectory: mean and rms by its own quadrature
+        (:meth:`element_mean_and_rms`), rms about the mean likewise; the extremes on every segment
+        (the motion is analytic there) from a grid of 40 points per time scale that includes both
+        segment ends — so δ_e'' counts its one-sided values at every switching — refined where δ_e'
+        changes sign (δ extremes, by Brent's method on the segment's exact solution) and at the grid
+        extrema of δ_e'' and in the first and last cell of every segment (bounded Brent
+        minimisation)."""
+        T = self.t1 - self.t0
+        if not T > 0.0:
+            raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
+        fsys = self.system
+        A = fsys.system.element_rows
+        n, m = fsys.n, A.shape[0]
+        mean, rms = self.element_mean_and_rms()
+        ms_ac = self.integrate(lambda z: (z[:, :n] @ A.T - mean) ** 2) / T
+        dmin, dmax = np.full(m, np.inf), np.full(m, -np.inf)
+        amin, amax = np.full(m, np.inf), np.full(m, -np.inf)
+        k_seg = len(self.segments)
+        for i, seg in enumerate(self.segments):
+            length = float(self.t_end[i] - self.t_start[i])
+            if length < 0.0 or (length == 0.0 and k_seg > 1):
+                continue
+            scale = float(seg.sol.time_scale)
+            if not math.isfinite(scale) or scale <= 0.0:
+                scale = max(T, 1.0)
+            cells = max(2, math.ceil(length / (scale / _EXTREMA_PER_SCALE)))
+            tg = np.linspace(0.0, length, cells + 1)
+            z, zd = seg.state(tg)
+            d, v, a = z[:, :n] @ A.T, z[:, n:] @ A.T, zd[:, n:] @ A.T
+            dmin, dmax = np.minimum(dmin, d.min(axis=0)), np.maximum(dmax, d.max(axis=0))
+            amin, amax = np.minimum(amin, a.min(axis=0)), np.maximum(amax, a.max(axis=0))
+            if length == 0.0:
+                continue
+            for e in range(m):
+                ve, ae = v[:, e], a[:, e]
+                for q in np.flatnonzero((ve[:-1] > 0.0) != (ve[1:] > 0.0)).tolist():
+                    tq = _brent(lambda x, e=e: seg.element_point(x, e)[1], float(tg[q]), float(tg[q + 1]),
+                                0.0, 0.0)
+                    val = seg.element_point(tq, e)[0]
+                    dmin[e], dmax[e] = min(dmin[e], val), max(dmax[e], val)
+                da = np.diff(ae)
+                if not np.any(da):
+                    continue
+                # an interior grid extremum, and both ways the first and the last cell (an extremum
+                # next to a segment end leaves no sign change of the grid differences)
+                brackets = [(float(tg[q - 1]), float(tg[q + 1]), 1.0 if da[q - 1] < 0.0 else -1.0)
+                            for q in (np.flatnonzero(da[:-1] * da[1:] < 0.0) + 1).tolist()]
+                for lo_c, hi_c in ((tg[0], tg[1]), (tg[-2], tg[-1])):
+                    brackets += [(float(lo_c), float(hi_c), 1.0), (float(lo_c), float(hi_c), -1.0)]
+                for lo_c, hi_c, sign in brackets:  # sign +1: a minimum of δ_e'', −1: a maximum
+                    res = minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
+                                          bounds=(lo_c, hi_c), method="bounded",
+                                          options={"xatol": 1e-12 * max(length, 1.0)})
+                    val = seg.element_point(float(res.x), e)[2]
+                    amin[e], amax[e] = min(amin[e], val), max(amax[e], val)
+        return SystemMeasures(names=fsys.element_names, mean=mean, rms=rms, rms_ac=np.sqrt(np.maximum(ms_ac, 0.0)),
+                              delta_min=dmin, delta_max=dmax, p2p=dmax - dmin, acc_min=amin, acc_max=amax,
+                              acc_p2p=amax - amin)
 
     def sample(self, t: FloatArray | float) -> tuple[FloatArray, FloatArray]:
         """z = (x, x') and z' = (x', x'') at times ``t``: shapes t.shape + (2n,) each."""
@@ -454,8 +506,10 @@ class FrictionIntegrator:
             locked=np.asarray(rec["lk"], dtype=bool).reshape(-1, self.m),
         )
 
-    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float) -> tuple[FloatArray, FloatArray]:
-        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path)."""
+    def advance(self, z0: FloatArray, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[FloatArray, FloatArray]:
+        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path; the
+        ``sensitivity`` is there for the common signature: M is always computed)."""
         return self._march(np.asarray(z0, dtype=float).copy(), float(t0), float(t1), float(omega), None)
 
     def _march(self, z: FloatArray, t0: float, t1: float, omega: float,
@@ -827,105 +881,4 @@ class FrictionIntegrator:
         return None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class FrictionOrbit(ShotOrbit):
-    """A periodic orbit of a chain with friction by Newton shooting on the exact period map:
-    ``state0`` z(0) (2n,), ``monodromy`` (with saltation matrices), ``multipliers``,
-    ``trajectory`` over one period, every element's ``mean`` and ``rms`` (m,) and
-    ``stick_fraction`` (m,: the fraction of the period it sticks)."""
-
-    trajectory: FrictionTrajectory
-    mean: FloatArray
-    rms: FloatArray
-    stick_fraction: FloatArray
-
-
-def _newton_held(integ: FrictionIntegrator, omega: float, z: FloatArray, T: float, hold: dict[int, float],
-                 scale: FloatArray, tol: float, max_iterations: int) -> tuple[FloatArray, float, int]:
-    """Gauss–Newton on [φ(z0) − z0; a_e·x0 − d_e (e held)] = 0 with the Jacobian [[M − I]; [a_e, 0]]
-    (least squares: M − I is singular along the family of orbits the holds pick one of)."""
-    n = integ.n
-    rows = np.zeros((len(hold), 2 * n))
-    target = np.zeros(len(hold))
-    for k, (e, d) in enumerate(hold.items()):
-        rows[k, :n] = integ.A[e]
-        target[k] = d
-    L = float(scale[0])
-
-    def residual(zz: FloatArray) -> tuple[FloatArray, FloatArray] | None:
-        try:
-            z1, M = integ.advance(zz, 0.0, T, omega)
-        except ConvergenceError:
-            return None
-        return np.concatenate(((z1 - zz) / scale, (rows @ zz - target) / L)), M
-
-    out = residual(z)
-    if out is None:
-        return z, math.inf, 0
-    r, M = out
-    res = float(np.max(np.abs(r)))
-    it = 0
-    while res > tol and it < max_iterations:
-        it += 1
-        J = np.vstack(((M - np.eye(2 * n)) / scale[:, None], rows / L))
-        dz = np.linalg.lstsq(J, -r, rcond=None)[0]
-        step = 1.0
-        for _ in range(31):
-            out = residual(z + step * dz)
-            if out is not None and float(np.max(np.abs(out[0]))) < res:
-                break
-            step *= 0.5
-        else:
-            break
-        z = z + step * dz
-        r, M = out  # type: ignore[misc]
-        res = float(np.max(np.abs(r)))
-    return z, res, it
-
-
-def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *, period: int = 1,
-                         tol: float = 1e-12, max_iterations: int = 50,
-                         integrator: FrictionIntegrator | None = None,
-                         hold: dict[int, float] | None = None) -> FrictionOrbit:
-    """Periodic orbit of the chain with friction by Newton shooting: r(z0) = φ(z0; 0 → T) − z0 = 0
-    with the Jacobian M − I (M the exact monodromy with saltation matrices), steps halved until
-    the scaled residual decreases. Scales: L for positions, L max(Ω, ω_n) for velocities. A
-    failed solve is returned with ``converged`` False.
-
-    ``hold`` {element: deflection}: elements that stick the whole period. Their orbits form a
-    family (the stuck deflection is free within the friction band; a multiplier 1, M − I
-    singular); the one whose held deflection is the given one is found, by Gauss–Newton on the
-    shooting equations with a_e·x0 = d_e added. The start is moved onto the holds: δ_e = d_e and
-    δ_e' = 0."""
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a FrictionSystem, got {system!r}")
-    omega = check_omega(omega)
-    check_shooting(period, tol, max_iterations)
-    integ = FrictionIntegrator(system) if integrator is None else integrator
-    if integ.fsys is not system:
-        raise ValueError("`integrator` was built for a different system than `system`")
-    z = check_system_state(z0, system.n).copy()
-    n = system.n
-    scale = np.concatenate((np.full(n, system.length_scale()), np.full(n, integ.velocity_scale(omega))))
-    T = period * 2.0 * math.pi / omega
-    if hold:
-        held = {int(e): float(d) for e, d in hold.items()}
-        for e, d in held.items():
-            if not 0 <= e < system.m:
-                raise ValueError(f"`hold` names element {e}; the system has elements 0 … {system.m - 1}")
-            a = integ.A[e]
-            z[:n] += a * ((d - float(a @ z[:n])) / float(a @ a))
-            z[n:] -= a * (float(a @ z[n:]) / float(a @ a))
-        z, res, it = _newton_held(integ, omega, z, T, held, scale, float(tol), int(max_iterations))
-        traj: FrictionTrajectory = integ.propagate(z, 0.0, T, omega)
-    else:  # Newton on φ(z0) − z0 with M − I (the shooting core shared with the smooth chain's)
-        shot = _newton_system(integ, omega, z, int(period), float(tol), int(max_iterations), scale, max_halvings=30)
-        z, res, it = shot.x, shot.residual, shot.iterations
-        traj = shot.trajectory  # type: ignore[assignment]
-    mean, rms = traj.element_mean_and_rms()
-    return FrictionOrbit(state0=z, omega=omega, period=int(period), monodromy=traj.sensitivity,
-                         multipliers=monodromy_multipliers(traj.sensitivity), converged=res <= tol, iterations=it,
-                         residual=res, trajectory=traj, mean=mean, rms=rms, stick_fraction=traj.stick_time() / T)
-
-
-__all__ = ["EVENT_NAMES", "FrictionIntegrator", "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit"]
+__all__ = ["EVENT_NAMES", "FrictionIntegrator", "FrictionTrajectory"]

@@ -41,8 +41,7 @@ from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_state
 from ..errors import ConvergenceError
-from ..model import Model
-from ..model._stage_matrix import transition_scalar
+from ..model import Model, transition_scalar
 from ._roots import bracketed_newton
 from ._stage_solutions import StageSolutions
 from ._trajectory import Trajectory
@@ -189,6 +188,13 @@ class ExactIntegrator:
             stage=np.asarray(stages, dtype=np.int64), x_start=np.asarray(states, dtype=float).reshape(-1, 2),
             solutions=sol, homogeneous=np.asarray(homog, dtype=float).reshape(-1, 2),
         )
+
+    def advance(self, x0: FloatArray, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
+        """The state (δ, δ') at ``t1`` and the sensitivity ∂x(t1)/∂x(t0) (None when
+        ``sensitivity`` is False) only — no record kept, no checks: the period map of a shooting."""
+        d, v, m = self._march(self.solutions(omega), float(x0[0]), float(x0[1]), float(t0), float(t1), None)
+        return np.array([d, v]), (np.array([[m[0], m[1]], [m[2], m[3]]]) if sensitivity else None)
 
     def _advance(self, delta: float, velocity: float, t0: float, t1: float, omega: float) -> tuple[float, float]:
         """The state (δ, δ') at t1 only, from (δ, δ') at t0 (no checks, no record): the hot path of

@@ -40,7 +40,7 @@ the δ-crossings by the crossing search of :class:`~rattle.timeint.ExactIntegrat
 
 Between events the sensitivity is the stage transition matrix exp(A τ), A = [[0, 1], [−k s_j, −c]],
 so ∂x(t1)/∂x(t0) = Π (exp(A τ) and S) is exact, and so are the Floquet multipliers of
-:func:`shoot_nonsmooth_orbit`. Grazing (a tangential touch of a switching surface) is not
+:func:`~rattle.timeint.shoot_nonsmooth_orbit`. Grazing (a tangential touch of a switching surface) is not
 resolved: the map is not differentiable there.
 """
 
@@ -55,13 +55,12 @@ import numpy as np
 
 from .._limits import check_interval
 from .._typing import FloatArray, IntArray
-from .._validate import check_omega, check_shooting, check_state
+from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
-from ..model._elastic import Stages
-from ..model._nonsmooth_system import NonsmoothSystem
+from ..model import NonsmoothSystem, Stages
 from ._integrator import ExactIntegrator, _Segment
+from ._trajectory import ExactMeasures, ExactTrajectory
 from ._roots import bracketed_newton
-from ._shooting import ShotOrbit, _newton_shooting
 from ._stage_solutions import StageSolutions
 
 _EPS = float(np.finfo(float).eps)
@@ -136,7 +135,7 @@ def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: in
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class NonsmoothTrajectory:
+class NonsmoothTrajectory(ExactTrajectory):
     """An exact trajectory from ``t0`` to ``t1``: segments i from ``t_start[i]`` to ``t_end[i]``
     of ``kind[i]`` (0 slip, 1 stick, 2 lock) on ``stage[i]`` with friction sign ``sign[i]``
     (slip only), start state ``x_start[i]`` and homogeneous part ``homogeneous[i]`` (slip);
@@ -145,14 +144,6 @@ class NonsmoothTrajectory:
     ``stick``, ``unstick``, ``lock``, ``unlock``)."""
 
     system: NonsmoothSystem
-    omega: float
-    t0: float
-    t1: float
-    state0: FloatArray
-    state1: FloatArray
-    sensitivity: FloatArray
-    t_start: FloatArray
-    t_end: FloatArray
     kind: IntArray
     stage: IntArray
     sign: IntArray
@@ -162,15 +153,31 @@ class NonsmoothTrajectory:
     event_kind: tuple[str, ...]
     solutions: StageSolutions = field(repr=False)
 
-    def _segment_of(self, t: FloatArray) -> IntArray:
-        return np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """(δ, δ') at times ``t``, shape t.shape + (2,)."""
+        d, v, _ = self.sample(np.asarray(t, dtype=float))
+        return np.stack((d, v), axis=-1)
+
+    def measures(self) -> ExactMeasures:
+        """The measures of δ (SPEC §1) over the trajectory: mean and rms by its own quadrature
+        (:meth:`mean_and_rms`, Gauss–Legendre inside the segments), rms about the
+        mean likewise, the extremes of δ and δ'' by :meth:`extremes` (δ'' jumps at a switching: both
+        one-sided values count, a stick or lock contributes δ'' = 0)."""
+        T = self.t1 - self.t0
+        if not T > 0.0:
+            raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
+        mean, rms = self.mean_and_rms()
+        ms_ac = self.integrate(lambda t, d, v, a: (d - mean) ** 2) / T
+        dmin, dmax, amin, amax = self.extremes()
+        return ExactMeasures(mean=mean, rms=rms, rms_ac=math.sqrt(max(ms_ac, 0.0)), delta_min=dmin, delta_max=dmax,
+                             p2p=dmax - dmin, acc_min=amin, acc_max=amax, acc_p2p=amax - amin)
 
     def sample(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """δ, δ' and δ'' at times ``t`` in [t0, t1] (arrays of t's shape); δ'' on a stick or lock
         is 0, at a switching time the value of the segment starting there."""
         t = np.asarray(t, dtype=float)
         flat = t.ravel()
-        idx = self._segment_of(flat)
+        idx = self.segment_index(flat)
         d, v, a = np.empty_like(flat), np.zeros_like(flat), np.zeros_like(flat)
         sol = self.solutions
         for i in np.unique(idx):
@@ -421,6 +428,13 @@ class NonsmoothIntegrator:
             sign=np.asarray(rec["sign"], dtype=np.int64), x_start=np.asarray(rec["x"], dtype=float).reshape(-1, 2),
             homogeneous=np.asarray(rec["h"], dtype=float).reshape(-1, 2),
             event_time=np.asarray(rec["et"], dtype=float), event_kind=tuple(rec["ek"]), solutions=sol)
+
+    def advance(self, x0: FloatArray, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
+        """The state (δ, δ') at ``t1`` and ∂x(t1)/∂x(t0) (None when ``sensitivity`` is False): the
+        period map of a shooting."""
+        traj = self.propagate(x0, t0, t1, omega)
+        return traj.state1, (traj.sensitivity if sensitivity else None)
 
     # --- the march ---------------------------------------------------------------------------
     def _march(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
@@ -679,56 +693,4 @@ class NonsmoothIntegrator:
         return None, False
 
 
-# ---------------------------------------------------------------------------------------------
-# Periodic orbits
-# ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class NonsmoothOrbit(ShotOrbit):
-    """A periodic orbit of the discontinuous equation found by Newton shooting on the exact period
-    map: ``state0`` (δ, δ') at t = 0, ``omega``, ``period`` p (T = p 2π/Ω), ``monodromy`` M (with
-    the saltation matrices), ``multipliers`` (eigenvalues of M, largest modulus first),
-    ``converged``, ``iterations``, ``residual`` (scaled ‖φ(x0) − x0‖∞), ``trajectory`` over one
-    period, ``mean`` and ``rms`` of δ."""
-
-    trajectory: NonsmoothTrajectory
-    mean: float
-    rms: float
-
-    @property
-    def regime(self) -> str:
-        """``no_impact``, ``single_sided`` or ``double_sided`` from the breakpoints crossed or
-        locked on (a jump at δ = 0 is on neither side: crossing only it is ``single_sided``)."""
-        crossed = self.trajectory.crossed_breakpoints
-        if crossed.size == 0:
-            return "no_impact"
-        if np.all(crossed >= 0.0) or np.all(crossed <= 0.0):
-            return "single_sided"
-        return "double_sided"
-
-
-def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray | tuple[float, float], *,
-                          period: int = 1, tol: float = 1e-12, max_iterations: int = 50,
-                          integrator: NonsmoothIntegrator | None = None) -> NonsmoothOrbit:
-    """Periodic orbit of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) by Newton shooting: r(x0) =
-    φ(x0; 0 → T) − x0 = 0 with the Jacobian M − I, M the exact monodromy (stage transition and
-    saltation matrices). The residual is scaled by (L, L ν) (:meth:`NonsmoothIntegrator.velocity_scale`).
-    A failed solve is returned with ``converged`` False."""
-    if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
-    omega = check_omega(omega)
-    check_shooting(period, tol, max_iterations)
-    integ = NonsmoothIntegrator(system) if integrator is None else integrator
-    if integ.system != system:
-        raise ValueError("`integrator` was built for a different system than `system`")
-    L = system.length_scale()
-    scale = np.array([L, integ.velocity_scale(omega)])
-    shot = _newton_shooting(integ, omega, check_state(x0), int(period), float(tol), int(max_iterations), scale)  # type: ignore[arg-type]
-    traj: NonsmoothTrajectory = shot.trajectory  # type: ignore[assignment]
-    mean, rms = traj.mean_and_rms()
-    return NonsmoothOrbit(state0=shot.x, omega=omega, period=int(period), monodromy=traj.sensitivity,
-                          multipliers=shot.multipliers(), converged=shot.residual <= tol, iterations=shot.iterations,
-                          residual=shot.residual, trajectory=traj, mean=mean, rms=rms)
-
-
-__all__ = ["NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory",
-           "shoot_nonsmooth_orbit"]
+__all__ = ["NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothTrajectory"]

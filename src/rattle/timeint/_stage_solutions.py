@@ -25,8 +25,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_omega
-from ..model import Model
-from ..model._stage_matrix import stage_constants, transition_entries, transition_scalar
+from ..model import Model, stage_constants, transition_entries, transition_scalar
 
 _EPS = float(np.finfo(float).eps)
 _TWO_PI = 2.0 * math.pi

@@ -49,7 +49,58 @@ class ExactMeasures:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
-class Trajectory:
+class ExactTrajectory:
+    """What every exact integrator returns: the motion from ``t0`` to ``t1`` at forcing frequency
+    ``omega``, ``state0``/``state1`` z = (x, x') at t0/t1 ((δ, δ') for the single equation),
+    ``sensitivity`` ∂z(t1)/∂z(t0) (the product of the stage transition matrices exp(A τ) and of
+    the saltation matrices of the switchings: the identity across a breakpoint of a continuous
+    law), and its segments: segment i runs from ``t_start[i]`` to ``t_end[i]`` on one stage (or
+    mode) of the law, analytic inside. The law-specific records (stages, events, stick and lock
+    flags, the exact segment solutions) are the extras of :class:`Trajectory`,
+    :class:`~rattle.timeint.SystemTrajectory`, :class:`~rattle.timeint.NonsmoothTrajectory` and
+    :class:`~rattle.timeint.FrictionTrajectory`, which all answer :meth:`states` and :meth:`measures`."""
+
+    omega: float
+    t0: float
+    t1: float
+    state0: FloatArray
+    state1: FloatArray
+    sensitivity: FloatArray
+    t_start: FloatArray
+    t_end: FloatArray
+
+    @property
+    def n_segments(self) -> int:
+        return int(self.t_start.size)
+
+    def segment_index(self, t: FloatArray | float) -> IntArray:
+        """Index of the segment holding each time (the later one at a switching)."""
+        idx = np.searchsorted(self.t_start, t, side="right") - 1
+        return np.clip(idx, 0, self.n_segments - 1)
+
+    def check_times(self, t: FloatArray) -> None:
+        """Refuse (ValueError) times outside [t0, t1] (beyond round-off)."""
+        span = max(abs(self.t0), abs(self.t1), self.t1 - self.t0)
+        if t.size and (np.min(t) < self.t0 - 4 * _EPS * span or np.max(t) > self.t1 + 4 * _EPS * span):
+            raise ValueError(
+                f"`t` must lie within the trajectory's interval [{self.t0!r}, {self.t1!r}], got values "
+                f"in [{float(np.min(t))!r}, {float(np.max(t))!r}]"
+            )
+
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """The states z(t) = (x, x'), shape t.shape + (2n,) (each kind of trajectory evaluates
+        its own exact segments)."""
+        raise NotImplementedError
+
+    def measures(self) -> object:
+        """The response measures over [t0, t1] (SPEC §1), exact to round-off: an
+        :class:`ExactMeasures` of δ for the single equations, a
+        :class:`~rattle.timeint.SystemMeasures` of every element for a chain."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)  # arrays: identity equality
+class Trajectory(ExactTrajectory):
     """An exact trajectory of δ'' + c δ' + k f(δ) = F(t) from ``t0`` to ``t1``.
 
     It is a sequence of segments, each on one stage of the law: segment i runs from
@@ -60,22 +111,10 @@ class Trajectory:
     crossings are the identity because f is continuous).
     """
 
-    omega: float
-    t0: float
-    t1: float
-    state0: FloatArray
-    state1: FloatArray
-    sensitivity: FloatArray
-    t_start: FloatArray
-    t_end: FloatArray
     stage: IntArray
     x_start: FloatArray
     solutions: StageSolutions = field(repr=False, compare=False)
     homogeneous: FloatArray = field(repr=False, compare=False)  # (n, 2): x_start − p(t_start)
-
-    @property
-    def n_segments(self) -> int:
-        return int(self.t_start.size)
 
     @property
     def crossing_times(self) -> FloatArray:
@@ -87,11 +126,6 @@ class Trajectory:
         """The breakpoint crossed at each of ``crossing_times`` (rad), shape (n−1,)."""
         return self.x_start[1:, 0]
 
-    def segment_index(self, t: FloatArray | float) -> IntArray:
-        """Index of the segment holding each time (the later one at a crossing)."""
-        idx = np.searchsorted(self.t_start, t, side="right") - 1
-        return np.clip(idx, 0, self.n_segments - 1)
-
     def derivatives(self, t: FloatArray | float, order: int = 2, segment: IntArray | None = None) -> list[FloatArray]:
         """[δ, δ', …, δ^(order)] at times ``t`` (any shape, within [t0, t1]); ``order`` ≤ 4.
 
@@ -99,12 +133,7 @@ class Trajectory:
         at its ends, where δ''' and δ'''' jump).
         """
         t = np.asarray(t, dtype=float)
-        span = max(abs(self.t0), abs(self.t1), self.t1 - self.t0)
-        if t.size and (np.min(t) < self.t0 - 4 * _EPS * span or np.max(t) > self.t1 + 4 * _EPS * span):
-            raise ValueError(
-                f"`t` must lie within the trajectory's interval [{self.t0!r}, {self.t1!r}], got values "
-                f"in [{float(np.min(t))!r}, {float(np.max(t))!r}]"
-            )
+        self.check_times(t)
         seg = self.segment_index(t) if segment is None else np.broadcast_to(segment, t.shape)
         stage = self.stage[seg]
         out = [np.empty(t.shape) for _ in range(order + 1)]
@@ -123,6 +152,11 @@ class Trajectory:
         t = np.asarray(t, dtype=float)
         d, v, a = self.derivatives(t, 2)
         return StateSamples(t=t, delta=d, velocity=v, acceleration=a, stage=self.stage[self.segment_index(t)])
+
+    def states(self, t: FloatArray | float) -> FloatArray:
+        """(δ, δ') at times ``t``, shape t.shape + (2,)."""
+        d, v = self.derivatives(t, 1)
+        return np.stack((d, v), axis=-1)
 
     # --- exact measures ------------------------------------------------------------------------
     def _segment_points(self, per_scale: float) -> tuple[IntArray, FloatArray, FloatArray]:
