@@ -26,7 +26,7 @@ INTEGRATORS = ("ExactIntegrator", "SystemIntegrator", "NonsmoothIntegrator", "Fr
 #: Functions outside this helper's reach that still pick an integrator by the kind of system
 #: (``rattle.results`` may change only its import lines in this step): they should call
 #: :func:`rattle.timeint.make_integrator`.
-LADDERS_LEFT = {("rattle.results._sweep", "records")}
+LADDERS_LEFT: set[tuple[str, str]] = set()
 
 
 def _name(path: Path) -> str:

@@ -405,18 +405,9 @@ class SweepResult:
         non-periodic row (period 0) the record of ``record_periods`` forcing periods the sweep
         measured (``settings["steady_state"]``). The integrator is deterministic, so these are the
         trajectories the sweep's measures were taken on. A failed row has none: (None, 0)."""
-        from ..model import FrictionSystem, NonsmoothSystem
-        from ..timeint import ExactIntegrator, FrictionIntegrator, NonsmoothIntegrator, SystemIntegrator
+        from ..timeint import make_integrator
 
-        integ: Any
-        if isinstance(self.model, Model):
-            integ = ExactIntegrator(self.model)
-        elif isinstance(self.model, NonsmoothSystem):
-            integ = NonsmoothIntegrator(self.model)
-        elif isinstance(self.model, FrictionSystem):
-            integ = FrictionIntegrator(self.model)
-        else:
-            integ = SystemIntegrator(self.model.system())
+        integ = make_integrator(self.model)  # the one choice of the exact integrator by kind of system
         record = int(self.settings.get("steady_state", {}).get("record_periods", _RECORD_PERIODS))
         for w, p, x, m in zip(self.omega, self.period, self.state0, self.method):
             if m == SWEEP_FAILED:
