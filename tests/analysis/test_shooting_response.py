@@ -177,6 +177,34 @@ def test_options_are_validated():
         ShootingOptions(hops=(0.7,))
     with pytest.raises(TypeError, match="locate"):
         ShootingOptions(locate=1)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="check"):
+        ShootingOptions(check=16)  # type: ignore[arg-type]
+
+
+def test_where_no_computed_orbit_is_stable_the_attractor_a_sweep_settles_on_is_continued():
+    """A random preload (benchmarks/crossval_doors.py seed 1, case 13): the branch from Ω_min covers
+    the range but is unstable over Ω 1.04–1.65, a small orbit (rms ~0.006), while exact sweeps
+    settle there on a stable one of rms 0.1–0.3. By default the frequencies with no stable row are
+    swept exactly and that attractor is continued: stable rows over that stretch, each an
+    attractor — an exact simulation started next to the row settles back on it (rms to 1e-6).
+    (Measured: with ``check=None`` the response has no stable row there.)"""
+    from rattle.analysis import SteadyStateOptions, steady_state
+
+    law = NonsmoothLaw(elastic=Preload(preload=0.0431))
+    system = NonsmoothSystem(damping=0.0713, stiffness=1.0, law=law,
+                             excitation=Excitation(mean=0.0215, amplitudes=(0.0369,)))
+    res = nonsmooth_response(system, (0.3, 2.0))
+    found = [b for b in (res, *res.branches)
+             if np.sum((b.omega > 1.1) & (b.omega < 1.6) & b.stable & (b.rms > 0.05)) >= 20]
+    assert found, "the stable attractor over Ω 1.1–1.6 is not on the response"
+    frf = found[0]
+    big = (frf.omega > 1.1) & (frf.omega < 1.6) & frf.stable & (frf.rms > 0.05)
+    assert np.ptp(frf.omega[big]) > 0.4
+    i = int(np.flatnonzero(big)[len(np.flatnonzero(big)) // 2])
+    w = float(frf.omega[i])
+    settled = steady_state(system, w, x0=tuple(frf.states[i] * (1.0 + 1e-3)),
+                           options=SteadyStateOptions(max_period_multiple=1))
+    assert settled.period == 1 and settled.rms == pytest.approx(float(frf.rms[i]), rel=1e-6)
 
 
 def test_the_cli_default_for_a_preload_is_exact_shooting(tmp_path):

@@ -43,6 +43,19 @@ phase appears or vanishes, ``grazing`` where a pair of crossings does.
 **Coverage.** A branch followed from Ω_min that turns back and leaves the range at Ω_min, or ends
 early, leaves the frequencies above it uncovered: the branch through Ω_max is then followed down
 from there (a second branch) until it reaches the frequencies covered.
+
+**Where no computed orbit is stable.** A bounded, damped motion settles on some attractor at every
+Ω; where no row of the branches is stable, the one followed is not what a run-up shows (measured: a
+preload whose only branch from Ω_min stayed on an unstable small orbit over Ω 1.04–1.65 while
+sweeps settled on a stable one of 10–30× its rms). There an exact up/down sweep
+(:class:`~rattle.analysis.SweepCheck`: ``check.points`` frequencies each way over the whole range,
+spread over those intervals, the state carried) settles on the attractors, and every period-1
+attractor no stable stretch explains (every element's rms within ``check.rtol``) is shot to its
+exact orbit and followed both ways as a branch of its own until it leaves the range or joins rows
+already computed (:func:`_missed_branches`, at most ``check.max_branches`` branches of at most
+:data:`SEEDED_POINTS` points each way). Intervals narrower than :data:`MIN_GAP` of the range
+are left (a stability change and its jump). Sub-harmonic and non-periodic attractors are not
+continued here (``subharmonics=True``).
 """
 
 from __future__ import annotations
@@ -68,6 +81,7 @@ from ..errors import Status
 from ..model import FrictionSystem, NonsmoothSystem
 from ..stability import classify_loss
 from ..timeint import FLOW_FAILURES, ShootingProblem, monodromy_multipliers
+from ._sweep_check import SweepCheck
 
 #: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
 #: gives a neutral multiplier 1 (a family of orbits).
@@ -97,6 +111,10 @@ RESTART_RMS = 0.1
 #: A branch followed from a restart onto another branch ends where its state comes within this
 #: scaled distance of the orbit interpolated between two rows of the branch it started from.
 JOIN_DISTANCE = 1e-2
+#: The most points followed each way from an attractor the sweep found (module docstring).
+SEEDED_POINTS = 400
+#: Intervals without a stable row narrower than this share of the range are not swept.
+MIN_GAP = 0.02
 #: Multipliers that move by less than this across a located point left the unit circle
 #: continuously (a smooth bifurcation); a larger jump is the event structure's.
 CONTINUOUS_JUMP = 1e-3
@@ -111,13 +129,15 @@ class ShootingOptions:
     ``hops`` the relative frequency offsets tried in turn past a grazing (module docstring);
     ``max_pieces`` the most pieces (grazings passed) per branch; ``locate`` the stability
     changes on the branch (module docstring); ``xtol`` the location's tolerance in scaled arc
-    length."""
+    length; ``check`` the exact sweep over the frequencies where no computed orbit is stable (module
+    docstring; None: none)."""
 
     settle_periods: int = 40
     hops: tuple[float, ...] = (1e-5, 1e-4, 1e-3, 1e-2)
     max_pieces: int = 64
     locate: bool = True
     xtol: float = 1e-10
+    check: SweepCheck | None = SweepCheck()
 
     def __post_init__(self) -> None:
         if isinstance(self.settle_periods, bool) or not isinstance(self.settle_periods, int) or self.settle_periods < 0:
@@ -132,6 +152,8 @@ class ShootingOptions:
             raise TypeError(f"`locate` must be True or False, got {self.locate!r}")
         if not (isinstance(self.xtol, (int, float)) and 0 < self.xtol < 1e-2):
             raise ValueError(f"`xtol` must be in (0, 0.01), got {self.xtol!r}")
+        if self.check is not None and not isinstance(self.check, SweepCheck):
+            raise TypeError(f"`check` must be a SweepCheck or None, got {self.check!r}")
 
 
 @dataclass(slots=True)
@@ -579,10 +601,91 @@ def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float
             second.origin = f"Ω = {hi:.6g}"
             if second.rows:
                 out.append(second)
+    if opts.check is not None and period == 1 and any(b.rows for b in out):
+        gaps = _unstable_intervals(out, lo, hi)
+        if gaps:
+            out.extend(_missed_branches(follower, out, opts.check, gaps))
     if opts.locate:
         for b in out:
             follower.locate(b)
     _coverage(out, lo, hi)
+    return out
+
+
+def _unstable_intervals(branches: list[ExactBranch], lo: float, hi: float) -> list[tuple[float, float]]:
+    """The Ω intervals of [lo, hi] (wider than :data:`MIN_GAP` of the range) where no stretch of
+    two consecutive stable rows of any branch lies."""
+    spans = sorted((min(a.omega, c.omega), max(a.omega, c.omega)) for b in branches
+                   for a, c in zip(b.rows, b.rows[1:]) if a.unstable_count == 0 and c.unstable_count == 0)
+    gaps: list[tuple[float, float]] = []
+    reach = lo
+    for a, c in spans:
+        if a > reach:
+            gaps.append((reach, a))
+        reach = max(reach, c)
+    if reach < hi:
+        gaps.append((reach, hi))
+    return [(a, c) for a, c in gaps if c - a > MIN_GAP * (hi - lo)]
+
+
+def _explained(branches: list[ExactBranch], row: ExactRow, rms: FloatArray, rtol: float) -> bool:
+    """Whether a stable stretch of one of ``branches`` passes through the row's Ω with every
+    element's rms within ``rtol`` of ``rms`` (linear between the two rows around Ω)."""
+    w = row.omega
+    for b in branches:
+        for a, c in zip(b.rows, b.rows[1:]):
+            if a.unstable_count or c.unstable_count or not min(a.omega, c.omega) <= w <= max(a.omega, c.omega):
+                continue
+            t = 0.0 if a.omega == c.omega else (w - a.omega) / (c.omega - a.omega)
+            est = (1.0 - t) * _row_rms(a) + t * _row_rms(c)
+            if np.all(np.abs(est - rms) <= rtol * np.abs(rms)):
+                return True
+    return False
+
+
+def _missed_branches(follower: _Follower, found: list[ExactBranch], check: SweepCheck,
+                     gaps: list[tuple[float, float]]) -> list[ExactBranch]:
+    """The branches through the period-1 attractors that an exact up/down sweep over ``gaps``
+    settles on and ``found`` does not explain (module docstring)."""
+    from ._steady import SteadyStateOptions
+    from ._time_sweep import time_sweep
+
+    problem = follower.problem
+    width = follower.hi - follower.lo
+    settle = SteadyStateOptions(max_periods=check.max_periods, max_period_multiple=1, record_periods=1)
+    out: list[ExactBranch] = []
+    for a, c in gaps:
+        points = max(3, math.ceil(check.points * (c - a) / width))
+        sweep = time_sweep(problem.system, omega=(a, c), points=points, direction="both", options=settle)
+        for j in range(len(sweep.omega)):
+            if int(sweep.period[j]) != 1 or len(out) >= check.max_branches:
+                continue
+            w = float(sweep.omega[j])
+            res = solve_fixed(problem, np.asarray(sweep.state0[j], dtype=float), w, follower.newton)
+            if not res.converged:
+                continue
+            row = _row(problem, res.q, w)
+            if row.unstable_count or _explained([*found, *out], row, _row_rms(row), check.rtol):
+                continue
+            known = [r for b in (*found, *out) for r in b.rows]
+            seen = [0]
+
+            def stop(pt: BranchPoint, known: list[ExactRow] = known, w0: float = w, seen: list[int] = seen
+                     ) -> str | None:
+                seen[0] += 1
+                if seen[0] > SEEDED_POINTS:
+                    return f"the budget of {SEEDED_POINTS} points a way of a branch found by the sweep was spent"
+                return _joins(problem, pt, known, w0)
+
+            down = follower.follow(res.q, w, -1.0, stop=stop)
+            seen[0] = 0
+            up = follower.follow(res.q, w, 1.0, stop=stop)
+            if not down.rows or not up.rows:
+                continue
+            pieces = [*reversed(down.pieces[1:]), down.pieces[0] + up.pieces[0] - 1, *up.pieces[1:]]
+            out.append(ExactBranch(rows=[*reversed(down.rows), *up.rows[1:]], status=up.status, message=up.message,
+                                   pieces=pieces, origin=f"the attractor an exact sweep settled on at Ω = {w:.6g}",
+                                   bridges=[*down.bridges, *up.bridges]))
     return out
 
 
