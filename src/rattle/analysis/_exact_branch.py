@@ -45,7 +45,8 @@ early, leaves the frequencies above it uncovered: the branch through Ω_max is t
 from there (a second branch) until it reaches the frequencies covered.
 
 **Where no computed orbit is stable.** A bounded, damped motion settles on some attractor at every
-Ω; where no row of the branches is stable, the one followed is not what a run-up shows (measured: a
+Ω; where no row of the branches is stable (nor unstable only by a period doubling, whose
+period-2 orbit is the motion there), the one followed is not what a run-up shows (measured: a
 preload whose only branch from Ω_min stayed on an unstable small orbit over Ω 1.04–1.65 while
 sweeps settled on a stable one of 10–30× its rms). There an exact up/down sweep
 (:class:`~rattle.analysis.SweepCheck`: ``check.points`` frequencies each way over the whole range,
@@ -612,11 +613,18 @@ def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float
     return out
 
 
+def _accounted(row: ExactRow) -> bool:
+    """The row is stable, or unstable only by multipliers below −1 (a period doubling: the motion
+    there is the period-2 orbit born at it, ``subharmonics=True``, not a period-1 one missed)."""
+    out = row.multipliers[np.abs(row.multipliers) > 1.0 + UNIT_TOL]
+    return bool(np.all((np.abs(out.imag) <= 1e-9 * np.abs(out)) & (out.real < 0.0)))
+
+
 def _unstable_intervals(branches: list[ExactBranch], lo: float, hi: float) -> list[tuple[float, float]]:
     """The Ω intervals of [lo, hi] (wider than :data:`MIN_GAP` of the range) where no stretch of
-    two consecutive stable rows of any branch lies."""
+    two consecutive rows of any branch is stable or period-doubled (:func:`_accounted`)."""
     spans = sorted((min(a.omega, c.omega), max(a.omega, c.omega)) for b in branches
-                   for a, c in zip(b.rows, b.rows[1:]) if a.unstable_count == 0 and c.unstable_count == 0)
+                   for a, c in zip(b.rows, b.rows[1:]) if _accounted(a) and _accounted(c))
     gaps: list[tuple[float, float]] = []
     reach = lo
     for a, c in spans:
