@@ -113,7 +113,7 @@ RESTART_RMS = 0.1
 #: scaled distance of the orbit interpolated between two rows of the branch it started from.
 JOIN_DISTANCE = 1e-2
 #: The most points followed each way from an attractor the sweep found (module docstring).
-SEEDED_POINTS = 400
+SEEDED_POINTS = 200
 #: Intervals without a stable row narrower than this share of the range are not swept.
 MIN_GAP = 0.02
 #: Multipliers that move by less than this across a located point left the unit circle
