@@ -676,24 +676,22 @@ def _missed_branches(follower: _Follower, found: list[ExactBranch], check: Sweep
             if row.unstable_count or _explained([*found, *out], row, _row_rms(row), check.rtol):
                 continue
             known = [r for b in (*found, *out) for r in b.rows]
-            seen = [0]
 
-            def stop(pt: BranchPoint, known: list[ExactRow] = known, w0: float = w, seen: list[int] = seen
-                     ) -> str | None:
-                seen[0] += 1
-                if seen[0] > SEEDED_POINTS:
-                    return f"the budget of {SEEDED_POINTS} points a way of a branch found by the sweep was spent"
-                return _joins(problem, pt, known, w0)
+            def joins(known: list[ExactRow] = known, w0: float = w) -> Any:
+                """A stop for one side: the point budget, or joined rows already computed."""
+                seen = [0]
 
-            down = follower.follow(res.q, w, -1.0, stop=stop)
-            seen[0] = 0
-            up = follower.follow(res.q, w, 1.0, stop=stop)
-            if not down.rows or not up.rows:
-                continue
-            pieces = [*reversed(down.pieces[1:]), down.pieces[0] + up.pieces[0] - 1, *up.pieces[1:]]
-            out.append(ExactBranch(rows=[*reversed(down.rows), *up.rows[1:]], status=up.status, message=up.message,
-                                   pieces=pieces, origin=f"the attractor an exact sweep settled on at Ω = {w:.6g}",
-                                   bridges=[*down.bridges, *up.bridges]))
+                def stop(pt: BranchPoint) -> str | None:
+                    seen[0] += 1
+                    if seen[0] > SEEDED_POINTS:
+                        return f"the budget of {SEEDED_POINTS} points a way of a branch found by the sweep was spent"
+                    return _joins(problem, pt, known, w0)
+                return stop
+
+            branch = _both_ways(follower, [], res.q, w, f"the attractor an exact sweep settled on at Ω = {w:.6g}",
+                                locate=False, also=joins)
+            if len(branch.rows) >= 2:
+                out.append(branch)
     return out
 
 
@@ -845,26 +843,35 @@ def _close_stop(problem: ShootingProblem, z0: FloatArray, w0: float, inner: Any)
 
 
 def _both_ways(follower: _Follower, shorter: list[ShootingProblem], z0: FloatArray, w0: float, origin: str,
-               locate: bool, close: bool = False) -> ExactBranch:
+               locate: bool, close: bool = False, also: Any = None) -> ExactBranch:
     """The branch through the orbit z(0) = ``z0`` at ``w0`` followed down and up in Ω (each side
     stopped where it rejoins a shorter period, :func:`_rejoin_stop`; with ``close`` also where it
     comes back to its start, :func:`_close_stop`: an isola is then followed once, down from
-    ``w0`` round to it), joined in order of the continuation (down reversed, then up); its
-    special points located with ``locate``."""
+    ``w0`` round to it; and where ``also()``, a stop made afresh for each side, says so), joined in
+    order of the continuation (down reversed, then up; the pieces of both sides kept, the two
+    through ``w0`` one piece); its special points located with ``locate``."""
     period = follower.problem.period
 
     def stop() -> Any:
         inner = _rejoin_stop(shorter, period) if shorter else None
-        return _close_stop(follower.problem, z0, w0, inner) if close else inner
+        inner = _close_stop(follower.problem, z0, w0, inner) if close else inner
+        extra = also() if also is not None else None
+        if inner is None or extra is None:
+            return inner if extra is None else extra
+        return lambda pt: inner(pt) or extra(pt)
 
     down = follower.follow(z0, w0, -1.0, stop=stop())
     if close and down.message == CLOSED:
-        up = ExactBranch(rows=down.rows[:1])
+        up = ExactBranch(rows=down.rows[:1], pieces=[1])
     else:
         up = follower.follow(z0, w0, 1.0, stop=stop())
-    branch = ExactBranch(origin=origin)
+    branch = ExactBranch(origin=origin, bridges=[*down.bridges, *up.bridges])
     branch.rows = list(reversed(down.rows[1:])) + up.rows
-    branch.pieces = [len(branch.rows)]
+    sides = [*reversed(down.pieces or [len(down.rows)]), *(up.pieces or [len(up.rows)])]
+    if down.rows and up.rows:
+        mid = len(down.pieces or [0]) - 1  # the seed row is in both sides' first pieces: once, in one piece
+        sides[mid:mid + 2] = [sides[mid] + sides[mid + 1] - 1]
+    branch.pieces = [n for n in sides if n > 0]
     branch.status = Status.SUCCESS
     branch.message = "; ".join(m for m in (down.message, up.message) if m)
     if locate:
