@@ -44,7 +44,7 @@ def system() -> FrictionSystem:
 
 @pytest.fixture(scope="module")
 def result(system: FrictionSystem) -> FrictionOrbitResult:
-    return friction_orbit(system, OMEGA, OPTIONS)
+    return friction_orbit(system, OMEGA, OPTIONS, every=False)
 
 
 def _three_inertias() -> FrictionSystem:
@@ -81,7 +81,7 @@ def test_the_hb_rms_is_within_half_a_percent_and_the_orbits_match(result):
 
 def test_the_hb_multipliers_by_the_regularised_monodromy(system, result):
     opts = RegularisationOptions(harmonics=32, regularisation=0.001, stability="regularised")
-    r = friction_orbit(system, OMEGA, opts)
+    r = friction_orbit(system, OMEGA, opts, every=False)
     assert abs(float(r.rms[0]) - float(result.rms[0])) <= 1e-9
     assert abs(float(np.max(np.abs(r.multipliers_hb))) - result.mu_abs) <= 1e-3
     assert not np.allclose(r.multipliers_hb, result.multipliers_hb)
@@ -105,14 +105,14 @@ def test_the_damper_sticks_and_its_stick_phases_are_exact(result):
 
 
 def test_x0_starts_the_shooting_and_a_failed_hb_falls_back_on_settling(system, result, monkeypatch):
-    again = friction_orbit(system, OMEGA, OPTIONS, x0=result.state0 + 1e-3)
+    again = friction_orbit(system, OMEGA, OPTIONS, x0=result.state0 + 1e-3, every=False)
     assert again.start == "x0" and abs(float(again.rms[0]) - float(result.rms[0])) <= 1e-9
 
     def fails(*_args, **_kwargs):
         raise ConvergenceError("no start")
 
     monkeypatch.setattr(friction_orbit_module, "_start", fails)
-    settled = friction_orbit(system, OMEGA, OPTIONS)
+    settled = friction_orbit(system, OMEGA, OPTIONS, every=False)
     assert settled.start == "settled" and settled.hb_start == "exact"
     assert "the regularised HB failed (no start)" in settled.message
     assert abs(float(settled.rms[0]) - float(result.rms[0])) <= 1e-9
@@ -121,7 +121,7 @@ def test_x0_starts_the_shooting_and_a_failed_hb_falls_back_on_settling(system, r
 
 def test_an_element_stuck_the_whole_period_is_held_at_the_hbs_deflection():
     fs = _three_inertias()
-    r = friction_orbit(fs, 3.0, RegularisationOptions(harmonics=32, regularisation=0.001))
+    r = friction_orbit(fs, 3.0, RegularisationOptions(harmonics=32, regularisation=0.001), every=False)
     assert r.converged and r.start == "held" and r.held == ("clutch",)
     assert r.stick_fraction[0] == pytest.approx(1.0, abs=1e-12) and r.stick_fraction[1] == 0.0
     assert r.stick_intervals[0] == ((0.0, pytest.approx(r.period, rel=1e-12)),) and r.stuck[:, 0].all()
@@ -145,10 +145,10 @@ def test_an_element_stuck_the_whole_period_is_held_at_the_hbs_deflection():
 def test_bad_arguments_raise_naming_the_argument(system, kwargs, error, fragment):
     args = {"system": system, "omega": OMEGA, "options": OPTIONS, **kwargs}
     with pytest.raises(error) as info:
-        friction_orbit(args.pop("system"), args.pop("omega"), args.pop("options"), **args)
+        friction_orbit(args.pop("system"), args.pop("omega"), args.pop("options"), **args, every=False)
     assert fragment in str(info.value)
     with pytest.raises(TypeError):
-        friction_orbit(system, OMEGA, OPTIONS, x_0=None)  # type: ignore[call-arg]
+        friction_orbit(system, OMEGA, OPTIONS, x_0=None, every=False)  # type: ignore[call-arg]
 
 
 def test_csv_metadata_and_plot(result, tmp_path):
@@ -186,7 +186,7 @@ def test_rattle_orbit_writes_the_three_files_with_the_documented_columns(tmp_pat
     except TypeError:
         runner = CliRunner()
     out = tmp_path / "out"
-    res = runner.invoke(cli, ["orbit", str(EXAMPLE), "--omega", str(OMEGA), "-o", str(out)], catch_exceptions=False)
+    res = runner.invoke(cli, ["orbit", str(EXAMPLE), "--omega", str(OMEGA), "--single", "-o", str(out)], catch_exceptions=False)
     assert res.exit_code == 0, (res.stdout, res.stderr)
     assert sorted(p.name for p in out.iterdir()) == ["orbit.csv", "orbit.json", "orbit.png"]
     header = (out / "orbit.csv").read_text().splitlines()[0]
@@ -206,8 +206,8 @@ def test_nonsmooth_orbit_dispatches_a_friction_system(system, result):
     """``nonsmooth_orbit`` takes the chain too (as ``nonsmooth_response`` does): the same orbit."""
     from rattle.analysis import nonsmooth_orbit
 
-    r = nonsmooth_orbit(system, OMEGA, OPTIONS)
+    r = nonsmooth_orbit(system, OMEGA, OPTIONS, every=False)
     assert type(r) is type(result)
     np.testing.assert_array_equal(r.rms, result.rms)
     with pytest.raises(TypeError, match="FrictionSystem"):
-        nonsmooth_orbit("chain", OMEGA)  # type: ignore[arg-type]
+        nonsmooth_orbit("chain", OMEGA, every=False)  # type: ignore[arg-type]

@@ -72,7 +72,7 @@ def test_more_samples_change_a_smooth_orbits_residual_by_the_aliasing_only(locku
 
 @pytest.fixture(scope="module")
 def exact(lockup):  # type: ignore[no-untyped-def]
-    return friction_orbit(lockup[0], OMEGA, RegularisationOptions(harmonics=64, regularisation=1e-3))
+    return friction_orbit(lockup[0], OMEGA, RegularisationOptions(harmonics=64, regularisation=1e-3), every=False)
 
 
 def test_narrowing_the_held_clutch_brings_its_rms_to_the_exact_one(lockup, exact) -> None:  # type: ignore[no-untyped-def]
@@ -91,7 +91,7 @@ def test_narrowing_the_held_clutch_brings_its_rms_to_the_exact_one(lockup, exact
 def test_the_orbit_carries_the_held_limit(lockup, exact) -> None:  # type: ignore[no-untyped-def]
     fsys, _, _ = lockup
     opts = RegularisationOptions(harmonics=64, regularisation=1e-3, held=True, held_harmonics=64)
-    res = friction_orbit(fsys, OMEGA, opts)
+    res = friction_orbit(fsys, OMEGA, opts, every=False)
     rec = res.held_limit
     assert rec is not None and rec.elements == ("tcc",) and rec.harmonics == 64 and rec.eps == 1e-3
     assert abs(res.held_limit_error[0]) < 0.02 and abs(res.element_rms_error[0]) > 0.15

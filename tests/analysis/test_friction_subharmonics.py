@@ -209,7 +209,7 @@ def test_friction_orbit_of_period_two_is_the_branchs_orbit(response):
     i = int(np.argmin(np.abs(br.omega - 1.375)))
     w = float(br.omega[i])
     res = friction_orbit(_chain().friction_system(), w, RegularisationOptions(harmonics=32, regularisation=0.001),
-                         period=2)
+                         period=2, every=False)
     assert res.converged and res.periods == 2 and res.harmonics == 64
     np.testing.assert_allclose(res.rms, br.rms[i], rtol=1e-8)
     assert res.t[-1] == pytest.approx(2 * 2 * math.pi / w) and res.period == pytest.approx(2 * 2 * math.pi / w)
@@ -225,9 +225,9 @@ def test_friction_orbit_of_period_two_where_the_motion_has_period_one():
 
     with pytest.raises(ConvergenceError, match="no periodic orbit of period 2 at `omega` = 1.312: .*repeats after one"):
         friction_orbit(_chain().friction_system(), 1.312, RegularisationOptions(harmonics=32, regularisation=0.001),
-                       period=2)
+                       period=2, every=False)
     with pytest.raises(ValueError, match="`period` must be 1 or 2"):
-        friction_orbit(_chain().friction_system(), 1.3, period=3)
+        friction_orbit(_chain().friction_system(), 1.3, period=3, every=False)
 
 
 def test_cli_orbit_period_two_on_a_chain(tmp_path):

@@ -39,13 +39,13 @@ def _span(patch) -> tuple[float, float]:  # type: ignore[no-untyped-def]
 @pytest.fixture(scope="module")
 def sticking() -> NonsmoothOrbitResult:
     """T_p = 0.2, r = 0.05, Ω = 0.6: three stick phases, 1.97 s of the 10.5 s period."""
-    return nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    return nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, every=False)
 
 
 @pytest.fixture(scope="module")
 def locking() -> NonsmoothOrbitResult:
     """T_p = 0.25, r = 0.02, Ω = 0.3: two stick phases and a lock at the jump δ = 0."""
-    return nonsmooth_orbit(_system(0.25, 0.02), 0.3, OPTS)
+    return nonsmooth_orbit(_system(0.25, 0.02), 0.3, OPTS, every=False)
 
 
 def test_the_stick_phases_are_the_trajectory_s(sticking: NonsmoothOrbitResult) -> None:
@@ -100,7 +100,7 @@ def test_rms_is_an_independent_shooting_s_and_the_hb_is_kept(sticking: Nonsmooth
     import json
 
     assert json.loads(json.dumps(summary))["regime"] == "single_sided"
-    again = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, x0=res.orbit.state0)
+    again = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, x0=res.orbit.state0, every=False)
     assert again.start == "x0" and again.rms == pytest.approx(res.rms, rel=1e-12)
 
 
@@ -185,7 +185,7 @@ def test_a_failed_shooting_is_retried_after_settling(sticking: NonsmoothOrbitRes
         return real(system, omega, x0, **kw)
 
     monkeypatch.setattr(mod, "shoot_nonsmooth_orbit", flaky)
-    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, every=False)
     assert len(calls) == 2 and np.array_equal(calls[0], res.hb_state)
     x100 = NonsmoothIntegrator(_system(0.2, 0.05)).propagate(res.hb_state, 0.0, 100 * res.period, 0.6).state1
     np.testing.assert_array_equal(calls[1], x100)
@@ -209,7 +209,7 @@ def test_a_failed_hb_ladder_is_replaced_by_settling_and_the_exact_spectrum(stick
         return real(make, omega, q0, **kw)
 
     monkeypatch.setattr(mod, "regularisation_limit", flaky)
-    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, every=False)
     assert starts == [0.1, 0.01]
     assert res.start == "settled" and res.hb_start == "exact" and "ladder made to fail" in res.message
     assert res.rms == pytest.approx(sticking.rms, rel=1e-9)
@@ -219,21 +219,21 @@ def test_a_failed_hb_ladder_is_replaced_by_settling_and_the_exact_spectrum(stick
         raise mod.ConvergenceError("no HB")
 
     monkeypatch.setattr(mod, "regularisation_limit", fails)
-    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)  # the exact orbit alone: HB columns nan
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, every=False)  # the exact orbit alone: HB columns nan
     assert res.converged and res.hb_start == "" and np.all(np.isnan(res.coefficients))
     assert math.isnan(res.rms_hb) and math.isnan(res.hb_distance) and not res.matched
     cols = res.columns(64)
     assert np.all(np.isnan(cols["delta_hb"])) and np.all(np.isfinite(cols["delta"]))
     monkeypatch.setattr(mod, "shoot_nonsmooth_orbit", lambda *a, **k: (_ for _ in ()).throw(mod.ConvergenceError("x")))
     with pytest.raises(mod.ConvergenceError, match="`omega`"):
-        nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+        nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, every=False)
 
 
 def test_without_an_exact_orbit_the_hb_stands_alone(monkeypatch, tmp_path) -> None:
     import rattle.analysis._nonsmooth_orbit as mod
 
     monkeypatch.setattr(mod, "shoot_nonsmooth_orbit", lambda *a, **k: (_ for _ in ()).throw(mod.ConvergenceError("x")))
-    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS)
+    res = nonsmooth_orbit(_system(0.2, 0.05), 0.6, OPTS, every=False)
     assert not res.converged and res.orbit is None and res.start == "" and "no exact orbit" in res.message
     assert math.isnan(res.rms) and math.isnan(res.stick_time) and res.stable is None and res.regime == ""
     assert res.stick_intervals == [] and np.all(np.isnan(res.multipliers)) and res.rms_hb > 0
@@ -273,14 +273,14 @@ def test_the_branch_plot_shades_where_the_exact_orbit_sticks() -> None:
 ])
 def test_bad_arguments_are_refused_by_name(args: tuple, kwargs: dict, error: type, message: str) -> None:
     with pytest.raises(error, match=message):
-        nonsmooth_orbit(_system(0.2, 0.05), *args, **kwargs)
+        nonsmooth_orbit(_system(0.2, 0.05), *args, **kwargs, every=False)
 
 
 def test_a_system_that_is_not_nonsmooth_is_refused() -> None:
     with pytest.raises(TypeError, match="`system`"):
-        nonsmooth_orbit("clutch", 0.6)  # type: ignore[arg-type]
+        nonsmooth_orbit("clutch", 0.6, every=False)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="`system`"):
-        nonsmooth_orbit(_system(0.2, 0.05).law, 0.6)  # type: ignore[arg-type]
+        nonsmooth_orbit(_system(0.2, 0.05).law, 0.6, every=False)  # type: ignore[arg-type]
 
 
 @pytest.fixture(autouse=True)
@@ -289,3 +289,36 @@ def _close_figures():  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
     plt.close("all")
+
+
+def test_every_orbit_at_the_speed_is_listed_beside_the_one_asked_for():
+    """The torque converter (examples/torque_converter_preload.toml) at Ω = 0.9: the orbit door
+    used to give the period-1 orbit alone, while a stable period-3 orbit coexists there (the map's
+    search finds it; an exact simulation from next to it stays on it). ``every`` (the default)
+    lists both, and the unstable period-3 orbit between their basins; each listed orbit is exact:
+    the period-1 one is the orbit asked for (rms to 1e-9), and the stable period-3 one is a fixed
+    point of the exact period map over three forcing periods (shooting from its own state
+    converges in at most one step to the same rms) that does not repeat after one period."""
+    from pathlib import Path
+
+    from rattle.io import load_config
+
+    system = load_config(Path(__file__).resolve().parents[2] / "examples" / "torque_converter_preload.toml").model
+    res = nonsmooth_orbit(system, 0.9)
+    periods = sorted((o.period, o.stable) for o in res.solutions)
+    assert (1, True) in periods and (3, True) in periods and (3, False) in periods
+    one = next(o for o in res.solutions if o.period == 1)
+    assert abs(one.rms - res.rms) <= 1e-9 and one.source == "continuation"
+    three = next(o for o in res.solutions if o.period == 3 and o.stable)
+    assert np.max(np.abs(three.multipliers)) < 1.0 and abs(three.rms - one.rms) > 1e-3
+    # the series of the exact period-3 orbit: its state at t = 0 shot again over three periods
+    H = three.harmonics
+    q = three.coefficients
+    k = np.arange(1, H + 1)
+    x0 = np.array([q[0] + q[1:H + 1].sum(), np.sum(k * (0.9 / 3) * q[H + 1:])])
+    again = shoot_nonsmooth_orbit(system, 0.9, x0, period=3)
+    assert again.converged and again.rms == pytest.approx(three.rms, rel=1e-6)
+    summary = res.summary()
+    assert len(summary["orbits"]) == len(res.solutions)
+    # every=False: the one orbit (what the map and the tests of a single orbit ask for)
+    assert nonsmooth_orbit(system, 0.9, every=False).solutions == ()

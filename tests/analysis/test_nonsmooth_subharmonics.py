@@ -179,17 +179,17 @@ def test_nonsmooth_orbit_of_period_two_is_the_branch_orbit(response):
 
     (br,) = response.branches
     i = int(np.argmin(np.abs(br.omega - 0.552)))
-    res = nonsmooth_orbit(_system(), float(br.omega[i]), OPTIONS, period=2)
+    res = nonsmooth_orbit(_system(), float(br.omega[i]), OPTIONS, period=2, every=False)
     assert res.periods == 2 and res.orbit is not None and res.orbit.period == 2
     assert res.rms == pytest.approx(float(br.rms[i]), rel=1e-9) and res.stable == bool(br.stable[i])
     assert res.rms_hb == pytest.approx(float(br.rms_hb[i]), rel=1e-6) and res.matched
     assert res.period == pytest.approx(2 * 2 * math.pi / float(br.omega[i]))
     with pytest.raises(ValueError, match="`period` must be 1 or 2"):
-        nonsmooth_orbit(_system(), 0.552, OPTIONS, period=3)
+        nonsmooth_orbit(_system(), 0.552, OPTIONS, period=3, every=False)
     from _cases import clutch_gear_chain
     from rattle.errors import ConvergenceError
 
     # a chain goes to friction_orbit, period 2 included (there the motion has period 1)
     with pytest.raises(ConvergenceError, match="no periodic orbit of period 2 at `omega` = 1.312"):
         nonsmooth_orbit(clutch_gear_chain().friction_system(), 1.312,
-                        RegularisationOptions(harmonics=32, regularisation=0.001), period=2)
+                        RegularisationOptions(harmonics=32, regularisation=0.001), period=2, every=False)

@@ -81,7 +81,7 @@ def test_orbit_writes_the_exact_orbit_of_the_chain_as_one_set(tmp_path):
     from rattle.timeint import shoot_friction_orbit
 
     config = write_config(tmp_path, CHAIN)
-    result = invoke(["orbit", str(config), "--omega", "0.9", "-o", "out"], tmp_path)
+    result = invoke(["orbit", str(config), "--omega", "0.9", "--single", "-o", "out"], tmp_path)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     out = tmp_path / "out"
     assert sorted(p.name for p in out.iterdir()) == ["orbit.csv", "orbit.json", "orbit.png"]
@@ -300,7 +300,7 @@ def test_a_preload_element_is_solved_by_orbit_and_named_where_refused(tmp_path):
 
     assert PRELOAD_CHAIN != CHAIN
     config = write_config(tmp_path, PRELOAD_CHAIN)
-    result = invoke(["orbit", str(config), "--omega", "0.9", "-o", "out"], tmp_path)
+    result = invoke(["orbit", str(config), "--omega", "0.9", "--single", "-o", "out"], tmp_path)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     meta = json.loads((tmp_path / "out" / "orbit.json").read_text())
     assert meta["settings"]["regularisation"] == 0.01

@@ -155,6 +155,12 @@ def test_orbit_writes_the_exact_orbit_with_its_stick_phase(tmp_path):
     (a, b, kind), = orbit["phases"]
     assert kind == "stick" and b - a == pytest.approx(orbit["stick_time"], rel=1e-12)
     assert "sticks or locks 1 time(s) per period" in result.stdout
+    # every orbit at Ω beside it (the census of Ω (1 ± 0.1)): the orbit asked for is one of them,
+    # with the same rms and stability
+    listed = orbit["orbits"]
+    assert listed and all(o["period"] >= 1 for o in listed)
+    assert any(abs(o["rms"] - orbit["rms"]) <= 1e-9 and o["stable"] for o in listed)
+    assert "every orbit at Ω = 0.35 rad/s (exact" in result.stdout
 
 
 def test_orbit_of_a_discontinuous_law_refuses_period_and_range_options(tmp_path):
@@ -228,7 +234,7 @@ def test_orbit_period_two_writes_the_period_doubled_orbit(tmp_path):
     over two forcing periods (not the period-1 orbit run twice), stable, with its HB of period 2
     beside it; where the motion has period 1 it exits 1 with nothing written."""
     config = write_config(tmp_path, TORQUE_CONVERTER)
-    result = invoke(["orbit", str(config), "--omega", "0.552", "--period", "2", "-o", "out"], tmp_path)
+    result = invoke(["orbit", str(config), "--omega", "0.552", "--period", "2", "--single", "-o", "out"], tmp_path)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     meta = json.loads((tmp_path / "out" / "orbit.json").read_text())
     orbit = meta["orbit"]
@@ -240,7 +246,7 @@ def test_orbit_period_two_writes_the_period_doubled_orbit(tmp_path):
     T = 2 * math.pi / 0.552
     half = int(np.argmin(np.abs(t - T)))
     assert t[-1] == pytest.approx(2 * T) and abs(d[half] - d[0]) > 1e-3 * np.ptp(d)
-    result = invoke(["orbit", str(config), "--omega", "0.7", "--period", "2", "-o", "out2"], tmp_path)
+    result = invoke(["orbit", str(config), "--omega", "0.7", "--period", "2", "--single", "-o", "out2"], tmp_path)
     assert result.exit_code == 1 and "no periodic orbit of period 2" in result.stderr
     assert not (tmp_path / "out2").exists()
 

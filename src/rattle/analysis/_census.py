@@ -38,9 +38,10 @@ from .._typing import FloatArray
 from ..continuation import NewtonOptions, solve_fixed
 from ..errors import Status
 from ..model import FrictionSystem, NonsmoothSystem
-from ..results import FrequencyResponse, SteadyState
+from ..hb import FourierBasis, HBOptions
+from ..results import FrequencyResponse, OrbitSolution, SteadyState
 from ..timeint import FLOW_FAILURES, ShootingProblem, make_integrator
-from ._attractors import AttractorSearch, Census, _Search, find_attractors, run_search
+from ._attractors import AttractorSearch, Census, SimulatedAttractor, _Search, find_attractors, run_search
 from ._exact_branch import ExactBranch, ExactRow, ShootingOptions, _row, branch_through
 from ._grid import GridSolution, _crossings, solutions_on_grid
 from ._settings import RunSettings
@@ -362,5 +363,112 @@ def attractor_census(model: Any, grid: FloatArray, run: RunSettings, search: Att
                       {"frequency_response": t1 - t0, "grid": t2 - t1, "search": t3 - t2})
 
 
-__all__ = ["CellCensus", "attractor_census", "exact_solutions_on_grid", "find_exact_attractors", "special_points",
+# ---------------------------------------------------------------------------------------------
+# Every exact orbit at one frequency (rattle orbit of a discontinuous law)
+# ---------------------------------------------------------------------------------------------
+#: Half-width of the window Ω (1 ± w) whose census gives the orbits at Ω, and its grid points (odd:
+#: Ω is the middle one). The branches are followed over the window from both ends with the
+#: sweep check (an exact up/down sweep over the frequencies where no computed orbit is stable),
+#: and the attractor search simulates at every grid point: a coexisting orbit needs only to be
+#: reached somewhere in the window.
+ORBIT_WINDOW = 0.1
+ORBIT_POINTS = 5
+#: The search's budget at one frequency: its multi-start (8 starts) and the starts displaced from
+#: the stable period-1 orbit (9) at Ω itself (one band, one point), the runs from the unstable
+#: orbits over the window.
+ORBIT_SEARCH = AttractorSearch(bands=1, starts=8, hb_points=1)
+#: Harmonics of an exact orbit's Fourier series in an :class:`~rattle.results.OrbitSolution`.
+ORBIT_HARMONICS = 64
+
+
+@dataclass
+class ExactOrbits:
+    """Every orbit at one forcing frequency found by :func:`exact_orbits_at`: the periodic ones
+    (``solutions``, each an exact orbit, stable and unstable, with the multipliers of its exact
+    monodromy), the non-periodic attractors the simulations settled on (``nonperiodic``) and the
+    census they come from (``census``)."""
+
+    solutions: tuple[OrbitSolution, ...]
+    nonperiodic: tuple[SimulatedAttractor, ...]
+    census: CellCensus
+
+
+def _orbit_solution(system: NonsmoothSystem | FrictionSystem, row: ExactRow, period: int, source: str) -> OrbitSolution:
+    """An exact orbit as the orbit door's :class:`~rattle.results.OrbitSolution`: its measures
+    (the trajectory's own quadrature), multipliers (exact monodromy with saltation matrices) and
+    the Fourier series x_k(t) = a_0 + Σ a_h cos(hωt) + b_h sin(hωt), ω = Ω/period, h ≤
+    :data:`ORBIT_HARMONICS`, of every coordinate sampled on the exact trajectory."""
+    st = _orbit_state(system, row, period)
+    n = row.q.size // 2
+    H = ORBIT_HARMONICS
+    basis = FourierBasis(H, 4 * (2 * H + 1))
+    x = np.asarray(row.trajectory.states(basis.times(period * 2.0 * math.pi / row.omega)), dtype=float)[:, :n]
+    regimes = st.regimes()
+    elements = {}
+    if isinstance(system, FrictionSystem):
+        elements = {name: {**st.element(name), "regime": regimes[e]} for e, name in enumerate(system.element_names)}
+    coefficients = basis.analyze(x.T).reshape(-1) if elements else basis.analyze(x[:, 0])
+    return OrbitSolution(omega=float(row.omega), period=int(period), coefficients=coefficients,
+                         stable=bool(np.all(np.abs(row.multipliers) < 1.0)),
+                         multipliers=np.asarray(row.multipliers, dtype=complex), mean=st.mean, rms=st.rms,
+                         rms_ac=st.rms_ac, p2p=st.p2p, acc_p2p=st.acc_p2p, delta_min=st.delta_min,
+                         delta_max=st.delta_max, regime=regimes[0], source=source, elements=elements)
+
+
+def exact_orbits_at(system: NonsmoothSystem | FrictionSystem, omega: float, run: RunSettings | None = None, *,
+                    window: float = ORBIT_WINDOW, points: int = ORBIT_POINTS,
+                    search: AttractorSearch | None = None, max_period: int = 4) -> ExactOrbits:
+    """Every periodic orbit at Ω = ``omega`` of a discontinuous law, and the non-periodic
+    attractors there: the census (:func:`attractor_census`) of the window Ω (1 ± ``window``) on
+    ``points`` equally spaced frequencies, Ω the middle one — the exact branches followed over the
+    window (period 2 from its period doublings), solved at Ω by Newton on the period map, and the
+    attractors the simulations settle on that no branch explains, continued by exact shooting.
+
+    Each orbit is solved once more at Ω for its row (exact trajectory and monodromy) and reduced
+    to one copy: two orbits of the same period whose states at t = 0 (or at a whole forcing period
+    later) agree to 1e-6 of the length scale are one. ``source`` says what found it first:
+    ``"continuation"`` (a branch of the window's frequency response), ``"simulation"`` (a branch
+    through an attractor the search simulated). Stable first, then by rms (largest first)."""
+    if points < 3 or points % 2 == 0:
+        raise ValueError(f"`points` must be odd and at least 3, got {points!r}")
+    if not 0.0 < window < 1.0:
+        raise ValueError(f"`window` must be in (0, 1), got {window!r}")
+    run = run or RunSettings.make(HBOptions(), None, None)
+    grid = omega * (1.0 + window * np.linspace(-1.0, 1.0, points))
+    j = points // 2
+    grid[j] = omega
+    search = search or ORBIT_SEARCH
+    cell = attractor_census(system, grid, run, search, max_period=max_period)
+    first = cell.branches
+    integ = make_integrator(system)
+    L = float(system.length_scale())
+    kept: list[tuple[OrbitSolution, FloatArray]] = []
+    with one_blas_thread():
+        for s in (s for s in cell.census.solutions if s.index == j and s.converged):
+            problem = ShootingProblem(system, period=int(s.period), integrator=integ)
+            try:
+                row = _row(problem, s.q, float(omega))
+            except FLOW_FAILURES:
+                continue
+            cycle = np.asarray(s.section, dtype=float)
+            if any(k.period == s.period and np.min(np.max(np.abs(c - cycle[0]), axis=-1)) <= 1e-6 * L
+                   for k, c in kept):
+                continue
+            source = "continuation" if s.branch < first else "simulation"
+            kept.append((_orbit_solution(system, row, int(s.period), source), cycle))
+    solutions = sorted((k for k, _ in kept), key=lambda o: (not o.stable, -o.rms))
+    nonperiodic = tuple(a for a in cell.census.simulated if a.index == j and a.period == 0)
+    return ExactOrbits(tuple(solutions), nonperiodic, cell)
+
+
+def with_every_orbit(system: NonsmoothSystem | FrictionSystem, result: Any) -> Any:
+    """``result`` (a NonsmoothOrbitResult or FrictionOrbitResult at Ω) with every orbit at Ω
+    (:func:`exact_orbits_at`) in its ``solutions`` and ``nonperiodic``."""
+    import dataclasses
+
+    found = exact_orbits_at(system, float(result.omega))
+    return dataclasses.replace(result, solutions=found.solutions, nonperiodic=found.nonperiodic)
+
+
+__all__ = ["CellCensus", "ExactOrbits", "attractor_census", "exact_orbits_at", "with_every_orbit", "exact_solutions_on_grid", "find_exact_attractors", "special_points",
            "response_parts", "first_rms", "branch_count"]

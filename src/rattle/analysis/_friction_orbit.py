@@ -114,6 +114,7 @@ def friction_orbit(
     *,
     x0: FloatArray | None = None,
     period: int = 1,
+    every: bool = True,
 ) -> FrictionOrbitResult:
     """The periodic orbit of the chain with friction ``system`` at forcing frequency ``omega``
     (module docstring), with the HB settings ``options``
@@ -128,9 +129,20 @@ def friction_orbit(
     HB leaves nan series. Raises :class:`~rattle.errors.ConvergenceError` when neither is found,
     TypeError/ValueError on bad arguments (``system`` not a FrictionSystem, ``omega`` not finite
     and > 0, ``options`` not a RegularisationOptions or with too few harmonics for the
-    excitation, ``x0`` not a finite state of shape (2n,), ``period`` not 1 or 2)."""
+    excitation, ``x0`` not a finite state of shape (2n,), ``period`` not 1 or 2).
+
+    ``every`` (default True): the result also lists every orbit at Ω, stable and unstable, of
+    every period, and the non-periodic attractors there (``solutions``, ``nonperiodic``:
+    :func:`~rattle.analysis._census.exact_orbits_at`, the census of the window Ω (1 ± 0.1): a few
+    seconds of exact continuation and simulation)."""
     if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period not in (1, 2):
         raise ValueError(f"`period` must be 1 or 2, got {period!r}")
+    if not isinstance(every, bool):
+        raise TypeError(f"`every` must be True or False, got {every!r}")
+    if every:  # the orbit asked for, then every orbit at Ω beside it
+        from ._census import with_every_orbit
+
+        return with_every_orbit(system, friction_orbit(system, omega, options, x0=x0, period=period, every=False))
     if period == 2:
         return _period_two(system, omega, options, x0)
     if not isinstance(system, FrictionSystem):
@@ -281,7 +293,7 @@ def _period_two(system: FrictionSystem, omega: float, options: RegularisationOpt
     from ._friction_subharmonics import _period_two_start, period_two_orbit
     from ._period_two import beyond_minus_one
 
-    one = friction_orbit(system, omega, options, x0=x0)  # validates every argument
+    one = friction_orbit(system, omega, options, x0=x0, every=False)  # validates every argument
     opts = chain_options(system) if options is None else options
     n = system.n
     integ = FrictionIntegrator(system)

@@ -87,6 +87,7 @@ def nonsmooth_orbit(
     *,
     x0: FloatArray | tuple[float, float] | None = None,
     period: int = 1,
+    every: bool = True,
 ) -> NonsmoothOrbitResult | FrictionOrbitResult:
     """The periodic orbit at forcing frequency ``omega`` (module docstring), with the HB settings
     ``options`` (:class:`RegularisationOptions`: ``harmonics``, ``regularisation`` and ``match``;
@@ -105,13 +106,24 @@ def nonsmooth_orbit(
     A chain with friction on its elements (:class:`~rattle.model.FrictionSystem`) goes to
     :func:`~rattle.analysis._friction_orbit.friction_orbit` (a :class:`FrictionOrbitResult`;
     ``x0`` then the chain's state (x, x'), 2n values).
+
+    ``every`` (default True): the result also lists every orbit at Ω, stable and unstable, of
+    every period, and the non-periodic attractors there (``solutions``, ``nonperiodic``:
+    :func:`~rattle.analysis._census.exact_orbits_at`, the census of the window Ω (1 ± 0.1): a few
+    seconds of exact continuation and simulation); ``every=False`` computes the one orbit only.
     """
     if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period not in (1, 2):
         raise ValueError(f"`period` must be 1 or 2 (a period-2 sub-harmonic orbit), got {period!r}")
+    if not isinstance(every, bool):
+        raise TypeError(f"`every` must be True or False, got {every!r}")
     if isinstance(system, FrictionSystem):
         from ._friction_orbit import friction_orbit
 
-        return friction_orbit(system, omega, options, x0=x0, period=period)
+        return friction_orbit(system, omega, options, x0=x0, period=period, every=every)
+    if every and isinstance(system, NonsmoothSystem):  # the orbit asked for, then every orbit at Ω beside it
+        from ._census import with_every_orbit
+
+        return with_every_orbit(system, nonsmooth_orbit(system, omega, options, x0=x0, period=period, every=False))
     if not isinstance(system, NonsmoothSystem):
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
                         f"friction on its elements; rattle.model), got {system!r}")
@@ -193,7 +205,7 @@ def _period_two(system: NonsmoothSystem, omega: float, opts: RegularisationOptio
 
     integ = NonsmoothIntegrator(system)
     notes: list[str] = []
-    one = nonsmooth_orbit(system, omega, opts, x0=x0)
+    one = nonsmooth_orbit(system, omega, opts, x0=x0, every=False)
     seed, start = None, ""
     if one.orbit is not None:
         if beyond_minus_one(one.orbit.multipliers):

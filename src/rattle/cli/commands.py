@@ -377,9 +377,12 @@ def _raise_if_incomplete(sweep: Any, written: Sequence[str], output: Path) -> No
 @_harmonics_option
 @_omega_min_option
 @_omega_max_option
+@click.option("--single", is_flag=True, default=False,
+              help="A discontinuous law: compute only the orbit asked for, not every orbit at W (the census of "
+                   "the window W (1 ± 0.1) costs seconds).")
 def orbit_command(
     config: Path, output: Path, omega: float, period: int, harmonics: int | None,
-    omega_min: float | None, omega_max: float | None,
+    omega_min: float | None, omega_max: float | None, single: bool = False,
 ) -> None:
     """Periodic orbits at the forcing frequency W for the model in CONFIG: orbit.csv, orbit.png,
     orbit.json in OUTPUT.
@@ -395,17 +398,23 @@ def orbit_command(
     or 2 with --period 2: exit 1 where the motion has period 1), exact (event-driven shooting,
     sticking exact) and regularised harmonic balance side by side; orbit.csv holds t and per
     element NAME_delta, NAME_velocity, NAME_stuck, NAME_delta_hb for the chain. --period above 2
-    and --omega-min/--omega-max are refused there.
+    and --omega-min/--omega-max are refused there. Beside it, every orbit at W is listed (stable
+    and unstable, of any period, exact; and the non-periodic attractors): the exact branches over
+    the window W (1 ± 0.1) solved at W and the attractors simulations settle on at W (orbit.json:
+    "orbits", "nonperiodic"); --single skips that census.
     """
     check_omega(omega)
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
     if getattr(run_config, "chain_friction", False):
-        run_friction_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max)
+        run_friction_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max, every=not single)
         return
     if run_config.discontinuous:
-        run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max)
+        run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max, every=not single)
         return
+    if single:
+        raise ConfigError("`--single` applies to a discontinuous law (a torque jump or friction): the orbits of this "
+                          "model are every harmonic-balance solution at --omega; leave it out")
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
@@ -431,7 +440,8 @@ def orbit_command(
 
 
 def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
-                        harmonics: int | None, omega_min: float | None, omega_max: float | None) -> None:
+                        harmonics: int | None, omega_min: float | None, omega_max: float | None, *,
+                        every: bool = True) -> None:
     """``rattle orbit`` on a discontinuous law: :func:`rattle.analysis.nonsmooth_orbit` (the regularised
     HB orbit at Ω and the exact orbit shot from it, with its stick and lock phases), written as one
     set orbit.csv, orbit.json, orbit.png.
@@ -445,7 +455,7 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
 
     logger.info("computing the orbit of a discontinuous law at Ω = %g: regularised harmonic balance (H = %d, ε = %g) "
                 "and exact shooting", omega, options.harmonics, options.regularisation)
-    result = nonsmooth_orbit(run_config.model, omega, options, period=period)
+    result = nonsmooth_orbit(run_config.model, omega, options, period=period, every=every)
     timings = {"nonsmooth_orbit": time.perf_counter() - t_start}
     ok = result.orbit is not None and bool(result.converged)
     meta = {
@@ -473,6 +483,7 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
                          f"({held / result.period:.0%} of the period)")
     if result.message:
         lines.append(result.message)
+    lines += result.every_orbit_text()
     echo_written("\n".join(lines), written, output)
     if not ok:
         raise _orbit_not_found(omega, result.message, written, output)
@@ -526,7 +537,8 @@ def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | No
 
 
 def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
-                       harmonics: int | None, omega_min: float | None, omega_max: float | None) -> None:
+                       harmonics: int | None, omega_min: float | None, omega_max: float | None, *,
+                       every: bool = True) -> None:
     """``rattle orbit`` on a chain with Coulomb friction on its elements:
     :func:`rattle.analysis.friction_orbit` (the chain's regularised HB orbit at Ω and the exact orbit
     shot from it, every element's stick phases), written as one set orbit.csv, orbit.json,
@@ -543,7 +555,7 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     system = run_config.model
     logger.info("computing the orbit of a chain with friction at Ω = %g: regularised harmonic balance (H = %d, "
                 "ε = %g) and exact shooting", omega, options.harmonics, options.regularisation)
-    result = friction_orbit(system, omega, options, period=period)
+    result = friction_orbit(system, omega, options, period=period, every=every)
     timings = {"friction_orbit": time.perf_counter() - t_start}
     elements = [{"name": name, "law": law.elastic.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}
                 for e, (name, law) in enumerate(zip(system.element_names, system.laws))]

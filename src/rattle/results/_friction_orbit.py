@@ -27,6 +27,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
+from ._orbit import OrbitSolution, every_orbit_lines, solution_record
 from ._plotter import plot_with
 
 #: The per-element columns of :meth:`FrictionOrbitResult.to_csv`, NAME_ prefixed, after ``t``.
@@ -129,6 +130,10 @@ class FrictionOrbitResult:
     held: tuple[str, ...] = ()
     settle_periods: int = 100
     periods: int = 1
+    #: Every orbit at Ω (:func:`rattle.analysis.exact_orbits_at`: exact, stable and unstable, of every
+    #: period the census found; empty when not asked for) and the non-periodic attractors there.
+    solutions: tuple[OrbitSolution, ...] = ()
+    nonperiodic: tuple[Any, ...] = ()
     held_limit: HeldLimitRecord | None = None
 
     # --- the period and the HB series --------------------------------------------------------
@@ -251,7 +256,8 @@ class FrictionOrbitResult:
         speed_rpm, period, converged, status, message, start, hb_start, held, regularisation,
         harmonics, stable, stable_hb, mu_abs, multipliers_abs, multipliers_hb_abs, match,
         match_distance, matched, rms_error, and ``elements``: per element its name, rms, mean,
-        stick_fraction, rms_hb, rms_error and ``stick_phases`` [[t_start, t_end], …]."""
+        stick_fraction, rms_hb, rms_error and ``stick_phases`` [[t_start, t_end], …]; ``orbits``: every orbit
+        at Ω (:attr:`solutions`), ``nonperiodic``: the non-periodic attractors there."""
         err = self.element_rms_error
         elements = [{"name": name, "rms": _num(self.rms[e]), "mean": _num(self.mean[e]),
                      "stick_fraction": _num(self.stick_fraction[e]), "rms_hb": _num(self.rms_hb[e]),
@@ -271,7 +277,14 @@ class FrictionOrbitResult:
             "rms_error": _num(self.rms_error), "elements": elements,
             "held_limit": None if self.held_limit is None else {
                 **self.held_limit.to_dict(), "rms_error": [_num(v) for v in self.held_limit_error]},
+            "orbits": [solution_record(o) for o in self.solutions],
+            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin}
+                            for a in self.nonperiodic],
         }
+
+    def every_orbit_text(self) -> list[str]:
+        """The terminal lines of every orbit found at Ω (:attr:`solutions`, :attr:`nonperiodic`)."""
+        return every_orbit_lines(self.omega, self.solutions, self.nonperiodic)
 
     def summary(self) -> str:
         """A few lines: the orbit, every element's exact and HB rms and stick phases, the stability."""
@@ -304,6 +317,7 @@ class FrictionOrbitResult:
                          f"{self.start}, {how}")
         if self.message:
             lines.append(self.message)
+        lines += self.every_orbit_text()
         return "\n".join(lines)
 
     def plot(self) -> tuple:

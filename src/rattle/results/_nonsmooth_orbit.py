@@ -25,6 +25,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..model import NonsmoothSystem
 from ..timeint import NonsmoothOrbit
+from ._orbit import OrbitSolution, every_orbit_lines, solution_record
 from ._plotter import plot_with
 
 #: The columns of :meth:`NonsmoothOrbitResult.to_csv`.
@@ -67,6 +68,10 @@ class NonsmoothOrbitResult:
     match: float = 0.1
     settle_periods: int = 100
     periods: int = 1
+    #: Every orbit at Ω (:func:`rattle.analysis.exact_orbits_at`: exact, stable and unstable, of every
+    #: period the census found; empty when not asked for) and the non-periodic attractors there.
+    solutions: tuple[OrbitSolution, ...] = ()
+    nonperiodic: tuple[Any, ...] = ()
 
     # --- the periods and the HB series ------------------------------------------------------
     @property
@@ -218,7 +223,8 @@ class NonsmoothOrbitResult:
         """The scalars of the orbit as plain Python values (JSON-ready; nan stays nan, None for
         ``stable`` without an exact orbit): omega, period (s), periods (p), rms, mean, rms_hb, rms_error,
         hb_distance, matched, stable, mu1_abs, mu2_abs, stick_time, regime, start, hb_start,
-        regularisation, harmonics, message, and ``phases``: [[t_start, t_end, kind], …]."""
+        regularisation, harmonics, message, ``phases``: [[t_start, t_end, kind], …], ``orbits``: every
+        orbit at Ω (:attr:`solutions`) and ``nonperiodic``: the non-periodic attractors there."""
         mu = np.abs(self.multipliers)
         return {
             "omega": self.omega, "period": self.period, "periods": self.periods, "rms": self.rms, "mean": self.mean, "rms_hb": self.rms_hb,
@@ -227,7 +233,14 @@ class NonsmoothOrbitResult:
             "regime": self.regime, "start": self.start, "hb_start": self.hb_start,
             "regularisation": self.regularisation, "harmonics": self.harmonics, "message": self.message,
             "phases": [[a, b, k] for a, b, k in self.stick_intervals],
+            "orbits": [solution_record(o) for o in self.solutions],
+            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin}
+                            for a in self.nonperiodic],
         }
+
+    def every_orbit_text(self) -> list[str]:
+        """The terminal lines of every orbit found at Ω (:attr:`solutions`, :attr:`nonperiodic`)."""
+        return every_orbit_lines(self.omega, self.solutions, self.nonperiodic)
 
     def to_csv(self, path: str | Path, points: int = 512) -> Path:
         """Write :meth:`columns` to ``path`` atomically; returns the path."""

@@ -119,6 +119,45 @@ class OrbitSolution:
         )
 
 
+def solution_lines(solutions: "tuple[OrbitSolution, ...] | list[OrbitSolution]", selected: int | None = None) -> list[str]:
+    """One terminal line per orbit at one frequency: its index, period, rms, p2p, stability (the
+    largest |μ|), regime and what found it; ``*`` marks the ``selected`` one."""
+    lines = []
+    for i, s in enumerate(solutions):
+        mark = "*" if i == selected else " "
+        lines.append(
+            f" {mark} [{i}] period {s.period}, rms {s.rms:.6g} rad, p2p {s.p2p:.5g} rad, "
+            f"{'stable' if s.stable else 'unstable'} (|μ|max {float(np.max(np.abs(s.multipliers))):.4g}), "
+            f"{s.regime}, from {s.source}{'; the simulation settles here' if s.simulated and s.source != 'simulation' else ''}"
+        )
+    return lines
+
+
+def solution_record(s: OrbitSolution) -> dict[str, Any]:
+    """One orbit's period, stability, source, measures and multipliers (JSON-serialisable)."""
+    return {
+        "period": s.period, "stable": s.stable, "source": s.source, "simulated": s.simulated,
+        "mean": s.mean, "rms": s.rms, "rms_ac": s.rms_ac, "p2p": s.p2p, "acc_p2p": s.acc_p2p,
+        "delta_min": s.delta_min, "delta_max": s.delta_max, "regime": s.regime,
+        "multipliers": [[float(z.real), float(z.imag)] for z in s.multipliers],
+        "residual": s.residual,
+        **({"elements": s.elements} if s.elements else {}),
+    }
+
+
+def every_orbit_lines(omega: float, solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...]) -> list[str]:
+    """The terminal lines of every orbit found at Ω (an exact orbit's census, each orbit exact) and
+    of the non-periodic attractors the simulations settled on there."""
+    if not solutions and not nonperiodic:
+        return []
+    lines = [f"every orbit at Ω = {omega:.6g} rad/s (exact, {len(solutions)} periodic"
+             f"{f', {len(nonperiodic)} non-periodic attractor(s)' if nonperiodic else ''}):"]
+    lines += solution_lines(solutions)
+    lines += [f"     non-periodic attractor (no period ≤ 8): rms {a.rms:.6g} rad over the recorded window, {a.regime}"
+              for a in nonperiodic]
+    return lines
+
+
 def _measures_of(simulation: Any) -> Any:
     """The object holding a SteadyState's measures (the state itself or its ``measures``)."""
     inner = getattr(simulation, "measures", None)
@@ -338,13 +377,7 @@ class PeriodicOrbit:
         """A few lines for the terminal."""
         lines = [f"{len(self)} harmonic-balance solution(s) at Ω = {self.omega:.6g} rad/s (H = {self.harmonics}):"]
         sel = self.selected
-        for i, s in enumerate(self.solutions):
-            mark = "*" if i == sel else " "
-            lines.append(
-                f" {mark} [{i}] period {s.period}, rms {s.rms:.6g} rad, p2p {s.p2p:.5g} rad, "
-                f"{'stable' if s.stable else 'unstable'} (|μ|max {float(np.max(np.abs(s.multipliers))):.4g}), "
-                f"{s.regime}, from {s.source}{'; the simulation settles here' if s.simulated and s.source != 'simulation' else ''}"
-            )
+        lines += solution_lines(self.solutions, sel)
         if self.simulation is not None:
             p = self.simulated_period
             rms = self.simulated_rms
@@ -382,17 +415,7 @@ class PeriodicOrbit:
             "period": self.period,
             "harmonics": self.harmonics,
             "selected": self.selected,
-            "solutions": [
-                {
-                    "period": s.period, "stable": s.stable, "source": s.source, "simulated": s.simulated,
-                    "mean": s.mean, "rms": s.rms, "rms_ac": s.rms_ac, "p2p": s.p2p, "acc_p2p": s.acc_p2p,
-                    "delta_min": s.delta_min, "delta_max": s.delta_max, "regime": s.regime,
-                    "multipliers": [[float(z.real), float(z.imag)] for z in s.multipliers],
-                    "residual": s.residual,
-                    **({"elements": s.elements} if s.elements else {}),
-                }
-                for s in self.solutions
-            ],
+            "solutions": [solution_record(s) for s in self.solutions],
             "simulation": sim_doc,
             "settings": self.settings,
             "timings": self.timings,
