@@ -147,6 +147,23 @@ def test_the_summary_and_the_labels_cannot_break_out_of_the_page(smooth_frf):
 
 
 @needs_plotly
+@pytest.mark.parametrize("quantity", ["p2p", "acc_p2p", "delta_max", "mean"])
+def test_the_quantity_drawn_is_the_column_asked_for(smooth_frf, quantity):
+    frf = smooth_frf
+    fig = figure_of(frequency_response_html(frf, quantity=quantity))
+    assert points(fig, "branch 0") == {(float(w), float(v)) for w, v in zip(frf.omega, getattr(frf, quantity))}
+    assert all(f"<br>{quantity} = " in t for t in hovers(fig, "branch 0"))
+    assert bool(points(fig, "linear system")) == (quantity == "mean")  # the linear system: mean, rms, rms_ac
+
+
+@needs_plotly
+@pytest.mark.parametrize("quantity, error", [("spl_db", ValueError), ("omega_max", ValueError), (3, TypeError)])
+def test_a_quantity_the_result_does_not_carry_is_refused(smooth_frf, quantity, error):
+    with pytest.raises(error, match="`quantity`"):
+        frequency_response_html(smooth_frf, quantity=quantity)
+
+
+@needs_plotly
 def test_sub_harmonic_branches_are_named_by_their_period(smooth_frf):
     frf = smooth_frf
     half = len(frf) // 2  # the second half as a period-2 branch: the page reads the columns
@@ -251,6 +268,20 @@ def test_a_compare_page_has_the_sweep_points_and_the_histories(tmp_path):
     assert {tr["xaxis"] for tr in fig["data"] if tr["name"].startswith("HB P")} == \
         {f"x{j + 2}" for j in range(len(result.at))}  # one time-history panel per examined frequency
     assert summary_of(page) == result.summary()
+
+
+@needs_plotly
+def test_compare_html_of_a_law_with_jumps_sets_the_exact_rows_against_the_sweep(tmp_path):
+    config = write_config(tmp_path, preload_spring_toml((0.5, 0.6), harmonics=32, friction=None))
+    out = tmp_path / "out"
+    result = invoke(["compare", str(config), "-o", str(out), "--points", "8", "--html"], tmp_path)
+    assert result.exit_code == 0, result.stderr
+    page = (out / "compare.html").read_text(encoding="utf-8")
+    assert_offline(page)
+    fig = figure_of(page)
+    assert points(fig, "exact, period 1") and points(fig, "regularised HB")
+    assert len(points(fig, "sweep up")) + len(points(fig, "sweep down")) == 16
+    assert summary_of(page) in result.stdout
 
 
 def test_importing_the_plotting_layer_and_the_cli_does_not_import_plotly():

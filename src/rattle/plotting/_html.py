@@ -384,13 +384,14 @@ def _frf_figure(frf: Any, *, quantity: str = "rms", title: str | None = None) ->
 
     if not isinstance(quantity, str):
         raise TypeError(f"`quantity` must be a column name (str), got {quantity!r}")
-    panels = _check_panels(frf, quantity) if frf.check is not None else _hb_panels(frf, quantity)
-    if frf.check is None and quantity != "spl_db":
+    if frf.check is None:
         from ._frf import QUANTITY_LABELS
 
-        if quantity not in QUANTITY_LABELS and quantity not in (getattr(frf, "extra_columns", {}) or {}):
-            raise ValueError(f"`quantity` must be one of {', '.join(QUANTITY_LABELS)} (or a column the result "
-                             f"carries: {', '.join(frf.extra_columns) or 'none'}), got {quantity!r}")
+        sound = [k for k in ("spl_db", "spl_dba") if k in (getattr(frf, "extra_columns", {}) or {})]
+        if quantity not in QUANTITY_LABELS and quantity not in sound:
+            raise ValueError(f"`quantity` must be one of {', '.join([*QUANTITY_LABELS, *sound])} (spl_db and spl_dba "
+                             f"with sound paths: FrequencyResponse.with_sound), got {quantity!r}")
+    panels = _check_panels(frf, quantity) if frf.check is not None else _hb_panels(frf, quantity)
     rows = len(panels)
     fig = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.06 if rows > 1 else 0.0,
                         subplot_titles=[t for _, t, _ in panels] if rows > 1 else None)
