@@ -26,9 +26,11 @@ from .checks import (
 )
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
-    map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections, set_verbose, warning,
+    frf_steps, map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections,
+    set_verbose, warning,
     write_frf, write_set,
 )
+from .pages import check_html, html_option, html_writer
 
 if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
     from ..io import AnalysisSettings
@@ -42,6 +44,9 @@ __all__ = [
 
 #: Output directory when ``-o`` is not given.
 DEFAULT_OUTPUT = "rattle-out"
+#: The output sets with the interactive page (``--html``); without it a page of an earlier run is removed.
+FRF_PAGE_FILES = (*FRF_FILES, "frf.html")
+COMPARE_PAGE_FILES = (*COMPARE_FILES, "compare.html")
 
 
 def _io() -> Any:
@@ -153,9 +158,9 @@ def compute_frf(
 
 def run_frf(
     model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False,
-    paths: Sequence[Any] = (), start: str = "low", fixed_harmonics: bool = False,
+    paths: Sequence[Any] = (), start: str = "low", fixed_harmonics: bool = False, html: bool = False,
 ) -> None:
-    """Compute the frequency response, write the three files and print the summary.
+    """Compute the frequency response, write the three files (and frf.html) and print the summary.
 
     Parameters
     ----------
@@ -174,6 +179,8 @@ def run_frf(
         The end the branch is started from (``frequency_response(start=...)``).
     fixed_harmonics : bool, default False
         Keep H fixed (``frequency_response(adaptive=None)``).
+    html : bool, default False
+        Also write frf.html, the interactive page (:func:`rattle.plotting.frequency_response_html`).
 
     Raises
     ------
@@ -183,10 +190,15 @@ def run_frf(
     """
     t_start = time.perf_counter()
     result = compute_frf(model, analysis, output, sections, t_start, subharmonics=subharmonics, start=start,
-                         fixed_harmonics=fixed_harmonics)
+                         fixed_harmonics=fixed_harmonics, names=FRF_PAGE_FILES)
     if paths:  # SPEC §6: the sound pressure level at the receiver, per point
         result = result.with_sound(tuple(paths))
-    written = write_frf(result, output, sections, t_start)
+    steps = frf_steps(result, sections, t_start)
+    if html:
+        from ..plotting import frequency_response_html
+
+        steps.append(("frf.html", html_writer(lambda: frequency_response_html(result))))
+    written = write_set(output, FRF_PAGE_FILES, steps)
     echo_written(result.summary(), written, output)
 
 
@@ -222,12 +234,14 @@ def _law_keys(run_config: Any) -> str:
 @click.option("--fixed-harmonics", is_flag=True, default=False,
               help="Keep H = --harmonics on the whole range (by default H is raised where the truncation "
                    "error or a failing corrector demands it, up to 128, and lowered again where it allows).")
+@html_option
 def frf_command(
     config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
     rpm_min: float | None, rpm_max: float | None, subharmonics: bool, start: str = "low",
-    fixed_harmonics: bool = False,
+    fixed_harmonics: bool = False, html: bool = False,
 ) -> None:
-    """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
+    """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json (and frf.html, an
+    interactive page, with --html) in OUTPUT.
 
     With --subharmonics every period-doubling point found on the primary branch starts a
     period-2 branch (and so on, up to period 4); each branch has its colour in frf.png. On a
@@ -236,6 +250,7 @@ def frf_command(
     over two periods.
     """
     precheck(config, output, harmonics=harmonics)
+    check_html(html)
     run_config = _io().load_config(config)
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
@@ -244,9 +259,10 @@ def frf_command(
     )
     options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None,
-               "start": None if start == "low" else start, "fixed_harmonics": True if fixed_harmonics else None}
+               "start": None if start == "low" else start, "fixed_harmonics": True if fixed_harmonics else None,
+               "html": True if html else None}
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
-            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics)
+            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics, html=html)
 
 
 # --------------------------------------------------------------------------------------------
@@ -597,19 +613,22 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
 @_rpm_min_option
 @_rpm_max_option
 @_quiet_option
+@html_option
 def compare_command(
     config: Path, output: Path, points: int, at: str | None, workers: int, measured: Path | None,
     harmonics: int | None, omega_min: float | None, omega_max: float | None, rpm_min: float | None,
-    rpm_max: float | None, quiet: bool,
+    rpm_max: float | None, quiet: bool, html: bool = False,
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
-    compare.png, frf.csv, sweep.csv, compare.json in OUTPUT.
+    compare.png, frf.csv, sweep.csv, compare.json (and compare.html, an interactive page, with --html) in
+    OUTPUT.
 
     With --measured FILE.csv the measured points are drawn over the computed curves of the same
     quantity and tabled against them in measured.csv (HB largest stable, sweep up, sweep down,
     differences).
     """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
+    check_html(html)
     parse_at(at)  # the list's form and size: no numpy (the range is checked once the file is read)
     measured_table = None
     if measured is not None:
@@ -636,7 +655,8 @@ def compare_command(
     if run_config.discontinuous:
         run_discontinuous_compare(run_config, config, analysis, output, points, workers, quiet, {
             "points": points, "workers": workers, "harmonics": harmonics, "omega_min": omega_min,
-            "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max})
+            "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max, "html": True if html else None},
+            html=html)
         return
     at_values = parse_at(at, analysis.omega_min, analysis.omega_max)
     measured_run = None if measured_table is None else _io().read_measured_csv(
@@ -655,7 +675,7 @@ def compare_command(
     meta = sections("compare", config, run_config, analysis, {
         "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
-        "measured": None if measured is None else str(measured),
+        "measured": None if measured is None else str(measured), "html": True if html else None,
     })
     frf = result.frf.with_sound(run_config.paths) if run_config.paths else result.frf
     sweep = result.sweep.with_sound(run_config.paths) if run_config.paths else result.sweep
@@ -677,17 +697,22 @@ def compare_command(
         beside = compare_measured(measured_run, frf, sweep)  # the sweeps with their sound pressure (paths)
         summary += "\n" + beside.summary()
         steps += [("compare.png", lambda path: save_figure(draw_measured, path)), ("measured.csv", beside.to_csv)]
-    written = write_set(output, COMPARE_FILES, steps)
+    if html:
+        from ..plotting import compare_html
+
+        steps.append(("compare.html", html_writer(lambda: compare_html(result, summary=summary))))
+    written = write_set(output, COMPARE_PAGE_FILES, steps)
     echo_written(summary, written, output)
     _raise_if_incomplete(result.sweep, written, output)
 
 
 def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisSettings, output: Path, points: int,
-                              workers: int, quiet: bool, options: dict[str, Any]) -> None:
+                              workers: int, quiet: bool, options: dict[str, Any], *, html: bool = False) -> None:
     """``rattle compare`` on a discontinuous law, or a chain with friction on its elements:
     :func:`rattle.analysis.compare` with the file's ``[analysis]`` (harmonics, regularisation,
     refine) — the regularised harmonic balance checked by exact shooting against the exact up and
-    down sweep, written as frf.csv (the response's columns), sweep.csv, compare.json, compare.png."""
+    down sweep, written as frf.csv (the response's columns), sweep.csv, compare.json, compare.png (and
+    compare.html with ``html``)."""
     t_start = time.perf_counter()
     from ..analysis import compare  # only now: all input has been validated
     from ..analysis import regularisation_options
@@ -703,11 +728,16 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
     finally:
         bar.close()
     meta = sections("compare", config, run_config, analysis, options)
-    written = write_set(output, COMPARE_FILES, [
+    steps: list[tuple[str, Any]] = [
         ("frf.csv", result.frf.to_csv), ("sweep.csv", result.sweep.to_csv),
         ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
         ("compare.png", lambda path: save_plot(result, path)),
-    ])
+    ]
+    if html:
+        from ..plotting import compare_html
+
+        steps.append(("compare.html", html_writer(lambda: compare_html(result))))
+    written = write_set(output, COMPARE_PAGE_FILES, steps)
     echo_written(result.summary(), written, output)
     _raise_if_incomplete(result.sweep, written, output)
 
@@ -738,13 +768,14 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
 @click.option("--report", is_flag=True, default=False,
               help="Also write map.md, the design summary (special points, rattle-free intervals, the search).")
 @_quiet_option
+@html_option
 def map_command(
     config: Path, output: Path, vary: tuple[str, ...], omega_points: int, workers: int | None,
     scheduler: str | None, harmonics: int | None, omega_min: float | None, omega_max: float | None,
-    rpm_min: float | None, rpm_max: float | None, report: bool, quiet: bool,
+    rpm_min: float | None, rpm_max: float | None, report: bool, quiet: bool, html: bool = False,
 ) -> None:
     """Response map of the model in CONFIG over the --vary parameters and the frequency: map.csv,
-    map.nc, map.json, map.png (and map.md with --report) in OUTPUT.
+    map.nc, map.json, map.png (map.md with --report, map.html, an interactive page, with --html) in OUTPUT.
 
     For every combination of the varied values: the frequency response with its sub-harmonic
     branches, every branch solved on the grid of N frequencies, and a search for the attractors
@@ -755,6 +786,7 @@ def map_command(
 
     parsed = parse_all(vary)  # first: a malformed --vary needs no file
     precheck(config, output, harmonics=harmonics, workers=workers)
+    check_html(html)
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
     run_config = _io().load_config(config)
@@ -790,7 +822,7 @@ def map_command(
     meta = sections("map", config, run_config, analysis, {
         "vary": list(vary), "omega_points": omega_points, "workers": workers, "scheduler": scheduler,
         "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min,
-        "rpm_max": rpm_max, "report": True if report else None,
+        "rpm_max": rpm_max, "report": True if report else None, "html": True if html else None,
     })
 
     steps: list[tuple[str, Any]] = [
@@ -801,9 +833,13 @@ def map_command(
     ]
     if report:
         steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
+    if html:
+        from ..plotting import map_html
+
+        steps.append(("map.html", html_writer(lambda: map_html(result, summary=map_summary(result)))))
     # the set: also every map_<NAME>.png of an earlier map in OUTPUT, so that none is left beside the new one
     earlier = sorted(p.name for p in output.glob("map_*.png")) if output.is_dir() else []
-    names = tuple(dict.fromkeys([*MAP_FILES, *(name for name, _ in figures[1:]), *earlier]))
+    names = tuple(dict.fromkeys([*MAP_FILES, "map.html", *(name for name, _ in figures[1:]), *earlier]))
     written = write_set(output, names, steps)
     failed = [c for c in result.cells if c.status == "failed"]
     echo_written(map_summary(result), written, output)

@@ -1,7 +1,8 @@
 """Plots (with :mod:`rattle.demo`'s figures, the only matplotlib importers); every function returns
 (figure, axes), ``axes`` a :class:`PlotAxes` (panel name → matplotlib Axes, with a primary one).
 
-matplotlib is imported inside the functions, so importing this package stays cheap. The paper's
+matplotlib (and plotly, for the interactive HTML pages of :mod:`._html`) is imported inside the
+functions, so importing this package stays cheap. The paper's
 own figures (Figures 4–7) are :mod:`rattle.demo`'s, drawn with the pieces here: the building
 blocks below the plot functions in ``__all__`` (branch colours and labels, special-point markers,
 period colours, spectra) are public for that use.
@@ -15,6 +16,7 @@ from ._frf import (
 )
 from ._friction import friction_response_plot
 from ._friction_orbit import friction_orbit_plot
+from ._html import PLOTLY_MISSING, compare_html, frequency_response_html, map_html, plotly_available
 from ._map import map_plot_names, plot_map
 from ..results import held_runs
 from ._nonsmooth import nonsmooth_orbit_plot, nonsmooth_response_plot
@@ -24,6 +26,8 @@ from ._sweep import PERIOD_COLORS, period_label, sweep_plot
 __all__ = [
     "frequency_response_plot", "sweep_plot", "orbit_plot", "compare_plot", "plot_map", "PlotAxes",
     "nonsmooth_response_plot", "nonsmooth_orbit_plot", "friction_response_plot", "friction_orbit_plot",
+    # interactive pages (plotly, ``pip install "rattle[html]"``): one self-contained HTML file each
+    "frequency_response_html", "compare_html", "map_html", "plotly_available", "PLOTLY_MISSING",
     # the figures ``rattle map`` writes
     "map_plot_names",
     # building blocks (the demo's figures, the command line's summaries)
