@@ -7,7 +7,7 @@ grounded two-inertia system with a clutch element, the three-inertia free drivel
 four-stage clutch damper and gear backlash) over whole frequency ranges:
 
 * special points: ``rattle.frequency_response`` (H harmonics) against the exact reference of
-  ``tests/_exact_branch.py`` (shooting continuation on the exact flow of ``SystemIntegrator``,
+  ``tests/_exact_branch.py`` (shooting continuation on the exact flow of ``ExactIntegrator``,
   every change of stability located by Brent to 1e-11, hidden-pair guard) — kinds in order and
   the worst |ΔΩ|;
 * orbits: at up to ``--orbits`` points of each branch away from special points, the exact
@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import rattle
-from rattle.timeint import SystemIntegrator, shoot_system_orbit
+from rattle.timeint import ExactIntegrator, shoot_system_orbit
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import _exact_branch as xb  # noqa: E402
@@ -67,7 +67,7 @@ def main(argv=None) -> int:
             print("   HB   ", [(k, round(w, 6)) for k, w in hb])
             print("   exact", [(k, round(w, 6)) for k, w in ref.special])
         special = np.array([w for _, w in hb])
-        integ = SystemIntegrator(system)
+        integ = ExactIntegrator(system)
         worst_rms, n, agree = 0.0, 0, 0
         for i in np.linspace(0, len(frf) - 1, args.orbits).astype(int):
             w = float(frf.omega[i])

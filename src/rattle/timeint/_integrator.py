@@ -44,6 +44,7 @@ from ..errors import ConvergenceError
 from ..model import Model, transition_scalar
 from ._roots import bracketed_newton
 from ._stage_solutions import StageSolutions
+from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import Trajectory
 
 _EPS = float(np.finfo(float).eps)
@@ -131,31 +132,17 @@ class _Segment:
 # ---------------------------------------------------------------------------------------------
 # Integrator
 # ---------------------------------------------------------------------------------------------
-class ExactIntegrator:
-    """Exact integrator of δ'' + c δ' + k f(δ) = F(t) for a model with a continuous
-    piecewise-linear law (see the module docstring).
+class _ScalarFlow(ExactIntegrator, for_system=Model):
+    """The compiled scalar path of :class:`~rattle.timeint.ExactIntegrator`: δ'' + c δ' + k f(δ) = F(t)
+    for a model with a continuous piecewise-linear law (see the module docstring); the grid of
+    ``options.samples_per_scale`` points per fastest time scale of a stage brackets the crossings,
+    ``options.max_events`` is the budget of segments of one ``propagate`` call (exceeded:
+    ``ConvergenceError``)."""
 
-    Parameters
-    ----------
-    model
-        The model (c = C/I, k = K/I, law f, excitation F).
-    samples_per_scale
-        Grid points per fastest time scale of a stage used to bracket crossings (≥ 8).
-    max_segments
-        Budget of segments of one ``propagate`` call; exceeding it raises ``ConvergenceError``.
-    """
-
-    def __init__(self, model: Model, *, samples_per_scale: int = 40, max_segments: int = 1_000_000) -> None:
-        if not isinstance(model, Model):
-            raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-        for name, value, low in (("samples_per_scale", samples_per_scale, 8), ("max_segments", max_segments, 1)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise TypeError(f"`{name}` must be an integer, got {value!r}")
-            if value < low:
-                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-        self.model = model
-        self.samples_per_scale = int(samples_per_scale)
-        self.max_segments = int(max_segments)
+    def __init__(self, system: Model, options: FlowOptions | None = None) -> None:
+        super().__init__(system, options)
+        self.model = self.system
+        self.max_segments = self.options.budget(events=False)
         self._cache: tuple[float, StageSolutions] | None = None
 
     def solutions(self, omega: float) -> StageSolutions:
@@ -348,4 +335,4 @@ class ExactIntegrator:
         return tau_c, seg.j + 1 if up else seg.j - 1, bound, v_c
 
 
-__all__ = ["ExactIntegrator"]
+__all__: list[str] = []
