@@ -11,8 +11,8 @@ This module gathers them under their old names (the N-coordinate counterparts ar
 :mod:`._stage_flow`, :mod:`._events` and :mod:`._flow`).
 """
 
-from ._exact_flow import ExactIntegrator
 from . import _integrator  # noqa: F401  (the scalar path registers itself)
+from ._exact_flow import ExactIntegrator
 from ._stage_solutions import StageSolutions
 from ._trajectory import ExactMeasures, ExactTrajectory, StateSamples, Trajectory
 

@@ -86,6 +86,7 @@ from .._validate import check_omega
 from ..errors import ConvergenceError
 from ..model import FrictionSystem, ReducedElement, System
 from ._events import first_exit
+from ._roots import grid_chunk, polish_crossing
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
@@ -708,27 +709,13 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
     def _crossing_time(self, seg: Segment, e: int, direction: int, lo: FloatArray, hi: FloatArray,
                        stages: tuple[int, ...], tau: float, tau_max: float) -> float:
         """The time ``tau`` of element ``e``'s crossing of its stage bound (``hi`` upwards, ``lo``
-        downwards), polished (:meth:`_polish_crossing`) where the field jumps there: a jump of
+        downwards), polished (:func:`~._roots.polish_crossing`) where the field jumps there: a jump of
         the law or a change of friction level."""
         i_bp = stages[e] if direction > 0 else stages[e] - 1
         if self.jumps[e][i_bp] > 0.0 or self.levels[e][i_bp] != self.levels[e][i_bp + 1]:
-            return self._polish_crossing(seg, e, float(hi[e] if direction > 0 else lo[e]), tau, tau_max)
-        return tau
-
-    def _polish_crossing(self, seg: Segment, e: int, bound: float, tau: float, tau_max: float) -> float:
-        """The crossing time of a breakpoint where the field jumps, polished by Newton steps on
-        δ_e(τ) − d to the last bit: an error dτ there becomes an error (a⁺ − a⁻) dτ in δ_e'."""
-        tp = tau
-        for _ in range(3):
-            dd, vv, _ = seg.element_point(tp, e)
-            if vv == 0.0:
-                break
-            dt = (dd - bound) / vv
-            tp -= dt
-            if abs(dt) <= 2.0 * _EPS * abs(tp):
-                break
-        if 0.0 < tp <= tau_max and abs(tp - tau) <= 1e-6 * max(tau, 1e-300) + 1e-12:
-            return tp
+            polished = polish_crossing(lambda x: seg.element_point(x, e), float(hi[e] if direction > 0 else lo[e]),
+                                       tau, tau_max)
+            return tau if polished is None else polished
         return tau
 
     def _lock_entry(self, t: float, z: FloatArray, e: int, i: int, stages: tuple[int, ...], key: _Key,
@@ -792,10 +779,7 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         sg = np.array([sigma[e] for e in slip], dtype=float)
         tau_a = 0.0
         while tau_a < tau_end:
-            k = max(1, min(_CHUNK, math.ceil((tau_end - tau_a) / step)))
-            taus = tau_a + step * np.arange(k + 1)
-            if k < _CHUNK or taus[-1] >= tau_end:
-                taus[-1] = tau_end
+            taus = grid_chunk(tau_a, tau_end, step, _CHUNK)
             z, zd = seg.state(taus)
             best = (math.inf, -1, -1, 0)
             if slip:

@@ -61,7 +61,7 @@ from ..model import NonsmoothSystem, Stages
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
-from ._roots import bracketed_newton
+from ._roots import bracketed_newton, grid_chunk, polish_crossing
 from ._stage_solutions import StageSolutions
 
 _EPS = float(np.finfo(float).eps)
@@ -73,13 +73,8 @@ _KIND_NAMES = ("slip", "stick", "lock")
 
 
 def _chunk(start: float, end: float, step: float) -> FloatArray:
-    """The grid points of the next at most ``_CHUNK`` cells of width ``step`` from ``start``, the
-    last one placed exactly on ``end`` when the chunk reaches it."""
-    n = max(1, min(_CHUNK, math.ceil((end - start) / step)))
-    pts = start + step * np.arange(n + 1)
-    if pts[-1] >= end or n < _CHUNK:
-        pts[-1] = end
-    return pts
+    """The next at most ``_CHUNK`` cells of the event grid (:func:`~._roots.grid_chunk`)."""
+    return grid_chunk(start, end, step, _CHUNK)
 
 
 def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: int) -> StageSolutions:
@@ -441,17 +436,8 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
                         # The field jumps here: an error dτ of the crossing time becomes an error
                         # (a⁺ − a⁻) dτ of δ'. The search stops at |δ − d_i| ≤ its round-off floor;
                         # polish τ by Newton steps on δ(τ) − d_i to the last bit.
-                        tau_p = tau_c
-                        for _ in range(3):
-                            dd, vv, _ = seg.state(tau_p)
-                            if vv == 0.0:
-                                break
-                            dt = (dd - d) / vv
-                            tau_p -= dt
-                            if abs(dt) <= 2.0 * _EPS * abs(tau_p):
-                                break
-                        tau_max = tau_end if tau_v is None else tau_v
-                        if 0.0 < tau_p <= tau_max and abs(tau_p - tau_c) <= 1e-6 * max(tau_c, 1e-300) + 1e-12:
+                        tau_p = polish_crossing(seg.state, d, tau_c, tau_end if tau_v is None else tau_v)
+                        if tau_p is not None:
                             t = t - tau + tau_p
                             tau = tau_p
                             _, v_c, _ = seg.state(tau)
