@@ -4,8 +4,8 @@ Run:  python benchmarks/bench_system_flow.py  [--repeat 5] [--periods 100]
 
 Prints, best of ``--repeat`` runs, the time to integrate ``--periods`` forcing periods:
 
-(a) n = 1: the paper's clutch (reference case) as a System (``ExactIntegrator``) next to the
-    single-equation ``ExactIntegrator`` on the same model, at Ω = 0.3, 0.8, 1.6, and the largest
+(a) n = 1: the paper's clutch (reference case) as a System (``ExactIntegrator(model.system())``:
+    the stage-matrix path) next to ``ExactIntegrator(model)`` (the compiled scalar path), at Ω = 0.3, 0.8, 1.6, and the largest
     difference of their final states;
 (b) n = 3: a grounded 3-inertia chain (M = diag(1, 2, 1.5), clutch between 1 and 2, gear
     backlash between 2 and 3, two forcing harmonics) and n = 2: the free version of that chain
@@ -67,7 +67,7 @@ def main() -> None:
     P = args.periods
 
     print(f"(a) n = 1, reference case, {P} periods from (0.01, 0)")
-    print("    Omega   ExactIntegrator   ExactIntegrator   ratio   segments   max |dz|")
+    print("    Omega       scalar path    stage-matrix path   ratio   segments   max |dz|")
     model = rattle.reference_case()
     system = model.system()
     for om in (0.3, 0.8, 1.6):
@@ -79,7 +79,7 @@ def main() -> None:
               f"   {np.abs(a.state1 - b.state1).max():.1e}")
 
     print(f"\n(b) chains, {P} periods from the static equilibrium at rest")
-    print("    system              Omega   ExactIntegrator   segments   per segment   solve_ivp (5 periods)")
+    print("    system              Omega   stage-matrix path   segments   per segment   solve_ivp (5 periods)")
     for name, sysm in (("grounded n=3, m=2", chain(False)), ("free n=2, m=2", chain(True))):
         for om in (0.4, 1.0):
             T = 2 * math.pi / om

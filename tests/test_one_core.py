@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import pickle
 from pathlib import Path
 
 import pytest
@@ -143,7 +144,10 @@ def test_one_flow_takes_every_system() -> None:
         integ = timeint.ExactIntegrator(system)
         assert isinstance(integ, timeint.ExactIntegrator) and type(integ) is not timeint.ExactIntegrator
         assert timeint.built_for(integ, system) and integ.system is system
-    for name in INTEGRATORS[1:]:
+        assert type(pickle.loads(pickle.dumps(integ))) is type(integ)  # the paths go to worker processes
+    for name in (*INTEGRATORS[1:], "NonsmoothOptions"):
         assert name not in timeint.__all__ and name not in rattle.__all__, name
+        with pytest.warns(DeprecationWarning, match="ExactIntegrator|FlowOptions"):
+            assert getattr(timeint, name) in (timeint.ExactIntegrator, timeint.FlowOptions)
     with pytest.raises(TypeError, match="`system`"):
         timeint.ExactIntegrator("clutch")

@@ -9,7 +9,7 @@ The steady state of a simulation with period detection is an analysis built on t
 from typing import Any
 
 from ._exact import ExactIntegrator, ExactMeasures, ExactTrajectory, StageSolutions, StateSamples, Trajectory
-from ._exact_flow import FlowOptions, NonsmoothOptions
+from ._exact_flow import FlowOptions
 from ._flow import SystemMeasures, SystemSamples, SystemTrajectory, check_system_state
 from ._general import GeneralSolution, integrate_general
 from ._friction_chain import CROSSING, LOCK, STICK, FrictionTrajectory
@@ -28,7 +28,7 @@ __all__ = [
     "Shot", "ShotOrbit", "state_scale", "make_integrator", "built_for", "check_system_state",
     "integrate_general", "GeneralSolution",
     "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
-    "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
+    "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
     "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit",
     "CROSSING", "LOCK", "STICK",  # the segment kinds of a FrictionTrajectory
 ]
@@ -42,17 +42,19 @@ _MOVED: dict[str, str] = {
 
 
 #: The per-system integrator classes folded into the one flow :class:`ExactIntegrator` (issue
-#: 23): still served here, with a DeprecationWarning, as that class (which picks the path).
-_FOLDED = ("SystemIntegrator", "NonsmoothIntegrator", "FrictionIntegrator")
+#: 23), and their options: still served here, with a DeprecationWarning, as that class (which
+#: picks the path by the system) and :class:`FlowOptions`.
+_FOLDED = {"SystemIntegrator": "ExactIntegrator", "NonsmoothIntegrator": "ExactIntegrator",
+           "FrictionIntegrator": "ExactIntegrator", "NonsmoothOptions": "FlowOptions"}
 
 
 def __getattr__(name: str) -> Any:
     if name in _FOLDED:
         import warnings
 
-        warnings.warn(f"`rattle.timeint.{name}` is deprecated; use `rattle.timeint.ExactIntegrator(system)`, the one "
-                      "exact flow of every system", DeprecationWarning, stacklevel=2)
-        return ExactIntegrator
+        warnings.warn(f"`rattle.timeint.{name}` is deprecated; use `rattle.timeint.{_FOLDED[name]}` (the one exact "
+                      "flow of every system and its options)", DeprecationWarning, stacklevel=2)
+        return globals()[_FOLDED[name]]
     if name in _MOVED:
         import importlib
         import warnings

@@ -79,10 +79,6 @@ class FlowOptions:
         return 200_000 if events else 1_000_000
 
 
-#: The name the options had while they served only the discontinuous laws.
-NonsmoothOptions = FlowOptions
-
-
 def _reduced(system: Any) -> Any:
     """A :class:`~rattle.model.Chain`'s reduced form: its FrictionSystem when it has friction or a
     torque jump on an element, else its System; any other object as it is."""
@@ -126,8 +122,8 @@ class ExactIntegrator:
             cls._for = for_system
             ExactIntegrator._PATHS.append((for_system, cls))
 
-    def __new__(cls, system: Any, options: FlowOptions | None = None) -> ExactIntegrator:
-        if cls is not ExactIntegrator:
+    def __new__(cls, system: Any = None, options: FlowOptions | None = None) -> ExactIntegrator:
+        if cls is not ExactIntegrator:  # a path itself (or unpickling one: no arguments)
             return super().__new__(cls)
         system = _reduced(system)
         for kind, path in ExactIntegrator._PATHS:
@@ -161,4 +157,4 @@ class ExactIntegrator:
         raise NotImplementedError
 
 
-__all__ = ["ExactIntegrator", "FlowOptions", "NonsmoothOptions"]
+__all__ = ["ExactIntegrator", "FlowOptions"]
