@@ -1,4 +1,4 @@
-"""Random cross-validation of the exact integrator of chains with friction (rattle.timeint.FrictionIntegrator).
+"""Random cross-validation of the exact integrator of chains with friction (rattle.timeint.ExactIntegrator).
 
     python benchmarks/bench_friction_chain_exact.py [CASES] [SEED]
 
@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_friction_chain import _reference
 
 from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Torque
-from rattle.timeint import FrictionIntegrator
+from rattle.timeint import ExactIntegrator
 
 
 def draw(rng: np.random.Generator) -> tuple[Chain, float, np.ndarray]:
@@ -62,7 +62,7 @@ def main() -> None:
         fs = ch.friction_system()
         T = 2 * math.pi / omega
         t0 = time.perf_counter()
-        ex = FrictionIntegrator(fs).propagate(z0, 0.0, 2 * T, omega)
+        ex = ExactIntegrator(fs).propagate(z0, 0.0, 2 * T, omega)
         t1 = time.perf_counter()
         ref = _reference(fs, z0, 2 * T, omega)
         t2 = time.perf_counter()

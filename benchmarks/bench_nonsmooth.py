@@ -28,7 +28,7 @@ from rattle.hb._regularised import RegularisedBalance
 from rattle.model import Excitation
 from rattle.model._discontinuous import Friction, NonsmoothLaw, Preload
 from rattle.model._nonsmooth_system import NonsmoothSystem
-from rattle.timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
+from rattle.timeint import ExactIntegrator, shoot_nonsmooth_orbit
 
 C, FM, FP, PHASE = 0.05, 0.01, 0.3, 0.3
 CASES = [  # (T_p, r, Ω)
@@ -45,7 +45,7 @@ def main() -> None:
         law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r))
         sysx = NonsmoothSystem(damping=C, stiffness=1.0, law=law,
                                excitation=Excitation(mean=FM, amplitudes=(FP,), phases=(PHASE,)))
-        integ = NonsmoothIntegrator(sysx)
+        integ = ExactIntegrator(sysx)
         T = 2 * math.pi / w
         x = np.array([0.3, 0.0])
         for _ in range(60):  # settle

@@ -33,7 +33,7 @@ from rattle.errors import RattleError
 from rattle.hb import HBOptions, RegularisedBalance
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
 from rattle.stability import regularised_multipliers
-from rattle.timeint import NonsmoothIntegrator, shoot_nonsmooth_orbit
+from rattle.timeint import ExactIntegrator, shoot_nonsmooth_orbit
 
 
 def draw(rng: np.random.Generator) -> tuple[NonsmoothSystem, float]:
@@ -72,7 +72,7 @@ def main() -> None:
             pb = make(0.01, 128)
             q = lad.last.q
             d0, v0 = (float(a[0]) for a in pb.samples(q, w))
-            orbit = shoot_nonsmooth_orbit(sysx, w, (d0, v0), integrator=NonsmoothIntegrator(sysx), max_iterations=30)
+            orbit = shoot_nonsmooth_orbit(sysx, w, (d0, v0), integrator=ExactIntegrator(sysx), max_iterations=30)
         except (RattleError, ValueError, ArithmeticError) as exc_:
             print(f"case {i:2d}: Ω = {w:.3f}: failed ({exc_.__class__.__name__}: {str(exc_)[:80]})")
             rows.append(("failed",))
@@ -89,7 +89,7 @@ def main() -> None:
         e1 = lad.last.rms / orbit.rms - 1
         mu_hb = regularised_multipliers(pb, q, w)
         agree_reg = bool(np.all(np.abs(mu_hb) < 1)) == bool(orbit.stable)
-        M = NonsmoothIntegrator(sysx).propagate(np.array([d0, v0]), 0.0, 2 * math.pi / w, w).sensitivity
+        M = ExactIntegrator(sysx).propagate(np.array([d0, v0]), 0.0, 2 * math.pi / w, w).sensitivity
         agree = bool(np.all(np.abs(np.linalg.eigvals(M)) < 1)) == bool(orbit.stable)  # nonsmooth_response's
         try:
             lim = regularisation_limit(make, w, q, eps_start=0.01, eps_min=1e-3, harmonics=128, max_harmonics=256)

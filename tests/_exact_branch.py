@@ -97,7 +97,7 @@ import scipy.optimize
 
 from rattle.model import Model
 from rattle.analysis import steady_state
-from rattle.timeint import ExactIntegrator, SystemIntegrator, shoot_periodic_orbit, shoot_system_orbit
+from rattle.timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
 
 KINDS = ("fold", "period_doubling", "neimark_sacker")
 
@@ -159,14 +159,14 @@ def _psi(M: np.ndarray) -> tuple[float, ...]:
 class _ShootingProblem:
     """G(y) in scaled variables, with the exact monodromy: for a single-equation ``Model`` on the
     closed-form :class:`~rattle.timeint.ExactIntegrator` (state (δ, δ')), for any other model (a
-    chain) on the :class:`~rattle.timeint.SystemIntegrator` of its System (state (x, x'), 2n)."""
+    chain) on the :class:`~rattle.timeint.ExactIntegrator` of its System (state (x, x'), 2n)."""
 
     def __init__(self, model, fd_step: float = 1e-6) -> None:
         self.model = model
         self.single = isinstance(model, Model)
         system = model.system()
         self.system = system
-        self.integ = ExactIntegrator(model) if self.single else SystemIntegrator(system)
+        self.integ = ExactIntegrator(model) if self.single else ExactIntegrator(system)
         self.L = model.length_scale()
         self.wn = model.natural_frequency
         n = system.n

@@ -65,7 +65,6 @@ PUBLIC_API = {
     "NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction",
     "ShootingOptions", "RegularisationOptions", "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
-    "SystemIntegrator",
     "sound_pressure", "linear_sound_pressure", "SoundPressure", "SoundPath",
     "Drag", "clutch_damper", "hub_spline", "gear_pair", "loose_gear",
     "Status", "RattleError", "ConfigError", "ConvergenceError",

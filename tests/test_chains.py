@@ -1,7 +1,7 @@
 """Chains against their exact references (issue: N inertias, several clearances, Neimark–Sacker).
 
 The references are independent of harmonic balance: the exact piecewise-linear flow of the
-chain's System (``rattle.timeint.SystemIntegrator``: stage solutions, crossings to round-off,
+chain's System (``rattle.timeint.ExactIntegrator``: stage solutions, crossings to round-off,
 monodromy from the stage matrices) continued by shooting in ``tests/_exact_branch.py``.
 """
 
@@ -13,7 +13,7 @@ import pytest
 import rattle
 from rattle.model import Backlash, Chain, Clutch, Element, Link, Piecewise, Torque
 from rattle.model.library import REFERENCE_B
-from rattle.timeint import SystemIntegrator, shoot_system_orbit
+from rattle.timeint import ExactIntegrator, shoot_system_orbit
 
 import _exact_branch as xb
 from _cases import hb_chain_state0
@@ -83,7 +83,7 @@ def test_two_inertia_chain_reproduces_the_single_equation(I1, I2):
 
 
 def test_two_inertia_chain_exact_reference_equals_the_single_equation_reference():
-    """The N-DOF reference (SystemIntegrator) finds the single-equation reference's (closed-form
+    """The N-DOF reference (ExactIntegrator) finds the single-equation reference's (closed-form
     ExactIntegrator) period doubling at 1.2426 to 1e-8."""
     a = xb.exact_special_points(rattle.reference_case(), (1.2, 1.3))
     b = xb.exact_special_points(two_inertia(3.0, 1.5), (1.2, 1.3))
@@ -138,7 +138,7 @@ def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega)
     system = model.system()
     frf = rattle.frequency_response(model, omega=omega, harmonics=32, confirm_tori=False)
     special = np.array([s.omega for s in frf.special_points])
-    integ = SystemIntegrator(system)
+    integ = ExactIntegrator(system)
     rows = np.linspace(0, len(frf) - 1, 14).astype(int)
     checked = 0
     for i in rows:

@@ -15,7 +15,7 @@ from rattle.analysis import SteadyStateOptions, steady_state, time_sweep
 from rattle.analysis._steady import static_state, stick_fraction
 from rattle.errors import Status
 from rattle.model import Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, NonsmoothSystem, Preload, Torque
-from rattle.timeint import NonsmoothIntegrator, shoot_friction_orbit, shoot_nonsmooth_orbit
+from rattle.timeint import ExactIntegrator, shoot_friction_orbit, shoot_nonsmooth_orbit
 
 
 def _preload(friction: float | None = 0.02) -> NonsmoothSystem:
@@ -62,13 +62,13 @@ def test_a_sticking_preload_with_friction_settles_on_the_exact_orbit():
 def test_the_integrator_and_the_start_state_of_a_nonsmooth_system():
     ns = _preload(None)
     np.testing.assert_allclose(static_state(ns), [0.02, 0.0])  # δ + T_p = F_m on the drive side
-    integ = NonsmoothIntegrator(ns)
+    integ = ExactIntegrator(ns)
     a = steady_state(ns, 0.7, integrator=integ)
     b = steady_state(ns, 0.7, a.final_state, integrator=integ)
     assert a.settled and b.settled and abs(a.rms - b.rms) <= 1e-9
     with pytest.raises(ValueError, match="different system"):
-        steady_state(ns, 0.7, integrator=NonsmoothIntegrator(_preload(0.01)))
-    with pytest.raises(TypeError, match="NonsmoothIntegrator"):
+        steady_state(ns, 0.7, integrator=ExactIntegrator(_preload(0.01)))
+    with pytest.raises(TypeError, match="ExactIntegrator"):
         steady_state(ns, 0.7, integrator=object())
 
 

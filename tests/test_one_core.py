@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import pickle
 from pathlib import Path
 
 import pytest
@@ -125,7 +126,28 @@ def _public_integrator_classes() -> list[str]:
     return sorted(found)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 23 item 2, last step not done: the N-dimensional integrators are not yet "
-                   "folded into one flow (FrictionIntegrator is 2-3.5x SystemIntegrator on smooth chains, measured)")
 def test_at_most_two_public_integrator_classes() -> None:
     assert len(_public_integrator_classes()) <= 2, _public_integrator_classes()
+
+
+def test_one_flow_takes_every_system() -> None:
+    """ExactIntegrator(system) is the flow of every kind of system (its paths are private
+    subclasses), built for that system; the folded names are gone from the public lists."""
+    import rattle
+    from rattle.model import Friction, FrictionSystem, NonsmoothSystem
+
+    model = rattle.reference_case()
+    chain = model.system()
+    systems = (model, chain, NonsmoothSystem.from_model(model, friction=Friction(levels=0.01)),
+               FrictionSystem.from_system(chain, (0.01,)))
+    for system in systems:
+        integ = timeint.ExactIntegrator(system)
+        assert isinstance(integ, timeint.ExactIntegrator) and type(integ) is not timeint.ExactIntegrator
+        assert timeint.built_for(integ, system) and integ.system is system
+        assert type(pickle.loads(pickle.dumps(integ))) is type(integ)  # the paths go to worker processes
+    for name in (*INTEGRATORS[1:], "NonsmoothOptions"):
+        assert name not in timeint.__all__ and name not in rattle.__all__, name
+        with pytest.warns(DeprecationWarning, match="ExactIntegrator|FlowOptions"):
+            assert getattr(timeint, name) in (timeint.ExactIntegrator, timeint.FlowOptions)
+    with pytest.raises(TypeError, match="`system`"):
+        timeint.ExactIntegrator("clutch")

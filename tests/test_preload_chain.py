@@ -1,5 +1,5 @@
 """Torque jumps (preload) on a chain's elements, solved by the exact event-driven integrator
-(rattle.timeint.FrictionIntegrator): the model (Chain, FrictionSystem), one coordinate against
+(rattle.timeint.ExactIntegrator): the model (Chain, FrictionSystem), one coordinate against
 the single equation's own integrator, chains against an independent scipy event integration of
 the same Filippov system (jumps, locks, sticks), finite differences of the period map against the
 saltation monodromy (jump crossings, locks entered, left and started in), and shooting."""
@@ -28,7 +28,7 @@ from rattle.model import (
     Torque,
 )
 from rattle.model._system import single_equation_system
-from rattle.timeint import FrictionIntegrator, NonsmoothIntegrator, NonsmoothOptions, shoot_friction_orbit
+from rattle.timeint import ExactIntegrator, FlowOptions, shoot_friction_orbit
 from rattle.timeint._friction_chain import EVENT_NAMES, LOCK, UNLOCK
 
 from _cases import lockup_chain  # tests/ is on sys.path through its conftest
@@ -66,8 +66,8 @@ def test_one_coordinate_agrees_with_the_single_equation(law, levels, omega, amp,
     fs, ns = _single(law, levels, amp)
     z0 = np.array([0.02, 0.1])
     T = 2 * math.pi / omega
-    a = NonsmoothIntegrator(ns).propagate(z0, 0.0, 5 * T, omega)
-    b = FrictionIntegrator(fs).propagate(z0, 0.0, 5 * T, omega)
+    a = ExactIntegrator(ns).propagate(z0, 0.0, 5 * T, omega)
+    b = ExactIntegrator(fs).propagate(z0, 0.0, 5 * T, omega)
     assert np.abs(b.state1 - a.state1).max() <= 1e-12  # measured ≤ 7e-15
     assert np.abs(b.sensitivity - a.sensitivity).max() <= 1e-10 * max(1.0, np.abs(a.sensitivity).max())
     c = _counts(b)
@@ -302,7 +302,7 @@ def test_chain_agrees_with_an_independent_event_integration(case):
     released at rest whose excursion beyond its jump and back fits in one grid cell."""
     fs, omega, z0 = _case(case) if isinstance(case, str) else _random_chain(case)
     T = 2 * math.pi / omega
-    exact = FrictionIntegrator(fs).propagate(z0, 0.0, 2 * T, omega)
+    exact = ExactIntegrator(fs).propagate(z0, 0.0, 2 * T, omega)
     ref, counts = _reference(fs, z0, 2 * T, omega)
     assert np.abs(exact.state1 - ref).max() <= 1e-9 * max(np.abs(exact.state1).max(), 1e-3)  # measured ≤ 2.3e-11
     c = _counts(exact)
@@ -326,7 +326,7 @@ def test_sensitivity_is_the_derivative_of_the_period_map(case):
     entry blockdiag(Π, Π) and exit) against central differences of the flow (h = 1e-6). Across a
     lock the differences' own error is set by the chatter's snap (lock_excursion): 1e-7 of ‖M‖."""
     fs, omega, z0 = _case(case)
-    integ = FrictionIntegrator(fs)
+    integ = ExactIntegrator(fs)
     T = 2 * math.pi / omega
     traj = integ.propagate(z0, 0.0, 2 * T, omega)
     n2 = z0.size
@@ -354,7 +354,7 @@ def test_lock_entry_removes_the_chatter_momentum_along_the_elements_column():
     column), not its orthogonal projection: the other coordinates keep the chatter's momentum.
     Inside the lock δ_e sits on the jump and δ_e' = 0 exactly; the locked flags are stuck flags."""
     fs, omega, z0 = _case("locks")
-    traj = FrictionIntegrator(fs).propagate(z0, 0.0, 4 * math.pi / omega, omega)
+    traj = ExactIntegrator(fs).propagate(z0, 0.0, 4 * math.pi / omega, omega)
     assert traj.locked is not None and np.all(traj.stuck[traj.locked])
     seen = 0
     for i in np.flatnonzero(traj.locked[:, 0]):
@@ -394,7 +394,7 @@ def test_start_in_a_lock_and_shooting():
     # δx → δx − w_e ε, δx' → P_S (δx' + C w_e ε) plus O(ε^1.5), so one-sided differences converge
     # like √h (measured 6.9e-3 / 5.0e-2 at h = ±1e-6, 6.9e-5 / 5.1e-4 at ±1e-10); without the
     # damping term C w_e ε they stay 1.1e-2 off
-    integ = FrictionIntegrator(fs)
+    integ = ExactIntegrator(fs)
     z1 = integ.advance(o.state0, 0.0, T, omega)[0]
     err = {}
     for h in (1e-8, 1e-10):
@@ -413,7 +413,7 @@ def test_start_in_a_lock_and_shooting():
     o = shoot_friction_orbit(fs, omega, np.zeros(4))
     assert o.converged
     T = 2 * math.pi / omega
-    z1 = FrictionIntegrator(fs).propagate(o.state0, 0.0, T, omega).state1
+    z1 = ExactIntegrator(fs).propagate(o.state0, 0.0, T, omega).state1
     assert np.abs(z1 - o.state0).max() <= 1e-10 * np.abs(o.state0).max()
     assert 0.0 < o.trajectory.lock_time()[0] < T
     assert np.sum(o.trajectory.event_kinds == LOCK) >= 1 and np.sum(o.trajectory.event_kinds == UNLOCK) >= 1
@@ -425,7 +425,7 @@ def test_chatter_without_friction_exhausts_the_budget_with_a_clear_message():
     """No friction at the jump: the crossings decay only exponentially (rate ≈ c/3), so a forcing
     inside the lock band for long runs out of max_events; the error names the element and the jump."""
     fs = _chain(Preload(preload=0.1), None, torque=0.03).friction_system()
-    integ = FrictionIntegrator(fs, NonsmoothOptions(max_events=2000))
+    integ = ExactIntegrator(fs, FlowOptions(max_events=2000))
     with pytest.raises(ConvergenceError, match="'tcc' chatters into a lock at the jump of its law"):
         integ.propagate(np.array([0.0, 0.0, 0.0, 0.05, 0.0, 0.0]), 0.0, 200.0, 0.5)
 
@@ -484,7 +484,7 @@ def test_a_release_with_a_round_off_velocity_against_its_slip_keeps_slipping():
                                               "0x1.118a900a7486ap-7", "-0x1.5084ab740df30p-8",
                                               "-0x1.3b416185a1fb4p-9")])
     omega = float.fromhex("0x1.0e7c634a05950p+1")
-    tr = FrictionIntegrator(fs).propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
+    tr = ExactIntegrator(fs).propagate(z0, 0.0, 2.0 * math.pi / omega, omega)
     names = [EVENT_NAMES[k] for k in tr.event_kinds]
     i = names.index("release")
     # after the release the clutch slips (no event at the same instant), then stops or reverses

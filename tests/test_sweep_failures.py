@@ -18,7 +18,7 @@ from rattle.cli import cli
 from rattle.errors import ConfigError, ConvergenceError, Status
 from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload, SoundPath, reference_case
 from rattle.results._sweep import FAILED_PERIOD, SWEEP_FAILED
-from rattle.timeint import NonsmoothIntegrator, NonsmoothOptions
+from rattle.timeint import ExactIntegrator, FlowOptions
 
 from _cases import preload_spring_toml  # tests/ is on sys.path through its conftest
 
@@ -40,7 +40,7 @@ def _preload() -> NonsmoothSystem:
 def small_budget(monkeypatch):
     """The sweep's exact integrator with a budget of ``_BUDGET`` events: the real integrator
     raises its real ConvergenceError at the low frequencies."""
-    monkeypatch.setattr(ts, "make_integrator", lambda model: NonsmoothIntegrator(model, NonsmoothOptions(max_events=_BUDGET)))
+    monkeypatch.setattr(ts, "make_integrator", lambda model: ExactIntegrator(model, FlowOptions(max_events=_BUDGET)))
 
 
 def _failing_at(monkeypatch, bad: set[float], exc: type[BaseException] = ConvergenceError) -> None:

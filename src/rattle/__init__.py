@@ -12,7 +12,7 @@ bifurcation labels for torsional sub-systems with clearance non-linearities:
 
 The curated public API (``__all__``): the front ends and their result types, the model types
 (``Model``, ``Chain``, ``System``), the option objects, and the extension points — the elastic
-law base class ``AbstractElastic``, the integrators (``ExactIntegrator``, ``SystemIntegrator``),
+law base class ``AbstractElastic``, the exact flow (``ExactIntegrator``, every system),
 the continuation core (``ContinuationProblem``, implemented by ``HarmonicBalance`` and
 ``ShootingProblem``; ``ContinuationStepper``) and the stability method objects (``Monodromy``,
 ``Hill``). Everything else lives in the sub-packages.
@@ -65,7 +65,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(["Hill", "Monodromy"], ".stability"),
     **dict.fromkeys(["AttractorSearch", "ResponseMap", "response_map"], ".maps"),
     **dict.fromkeys(
-        ["ExactIntegrator", "ShootingProblem", "SystemIntegrator", "shoot_periodic_orbit"], ".timeint",
+        ["ExactIntegrator", "ShootingProblem", "shoot_periodic_orbit"], ".timeint",
     ),
     **dict.fromkeys(["SoundPath", "Drag"], ".model"),
     **dict.fromkeys(["NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction"], ".model"),
@@ -98,7 +98,6 @@ __all__ = [
     "ShootingOptions", "RegularisationOptions", "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     # extension points: problems, the stepper, the integrators
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
-    "SystemIntegrator",
     # sound pressure at a receiver (SPEC §6)
     "sound_pressure", "linear_sound_pressure", "SoundPressure", "SoundPath",
     # status and errors
@@ -144,7 +143,7 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     )
     from .maps import AttractorSearch, ResponseMap, response_map
     from .stability import Hill, Monodromy
-    from .timeint import ExactIntegrator, ShootingProblem, SystemIntegrator, shoot_periodic_orbit
+    from .timeint import ExactIntegrator, ShootingProblem, shoot_periodic_orbit
     from .model import Drag, SoundPath
     from .model import Friction, NonsmoothLaw, NonsmoothSystem, PiecewiseJump, Preload
     from .model import clutch_damper, gear_pair, hub_spline, loose_gear

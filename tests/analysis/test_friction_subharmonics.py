@@ -25,7 +25,7 @@ from rattle.analysis._friction_response import period_gap
 from rattle.continuation import ContinuationOptions
 from rattle.io import read_csv
 from rattle.model import Chain
-from rattle.timeint import FrictionIntegrator, shoot_friction_orbit
+from rattle.timeint import ExactIntegrator, shoot_friction_orbit
 
 RANGE = (1.30, 1.38)
 WIDE = ContinuationOptions(max_step=0.3)
@@ -66,7 +66,7 @@ def test_every_matched_row_is_an_exact_orbit_of_period_two(response):
     (rms to 1e-9), and that orbit does not repeat after one period."""
     (br,) = response.branches
     system = _chain().friction_system()
-    integ = FrictionIntegrator(system)
+    integ = ExactIntegrator(system)
     rows = np.flatnonzero(br.matched)
     for i in rows[:: max(1, rows.size // 6)]:
         w = float(br.omega[i])
@@ -101,7 +101,7 @@ def test_a_long_simulation_settles_on_the_stable_period_two_orbit(response):
     assert br.matched[i] and br.stable[i]
     w = float(br.omega[i])
     system = _chain().friction_system()
-    integ = FrictionIntegrator(system)
+    integ = ExactIntegrator(system)
     j = int(np.argmin(np.abs(response.omega - w)))
     one = shoot_friction_orbit(system, w, response.states[j], integrator=integ)
     assert one.converged and np.abs(one.multipliers).max() > 1.0

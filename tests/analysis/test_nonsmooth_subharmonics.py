@@ -14,7 +14,7 @@ import pytest
 from rattle.analysis import RegularisationOptions
 from rattle.analysis._nonsmooth import nonsmooth_response, nonsmooth_subharmonics
 from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
-from rattle.timeint import NonsmoothIntegrator
+from rattle.timeint import ExactIntegrator
 
 #: The period-1 branch loses stability by period doubling at Ω ≈ 0.545 and regains it at ≈ 0.562.
 RANGE = (0.53, 0.575)
@@ -66,7 +66,7 @@ def test_every_row_is_a_genuine_period_two_orbit(response):
     """The exact orbit does not repeat after one forcing period (it is not the period-1 orbit run
     twice) and repeats after two, to the shooting's tolerance."""
     (br,) = response.branches
-    integ = NonsmoothIntegrator(_system())
+    integ = ExactIntegrator(_system())
     rows = np.flatnonzero(br.matched)
     for i in rows[:: max(1, rows.size // 8)].tolist() + [int(rows[0]), int(rows[-1])]:
         w, z0 = float(br.omega[i]), br.states[i]
@@ -86,7 +86,7 @@ def _settles_on(system: NonsmoothSystem, primary, br, i: int) -> None:
     T = 2.0 * math.pi / w
     i1 = int(np.argmin(np.abs(np.where(primary.matched, primary.omega, np.inf) - w)))
     z = np.asarray(primary.states[i1], dtype=float) + np.array([1e-4, 0.0])
-    integ = NonsmoothIntegrator(system)
+    integ = ExactIntegrator(system)
     end = integ.propagate(z, 0.0, 300 * T, w).sample(np.array([300 * T]))  # whole periods: the phase is 0 again
     z = np.array([end[0][0], end[1][0]])
     tr = integ.propagate(z, 0.0, 2.0 * T, w)
@@ -151,7 +151,7 @@ def test_where_friction_sticks_the_branch_is_followed_by_exact_shooting():
     assert len(br) >= 3 and bool(np.all(br.matched)) and bool(np.all(np.isnan(br.rms_hb)))
     assert bool(np.all(br.stick_time > 0.0)) and bool(np.all(br.sticks >= 1))
     assert float(np.min(br.omega)) < 0.4225 and float(np.max(br.omega)) == pytest.approx(0.428)
-    integ = NonsmoothIntegrator(cfg.model)
+    integ = ExactIntegrator(cfg.model)
     for i in range(len(br)):  # each a genuine period-2 orbit
         T = 2.0 * math.pi / float(br.omega[i])
         d = integ.propagate(br.states[i], 0.0, 2.0 * T, float(br.omega[i])).sample(np.array([0.0, T, 2.0 * T]))[0]

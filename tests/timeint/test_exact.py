@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
-from rattle.timeint import ExactIntegrator, StageSolutions
+from rattle.timeint import ExactIntegrator, FlowOptions, StageSolutions
 
 
 def _model(elastic, *, damping=0.05, mean=0.05, amplitudes=(0.03,), phases=None, inertia=1.0, stiffness=1.0):
@@ -96,7 +96,7 @@ def test_bad_interval_and_state_are_refused():
     with pytest.raises(ValueError, match="`x0`"):
         integ.propagate((0.0, 0.0, 0.0), 0.0, 1.0, 1.0)
     with pytest.raises(ValueError, match="samples_per_scale"):
-        ExactIntegrator(reference_case(), samples_per_scale=2)
+        ExactIntegrator(reference_case(), FlowOptions(samples_per_scale=2))
 
 
 # --- linear law: closed forms -----------------------------------------------------------------------

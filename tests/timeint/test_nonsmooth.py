@@ -25,7 +25,7 @@ from rattle.model._discontinuous import (
 )
 from rattle.model._nonsmooth_system import NonsmoothSystem
 from rattle.timeint import ExactIntegrator
-from rattle.timeint import NonsmoothIntegrator, NonsmoothOptions, shoot_nonsmooth_orbit
+from rattle.timeint import ExactIntegrator, FlowOptions, shoot_nonsmooth_orbit
 
 
 # ---------------------------------------------------------------------------------------------
@@ -57,7 +57,7 @@ def _random_cases(n: int):
 @pytest.mark.parametrize("case", range(6))
 def test_random_cases_match_solve_ivp(case: int) -> None:
     sysx, x0, w = _random_cases(6)[case]
-    traj = NonsmoothIntegrator(sysx).propagate(x0, 0.0, 30.0, w)
+    traj = ExactIntegrator(sysx).propagate(x0, 0.0, 30.0, w)
     x_ref, t_ref, y_ref = _reference(sysx, x0, 30.0, w)
     d, v, _ = traj.sample(t_ref)
     # DOP853 at rtol 1e-12 with event location: its own error is ~1e-11 over 30 s
@@ -70,7 +70,7 @@ def test_random_cases_match_solve_ivp(case: int) -> None:
 def test_stick_phases_match_solve_ivp() -> None:
     # Friction on the reference clutch at low frequency: the orbit sticks and reverses.
     sysx = NonsmoothSystem.from_model(reference_case(), friction=Friction(levels=(0.005, 0.02, 0.005)))
-    traj = NonsmoothIntegrator(sysx).propagate((0.1, 0.05), 0.0, 40.0, 0.4)
+    traj = ExactIntegrator(sysx).propagate((0.1, 0.05), 0.0, 40.0, 0.4)
     assert {"stick", "unstick", "reversal", "crossing"} <= set(traj.event_kind)
     _, t_ref, y_ref = _reference(sysx, (0.1, 0.05), 40.0, 0.4)
     d, v, _ = traj.sample(t_ref)
@@ -82,20 +82,20 @@ def test_zero_preload_and_friction_recover_the_exact_integrator(omega: float) ->
     m = reference_case()
     ref = ExactIntegrator(m).propagate((0.1, 0.05), 0.0, 50.0, omega)
     for sysx in (NonsmoothSystem.from_model(m), NonsmoothSystem.from_model(m, friction=Friction(levels=0.0))):
-        traj = NonsmoothIntegrator(sysx).propagate((0.1, 0.05), 0.0, 50.0, omega)
+        traj = ExactIntegrator(sysx).propagate((0.1, 0.05), 0.0, 50.0, omega)
         assert np.array_equal(traj.state1, ref.state1)  # the same stage solutions and crossings
         np.testing.assert_allclose(traj.sensitivity, ref.sensitivity, rtol=0, atol=1e-13)
     # Preload(T_p = 0) is the linear law; T_p → 0 converges linearly to it
     lin = Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=Linear(), excitation=m.excitation)
     ref = ExactIntegrator(lin).propagate((0.1, 0.05), 0.0, 50.0, omega)
-    zero = NonsmoothIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=0.0)))
+    zero = ExactIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=0.0)))
     assert np.max(np.abs(zero.propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) < 1e-14
-    errs = [np.max(np.abs(NonsmoothIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=tp)))
+    errs = [np.max(np.abs(ExactIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=tp)))
                           .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for tp in (1e-6, 1e-7)]
     assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
     # r → 0 likewise on the clutch (the reversals' saltations vanish with r)
     ref = ExactIntegrator(m).propagate((0.1, 0.05), 0.0, 50.0, omega)
-    errs = [np.max(np.abs(NonsmoothIntegrator(NonsmoothSystem.from_model(m, friction=Friction(levels=r)))
+    errs = [np.max(np.abs(ExactIntegrator(NonsmoothSystem.from_model(m, friction=Friction(levels=r)))
                           .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for r in (1e-6, 1e-7)]
     assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
 
@@ -103,7 +103,7 @@ def test_zero_preload_and_friction_recover_the_exact_integrator(omega: float) ->
 def test_stuck_mass_stays_exactly_stuck_inside_the_band() -> None:
     # linear law, friction r = 0.1 > |F − k δ0| = |0.02 cos Ωt + 0.01 − 0.02| for all t
     sysx = _system(Linear(), Friction(levels=0.1), mean=0.01, amps=(0.02,))
-    traj = NonsmoothIntegrator(sysx).propagate((0.02, 0.0), 0.0, 100.0, 0.7)
+    traj = ExactIntegrator(sysx).propagate((0.02, 0.0), 0.0, 100.0, 0.7)
     assert traj.state1[0] == 0.02 and traj.state1[1] == 0.0
     assert traj.event_kind == () and traj.stick_time == 100.0
     d, v, a = traj.sample(np.linspace(0.0, 100.0, 501))
@@ -116,7 +116,7 @@ def test_stick_ends_when_the_force_leaves_the_band() -> None:
     # 0.2 cos Ωt − 0.15 = −0.1 → cos Ωt = 1/4, downwards
     w = 0.9
     sysx = _system(Linear(), Friction(levels=0.1), mean=0.0, amps=(0.2,))
-    traj = NonsmoothIntegrator(sysx).propagate((0.15, 0.0), 0.0, 6.0, w)
+    traj = ExactIntegrator(sysx).propagate((0.15, 0.0), 0.0, 6.0, w)
     assert traj.event_kind[0] == "unstick"
     t_exit = math.acos(0.25) / w
     assert abs(traj.event_time[0] - t_exit) < 1e-14 * 10
@@ -128,7 +128,7 @@ def test_preload_lock_and_release() -> None:
     # (F < −0.1) at Ω t = π/6 exactly.
     w = 0.8
     sysx = _system(Preload(preload=0.1), None, mean=0.0, amps=(0.2,), phases=(math.pi / 2,))
-    traj = NonsmoothIntegrator(sysx).propagate((0.0, 0.0), 0.0, 3.0, w)
+    traj = ExactIntegrator(sysx).propagate((0.0, 0.0), 0.0, 3.0, w)
     assert traj.kind[0] == 2 and traj.event_kind[0] == "unlock"
     assert abs(traj.event_time[0] - math.pi / 6 / w) < 1e-14
     assert traj.stage[1] == 0  # below the jump
@@ -140,7 +140,7 @@ def test_chattering_approach_to_the_lock_with_friction_is_zeno_and_snaps() -> No
     # |F| ≤ 0.03 < k T_p = 0.1: the spiral around (0, 0) loses a fixed fraction per crossing
     # (friction), accumulates in finite time and ends in the lock; afterwards δ ≡ 0.
     sysx = _system(Preload(preload=0.1), Friction(levels=0.01), mean=0.0, amps=(0.03,))
-    traj = NonsmoothIntegrator(sysx).propagate((0.05, 0.0), 0.0, 60.0, 0.8)
+    traj = ExactIntegrator(sysx).propagate((0.05, 0.0), 0.0, 60.0, 0.8)
     assert "lock" in traj.event_kind and traj.event_kind[-1] == "lock"
     # |δ'| at the successive crossings of δ = 0 falls by a nearly fixed factor (Zeno), down to the
     # round-off level of the excursions δ'²/(2|a|) ~ 1e-13 L, where the lock is entered
@@ -153,7 +153,7 @@ def test_chattering_approach_to_the_lock_with_friction_is_zeno_and_snaps() -> No
 
 def test_chatter_without_snap_runs_out_of_budget() -> None:
     sysx = _system(Preload(preload=0.1), None, mean=0.0, amps=(0.03,))
-    integ = NonsmoothIntegrator(sysx, NonsmoothOptions(lock_excursion=0.0, max_events=50))
+    integ = ExactIntegrator(sysx, FlowOptions(lock_excursion=0.0, max_events=50))
     with pytest.raises(ConvergenceError, match="max_events"):
         integ.propagate((0.05, 0.0), 0.0, 200.0, 0.8)
 
@@ -181,7 +181,7 @@ def test_monodromy_matches_finite_differences(case: str) -> None:
                            (0.1, 0.05), 1.5),
         "stick": (NonsmoothSystem.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))), (0.1, 0.05), 0.4),
     }[case]
-    integ = NonsmoothIntegrator(sysx)
+    integ = ExactIntegrator(sysx)
     T = 2 * math.pi / w * (2 if case == "stick" else 1)
     traj = integ.propagate(np.array(x0), 0.0, T, w)
     kinds = set(traj.event_kind)
@@ -205,7 +205,7 @@ def test_shooting_stick_slip_orbit_has_a_zero_multiplier() -> None:
     # stick removes velocity perturbations: rank-1 monodromy, one multiplier exactly 0
     assert abs(np.linalg.det(orbit.monodromy)) < 1e-15
     assert np.abs(orbit.multipliers[1]) < 1e-14
-    fd = _fd_sensitivity(NonsmoothIntegrator(sysx), orbit.state0, 2 * math.pi / 0.4, 0.4)
+    fd = _fd_sensitivity(ExactIntegrator(sysx), orbit.state0, 2 * math.pi / 0.4, 0.4)
     np.testing.assert_allclose(orbit.monodromy, fd, atol=1e-8)
     np.testing.assert_allclose(np.abs(orbit.multipliers[0]), np.abs(np.linalg.eigvals(fd)).max(), atol=1e-8)
 
@@ -215,12 +215,12 @@ def test_shooting_preload_orbit_is_periodic_with_exact_multipliers() -> None:
     orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
     assert orbit.converged
     T = 2 * math.pi / 0.8
-    again = NonsmoothIntegrator(sysx).propagate(orbit.state0, 0.0, T, 0.8)
+    again = ExactIntegrator(sysx).propagate(orbit.state0, 0.0, T, 0.8)
     assert np.max(np.abs(again.state1 - orbit.state0)) < 1e-12
     # det M = exp(−c T) · Π (a⁺/a⁻ of the v-reversals) = exp(−cT) here (no friction): a saltation
     # matrix of a δ-jump crossing has determinant 1
     assert abs(np.linalg.det(orbit.monodromy) - math.exp(-0.05 * T)) < 1e-12
-    fd = _fd_sensitivity(NonsmoothIntegrator(sysx), orbit.state0, T, 0.8)
+    fd = _fd_sensitivity(ExactIntegrator(sysx), orbit.state0, T, 0.8)
     np.testing.assert_allclose(orbit.monodromy, fd, atol=1e-8)
 
 
@@ -230,7 +230,7 @@ def test_energy_balance_with_friction_work() -> None:
     sysx = _system(Preload(preload=0.02, clearance=0.1), Friction(levels=(0.02, 0.03, 0.02)), mean=0.02,
                    amps=(0.06, 0.01))
     w = 0.3
-    traj = NonsmoothIntegrator(sysx).propagate((0.12, -0.03), 0.0, 40.0, w)
+    traj = ExactIntegrator(sysx).propagate((0.12, -0.03), 0.0, 40.0, w)
     assert {"stick", "crossing", "reversal"} <= set(traj.event_kind)
     power_in = traj.integrate(lambda t, d, v, a: sysx.excitation(t, w) * v)
     viscous = sysx.c * traj.integrate(lambda t, d, v, a: v * v)
@@ -303,7 +303,7 @@ def test_invalid_laws_are_refused() -> None:
     with pytest.raises(TypeError, match="`law`"):
         NonsmoothSystem(damping=0.1, stiffness=1.0, law=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,)))
     with pytest.raises(ValueError, match="`lock_excursion`"):
-        NonsmoothOptions(lock_excursion=-1.0)
+        FlowOptions(lock_excursion=-1.0)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -346,7 +346,7 @@ def test_random_trajectories_are_filippov_consistent(seed: int) -> None:
                    c=rng.uniform(0.02, 0.1), mean=rng.uniform(-0.3, 0.3) * tp, amps=(rng.uniform(0.6, 1.8) * tp,),
                    phases=(rng.uniform(0, 6),))
     w = rng.uniform(0.3, 1.5)
-    traj = NonsmoothIntegrator(sysx).propagate((rng.uniform(-0.2, 0.2), rng.uniform(-0.1, 0.1)), 0.0, 40.0, w)
+    traj = ExactIntegrator(sysx).propagate((rng.uniform(-0.2, 0.2), rng.uniform(-0.1, 0.1)), 0.0, 40.0, w)
     _check_filippov(traj, sysx, w)
     assert len(traj.event_time) > 2
     if seed >= 6:
@@ -358,7 +358,7 @@ def test_orbit_with_a_lock_phase_is_superstable() -> None:
     # accumulates (Zeno) into the lock; the lock erases every perturbation
     w = 0.3
     sysx = _system(Preload(preload=0.1), Friction(levels=0.02), mean=0.02, amps=(0.15,))
-    integ = NonsmoothIntegrator(sysx)
+    integ = ExactIntegrator(sysx)
     x = np.array([0.1, 0.0])
     for _ in range(5):
         x = integ.propagate(x, 0.0, 2 * math.pi / w, w).state1

@@ -9,7 +9,7 @@ import pytest
 from _systems import free_chain, grounded_chain
 
 import rattle
-from rattle.timeint import SystemIntegrator, shoot_periodic_orbit, shoot_system_orbit
+from rattle.timeint import ExactIntegrator, shoot_periodic_orbit, shoot_system_orbit
 
 
 def _rest(system):
@@ -41,7 +41,7 @@ def test_chain_orbit_is_periodic_and_its_multipliers_are_those_of_the_fd_monodro
     orbit = shoot_system_orbit(system, omega, _rest(system))
     assert orbit.converged and orbit.residual <= 1e-12
     T = 2 * math.pi / omega
-    integ = SystemIntegrator(system)
+    integ = ExactIntegrator(system)
     z1 = integ.propagate(orbit.state0, 0.0, T, omega).state1
     np.testing.assert_allclose(z1, orbit.state0, rtol=0, atol=1e-12 * max(1.0, np.abs(orbit.state0).max()))
     assert orbit.trajectory.crossing_times.size > 0
@@ -92,7 +92,7 @@ def test_sub_harmonic_period_and_argument_checks():
     with pytest.raises(ValueError, match="`tol`"):
         shoot_system_orbit(system, 1.0, _rest(system), tol=0.0)
     with pytest.raises(ValueError, match="`integrator`"):
-        shoot_system_orbit(system, 1.0, _rest(system), integrator=SystemIntegrator(free_chain()))
+        shoot_system_orbit(system, 1.0, _rest(system), integrator=ExactIntegrator(free_chain()))
     with pytest.raises(TypeError, match="`system`"):
         shoot_system_orbit(rattle.reference_case(), 1.0, [0.0, 0.0])
 

@@ -48,7 +48,7 @@ from ..hb import RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionOrbitResult, HeldLimitRecord
 from ..stability import regularised_system_multipliers
-from ..timeint import FLOW_FAILURES, FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
+from ..timeint import FLOW_FAILURES, ExactIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ._friction_response import (
     REPEAT_TOL,
     _departures,
@@ -81,7 +81,7 @@ def _check_x0(value: object, n: int) -> FloatArray:
     return z.copy()
 
 
-def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: FrictionIntegrator,
+def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: ExactIntegrator,
            hold: dict[int, float] | None = None, period: int = 1) -> tuple[FrictionOrbit | None, str]:
     """The exact orbit of ``period`` forcing periods from ``z0`` (``hold`` the elements held), or
     (None, why)."""
@@ -156,7 +156,7 @@ def friction_orbit(
     H, eps = opts.harmonics, opts.regularisation
     make = friction_balance_factory(system)
     problem = make(eps, H)  # raises on too few harmonics for the excitation
-    integ = FrictionIntegrator(system)
+    integ = ExactIntegrator(system)
     notes: list[str] = []
 
     # 1. the regularised HB at Ω
@@ -296,7 +296,7 @@ def _period_two(system: FrictionSystem, omega: float, options: RegularisationOpt
     one = friction_orbit(system, omega, options, x0=x0, every=False)  # validates every argument
     opts = chain_options(system) if options is None else options
     n = system.n
-    integ = FrictionIntegrator(system)
+    integ = ExactIntegrator(system)
     notes: list[str] = []
     seed, start = None, ""
     if one.converged and beyond_minus_one(one.multipliers):

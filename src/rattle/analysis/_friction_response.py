@@ -73,7 +73,7 @@ from ..hb import HBOptions, RegularisedSystemBalance
 from ..model import FrictionSystem
 from ..results import FrictionCheck
 from ..stability import regularised_system_multipliers
-from ..timeint import FrictionIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
+from ..timeint import ExactIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
 from ..timeint import CROSSING, FLOW_FAILURES, LOCK, STICK, monodromy_multipliers
 from ._exact_branch import ExactBranch, ShootingOptions, exact_branches
 from ._held_limit import held_limit
@@ -134,7 +134,7 @@ def friction_balance_factory(system: FrictionSystem, period: int = 1) -> Callabl
     return make
 
 
-def _hb_flow(integ: FrictionIntegrator, z0: FloatArray, omega: float, period: int = 1) -> FrictionTrajectory | None:
+def _hb_flow(integ: ExactIntegrator, z0: FloatArray, omega: float, period: int = 1) -> FrictionTrajectory | None:
     """``period`` forcing periods of the exact flow from the state ``z0`` at t = 0 (the HB orbit's,
     or a settled one); None when it cannot be followed (:data:`FLOW_FAILURES`)."""
     try:
@@ -216,7 +216,7 @@ def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], 
 
 
 def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], system: FrictionSystem,
-                    integ: FrictionIntegrator, omega: float, lad: RegularisationLimit, t: FloatArray,
+                    integ: ExactIntegrator, omega: float, lad: RegularisationLimit, t: FloatArray,
                     d_hb: FloatArray, size_hb: FloatArray, match: float) -> tuple[FrictionTrajectory, float] | None:
     """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` and its departure
     from that HB orbit (:func:`_held_scale`); None when the shooting fails. The departure is inf
@@ -299,7 +299,7 @@ def _damped_newton(pb: RegularisedSystemBalance, q: FloatArray, omega: float, it
 SETTLE_PERIODS = 40
 
 
-def _settled(integ: FrictionIntegrator, z0: FloatArray, omega: float, periods: int) -> FloatArray | None:
+def _settled(integ: ExactIntegrator, z0: FloatArray, omega: float, periods: int) -> FloatArray | None:
     """The state after ``periods`` forcing periods of the exact flow from ``z0``; None when the
     flow cannot be followed (:data:`FLOW_FAILURES`) or leaves the finite numbers."""
     T = 2.0 * math.pi / omega
@@ -325,7 +325,7 @@ def _exact_spectrum(pb: RegularisedSystemBalance, omega: float) -> FloatArray | 
     by simulating :data:`SETTLE_PERIODS` periods from the linear solution's state and shooting;
     None when that fails."""
     fs: FrictionSystem = pb.fsys
-    integ = FrictionIntegrator(fs)
+    integ = ExactIntegrator(fs)
     try:
         z = _settled(integ, pb.state_at_zero(pb.linear_solution(omega), omega), omega, SETTLE_PERIODS)
         if z is None:
@@ -420,7 +420,7 @@ def friction_response(
     stepper = ContinuationStepper(problem, start, lo, (lo, hi), options=continuation or ContinuationOptions(),
                                   newton=newton or NewtonOptions())
     points = stepper.run()
-    return check_branch(system, make, points, opts, FrictionIntegrator(system),
+    return check_branch(system, make, points, opts, ExactIntegrator(system),
                         status=stepper.status or Status.SUCCESS, message=stepper.message)
 
 
@@ -504,7 +504,7 @@ REPEAT_TOL = 1e-6
 
 
 def check_branch(system: FrictionSystem, make: Callable[[float, int], RegularisedSystemBalance],
-                 points: list, opts: RegularisationOptions, integ: FrictionIntegrator, *,  # type: ignore[type-arg]
+                 points: list, opts: RegularisationOptions, integ: ExactIntegrator, *,  # type: ignore[type-arg]
                  status: Status, message: str, branch: int = 0, origin: str = "") -> FrictionCheck:
     """The rows of a continued HB branch ``points`` (:class:`~rattle.continuation.ContinuationPoint`
     of ``make(ε, H)``'s problem, whose period p forcing periods is the orbits'), each checked by exact

@@ -42,7 +42,7 @@ from ..continuation import ContinuationOptions, NewtonOptions
 from ..errors import Status
 from ..model import FrictionSystem
 from ..results import FrictionCheck
-from ..timeint import FLOW_FAILURES, FrictionIntegrator, FrictionOrbit, shoot_friction_orbit
+from ..timeint import FLOW_FAILURES, ExactIntegrator, FrictionOrbit, shoot_friction_orbit
 from ._friction_response import (
     REPEAT_TOL,
     UNIT_TOL,
@@ -66,7 +66,7 @@ SEED_GAP = 1e-3
 EXACT_ITERATIONS = 20
 
 
-def period_two_orbit(system: FrictionSystem, integ: FrictionIntegrator, omega: float,
+def period_two_orbit(system: FrictionSystem, integ: ExactIntegrator, omega: float,
                      state: FloatArray) -> FrictionOrbit | None:
     """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``,
     one of whose multipliers lies near −1 (module docstring, step 1); None when every shot
@@ -129,7 +129,7 @@ def friction_subharmonics(
     opts2 = dataclasses.replace(opts, harmonics=H2, limit_harmonics=max(opts.limit_harmonics, H2),
                                 deep_harmonics=max(opts.deep_harmonics, H2))
     make2 = friction_balance_factory(system, period=2)
-    integ = FrictionIntegrator(system)
+    integ = ExactIntegrator(system)
     states = primary.states
 
     def seed(i: int) -> FrictionOrbit | None:
@@ -152,7 +152,7 @@ def friction_subharmonics(
     return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
-def _exact_branch(system: FrictionSystem, integ: FrictionIntegrator, seed: FrictionOrbit, omega: float,
+def _exact_branch(system: FrictionSystem, integ: ExactIntegrator, seed: FrictionOrbit, omega: float,
                   grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> FrictionCheck:
     """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
     ``grid`` each way by Newton shooting over two periods from the orbit at the previous frequency

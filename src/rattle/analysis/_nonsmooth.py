@@ -69,7 +69,7 @@ from ..model import Chain, FrictionSystem, NonsmoothSystem
 from ..results import FrequencyResponse, FrictionCheck, NonsmoothCheck
 from ..stability import regularised_multipliers
 from ..timeint import (
-    FLOW_FAILURES, NonsmoothIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
+    FLOW_FAILURES, ExactIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
     make_integrator, shoot_nonsmooth_orbit,
 )
 from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
@@ -91,7 +91,7 @@ def _rms(q: FloatArray, H: int) -> float:
     return math.sqrt(q[0] ** 2 + 0.5 * float(np.sum(q[1:] ** 2)))
 
 
-def _hb_flow(integ: NonsmoothIntegrator, state: tuple[float, float], omega: float,
+def _hb_flow(integ: ExactIntegrator, state: tuple[float, float], omega: float,
              period: int = 1) -> NonsmoothTrajectory | None:
     """One period p 2π/Ω of the exact flow from ``state`` (the HB orbit's at t = 0); None when it
     cannot be followed (the event budget of a chattering flow)."""
@@ -163,7 +163,7 @@ def _holds(flow: NonsmoothTrajectory | None, orbit: NonsmoothOrbit | None) -> bo
 
 
 def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: NonsmoothSystem,
-                    integ: NonsmoothIntegrator, omega: float, lad: RegularisationLimit,
+                    integ: ExactIntegrator, omega: float, lad: RegularisationLimit,
                     L: float) -> tuple[NonsmoothOrbit, float] | None:
     """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` (one that stayed
     on the row's orbit, :data:`LADDER_STEP_GUARD`) and its departure from that HB orbit, relative
@@ -473,7 +473,7 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
     problem = make(regularisation, harmonics)
     period = problem.period
     L = system.length_scale()
-    integ = NonsmoothIntegrator(system)
+    integ = ExactIntegrator(system)
     rows: dict[str, list] = {k: [] for k in _ROW_KEYS}
     ladders: dict[int, RegularisationLimit | None] = {}  # row: its ladder (None: it stalled)
 
@@ -565,7 +565,7 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
     )
 
 
-def _period_two_orbit(system: NonsmoothSystem, integ: NonsmoothIntegrator, omega: float,
+def _period_two_orbit(system: NonsmoothSystem, integ: ExactIntegrator, omega: float,
                       state: FloatArray) -> NonsmoothOrbit | None:
     """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``, one
     of whose multipliers lies near −1: shot over two forcing periods from the period-1 state pushed
@@ -642,7 +642,7 @@ def nonsmooth_subharmonics(
         raise TypeError(f"`options` must be a RegularisationOptions, got {opts!r}")
     make2 = balance_factory(system, period=2)
     H2 = 2 * opts.harmonics
-    integ = NonsmoothIntegrator(system)
+    integ = ExactIntegrator(system)
 
     def seed(i: int) -> NonsmoothOrbit | None:
         return _period_two_orbit(system, integ, float(primary.omega[i]), primary.states[i])
@@ -663,7 +663,7 @@ def nonsmooth_subharmonics(
     return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
-def _exact_branch(system: NonsmoothSystem, integ: NonsmoothIntegrator, seed: NonsmoothOrbit, omega: float,
+def _exact_branch(system: NonsmoothSystem, integ: ExactIntegrator, seed: NonsmoothOrbit, omega: float,
                   grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> NonsmoothCheck:
     """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
     ``grid`` each way by Newton shooting over two periods from the orbit at the previous

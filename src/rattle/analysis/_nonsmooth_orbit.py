@@ -37,7 +37,7 @@ from ..errors import ConvergenceError
 from ..hb import RegularisedBalance
 from ..model import FrictionSystem, NonsmoothSystem
 from ..results import FrictionOrbitResult, NonsmoothOrbitResult
-from ..timeint import FLOW_FAILURES, NonsmoothIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
+from ..timeint import FLOW_FAILURES, ExactIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
 from ._nonsmooth import RegularisationOptions, balance_factory
 from ._regularisation import regularisation_limit
 
@@ -56,7 +56,7 @@ def _hb_orbit(make: Callable[[float, int], RegularisedBalance], omega: float, q0
     return q, np.array([d0, v0])
 
 
-def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: NonsmoothIntegrator, period: int = 1,
+def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: ExactIntegrator, period: int = 1,
            max_iterations: int = 30) -> tuple[NonsmoothOrbit | None, str]:
     """The exact orbit of ``period`` forcing periods from ``x0``, or (None, why)."""
     try:
@@ -69,7 +69,7 @@ def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: Nonsmoo
     return orbit, ""
 
 
-def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: NonsmoothIntegrator,
+def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: ExactIntegrator,
                       period: int = 1, max_iterations: int = 30) -> tuple[NonsmoothOrbit | None, str]:
     """The exact flow run for :data:`SETTLE_PERIODS` orbit periods (× ``period`` forcing periods)
     from ``x0``, then shot over ``period`` forcing periods; or (None, why)."""
@@ -136,7 +136,7 @@ def nonsmooth_orbit(
         return _period_two(system, omega, opts, start_x)
     H, eps = opts.harmonics, opts.regularisation
     make = balance_factory(system)
-    integ = NonsmoothIntegrator(system)
+    integ = ExactIntegrator(system)
     notes: list[str] = []
     q: FloatArray | None = None
     hb_state = np.full(2, math.nan)
@@ -203,7 +203,7 @@ def _period_two(system: NonsmoothSystem, omega: float, opts: RegularisationOptio
     from ._nonsmooth import _period_two_orbit, _period_two_start, _repeats_early
     from ._period_two import beyond_minus_one
 
-    integ = NonsmoothIntegrator(system)
+    integ = ExactIntegrator(system)
     notes: list[str] = []
     one = nonsmooth_orbit(system, omega, opts, x0=x0, every=False)
     seed, start = None, ""

@@ -4,12 +4,11 @@
 An analysis on top of :mod:`rattle.timeint`: it runs the exact integrators and Newton shooting
 there and returns a :class:`~rattle.results.SteadyState` (whose ``status`` tells how it ended).
 
-One settling loop serves every system, on its exact integrator (:func:`make_integrator`): the
-single equation on :class:`ExactIntegrator` (state (δ, δ'), its fast scalar path), a chain on
-:class:`SystemIntegrator` (state z = (x, x') of its n coordinates; the scaled norm below then
+One settling loop serves every system, on its exact flow (:class:`ExactIntegrator`, which picks
+its path by the system: :func:`make_integrator`): the single equation with state (δ, δ') on the
+fast scalar path, a chain with state z = (x, x') of its n coordinates (the scaled norm below then
 takes every coordinate by the System's length scale and every velocity by that times ν,
-:func:`~rattle.timeint.state_scale`), the discontinuous laws on :class:`NonsmoothIntegrator`
-and :class:`FrictionIntegrator`; shooting is :meth:`ShootingProblem.solve` on the same exact
+:func:`~rattle.timeint.state_scale`), the discontinuous laws likewise; shooting is :meth:`ShootingProblem.solve` on the same exact
 flows.
 
 The state is integrated exactly (:class:`ExactIntegrator`) one forcing period T = 2π/Ω at a time,
@@ -67,9 +66,8 @@ from ..errors import ConvergenceError
 from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check_analysable_model
 from ..results import STEADY_METHODS as METHODS, SteadyState
 from ..timeint import (
-    ExactIntegrator, ExactMeasures, ExactTrajectory, FrictionIntegrator, FrictionTrajectory, NonsmoothIntegrator,
-    NonsmoothTrajectory, ShootingProblem, Shot, SystemIntegrator, SystemMeasures, built_for, check_system_state,
-    make_integrator,
+    ExactIntegrator, ExactMeasures, ExactTrajectory, FrictionTrajectory, NonsmoothTrajectory, ShootingProblem, Shot,
+    SystemMeasures, built_for, check_system_state, make_integrator,
 )
 
 _TWO_PI = 2.0 * math.pi
@@ -464,13 +462,13 @@ def static_state(model: Model | Chain | System | NonsmoothSystem | FrictionSyste
 
 def _checked_integrator(integrator: object, system: Model | System | NonsmoothSystem | FrictionSystem) -> Any:
     """``integrator``, or :func:`make_integrator` of ``system`` when None: refused (TypeError)
-    when not the exact integrator of ``system``'s kind, (ValueError) when built for another
+    when not an exact flow (:class:`ExactIntegrator`), (ValueError) when built for another
     system."""
     integ = make_integrator(system) if integrator is None else integrator
     if not built_for(integ, system):
-        kind = type(make_integrator(system)).__name__ if integrator is not None else ""
-        if not isinstance(integ, type(make_integrator(system))):
-            raise TypeError(f"`integrator` must be a {kind} for a {type(system).__name__}, got {integrator!r}")
+        if not isinstance(integ, ExactIntegrator):
+            raise TypeError(f"`integrator` must be an ExactIntegrator built for the {type(system).__name__}, "
+                            f"got {integrator!r}")
         raise ValueError(f"`integrator` was built for a different {'model' if isinstance(system, Model) else 'system'} "
                          "than `model`")
     return integ
@@ -483,7 +481,7 @@ def steady_state(
     x0: FloatArray | tuple[float, float] | None = None,
     *,
     options: SteadyStateOptions | None = None,
-    integrator: ExactIntegrator | SystemIntegrator | NonsmoothIntegrator | FrictionIntegrator | None = None,
+    integrator: ExactIntegrator | None = None,
 ) -> SteadyState:
     """Steady motion reached from ``x0`` at the forcing frequency ``omega``, and its period.
 
@@ -492,17 +490,17 @@ def steady_state(
     scaled ``tolerance``; with ``accelerate`` the settling is shortened by Newton shooting,
     accepting only the stable orbit the simulation is seen to converge to (module docstring).
 
-    The single equation δ'' + c δ' + k f(δ) = F(t) (a :class:`~rattle.model.Model`) runs on
-    :class:`ExactIntegrator`, state (δ, δ'); a :class:`~rattle.model.Chain` (or a bare
-    :class:`~rattle.model.System`) on :class:`SystemIntegrator`, state z = (x, x') of its n
-    coordinates, with the measures of every clearance element (the flat fields: the first).
+    Every system runs on its exact flow (:class:`ExactIntegrator`): the single equation
+    δ'' + c δ' + k f(δ) = F(t) (a :class:`~rattle.model.Model`) with state (δ, δ') on the scalar
+    path; a :class:`~rattle.model.Chain` (or a bare :class:`~rattle.model.System`) with state
+    z = (x, x') of its n coordinates, with the measures of every clearance element (the flat
+    fields: the first).
 
-    The discontinuous laws run on their event-driven exact integrators, the same loop on top:
+    The discontinuous laws run on the event-driven paths of the same flow, the same loop on top:
     δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (a :class:`~rattle.model.NonsmoothSystem`: jumps
-    and Coulomb friction, Filippov sticking, locks at jumps) on :class:`NonsmoothIntegrator`,
-    state (δ, δ'), scaled by (L, L ν); a chain with friction x'' + C x' + K x + Σ_e b_e [f_e(δ_e)
-    + r_e(δ_e) sgn δ_e'] = F(t) (a :class:`~rattle.model.FrictionSystem`) on
-    :class:`FrictionIntegrator`, state (x, x'), with the measures of every element. Their shooting
+    and Coulomb friction, Filippov sticking, locks at jumps), state (δ, δ'), scaled by (L, L ν);
+    a chain with friction x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t) (a
+    :class:`~rattle.model.FrictionSystem`), state (x, x'), with the measures of every element. Their shooting
     uses the exact monodromy with the saltation matrices (a stick or lock phase gives an exact
     zero multiplier, a stable direction); the measures come from the exact trajectories, the
     extremes of δ'' with their one-sided values at the switchings.
@@ -518,7 +516,7 @@ def steady_state(
         x'_n) for a chain; default the static equilibrium at rest.
     options : SteadyStateOptions, optional
         Tolerances and budget (default ``SteadyStateOptions()``).
-    integrator : ExactIntegrator, SystemIntegrator, NonsmoothIntegrator or FrictionIntegrator, optional
+    integrator : ExactIntegrator, optional
         The exact integrator of ``model`` (:func:`make_integrator`; reuse one across calls to
         share its cache).
 

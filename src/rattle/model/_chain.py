@@ -99,7 +99,7 @@ class Element:
 
     A chain with friction or a torque jump on any element is solved on
     :meth:`Chain.friction_system` (:func:`rattle.frequency_response`, the exact flow of
-    :class:`rattle.timeint.FrictionIntegrator`); the smooth analyses refuse it."""
+    :class:`rattle.timeint.ExactIntegrator`); the smooth analyses refuse it."""
 
     name: str
     between: tuple[int, int]

@@ -9,10 +9,11 @@ The steady state of a simulation with period detection is an analysis built on t
 from typing import Any
 
 from ._exact import ExactIntegrator, ExactMeasures, ExactTrajectory, StageSolutions, StateSamples, Trajectory
-from ._flow import SystemIntegrator, SystemMeasures, SystemSamples, SystemTrajectory, check_system_state
+from ._exact_flow import FlowOptions
+from ._flow import SystemMeasures, SystemSamples, SystemTrajectory, check_system_state
 from ._general import GeneralSolution, integrate_general
-from ._friction_chain import CROSSING, LOCK, STICK, FrictionIntegrator, FrictionTrajectory
-from ._nonsmooth import NonsmoothIntegrator, NonsmoothOptions, NonsmoothTrajectory
+from ._friction_chain import CROSSING, LOCK, STICK, FrictionTrajectory
+from ._nonsmooth import NonsmoothTrajectory
 from ._shooting_problem import (
     FLOW_FAILURES, ShootingProblem, Shot, built_for, make_integrator, monodromy_multipliers, state_scale,
 )
@@ -22,13 +23,13 @@ from ._shooting import (
 )
 
 __all__ = [
-    "ExactIntegrator", "ExactTrajectory", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
+    "ExactIntegrator", "FlowOptions", "ExactTrajectory", "Trajectory", "StateSamples", "ExactMeasures", "StageSolutions",
     "ShootingOrbit", "shoot_periodic_orbit", "ShootingProblem", "monodromy_multipliers", "FLOW_FAILURES",
     "Shot", "ShotOrbit", "state_scale", "make_integrator", "built_for", "check_system_state",
     "integrate_general", "GeneralSolution",
-    "SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
-    "NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
-    "FrictionIntegrator", "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit",
+    "SystemTrajectory", "SystemSamples", "SystemMeasures", "SystemOrbit", "shoot_system_orbit",
+    "NonsmoothOrbit", "NonsmoothTrajectory", "shoot_nonsmooth_orbit",
+    "FrictionOrbit", "FrictionTrajectory", "shoot_friction_orbit",
     "CROSSING", "LOCK", "STICK",  # the segment kinds of a FrictionTrajectory
 ]
 
@@ -40,7 +41,20 @@ _MOVED: dict[str, str] = {
 }
 
 
+#: The per-system integrator classes folded into the one flow :class:`ExactIntegrator` (issue
+#: 23), and their options: still served here, with a DeprecationWarning, as that class (which
+#: picks the path by the system) and :class:`FlowOptions`.
+_FOLDED = {"SystemIntegrator": "ExactIntegrator", "NonsmoothIntegrator": "ExactIntegrator",
+           "FrictionIntegrator": "ExactIntegrator", "NonsmoothOptions": "FlowOptions"}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _FOLDED:
+        import warnings
+
+        warnings.warn(f"`rattle.timeint.{name}` is deprecated; use `rattle.timeint.{_FOLDED[name]}` (the one exact "
+                      "flow of every system and its options)", DeprecationWarning, stacklevel=2)
+        return globals()[_FOLDED[name]]
     if name in _MOVED:
         import importlib
         import warnings

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .._typing import FloatArray
-from ._roots import bracketed_newton, vector_bracketed_newton
+from ._roots import bracketed_newton, grid_chunk, resolve_cell, vector_bracketed_newton
 from ._stage_flow import Segment
 
 _EPS = float(np.finfo(float).eps)
@@ -41,10 +41,8 @@ def first_exit(
     tau_a = 0.0
     chunk = _FIRST_CHUNK
     while tau_a < tau_end:
-        n = max(1, min(chunk, math.ceil((tau_end - tau_a) / step)))
-        taus = tau_a + step * np.arange(n + 1)
-        if n < chunk or taus[-1] >= tau_end:
-            taus[-1] = tau_end
+        taus = grid_chunk(tau_a, tau_end, step, chunk)
+        n = taus.size - 1
         d, v = seg.scan(taus)
         D = d[1:]
         outside = (D >= hi) | (D < lo)  # (n, m)
@@ -94,57 +92,15 @@ def _resolve_cell(
     d_a: float, d_b: float, v_a: float, v_b: float, at_start: bool,
 ) -> tuple[float, int] | None:
     """The exit of element ``e`` from its stage inside the grid cell [tau_a, tau_b], if any:
-    (τ, direction); None when δ_e stays inside or only grazes a breakpoint (an excursion beyond
-    it below round-off)."""
+    (τ, direction); None when δ_e stays inside or only grazes a breakpoint (:func:`resolve_cell`
+    on δ_e, its round-off floor raised by that of the bounds)."""
 
     def state(tau: float) -> tuple[float, float, float]:
         return seg.element_point(tau, e)
 
-    def velocity_and_acceleration(tau: float) -> tuple[float, float]:
-        _, v, a = state(tau)
-        return v, a
-
     d_floor, v_floor = seg.element_floors(e)
     d_floor += 8.0 * _EPS * max(abs(lo) if math.isfinite(lo) else 0.0, abs(hi) if math.isfinite(hi) else 0.0)
-    tol = 4.0 * _EPS * tau_b + 1e-300
-    end_up, end_down = d_b >= hi, d_b < lo
-    if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):
-        tau_e = tau_b if v_b == 0.0 else bracketed_newton(
-            velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol, v_floor)
-        d_e = state(tau_e)[0]
-        if v_a > 0.0:  # a maximum
-            if d_e - hi > d_floor or end_up:
-                up, a_, b_, d_a_, d_b_ = True, tau_a, tau_e, d_a, d_e
-            elif end_down:
-                up, a_, b_, d_a_, d_b_ = False, tau_e, tau_b, d_e, d_b
-            else:
-                return None
-        else:  # a minimum
-            if lo - d_e > d_floor or end_down:
-                up, a_, b_, d_a_, d_b_ = False, tau_a, tau_e, d_a, d_e
-            elif end_up:
-                up, a_, b_, d_a_, d_b_ = True, tau_e, tau_b, d_e, d_b
-            else:
-                return None
-    elif end_up or end_down:
-        up, a_, b_, d_a_, d_b_ = end_up, tau_a, tau_b, d_a, d_b
-    else:
-        return None
-    bound = hi if up else lo
-    fa, fb = d_a_ - bound, d_b_ - bound
-    tau_c = a_
-    if (fa >= 0.0) if up else (fa < 0.0):
-        if at_start and a_ == 0.0:
-            fa = -1e-300 if up else 1e-300  # the segment start is inside by construction
-        else:
-            return tau_c, (1 if up else -1)  # round-off at a graze: the crossing is at the bracket's start
-
-    def gap(tau: float) -> tuple[float, float]:
-        d, v, _ = state(tau)
-        return d - bound, v
-
-    tau_c = bracketed_newton(gap, a_, b_, fa, fb, tol, d_floor)
-    return tau_c, (1 if up else -1)
+    return resolve_cell(state, lo, hi, tau_a, tau_b, d_a, d_b, v_a, v_b, at_start, d_floor, v_floor)
 
 
 __all__ = ["first_exit", "bracketed_newton", "vector_bracketed_newton"]

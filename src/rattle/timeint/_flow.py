@@ -28,6 +28,7 @@ from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError
 from ..model import System
 from ._events import first_exit, vector_bracketed_newton
+from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._stage_flow import Segment, SystemStages
 
@@ -313,30 +314,16 @@ class SystemTrajectory(ExactTrajectory):
 # ---------------------------------------------------------------------------------------------
 # Integrator
 # ---------------------------------------------------------------------------------------------
-class SystemIntegrator:
-    """Exact integrator of a :class:`~rattle.model.System` (module docstring).
+class _StageFlow(ExactIntegrator, for_system=System):
+    """The stage-matrix path of :class:`~rattle.timeint.ExactIntegrator`: a
+    :class:`~rattle.model.System` with continuous laws (module docstring); the grid of
+    ``options.samples_per_scale`` points per fastest time scale of a stage combination brackets
+    the crossings, ``options.max_events`` is the budget of segments of one ``propagate`` call
+    (exceeded: ``ConvergenceError``)."""
 
-    Parameters
-    ----------
-    system
-        The equations of motion.
-    samples_per_scale
-        Grid points per fastest time scale of a stage combination used to bracket crossings (≥ 8).
-    max_segments
-        Budget of segments of one ``propagate`` call; exceeding it raises ``ConvergenceError``.
-    """
-
-    def __init__(self, system: System, *, samples_per_scale: int = 40, max_segments: int = 1_000_000) -> None:
-        if not isinstance(system, System):
-            raise TypeError(f"`system` must be a rattle.model.System, got {system!r}")
-        for name, value, low in (("samples_per_scale", samples_per_scale, 8), ("max_segments", max_segments, 1)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise TypeError(f"`{name}` must be an integer, got {value!r}")
-            if value < low:
-                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-        self.system = system
-        self.samples_per_scale = int(samples_per_scale)
-        self.max_segments = int(max_segments)
+    def __init__(self, system: System, options: FlowOptions | None = None) -> None:
+        super().__init__(system, options)
+        self.max_segments = self.options.budget(events=False)
         self._cache: tuple[float, SystemStages] | None = None
         self._modal: dict = {}  # stage combination -> its Ω-independent modal form (SystemStages)
 
@@ -435,4 +422,4 @@ class SystemIntegrator:
 
 
 
-__all__ = ["SystemIntegrator", "SystemTrajectory", "SystemSamples", "SystemMeasures", "check_system_state"]
+__all__ = ["SystemTrajectory", "SystemSamples", "SystemMeasures", "check_system_state"]

@@ -86,9 +86,10 @@ from .._validate import check_omega
 from ..errors import ConvergenceError
 from ..model import FrictionSystem, ReducedElement, System
 from ._events import first_exit
+from ._roots import grid_chunk, polish_crossing
+from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
-from ._nonsmooth import NonsmoothOptions
 from ._stage_flow import Segment, StageSolution, SystemStages
 
 _EPS = float(np.finfo(float).eps)
@@ -290,18 +291,15 @@ class FrictionTrajectory(ExactTrajectory):
         return np.unique(self.event_values[sel])
 
 
-class FrictionIntegrator:
-    """Exact event-driven integrator of a :class:`~rattle.model.FrictionSystem` (module
-    docstring); ``options`` the event grid and budget (:class:`~rattle.timeint.NonsmoothOptions`:
-    ``samples_per_scale``, ``max_events``)."""
+class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
+    """The stage-matrix path of :class:`~rattle.timeint.ExactIntegrator` with the Filippov
+    events: a :class:`~rattle.model.FrictionSystem` (module docstring); ``options`` the event
+    grid, budget and lock snap (:class:`~rattle.timeint.FlowOptions`)."""
 
-    def __init__(self, system: FrictionSystem, options: NonsmoothOptions | None = None) -> None:
-        if not isinstance(system, FrictionSystem):
-            raise TypeError(f"`system` must be a rattle.model.FrictionSystem, got {system!r}")
-        if options is not None and not isinstance(options, NonsmoothOptions):
-            raise TypeError(f"`options` must be a NonsmoothOptions, got {options!r}")
-        self.fsys = system
-        self.options = NonsmoothOptions() if options is None else options
+    def __init__(self, system: FrictionSystem, options: FlowOptions | None = None) -> None:
+        super().__init__(system, options)
+        self.max_events = self.options.budget(events=True)
+        system = self.system  # a Chain's reduced form
         base = system.system
         self.base = base
         self.n, self.m = base.n, base.m
@@ -344,7 +342,7 @@ class FrictionIntegrator:
         flow = self._flows.get(key)
         if flow is None:
             cache = self._modal.setdefault(key, {}) if self.base.load is None else None
-            flow = SystemStages(self._mode_system(key, omega), omega, self.options.samples_per_scale, modal_cache=cache)
+            flow = SystemStages(self._mode_system(key, omega), omega, self.samples_per_scale, modal_cache=cache)
             self._flows[key] = flow
         return flow
 
@@ -353,7 +351,7 @@ class FrictionIntegrator:
         of the free chain (its highest natural frequency), over ``samples_per_scale`` — a stuck
         mode's own time scale can be far longer than that of the torque that must hold it."""
         fast = max(float(omega) * max(self.base.forced_harmonics, 1), self._wn)
-        return 2.0 * math.pi / fast / self.options.samples_per_scale
+        return 2.0 * math.pi / fast / self.samples_per_scale
 
     @staticmethod
     def _solution(flow: SystemStages, key: _Key, stages: tuple[int, ...]) -> StageSolution:
@@ -498,7 +496,7 @@ class FrictionIntegrator:
         z1, M = self._march(z, t0, t1, omega, rec)
         ts = np.asarray(rec["ts"], dtype=float)
         return FrictionTrajectory(
-            system=self.fsys, omega=omega, t0=t0, t1=t1, state0=z, state1=z1, sensitivity=M, t_start=ts,
+            system=self.system, omega=omega, t0=t0, t1=t1, state0=z, state1=z1, sensitivity=M, t_start=ts,
             t_end=np.append(ts[1:], t1), stages=np.asarray(rec["st"], dtype=np.int64).reshape(-1, self.m),
             stuck=np.asarray(rec["sk"], dtype=bool).reshape(-1, self.m), segments=tuple(rec["seg"]),
             event_times=np.asarray(rec["et"], dtype=float), event_elements=np.asarray(rec["ee"], dtype=np.int64),
@@ -595,7 +593,7 @@ class FrictionIntegrator:
                 z = zc
                 continue
             events += 1
-            if events > self.options.max_events:
+            if events > self.max_events:
                 raise ConvergenceError(self._budget_message(t0, t1, last))
             a = self.A[e_ev]
             phi_minus = self._field(key, stages, t, zc, omega)
@@ -711,27 +709,13 @@ class FrictionIntegrator:
     def _crossing_time(self, seg: Segment, e: int, direction: int, lo: FloatArray, hi: FloatArray,
                        stages: tuple[int, ...], tau: float, tau_max: float) -> float:
         """The time ``tau`` of element ``e``'s crossing of its stage bound (``hi`` upwards, ``lo``
-        downwards), polished (:meth:`_polish_crossing`) where the field jumps there: a jump of
+        downwards), polished (:func:`~._roots.polish_crossing`) where the field jumps there: a jump of
         the law or a change of friction level."""
         i_bp = stages[e] if direction > 0 else stages[e] - 1
         if self.jumps[e][i_bp] > 0.0 or self.levels[e][i_bp] != self.levels[e][i_bp + 1]:
-            return self._polish_crossing(seg, e, float(hi[e] if direction > 0 else lo[e]), tau, tau_max)
-        return tau
-
-    def _polish_crossing(self, seg: Segment, e: int, bound: float, tau: float, tau_max: float) -> float:
-        """The crossing time of a breakpoint where the field jumps, polished by Newton steps on
-        δ_e(τ) − d to the last bit: an error dτ there becomes an error (a⁺ − a⁻) dτ in δ_e'."""
-        tp = tau
-        for _ in range(3):
-            dd, vv, _ = seg.element_point(tp, e)
-            if vv == 0.0:
-                break
-            dt = (dd - bound) / vv
-            tp -= dt
-            if abs(dt) <= 2.0 * _EPS * abs(tp):
-                break
-        if 0.0 < tp <= tau_max and abs(tp - tau) <= 1e-6 * max(tau, 1e-300) + 1e-12:
-            return tp
+            polished = polish_crossing(lambda x: seg.element_point(x, e), float(hi[e] if direction > 0 else lo[e]),
+                                       tau, tau_max)
+            return tau if polished is None else polished
         return tau
 
     def _lock_entry(self, t: float, z: FloatArray, e: int, i: int, stages: tuple[int, ...], key: _Key,
@@ -757,7 +741,7 @@ class FrictionIntegrator:
 
     def _budget_message(self, t0: float, t1: float, last: tuple[int, int, float]) -> str:
         e, kind, value = last
-        base = f"more than `max_events` = {self.options.max_events} events between t0 = {t0!r} and t1 = {t1!r}"
+        base = f"more than `max_events` = {self.max_events} events between t0 = {t0!r} and t1 = {t1!r}"
         if kind == CROSSING and e >= 0:
             i = int(np.searchsorted(self.breakpoints[e], value))
             r = self.levels[e]
@@ -766,8 +750,8 @@ class FrictionIntegrator:
                 return (f"{base}: element {name!r} chatters into a lock at the jump of its law at δ = {value:g} "
                         "without friction there (its crossings decay only exponentially, at about a third of the "
                         "damping rate; the lock is reached when an excursion falls below `lock_excursion`); raise "
-                        "NonsmoothOptions(max_events=...) or `lock_excursion`, or shorten the interval")
-        return f"{base} (stick–slip chatter?): raise NonsmoothOptions(max_events=...) or shorten the interval"
+                        "FlowOptions(max_events=...) or `lock_excursion`, or shorten the interval")
+        return f"{base} (stick–slip chatter?): raise FlowOptions(max_events=...) or shorten the interval"
 
     def _friction_event(self, seg: Segment, sol: StageSolution, key: _Key, stages: tuple[int, ...],
                         tau_end: float, omega: float,
@@ -795,10 +779,7 @@ class FrictionIntegrator:
         sg = np.array([sigma[e] for e in slip], dtype=float)
         tau_a = 0.0
         while tau_a < tau_end:
-            k = max(1, min(_CHUNK, math.ceil((tau_end - tau_a) / step)))
-            taus = tau_a + step * np.arange(k + 1)
-            if k < _CHUNK or taus[-1] >= tau_end:
-                taus[-1] = tau_end
+            taus = grid_chunk(tau_a, tau_end, step, _CHUNK)
             z, zd = seg.state(taus)
             best = (math.inf, -1, -1, 0)
             if slip:
@@ -881,4 +862,4 @@ class FrictionIntegrator:
         return None
 
 
-__all__ = ["EVENT_NAMES", "FrictionIntegrator", "FrictionTrajectory"]
+__all__ = ["EVENT_NAMES", "FrictionTrajectory"]

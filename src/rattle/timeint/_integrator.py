@@ -1,23 +1,12 @@
-"""Exact integrator of the single equation for continuous piecewise-linear laws.
+"""The compiled scalar path of the exact flow (:class:`~rattle.timeint.ExactIntegrator`): the single
+equation δ'' + c δ' + k f(δ) = F(t) (c = C/I, k = K/I) for continuous piecewise-linear laws.
 
-The equation (c = C/I, k = K/I)
-
-    δ'' + c δ' + k f(δ) = F(t) = F_m + Σ_n F_pn cos(n Ω t + φ_n)
-
-is linear on every stage j of the law, f(δ) = s_j δ + e_j:
-
-    δ'' + c δ' + k s_j δ = F(t) − k e_j.
-
-Its solution from a state x_s = (δ_s, δ'_s) at time t_s is, with τ = t − t_s,
-
-    x(t) = p(t) + Φ_j(τ) (x_s − p(t_s)),      Φ_j(τ) = exp(A_j τ),  A_j = [[0, 1], [−k s_j, −c]],
-
-where p is a particular solution: the constant (F_m − k e_j)/(k s_j) (a ramp ((F_m − k e_j)/c) τ on a
-zero-stiffness stage with c > 0, a parabola ½ (F_m − k e_j) τ² when also c = 0) plus
-Re[X_jn e^{i n Ω t}], X_jn = F_pn e^{iφ_n} / (k s_j − (nΩ)² + i c nΩ) for every harmonic. Φ_j is
-written in closed form (under-, critically and over-damped, zero stiffness), so nothing here is
-approximated: the only numerical step is locating the times where δ(t) reaches a breakpoint,
-which is done to round-off.
+On every stage j of the law, f(δ) = s_j δ + e_j, the equation is linear and its solution from a
+state x_s = (δ_s, δ'_s) at t_s is x(t) = p(t) + Φ_j(τ) (x_s − p(t_s)), Φ_j(τ) = exp(A_j τ),
+τ = t − t_s, in closed form (:mod:`._stage_solutions`), so nothing here is approximated: the only
+numerical step is locating the times where δ(t) reaches a breakpoint, which is done to
+round-off. The segment is evaluated in modal form with Python floats (:class:`_Segment`), the
+one-coordinate, one-element fast path.
 
 Crossings are bracketed on a grid of ``samples_per_scale`` points per fastest time scale of the
 stage (the period of the highest forcing harmonic, the stage's natural period and the damping
@@ -42,7 +31,8 @@ from .._typing import FloatArray
 from .._validate import check_state
 from ..errors import ConvergenceError
 from ..model import Model, transition_scalar
-from ._roots import bracketed_newton
+from ._exact_flow import ExactIntegrator, FlowOptions
+from ._roots import grid_chunk, resolve_cell
 from ._stage_solutions import StageSolutions
 from ._trajectory import Trajectory
 
@@ -131,31 +121,17 @@ class _Segment:
 # ---------------------------------------------------------------------------------------------
 # Integrator
 # ---------------------------------------------------------------------------------------------
-class ExactIntegrator:
-    """Exact integrator of δ'' + c δ' + k f(δ) = F(t) for a model with a continuous
-    piecewise-linear law (see the module docstring).
+class _ScalarFlow(ExactIntegrator, for_system=Model):
+    """The compiled scalar path of :class:`~rattle.timeint.ExactIntegrator`: δ'' + c δ' + k f(δ) = F(t)
+    for a model with a continuous piecewise-linear law (see the module docstring); the grid of
+    ``options.samples_per_scale`` points per fastest time scale of a stage brackets the crossings,
+    ``options.max_events`` is the budget of segments of one ``propagate`` call (exceeded:
+    ``ConvergenceError``)."""
 
-    Parameters
-    ----------
-    model
-        The model (c = C/I, k = K/I, law f, excitation F).
-    samples_per_scale
-        Grid points per fastest time scale of a stage used to bracket crossings (≥ 8).
-    max_segments
-        Budget of segments of one ``propagate`` call; exceeding it raises ``ConvergenceError``.
-    """
-
-    def __init__(self, model: Model, *, samples_per_scale: int = 40, max_segments: int = 1_000_000) -> None:
-        if not isinstance(model, Model):
-            raise TypeError(f"`model` must be a rattle Model, got {model!r}")
-        for name, value, low in (("samples_per_scale", samples_per_scale, 8), ("max_segments", max_segments, 1)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise TypeError(f"`{name}` must be an integer, got {value!r}")
-            if value < low:
-                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-        self.model = model
-        self.samples_per_scale = int(samples_per_scale)
-        self.max_segments = int(max_segments)
+    def __init__(self, system: Model, options: FlowOptions | None = None) -> None:
+        super().__init__(system, options)
+        self.model = self.system
+        self.max_segments = self.options.budget(events=False)
         self._cache: tuple[float, StageSolutions] | None = None
 
     def solutions(self, omega: float) -> StageSolutions:
@@ -256,10 +232,8 @@ class ExactIntegrator:
             tau_a = 0.0
             chunk = _FIRST_CHUNK
             while tau_a < tau_end:
-                n = max(1, min(chunk, math.ceil((tau_end - tau_a) / step)))
-                taus = tau_a + step * np.arange(n + 1)  # the cell starts, then the last end
-                if n < chunk or taus[-1] >= tau_end:
-                    taus[-1] = tau_end
+                taus = grid_chunk(tau_a, tau_end, step, chunk)  # the cell starts, then the last end
+                n = taus.size - 1
                 d, v = seg.scan(taus)
                 if lo == -math.inf:
                     outside = d[1:] >= hi
@@ -297,55 +271,12 @@ class ExactIntegrator:
     ) -> tuple[float, int, float, float] | None:
         """The exit from the segment's stage inside the grid cell [tau_a, tau_b], if any:
         (τ, stage entered, δ, δ' there); None when δ stays inside or only grazes a breakpoint
-        (an excursion beyond it below round-off)."""
-        state = seg.state
-
-        def velocity_and_acceleration(tau: float) -> tuple[float, float]:
-            _, v, a = state(tau)
-            return v, a
-
-        tol = 4.0 * _EPS * tau_b + 1e-300
-        end_up, end_down = d_b >= hi, d_b < lo
-        if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):
-            # δ has an extremum in the cell: refine it (a tangential touch may hide inside).
-            tau_e = tau_b if v_b == 0.0 else bracketed_newton(
-                velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol, seg.v_floor)
-            d_e = state(tau_e)[0]
-            graze = seg.d_floor
-            if v_a > 0.0:  # a maximum: beyond hi, cross before it; else maybe down after it
-                if d_e - hi > graze or end_up:
-                    up, a_, b_, d_a_, d_b_ = True, tau_a, tau_e, d_a, d_e
-                elif end_down:
-                    up, a_, b_, d_a_, d_b_ = False, tau_e, tau_b, d_e, d_b
-                else:
-                    return None
-            else:  # a minimum
-                if lo - d_e > graze or end_down:
-                    up, a_, b_, d_a_, d_b_ = False, tau_a, tau_e, d_a, d_e
-                elif end_up:
-                    up, a_, b_, d_a_, d_b_ = True, tau_e, tau_b, d_e, d_b
-                else:
-                    return None
-        elif end_up or end_down:
-            up, a_, b_, d_a_, d_b_ = end_up, tau_a, tau_b, d_a, d_b
-        else:
+        (:func:`~._roots.resolve_cell` on the segment's modal form)."""
+        hit = resolve_cell(seg.state, lo, hi, tau_a, tau_b, d_a, d_b, v_a, v_b, at_start, seg.d_floor, seg.v_floor)
+        if hit is None:
             return None
-        bound = hi if up else lo
-        fa, fb = d_a_ - bound, d_b_ - bound
-        if (fa >= 0.0) if up else (fa < 0.0):
-            if not (at_start and a_ == 0.0):
-                tau_c = a_  # round-off at a graze: the crossing is at the bracket's start
-            else:
-                fa = -1e-300 if up else 1e-300  # the segment start is inside by construction
-        if (fa < 0.0) if up else (fa >= 0.0):
-
-            def gap(tau: float) -> tuple[float, float]:
-                d, v, _ = state(tau)
-                return d - bound, v
-
-            tau_c = bracketed_newton(gap, a_, b_, fa, fb, tol, seg.d_floor)
-        _, v_c, _ = state(tau_c)
-        return tau_c, seg.j + 1 if up else seg.j - 1, bound, v_c
+        tau_c, direction = hit
+        return tau_c, seg.j + direction, hi if direction > 0 else lo, seg.state(tau_c)[1]
 
 
-__all__ = ["ExactIntegrator"]
+__all__: list[str] = []

@@ -58,9 +58,10 @@ from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import NonsmoothSystem, Stages
-from ._integrator import ExactIntegrator, _Segment
+from ._exact_flow import ExactIntegrator, FlowOptions
+from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
-from ._roots import bracketed_newton
+from ._roots import bracketed_newton, grid_chunk, polish_crossing
 from ._stage_solutions import StageSolutions
 
 _EPS = float(np.finfo(float).eps)
@@ -72,48 +73,8 @@ _KIND_NAMES = ("slip", "stick", "lock")
 
 
 def _chunk(start: float, end: float, step: float) -> FloatArray:
-    """The grid points of the next at most ``_CHUNK`` cells of width ``step`` from ``start``, the
-    last one placed exactly on ``end`` when the chunk reaches it."""
-    n = max(1, min(_CHUNK, math.ceil((end - start) / step)))
-    pts = start + step * np.arange(n + 1)
-    if pts[-1] >= end or n < _CHUNK:
-        pts[-1] = end
-    return pts
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class NonsmoothOptions:
-    """``samples_per_scale`` grid points per fastest time scale to bracket events (≥ 8);
-    ``max_events`` the budget of one integration (exceeded: ``ConvergenceError``);
-    ``lock_excursion`` the excursion beyond a jump (relative to the system's length scale L)
-    below which a crossing of a jump whose lock band holds F snaps into the lock: the chatter
-    around a lock is followed crossing by crossing until its excursions δ'²/(2|a|) reach this
-    (default 1e-13, a few hundred ulps: round-off level); 0 never snaps (the chatter is then
-    followed to ``max_events``)."""
-
-    samples_per_scale: int = 40
-    max_events: int = 200_000
-    lock_excursion: float = 1e-13
-
-    def __post_init__(self) -> None:
-        for name, value, low in (("samples_per_scale", self.samples_per_scale, 8), ("max_events", self.max_events, 1)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise TypeError(f"`{name}` must be an integer, got {value!r}")
-            if value < low:
-                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
-        lv = self.lock_excursion
-        if isinstance(lv, bool) or not isinstance(lv, (int, float)) or not (math.isfinite(lv) and 0.0 <= lv < 1.0):
-            raise ValueError(f"`lock_excursion` must be a number in [0, 1) (relative to the length scale), got {lv!r}")
-
-
-class _Search(ExactIntegrator):
-    """The δ-crossing search of :class:`ExactIntegrator` (``_first_exit``), on the mode table."""
-
-    def __init__(self, samples_per_scale: int, max_events: int) -> None:  # no model: only the search is used
-        self.model = None
-        self.samples_per_scale = samples_per_scale
-        self.max_segments = max_events
-        self._cache = None
+    """The next at most ``_CHUNK`` cells of the event grid (:func:`~._roots.grid_chunk`)."""
+    return grid_chunk(start, end, step, _CHUNK)
 
 
 def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: int) -> StageSolutions:
@@ -332,24 +293,21 @@ class NonsmoothTrajectory(ExactTrajectory):
         return np.unique(np.asarray(hit, dtype=float))
 
 
-#: Frequencies whose stage solutions :meth:`NonsmoothIntegrator.solutions` keeps.
+#: Frequencies whose stage solutions :meth:`_ScalarEventFlow.solutions` keeps.
 SOLUTION_CACHE = 4
 
 
-class NonsmoothIntegrator:
-    """Event-driven exact integrator of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (module
-    docstring) for a :class:`~rattle.model._nonsmooth_system.NonsmoothSystem`."""
+class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
+    """The scalar path of :class:`~rattle.timeint.ExactIntegrator` with events: δ'' + c δ' +
+    k [f(δ) + r(δ) sgn δ'] = F(t) (module docstring) for a
+    :class:`~rattle.model.NonsmoothSystem`; the δ-crossings by the scalar path's own search
+    (``_first_exit`` on the mode table)."""
 
-    def __init__(self, system: NonsmoothSystem, options: NonsmoothOptions | None = None) -> None:
-        if not isinstance(system, NonsmoothSystem):
-            raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
-        options = NonsmoothOptions() if options is None else options
-        if not isinstance(options, NonsmoothOptions):
-            raise TypeError(f"`options` must be NonsmoothOptions, got {options!r}")
-        self.system = system
-        self.options = options
-        self._search = _Search(options.samples_per_scale, options.max_events)
-        self._cache: dict[float, StageSolutions] = {}
+    def __init__(self, system: NonsmoothSystem, options: FlowOptions | None = None) -> None:
+        ExactIntegrator.__init__(self, system, options)
+        self.model = None  # the modes' table stands for the model (:meth:`solutions`)
+        self.max_segments = self.options.budget(events=True)
+        self._solution_cache: dict[float, StageSolutions] = {}
         st = system.law.stages
         self._d = st.breakpoints.tolist()
         self._s = st.slopes.tolist()
@@ -360,13 +318,13 @@ class NonsmoothIntegrator:
     def solutions(self, omega: float) -> StageSolutions:
         """The closed-form solutions of every mode at ``omega`` (the last :data:`SOLUTION_CACHE`
         frequencies cached: a shooting continuation evaluates the period map at Ω and at Ω + h)."""
-        sol = self._cache.get(omega)
+        sol = self._solution_cache.get(omega)
         if sol is not None:
             return sol
-        sol = _mode_solutions(self.system, omega, self.options.samples_per_scale)
-        if len(self._cache) >= SOLUTION_CACHE:
-            del self._cache[next(iter(self._cache))]
-        self._cache[float(omega)] = sol
+        sol = _mode_solutions(self.system, omega, self.samples_per_scale)
+        if len(self._solution_cache) >= SOLUTION_CACHE:
+            del self._solution_cache[next(iter(self._solution_cache))]
+        self._solution_cache[float(omega)] = sol
         return sol
 
     def velocity_scale(self, omega: float) -> float:
@@ -419,7 +377,7 @@ class NonsmoothIntegrator:
         t0, t1 = check_interval(t0, t1, omega)
         sol = self.solutions(omega)
         rec: dict[str, list] = {k: [] for k in ("t", "kind", "stage", "sign", "x", "h", "et", "ek")}
-        d, v, M = self._march(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
+        d, v, M = self._march_events(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
         t_start = np.asarray(rec["t"], dtype=float)
         return NonsmoothTrajectory(
             system=self.system, omega=omega, t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
@@ -437,7 +395,7 @@ class NonsmoothIntegrator:
         return traj.state1, (traj.sensitivity if sensitivity else None)
 
     # --- the march ---------------------------------------------------------------------------
-    def _march(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
+    def _march_events(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
                rec: dict[str, list]) -> tuple[float, float, tuple[float, float, float, float]]:
         k, c = self.system.k, self.system.c
         kind, j, sigma = self._classify(sol, t0, d, v)
@@ -458,7 +416,7 @@ class NonsmoothIntegrator:
                 self._record(rec, t, SLIP, j, sigma, d, v, (seg.h0, seg.h1))
                 tau_end = t1 - t
                 tau_v = self._first_stop(sol, seg, sigma, tau_end) if sigma != 0 else None
-                tau_c, j_new, _, v_c = self._search._first_exit(seg, tau_end if tau_v is None else tau_v)
+                tau_c, j_new, _, v_c = self._first_exit(seg, tau_end if tau_v is None else tau_v)
                 tau = tau_c if j_new >= 0 else (tau_end if tau_v is None else tau_v)
                 m_before = (m11, m12, m21, m22)
                 f11, f12, f21, f22 = sol.transition_scalar(mode, tau)
@@ -478,17 +436,8 @@ class NonsmoothIntegrator:
                         # The field jumps here: an error dτ of the crossing time becomes an error
                         # (a⁺ − a⁻) dτ of δ'. The search stops at |δ − d_i| ≤ its round-off floor;
                         # polish τ by Newton steps on δ(τ) − d_i to the last bit.
-                        tau_p = tau_c
-                        for _ in range(3):
-                            dd, vv, _ = seg.state(tau_p)
-                            if vv == 0.0:
-                                break
-                            dt = (dd - d) / vv
-                            tau_p -= dt
-                            if abs(dt) <= 2.0 * _EPS * abs(tau_p):
-                                break
-                        tau_max = tau_end if tau_v is None else tau_v
-                        if 0.0 < tau_p <= tau_max and abs(tau_p - tau_c) <= 1e-6 * max(tau_c, 1e-300) + 1e-12:
+                        tau_p = polish_crossing(seg.state, d, tau_c, tau_end if tau_v is None else tau_v)
+                        if tau_p is not None:
                             t = t - tau + tau_p
                             tau = tau_p
                             _, v_c, _ = seg.state(tau)
@@ -548,9 +497,9 @@ class NonsmoothIntegrator:
                     self._event(rec, t, "unlock")
                 kind, v = SLIP, 0.0
             n_events += 1
-            if n_events > self.options.max_events:
+            if n_events > self.max_segments:
                 raise ConvergenceError(
-                    f"more than `max_events` = {self.options.max_events} switching events between t0 = {t0!r} "
+                    f"more than `max_events` = {self.max_segments} switching events between t0 = {t0!r} "
                     f"and t1 = {t1!r} (a chattering approach to a lock?): raise `max_events` or `lock_excursion`, "
                     "or shorten the interval")
 
@@ -578,7 +527,7 @@ class NonsmoothIntegrator:
         m = seg.j
         step = float(sol.grid_step[m])
         if not math.isfinite(step):
-            step = max(tau_end, 1e-300) / self.options.samples_per_scale
+            step = max(tau_end, 1e-300) / self.samples_per_scale
         c, ks, ke = sol.c, float(sol.ks[m]), float(sol.ke[m])
 
         def vel(tau: float) -> tuple[float, float]:
@@ -642,7 +591,7 @@ class NonsmoothIntegrator:
         if sol.nw.size == 0:
             F = sol.mean
             return (None, False) if lo <= F <= hi else (t0, F > hi)
-        step = 2.0 * math.pi / float(np.max(sol.nw)) / self.options.samples_per_scale
+        step = 2.0 * math.pi / float(np.max(sol.nw)) / self.samples_per_scale
         tol = 4.0 * _EPS * max(abs(t1), 1.0)
 
         def g_up(t: float) -> tuple[float, float]:
@@ -693,4 +642,4 @@ class NonsmoothIntegrator:
         return None, False
 
 
-__all__ = ["NonsmoothIntegrator", "NonsmoothOptions", "NonsmoothTrajectory"]
+__all__ = ["NonsmoothTrajectory"]

@@ -1,9 +1,12 @@
-"""Root finding shared by the exact integrators: Newton's method safeguarded by bisection on a
-bracket, one root at a time (the crossing search's hot loop, Python floats) or many at once
-(extrema of a trajectory's measures, numpy)."""
+"""Root finding shared by every path of the exact flow: Newton's method safeguarded by bisection on
+a bracket, one root at a time (the crossing search's hot loop, Python floats) or many at once
+(extrema of a trajectory's measures, numpy); the event grid's chunks (:func:`grid_chunk`), a
+crossing inside one grid cell, grazing-safe (:func:`resolve_cell`), and the polish of a crossing
+where the field jumps (:func:`polish_crossing`)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -78,4 +81,97 @@ def vector_bracketed_newton(
     return x
 
 
-__all__ = ["bracketed_newton", "vector_bracketed_newton"]
+_EPS = float(np.finfo(float).eps)
+
+
+def grid_chunk(start: float, end: float, step: float, cells: int) -> FloatArray:
+    """The grid points of the next at most ``cells`` cells of width ``step`` from ``start`` (the
+    event grid is scanned a chunk at a time), the last one placed exactly on ``end`` when the
+    chunk reaches it."""
+    n = max(1, min(cells, math.ceil((end - start) / step)))
+    pts = start + step * np.arange(n + 1)
+    if n < cells or pts[-1] >= end:
+        pts[-1] = end
+    return pts
+
+
+def resolve_cell(
+    state: Callable[[float], tuple[float, float, float]], lo: float, hi: float, tau_a: float, tau_b: float,
+    d_a: float, d_b: float, v_a: float, v_b: float, at_start: bool, d_floor: float, v_floor: float,
+) -> tuple[float, int] | None:
+    """The exit of a deflection δ(τ) from its stage [lo, hi) inside the grid cell [tau_a, tau_b],
+    if any: (τ, direction +1 up / −1 down); None when δ stays inside or only grazes a breakpoint
+    (an excursion beyond it of at most ``d_floor``, its round-off floor).
+
+    ``state(τ)`` = (δ, δ', δ''); d_a, d_b, v_a, v_b the grid values of δ and δ' at the cell's
+    ends. An extremum of δ inside the cell (δ' changes sign) is located first (Newton on δ' to
+    ``v_floor``), so a trajectory touching a breakpoint tangentially inside a cell is not
+    missed; the crossing is then bracketed on the side of the extremum where δ passes the bound
+    and located by Newton on δ − bound to its round-off floor. ``at_start``: the cell starts at
+    the segment's start, which is inside the stage by construction whatever round-off says.
+    """
+    tol = 4.0 * _EPS * tau_b + 1e-300
+    end_up, end_down = d_b >= hi, d_b < lo
+    if v_a != 0.0 and (v_a > 0.0) != (v_b > 0.0):
+
+        def velocity_and_acceleration(tau: float) -> tuple[float, float]:
+            _, v, a = state(tau)
+            return v, a
+
+        tau_e = tau_b if v_b == 0.0 else bracketed_newton(
+            velocity_and_acceleration, tau_a, tau_b, v_a, v_b, tol, v_floor)
+        d_e = state(tau_e)[0]
+        if v_a > 0.0:  # a maximum: beyond hi, cross before it; else maybe down after it
+            if d_e - hi > d_floor or end_up:
+                up, a_, b_, d_a_, d_b_ = True, tau_a, tau_e, d_a, d_e
+            elif end_down:
+                up, a_, b_, d_a_, d_b_ = False, tau_e, tau_b, d_e, d_b
+            else:
+                return None
+        else:  # a minimum
+            if lo - d_e > d_floor or end_down:
+                up, a_, b_, d_a_, d_b_ = False, tau_a, tau_e, d_a, d_e
+            elif end_up:
+                up, a_, b_, d_a_, d_b_ = True, tau_e, tau_b, d_e, d_b
+            else:
+                return None
+    elif end_up or end_down:
+        up, a_, b_, d_a_, d_b_ = end_up, tau_a, tau_b, d_a, d_b
+    else:
+        return None
+    bound = hi if up else lo
+    fa, fb = d_a_ - bound, d_b_ - bound
+    if (fa >= 0.0) if up else (fa < 0.0):
+        if not (at_start and a_ == 0.0):
+            return a_, (1 if up else -1)  # round-off at a graze: the crossing is at the bracket's start
+        fa = -1e-300 if up else 1e-300  # the segment start is inside by construction
+
+    def gap(tau: float) -> tuple[float, float]:
+        d, v, _ = state(tau)
+        return d - bound, v
+
+    return bracketed_newton(gap, a_, b_, fa, fb, tol, d_floor), (1 if up else -1)
+
+
+def polish_crossing(state: Callable[[float], tuple[float, float, float]], bound: float, tau: float,
+                    tau_max: float) -> float | None:
+    """The crossing time ``tau`` of δ(τ) = ``bound`` where the field jumps (a jump of the law, a
+    change of friction level), polished by up to three Newton steps on δ(τ) − bound to the last
+    bit: an error dτ there becomes an error (a⁺ − a⁻) dτ of δ'. ``state(τ)`` = (δ, δ', δ'');
+    the polished time, or None when it leaves (0, ``tau_max``] or moves by more than a relative
+    1e-6 of ``tau`` (then ``tau`` stands)."""
+    tp = tau
+    for _ in range(3):
+        dd, vv, _ = state(tp)
+        if vv == 0.0:
+            break
+        dt = (dd - bound) / vv
+        tp -= dt
+        if abs(dt) <= 2.0 * _EPS * abs(tp):
+            break
+    if 0.0 < tp <= tau_max and abs(tp - tau) <= 1e-6 * max(tau, 1e-300) + 1e-12:
+        return tp
+    return None
+
+
+__all__ = ["bracketed_newton", "grid_chunk", "polish_crossing", "resolve_cell", "vector_bracketed_newton"]

@@ -32,14 +32,14 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from .._validate import check_omega, check_shooting, check_state
 from ..model import FrictionSystem, Model, NonsmoothSystem, System
-from ._flow import SystemIntegrator, SystemMeasures, SystemTrajectory, check_system_state
-from ._friction_chain import FrictionIntegrator, FrictionTrajectory
-from ._nonsmooth import NonsmoothIntegrator, NonsmoothTrajectory
+from ._flow import SystemMeasures, SystemTrajectory, check_system_state
+from ._friction_chain import FrictionTrajectory
+from ._nonsmooth import NonsmoothTrajectory
 from ._shooting_problem import (
     FLOW_FAILURES, ShootingProblem, Shot, built_for, make_integrator, monodromy_multipliers, state_scale,
 )
 from ._trajectory import Trajectory
-from ._integrator import ExactIntegrator
+from ._exact_flow import ExactIntegrator
 
 _MAX_HALVINGS = 12
 
@@ -231,7 +231,7 @@ def shoot_system_orbit(
     period: int = 1,
     tol: float = 1e-12,
     max_iterations: int = 50,
-    integrator: SystemIntegrator | None = None,
+    integrator: ExactIntegrator | None = None,
 ) -> SystemOrbit:
     """Periodic orbit of a System through Newton shooting on the exact flow.
 
@@ -251,7 +251,7 @@ def shoot_system_orbit(
     max_iterations
         Newton iteration budget.
     integrator
-        The :class:`SystemIntegrator` to use (default: one with default settings).
+        The :class:`ExactIntegrator` to use (default: one with default settings).
 
     Returns
     -------
@@ -263,9 +263,9 @@ def shoot_system_orbit(
     omega = check_omega(omega)
     z = check_system_state(z0, system.n)
     check_shooting(period, tol, max_iterations)
-    integ = SystemIntegrator(system) if integrator is None else integrator
-    if not isinstance(integ, SystemIntegrator):
-        raise TypeError(f"`integrator` must be a SystemIntegrator or None, got {integrator!r}")
+    integ = ExactIntegrator(system) if integrator is None else integrator
+    if not isinstance(integ, ExactIntegrator):
+        raise TypeError(f"`integrator` must be an ExactIntegrator or None, got {integrator!r}")
     if integ.system is not system:
         raise ValueError("`integrator` was built for a different system than `system`")
     shot = _solve(system, integ, omega, z, period, tol, max_iterations)
@@ -297,7 +297,7 @@ class NonsmoothOrbit(ShotOrbit):
 
 def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray | tuple[float, float], *,
                           period: int = 1, tol: float = 1e-12, max_iterations: int = 50,
-                          integrator: NonsmoothIntegrator | None = None) -> NonsmoothOrbit:
+                          integrator: ExactIntegrator | None = None) -> NonsmoothOrbit:
     """Periodic orbit of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) by Newton shooting: r(x0) =
     φ(x0; 0 → T) − x0 = 0 with the Jacobian M − I, M the exact monodromy (stage transition and
     saltation matrices). The residual is scaled by (L, L ν) (:func:`~rattle.timeint.state_scale`).
@@ -306,8 +306,8 @@ def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray 
         raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
     omega = check_omega(omega)
     check_shooting(period, tol, max_iterations)
-    integ = NonsmoothIntegrator(system) if integrator is None else integrator
-    if integ.system != system:
+    integ = ExactIntegrator(system) if integrator is None else integrator
+    if not built_for(integ, system):
         raise ValueError("`integrator` was built for a different system than `system`")
     if integ.system is not system:  # an equal system: the problem checks identity
         system = integ.system
@@ -331,7 +331,7 @@ class FrictionOrbit(ShotOrbit):
 
 def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *, period: int = 1,
                          tol: float = 1e-12, max_iterations: int = 50,
-                         integrator: FrictionIntegrator | None = None,
+                         integrator: ExactIntegrator | None = None,
                          hold: dict[int, float] | None = None) -> FrictionOrbit:
     """Periodic orbit of the chain with friction by Newton shooting: r(z0) = φ(z0; 0 → T) − z0 = 0
     with the Jacobian M − I (M the exact monodromy with saltation matrices), steps halved until
@@ -347,8 +347,8 @@ def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *
         raise TypeError(f"`system` must be a FrictionSystem, got {system!r}")
     omega = check_omega(omega)
     check_shooting(period, tol, max_iterations)
-    integ = FrictionIntegrator(system) if integrator is None else integrator
-    if integ.fsys is not system:
+    integ = ExactIntegrator(system) if integrator is None else integrator
+    if not isinstance(integ, ExactIntegrator) or integ.system is not system:
         raise ValueError("`integrator` was built for a different system than `system`")
     z = check_system_state(z0, system.n).copy()
     n = system.n

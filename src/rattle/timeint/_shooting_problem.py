@@ -57,10 +57,9 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..errors import RattleError
 from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System
-from ._flow import SystemIntegrator
-from ._friction_chain import FrictionIntegrator
-from ._integrator import ExactIntegrator
-from ._nonsmooth import NonsmoothIntegrator
+from . import _flow, _friction_chain, _nonsmooth  # noqa: F401  (the paths register themselves)
+from ._exact_flow import ExactIntegrator
+from ._integrator import _ScalarFlow
 
 #: What an exact flow or its shooting raises when it cannot follow the motion (the event budget
 #: of a chatter, a loop of stuck elements, a singular step; numpy's LinAlgError is a ValueError):
@@ -75,13 +74,6 @@ REUSE_DISTANCE = 1e-4
 
 Shootable = Model | System | NonsmoothSystem | FrictionSystem
 
-#: The exact integrator of each kind of system, and the attribute naming the system it was built for.
-_INTEGRATORS: tuple[tuple[type, type, str], ...] = (
-    (Model, ExactIntegrator, "model"), (System, SystemIntegrator, "system"),
-    (NonsmoothSystem, NonsmoothIntegrator, "system"), (FrictionSystem, FrictionIntegrator, "fsys"),
-)
-
-
 def monodromy_multipliers(M: FloatArray) -> ComplexArray:
     """The Floquet multipliers: the eigenvalues of the monodromy matrix ``M``, largest modulus
     first (a stable sort: equal moduli keep the solver's order)."""
@@ -89,27 +81,15 @@ def monodromy_multipliers(M: FloatArray) -> ComplexArray:
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
-def make_integrator(system: Shootable | Chain) -> Any:
-    """The exact integrator of ``system`` with default settings: :class:`ExactIntegrator` for the
-    single equation (its compiled scalar path), :class:`SystemIntegrator` for a smooth System (a
-    Chain: of its System), :class:`NonsmoothIntegrator` or :class:`FrictionIntegrator` for the
-    discontinuous laws (reuse it across calls to share its cache)."""
-    if isinstance(system, Chain):
-        system = system.system()
-    for kind, integ, _ in _INTEGRATORS:
-        if isinstance(system, kind):
-            return integ(system)
-    raise TypeError("`system` must be a rattle Model, Chain, System, NonsmoothSystem or FrictionSystem, "
-                    f"got {system!r}")
+def make_integrator(system: Shootable | Chain) -> ExactIntegrator:
+    """The exact flow of ``system`` with default settings, ``ExactIntegrator(system)`` (a Chain:
+    of its System; reuse it across calls to share its cache)."""
+    return ExactIntegrator(system)
 
 
 def built_for(integrator: object, system: Shootable) -> bool:
-    """True when ``integrator`` is the exact integrator of ``system``'s kind and was built for it."""
-    for kind, integ, owner in _INTEGRATORS:
-        if isinstance(system, kind):
-            own = getattr(integrator, owner, None)
-            return isinstance(integrator, integ) and (own is system or bool(own == system))
-    return False
+    """True when ``integrator`` is an exact flow built for ``system``."""
+    return isinstance(integrator, ExactIntegrator) and integrator.built_for(system)
 
 
 def _scales(system: Shootable) -> tuple[int, float, float]:
@@ -179,7 +159,7 @@ class ShootingProblem:
         self.integrator = integ
         self._smooth = isinstance(system, System)
         # the flows whose record costs next to nothing: their Newton iterates are recorded as they go
-        self._records = isinstance(integ, (ExactIntegrator, NonsmoothIntegrator))
+        self._records = isinstance(integ, _ScalarFlow)
         n, L, omega_s = _scales(system)
         self.n = n
         self._L = L

@@ -1,0 +1,160 @@
+"""The one exact flow of every rattle system: :class:`ExactIntegrator` and its options.
+
+Every equation of motion rattle integrates is, between events, linear with constant
+coefficients, z' = A_s z + g_s(t), so the flow from (t_0, z_0) is written in closed form,
+z(t) = p_s(t) + exp(A_s (t − t_0)) (z_0 − p_s(t_0)); the only numerical steps are locating the
+events (an element's deflection reaching a breakpoint; with friction a velocity zero or a held
+torque leaving its band) to round-off, and the sensitivity ∂z(t1)/∂z(t0) is the product of the
+transition matrices exp(A_s τ) and, where the field jumps, the saltation matrices
+S = I + (φ⁺ − φ⁻) nᵀ / (nᵀ φ⁻).
+
+``ExactIntegrator(system)`` takes any system and picks the path that computes this flow fastest
+(the class it returns is a private subclass, so ``isinstance(integ, ExactIntegrator)`` holds):
+
+=====================================  =========================================================
+system                                 path (module)
+=====================================  =========================================================
+:class:`~rattle.model.Model`           the compiled scalar path: one coordinate, one element,
+                                       modal closed form (:mod:`._integrator`)
+:class:`~rattle.model.NonsmoothSystem`  the same scalar path with the Filippov events: jumps,
+                                       stick, slip, lock (:mod:`._nonsmooth`)
+:class:`~rattle.model.System`,         the stage-matrix path: n coordinates, m elements,
+:class:`~rattle.model.Chain`           continuous laws (:mod:`._flow`)
+:class:`~rattle.model.FrictionSystem`  the stage-matrix path with the Filippov events and the
+                                       active-set choice of the held elements
+                                       (:mod:`._friction_chain`)
+=====================================  =========================================================
+
+All answer ``advance(z0, t0, t1, Ω, sensitivity)`` → (z1, ∂z1/∂z0) (the period map of a
+shooting, no record) and ``propagate(z0, t0, t1, Ω)`` → an
+:class:`~rattle.timeint.ExactTrajectory` (``states(t)``, ``measures()``); ``system`` is the
+system the flow was built for (:func:`~rattle.timeint.built_for`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..model import Chain
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FlowOptions:
+    """Settings of the exact flow.
+
+    ``samples_per_scale`` grid points per fastest time scale to bracket events (≥ 8);
+    ``max_events`` the budget of events (segments) of one integration, exceeded:
+    ``ConvergenceError`` (None: 1 000 000 on a continuous law, whose only events are crossings;
+    200 000 with jumps or friction, where a chatter must be stopped sooner);
+    ``lock_excursion`` the excursion beyond a jump (relative to the system's length scale L)
+    below which a crossing of a jump whose lock band holds the torque snaps into the lock: the
+    chatter around a lock is followed crossing by crossing until its excursions δ'²/(2|a|) reach
+    this (default 1e-13, a few hundred ulps: round-off level); 0 never snaps (the chatter is then
+    followed to ``max_events``). Continuous laws have no locks and ignore it."""
+
+    samples_per_scale: int = 40
+    max_events: int | None = None
+    lock_excursion: float = 1e-13
+
+    def __post_init__(self) -> None:
+        for name, value, low in (("samples_per_scale", self.samples_per_scale, 8), ("max_events", self.max_events, 1)):
+            if value is None and name == "max_events":
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+                raise TypeError(f"`{name}` must be an integer, got {value!r}")
+            if value < low:
+                raise ValueError(f"`{name}` must be >= {low}, got {value!r}")
+        lv = self.lock_excursion
+        if isinstance(lv, bool) or not isinstance(lv, (int, float)) or not (math.isfinite(lv) and 0.0 <= lv < 1.0):
+            raise ValueError(f"`lock_excursion` must be a number in [0, 1) (relative to the length scale), got {lv!r}")
+
+    def budget(self, events: bool) -> int:
+        """``max_events``, or its default for a flow with (``events``) or without jumps/friction."""
+        if self.max_events is not None:
+            return int(self.max_events)
+        return 200_000 if events else 1_000_000
+
+
+def _reduced(system: Any) -> Any:
+    """A :class:`~rattle.model.Chain`'s reduced form: its FrictionSystem when it has friction or a
+    torque jump on an element, else its System; any other object as it is."""
+    if isinstance(system, Chain):
+        return system.friction_system() if system.discontinuous else system.system()
+    return system
+
+
+class ExactIntegrator:
+    """The exact flow of ``system`` (module docstring): a :class:`~rattle.model.Model`,
+    :class:`~rattle.model.Chain`, :class:`~rattle.model.System`,
+    :class:`~rattle.model.NonsmoothSystem` or :class:`~rattle.model.FrictionSystem`.
+
+    Parameters
+    ----------
+    system
+        The equations of motion (a Chain: its System, or its FrictionSystem when an element has
+        friction or a torque jump).
+    options
+        :class:`FlowOptions` (the event grid, the event budget, the lock snap).
+
+    Attributes
+    ----------
+    system
+        The system the flow was built for.
+    options
+        The :class:`FlowOptions`.
+    """
+
+    #: The kind of system each path takes, in the order they are tried (filled by the paths).
+    _PATHS: ClassVar[list[tuple[type, type]]] = []
+    #: The kind of system this path takes (set on the path's class).
+    _for: ClassVar[type | None] = None
+
+    system: Any
+    options: FlowOptions
+
+    def __init_subclass__(cls, /, for_system: type | None = None, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if for_system is not None:
+            cls._for = for_system
+            ExactIntegrator._PATHS.append((for_system, cls))
+
+    def __new__(cls, system: Any = None, options: FlowOptions | None = None) -> ExactIntegrator:
+        if cls is not ExactIntegrator:  # a path itself (or unpickling one: no arguments)
+            return super().__new__(cls)
+        system = _reduced(system)
+        for kind, path in ExactIntegrator._PATHS:
+            if isinstance(system, kind):
+                return super().__new__(path)
+        raise TypeError("`system` must be a rattle Model, Chain, System, NonsmoothSystem or FrictionSystem, "
+                        f"got {system!r}")
+
+    def __init__(self, system: Any, options: FlowOptions | None = None) -> None:
+        system = _reduced(system)
+        if self._for is None or not isinstance(system, self._for):
+            raise TypeError(f"`system` must be a {getattr(self._for, '__name__', 'rattle system')}, got {system!r}")
+        if options is not None and not isinstance(options, FlowOptions):
+            raise TypeError(f"`options` must be a FlowOptions (or None), got {options!r}")
+        self.system = system
+        self.options = FlowOptions() if options is None else options
+        self.samples_per_scale = int(self.options.samples_per_scale)
+
+    def built_for(self, system: Any) -> bool:
+        """True when this flow was built for ``system`` (the same object, or an equal one)."""
+        return isinstance(system, self._for) and (self.system is system or bool(self.system == system))
+
+    def advance(self, z0: Any, t0: float, t1: float, omega: float,
+                sensitivity: bool = True) -> tuple[Any, Any]:  # pragma: no cover - every path defines it
+        """The state at ``t1`` and ∂z(t1)/∂z(t0) (None when ``sensitivity`` is False, where the
+        path can skip it) from ``z0`` at ``t0``: no record kept, no checks."""
+        raise NotImplementedError
+
+    def propagate(self, z0: Any, t0: float, t1: float, omega: float) -> Any:  # pragma: no cover
+        """The exact trajectory from ``z0`` at ``t0`` to ``t1`` ≥ t0 at forcing frequency ``omega``."""
+        raise NotImplementedError
+
+
+__all__ = ["ExactIntegrator", "FlowOptions"]
