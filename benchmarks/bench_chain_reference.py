@@ -7,7 +7,7 @@ grounded two-inertia system with a clutch element, the three-inertia free drivel
 four-stage clutch damper and gear backlash) over whole frequency ranges:
 
 * special points: ``rattle.frequency_response`` (H harmonics) against the exact reference of
-  ``tests/_exact_branch.py`` (shooting continuation on the exact flow of ``SystemIntegrator``,
+  ``tests/_exact_branch.py`` (shooting continuation on the exact flow of ``rattle.timeint.ExactIntegrator``,
   every change of stability located by Brent to 1e-11, hidden-pair guard) — kinds in order and
   the worst |ΔΩ|;
 * orbits: at up to ``--orbits`` points of each branch away from special points, the exact
