@@ -231,9 +231,9 @@ def frf_command(
 
     With --subharmonics every period-doubling point found on the primary branch starts a
     period-2 branch (and so on, up to period 4); each branch has its colour in frf.png. On a
-    discontinuous law, or a chain with friction or jumps on its elements, the period-2 branches
-    born at the period doublings of the period-1 branch, every point checked by exact shooting
-    over two periods.
+    discontinuous law, or a chain with friction or jumps on its elements, it follows the period-2
+    branches born at the period doublings of the period-1 branch, every orbit shot exactly over
+    two periods; --start and --fixed-harmonics are refused there.
     """
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
