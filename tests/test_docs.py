@@ -336,6 +336,56 @@ def test_option_fields_are_documented():
                 assert f"`{f.name}`" in text, f"{cls.__name__}.{f.name} is not in docs/python.md"
 
 
+def _documented_signatures() -> list[tuple[str, str, str]]:
+    """``name(arguments)`` entries of the ```text blocks of the docs whose name is a public
+    callable of rattle (``frequency_response``, ``rattle.analysis.nonsmooth_orbit``,
+    ``Clutch``), as (page, name, arguments); continuation lines are joined."""
+    import rattle
+
+    out = []
+    for path in sorted(DOCS.glob("*.md")):
+        for block in _blocks(path.read_text(encoding="utf-8"), "text"):
+            entries: list[str] = []
+            for line in block.splitlines():
+                if line.startswith(" ") and entries:
+                    entries[-1] += " " + line.strip()
+                else:
+                    entries.append(line.strip())
+            for entry in entries:
+                for m in re.finditer(r"((?:rattle\.)?[A-Za-z_][\w.]*)\((.*?)\)(?=\s*->|\s{2,}|\s*$)", entry):
+                    obj = rattle
+                    for part in m.group(1).removeprefix("rattle.").split("."):
+                        obj = getattr(obj, part, None)
+                    if callable(obj):
+                        out.append((path.name, m.group(1), m.group(2)))
+    return out
+
+
+def test_documented_signatures_match_the_code():
+    """Every signature written out in the docs names the function's parameters in its order:
+    all of them, or, where the entry ends in ``…``, some of them (the first may be renamed)."""
+    import ast
+    import inspect
+
+    import rattle
+
+    signatures = _documented_signatures()
+    assert len(signatures) >= 15, signatures
+    for page, name, arguments in signatures:
+        partial = "…" in arguments
+        args = ast.parse(f"def f({arguments.replace('…', '').rstrip(', ')}): pass").body[0].args
+        documented = [a.arg for a in (*args.posonlyargs, *args.args, *args.kwonlyargs)]
+        obj = rattle
+        for part in name.removeprefix("rattle.").split("."):
+            obj = getattr(obj, part)
+        actual = [p for p in inspect.signature(obj).parameters if p != "self"]
+        if partial:
+            it = iter(actual[1:])
+            assert all(a in it for a in documented[1:]), f"docs/{page}: {name}({arguments}) against {actual}"
+        else:
+            assert documented == actual, f"docs/{page}: {name} documents {documented}, the code has {actual}"
+
+
 # --------------------------------------------------------------------------------------------
 # Every code block runs on its own
 # --------------------------------------------------------------------------------------------
