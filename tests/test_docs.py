@@ -117,6 +117,9 @@ def test_readme_keeps_the_two_set_up_commands():
     readme = README.read_text(encoding="utf-8")
     assert "python3 -m pip install -e . && rattle demo" in readme
     assert 'python3 -m pip install -e ".[test]" && python3 -m pytest' in readme
+    # ... inside a virtual environment, said in their explanation (not a third command)
+    setup = readme.split("## Set-up", 1)[1].split("```", 1)[0]
+    assert "python3 -m venv .venv && . .venv/bin/activate" in setup, setup
 
 
 # --------------------------------------------------------------------------------------------
