@@ -11,6 +11,7 @@ wording this test does not know.
 
 from __future__ import annotations
 
+import itertools
 import re
 import sys
 from pathlib import Path
@@ -67,16 +68,17 @@ _CLUTCH = 'type = "clutch"\nalpha = 0.25\nb = 0.174533'
 # The law of each row, by the start of its first cell. refine = 0 (and a chain's ladder kept at
 # H = 8) keeps the regularised HB to its first pass: seconds, not minutes.
 _CASES = {
-    "continuous, one equation": (_SINGLE, _CLUTCH, ""),
-    "continuous, a chain": (_CHAIN, _CLUTCH, ""),
-    "continuous, either form": (_SINGLE, _CLUTCH, ""),
-    "a torque jump": (_SINGLE, 'type = "preload"\npreload = 0.03', "refine = 0"),
-    "friction": (_SINGLE, _CLUTCH + "\nfriction = 0.01", "refine = 0"),
-    "a chain with friction or a jump": (_CHAIN, _CLUTCH + "\nfriction = 0.002", "refine = 0\nlimit_harmonics = 8"),
+    "continuous, one equation": [(_SINGLE, _CLUTCH, "")],
+    "continuous, a chain": [(_CHAIN, _CLUTCH, "")],
+    "continuous, either form": [(_SINGLE, _CLUTCH, ""), (_CHAIN, _CLUTCH, "")],
+    "a torque jump": [(_SINGLE, 'type = "preload"\npreload = 0.03', "refine = 0")],
+    "friction": [(_SINGLE, _CLUTCH + "\nfriction = 0.01", "refine = 0")],
+    "a chain with friction or a jump": [(_CHAIN, _CLUTCH + "\nfriction = 0.002", "refine = 0\nlimit_harmonics = 8")],
 }
 
 # What a cell's method looks like in the command's summary (stdout), and what it must not say.
 _REPORTS = {
+    "HB": (r"\(H = \d+ harmonics", r"exact shooting continuation|regularised|ε = "),
     "exact shooting": (r"exact shooting continuation", r"regularised|ε = "),
     "regularised HB + exact check": (r"regularised|ε = ", r"exact shooting continuation"),
 }
@@ -100,17 +102,15 @@ def _row_id(row: dict[str, str]) -> str:
     return f"{row['law'].split(' (')[0]} / {row['method']}"
 
 
-def _case(row: dict[str, str]) -> str:
-    for start, (template, law, analysis) in _CASES.items():
-        if row["law"].startswith(start):
-            break
-    else:
-        raise AssertionError(f"docs/cli.md's law table has a row {row['law']!r} this test has no case for")
-    method = re.findall(r'`"(\w+)"`', row["method"])
-    if row["method"] != "not given":
-        assert method, f"the method cell {row['method']!r} names no method"
-        analysis = f'method = "{method[0]}"\n{analysis}'
-    return template.format(law=law, analysis=analysis)
+def _cases(row: dict[str, str]) -> list[str]:
+    """The case files of a row: each of its law's forms with each method the row names."""
+    variants = next((v for start, v in _CASES.items() if row["law"].startswith(start)), None)
+    assert variants, f"docs/cli.md's law table has a row {row['law']!r} this test has no case for"
+    methods = re.findall(r'`"(\w+)"`', row["method"])
+    assert bool(methods) == (row["method"] != "not given"), f"the method cell {row['method']!r}"
+    lines = [f'method = "{m}"\n' for m in methods] or [""]
+    return [template.format(law=law, analysis=line + analysis)
+            for template, law, analysis in variants for line in lines]
 
 
 _ROWS = _table()
@@ -128,8 +128,6 @@ def test_every_command_does_what_the_table_says(row, tmp_path, monkeypatch):
     # Run as without matplotlib (the commands then write their sets without the figures, with a
     # warning): the figures are three quarters of the time here and are tested on their own.
     monkeypatch.setitem(sys.modules, "matplotlib", None)
-    config = tmp_path / "case.toml"
-    config.write_text(_case(row), encoding="utf-8")
     args = {
         "frf": [],
         "sweep": ["--direction", "up", "--points", "2", "-q"],
@@ -137,14 +135,18 @@ def test_every_command_does_what_the_table_says(row, tmp_path, monkeypatch):
         "compare": ["--points", "2", "-q"],
         "map": ["--vary", "damping=0.05", "--omega-points", "2", "--workers", "1", "-q"],
     }
-    for command in COMMANDS:
+    for (n, text), command in itertools.product(enumerate(_cases(row)), COMMANDS):
+        config = tmp_path / f"case{n}.toml"
+        config.write_text(text, encoding="utf-8")
         cell = row[command]
         assert cell in _KNOWN, f"docs/cli.md: {_row_id(row)}, `rattle {command}`: unknown cell {cell!r}"
-        result = invoke([command, str(config), *args[command], "-o", str(tmp_path / command)], tmp_path)
-        where = f"docs/cli.md says `rattle {command}` on {_row_id(row)}: {cell!r}; got exit {result.exit_code}"
+        result = invoke([command, str(config), *args[command], "-o", str(tmp_path / f"{command}{n}")], tmp_path)
+        where = (f"docs/cli.md says `rattle {command}` on {_row_id(row)}: {cell!r}; got exit {result.exit_code} "
+                 f"on {config.name}:\n{text}")
         if cell == "refused":
             assert result.exit_code == 2, f"{where}\n{result.stdout}{result.stderr}"
             assert result.stderr.startswith("rattle: error: ") and result.stderr.count("\n") == 1, result.stderr
+            assert "`" in result.stderr, f"the refusal names no key: {result.stderr}"
             continue
         assert result.exit_code == 0, f"{where}\n{result.stderr}"
         for method, (says, never) in _REPORTS.items():
