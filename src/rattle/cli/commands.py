@@ -596,6 +596,10 @@ def compare_command(
     With --measured FILE.csv the measured points are drawn over the computed curves of the same
     quantity and tabled against them in measured.csv (HB largest stable, sweep up, sweep down,
     differences).
+
+    A discontinuous law, or a chain with friction or jumps on its elements: the regularised
+    harmonic balance checked by exact shooting (whatever [analysis] method says) beside the exact
+    up/down sweep, without time histories; --at and --measured are refused there.
     """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
     parse_at(at)  # the list's form and size: no numpy (the range is checked once the file is read)
@@ -738,6 +742,10 @@ def map_command(
     branches, every branch solved on the grid of N frequencies, and a search for the attractors
     the branches miss. Every combination finished is kept in OUTPUT/map.parts: a rerun of the
     same command into the same folder reads them back instead of recomputing them.
+
+    A discontinuous law, or a chain with friction or jumps on its elements: every branch by exact
+    shooting continuation (as rattle frf at its defaults) and the search on the exact flow;
+    [analysis] method = "hb" is refused there.
     """
     from ..maps import build_all, combinations, parameters, parse_all
 
