@@ -117,6 +117,9 @@ def test_readme_keeps_the_two_set_up_commands():
     readme = README.read_text(encoding="utf-8")
     assert "python3 -m pip install -e . && rattle demo" in readme
     assert 'python3 -m pip install -e ".[test]" && python3 -m pytest' in readme
+    # ... inside a virtual environment, said in their explanation (not a third command)
+    setup = readme.split("## Set-up", 1)[1].split("```", 1)[0]
+    assert "python3 -m venv .venv && . .venv/bin/activate" in setup, setup
 
 
 # --------------------------------------------------------------------------------------------
@@ -232,7 +235,7 @@ def test_every_command_and_option_is_documented():
 
 def _command_lines() -> list[tuple[str, list[str]]]:
     lines = []
-    for page in [*(DOCS / p for p in PAGES), README]:
+    for page in _user_files():
         for block in _blocks(page.read_text(encoding="utf-8"), "bash"):
             for line in block.splitlines():
                 line = line.split("#", 1)[0].strip()
@@ -244,7 +247,8 @@ def _command_lines() -> list[tuple[str, list[str]]]:
 
 
 def test_command_examples_parse():
-    """Every ``rattle …`` line in a bash block names a real command with real options and files."""
+    """Every ``rattle …`` line in a bash block of the README and docs/ names a real command with
+    real options and files, and click parses it as the command line would."""
     from rattle.cli.main import cli
 
     examples = _command_lines()
@@ -335,23 +339,170 @@ def test_option_fields_are_documented():
                 assert f"`{f.name}`" in text, f"{cls.__name__}.{f.name} is not in docs/python.md"
 
 
+def _documented_signatures() -> list[tuple[str, str, str]]:
+    """``name(arguments)`` entries of the ```text blocks of the docs whose name is a public
+    callable of rattle (``frequency_response``, ``rattle.analysis.nonsmooth_orbit``,
+    ``Clutch``), as (page, name, arguments); continuation lines are joined."""
+    import rattle
+
+    out = []
+    for path in sorted(DOCS.glob("*.md")):
+        for block in _blocks(path.read_text(encoding="utf-8"), "text"):
+            entries: list[str] = []
+            for line in block.splitlines():
+                if line.startswith(" ") and entries:
+                    entries[-1] += " " + line.strip()
+                else:
+                    entries.append(line.strip())
+            for entry in entries:
+                for m in re.finditer(r"((?:rattle\.)?[A-Za-z_][\w.]*)\((.*?)\)(?=\s*->|\s{2,}|\s*$)", entry):
+                    obj = rattle
+                    for part in m.group(1).removeprefix("rattle.").split("."):
+                        obj = getattr(obj, part, None)
+                    if callable(obj):
+                        out.append((path.name, m.group(1), m.group(2)))
+    return out
+
+
+def test_documented_signatures_match_the_code():
+    """Every signature written out in the docs names the function's parameters in its order:
+    all of them, or, where the entry ends in ``…``, some of them (the first may be renamed)."""
+    import ast
+    import inspect
+
+    import rattle
+
+    signatures = _documented_signatures()
+    assert len(signatures) >= 15, signatures
+    for page, name, arguments in signatures:
+        partial = "…" in arguments
+        args = ast.parse(f"def f({arguments.replace('…', '').rstrip(', ')}): pass").body[0].args
+        documented = [a.arg for a in (*args.posonlyargs, *args.args, *args.kwonlyargs)]
+        obj = rattle
+        for part in name.removeprefix("rattle.").split("."):
+            obj = getattr(obj, part)
+        actual = [p for p in inspect.signature(obj).parameters if p != "self"]
+        if partial:
+            it = iter(actual[1:])
+            assert all(a in it for a in documented[1:]), f"docs/{page}: {name}({arguments}) against {actual}"
+        else:
+            assert documented == actual, f"docs/{page}: {name} documents {documented}, the code has {actual}"
+
+
 # --------------------------------------------------------------------------------------------
-# The Python page runs
+# Every code block runs on its own
 # --------------------------------------------------------------------------------------------
-def test_python_examples_run(tmp_path, monkeypatch):
-    """Every ```python block of docs/python.md runs, in order, in one namespace."""
+#: The marker of an illustrative block, on the line before its fence; used only where a block
+#: cannot run here (it needs a cluster, a licence, hours). docs/index.md states the convention.
+NO_RUN = "<!-- no-run -->"
+
+
+def _python_blocks() -> list[tuple[str, int, str]]:
+    """Every ```python block of the README and docs/ as (page, line of the fence, code), the
+    ones marked NO_RUN left out."""
+    out = []
+    for path in _user_files():
+        text = path.read_text(encoding="utf-8")
+        for m in re.finditer(r"^```python[ \t]*\n(.*?)^```", text, flags=re.S | re.M):
+            before = text[: m.start()].rstrip("\n").rsplit("\n", 1)[-1].strip()
+            if before == NO_RUN:
+                continue
+            out.append((str(path.relative_to(ROOT)), text.count("\n", 0, m.start()) + 1, m.group(1)))
+    return out
+
+
+_PY_BLOCKS = _python_blocks()
+
+
+def test_the_no_run_marker_is_rare():
+    """Illustrative blocks stay the exception: at most three, each an HTML comment line right
+    before its fence."""
+    marked = [path.name for path in _user_files()
+              for _ in re.finditer(rf"^{re.escape(NO_RUN)}\n```", path.read_text(encoding="utf-8"), flags=re.M)]
+    assert len(_PY_BLOCKS) >= 15 and len(marked) <= 3, (len(_PY_BLOCKS), marked)
+
+
+def _private_names(code: str) -> list[str]:
+    """Imports or attribute chains of ``rattle`` that go through a name starting with ``_``, or
+    that name something a package does not list in its ``__all__``."""
+    import ast
+    import importlib.util
+
+    def public(module: str, name: str) -> bool:
+        if name.startswith("_"):
+            return False
+        try:
+            mod = importlib.import_module(module)
+        except ImportError:
+            return False
+        names = getattr(mod, "__all__", None)
+        if names is None or name in names:
+            return True
+        return hasattr(mod, "__path__") and importlib.util.find_spec(f"{module}.{name}") is not None  # a sub-package
+
+    bad = []
+    for node in ast.walk(ast.parse(code)):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "rattle":
+            parts = node.module.split(".")
+            bad += [node.module for i in range(1, len(parts)) if not public(".".join(parts[:i]), parts[i])]
+            bad += [f"{node.module}.{a.name}" for a in node.names if not public(node.module, a.name)]
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                parts = a.name.split(".")
+                if parts[0] == "rattle":
+                    bad += [a.name for i in range(1, len(parts)) if not public(".".join(parts[:i]), parts[i])]
+        elif isinstance(node, ast.Attribute):
+            chain, inner = [node.attr], node.value
+            while isinstance(inner, ast.Attribute):
+                chain.insert(0, inner.attr)
+                inner = inner.value
+            if isinstance(inner, ast.Name) and inner.id == "rattle":
+                module = "rattle"
+                for name in chain:
+                    if not public(module, name):
+                        bad.append(f"{module}.{name}")
+                        break
+                    if importlib.util.find_spec(f"{module}.{name}") is None:
+                        break
+                    module = f"{module}.{name}"
+    return sorted(set(bad))
+
+
+@pytest.mark.parametrize("page,line,code", _PY_BLOCKS, ids=[f"{p}:{n}" for p, n, _ in _PY_BLOCKS])
+def test_docs_use_public_names_only(page, line, code):
+    assert not _private_names(code), f"{page}:{line} uses names that are not public: {_private_names(code)}"
+
+
+def test_the_private_name_check_bites():
+    assert _private_names("from rattle.maps._report import map_report") == ["rattle.maps._report"]
+    assert _private_names("import rattle\nrattle.maps._report.map_report") == ["rattle.maps._report"]
+    assert _private_names("from rattle.maps import map_report\nimport rattle\nrattle.io.read_csv") == []
+
+
+@pytest.mark.parametrize("page,line,code", _PY_BLOCKS, ids=[f"{p}:{n}" for p, n, _ in _PY_BLOCKS])
+def test_code_blocks_run_on_their_own(page, line, code, tmp_path, monkeypatch):
+    """Each ```python block of the README and docs/ runs in a fresh namespace, in a folder that
+    holds a copy of examples/ (the blocks name files as a user in the project folder does); the
+    files it writes with ``to_csv``/``savefig`` exist afterwards, a frf.csv with the SPEC columns."""
+    import shutil
+
+    import matplotlib.pyplot as plt
+
     from rattle.io import read_csv
     from rattle.results import FRF_COLUMNS
 
-    blocks = _blocks(_text("python.md"), "python")
-    assert len(blocks) >= 3
+    shutil.copytree(ROOT / "examples", tmp_path / "examples")
     monkeypatch.chdir(tmp_path)
     namespace: dict[str, object] = {"__name__": "__docs__"}
     out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        for i, block in enumerate(blocks):
-            exec(compile(block, f"docs/python.md block {i + 1}", "exec"), namespace)  # noqa: S102
-    assert tuple(read_csv(tmp_path / "frf.csv")) == (*FRF_COLUMNS, "harmonics")  # SPEC §3 + §8
-    for name in ("frf.png", "sweep.csv", "orbit.csv", "compare.png"):
-        assert (tmp_path / name).is_file(), f"the example did not write {name}"
-    assert "fold" in out.getvalue()
+    try:
+        with contextlib.redirect_stdout(out):
+            exec(compile(code, f"{page}:{line}", "exec"), namespace)  # noqa: S102
+    finally:
+        plt.close("all")
+    for name in re.findall(r"""(?:to_csv|savefig)\(\s*["']([^"']+)["']""", code):
+        assert (tmp_path / name).is_file(), f"{page}:{line} did not write {name}"
+        if Path(name).name == "frf.csv":
+            assert tuple(read_csv(tmp_path / name))[: len(FRF_COLUMNS)] == FRF_COLUMNS, f"{page}:{line}: {name}"
+    if "sp.kind" in code:  # docs/python.md's first block prints the folds of the bent resonance
+        assert "fold" in out.getvalue()

@@ -245,9 +245,9 @@ def frf_command(
 
     With --subharmonics every period-doubling point found on the primary branch starts a
     period-2 branch (and so on, up to period 4); each branch has its colour in frf.png. On a
-    discontinuous law, or a chain with friction or jumps on its elements, the period-2 branches
-    born at the period doublings of the period-1 branch, every point checked by exact shooting
-    over two periods.
+    discontinuous law, or a chain with friction or jumps on its elements, it follows the period-2
+    branches born at the period doublings of the period-1 branch, every orbit shot exactly over
+    two periods; --start and --fixed-harmonics are refused there.
     """
     precheck(config, output, harmonics=harmonics)
     check_html(html)
@@ -626,6 +626,10 @@ def compare_command(
     With --measured FILE.csv the measured points are drawn over the computed curves of the same
     quantity and tabled against them in measured.csv (HB largest stable, sweep up, sweep down,
     differences).
+
+    A discontinuous law, or a chain with friction or jumps on its elements: the regularised
+    harmonic balance checked by exact shooting (whatever [analysis] method says) beside the exact
+    up/down sweep, without time histories; --at and --measured are refused there.
     """
     precheck(config, output, harmonics=harmonics, points=points, workers=workers)
     check_html(html)
@@ -781,6 +785,10 @@ def map_command(
     branches, every branch solved on the grid of N frequencies, and a search for the attractors
     the branches miss. Every combination finished is kept in OUTPUT/map.parts: a rerun of the
     same command into the same folder reads them back instead of recomputing them.
+
+    A discontinuous law, or a chain with friction or jumps on its elements: every branch by exact
+    shooting continuation (as rattle frf at its defaults) and the search on the exact flow;
+    [analysis] method = "hb" is refused there.
     """
     from ..maps import build_all, combinations, parameters, parse_all
 

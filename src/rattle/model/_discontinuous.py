@@ -159,7 +159,8 @@ class Preload(AbstractJumpLaw):
         f(δ) = s δ + T_p sgn δ                               (clearance = 0),
         f(δ) = 0 (|δ| < b),  s (δ ∓ b) ± T_p (±δ > b)         (clearance b > 0),
 
-    ``preload`` T_p ≥ 0 (relative to K, like f: the torque jump is K T_p each way), ``clearance``
+    ``preload`` T_p ≥ 0 (relative to K, like f: K f jumps from −K T_p to +K T_p, by 2 K T_p, across
+    δ = 0; with a clearance by K T_p at each of δ = ±b), ``clearance``
     b ≥ 0 (rad), ``slope`` s > 0. T_p = 0 is the linear law (b = 0) or the backlash (b > 0).
 
     ::
@@ -181,7 +182,7 @@ class Preload(AbstractJumpLaw):
         b = _check_real("clearance", self.clearance)
         s = _check_real("slope", self.slope)
         if tp < 0:
-            raise ValueError(f"`preload` (torque jump T_p) must be >= 0, got {tp!r}")
+            raise ValueError(f"`preload` (T_p, half the torque jump) must be >= 0, got {tp!r}")
         if b < 0:
             raise ValueError(f"`clearance` must be >= 0 rad, got {b!r}")
         if s <= 0:

@@ -673,8 +673,8 @@ def _chain_tables(check: _Checker, data: Mapping[str, Any], model_t: Mapping[str
 
 
 def _element_preload(check: _Checker, elastic: Preload, t: Mapping[str, Any], where: str, units: str) -> Preload:
-    """``[[model.elements]] type = "preload"``: the torque jump T_p relative to the element's
-    stiffness K_e (the jump is K_e T_p each way), or in N m with ``units = "SI"``, divided here by
+    """``[[model.elements]] type = "preload"``: the preload T_p relative to the element's
+    stiffness K_e (the torque jumps by 2 K_e T_p across zero), or in N m with ``units = "SI"``, divided here by
     K_e; a clearance in degrees by mistake is warned about as for the single equation."""
     if elastic.clearance > 0:
         check.build(_limits.warn_clearance, {"clearance": f"{where}.clearance"}, b=elastic.clearance,
