@@ -87,6 +87,7 @@ _REPORTS = {
 }
 _KNOWN = ("HB", "exact integration", "HB + simulation", "HB + exact integration", "HB + attractor search",
           "exact shooting", "exact flow", "regularised HB + exact check", "regularised HB + exact check, exact flow",
+          "regularised HB + exact check, every exact orbit",
           "exact shooting + search on the exact flow", "refused")
 
 
@@ -153,6 +154,8 @@ def test_every_command_does_what_the_table_says(row, tmp_path, monkeypatch):
             assert "`" in result.stderr, f"the refusal names no key: {result.stderr}"
             continue
         assert result.exit_code == 0, f"{where}\n{result.stderr}"
+        if cell.endswith("every exact orbit"):  # the census of the orbits at Ω beside the one asked for
+            assert "every orbit at Ω = 0.5 rad/s (exact" in result.stdout, f"{where}; summary:\n{result.stdout}"
         for method, (says, never) in _REPORTS.items():
             if cell.split(",")[0] == method:  # the map's summary names no method
                 assert re.search(says, result.stdout) and not re.search(never, result.stdout), (
