@@ -95,7 +95,9 @@ class SweepResult:
     Columns (numpy arrays of length P): SPEC §3 ``SWEEP_COLUMNS`` — ``direction`` (``up`` or
     ``down``), ``omega`` (rad/s), ``mean``, ``rms``, ``rms_ac``, ``p2p`` (rad), ``acc_p2p``
     (rad/s²), ``period`` (multiple of the forcing period, 0 when none up to the detection limit
-    was found). Also ``delta_min``, ``delta_max`` (rad), ``settled`` (bool), ``method``
+    was found). Also ``regime`` (``no_impact``, ``single_sided``, ``double_sided`` as in SPEC §1:
+    the breakpoints the row's steady motion crosses; written after ``period``), ``delta_min``,
+    ``delta_max`` (rad), ``settled`` (bool), ``method``
     (``shooting``/``simulation``/``unsettled``; ``status`` the same as :class:`~rattle.errors.Status`
     values, as ``SteadyState.status``), ``periods`` and ``shooting_periods`` (forcing
     periods simulated and integrated by Newton shooting: the effort), ``state0`` (P, 2) the
@@ -150,10 +152,13 @@ class SweepResult:
     element_columns: dict[str, np.ndarray] = field(default_factory=dict)
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
     failure: np.ndarray | None = None
+    regime: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.failure is None:  # a sweep without failures: "" on every row
             object.__setattr__(self, "failure", np.full(int(np.size(self.omega)), "", dtype=object))
+        if self.regime is None:  # not given by the sweep: from each row's extremes (frf.csv's rule)
+            object.__setattr__(self, "regime", _regimes_from_extremes(self))
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -242,11 +247,13 @@ class SweepResult:
         return ", ".join(f"Ω ≈ {j.omega:.4g} ({j.direction} sweep, rms {j.kind})" for j in jumps)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The SPEC columns in order, as a dict of arrays; for a chain followed by the
+        """The SPEC columns in order and ``regime`` (of each row's steady motion, SPEC §1's
+        vocabulary; empty on a failed row), as a dict of arrays; for a chain followed by the
         per-element columns (``NAME_mean`` … ``NAME_acc_p2p``), then ``speed_rpm`` with an engine,
         then the extra columns (``spl_db``, ``spl_dba``, ``spl_linear_db`` of :meth:`with_sound`)."""
         rpm = self.speed_rpm
-        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, **self.element_columns,
+        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, "regime": self.regime,
+                **self.element_columns,
                 **({} if rpm is None else {"speed_rpm": rpm}), **self.extra_columns}
 
     @property
@@ -467,8 +474,32 @@ class SweepResult:
 
 _ROW_FIELDS: tuple[str, ...] = (
     "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period", "delta_min", "delta_max",
-    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers", "failure",
+    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers", "failure", "regime",
 )
+
+
+def _regimes_from_extremes(result: SweepResult) -> np.ndarray:
+    """``regime`` of every row from its extremes ``delta_min``, ``delta_max`` and the breakpoints
+    of the model's (first) element, as frf.csv's (:func:`rattle.measures.regime_of_breakpoints`);
+    ``""`` on a failed row and where the model has no breakpoints to read. A sweep computed by
+    :func:`rattle.time_sweep` gives each row's regime from the breakpoints its trajectory crossed
+    instead (the same for a continuous law; a discontinuous law's jump at δ = 0 counts on
+    neither side)."""
+    from ..measures import regime_of_breakpoints
+
+    n = int(np.size(result.omega))
+    out = np.full(n, "", dtype=object)
+    model = result.model
+    try:
+        system = model if hasattr(model, "elements") and not hasattr(model, "system") else model.system()
+        d = np.asarray(system.elements[0].breakpoints, dtype=float)
+    except (AttributeError, IndexError, TypeError):
+        return out
+    lo, hi = np.asarray(result.delta_min, dtype=float), np.asarray(result.delta_max, dtype=float)
+    ok = np.isfinite(lo) & np.isfinite(hi)
+    if ok.any():
+        out[ok] = regime_of_breakpoints(d, lo[ok], hi[ok])
+    return out
 
 __all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS", "SWEEP_ELEMENT_COLUMNS", "SWEEP_FAILED",
            "FAILED_PERIOD"]
