@@ -15,6 +15,7 @@ from ._columns import SWEEP_COLUMNS
 from ._steady import METHOD_STATUS
 from ..model import Model
 from ._plotter import plot_with
+from ._speed import SpeedText, round_to_grid, rpm_of_omega
 
 #: Per-element columns of a chain's ``sweep.csv``: ``NAME_`` + each of these (the measures of
 #: element NAME's deflection, as the SPEC columns are of the first element's).
@@ -259,9 +260,18 @@ class SweepResult:
     @property
     def speed_rpm(self) -> FloatArray | None:
         """Crankshaft speed (rpm) of each row when the model has an engine (``Chain.speed_order``
-        q_0): Ω · 60 / (2π q_0); None otherwise."""
+        q_0): Ω · 60 / (2π q_0), rounded to a thousandth of the grid's step
+        (:func:`~rattle.results._speed.round_to_grid`: the speeds 400, 500, … of a grid the user
+        gave in rpm, not 499.99999999999994); None otherwise."""
         order = getattr(self.model, "speed_order", None)
-        return None if order is None else np.asarray(self.omega, dtype=float) * (60.0 / (2.0 * np.pi * order))
+        if order is None:
+            return None
+        rpm = rpm_of_omega(np.asarray(self.omega, dtype=float), order)
+        grid = self.settings.get("omega"), self.settings.get("points")
+        if isinstance(grid[0], (list, tuple)) and len(grid[0]) == 2 and isinstance(grid[1], int):
+            lo, hi = (float(rpm_of_omega(float(w), order)) for w in grid[0])
+            rpm = round_to_grid(rpm, lo, hi, grid[1])  # the rpm grid's round values, not their round-off
+        return rpm
 
     @property
     def element_names(self) -> tuple[str, ...]:
@@ -277,6 +287,7 @@ class SweepResult:
     def summary(self) -> str:
         """A few lines for the terminal: points per direction, periods found, jumps, effort."""
         lines = []
+        speed = SpeedText.of(self.model)  # rpm with an engine, else Ω
         for d in self.directions:
             m = self.direction == d
             w = self.omega[m]
@@ -287,19 +298,18 @@ class SweepResult:
                 per += (", " if per else "") + f"not periodic (period 0): {int(counts[0])}"
             if not ok.all():
                 per += (", " if per else "") + f"failed: {int(np.sum(~ok))}"
-            line = f"{d} sweep: {int(np.sum(m))} frequencies over Ω = {w.min():.4g} … {w.max():.4g} ({per})"
+            line = f"{d} sweep: {int(np.sum(m))} frequencies over {speed.span(w.min(), w.max(), 4)} ({per})"
             if ok.any():
                 i = int(np.flatnonzero(ok)[np.argmax(self.rms[m][ok])])
-                line += f"; largest rms {self.rms[m][i]:.5g} rad at Ω = {w[i]:.5g}"
+                line += f"; largest rms {self.rms[m][i]:.5g} rad at {speed.at(w[i])}"
             lines.append(line)
         jumps = self.jumps()
-        order = getattr(self.model, "speed_order", None)
-        rpm = (lambda w: "") if order is None else (lambda w: f" ({w * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
         if jumps:
             lines.append("jumps: " + "; ".join(
                 f"{j.direction} sweep, {j.element + ' ' if j.element else ''}rms {j.kind} {j.rms_before:.4g} → "
-                f"{j.rms_after:.4g} rad "
-                f"between Ω = {j.omega_before:.5g}{rpm(j.omega_before)} and {j.omega_after:.5g}{rpm(j.omega_after)}"
+                f"{j.rms_after:.4g} rad between "
+                + (f"{speed.number(j.omega_before)} and {speed.at(j.omega_after)}" if speed.engine
+                   else f"{speed.at(j.omega_before)} and {speed.number(j.omega_after)}")
                 for j in jumps))
         else:
             lines.append("jumps: none")
@@ -313,7 +323,7 @@ class SweepResult:
                 lines.append(f"{what}: never")
                 continue
             lines.append(f"{what}: {int(np.sum(col > 0))} of {col.size} rows, at most {100 * col[i]:.3g} % of the "
-                         f"period at Ω = {self.omega[i]:.5g} ({self.direction[i]} sweep)")
+                         f"period at {speed.at(self.omega[i])} ({self.direction[i]} sweep)")
         lines.append(
             f"effort: {int(np.sum(self.periods))} forcing periods simulated, "
             f"{int(np.sum(self.shooting_periods))} in Newton shooting"
