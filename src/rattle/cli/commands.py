@@ -751,7 +751,7 @@ def map_command(
     the branches miss. Every combination finished is kept in OUTPUT/map.parts: a rerun of the
     same command into the same folder reads them back instead of recomputing them.
     """
-    from ..maps import build_all, combinations, parameters, parse_all
+    from ..maps import build_all, combinations, mark_degrees, parameters, parse_all
 
     parsed = parse_all(vary)  # first: a malformed --vary needs no file
     precheck(config, output, harmonics=harmonics, workers=workers)
@@ -769,7 +769,7 @@ def map_command(
         tables = dataclasses.replace(run_config, analysis=analysis).to_dict()
     else:
         tables = _io().model_to_toml_dict(run_config.model, analysis)
-    params = parameters(tables, parsed)
+    params = mark_degrees(parameters(tables, parsed), run_config.source)  # angles given in degrees: shown so
     build_all(tables, params)  # every combination's model, before any work
     t_start = time.perf_counter()
     from ..maps import response_map  # only now: all input has been validated

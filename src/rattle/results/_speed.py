@@ -27,10 +27,11 @@ def rpm_of_omega(omega: Any, order: float) -> Any:
 
 def round_to_grid(values: Any, start: float, stop: float, count: int) -> Any:
     """``values`` (an array) rounded to the decimal digits that tell the points of a grid of
-    ``count`` values from ``start`` to ``stop`` apart, plus three (a thousandth of its step):
-    the round-off of a unit conversion (799.9999999999999 rpm of a grid 400, 800, …) goes, the
-    grid's own points and every value between them keep their information. A grid of one value:
-    12 significant digits of that value."""
+    ``count`` values from ``start`` to ``stop`` apart, plus six (a millionth of its step, at most
+    half of it lost): the round-off of a unit conversion (799.9999999999999 rpm of a grid 400,
+    500, …; some 1e-16 relative) goes, the grid's own points and every value between them keep
+    their information (426.66667 of a grid 400 … 480 in 4 points). A grid of one value: 12
+    significant digits of that value."""
     import numpy as np
 
     a = np.asarray(values, dtype=float)
@@ -38,7 +39,7 @@ def round_to_grid(values: Any, start: float, stop: float, count: int) -> Any:
     step = span / (count - 1) if count > 1 and span > 0 else abs(float(start)) or 1.0
     if not math.isfinite(step) or step <= 0:
         return a
-    decimals = 3 - math.floor(math.log10(step))
+    decimals = 6 - math.floor(math.log10(step))
     if count <= 1 or span == 0:
         decimals = 11 - math.floor(math.log10(step))
     return np.round(a, decimals) + 0.0  # + 0.0: no -0.0

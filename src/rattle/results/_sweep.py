@@ -260,7 +260,7 @@ class SweepResult:
     @property
     def speed_rpm(self) -> FloatArray | None:
         """Crankshaft speed (rpm) of each row when the model has an engine (``Chain.speed_order``
-        q_0): Ω · 60 / (2π q_0), rounded to a thousandth of the grid's step
+        q_0): Ω · 60 / (2π q_0), rounded to a millionth of the grid's step
         (:func:`~rattle.results._speed.round_to_grid`: the speeds 400, 500, … of a grid the user
         gave in rpm, not 499.99999999999994); None otherwise."""
         order = getattr(self.model, "speed_order", None)
