@@ -111,10 +111,10 @@ def override_analysis(base: AnalysisSettings, model: Model | None = None, *, lab
     ------
     ConfigError
         If the combination breaks a rule; the message names the option (``--omega-min``) or the
-        file key (``analysis.omega[1]``) each value came from.
+        file key (``analysis.omega.2``) each value came from.
     """
     given = {name: value for name, value in options.items() if value is not None}
-    names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics"}
+    names = {"omega_min": "analysis.omega.1", "omega_max": "analysis.omega.2", "harmonics": "analysis.harmonics"}
     names.update({name: "--" + name.replace("_", "-") for name in given})
     names.update({name: label for name, label in (labels or {}).items() if name in given})
     try:

@@ -81,11 +81,11 @@ _harmonics_option = click.option(
 )
 _omega_min_option = click.option(
     "--omega-min", type=float, default=None, metavar="X",
-    help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega[0].",
+    help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega.1 (the lower end).",
 )
 _omega_max_option = click.option(
     "--omega-max", type=float, default=None, metavar="Y",
-    help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].",
+    help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega.2 (the upper end).",
 )
 _rpm_min_option = click.option(
     "--rpm-min", type=float, default=None, metavar="N1",
@@ -194,7 +194,7 @@ def _law_keys(run_config: Any) -> str:
     """The keys that make the configuration's law discontinuous, as the user wrote them."""
     if getattr(run_config, "chain_friction", False):  # a chain with friction or preloads on its elements
         system = run_config.model
-        keys = [f"`model.elements[{e}].{k}`" for e in range(system.m)
+        keys = [f"`model.elements.{e + 1}.{k}`" for e in range(system.m)
                 for k, on in (("preload", bool(system.laws[e].stages.jumps.any())),
                               ("friction", bool(system.friction_levels(e).any()))) if on]
         return " and ".join(keys) or "`model.elements`"

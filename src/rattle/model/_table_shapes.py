@@ -111,6 +111,7 @@ def _per_degree(check: _Checker, table: dict[str, Any], where: str, key: str) ->
         if not v > 0:
             raise check.error(f"`{where}.{deg}[{i}]` must be > 0 N m/deg (a stage stiffness), got {_show(v)}")
     table[key] = [float(v) * _DEG_PER_RAD for v in values]
+    check.user_keys[f"{where}.{key}"] = (f"{where}.{deg}", "N m/rad")  # messages name the key written
 
 
 def _damper(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]:
