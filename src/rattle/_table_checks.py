@@ -314,9 +314,16 @@ def _in_base_units(check: _Checker, table: Mapping[str, Any], where: str, known:
         if twin not in allowed:
             why = (f"`{twin}` is not {kind}" if twin in known else f"`{where}.{twin}` is not a known key")
             same = [a + x for x, (b, _, _) in UNIT_SUFFIXES.items() if b == base for a in allowed]
+            here = f" (the `{suffix}`-style keys here are {_join(same)})" if same else ""
+            if base == "m" and twin in angles:  # a free play in length where the table takes an angle
+                raise check.error(
+                    f"`{where}.{key}` is not a known key: `{where}.{twin}` is an angle, in rad (or `{twin}_deg` in "
+                    f"degrees), not a length: a free play measured as a length s at a radius r is the angle s / r "
+                    f"(rad); write `{twin}` = s / r, or describe a gear mesh by [model.gear_pair], whose `backlash` "
+                    "is a length (m, or `backlash_mm`, `backlash_um`)")
             raise check.error(
-                f"`{where}.{key}` is not a known key: {why}, so it has no value in {unit} (the `{suffix}`-style keys "
-                f"here are {_join(same)}); remove it or correct its spelling"
+                f"`{where}.{key}` is not a known key: {why}, so it has no value in {unit}{here}; remove it or correct "
+                "its spelling"
             )
         earlier = check.converted_keys.get(where, {}).get(twin)  # KEY_mm and KEY_um both
         if twin in table or earlier is not None:

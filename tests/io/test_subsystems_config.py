@@ -332,14 +332,20 @@ def test_length_keys_are_refused_naming_the_key_and_rule(path, value, fragments)
 
 
 def test_a_length_suffix_on_an_angle_is_refused():
-    """A spline's backlash and a chain element's half-gap are angles: ``_mm`` names that."""
+    """A spline's backlash and a chain element's half-gap are angles: ``_mm`` names that, and how a
+    free play measured as a length becomes the angle (or the gear pair that takes a length)."""
     data = _data(DAMPER)
     spline = data["model"]["elements"][1]
     del spline["backlash_deg"]
     spline["backlash_mm"] = 0.1
-    with pytest.raises(ConfigError, match=r"`model.elements\.2.backlash_mm` is not a known key: `backlash` is not a "
-                                          r"length, so it has no value in mm"):
+    with pytest.raises(ConfigError, match=r"`model.elements\.2.backlash_mm` is not a known key: "
+                                          r"`model.elements.2.backlash` is an angle, in rad \(or `backlash_deg` in "
+                                          r"degrees\), not a length: .* the angle s / r .*\[model.gear_pair\]"):
         config_from_dict(data)
+    single = {"model": {"inertia": 1.0, "damping": 0.05, "stiffness": 1.0, "elastic": {"type": "backlash", "b_mm": 0.1}},
+              "excitation": {"mean": 0.05, "amplitudes": [0.03]}}
+    with pytest.raises(ConfigError, match=r"`model.elastic.b_mm` is not a known key: `model.elastic.b` is an angle"):
+        config_from_dict(single)
 
 
 @pytest.mark.parametrize("key, value, fragments", [
