@@ -197,8 +197,8 @@ class SweepResult:
         reasons = list(dict.fromkeys(str(r) for r in self.failure[rows]))  # type: ignore[index]
         i = int(rows[0])
         text = (f"no steady state at {rows.size} of {len(self)} frequencies ({self._failed_text()}; recorded as "
-                f"failed rows, the sweep carried on from the last state computed): at {self.direction[i]} Ω = "
-                f"{self.omega[i]:.6g}: {reasons[0]}")
+                f"failed rows, the sweep carried on from the last state computed): at {self.direction[i]} "
+                f"{SpeedText.of(self.model).at(self.omega[i], 6)}: {reasons[0]}")
         if len(reasons) > 1:
             text += f" (and {len(reasons) - 1} other reason{'s' if len(reasons) > 2 else ''} at other rows)"
         return text
@@ -210,7 +210,7 @@ class SweepResult:
             w = self.omega[(self.direction == d) & self.failed]
             if w.size:
                 more = f", … ({w.size} in all)" if w.size > _LISTED else ""
-                where.append(f"{d} sweep Ω = {', '.join(f'{x:.6g}' for x in w[:_LISTED])}{more}")
+                where.append(f"{d} sweep {SpeedText.of(self.model).values(w[:_LISTED], 6)}{more}")
         return "; ".join(where)
 
     @property
