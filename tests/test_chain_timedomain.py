@@ -106,7 +106,7 @@ def test_chain_sweep_has_element_columns(driveline: Chain, tmp_path: Path) -> No
 def test_single_equation_sweep_has_no_element_columns() -> None:
     r = time_sweep(reference_case(), (1.0, 1.2), 2, "up")
     assert r.element_columns == {} and list(r.columns()) == [
-        "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period"]
+        "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period", "regime"]
 
 
 # --- orbits ---------------------------------------------------------------------------------------

@@ -194,7 +194,7 @@ def test_clearance_in_degrees_warns() -> None:
     assert rec[0].filename == __file__  # stacklevel: the warning points at the caller
     with pytest.warns(UserWarning, match=r"`b` = 10 rad"):
         Clutch(alpha=0.25, b=10.0)
-    with pytest.warns(UserWarning, match=r"`breakpoints\[1\]` = 5 rad"):
+    with pytest.warns(UserWarning, match=r"`breakpoints\[1\]` = 5 rad"):  # the Python API: positions from 0
         rattle.Piecewise(breakpoints=(-0.1, 5.0), slopes=(1.0, 0.2, 1.0))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -243,11 +243,11 @@ FILE_CASES = [
     ("harmonics 10000", "harmonics = 32", "harmonics = 10000", ["`analysis.harmonics` must be <= 256"]),
     ("zero damping", "damping = 0.05", "damping = 0.0", ["`model.damping` must be > 0", "small positive damping"]),
     ("mean 1e300", "mean = 0.05", "mean = 1e300", ["`excitation.mean` must have magnitude <= 1e+50"]),
-    ("amplitude 1e300", "amplitudes = [0.03]", "amplitudes = [1e300]", ["`excitation.amplitudes[0]`"]),
+    ("amplitude 1e300", "amplitudes = [0.03]", "amplitudes = [1e300]", ["`excitation.amplitudes.1`"]),
     ("stiffness beyond float", "stiffness = 1.0", "stiffness = " + "9" * 400, ["`model.stiffness`", "400 digits"]),
     ("K/I overflows", "inertia = 1.0", "inertia = 1e-60", ["`model.stiffness` / `model.inertia`"]),
-    ("omega far below", "omega = [0.1, 3.0]", "omega = [1e-6, 3.0]", ["`analysis.omega[0]` must be >= 0.001"]),
-    ("omega far above", "omega = [0.1, 3.0]", "omega = [0.1, 1e6]", ["`analysis.omega[1]` must be <= 1000"]),
+    ("omega far below", "omega = [0.1, 3.0]", "omega = [1e-6, 3.0]", ["`analysis.omega.1` must be >= 0.001"]),
+    ("omega far above", "omega = [0.1, 3.0]", "omega = [0.1, 1e6]", ["`analysis.omega.2` must be <= 1000"]),
     ("too many amplitudes", "amplitudes = [0.03]", "amplitudes = [" + ", ".join(["0.001"] * 300) + "]",
      ["`excitation.amplitudes` must hold at most 256"]),
 ]

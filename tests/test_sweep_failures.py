@@ -177,9 +177,10 @@ def test_the_files_and_the_plot_cope_with_failed_rows(small_budget, tmp_path):
     r = time_sweep(_preload(), omega=_GRID, points=10, direction="both")
     path = r.to_csv(tmp_path / "sweep.csv")
     lines = path.read_text().splitlines()
-    assert lines[0] == "direction,omega,mean,rms,rms_ac,p2p,acc_p2p,period,stick_fraction"
-    assert lines[1] == "up,0.3,nan,nan,nan,nan,nan,-1,nan"
-    assert len(lines) == 21 and sum(line.endswith(",-1,nan") for line in lines) == 6
+    assert lines[0] == "direction,omega,mean,rms,rms_ac,p2p,acc_p2p,period,regime,stick_fraction"
+    assert lines[1] == "up,0.3,nan,nan,nan,nan,nan,-1,,nan"  # a failed row has no regime
+    assert len(lines) == 21 and sum(line.endswith(",-1,,nan") for line in lines) == 6
+    assert set(r.regime[~r.failed]) <= {"no_impact", "single_sided", "double_sided"}
     import matplotlib
 
     matplotlib.use("Agg")

@@ -111,6 +111,21 @@ def _did_you_mean(word: str, choices: Sequence[str]) -> str:
 
 _BACKTICKED = re.compile(r"`([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)`")
 
+#: A position written after a key as Python indexes it, from 0 (``elements[0]``, ``slopes[2]``).
+_POSITION = re.compile(r"(?<=[A-Za-z0-9_])\[(\d+)\]")
+
+
+def positions_from_one(message: str) -> str:
+    """``message`` with every list position after a key counted from 1 and written as the
+    dotted keys of ``rattle map --vary`` write it (SPEC §7): ``model.elements[0].b`` becomes
+    ``model.elements.1.b``, ``slopes[2]`` becomes ``slopes.3``.
+
+    The configuration readers build their keys with Python's positions (from 0); every message
+    about a case file goes through this once (:meth:`_Checker.error`, the warnings of
+    :meth:`_Checker.build`), so that an element, a link, a torque or an array entry has the same
+    number in every message as in the map's keys and in ``between`` (inertias from 1)."""
+    return _POSITION.sub(lambda m: f".{int(m.group(1)) + 1}", message)
+
 
 def rename_keys(message: str, names: Mapping[str, str]) -> str:
     """Replace backticked field names in ``message`` by the names the user wrote.
@@ -154,9 +169,23 @@ class _Checker:
         self.derived_keys: set[str] = set()
 
     def error(self, message: str) -> ConfigError:
+        return ConfigError(f"{self.source_name}: {self.as_written(message)}")
+
+    def as_written(self, message: str) -> str:
+        """``message`` naming every key as the user wrote it: a converted key by its suffixed
+        form (``b`` → ``b_deg``, with the unit its value is shown in), positions counted from 1
+        (:func:`positions_from_one`)."""
         for key, (written, unit) in self.user_keys.items():  # name the key the user wrote
-            message = message.replace(f"`{key}`", f"`{written}` (converted to {unit})").replace(f"`{key}[", f"`{written}[")
-        return ConfigError(f"{self.source_name}: {message}")
+            message = message.replace(f"`{key}`", f"`{written}` (converted to {unit})")
+            message = re.sub(re.escape(f"`{key}[") + r"(\d+)\]`",
+                             lambda m: f"`{written}[{m.group(1)}]` (converted to {unit})", message)
+            message = message.replace(f"`{key}[", f"`{written}[")
+            # the bare field name in the same message (a dataclass's rule naming its other fields)
+            field, user_field = key.rsplit(".", 1)[-1], written.rsplit(".", 1)[-1]
+            table = key.rsplit(".", 1)[0]
+            if field != user_field and (f"`{table}." in message or f"`{written}" in message):
+                message = re.sub(rf"(?<![\w.`]){re.escape(field)}(?=\[|\b)(?!_)", user_field, message)
+        return positions_from_one(message)
 
     # --- structure ---------------------------------------------------------------------------
     def table(self, parent: Mapping[str, Any], key: str, full: str) -> Mapping[str, Any]:
@@ -258,7 +287,7 @@ class _Checker:
                 text = rename_keys(str(w.message), names)
                 if any(f"`{key}`" in text or f"`{key}[" in text for key in self.derived_keys):
                     continue  # judged by the reader that derived it, naming the user's key
-                warnings.warn(f"{self.source_name}: {text}", w.category, stacklevel=3)
+                warnings.warn(f"{self.source_name}: {self.as_written(text)}", w.category, stacklevel=3)
             return result
         except (ValueError, TypeError) as exc:
             message = str(exc)
@@ -285,9 +314,16 @@ def _in_base_units(check: _Checker, table: Mapping[str, Any], where: str, known:
         if twin not in allowed:
             why = (f"`{twin}` is not {kind}" if twin in known else f"`{where}.{twin}` is not a known key")
             same = [a + x for x, (b, _, _) in UNIT_SUFFIXES.items() if b == base for a in allowed]
+            here = f" (the `{suffix}`-style keys here are {_join(same)})" if same else ""
+            if base == "m" and twin in angles:  # a free play in length where the table takes an angle
+                raise check.error(
+                    f"`{where}.{key}` is not a known key: `{where}.{twin}` is an angle, in rad (or `{twin}_deg` in "
+                    f"degrees), not a length: a free play measured as a length s at a radius r is the angle s / r "
+                    f"(rad); write `{twin}` = s / r, or describe a gear mesh by [model.gear_pair], whose `backlash` "
+                    "is a length (m, or `backlash_mm`, `backlash_um`)")
             raise check.error(
-                f"`{where}.{key}` is not a known key: {why}, so it has no value in {unit} (the `{suffix}`-style keys "
-                f"here are {_join(same)}); remove it or correct its spelling"
+                f"`{where}.{key}` is not a known key: {why}, so it has no value in {unit}{here}; remove it or correct "
+                "its spelling"
             )
         earlier = check.converted_keys.get(where, {}).get(twin)  # KEY_mm and KEY_um both
         if twin in table or earlier is not None:

@@ -42,7 +42,7 @@ def test_requested_frequencies_and_output(tmp_path, reference_model) -> None:
     assert c.at == (0.8, 1.41) and c.reasons == ("requested", "requested")
     frf_path, sweep_path = c.to_csv(tmp_path)
     assert list(read_csv(frf_path)) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
-    assert list(read_csv(sweep_path)) == list(SWEEP_COLUMNS)
+    assert list(read_csv(sweep_path)) == [*SWEEP_COLUMNS, "regime"]
     meta = c.metadata()
     assert [o["omega"] for o in meta["orbits"]] == [0.8, 1.41]
     assert "Ω = 0.8 (requested)" in c.summary()

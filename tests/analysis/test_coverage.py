@@ -73,7 +73,9 @@ def test_a_range_not_covered_exits_1_naming_the_intervals(tmp_path):
     ((ra, rb),) = meta["uncovered_rpm"]
     assert a == pytest.approx(267.21, abs=0.01) and 300.0 < b < 340.0
     assert ra == pytest.approx(1275.8, abs=0.1) and rb == pytest.approx(b * 60 / (4 * math.pi))
-    assert f"not covered (no branch found there): Ω = {a:.5g} … {b:.5g} ({ra:.5g} … {rb:.5g} rpm)" in result.output
+    # an engine case names its speeds in rpm, with Ω (the files' unit) beside the uncovered range
+    assert f"not covered (no branch found there): {ra:.5g} … {rb:.5g} rpm (Ω = {a:.5g} … {b:.5g})" in result.output
+    assert "largest rms" in result.output and " rpm (" in result.output.split("largest rms")[1]
     assert meta["status"] == "step_too_small"
     # not labelled "unstable" there: no branch is known there at all
     assert not [r for r in meta["regions"] if r["omega_max"] > a + 1e-9 and r["omega_min"] < b - 1e-9]

@@ -110,10 +110,10 @@ def test_orbit_writes_the_exact_orbit_of_the_chain_as_one_set(tmp_path):
 def test_frf_refuses_bad_friction_with_nothing_written(tmp_path):
     for old, new, fragments in [
         ("friction = [0.0, 0.03, 0.0]", "friction = [0.03, 0.0]",
-         ["`model.elements[0].friction` must hold one level", 'type = "clutch" has 3 stages', "give 3 levels"]),
-        ("friction = [0.0, 0.03, 0.0]", "friction = -0.01", ["`model.elements[0].friction`", "must be >= 0"]),
+         ["`model.elements.1.friction` must hold one level", 'type = "clutch" has 3 stages', "give 3 levels"]),
+        ("friction = [0.0, 0.03, 0.0]", "friction = -0.01", ["`model.elements.1.friction`", "must be >= 0"]),
         ("friction = [0.0, 0.03, 0.0]", "friction = [0.0, 0.03, 0.0]\npreload = 0.05",
-         ["`model.elements[0].preload` does not belong to type = \"clutch\"", '("preload")']),
+         ["`model.elements.1.preload` does not belong to type = \"clutch\"", '("preload")']),
         ("harmonics = 16", "harmonics = 16\nregularisation = 1.5", ["`analysis.regularisation`", "0 < ε < 1"]),
     ]:
         assert old in CHAIN

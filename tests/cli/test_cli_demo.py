@@ -77,7 +77,7 @@ def test_demo_writes_every_file(demo: tuple[Path, Result]) -> None:
     assert list(frf) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
     assert len(set(np.asarray(frf["branch"], dtype=int).tolist())) == 3
     sweep = read_csv(out / "sweep.csv")
-    assert list(sweep) == list(SWEEP_COLUMNS)
+    assert list(sweep) == [*SWEEP_COLUMNS, "regime"]
     assert np.sum(np.asarray(sweep["direction"]) == "up") == np.sum(np.asarray(sweep["direction"]) == "down") == 200
     meta = json.loads((out / "frf.json").read_text())
     assert meta["command"] == "demo" and meta["options"]["subharmonics"] is True

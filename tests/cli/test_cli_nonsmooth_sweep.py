@@ -99,7 +99,7 @@ def test_compare_of_a_chain_with_friction_writes_the_set(tmp_path):
 
 
 @pytest.mark.parametrize("text, keys", [(PRELOAD, "`model.elastic.preload` and `model.elastic.friction`"),
-                                        (CHAIN, "`model.elements[0].friction`")])
+                                        (CHAIN, "`model.elements.1.friction`")])
 @pytest.mark.parametrize("args, fragment", [
     (["compare", "--at", "0.6"], "`--at` is not supported for a discontinuous law"),
     (["compare", "--measured", "run.csv"], "`--measured` is not supported for a discontinuous law"),

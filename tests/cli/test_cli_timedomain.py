@@ -50,7 +50,10 @@ BAD = [
      ["`--omega-min` must be < `--omega-max`"]),
     ("sweep has no --harmonics", ["sweep", "case.toml", "--direction", "up", "--harmonics", "8"],
      ["No such option", "--harmonics"]),
-    ("orbit no omega", ["orbit", "case.toml"], ["Missing option '--omega'"]),
+    ("orbit no omega", ["orbit", "case.toml"], ["`--omega` or `--rpm` is required"]),
+    ("orbit omega and rpm", ["orbit", "case.toml", "--omega", "1", "--rpm", "800"], ["`--omega` and `--rpm` are both given"]),
+    ("orbit rpm without an engine", ["orbit", "case.toml", "--rpm", "800"], ["`--rpm` 800 needs a model with an engine"]),
+    ("orbit rpm negative", ["orbit", "case.toml", "--rpm", "-1"], ["`--rpm` must be a finite crankshaft speed > 0"]),
     ("orbit omega zero", ["orbit", "case.toml", "--omega", "0"], ["`--omega` must be a finite forcing frequency > 0"]),
     ("orbit omega negative", ["orbit", "case.toml", "--omega", "-1"], ["`--omega`", "got -1.0"]),
     ("orbit omega nan", ["orbit", "case.toml", "--omega", "nan"], ["`--omega`", "got nan"]),
@@ -112,7 +115,8 @@ def test_sweep_end_to_end(case: Path) -> None:
     out = case / "out"
     assert sorted(p.name for p in out.iterdir()) == ["sweep.csv", "sweep.json", "sweep.png"]
     cols = read_csv(out / "sweep.csv")
-    assert list(cols) == list(SWEEP_COLUMNS)
+    assert list(cols) == [*SWEEP_COLUMNS, "regime"]
+    assert set(cols["regime"].tolist()) <= {"no_impact", "single_sided", "double_sided"}
     assert list(cols["direction"]) == ["up"] * 20 + ["down"] * 20
     np.testing.assert_allclose(cols["omega"][:20], np.linspace(0.6, 1.6, 20))
     np.testing.assert_allclose(cols["omega"][20:], np.linspace(1.6, 0.6, 20))
@@ -154,7 +158,7 @@ def test_compare_end_to_end(case: Path) -> None:
     out = case / "out"
     assert sorted(p.name for p in out.iterdir()) == ["compare.json", "compare.png", "frf.csv", "sweep.csv"]
     assert list(read_csv(out / "frf.csv")) == [*FRF_COLUMNS, "harmonics"]  # SPEC §3 + §8
-    assert list(read_csv(out / "sweep.csv")) == list(SWEEP_COLUMNS)
+    assert list(read_csv(out / "sweep.csv")) == [*SWEEP_COLUMNS, "regime"]
     assert (out / "compare.png").read_bytes()[:8] == PNG
     meta = json.loads((out / "compare.json").read_text())
     assert [o["reason"] for o in meta["orbits"]] == ["multi-valued", "sub-harmonic"]

@@ -63,7 +63,7 @@ def test_zero_friction_is_the_smooth_chain():
     assert isinstance(rc.model, Chain) and not rc.discontinuous and not rc.chain_friction
     assert "friction" not in rc.to_dict()["model"]["elements"][0]
     _refused(_chain(0.0) | {"analysis": {"regularisation": 0.01}}, "`analysis.regularisation` = 0.01 applies only",
-             "`model.elements[k].friction`")
+             "`model.elements.K.friction`")
 
 
 def test_si_friction_is_a_torque_divided_by_the_element_stiffness():
@@ -113,7 +113,7 @@ def test_a_damper_and_a_spline_take_friction_per_stage_of_their_law():
     np.testing.assert_allclose(rc.model.system.elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
     bad = copy.deepcopy(data)
     bad["model"]["elements"][0]["friction"] = [1.0, 2.0]
-    _refused(bad, "`model.elements[0].friction` must hold one level (every stage) or one per stage of the damper",
+    _refused(bad, "`model.elements.1.friction` must hold one level (every stage) or one per stage of the damper",
              "4 stages (coast stage 2, coast stage 1, drive stage 1, drive stage 2; from the most negative twist)",
              "got 2 levels [1.0, 2.0]", "give 4 levels or a single number")
     bad["model"]["elements"][0].update(free_play_deg=0.5, coast_stiffness=[20.0, 150.0])  # c1 = k1, free play
@@ -125,14 +125,14 @@ def test_a_damper_and_a_spline_take_friction_per_stage_of_their_law():
 
 
 @pytest.mark.parametrize("friction, fragments", [
-    ([0.0, -0.02, 0.0], ["`model.elements[0].friction[1]`", "must be >= 0", "-0.02"]),
-    ([0.01, 0.02], ["`model.elements[0].friction` must hold one level (every stage) or one per stage of the law",
+    ([0.0, -0.02, 0.0], ["`model.elements.1.friction.2`", "must be >= 0", "-0.02"]),
+    ([0.01, 0.02], ["`model.elements.1.friction` must hold one level (every stage) or one per stage of the law",
                     'type = "clutch" has 3 stages (δ < -0.1, -0.1 < δ < 0.1, δ > 0.1)', "got 2 levels [0.01, 0.02]",
                     "give 3 levels or a single number"]),
-    ("0.02", ["`model.elements[0].friction` must be a number", '"0.02"', "e.g. friction = 0.02"]),
-    ([0.0, "a", 0.0], ["`model.elements[0].friction[1]` must be a number", "e.g. friction = 0.02"]),
-    ([], ["`model.elements[0].friction`", "at least one"]),
-    (math.inf, ["`model.elements[0].friction` must be a finite number"]),
+    ("0.02", ["`model.elements.1.friction` must be a number", '"0.02"', "e.g. friction = 0.02"]),
+    ([0.0, "a", 0.0], ["`model.elements.1.friction.2` must be a number", "e.g. friction = 0.02"]),
+    ([], ["`model.elements.1.friction`", "at least one"]),
+    (math.inf, ["`model.elements.1.friction` must be a finite number"]),
 ])
 def test_bad_friction_is_refused_naming_the_key(friction, fragments):
     _refused(_chain(friction), *fragments)
@@ -181,30 +181,30 @@ def test_a_preload_in_si_is_divided_by_the_element_stiffness():
 
 
 @pytest.mark.parametrize("element, fragments", [
-    ({"preload": -0.01}, ["`model.elements[0].preload`", "must be >= 0"]),
-    ({"preload": "0.05"}, ["`model.elements[0].preload` must be a number"]),
-    ({"slope": 0.0}, ["`model.elements[0].slope` must be > 0"]),
-    ({"friction": [0.01, 0.02, 0.03]}, ["`model.elements[0].friction` must hold one level",
+    ({"preload": -0.01}, ["`model.elements.1.preload`", "must be >= 0"]),
+    ({"preload": "0.05"}, ["`model.elements.1.preload` must be a number"]),
+    ({"slope": 0.0}, ["`model.elements.1.slope` must be > 0"]),
+    ({"friction": [0.01, 0.02, 0.03]}, ["`model.elements.1.friction` must hold one level",
                                         'type = "preload" has 2 stages']),
-    ({"b": 0.1}, ["`model.elements[0].b` does not belong to type = \"preload\"", "preload, clearance, slope"]),
+    ({"b": 0.1}, ["`model.elements.1.b` does not belong to type = \"preload\"", "preload, clearance, slope"]),
 ])
 def test_a_bad_preload_element_is_refused_naming_the_key(element, fragments):
     _refused(_preload_chain(**element), *fragments)
 
 
 def test_a_preload_key_on_another_law_points_to_the_preload_type():
-    _refused(_chain(preload=0.05), "`model.elements[0].preload` does not belong to type = \"clutch\"",
+    _refused(_chain(preload=0.05), "`model.elements.1.preload` does not belong to type = \"clutch\"",
              'choose a type that uses it ("preload")')
 
 
 def test_an_unknown_element_key_names_friction_among_the_allowed_ones():
-    _refused(_chain(0.01, frition=0.01), "`model.elements[0].frition` is not a known key", "(and friction)")
+    _refused(_chain(0.01, frition=0.01), "`model.elements.1.frition` is not a known key", "(and friction)")
 
 
 def test_sound_paths_with_chain_friction_are_refused():
     data = _chain(0.01)
     data["paths"] = [{"name": "p", "source": "acceleration", "table": "x.csv"}]
-    _refused(data, "`paths`", "`model.elements[k].friction`", "remove [[paths]]")
+    _refused(data, "`paths`", "`model.elements.K.friction`", "remove [[paths]]")
 
 
 def test_load_case_reads_a_chain_with_friction_with_the_chain_defaults(tmp_path):

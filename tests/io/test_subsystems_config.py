@@ -184,25 +184,25 @@ _DEL = object()
 
 @pytest.mark.parametrize("text, path, value, fragments", [
     (DAMPER, "model.elements.0.drive_angles_deg", [4.0, 3.0],
-     ["`model.elements[0].drive_angles_deg`", "must have one entry fewer"]),
+     ["`model.elements.1.drive_angles_deg`", "must have one entry fewer"]),
     (DAMPER, "model.elements.0.drive_stiffness_per_deg", [1.5, 30.0, 60.0],
-     ["`model.elements[0].drive_angles_deg`", "must have one entry fewer"]),
+     ["`model.elements.1.drive_angles_deg`", "must have one entry fewer"]),
     (DAMPER, "model.elements.0.drive_stiffness_per_deg", [1.5, -30.0],
-     ["`model.elements[0].drive_stiffness_per_deg[1]`", "must be > 0"]),
+     ["`model.elements.1.drive_stiffness_per_deg.2`", "must be > 0"]),
     (DAMPER, "model.elements.0.coast_stiffness", [0.0, 1000.0],
-     ["`model.elements[0].coast_stiffness[0]`", "must be > 0"]),
+     ["`model.elements.1.coast_stiffness.1`", "must be > 0"]),
     (DAMPER, "model.elements.0.free_play_deg", 7.0,
-     ["`model.elements[0].coast_angles_deg[0]`", "free_play/2"]),
-    (DAMPER, "model.elements.0.stiffness", 100.0, ["`model.elements[0].stiffness` is not a known key"]),
-    (DAMPER, "model.elements.0.coast_stiffness", _DEL, ["`model.elements[0].coast_stiffness` is missing"]),
+     ["`model.elements.1.coast_angles_deg.1`", "free_play_deg/2"]),
+    (DAMPER, "model.elements.0.stiffness", 100.0, ["`model.elements.1.stiffness` is not a known key"]),
+    (DAMPER, "model.elements.0.coast_stiffness", _DEL, ["`model.elements.1.coast_stiffness` is missing"]),
     (DAMPER, "model.elements.0.drive_angles", [0.1],
-     ["`model.elements[0].drive_angles` and `model.elements[0].drive_angles_deg` are both given"]),
-    (DAMPER, "model.elements.0.type", "dampr", ["`model.elements[0].type` must be one of", 'did you mean "damper"']),
-    (DAMPER, "model.elements.1.backlash_deg", -1.0, ["`model.elements[1].backlash_deg`", "must be > 0"]),
-    (DAMPER, "model.elements.1.stiffness", 0.0, ["`model.elements[1].stiffness` must be > 0"]),
-    (GEARS, "model.gear_pair.base_radii", [0.03, -0.04], ["`model.gear_pair.base_radii[1]` must be > 0"]),
+     ["`model.elements.1.drive_angles` and `model.elements.1.drive_angles_deg` are both given"]),
+    (DAMPER, "model.elements.0.type", "dampr", ["`model.elements.1.type` must be one of", 'did you mean "damper"']),
+    (DAMPER, "model.elements.1.backlash_deg", -1.0, ["`model.elements.2.backlash_deg`", "must be > 0"]),
+    (DAMPER, "model.elements.1.stiffness", 0.0, ["`model.elements.2.stiffness` must be > 0"]),
+    (GEARS, "model.gear_pair.base_radii", [0.03, -0.04], ["`model.gear_pair.base_radii.2` must be > 0"]),
     (GEARS, "model.gear_pair.base_radii", [0.03], ["`model.gear_pair.base_radii` must be a pair"]),
-    (GEARS, "model.gear_pair.inertias", [0.0, 6e-3], ["`model.gear_pair.inertias[0]` must be > 0"]),
+    (GEARS, "model.gear_pair.inertias", [0.0, 6e-3], ["`model.gear_pair.inertias.1` must be > 0"]),
     (GEARS, "model.gear_pair.mesh_stiffness", -2e8, ["`model.gear_pair.mesh_stiffness` must be > 0"]),
     (GEARS, "model.gear_pair.mesh_damping_ratio", 0.0, ["`model.gear_pair.mesh_damping_ratio` must be > 0"]),
     (GEARS, "model.gear_pair.backlash_um", 0.0, ["`model.gear_pair.backlash_um` (converted to m) must be > 0"]),
@@ -243,7 +243,7 @@ def test_refusal_exits_2_on_the_command_line(tmp_path):
         runner = CliRunner()
     result = runner.invoke(cli, ["frf", str(path), "-o", str(tmp_path / "out")], catch_exceptions=False)
     assert result.exit_code == 2
-    assert "`model.gear_pair.inertias[0]` must be > 0" in result.stderr
+    assert "`model.gear_pair.inertias.1` must be > 0" in result.stderr
     assert not (tmp_path / "out" / "frf.csv").exists()
 
 
@@ -332,14 +332,20 @@ def test_length_keys_are_refused_naming_the_key_and_rule(path, value, fragments)
 
 
 def test_a_length_suffix_on_an_angle_is_refused():
-    """A spline's backlash and a chain element's half-gap are angles: ``_mm`` names that."""
+    """A spline's backlash and a chain element's half-gap are angles: ``_mm`` names that, and how a
+    free play measured as a length becomes the angle (or the gear pair that takes a length)."""
     data = _data(DAMPER)
     spline = data["model"]["elements"][1]
     del spline["backlash_deg"]
     spline["backlash_mm"] = 0.1
-    with pytest.raises(ConfigError, match=r"`model.elements\[1\].backlash_mm` is not a known key: `backlash` is not a "
-                                          r"length, so it has no value in mm"):
+    with pytest.raises(ConfigError, match=r"`model.elements\.2.backlash_mm` is not a known key: "
+                                          r"`model.elements.2.backlash` is an angle, in rad \(or `backlash_deg` in "
+                                          r"degrees\), not a length: .* the angle s / r .*\[model.gear_pair\]"):
         config_from_dict(data)
+    single = {"model": {"inertia": 1.0, "damping": 0.05, "stiffness": 1.0, "elastic": {"type": "backlash", "b_mm": 0.1}},
+              "excitation": {"mean": 0.05, "amplitudes": [0.03]}}
+    with pytest.raises(ConfigError, match=r"`model.elastic.b_mm` is not a known key: `model.elastic.b` is an angle"):
+        config_from_dict(single)
 
 
 @pytest.mark.parametrize("key, value, fragments", [
@@ -399,3 +405,30 @@ def test_the_command_line_shows_the_warning_as_one_plain_line(tmp_path):
     assert len(warned) == 1, result.stderr
     assert warned[0].startswith(f"rattle: warning: {path}: `model.gear_pair.backlash` = 0.12 m")
     assert ".py" not in result.stderr and "rattle/" not in result.stderr.replace(str(tmp_path), "")
+
+
+def test_messages_count_elements_from_1_as_the_map_keys_and_name_the_key_written():
+    """One index base (issue 27 item 4): an error about the second element names
+    ``model.elements.2`` — the key ``rattle map --vary`` takes for it (SPEC §7 counts positions
+    from 1) — and a damper given in N m/deg is named by its ``*_per_deg`` key, never by the N m/rad
+    key the reader converted it to."""
+    from rattle.maps import parameters
+
+    (p,) = parameters(_data(DAMPER), {"model.elements.spline.stiffness": [8000.0]})
+    assert p.key == "model.elements.2.stiffness"
+    data = _data(DAMPER)
+    data["model"]["elements"][1]["stiffness"] = -1.0
+    with pytest.raises(ConfigError, match=r"^case.toml: `model.elements.2.stiffness` must be > 0"):
+        config_from_dict(data, source_name="case.toml")
+    data = _data(DAMPER)
+    data["model"]["elements"][0]["drive_stiffness_per_deg"] = []
+    with pytest.raises(ConfigError) as info:
+        config_from_dict(data, source_name="case.toml")
+    message = str(info.value)
+    assert "`model.elements.1.drive_stiffness_per_deg` (converted to N m/rad) must hold at least one stage" in message
+    assert "[0]" not in message and "drive_stiffness`" not in message
+    data = _data(DAMPER)
+    data["model"]["elements"][0]["drive_angles_deg"] = [4.0, 5.0]
+    with pytest.raises(ConfigError, match=r"`model.elements.1.drive_angles_deg` \(converted to rad\) must have one "
+                                          r"entry fewer than `model.elements.1.drive_stiffness_per_deg`"):
+        config_from_dict(data, source_name="case.toml")

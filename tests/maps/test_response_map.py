@@ -258,10 +258,55 @@ def test_map_of_an_engine_config_gives_speed_rpm(tmp_path):
                      omega_points=4, harmonics=8, search=AttractorSearch(bands=0, hb_points=0, from_unstable=False),
                      engine="serial")
     assert m.speed_order == order
-    np.testing.assert_allclose(m.speed_rpm, m.omega * 60 / (2 * np.pi * order), rtol=1e-15)
+    exact = m.omega * 60 / (2 * np.pi * order)
+    # rounded to a millionth of the grid's step (round-off of the conversion gone, nothing else)
+    np.testing.assert_allclose(m.speed_rpm, exact, rtol=0, atol=0.5e-6 * (exact[1] - exact[0]))
+    assert m.speed_rpm[0] == 400.0 and m.speed_rpm[1] == 426.66667
     table = read_csv(m.to_csv(tmp_path / "map.csv"))
     assert list(table)[-1] == "speed_rpm"
     np.testing.assert_allclose(np.asarray(table["speed_rpm"], float), m.speed_rpm, rtol=1e-12)
     np.testing.assert_allclose(m.dataset["speed_rpm"].values, m.speed_rpm)
     fig, axes = m.plot()
     assert axes.primary.get_xlabel() == "engine speed (rpm)"
+
+
+def test_the_report_of_an_engine_map_gives_speeds_in_rpm_and_angles_in_degrees(tmp_path):
+    """map.md of an engine case whose clearance was given in degrees (``b_deg``): the varied angle
+    in degrees, every speed in rpm; map.csv keeps rad and Ω (issue 27 item 3)."""
+    import math
+    from pathlib import Path
+
+    from rattle.cli.output import map_summary
+    from rattle.maps import Parameter, map_report, mark_degrees
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "engine_clutch_si.toml"
+    case = rattle.load_case(path)
+    source = rattle.io.load_config(path).source
+    (p,) = mark_degrees([Parameter(name="b", key="model.elements.1.b", values=(math.radians(4.0),))], source)
+    assert p.degrees and p.shown(p.values[0]) == pytest.approx(4.0, rel=1e-15)
+    lo = case.analysis.omega[0]
+    m = response_map(case, [p], omega=(lo, lo * 1.2), omega_points=4, harmonics=8,
+                     search=AttractorSearch(bands=0, hb_points=0, from_unstable=False), engine="serial")
+    assert m.parameters[0].degrees  # kept through response_map
+    text = map_report(m)
+    assert "given in degrees; map.csv in rad): 4 deg" in text and "| b (deg) |" in text and "### b = 4 deg" in text
+    assert "speed grid: 4 crankshaft speeds, 400 … 480 rpm" in text and "speed (rpm)" in text
+    body = text.split("## Rattle-free region")[1]
+    assert "rad/s" not in body and "Ω =" not in body
+    assert "rpm" in map_summary(m).splitlines()[-1] or "none" in map_summary(m).splitlines()[-1]
+    assert map_summary(m).splitlines()[-1].startswith("speeds rattle-free at every combination: ")
+    table = rattle.io.read_csv(m.to_csv(tmp_path / "map.csv"))
+    assert float(table["b"][0]) == math.radians(4.0)  # the files keep rad
+
+
+def test_which_angles_were_given_in_degrees():
+    from rattle.maps._vary import given_in_degrees
+
+    damper = {"model": {"elements": [{"type": "damper", "drive_angles_deg": [4.0], "drive_stiffness_per_deg": [1.0]},
+                                     {"type": "backlash", "b": 0.1}]}}
+    assert given_in_degrees(damper, "model.elements.1.breakpoints.4")
+    assert not given_in_degrees(damper, "model.elements.1.stiffness")
+    assert not given_in_degrees(damper, "model.elements.2.b") and not given_in_degrees(damper, "model.elements.3.b")
+    single = {"model": {"elastic": {"type": "clutch", "alpha": 0.25, "b_deg": 10.0}}}
+    assert given_in_degrees(single, "model.elastic.b") and not given_in_degrees(single, "model.elastic.alpha")
+    assert not given_in_degrees(single, "excitation.mean") and not given_in_degrees({}, "model.elastic.b")

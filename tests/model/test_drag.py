@@ -188,10 +188,10 @@ def test_round_trip_keeps_the_drag() -> None:
     ("[drag]\ninertia = 2\nspeed_rpm = [600.0, 500.0]\ntorque = [1.0, 2.0]\n", "drag.speed_rpm"),
     ("[drag]\ninertia = 2\nspeed_rpm = [600.0, 600.0]\ntorque = [1.0, 2.0]\n", "drag.speed_rpm"),
     ("[drag]\ninertia = 2\nspeed_rpm = [600.0, 900.0]\ntorque = [1.0]\n", "drag.torque"),
-    ("[drag]\ninertia = 2\nspeed_rpm = [600.0]\ntorque = [-1.0]\n", "drag.torque[0]"),
+    ("[drag]\ninertia = 2\nspeed_rpm = [600.0]\ntorque = [-1.0]\n", "drag.torque.1"),
     ("[drag]\ninertia = 3\nspeed_rpm = [600.0]\ntorque = [1.0]\n", "drag.inertia"),
     ("[drag]\ninertia = 2\nspeed_rpm = [600.0]\ntorque = [1.0]\nbalance = 2\n", "drag.balance"),
-    ("[drag]\ninertia = 2\nspeed_rpm = [0.0]\ntorque = [1.0]\n", "drag.speed_rpm[0]"),
+    ("[drag]\ninertia = 2\nspeed_rpm = [0.0]\ntorque = [1.0]\n", "drag.speed_rpm.1"),
     ("[drag]\ninertia = 2\nspeed = [600.0]\ntorque = [1.0]\n", "drag"),
 ])
 def test_bad_drag_tables_are_refused_naming_the_key(table: str, key: str) -> None:

@@ -165,16 +165,17 @@ def test_bad_input_is_refused(kwargs, error, match):
 def test_result_columns_csv_and_metadata(jump_sweep, tmp_path):
     r = jump_sweep
     assert len(r) == 160
-    assert tuple(r.columns()) == SWEEP_COLUMNS
+    assert tuple(r.columns()) == (*SWEEP_COLUMNS, "regime")
     row = r[0]
     assert tuple(row) == SWEEP_COLUMNS and row["direction"] == "up" and row["omega"] == 0.5
     path = r.to_csv(tmp_path / "sweep.csv")
-    assert path.read_text().splitlines()[0] == ",".join(SWEEP_COLUMNS)
+    assert path.read_text().splitlines()[0] == ",".join((*SWEEP_COLUMNS, "regime"))
     back = read_csv(path)
     np.testing.assert_array_equal(back["omega"], r.omega)
     np.testing.assert_array_equal(back["rms"], r.rms)
     np.testing.assert_array_equal(back["period"], r.period)
     assert list(back["direction"]) == list(r.direction)
+    assert list(back["regime"]) == list(r.regime)
     meta = r.metadata()
     json.dumps(meta)  # JSON-serialisable
     assert meta["settings"]["points"] == 80 and meta["settings"]["direction"] == "both"
@@ -209,3 +210,20 @@ def test_plot_delegates_to_the_plotting_layer(jump_sweep, monkeypatch):
 def test_exported():
     assert rattle.analysis.time_sweep is time_sweep
     assert rattle.results.SweepResult is SweepResult
+
+
+def test_every_row_has_the_regime_of_its_steady_motion(jump_sweep):
+    """``regime`` (SPEC §1's vocabulary) of each row: from the breakpoints its trajectory crossed,
+    the same as frf.csv's rule on the row's extremes for a continuous law; the reference clutch
+    crosses its drive-side breakpoint only off resonance, both at the resonance's large orbit."""
+    import dataclasses
+
+    r = jump_sweep
+    assert set(r.regime) <= {"no_impact", "single_sided", "double_sided"}
+    from_extremes = dataclasses.replace(r, regime=None).regime  # frf.csv's rule, on delta_min/delta_max
+    assert list(r.regime) == list(from_extremes)
+    big = r.rms > 0.3
+    assert big.any() and set(r.regime[big]) == {"double_sided"}
+    assert "single_sided" in set(r.regime[~big])
+    up = r.select("up")
+    assert list(up.regime) == list(r.regime[r.direction == "up"])

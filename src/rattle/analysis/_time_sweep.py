@@ -91,6 +91,7 @@ def sweep_direction(
     for key in sticks:
         rows[key] = np.empty(n)
     rows["failure"] = np.full(n, "", dtype=object)
+    rows["regime"] = np.full(n, "", dtype=object)
     failures = _failures(model)
     for i, w in enumerate(omegas):
         try:
@@ -111,6 +112,7 @@ def sweep_direction(
         rows["period"][i] = s.period
         rows["settled"][i] = s.settled
         rows["method"][i] = s.method
+        rows["regime"][i] = s.regime
         rows["periods"][i] = s.periods
         rows["shooting_periods"][i] = s.shooting_periods
         rows["state0"][i] = s.state0
@@ -158,6 +160,8 @@ def _fail_row(rows: dict[str, np.ndarray], i: int, omega: float, reason: str) ->
             col[i] = omega
         elif key == "failure":
             col[i] = reason
+        elif key == "regime":
+            col[i] = ""
         elif key == "period":
             col[i] = FAILED_PERIOD
         elif key == "method":

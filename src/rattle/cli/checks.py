@@ -30,7 +30,8 @@ if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when 
 __all__ = [
     "MAX_PERIOD", "DIRECTIONS", "VIRTUAL_FILESYSTEMS", "output_path", "override_analysis", "check_output_dir",
     "precheck", "as_bad_input", "check_points", "check_workers", "check_omega", "check_period", "parse_at",
-    "MAX_OMEGA_POINTS", "check_omega_points", "check_scheduler", "speed_options",
+    "MAX_OMEGA_POINTS", "check_omega_points", "check_scheduler", "speed_options", "check_rpm", "orbit_speed",
+    "orbit_omega",
 ]
 
 #: Most grid frequencies ``rattle map --omega-points`` accepts (each is an exact solve of every
@@ -110,10 +111,10 @@ def override_analysis(base: AnalysisSettings, model: Model | None = None, *, lab
     ------
     ConfigError
         If the combination breaks a rule; the message names the option (``--omega-min``) or the
-        file key (``analysis.omega[1]``) each value came from.
+        file key (``analysis.omega.2``) each value came from.
     """
     given = {name: value for name, value in options.items() if value is not None}
-    names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics"}
+    names = {"omega_min": "analysis.omega.1", "omega_max": "analysis.omega.2", "harmonics": "analysis.harmonics"}
     names.update({name: "--" + name.replace("_", "-") for name in given})
     names.update({name: label for name, label in (labels or {}).items() if name in given})
     try:
@@ -337,6 +338,42 @@ def check_scheduler(scheduler: str | None) -> str | None:
     from ..engines import check_scheduler_address
 
     return check_scheduler_address(scheduler, probe=False)
+
+
+def check_rpm(rpm: float, option: str = "--rpm") -> float:
+    """A crankshaft speed given on the command line: finite and > 0 rpm (its engine is checked
+    once the file is read, :func:`orbit_omega`)."""
+    if not (math.isfinite(rpm) and rpm > 0.0):
+        raise ConfigError(f"`{option}` must be a finite crankshaft speed > 0 rpm, got {rpm!r}; use e.g. 800")
+    return rpm
+
+
+def orbit_speed(omega: float | None, rpm: float | None) -> None:
+    """``rattle orbit``: exactly one of ``--omega`` (rad/s) and ``--rpm`` (crankshaft rpm), each
+    finite and > 0 — checked before the file is read."""
+    if omega is not None and rpm is not None:
+        raise ConfigError(f"`--omega` and `--rpm` are both given ({omega!r} rad/s and {rpm!r} rpm): they name the "
+                          "same forcing frequency; give one of them")
+    if omega is None and rpm is None:
+        raise ConfigError("`--omega` or `--rpm` is required: give the forcing frequency as --omega W (rad/s), or for a "
+                          "configuration with [engine] the crankshaft speed as --rpm N")
+    if omega is not None:
+        check_omega(omega)
+    else:
+        check_rpm(rpm)  # type: ignore[arg-type]
+
+
+def orbit_omega(model: Any, omega: float | None, rpm: float | None) -> tuple[float, str]:
+    """The forcing frequency Ω (rad/s) of ``rattle orbit`` and the option that gave it: ``--omega``
+    as given, or ``--rpm`` n as Ω = q_0 · 2π/60 · n with the model's engine order q_0 (refused
+    without an engine: the case has no crankshaft speed)."""
+    if rpm is None:
+        return float(omega), "--omega"  # type: ignore[arg-type]
+    order = getattr(model, "speed_order", None)
+    if order is None:
+        raise ConfigError(f"`--rpm` {rpm:g} needs a model with an engine ([engine] in the configuration): without "
+                          "engine orders there is no crankshaft speed; give the forcing frequency as --omega in rad/s")
+    return rpm * float(order) * 2.0 * math.pi / 60.0, "--rpm"
 
 
 def check_omega(omega: float, option: str = "--omega", model: Model | None = None) -> float:

@@ -21,8 +21,8 @@ import click
 
 from ..errors import ConfigError, ConvergenceError
 from .checks import (
-    DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, output_path,
-    override_analysis, parse_at, precheck, speed_options,
+    DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, orbit_omega, orbit_speed,
+    output_path, override_analysis, parse_at, precheck, speed_options,
 )
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
@@ -86,11 +86,11 @@ _harmonics_option = click.option(
 )
 _omega_min_option = click.option(
     "--omega-min", type=float, default=None, metavar="X",
-    help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega[0].",
+    help="Lower forcing frequency in rad/s (> 0); overrides analysis.omega.1 (the lower end).",
 )
 _omega_max_option = click.option(
     "--omega-max", type=float, default=None, metavar="Y",
-    help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega[1].",
+    help="Upper forcing frequency in rad/s (> omega-min); overrides analysis.omega.2 (the upper end).",
 )
 _rpm_min_option = click.option(
     "--rpm-min", type=float, default=None, metavar="N1",
@@ -206,7 +206,7 @@ def _law_keys(run_config: Any) -> str:
     """The keys that make the configuration's law discontinuous, as the user wrote them."""
     if getattr(run_config, "chain_friction", False):  # a chain with friction or preloads on its elements
         system = run_config.model
-        keys = [f"`model.elements[{e}].{k}`" for e in range(system.m)
+        keys = [f"`model.elements.{e + 1}.{k}`" for e in range(system.m)
                 for k, on in (("preload", bool(system.laws[e].stages.jumps.any())),
                               ("friction", bool(system.friction_levels(e).any()))) if on]
         return " and ".join(keys) or "`model.elements`"
@@ -386,8 +386,10 @@ def _raise_if_incomplete(sweep: Any, written: Sequence[str], output: Path) -> No
 @common_options
 @click.argument("config", type=click.Path(path_type=Path))
 @_output_option
-@click.option("--omega", "omega", type=float, required=True, metavar="W",
-              help="Forcing frequency in rad/s (finite, > 0).")
+@click.option("--omega", "omega", type=float, default=None, metavar="W",
+              help="Forcing frequency in rad/s (finite, > 0). Give this or --rpm.")
+@click.option("--rpm", "rpm", type=float, default=None, metavar="N",
+              help="Crankshaft speed in rpm (finite, > 0), for a configuration with [engine]; instead of --omega.")
 @click.option("--period", type=int, default=1, show_default=True, metavar="N",
               help=f"Period of the orbit as a multiple of the forcing period, 1 … {MAX_PERIOD} (N: a 1/N sub-harmonic).")
 @_harmonics_option
@@ -397,11 +399,14 @@ def _raise_if_incomplete(sweep: Any, written: Sequence[str], output: Path) -> No
               help="A discontinuous law: compute only the orbit asked for, not every orbit at W (the census of "
                    "the window W (1 ± 0.1) costs seconds).")
 def orbit_command(
-    config: Path, output: Path, omega: float, period: int, harmonics: int | None,
-    omega_min: float | None, omega_max: float | None, single: bool = False,
+    config: Path, output: Path, omega: float | None, period: int, harmonics: int | None,
+    omega_min: float | None, omega_max: float | None, rpm: float | None = None, single: bool = False,
 ) -> None:
     """Periodic orbits at the forcing frequency W for the model in CONFIG: orbit.csv, orbit.png,
     orbit.json in OUTPUT.
+
+    The frequency is --omega W (rad/s) or, for a configuration with [engine], --rpm N (the
+    crankshaft speed: W = order × 2π N/60); one of the two, not both.
 
     Every coexisting harmonic-balance solution at W is found (the primary branch is followed over
     the analysis range, widened to include W; sub-harmonics are seeded from a simulation) and its
@@ -419,14 +424,18 @@ def orbit_command(
     the window W (1 ± 0.1) solved at W and the attractors simulations settle on at W (orbit.json:
     "orbits", "nonperiodic"); --single skips that census.
     """
-    check_omega(omega)
+    orbit_speed(omega, rpm)
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
+    omega, option = orbit_omega(run_config.model, omega, rpm)  # --rpm: only with an engine
+    speed = {} if rpm is None else {"rpm": rpm}
     if getattr(run_config, "chain_friction", False):
-        run_friction_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max, every=not single)
+        run_friction_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max, speed,
+                           every=not single)
         return
     if run_config.discontinuous:
-        run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max, every=not single)
+        run_nonsmooth_orbit(run_config, config, output, omega, period, harmonics, omega_min, omega_max, speed,
+                            every=not single)
         return
     if single:
         raise ConfigError("`--single` applies to a discontinuous law (a torque jump or friction): the orbits of this "
@@ -434,7 +443,7 @@ def orbit_command(
     analysis = override_analysis(
         run_config.analysis, run_config.model, harmonics=harmonics, omega_min=omega_min, omega_max=omega_max
     )
-    check_omega(omega, model=run_config.model)
+    check_omega(omega, option, model=run_config.model)
     model = run_config.model
     forced = len(model.excitation.amplitudes) if hasattr(model, "excitation") else int(model.forced_harmonics)
     check_period(period, analysis.harmonics, forced)
@@ -444,7 +453,7 @@ def orbit_command(
     result = periodic_orbit(run_config.model, omega, period=period, harmonics=analysis.harmonics,
                             search_range=analysis.omega)
     meta = sections("orbit", config, run_config, analysis, {
-        "omega": omega, "period": period, "harmonics": harmonics,
+        "omega": omega, **speed, "period": period, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max,
     })
     written = write_set(output, ORBIT_FILES, [
@@ -456,8 +465,8 @@ def orbit_command(
 
 
 def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
-                        harmonics: int | None, omega_min: float | None, omega_max: float | None, *,
-                        every: bool = True) -> None:
+                        harmonics: int | None, omega_min: float | None, omega_max: float | None,
+                        speed: dict[str, float] | None = None, *, every: bool = True) -> None:
     """``rattle orbit`` on a discontinuous law: :func:`rattle.analysis.nonsmooth_orbit` (the regularised
     HB orbit at Ω and the exact orbit shot from it, with its stick and lock phases), written as one
     set orbit.csv, orbit.json, orbit.png.
@@ -483,7 +492,8 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
         "orbit": result.summary(),
         "timings": timings,
     }
-    written = _write_nonsmooth_orbit(result, meta, config, run_config, analysis, output, omega, harmonics, t_start)
+    written = _write_nonsmooth_orbit(result, meta, config, run_config, analysis, output, omega, harmonics, t_start,
+                                     speed)
     lines = [f"orbit at Ω = {omega:.6g} (period {result.period:.6g} s): "
              + (f"exact rms {result.rms:.6g} rad, mean {result.mean:.6g} rad, {result.regime}, "
                 f"{'stable' if result.stable else 'unstable'} (|μ| = {abs(result.multipliers[0]):.3g}, "
@@ -507,10 +517,11 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
 
 def _write_nonsmooth_orbit(result: Any, meta: dict[str, Any], config: Path, run_config: Any,
                            analysis: AnalysisSettings, output: Path, omega: float, harmonics: int | None,
-                           t_start: float) -> list[str]:
+                           t_start: float, speed: dict[str, float] | None = None) -> list[str]:
     """orbit.csv, orbit.json (``meta`` with the run's sections) and orbit.png of the orbit of a
     discontinuous law or a chain with friction, written as one set; the names written."""
-    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, "harmonics": harmonics})
+    sections_ = sections("orbit", config, run_config, analysis, {"omega": omega, **(speed or {}),
+                                                                 "harmonics": harmonics})
     return write_set(output, ORBIT_FILES, [
         ("orbit.csv", result.to_csv),
         ("orbit.json", metadata_writer(meta, sections_, t_start)),
@@ -553,8 +564,8 @@ def _nonsmooth_orbit_options(run_config: Any, period: int, omega_min: float | No
 
 
 def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
-                       harmonics: int | None, omega_min: float | None, omega_max: float | None, *,
-                       every: bool = True) -> None:
+                       harmonics: int | None, omega_min: float | None, omega_max: float | None,
+                       speed: dict[str, float] | None = None, *, every: bool = True) -> None:
     """``rattle orbit`` on a chain with Coulomb friction on its elements:
     :func:`rattle.analysis.friction_orbit` (the chain's regularised HB orbit at Ω and the exact orbit
     shot from it, every element's stick phases), written as one set orbit.csv, orbit.json,
@@ -587,7 +598,8 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
         "orbit": result.metadata(),
         "timings": timings,
     }
-    written = _write_nonsmooth_orbit(result, meta, config, run_config, analysis, output, omega, harmonics, t_start)
+    written = _write_nonsmooth_orbit(result, meta, config, run_config, analysis, output, omega, harmonics, t_start,
+                                     speed)
     echo_written(result.summary(), written, output)
     if not result.converged:
         raise _orbit_not_found(omega, result.message, written, output)
@@ -790,7 +802,7 @@ def map_command(
     shooting continuation (as rattle frf at its defaults) and the search on the exact flow;
     [analysis] method = "hb" is refused there.
     """
-    from ..maps import build_all, combinations, parameters, parse_all
+    from ..maps import build_all, combinations, mark_degrees, parameters, parse_all
 
     parsed = parse_all(vary)  # first: a malformed --vary needs no file
     precheck(config, output, harmonics=harmonics, workers=workers)
@@ -809,7 +821,7 @@ def map_command(
         tables = dataclasses.replace(run_config, analysis=analysis).to_dict()
     else:
         tables = _io().model_to_toml_dict(run_config.model, analysis)
-    params = parameters(tables, parsed)
+    params = mark_degrees(parameters(tables, parsed), run_config.source)  # angles given in degrees: shown so
     build_all(tables, params)  # every combination's model, before any work
     t_start = time.perf_counter()
     from ..maps import response_map  # only now: all input has been validated

@@ -309,7 +309,7 @@ def map_json_writer(response_map: Any, sections: dict[str, Any], t_start: float)
 
 def map_summary(response_map: Any) -> str:
     """What ``rattle map`` prints: the map's size, what was read back or failed, and the Ω
-    intervals rattle-free at every combination."""
+    intervals (an engine case: crankshaft speeds in rpm) rattle-free at every combination."""
     from ..maps import common_intervals, format_intervals
 
     cells = response_map.cells
@@ -319,7 +319,11 @@ def map_summary(response_map: Any) -> str:
     sizes = " × ".join(f"{len(p.values)} {p.name}" for p in response_map.parameters)
     lines = [f"response map: {len(cells)} combinations ({sizes}) × {len(response_map.omega)} frequencies; "
              f"{len(cells) - resumed} computed, {resumed} read back, {partial} partial, {failed} failed"]
+    from ..results import SpeedText
+
+    speed = SpeedText(None if response_map.speed_order is None else float(response_map.speed_order))
     common = common_intervals(response_map)
-    free = format_intervals(common["rattle_free_everywhere"])
-    lines.append(f"Ω rattle-free at every combination: {free}{'' if free == 'none' else ' rad/s'}")
+    free = format_intervals(common["rattle_free_everywhere"], speed)
+    what = "speeds" if speed.engine else "Ω"
+    lines.append(f"{what} rattle-free at every combination: {free}{'' if free == 'none' else ' ' + speed.unit}")
     return "\n".join(lines)

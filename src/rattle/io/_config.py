@@ -349,7 +349,7 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
         if rest.discontinuous:
             raise check.error(
                 "`paths` (sound paths) is not supported with a discontinuous law (`model.elastic.preload`, "
-                "`model.elastic.friction`, a `model.elements[k].friction` or a `model.elements[k]` with type = "
+                "`model.elastic.friction`, a `model.elements.K.friction` or a `model.elements.K` with type = "
                 "\"preload\") yet: the sound pressure is computed "
                 "from the smooth laws' responses; remove [[paths]] (rattle frf gives the law's response without it)"
             )
@@ -464,10 +464,10 @@ def check_analysis(
     within the bounds relative to the model's stiffest stage (:mod:`rattle._limits`).
 
     ``names`` maps ``omega_min`` / ``omega_max`` to the key or option the value came from
-    (default ``analysis.omega[0]`` / ``analysis.omega[1]``; the command line passes
+    (default ``analysis.omega.1`` / ``analysis.omega.2``; the command line passes
     ``--omega-min`` / ``--omega-max`` for the values it overrides). Raises ConfigError.
     """
-    names = {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", **(names or {})}
+    names = {"omega_min": "analysis.omega.1", "omega_max": "analysis.omega.2", **(names or {})}
     try:
         check_analysable_model(model)
         _limits.check_frequency_range(model, analysis.omega_min, analysis.omega_max,
@@ -489,8 +489,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.regularisation` = {_show(table['regularisation'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
-                "a `model.elements[k].preload` > 0), "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements.K.friction` level > 0, "
+                "a `model.elements.K.preload` > 0), "
                 "whose jumps the harmonic balance smooths; this law is continuous and solved without it: remove "
                 "`analysis.regularisation`"
             )
@@ -503,8 +503,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.refine` = {_show(table['refine'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
-                "a `model.elements[k].preload` > 0), "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements.K.friction` level > 0, "
+                "a `model.elements.K.preload` > 0), "
                 "whose regularised harmonic balance it refines; this law is continuous: remove `analysis.refine`"
             )
         refine = table["refine"]
@@ -523,8 +523,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.limit_harmonics` = {_show(table['limit_harmonics'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
-                "a `model.elements[k].preload` > 0), whose regularisation it continues to its limit; this law is "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements.K.friction` level > 0, "
+                "a `model.elements.K.preload` > 0), whose regularisation it continues to its limit; this law is "
                 "continuous: remove `analysis.limit_harmonics`"
             )
         limit_harmonics = table["limit_harmonics"]
@@ -539,7 +539,7 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not (system and discontinuous):
             raise check.error(
                 f"`analysis.held_limit` = {_show(table['held_limit'])} applies only to a chain with friction or a "
-                "torque jump on its elements (a `model.elements[k].friction` level > 0 or a `model.elements[k].preload` "
+                "torque jump on its elements (a `model.elements.K.friction` level > 0 or a `model.elements.K.preload` "
                 "> 0), whose held elements' steps it narrows: remove `analysis.held_limit`"
             )
         held_limit = table["held_limit"]
@@ -551,8 +551,8 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
         if not discontinuous:
             raise check.error(
                 f"`analysis.method` = {_show(table['method'])} applies only to a discontinuous law "
-                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements[k].friction` level > 0, "
-                "a `model.elements[k].preload` > 0), which exact shooting or the regularised harmonic balance "
+                "(`model.elastic.preload` > 0, a `model.elastic.friction` or `model.elements.K.friction` level > 0, "
+                "a `model.elements.K.preload` > 0), which exact shooting or the regularised harmonic balance "
                 "solves; this law is continuous and solved by harmonic balance: remove `analysis.method`"
             )
         method = table["method"]
@@ -562,7 +562,7 @@ def _analysis(check: _Checker, table: Mapping[str, Any], discontinuous: bool = F
                               f"write e.g. {_example('analysis.method')}")
     return check.build(
         AnalysisSettings,
-        {"omega_min": "analysis.omega[0]", "omega_max": "analysis.omega[1]", "harmonics": "analysis.harmonics",
+        {"omega_min": "analysis.omega.1", "omega_max": "analysis.omega.2", "harmonics": "analysis.harmonics",
          "regularisation": "analysis.regularisation", "refine": "analysis.refine",
          "limit_harmonics": "analysis.limit_harmonics", "held_limit": "analysis.held_limit",
          "method": "analysis.method"},

@@ -5,6 +5,11 @@ what the attractor search did and may have missed.
 
 Intervals are grid-resolved: ``a – b`` is the first and the last grid frequency of a run of
 grid frequencies, so the true boundary lies within one grid step outside it.
+
+Units as the case was given: with an ``[engine]`` every speed is the crankshaft speed in rpm
+(:class:`rattle.results.SpeedText`), else Ω in rad/s; a varied angle the case file gave in
+degrees (:attr:`Parameter.degrees <rattle.maps.Parameter>`) is shown in degrees. ``map.csv``,
+``map.nc`` and ``map.json`` keep Ω and rad.
 """
 
 from __future__ import annotations
@@ -14,7 +19,8 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from ._result import INTERVAL_KINDS, CellResult, ResponseMap, grid_runs
+from ..results import SpeedText
+from ._result import INTERVAL_KINDS, CellResult, Parameter, ResponseMap, grid_runs
 
 __all__ = ["map_report", "format_intervals", "common_intervals", "SEARCH_CAVEATS"]
 
@@ -40,12 +46,36 @@ def _g(x: float) -> str:
     return f"{x:.4g}"
 
 
-def format_intervals(intervals: Iterable[Sequence[float]]) -> str:
-    """``0.1 – 0.55, 1.2 – 3`` (a one-frequency run as that frequency); ``none`` when empty."""
+def format_intervals(intervals: Iterable[Sequence[float]], speed: SpeedText | None = None) -> str:
+    """``0.1 – 0.55, 1.2 – 3`` (a one-frequency run as that frequency); ``none`` when empty.
+    With ``speed`` (Ω intervals of an engine case: :class:`rattle.results.SpeedText`) the
+    values are written as it writes them: the crankshaft speed in rpm, to 5 digits."""
     parts = []
+    show, digits = (float, 4) if speed is None or not speed.engine else (speed.value, 5)
     for lo, hi in intervals:
-        parts.append(_g(lo) if lo == hi else f"{_g(lo)} – {_g(hi)}")
+        a, b = f"{show(lo):.{digits}g}", f"{show(hi):.{digits}g}"
+        parts.append(a if lo == hi else f"{a} – {b}")
     return ", ".join(parts) if parts else "none"
+
+
+def _speed(response_map: ResponseMap) -> SpeedText:
+    """Speeds of the report: rpm when the map's models have one engine order, else Ω."""
+    return SpeedText(None if response_map.speed_order is None else float(response_map.speed_order))
+
+
+def _axis(speed: SpeedText) -> str:
+    """The frequency axis's name with its unit: ``Ω (rad/s)`` or ``speed (rpm)``."""
+    return "speed (rpm)" if speed.engine else "Ω (rad/s)"
+
+
+def _value(p: Parameter, value: float) -> str:
+    """A parameter value as the case gave it (degrees for an angle given in degrees)."""
+    return _g(p.shown(value))
+
+
+def _header(p: Parameter) -> str:
+    """A parameter's column name, with ``(deg)`` when shown in degrees."""
+    return f"{p.name} (deg)" if p.degrees else p.name
 
 
 def _computed(cells: Sequence[CellResult]) -> list[CellResult]:
@@ -64,8 +94,13 @@ def common_intervals(response_map: ResponseMap) -> dict[str, list[list[float]]]:
             "impact_everywhere": grid_runs(rattle.all(axis=0), omega)}
 
 
-def _values_text(values: dict[str, float]) -> str:
-    return ", ".join(f"{k} = {_g(v)}" for k, v in values.items())
+def _values_text(values: dict[str, float], params: Sequence[Parameter] = ()) -> str:
+    by_name = {p.name: p for p in params}
+    out = []
+    for k, v in values.items():
+        p = by_name.get(k)
+        out.append(f"{k} = {_g(v)}" if p is None else f"{k} = {_value(p, v)}" + (" deg" if p.degrees else ""))
+    return ", ".join(out)
 
 
 def _table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> list[str]:
@@ -78,13 +113,19 @@ def _settings(response_map: ResponseMap) -> list[str]:
     omega = np.asarray(response_map.omega, dtype=float)
     cells = response_map.cells
     lines = ["## Settings", ""]
+    speed = _speed(response_map)
     for p in response_map.parameters:
         vals = p.values
-        span = f"{_g(vals[0])} … {_g(vals[-1])}" if len(vals) > 1 else _g(vals[0])
-        listed = ", ".join(_g(v) for v in vals) if len(vals) <= 12 else f"{len(vals)} values"
-        lines.append(f"- varied `{p.name}` (`{p.key}`): {span} ({len(vals)} value{'s' if len(vals) != 1 else ''}: "
+        unit = " deg" if p.degrees else ""
+        span = f"{_value(p, vals[0])} … {_value(p, vals[-1])}{unit}" if len(vals) > 1 else _value(p, vals[0]) + unit
+        listed = ", ".join(_value(p, v) for v in vals) if len(vals) <= 12 else f"{len(vals)} values"
+        given = ", given in degrees; map.csv in rad" if p.degrees else ""
+        lines.append(f"- varied `{p.name}` (`{p.key}`{given}): {span} ({len(vals)} value{'s' if len(vals) != 1 else ''}: "
                      f"{listed})")
-    if omega.size:
+    if omega.size and speed.engine:
+        lines.append(f"- speed grid: {omega.size} crankshaft speeds, {speed.span(omega[0], omega[-1])} "
+                     f"(Ω = {_g(omega[0])} … {_g(omega[-1])} rad/s, Ω = {speed.order:g} × crankshaft speed)")
+    elif omega.size:
         lines.append(f"- Ω grid: {omega.size} frequencies, {_g(omega[0])} … {_g(omega[-1])} rad/s")
     for key, value in response_map.settings.items():
         if value is None or isinstance(value, dict) or key in ("omega", "omega_points"):
@@ -101,34 +142,42 @@ def _settings(response_map: ResponseMap) -> list[str]:
 
 
 def _region(response_map: ResponseMap) -> list[str]:
-    names = list(response_map.names)
+    params = response_map.parameters
+    speed = _speed(response_map)
+    axis, what = ("speed", "crankshaft speed intervals (rpm") if speed.engine else ("Ω", "Ω intervals (rad/s")
     lines = ["## Rattle-free region", "",
-             "Where no attractor found crosses a breakpoint (`rattle` false), in the (parameter, Ω) plane: "
-             "for every combination, its rattle-free and impact Ω intervals (rad/s, grid-resolved: the "
+             f"Where no attractor found crosses a breakpoint (`rattle` false), in the (parameter, {axis}) plane: "
+             f"for every combination, its rattle-free and impact {what}, grid-resolved: the "
              "first and last grid frequency of each run).", ""]
     rows = []
     for (_, values), c in zip(response_map.combinations(), response_map.cells):
+        shown = [_value(p, values[p.name]) for p in params]
         if c.status == "failed":
-            rows.append([*(_g(values[n]) for n in names), "(failed)", "(failed)"])
+            rows.append([*shown, "(failed)", "(failed)"])
             continue
-        rows.append([*(_g(values[n]) for n in names), format_intervals(c.intervals.get("rattle_free", [])),
-                     format_intervals(c.intervals.get("impact", []))])
-    lines += _table([*names, "rattle-free Ω", "impacts Ω"], rows)
+        rows.append([*shown, format_intervals(c.intervals.get("rattle_free", []), speed),
+                     format_intervals(c.intervals.get("impact", []), speed)])
+    unit = " (rpm)" if speed.engine else ""
+    lines += _table([*(_header(p) for p in params), f"rattle-free {axis}{unit}", f"impacts {axis}{unit}"], rows)
     common = common_intervals(response_map)
-    free_everywhere = [_values_text(v) for (_, v), c in zip(response_map.combinations(), response_map.cells)
+    free_everywhere = [_values_text(v, params) for (_, v), c in zip(response_map.combinations(), response_map.cells)
                        if c.status != "failed" and not np.asarray(c.rattle, bool).any()]
     lines += _by_frequency(response_map)
+    free, impact = (format_intervals(common[k], speed) for k in ("rattle_free_everywhere", "impact_everywhere"))
+    rpm = (lambda text: text) if not speed.engine else (lambda text: text if text == "none" else f"{text} rpm")
     lines += ["",
-              f"- Ω rattle-free at every combination: {format_intervals(common['rattle_free_everywhere'])}",
-              f"- Ω with impacts at every combination: {format_intervals(common['impact_everywhere'])}",
-              "- combinations rattle-free over the whole Ω range: "
+              f"- {axis} rattle-free at every combination: {rpm(free)}",
+              f"- {axis} with impacts at every combination: {rpm(impact)}",
+              f"- combinations rattle-free over the whole {axis} range: "
               + ("; ".join(free_everywhere) if free_everywhere else "none")]
     return lines
 
 
-def _valuegrid_runs(mask: Sequence[bool], values: Sequence[float]) -> str:
-    """The parameter values where ``mask`` holds, as runs of consecutive values (``0 – 0.1, 0.5``)."""
-    return format_intervals(grid_runs(np.asarray(mask, bool), np.asarray(values, float)))
+def _valuegrid_runs(mask: Sequence[bool], p: Parameter) -> str:
+    """The values of ``p`` where ``mask`` holds, as runs of consecutive values (``0 – 0.1, 0.5``;
+    in degrees when the case gave them so)."""
+    shown = np.asarray([p.shown(v) for v in p.values], float)
+    return format_intervals(grid_runs(np.asarray(mask, bool), shown))
 
 
 def _by_frequency(response_map: ResponseMap) -> list[str]:
@@ -137,6 +186,7 @@ def _by_frequency(response_map: ResponseMap) -> list[str]:
     if len(response_map.parameters) != 1 or not response_map.cells:
         return []
     p = response_map.parameters[0]
+    speed = _speed(response_map)
     omega = np.asarray(response_map.omega, dtype=float)
     ok = np.array([c.status != "failed" for c in response_map.cells])
     rattle = np.array([np.asarray(c.rattle, bool) for c in response_map.cells])
@@ -147,24 +197,27 @@ def _by_frequency(response_map: ResponseMap) -> list[str]:
         k = j
         while k + 1 < omega.size and np.array_equal(free[:, k + 1], free[:, j]):
             k += 1
-        band = format_intervals([[float(omega[j]), float(omega[k])]])
-        rows.append([band, _valuegrid_runs(free[:, j], p.values), _valuegrid_runs((~free[:, j]) & ok, p.values)])
+        band = format_intervals([[float(omega[j]), float(omega[k])]], speed)
+        rows.append([band, _valuegrid_runs(free[:, j], p), _valuegrid_runs((~free[:, j]) & ok, p)])
         j = k + 1
-    return ["", f"Read along Ω: over each band of grid frequencies, the values of `{p.name}` that are rattle-free "
-            "there and those where some attractor impacts (runs of consecutive values).", "",
-            *_table(["Ω (rad/s)", f"rattle-free {p.name}", f"impacts at {p.name}"], rows)]
+    unit = " (deg)" if p.degrees else ""
+    return ["", f"Read along {'the speed' if speed.engine else 'Ω'}: over each band of grid frequencies, the values "
+            f"of `{p.name}`{unit} that are rattle-free there and those where some attractor impacts (runs of "
+            "consecutive values).", "",
+            *_table([_axis(speed), f"rattle-free {p.name}{unit}", f"impacts at {p.name}{unit}"], rows)]
 
 
-def _cell_section(values: dict[str, float], c: CellResult) -> list[str]:
-    lines = [f"### {_values_text(values)}", ""]
+def _cell_section(values: dict[str, float], c: CellResult, params: Sequence[Parameter] = (),
+                  speed: SpeedText = SpeedText()) -> list[str]:
+    lines = [f"### {_values_text(values, params)}", ""]
     if c.status != "ok":
         lines += [f"Status: **{c.status}** — {c.message or 'no reason given'}", ""]
     if c.status == "failed":
         return lines
     if c.special_points:
         lines += ["Special points, the primary branch (0) first, then each further branch:", ""]
-        lines += _table(["kind", "Ω (rad/s)", "branch", "period", "rms (rad)"],
-                        [[sp.get("kind", ""), f"{float(sp.get('omega', math.nan)):.5g}", sp.get("branch", ""),
+        lines += _table(["kind", _axis(speed), "branch", "period", "rms (rad)"],
+                        [[sp.get("kind", ""), speed.number(float(sp.get("omega", math.nan))), sp.get("branch", ""),
                           sp.get("period", ""), f"{float(sp.get('rms', math.nan)):.4g}"]
                          for sp in sorted(c.special_points, key=lambda s: (int(s.get("branch", 0) or 0),
                                                                            float(s.get("omega", 0.0)),
@@ -173,11 +226,12 @@ def _cell_section(values: dict[str, float], c: CellResult) -> list[str]:
         lines.append("No special points (no fold, period doubling or Neimark–Sacker point in the range).")
     lines.append("")
     for kind in INTERVAL_KINDS:
-        lines.append(f"- {_KIND_TITLES.get(kind, kind)}: {format_intervals(c.intervals.get(kind, []))}")
+        found_in = format_intervals(c.intervals.get(kind, []), speed)
+        lines.append(f"- {_KIND_TITLES.get(kind, kind)}: {found_in}{' rpm' if speed.engine and found_in != 'none' else ''}")
     if c.attractors:
         found = []
         for a in c.attractors:
-            text = f"period {a.get('period', '?')} at Ω = {_g(float(a.get('omega', math.nan)))}"
+            text = f"period {a.get('period', '?')} at {speed.at(float(a.get('omega', math.nan)), 5 if speed.engine else 4)}"
             if a.get("origin"):
                 text += f" (from {a['origin']})"
             if a.get("branch") is not None:
@@ -260,6 +314,6 @@ def map_report(response_map: ResponseMap) -> str:
     lines += _region(response_map)
     lines += ["", "## Combinations", ""]
     for (_, values), c in zip(response_map.combinations(), response_map.cells):
-        lines += _cell_section(values, c)
+        lines += _cell_section(values, c, response_map.parameters, _speed(response_map))
     lines += _search(response_map)
     return "\n".join(lines).rstrip() + "\n"

@@ -299,11 +299,25 @@ class CellResult:
 @dataclass(frozen=True)
 class Parameter:
     """A varied parameter: its NAME (as given: a short name or a dotted key), the dotted key of
-    the configuration it sets, and its values."""
+    the configuration it sets, and its values (in the configuration's base unit: angles in rad).
+
+    ``degrees``: the angle was given in degrees in the case file (a ``KEY_deg`` key, or a damper's
+    angles in degrees: :func:`rattle.maps.mark_degrees`); reports then show its values in
+    degrees, value × 180/π (the files keep rad)."""
 
     name: str
     key: str
     values: tuple[float, ...]
+    degrees: bool = False
+
+    def shown(self, value: float) -> float:
+        """``value`` as reports show it: in degrees when the case gave the angle in degrees."""
+        return math.degrees(value) if self.degrees else float(value)
+
+    @property
+    def unit(self) -> str:
+        """``"deg"`` when the reports show degrees, else ``""`` (the key's own unit)."""
+        return "deg" if self.degrees else ""
 
 
 @dataclass(frozen=True)
@@ -335,10 +349,15 @@ class ResponseMap:
     @property
     def speed_rpm(self) -> np.ndarray | None:
         """The grid as crankshaft speed (rpm) when the model has an engine (``[engine]``: Ω is
-        ``speed_order`` × the crankshaft speed), else None: rpm = Ω · 60 / (2π · order)."""
+        ``speed_order`` × the crankshaft speed), else None: rpm = Ω · 60 / (2π · order), rounded
+        to a millionth of the grid's step (:func:`rattle.results.round_to_grid`)."""
         if self.speed_order is None:
             return None
-        return np.asarray(self.omega, dtype=float) * 60.0 / (2.0 * math.pi * float(self.speed_order))
+        from ..results import round_to_grid, rpm_of_omega
+
+        rpm = rpm_of_omega(np.asarray(self.omega, dtype=float), float(self.speed_order))
+        # the grid is equally spaced: its rpm as round as the range given (800, not 799.9999999999999)
+        return round_to_grid(rpm, float(rpm[0]), float(rpm[-1]), rpm.size) if rpm.size else rpm
 
     @property
     def shape(self) -> tuple[int, ...]:

@@ -49,7 +49,7 @@ from ._result import Parameter
 
 __all__ = [
     "SHORT_NAMES", "MAX_VALUES", "MAX_COMBINATIONS", "parse_vary", "parse_all", "resolve", "numeric_keys",
-    "get_value", "apply", "parameters", "combinations", "build_all",
+    "get_value", "apply", "parameters", "combinations", "build_all", "given_in_degrees", "mark_degrees",
 ]
 
 #: Short names and the dotted key they mean for a single-equation configuration (SPEC §7).
@@ -464,6 +464,7 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
         A rule of the grid or of the names (``--vary …``).
     """
     items: list[tuple[str, Sequence[float]]] = []
+    in_degrees: set[str] = set()  # Parameter objects given keep their unit of display
     if isinstance(vary, Mapping):
         pairs: list[Any] = list(vary.items())
     elif isinstance(vary, (str, bytes, Set)) or vary is None or not isinstance(vary, Iterable):
@@ -474,6 +475,8 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
         for item in vary:
             if isinstance(item, Parameter):
                 pairs.append((item.name, item.values))
+                if item.degrees:
+                    in_degrees.add(item.name)
             elif isinstance(item, (tuple, list)) and len(item) == 2:
                 pairs.append(tuple(item))
             else:
@@ -501,12 +504,52 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
                 raise _err(f"gives {name!r} twice; give every parameter once")
             if p.key == key:
                 raise _err(f"{p.name!r} and {name!r} both set `{key}`; give it once")
-        out.append(Parameter(name=name, key=key, values=vals))
+        out.append(Parameter(name=name, key=key, values=vals, degrees=name in in_degrees))
     total = math.prod(len(p.values) for p in out)
     if total > MAX_COMBINATIONS:
         raise _err(f"gives {total} combinations ({' × '.join(str(len(p.values)) for p in out)}), more than "
                    f"{MAX_COMBINATIONS}: each is a frequency response; use fewer values")
     return tuple(out)
+
+
+#: The angle fields of a law (rad; ``KEY_deg`` in degrees) and the keys of a damper's data sheet
+#: that give its breakpoints in degrees.
+_ANGLE_FIELDS = ("b", "breakpoints", "gap")
+_DAMPER_DEGREE_KEYS = ("drive_angles_deg", "coast_angles_deg", "free_play_deg")
+
+
+def given_in_degrees(source: Mapping[str, Any], key: str) -> bool:
+    """Whether the angle that the canonical dotted ``key`` sets (``model.elastic.b``,
+    ``model.elements.2.breakpoints.3``) was written in degrees in the case file ``source`` (the
+    tables as written): its table has ``FIELD_deg``, or it is a damper whose stage angles are in
+    degrees. False for every other key."""
+    parts = key.split(".")
+    if len(parts) < 3 or parts[0] != "model":
+        return False
+    model = source.get("model") if isinstance(source, Mapping) else None
+    if not isinstance(model, Mapping):
+        return False
+    if parts[1] == "elastic":
+        table, field = model.get("elastic"), parts[2]
+    elif parts[1] == "elements" and len(parts) >= 4 and parts[2].isdigit():
+        elements, i = model.get("elements"), int(parts[2]) - 1
+        table = elements[i] if isinstance(elements, list) and 0 <= i < len(elements) else None
+        field = parts[3]
+    else:
+        return False
+    if field not in _ANGLE_FIELDS or not isinstance(table, Mapping):
+        return False
+    if f"{field}_deg" in table:
+        return True
+    return field == "breakpoints" and table.get("type") == "damper" and any(k in table for k in _DAMPER_DEGREE_KEYS)
+
+
+def mark_degrees(params: Sequence[Parameter], source: Mapping[str, Any]) -> tuple[Parameter, ...]:
+    """``params`` with ``degrees`` set on every angle the case file ``source`` gave in degrees
+    (:func:`given_in_degrees`): the report shows those in degrees."""
+    import dataclasses
+
+    return tuple(dataclasses.replace(p, degrees=p.degrees or given_in_degrees(source, p.key)) for p in params)
 
 
 def combinations(params: Sequence[Parameter]) -> Iterator[dict[str, float]]:

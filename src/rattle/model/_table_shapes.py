@@ -87,6 +87,11 @@ def _keys(check: _Checker, table: Mapping[str, Any], where: str, allowed: tuple[
             from .._table_checks import _did_you_mean
 
             lengths = ", lengths also as KEY_mm or KEY_um" if "backlash" in allowed and kind != "spline" else ""
+            stem = str(key).rsplit("_", 1)[0]
+            if lengths and stem in ("backlash", "base_radii") and stem in allowed:  # a length in another unit
+                raise check.error(
+                    f"`{where}.{key}` is not a known key: `{stem}` is a length in metres (lengths also as KEY_mm or "
+                    f"KEY_um); write it in m as `{stem}`, in millimetres as `{stem}_mm` or in micrometres as `{stem}_um`")
             raise check.error(
                 f"`{where}.{key}` is not a known key: {what} allows only {', '.join(allowed)} (angles also as "
                 f"KEY_deg{lengths}); {_did_you_mean(str(key), allowed)}remove it or correct its spelling"
@@ -111,6 +116,7 @@ def _per_degree(check: _Checker, table: dict[str, Any], where: str, key: str) ->
         if not v > 0:
             raise check.error(f"`{where}.{deg}[{i}]` must be > 0 N m/deg (a stage stiffness), got {_show(v)}")
     table[key] = [float(v) * _DEG_PER_RAD for v in values]
+    check.user_keys[f"{where}.{key}"] = (f"{where}.{deg}", "N m/rad")  # messages name the key written
 
 
 def _damper(check: _Checker, t: Mapping[str, Any], where: str) -> dict[str, Any]:

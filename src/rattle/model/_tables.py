@@ -66,6 +66,7 @@ from .._table_checks import (
     _EXAMPLES,
     ANGLE_KEYS,
     _Checker,
+    positions_from_one,
     _did_you_mean,
     _example,
     _in_base_units,
@@ -289,7 +290,8 @@ def _friction(check: _Checker, elastic: Any, friction_t: Any, key: str) -> Frict
     except ConfigError as exc:
         if isinstance(friction_t, (list, tuple)):
             raise
-        raise check.error(str(exc).split(": ", 1)[1].replace(f"`{key}[0]`", f"`{key}`")) from None  # as written
+        shown = positions_from_one(key)  # the message counts positions from 1 already
+        raise check.error(str(exc).split(": ", 1)[1].replace(f"`{shown}.1`", f"`{shown}`")) from None  # as written
     n = len(elastic.stages.slopes)
     if len(friction.levels) not in (1, n):
         raise check.error(

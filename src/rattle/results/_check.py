@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 
+from ._speed import SpeedText
+
 
 def held_runs(omega: np.ndarray, held: np.ndarray) -> list[tuple[float, float]]:
     """The Ω-ranges (min, max) of the consecutive runs of rows where ``held`` is true.
@@ -49,12 +51,13 @@ def largest(values: Any, rows: Any) -> float | None:
     return float(np.max(v)) if v.size else None
 
 
-def stable_spans(branch: Any) -> str:
+def stable_spans(branch: Any, speed: SpeedText = SpeedText()) -> str:
     """The Ω ranges of a branch's consecutive matched stable rows, as text (the runs its plot
-    shades, :func:`held_runs`)."""
+    shades, :func:`held_runs`): ``Ω = 0.5 … 0.7, 0.9 … 1`` or, with an engine (``speed``),
+    ``500 … 700 rpm, …``."""
     ok = np.asarray(branch.matched, dtype=bool) & np.asarray(branch.stable, dtype=bool)
     runs = held_runs(np.asarray(branch.omega, dtype=float), ok)
-    return ", ".join(f"{a:.5g} … {b:.5g}" for a, b in runs) if runs else "nowhere"
+    return speed.spans(runs) if runs else "nowhere"
 
 
 def branch_metadata(branch: Any) -> dict[str, Any]:
@@ -76,18 +79,18 @@ def branch_metadata(branch: Any) -> dict[str, Any]:
     }
 
 
-def branch_lines(check: Any, subharmonics: bool) -> list[str]:
+def branch_lines(check: Any, subharmonics: bool, speed: SpeedText = SpeedText()) -> list[str]:
     """The summary's lines on the sub-harmonic branches of ``check`` (a discontinuous law's or a
     chain's), or on the period doublings that started none (``subharmonics``: whether they were
-    asked for)."""
+    asked for); speeds as ``speed`` writes them (rpm with an engine)."""
     lines = []
     for b in check.branches:
         m = np.asarray(b.matched, dtype=bool)
         worst = largest(b.rms_error, m)
         how = (f"{int(np.count_nonzero(m))} matched by exact shooting over {b.period} periods"
                if b.followed == "harmonic balance" else "every row an exact orbit (exact shooting continuation)")
-        lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over Ω = "
-                     f"{np.min(b.omega):.5g} … {np.max(b.omega):.5g}, {how}; stable over Ω = {stable_spans(b)}"
+        lines.append(f"branch {b.branch} (period {b.period}, {b.origin}): {len(b)} points over "
+                     f"{speed.span(np.min(b.omega), np.max(b.omega))}, {how}; stable over {stable_spans(b, speed)}"
                      + (f"; HB rms error at most {worst:.2g}" if worst is not None else ""))
     if "period_doubling" in set(check.bifurcation.tolist()) and not check.branches:
         lines.append("no period-2 orbit was found next to the period doubling(s)" if subharmonics else

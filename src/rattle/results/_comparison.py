@@ -15,6 +15,7 @@ from ._frequency_response import FrequencyResponse
 from ._orbit import PeriodicOrbit
 from ._sweep import SweepResult
 from ._plotter import plot_with
+from ._speed import SpeedText
 
 if TYPE_CHECKING:  # annotations only
     from ._steady import SteadyState
@@ -112,13 +113,18 @@ class Comparison:
                 "median": float(np.median(err)) if err.size else None,
                 "largest": float(np.max(err)) if err.size else None, "without": without}
 
+    @property
+    def _speed(self) -> SpeedText:
+        """Speeds in text: rpm with an engine, else Ω."""
+        return SpeedText.of(self.sweep.model)
+
     def _frf_lines(self) -> list[str]:
         """A discontinuous law's response in a few lines."""
         frf = self.frf.check
         stable = np.asarray(frf.stable, dtype=bool) & np.asarray(frf.matched, dtype=bool)
         return [
             f"regularised harmonic balance (H = {frf.harmonics}, ε = {frf.regularisation:g}) checked by exact "
-            f"shooting: {len(frf)} rows over Ω = {float(np.min(frf.omega)):.4g} … {float(np.max(frf.omega)):.4g}, "
+            f"shooting: {len(frf)} rows over {self._speed.span(float(np.min(frf.omega)), float(np.max(frf.omega)), 4)}, "
             f"{int(np.sum(frf.matched))} matched, {int(np.sum(stable))} matched and stable; "
             f"{frf.status.name.lower()}" + (f": {frf.message}" if frf.message else ""),
         ]
@@ -133,7 +139,7 @@ class Comparison:
             lines.append(f"sweep against the response: {ag['compared']} of {ag['rows']} settled period-1 rows on a "
                          f"stable matched stretch of the response, relative rms difference {text}")
             if ag["without"]:
-                lines.append("  rows without one at Ω = " + ", ".join(f"{w:.4g}" for w in sorted(set(ag["without"]))))
+                lines.append("  rows without one at " + self._speed.values(sorted(set(ag["without"])), 4))
             return "\n".join(lines)
         lines = ["frequency response:", *("  " + s for s in self.frf.summary().splitlines())]
         lines += ["time-domain sweep:", *("  " + s for s in self.sweep.summary().splitlines())]
@@ -142,7 +148,7 @@ class Comparison:
                 f"P{s.period} rms {s.rms:.4g} {'stable' if s.stable else 'unstable'}" for s in orbit.solutions
             )
             sim = ", ".join(f"{d} sweep P{s.period} rms {s.rms:.4g}" for d, s in sims.items())
-            lines.append(f"Ω = {w:.5g} ({why}): HB {hb or 'none'}; simulation {sim or 'none'}")
+            lines.append(f"{self._speed.at(w)} ({why}): HB {hb or 'none'}; simulation {sim or 'none'}")
         return "\n".join(lines)
 
     def metadata(self) -> dict[str, Any]:

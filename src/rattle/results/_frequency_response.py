@@ -20,6 +20,7 @@ from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model, check_analysable_model
 from ._plotter import plot_with
 from ._sound import sound_pressure
+from ._speed import SpeedText, rpm_of_omega
 
 #: Per-element columns of a chain's ``frf.csv`` (SPEC §5): ``NAME_`` + each of these.
 ELEMENT_COLUMNS: tuple[str, ...] = ("mean", "rms", "rms_ac", "p2p", "acc_p2p", "min", "max", "regime")
@@ -254,7 +255,7 @@ class FrequencyResponse:
         """Crankshaft speed (rpm) of each row when the model has an engine (``[engine]``,
         ``Chain.speed_order`` q_0): Ω · 60 / (2π q_0); None otherwise."""
         order = getattr(self.model, "speed_order", None)
-        return None if order is None else np.asarray(self.omega, dtype=float) * (60.0 / (2.0 * np.pi * order))
+        return None if order is None else rpm_of_omega(np.asarray(self.omega, dtype=float), order)
 
     @property
     def element_names(self) -> tuple[str, ...]:
@@ -273,35 +274,37 @@ class FrequencyResponse:
         :meth:`~NonsmoothCheck.frf_summary`)."""
         if self.check is not None:
             return self.check.frf_summary(self.settings)
+        speed = SpeedText.of(self.model)  # rpm with an engine, else Ω
+        over = (f"{speed.span(self.omega.min(), self.omega.max(), 4)} (Ω = {self.omega.min():.4g} … "
+                f"{self.omega.max():.4g} rad/s; " if speed.engine
+                else f"Ω = {self.omega.min():.4g} … {self.omega.max():.4g} (")
         lines = [
-            f"{len(self)} solution points over Ω = {self.omega.min():.4g} … {self.omega.max():.4g} "
-            f"(H = {self.harmonics_text()} harmonics per forcing period), {int(np.sum(~self.stable))} unstable",
+            f"{len(self)} solution points over {over}H = {self.harmonics_text()} harmonics per forcing period), "
+            f"{int(np.sum(~self.stable))} unstable",
             f"status: {self.status.name.lower()} — {self.message or self.status.message}",
         ]
-        order = getattr(self.model, "speed_order", None)
         gaps = self.uncovered
         if gaps:
             lines.append("not covered (no branch found there): " + ", ".join(
-                f"Ω = {a:.5g} … {b:.5g}" + ("" if order is None else
-                                            f" ({a * 60.0 / (2.0 * np.pi * order):.5g} … {b * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
-                for a, b in gaps))
+                speed.span(a, b) + (f" (Ω = {a:.5g} … {b:.5g})" if speed.engine else "") for a, b in gaps))
         if len(np.unique(self.branch)) > 1:
             lines.append("branches: " + ", ".join(
-                f"{b} (period {int(self.period[self.branch == b][0])}, Ω = {self.omega[self.branch == b].min():.4g}…{self.omega[self.branch == b].max():.4g})"
+                f"{b} (period {int(self.period[self.branch == b][0])}, "
+                f"{speed.span(self.omega[self.branch == b].min(), self.omega[self.branch == b].max(), 4, '…')})"
                 for b in np.unique(self.branch)))
-        if order is not None:
-            rpm = self.speed_rpm
-            lines.append(f"engine speed {rpm.min():.5g} … {rpm.max():.5g} rpm (Ω = {order:g} × crankshaft speed)")
+        if speed.engine:
+            lines.append(f"engine speed: Ω = {speed.order:g} × crankshaft speed")
         if self.special_points:
-            lines.append("stability changes: " + ", ".join(
-                f"{s.kind} at Ω = {s.omega:.5g}" + ("" if order is None else f" ({s.omega * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
-                for s in self.special_points))
+            lines.append("stability changes: " + ", ".join(f"{s.kind} at {speed.at(s.omega)}"
+                                                         for s in self.special_points))
         if self.regions:
+            digits = 5 if speed.engine else 4  # rpm as the stability changes give them
             lines.append("regions: " + "; ".join(
-                f"{g.label} at Ω = {g.omega_min:.4g}" if g.omega_min == g.omega_max else f"{g.label} Ω = {g.omega_min:.4g}…{g.omega_max:.4g}"
+                f"{g.label} at {speed.at(g.omega_min, digits)}" if g.omega_min == g.omega_max
+                else f"{g.label} {speed.span(g.omega_min, g.omega_max, digits, '…')}"
                 for g in self.regions))
         i = int(np.argmax(self.rms))
-        lines.append(f"largest rms {self.rms[i]:.5g} rad at Ω = {self.omega[i]:.5g} ({self.regime[i]})")
+        lines.append(f"largest rms {self.rms[i]:.5g} rad at {speed.at(self.omega[i])} ({self.regime[i]})")
         if self.timings:
             lines.append("time: " + ", ".join(f"{k} {v:.3g} s" for k, v in self.timings.items()))
         return "\n".join(lines)

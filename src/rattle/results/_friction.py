@@ -29,6 +29,7 @@ from .._typing import ComplexArray, FloatArray
 from ..errors import Status
 from ..stability import classify_loss
 from ._check import branch_lines, branch_metadata
+from ._speed import SpeedText
 
 #: The per-element columns of :meth:`FrictionCheck.columns`, NAME_ prefixed, in this order.
 FRICTION_ELEMENT_COLUMNS = ("rms", "rms_hb", "mean", "stick", "rms_error", "rms_hb_limit", "rms_hb_extrapolated",
@@ -380,6 +381,13 @@ class FrictionCheck:
         out = np.max(np.where(self._held(), 0.0, np.nan_to_num(err, nan=np.inf)), axis=1)
         return np.where(self.matched, out, np.nan)
 
+    @property
+    def speed(self) -> SpeedText:
+        """Speeds in text: rpm with an engine order (``rpm`` given), else Ω."""
+        if self.rpm is None or not len(self) or not self.rpm[0] > 0:
+            return SpeedText()
+        return SpeedText(float(self.omega[0]) * 60.0 / (2.0 * math.pi * float(self.rpm[0])))
+
     def summary(self) -> str:
         """A few lines: the branch, how many rows the exact orbit confirmed, the HB's error."""
         md = self.metadata()
@@ -424,12 +432,12 @@ class FrictionCheck:
             st = np.nan_to_num(self.stick_fraction[:, e])
             if np.any(st > 0):
                 w = self.omega[st > 0]
-                lines.append(f"{name} sticks on {int(np.sum(st > 0))} rows (Ω {w.min():.4g} … {w.max():.4g}, "
+                lines.append(f"{name} sticks on {int(np.sum(st > 0))} rows ({self.speed.span(w.min(), w.max(), 4)}, "
                              f"up to {st.max():.0%} of the period)")
         labels = self.bifurcation
         where = "at" if self.labels is not None else "near"  # located on an exact branch, or between rows
         for i in np.flatnonzero(labels != ""):
-            lines.append(f"{labels[i].replace('_', ' ')} {where} Ω = {self.omega[i]:.7g}")
+            lines.append(f"{labels[i].replace('_', ' ')} {where} {self.speed.at(self.omega[i], 7)}")
         if not self.status.success:
             lines.append(f"continuation: {self.message}")
         return "\n".join(lines)
@@ -470,8 +478,8 @@ class FrictionCheck:
             col = np.where(matched, rms[:, e], np.nan)
             if np.any(np.isfinite(col)):
                 j = int(np.nanargmax(col))
-                lines.append(f"{name}: largest exact rms {col[j]:.5g} rad at Ω = {self.omega[j]:.5g}")
-        lines.extend(branch_lines(self, bool(settings.get("subharmonics"))))
+                lines.append(f"{name}: largest exact rms {col[j]:.5g} rad at {self.speed.at(self.omega[j])}")
+        lines.extend(branch_lines(self, bool(settings.get("subharmonics")), self.speed))
         return "\n".join(lines)
 
 

@@ -14,6 +14,7 @@ from .._validate import check_history_size
 
 from .._typing import ComplexArray, FloatArray
 from ._columns import ORBIT_COLUMNS
+from ._speed import SpeedText
 from ..measures import acceleration_batch, element_accelerations, evaluate_batch
 from ..model import Model
 from ._plotter import plot_with
@@ -375,7 +376,10 @@ class PeriodicOrbit:
     # --- summaries -------------------------------------------------------------------------
     def summary(self) -> str:
         """A few lines for the terminal."""
-        lines = [f"{len(self)} harmonic-balance solution(s) at Ω = {self.omega:.6g} rad/s (H = {self.harmonics}):"]
+        speed = SpeedText.of(self.model)
+        at = (f"{speed.at(self.omega, 6)} (Ω = {self.omega:.6g} rad/s; H = {self.harmonics})" if speed.engine
+              else f"Ω = {self.omega:.6g} rad/s (H = {self.harmonics})")
+        lines = [f"{len(self)} harmonic-balance solution(s) at {at}:"]
         sel = self.selected
         lines += solution_lines(self.solutions, sel)
         if self.simulation is not None:

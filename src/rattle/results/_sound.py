@@ -247,8 +247,10 @@ def _warn_uncovered(result: SoundPressure) -> None:
                      f"{f[0]:.4g} … {f[-1]:.4g} Hz) lies outside the table")
     warnings.warn(
         "sound paths transmit nothing outside their tables (no extrapolation), so the levels there are lower "
-        "bounds: " + "; ".join(lines) + "; extend the path tables to cover the harmonics, or keep fewer harmonics",
-        stacklevel=3)
+        "bounds: " + "; ".join(lines) + f"; extend the path tables to cover the harmonics, or keep fewer harmonics "
+        f"(warned above {100 * UNCOVERED_WARNING:g} % of the mean square, where the level may be more than "
+        f"{-10 * np.log10(1 - UNCOVERED_WARNING):.2g} dB low)",
+        UserWarning, stacklevel=3)
 
 
 def _linear_harmonics(model: Any, omega: FloatArray, K: int) -> ComplexArray:

@@ -15,6 +15,7 @@ from ._columns import SWEEP_COLUMNS
 from ._steady import METHOD_STATUS
 from ..model import Model
 from ._plotter import plot_with
+from ._speed import SpeedText, round_to_grid, rpm_of_omega
 
 #: Per-element columns of a chain's ``sweep.csv``: ``NAME_`` + each of these (the measures of
 #: element NAME's deflection, as the SPEC columns are of the first element's).
@@ -95,7 +96,9 @@ class SweepResult:
     Columns (numpy arrays of length P): SPEC §3 ``SWEEP_COLUMNS`` — ``direction`` (``up`` or
     ``down``), ``omega`` (rad/s), ``mean``, ``rms``, ``rms_ac``, ``p2p`` (rad), ``acc_p2p``
     (rad/s²), ``period`` (multiple of the forcing period, 0 when none up to the detection limit
-    was found). Also ``delta_min``, ``delta_max`` (rad), ``settled`` (bool), ``method``
+    was found). Also ``regime`` (``no_impact``, ``single_sided``, ``double_sided`` as in SPEC §1:
+    the breakpoints the row's steady motion crosses; written after ``period``), ``delta_min``,
+    ``delta_max`` (rad), ``settled`` (bool), ``method``
     (``shooting``/``simulation``/``unsettled``; ``status`` the same as :class:`~rattle.errors.Status`
     values, as ``SteadyState.status``), ``periods`` and ``shooting_periods`` (forcing
     periods simulated and integrated by Newton shooting: the effort), ``state0`` (P, 2) the
@@ -150,10 +153,13 @@ class SweepResult:
     element_columns: dict[str, np.ndarray] = field(default_factory=dict)
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
     failure: np.ndarray | None = None
+    regime: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.failure is None:  # a sweep without failures: "" on every row
             object.__setattr__(self, "failure", np.full(int(np.size(self.omega)), "", dtype=object))
+        if self.regime is None:  # not given by the sweep: from each row's extremes (frf.csv's rule)
+            object.__setattr__(self, "regime", _regimes_from_extremes(self))
 
     # --- container protocol ----------------------------------------------------------------
     def __len__(self) -> int:
@@ -191,8 +197,8 @@ class SweepResult:
         reasons = list(dict.fromkeys(str(r) for r in self.failure[rows]))  # type: ignore[index]
         i = int(rows[0])
         text = (f"no steady state at {rows.size} of {len(self)} frequencies ({self._failed_text()}; recorded as "
-                f"failed rows, the sweep carried on from the last state computed): at {self.direction[i]} Ω = "
-                f"{self.omega[i]:.6g}: {reasons[0]}")
+                f"failed rows, the sweep carried on from the last state computed): at {self.direction[i]} "
+                f"{SpeedText.of(self.model).at(self.omega[i], 6)}: {reasons[0]}")
         if len(reasons) > 1:
             text += f" (and {len(reasons) - 1} other reason{'s' if len(reasons) > 2 else ''} at other rows)"
         return text
@@ -204,7 +210,7 @@ class SweepResult:
             w = self.omega[(self.direction == d) & self.failed]
             if w.size:
                 more = f", … ({w.size} in all)" if w.size > _LISTED else ""
-                where.append(f"{d} sweep Ω = {', '.join(f'{x:.6g}' for x in w[:_LISTED])}{more}")
+                where.append(f"{d} sweep {SpeedText.of(self.model).values(w[:_LISTED], 6)}{more}")
         return "; ".join(where)
 
     @property
@@ -242,19 +248,30 @@ class SweepResult:
         return ", ".join(f"Ω ≈ {j.omega:.4g} ({j.direction} sweep, rms {j.kind})" for j in jumps)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The SPEC columns in order, as a dict of arrays; for a chain followed by the
+        """The SPEC columns in order and ``regime`` (of each row's steady motion, SPEC §1's
+        vocabulary; empty on a failed row), as a dict of arrays; for a chain followed by the
         per-element columns (``NAME_mean`` … ``NAME_acc_p2p``), then ``speed_rpm`` with an engine,
         then the extra columns (``spl_db``, ``spl_dba``, ``spl_linear_db`` of :meth:`with_sound`)."""
         rpm = self.speed_rpm
-        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, **self.element_columns,
+        return {**{name: getattr(self, name) for name in SWEEP_COLUMNS}, "regime": self.regime,
+                **self.element_columns,
                 **({} if rpm is None else {"speed_rpm": rpm}), **self.extra_columns}
 
     @property
     def speed_rpm(self) -> FloatArray | None:
         """Crankshaft speed (rpm) of each row when the model has an engine (``Chain.speed_order``
-        q_0): Ω · 60 / (2π q_0); None otherwise."""
+        q_0): Ω · 60 / (2π q_0), rounded to a millionth of the grid's step
+        (:func:`~rattle.results._speed.round_to_grid`: the speeds 400, 500, … of a grid the user
+        gave in rpm, not 499.99999999999994); None otherwise."""
         order = getattr(self.model, "speed_order", None)
-        return None if order is None else np.asarray(self.omega, dtype=float) * (60.0 / (2.0 * np.pi * order))
+        if order is None:
+            return None
+        rpm = rpm_of_omega(np.asarray(self.omega, dtype=float), order)
+        grid = self.settings.get("omega"), self.settings.get("points")
+        if isinstance(grid[0], (list, tuple)) and len(grid[0]) == 2 and isinstance(grid[1], int):
+            lo, hi = (float(rpm_of_omega(float(w), order)) for w in grid[0])
+            rpm = round_to_grid(rpm, lo, hi, grid[1])  # the rpm grid's round values, not their round-off
+        return rpm
 
     @property
     def element_names(self) -> tuple[str, ...]:
@@ -270,6 +287,7 @@ class SweepResult:
     def summary(self) -> str:
         """A few lines for the terminal: points per direction, periods found, jumps, effort."""
         lines = []
+        speed = SpeedText.of(self.model)  # rpm with an engine, else Ω
         for d in self.directions:
             m = self.direction == d
             w = self.omega[m]
@@ -280,19 +298,18 @@ class SweepResult:
                 per += (", " if per else "") + f"not periodic (period 0): {int(counts[0])}"
             if not ok.all():
                 per += (", " if per else "") + f"failed: {int(np.sum(~ok))}"
-            line = f"{d} sweep: {int(np.sum(m))} frequencies over Ω = {w.min():.4g} … {w.max():.4g} ({per})"
+            line = f"{d} sweep: {int(np.sum(m))} frequencies over {speed.span(w.min(), w.max(), 4)} ({per})"
             if ok.any():
                 i = int(np.flatnonzero(ok)[np.argmax(self.rms[m][ok])])
-                line += f"; largest rms {self.rms[m][i]:.5g} rad at Ω = {w[i]:.5g}"
+                line += f"; largest rms {self.rms[m][i]:.5g} rad at {speed.at(w[i])}"
             lines.append(line)
         jumps = self.jumps()
-        order = getattr(self.model, "speed_order", None)
-        rpm = (lambda w: "") if order is None else (lambda w: f" ({w * 60.0 / (2.0 * np.pi * order):.5g} rpm)")
         if jumps:
             lines.append("jumps: " + "; ".join(
                 f"{j.direction} sweep, {j.element + ' ' if j.element else ''}rms {j.kind} {j.rms_before:.4g} → "
-                f"{j.rms_after:.4g} rad "
-                f"between Ω = {j.omega_before:.5g}{rpm(j.omega_before)} and {j.omega_after:.5g}{rpm(j.omega_after)}"
+                f"{j.rms_after:.4g} rad between "
+                + (f"{speed.number(j.omega_before)} and {speed.at(j.omega_after)}" if speed.engine
+                   else f"{speed.at(j.omega_before)} and {speed.number(j.omega_after)}")
                 for j in jumps))
         else:
             lines.append("jumps: none")
@@ -306,7 +323,7 @@ class SweepResult:
                 lines.append(f"{what}: never")
                 continue
             lines.append(f"{what}: {int(np.sum(col > 0))} of {col.size} rows, at most {100 * col[i]:.3g} % of the "
-                         f"period at Ω = {self.omega[i]:.5g} ({self.direction[i]} sweep)")
+                         f"period at {speed.at(self.omega[i])} ({self.direction[i]} sweep)")
         lines.append(
             f"effort: {int(np.sum(self.periods))} forcing periods simulated, "
             f"{int(np.sum(self.shooting_periods))} in Newton shooting"
@@ -467,8 +484,32 @@ class SweepResult:
 
 _ROW_FIELDS: tuple[str, ...] = (
     "direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period", "delta_min", "delta_max",
-    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers", "failure",
+    "settled", "method", "periods", "shooting_periods", "state0", "final_state", "multipliers", "failure", "regime",
 )
+
+
+def _regimes_from_extremes(result: SweepResult) -> np.ndarray:
+    """``regime`` of every row from its extremes ``delta_min``, ``delta_max`` and the breakpoints
+    of the model's (first) element, as frf.csv's (:func:`rattle.measures.regime_of_breakpoints`);
+    ``""`` on a failed row and where the model has no breakpoints to read. A sweep computed by
+    :func:`rattle.time_sweep` gives each row's regime from the breakpoints its trajectory crossed
+    instead (the same for a continuous law; a discontinuous law's jump at δ = 0 counts on
+    neither side)."""
+    from ..measures import regime_of_breakpoints
+
+    n = int(np.size(result.omega))
+    out = np.full(n, "", dtype=object)
+    model = result.model
+    try:
+        system = model if hasattr(model, "elements") and not hasattr(model, "system") else model.system()
+        d = np.asarray(system.elements[0].breakpoints, dtype=float)
+    except (AttributeError, IndexError, TypeError):
+        return out
+    lo, hi = np.asarray(result.delta_min, dtype=float), np.asarray(result.delta_max, dtype=float)
+    ok = np.isfinite(lo) & np.isfinite(hi)
+    if ok.any():
+        out[ok] = regime_of_breakpoints(d, lo[ok], hi[ok])
+    return out
 
 __all__ = ["SweepResult", "Jump", "SWEEP_DIRECTIONS", "SWEEP_COLUMNS", "SWEEP_ELEMENT_COLUMNS", "SWEEP_FAILED",
            "FAILED_PERIOD"]
