@@ -9,6 +9,7 @@ numerics only then, calls one front end of the library and hands the result to
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import logging
 import math
 import sys
@@ -24,6 +25,7 @@ from .checks import (
     DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, output_path,
     override_analysis, parse_at, precheck, speed_options,
 )
+from ._quantity import MAP_QUANTITY, check_quantity, map_largest_line, quantity_option, with_largest
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
     map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections, set_verbose, warning,
@@ -153,7 +155,7 @@ def compute_frf(
 
 def run_frf(
     model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False,
-    paths: Sequence[Any] = (), start: str = "low", fixed_harmonics: bool = False,
+    paths: Sequence[Any] = (), start: str = "low", fixed_harmonics: bool = False, quantity: str = "rms",
 ) -> None:
     """Compute the frequency response, write the three files and print the summary.
 
@@ -174,6 +176,8 @@ def run_frf(
         The end the branch is started from (``frequency_response(start=...)``).
     fixed_harmonics : bool, default False
         Keep H fixed (``frequency_response(adaptive=None)``).
+    quantity : str, default "rms"
+        What frf.png draws and the summary's 'largest' line reports (``--quantity``).
 
     Raises
     ------
@@ -186,8 +190,8 @@ def run_frf(
                          fixed_harmonics=fixed_harmonics)
     if paths:  # SPEC §6: the sound pressure level at the receiver, per point
         result = result.with_sound(tuple(paths))
-    written = write_frf(result, output, sections, t_start)
-    echo_written(result.summary(), written, output)
+    written = write_frf(result, output, sections, t_start, quantity=quantity)
+    echo_written(with_largest(result.summary(), quantity, result), written, output)
 
 
 def _law_keys(run_config: Any) -> str:
@@ -222,10 +226,11 @@ def _law_keys(run_config: Any) -> str:
 @click.option("--fixed-harmonics", is_flag=True, default=False,
               help="Keep H = --harmonics on the whole range (by default H is raised where the truncation "
                    "error or a failing corrector demands it, up to 128, and lowered again where it allows).")
+@quantity_option
 def frf_command(
     config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
     rpm_min: float | None, rpm_max: float | None, subharmonics: bool, start: str = "low",
-    fixed_harmonics: bool = False,
+    fixed_harmonics: bool = False, quantity: str = "rms",
 ) -> None:
     """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json in OUTPUT.
 
@@ -237,16 +242,18 @@ def frf_command(
     """
     precheck(config, output, harmonics=harmonics)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "frf")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
         omega_max=w_max,
     )
-    options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
+    options = {"quantity": None if quantity == "rms" else quantity, "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None,
                "start": None if start == "low" else start, "fixed_harmonics": True if fixed_harmonics else None}
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
-            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics)
+            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics,
+            quantity=quantity)
 
 
 # --------------------------------------------------------------------------------------------
@@ -303,9 +310,11 @@ def _sweep_warnings() -> Iterator[None]:
 @_rpm_min_option
 @_rpm_max_option
 @_quiet_option
+@quantity_option
 def sweep_command(
     config: Path, output: Path, direction: str | None, points: int, workers: int,
     omega_min: float | None, omega_max: float | None, rpm_min: float | None, rpm_max: float | None, quiet: bool,
+    quantity: str = "rms",
 ) -> None:
     """Time-domain frequency sweep of the model in CONFIG: sweep.csv, sweep.png, sweep.json in OUTPUT.
 
@@ -327,6 +336,7 @@ def sweep_command(
         raise ConfigError("`--direction` is required: give --direction up, down or both")
     precheck(config, output, points=points, workers=workers)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "sweep")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(run_config.analysis, run_config.bounds_model, labels=labels, omega_min=w_min,
                                  omega_max=w_max)
@@ -345,13 +355,14 @@ def sweep_command(
     meta = sections("sweep", config, run_config, analysis, {
         "direction": direction, "points": points, "workers": workers,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
+        "quantity": None if quantity == "rms" else quantity,
     })
     written = write_set(output, SWEEP_FILES, [
         ("sweep.csv", result.to_csv),
         ("sweep.json", metadata_writer(result.metadata(), meta, t_start)),
-        ("sweep.png", lambda path: save_plot(result, path)),
+        ("sweep.png", lambda path: save_figure(lambda: result.plot(quantity=quantity), path)),
     ])
-    echo_written(result.summary(), written, output)
+    echo_written(with_largest(result.summary(), quantity, result), written, output)
     _raise_if_incomplete(result, written, output)
 
 
@@ -585,10 +596,11 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
 @_rpm_min_option
 @_rpm_max_option
 @_quiet_option
+@quantity_option
 def compare_command(
     config: Path, output: Path, points: int, at: str | None, workers: int, measured: Path | None,
     harmonics: int | None, omega_min: float | None, omega_max: float | None, rpm_min: float | None,
-    rpm_max: float | None, quiet: bool,
+    rpm_max: float | None, quiet: bool, quantity: str = "rms",
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
     compare.png, frf.csv, sweep.csv, compare.json in OUTPUT.
@@ -610,6 +622,7 @@ def compare_command(
         # every rule of the measured file that needs no configuration, before numpy is loaded
         measured_table = _io().parse_measured_csv(measured)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "compare")
     if run_config.discontinuous:
         for given, option in ((at, "--at"), (measured, "--measured")):
             if given is not None:
@@ -643,7 +656,7 @@ def compare_command(
     meta = sections("compare", config, run_config, analysis, {
         "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
-        "measured": None if measured is None else str(measured),
+        "measured": None if measured is None else str(measured), "quantity": None if quantity == "rms" else quantity,
     })
     frf = result.frf.with_sound(run_config.paths) if run_config.paths else result.frf
     sweep = result.sweep.with_sound(run_config.paths) if run_config.paths else result.sweep
@@ -651,16 +664,22 @@ def compare_command(
         ("frf.csv", frf.to_csv), ("sweep.csv", sweep.to_csv),
         ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
     ]
-    summary = result.summary()
+    summary = with_largest(result.summary(), quantity, frf, sweep, where=("frequency response: ", "sweep: "))
+    shown = result if quantity == "rms" else dataclasses.replace(result, frf=frf, sweep=sweep)  # spl_db: the paths'
     if measured_run is None:
-        steps.append(("compare.png", lambda path: save_plot(result, path)))
+        def draw() -> Any:
+            from ..plotting import compare_plot  # matplotlib checked by save_figure first
+
+            return compare_plot(shown, quantity=quantity)
+
+        steps.append(("compare.png", lambda path: save_plot(result, path) if quantity == "rms" else save_figure(draw, path)))
     else:
         from ..results import compare_measured
 
         def draw_measured() -> Any:
             from ..plotting import compare_plot  # matplotlib checked by save_figure first
 
-            return compare_plot(result, measured=beside)
+            return compare_plot(shown, measured=beside, quantity=quantity)
 
         beside = compare_measured(measured_run, frf, sweep)  # the sweeps with their sound pressure (paths)
         summary += "\n" + beside.summary()
@@ -726,10 +745,11 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
 @click.option("--report", is_flag=True, default=False,
               help="Also write map.md, the design summary (special points, rattle-free intervals, the search).")
 @_quiet_option
+@quantity_option
 def map_command(
     config: Path, output: Path, vary: tuple[str, ...], omega_points: int, workers: int | None,
     scheduler: str | None, harmonics: int | None, omega_min: float | None, omega_max: float | None,
-    rpm_min: float | None, rpm_max: float | None, report: bool, quiet: bool,
+    rpm_min: float | None, rpm_max: float | None, report: bool, quiet: bool, quantity: str = "rms",
 ) -> None:
     """Response map of the model in CONFIG over the --vary parameters and the frequency: map.csv,
     map.nc, map.json, map.png (and map.md with --report) in OUTPUT.
@@ -746,6 +766,7 @@ def map_command(
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "map")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
@@ -778,14 +799,15 @@ def map_command(
     meta = sections("map", config, run_config, analysis, {
         "vary": list(vary), "omega_points": omega_points, "workers": workers, "scheduler": scheduler,
         "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min,
-        "rpm_max": rpm_max, "report": True if report else None,
+        "rpm_max": rpm_max, "report": True if report else None, "quantity": None if quantity == "rms" else quantity,
     })
 
     steps: list[tuple[str, Any]] = [
         ("map.csv", map_csv_writer(result)),
         ("map.nc", result.to_netcdf),
         ("map.json", map_json_writer(result, meta, t_start)),
-        *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y), path)) for name, name_y in figures],
+        *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y, quantity=MAP_QUANTITY[quantity]), path))
+          for name, name_y in figures],
     ]
     if report:
         steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
@@ -794,7 +816,7 @@ def map_command(
     names = tuple(dict.fromkeys([*MAP_FILES, *(name for name, _ in figures[1:]), *earlier]))
     written = write_set(output, names, steps)
     failed = [c for c in result.cells if c.status == "failed"]
-    echo_written(map_summary(result), written, output)
+    echo_written(map_summary(result) + map_largest_line(result, quantity), written, output)
     if failed and len(failed) == len(result.cells):
         raise ConvergenceError(f"every combination failed; the first: {failed[0].message}; the files written say "
                                "which (status in map.json)")
