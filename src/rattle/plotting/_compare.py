@@ -148,8 +148,8 @@ def compare_plot(
         measured_axes = [fig.add_subplot(gs[m + k, 0]) for k in range(q)]
         rows = [[] for _ in range(m)]
     ax_frf = frf_axes[0]
-    for quantity, ax_q in zip(quantities, measured_axes):
-        _draw_measured(measured, quantity, ax_q)  # type: ignore[arg-type]
+    for measured_q, ax_q in zip(quantities, measured_axes):
+        _draw_measured(measured, measured_q, ax_q)  # type: ignore[arg-type]
 
     if not names:
         frequency_response_plot(frf, ax=ax_frf, quantity=quantity, linear=False, title="")
@@ -230,7 +230,7 @@ def compare_plot(
         fig.suptitle(title)
     separate_texts(fig, [*frf_axes, *measured_axes])
     tags = [f"history_{letters[j]}" if j < 26 else f"history_{j}" for j in range(n)]
-    extra = {f"measured_{quantity}": ax_q for quantity, ax_q in zip(quantities, measured_axes)}
+    extra = {f"measured_{measured_q}": ax_q for measured_q, ax_q in zip(quantities, measured_axes)}
     if not names:
         return fig, PlotAxes({"frf": ax_frf, **extra, **dict(zip(tags, rows[0]))}, aliases={"histories": rows[0]})
     panels: dict[str, Any] = {f"{name}_frf": ax_k for name, ax_k in zip(names, frf_axes)}
