@@ -28,6 +28,8 @@ QUANTITY_LABELS: dict[str, str] = {
     "spl_db": "sound pressure level (dB re 20 µPa)",
 }
 _LEGEND_PLACES = ("outside", "inside", "none")
+#: A sub-harmonic branch narrower than this fraction of the Ω range is drawn over the markers and named.
+SHORT_BRANCH = 0.04
 #: Room above the data (a fraction of its span) for the band labels at the top of a panel.
 LABEL_ROOM = 0.12
 #: Face colour of a ``no_stable_periodic`` band (hatched).
@@ -107,16 +109,29 @@ def draw_uncovered(frf: "FrequencyResponse", ax: Any) -> None:
 
 
 def draw_branches(
-    frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True, lw: float = 1.5
+    frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True, lw: float = 1.5,
+    name_short: bool = False,
 ) -> dict[int, str]:
-    """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours."""
+    """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours.
+
+    A sub-harmonic branch narrower than :data:`SHORT_BRANCH` of the Ω range is drawn thicker and
+    above the special points' markers (which would hide it), and with ``name_short`` named beside
+    it (an annotation below, in its colour)."""
     y_all = column(frf, quantity)
     colors = branch_colors(frf)
     x_all = np.asarray(frf.omega, dtype=float) * speed_axis(frf)[0]
+    width = float(np.ptp(x_all)) if x_all.size else 0.0
     for b, color in colors.items():
         sel = np.nonzero(frf.branch == b)[0]
         om, y, st = x_all[sel], y_all[sel], np.asarray(frf.stable[sel], dtype=bool)
         base = branch_label(frf, b)
+        short = b != min(colors) and om.size > 1 and float(np.ptp(om)) < SHORT_BRANCH * width
+        if short and name_short:  # a short branch: named beside it (its markers would hide it)
+            mid = int(np.argmin(np.abs(om - 0.5 * (om.min() + om.max()))))
+            note = ax.annotate(base, (om[mid], y[mid]), xytext=(0, -26), textcoords="offset points", ha="center",
+                               va="top", fontsize=7.5, color=color, zorder=7,
+                               arrowprops={"arrowstyle": "-", "color": color, "lw": 0.8, "shrinkA": 0, "shrinkB": 2})
+            note.rattle_move = -1
         for flag, style in ((True, "-"), (False, "--")):
             first = True
             for i0, i1 in true_runs(st == flag):
@@ -126,8 +141,8 @@ def draw_branches(
                 if labels and first:
                     lab = f"{base}, {'stable' if flag else 'unstable'}"
                     first = False
-                ax.plot(om[i0:j1], y[i0:j1], style, color=color,
-                        lw=lw if flag else 0.8 * lw, label=lab, zorder=3 if flag else 2)
+                ax.plot(om[i0:j1], y[i0:j1], style, color=color, lw=(1.8 if short else 1.0) * (lw if flag else 0.8 * lw),
+                        label=lab, zorder=(6 if short else 3) if flag else (6 if short else 2))
     return colors
 
 
@@ -413,7 +428,7 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
 def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, linear: bool, special_points: bool,
                 shown: Sequence[Any], legend: str, *, element: int = 0, label: str = "") -> None:
     """One frequency-response panel: column ``key`` (``quantity`` of element ``element``)."""
-    colors = draw_branches(frf, ax, key)
+    colors = draw_branches(frf, ax, key, name_short=special_points)
     draw_uncovered(frf, ax)
     if special_points:
         draw_special_points(frf, ax, key)

@@ -71,13 +71,23 @@ def _is_angle(response_map: ResponseMap, name: str) -> bool:
     return bool(words) and words[-1] in ANGLE_KEYS
 
 
+#: Longest y label with the configuration key beside the NAME (a longer one is cut by the figure).
+MAX_LABEL = 40
+
+
 def _label(response_map: ResponseMap, name: str) -> str:
-    """The y label: the parameter's NAME, a dotted key without its leading ``model.`` and
-    ``elements.`` (the full key is in map.json), with its unit where it is an angle."""
+    """The y label: the parameter's NAME with its key (``alpha (model.elastic.alpha)``) when that
+    is short, else the NAME alone — a dotted key without its leading ``model.`` and ``elements.``
+    (the full key is in map.json) — with its unit where it is an angle."""
+    key = next((p.key for p in response_map.parameters if p.name == name), name)
+    unit = " (rad)" if _is_angle(response_map, name) else ""
+    both = f"{name} ({key})" if key != name else name
+    if len(both + unit) <= MAX_LABEL:
+        return both + unit
     short = name
     for head in ("model.", "elements."):
         short = short[len(head):] if short.startswith(head) else short
-    return f"{short} (rad)" if _is_angle(response_map, name) else short
+    return short + unit
 
 
 def _panels(response_map: ResponseMap, name: str) -> list[tuple[str, list[int]]]:
