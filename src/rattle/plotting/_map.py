@@ -126,7 +126,7 @@ def map_plot_names(response_map: ResponseMap) -> list[tuple[str, str]]:
 MAP_QUANTITIES: dict[str, tuple[str, str, str]] = {
     "rms": ("rms_max_stable", "largest stable period-1 rms of δ (rad)", "no stable period-1 solution"),
     "spl": ("spl_max_stable_db", "largest stable sound pressure level (dB re 20 µPa)", "no stable periodic solution"),
-    "rms_ac": ("rms_ac_max_stable", "rms about the mean of the largest stable period-1 solution (rad)",
+    "rms_ac": ("rms_ac_max_stable", "rms about the mean (rms_ac) of the\nlargest stable period-1 solution (rad)",
                "no stable period-1 solution"),
 }
 
@@ -283,6 +283,8 @@ def plot_map(
         shown_as = {"rms": "largest stable rms", "spl": "largest stable sound pressure level",
                     "rms_ac": "rms about the mean (of the largest stable solution)"}[quantity]
         heading = f"response map: {shown_as}, impacts hatched, rattle-free outlined"
+        if len(heading) > 70:  # two lines: one would run past a one-panel figure's edges
+            heading = heading.replace(", impacts", ",\nimpacts", 1)
         if len(panels) > len(shown):
             heading += f" (first {len(shown)} of {len(panels)} panels)"
     if heading:
