@@ -5,6 +5,8 @@ exact shooting (``shoot_nonsmooth_orbit`` / ``shoot_friction_orbit``)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import math
 import pickle
 
@@ -110,8 +112,15 @@ def test_up_and_down_sweeps_of_a_preload_show_the_hysteresis_on_stable_exact_orb
     import matplotlib
 
     matplotlib.use("Agg")
-    _, axes = sweep.plot()  # the rms, and the stick fractions below
+    fig, axes = sweep.plot()  # never stuck or locked: no panel of zeros below (issue 27), the title says so
+    assert list(axes) == ["response"] and "never stuck or locked" in axes.primary.get_title()
+    matplotlib.pyplot.close(fig)
+    held = dataclasses.replace(sweep, extra_columns={**sweep.extra_columns,
+                                                     "stick_fraction": np.full(len(sweep), 0.05)})
+    fig, axes = held.plot()  # held part of the period: the stick fractions below, scaled to them
     assert axes["stick"].get_ylabel() == "stick / period" and axes.primary is axes["response"]
+    assert axes["stick"].get_ylim()[1] < 0.1
+    matplotlib.pyplot.close(fig)
     for w, p, x, rms, settled in zip(sweep.omega, sweep.period, sweep.state0, sweep.rms, sweep.settled):
         assert settled
         orbit = shoot_nonsmooth_orbit(ns, float(w), x, period=int(p))

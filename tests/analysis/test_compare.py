@@ -49,11 +49,16 @@ def test_requested_frequencies_and_output(tmp_path, reference_model) -> None:
     assert "Comparison(" in repr(c)
 
 
-def test_resonance_pick_when_nothing_else(reference_model) -> None:
-    # above the resonance and the period-2 region: one stable period-1 orbit everywhere
+def test_largest_rattle_pick_when_nothing_else(reference_model) -> None:
+    # above the resonance and the period-2 region: one stable period-1 orbit everywhere, impacting
     c = compare(reference_model, omega=(2.0, 3.0), harmonics=8, points=5)
-    assert c.reasons == ("resonance",)
-    assert pick_frequencies(c.frf, c.sweep) == [(c.at[0], "resonance")]
+    assert c.reasons == ("largest rattle",)
+    assert pick_frequencies(c.frf, c.sweep) == [(c.at[0], "largest rattle")]
+    # the pick is the largest stable motion about the mean (rms_ac) of an impacting row, not the largest rms
+    rows = c.frf.stable & np.isin(c.frf.regime.astype(str), ("single_sided", "double_sided"))
+    i = int(np.flatnonzero(rows)[np.argmax(c.frf.rms_ac[rows])])
+    grid = np.unique(c.sweep.omega)
+    assert c.at[0] == grid[np.argmin(np.abs(grid - c.frf.omega[i]))]
 
 
 @pytest.mark.parametrize(

@@ -77,3 +77,23 @@ def test_outline_is_the_boundary_between_free_and_impacting_cells():
     segs = {tuple(map(tuple, s)) for s in _outline(free, xe, ye)}
     assert segs == {((2.0, 0.0), (2.0, 1.0)), ((1.0, 1.0), (1.0, 2.0)), ((1.0, 1.0), (2.0, 1.0))}
     assert _outline(np.ones((2, 3), bool), xe, ye) == []  # all free: the frame is the outline
+
+
+def test_a_long_key_is_shortened_and_an_angle_has_its_units():
+    """Issue 27: "model.elements.damper.breakpoints.4 (model.elements.1.breakpoints.4)" was cut at
+    both ends, without a unit; now the NAME without its head, in rad, with degrees on the right."""
+    import matplotlib.pyplot as plt
+
+    m = synthetic_map(("model.elements.damper.breakpoints.4",), ((0.05, 0.07, 0.09),),
+                      keys=("model.elements.1.breakpoints.4",), points=20)
+    fig, ax = plot_map(m)
+    try:
+        assert ax.get_ylabel() == "damper.breakpoints.4 (rad)"
+        fig.canvas.draw()
+        label = ax.yaxis.label.get_window_extent(fig.canvas.get_renderer())
+        assert label.y0 >= 0 and label.y1 <= fig.bbox.height  # the whole label on the figure
+        (right,) = [c for c in ax.child_axes if "deg" in c.get_ylabel()]
+        lo, hi = right.get_ylim()
+        assert lo == pytest.approx(np.degrees(ax.get_ylim()[0])) and hi == pytest.approx(np.degrees(ax.get_ylim()[1]))
+    finally:
+        plt.close(fig)

@@ -15,8 +15,11 @@ Frequencies picked automatically (``at=None``), at most one per rule, on the swe
 2. **sub-harmonic** — the middle of the longest run of sweep points (either direction) with a
    period 2 … 8; if there is none, the middle of the longest run with period 0 (no period up
    to 8 found);
-3. **resonance** — only when fewer than two were found above: the frequency of the largest
-   stable rms on the FRF (the grid point nearest to it).
+3. **largest rattle** — only when fewer than two were found above: the frequency of the
+   largest stable motion about the mean (rms_ac) among the FRF's rows that impact (the grid
+   point nearest to it); where no stable row impacts, **resonance**: the largest stable rms_ac.
+   Not the largest rms: that holds the mean twist, which a drag growing with speed makes
+   largest at the end of the range whether or not anything rattles there.
 
 A discontinuous law (:class:`~rattle.model.NonsmoothSystem`: jumps and Coulomb friction) or a
 chain with friction on its elements (:class:`~rattle.model.FrictionSystem`): the frequency
@@ -111,13 +114,38 @@ def pick_frequencies(frf: FrequencyResponse, sweep: SweepResult) -> list[tuple[f
         if best is not None:
             picks.append((best[1], reason))
             break
-    # 3. resonance, when little else is of interest
+    # 3. the largest stable rattle (else resonance), when little else is of interest
     if len(picks) < 2 and np.any(frf.stable):
-        i = int(np.argmax(np.where(frf.stable, frf.rms, -np.inf)))
+        i, reason = _largest_rattle(frf)
         w = float(grid[int(np.argmin(np.abs(grid - frf.omega[i])))])
         if all(abs(w - p[0]) > 1e-12 for p in picks):
-            picks.append((w, "resonance"))
+            picks.append((w, reason))
     return sorted(picks)
+
+
+#: The regimes in which an orbit crosses a breakpoint (it rattles).
+_IMPACTING = ("single_sided", "double_sided")
+
+
+def _largest_rattle(frf: FrequencyResponse) -> tuple[int, str]:
+    """The row of the largest stable motion about the mean (``rms_ac``, not ``rms``: the rms
+    holds the mean twist, which a drag growing with speed makes largest at the range's end
+    whether or not anything rattles there) among the stable rows that impact — ``largest
+    rattle`` — or, where no stable row impacts, among the stable rows — ``resonance``. A chain:
+    an impact of any element counts, and the motion is the largest of its elements' rms_ac."""
+    names = tuple(getattr(frf, "element_names", ()) or ())
+    cols = getattr(frf, "element_columns", {}) or {}
+    if names:
+        motion = np.max([np.asarray(cols[f"{n}_rms_ac"], dtype=float) for n in names], axis=0)
+        impact = np.any([np.isin(np.asarray(cols[f"{n}_regime"]).astype(str), _IMPACTING) for n in names], axis=0)
+    else:
+        motion = np.asarray(frf.rms_ac, dtype=float)
+        impact = np.isin(np.asarray(frf.regime).astype(str), _IMPACTING)
+    stable = np.asarray(frf.stable, dtype=bool)
+    rattle = stable & impact & np.isfinite(motion)
+    rows = rattle if np.any(rattle) else stable
+    i = int(np.argmax(np.where(rows & np.isfinite(motion), motion, -np.inf)))
+    return i, "largest rattle" if np.any(rattle) else "resonance"
 
 
 def _check_at(at: object, lo: float, hi: float) -> list[float]:

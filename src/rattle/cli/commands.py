@@ -9,6 +9,7 @@ numerics only then, calls one front end of the library and hands the result to
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import logging
 import math
 import sys
@@ -24,6 +25,7 @@ from .checks import (
     DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, orbit_omega, orbit_speed,
     output_path, override_analysis, parse_at, precheck, speed_options,
 )
+from ._quantity import MAP_QUANTITY, check_quantity, map_largest_line, quantity_option, with_largest
 from .output import (
     COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
     frf_steps, map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections,
@@ -159,6 +161,7 @@ def compute_frf(
 def run_frf(
     model: Model, analysis: AnalysisSettings, output: Path, sections: dict[str, Any], *, subharmonics: bool = False,
     paths: Sequence[Any] = (), start: str = "low", fixed_harmonics: bool = False, html: bool = False,
+    quantity: str = "rms",
 ) -> None:
     """Compute the frequency response, write the three files (and frf.html) and print the summary.
 
@@ -181,6 +184,8 @@ def run_frf(
         Keep H fixed (``frequency_response(adaptive=None)``).
     html : bool, default False
         Also write frf.html, the interactive page (:func:`rattle.plotting.frequency_response_html`).
+    quantity : str, default "rms"
+        What frf.png (and frf.html) draws and the summary's 'largest' line reports (``--quantity``).
 
     Raises
     ------
@@ -193,13 +198,13 @@ def run_frf(
                          fixed_harmonics=fixed_harmonics, names=FRF_PAGE_FILES)
     if paths:  # SPEC §6: the sound pressure level at the receiver, per point
         result = result.with_sound(tuple(paths))
-    steps = frf_steps(result, sections, t_start)
+    steps = frf_steps(result, sections, t_start, quantity)
     if html:
         from ..plotting import frequency_response_html
 
-        steps.append(("frf.html", html_writer(lambda: frequency_response_html(result))))
+        steps.append(("frf.html", html_writer(lambda: frequency_response_html(result, quantity=quantity))))
     written = write_set(output, FRF_PAGE_FILES, steps)
-    echo_written(result.summary(), written, output)
+    echo_written(with_largest(result.summary(), quantity, result), written, output)
 
 
 def _law_keys(run_config: Any) -> str:
@@ -235,10 +240,11 @@ def _law_keys(run_config: Any) -> str:
               help="Keep H = --harmonics on the whole range (by default H is raised where the truncation "
                    "error or a failing corrector demands it, up to 128, and lowered again where it allows).")
 @html_option
+@quantity_option
 def frf_command(
     config: Path, output: Path, harmonics: int | None, omega_min: float | None, omega_max: float | None,
     rpm_min: float | None, rpm_max: float | None, subharmonics: bool, start: str = "low",
-    fixed_harmonics: bool = False, html: bool = False,
+    fixed_harmonics: bool = False, html: bool = False, quantity: str = "rms",
 ) -> None:
     """Frequency response of the model in CONFIG: frf.csv, frf.png, frf.json (and frf.html, an
     interactive page, with --html) in OUTPUT.
@@ -252,17 +258,19 @@ def frf_command(
     precheck(config, output, harmonics=harmonics)
     check_html(html)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "frf")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
         omega_max=w_max,
     )
-    options = {"harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
+    options = {"quantity": None if quantity == "rms" else quantity, "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max,
                "rpm_min": rpm_min, "rpm_max": rpm_max, "subharmonics": True if subharmonics else None,
                "start": None if start == "low" else start, "fixed_harmonics": True if fixed_harmonics else None,
                "html": True if html else None}
     run_frf(run_config.model, analysis, output, sections("frf", config, run_config, analysis, options),
-            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics, html=html)
+            subharmonics=subharmonics, paths=run_config.paths, start=start, fixed_harmonics=fixed_harmonics, html=html,
+            quantity=quantity)
 
 
 # --------------------------------------------------------------------------------------------
@@ -319,9 +327,11 @@ def _sweep_warnings() -> Iterator[None]:
 @_rpm_min_option
 @_rpm_max_option
 @_quiet_option
+@quantity_option
 def sweep_command(
     config: Path, output: Path, direction: str | None, points: int, workers: int,
     omega_min: float | None, omega_max: float | None, rpm_min: float | None, rpm_max: float | None, quiet: bool,
+    quantity: str = "rms",
 ) -> None:
     """Time-domain frequency sweep of the model in CONFIG: sweep.csv, sweep.png, sweep.json in OUTPUT.
 
@@ -343,6 +353,7 @@ def sweep_command(
         raise ConfigError("`--direction` is required: give --direction up, down or both")
     precheck(config, output, points=points, workers=workers)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "sweep")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(run_config.analysis, run_config.bounds_model, labels=labels, omega_min=w_min,
                                  omega_max=w_max)
@@ -361,13 +372,14 @@ def sweep_command(
     meta = sections("sweep", config, run_config, analysis, {
         "direction": direction, "points": points, "workers": workers,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
+        "quantity": None if quantity == "rms" else quantity,
     })
     written = write_set(output, SWEEP_FILES, [
         ("sweep.csv", result.to_csv),
         ("sweep.json", metadata_writer(result.metadata(), meta, t_start)),
-        ("sweep.png", lambda path: save_plot(result, path)),
+        ("sweep.png", lambda path: save_figure(lambda: result.plot(quantity=quantity), path)),
     ])
-    echo_written(result.summary(), written, output)
+    echo_written(with_largest(result.summary(), quantity, result), written, output)
     _raise_if_incomplete(result, written, output)
 
 
@@ -626,10 +638,11 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
 @_rpm_max_option
 @_quiet_option
 @html_option
+@quantity_option
 def compare_command(
     config: Path, output: Path, points: int, at: str | None, workers: int, measured: Path | None,
     harmonics: int | None, omega_min: float | None, omega_max: float | None, rpm_min: float | None,
-    rpm_max: float | None, quiet: bool, html: bool = False,
+    rpm_max: float | None, quiet: bool, html: bool = False, quantity: str = "rms",
 ) -> None:
     """Frequency response against the up/down time-domain sweep for the model in CONFIG:
     compare.png, frf.csv, sweep.csv, compare.json (and compare.html, an interactive page, with --html) in
@@ -657,6 +670,7 @@ def compare_command(
         # every rule of the measured file that needs no configuration, before numpy is loaded
         measured_table = _io().parse_measured_csv(measured)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "compare")
     if run_config.discontinuous:
         for given, option in ((at, "--at"), (measured, "--measured")):
             if given is not None:
@@ -692,6 +706,7 @@ def compare_command(
         "points": points, "at": at_values, "workers": workers, "harmonics": harmonics,
         "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min, "rpm_max": rpm_max,
         "measured": None if measured is None else str(measured), "html": True if html else None,
+        "quantity": None if quantity == "rms" else quantity,
     })
     frf = result.frf.with_sound(run_config.paths) if run_config.paths else result.frf
     sweep = result.sweep.with_sound(run_config.paths) if run_config.paths else result.sweep
@@ -699,16 +714,22 @@ def compare_command(
         ("frf.csv", frf.to_csv), ("sweep.csv", sweep.to_csv),
         ("compare.json", metadata_writer(result.metadata(), meta, t_start)),
     ]
-    summary = result.summary()
+    summary = with_largest(result.summary(), quantity, frf, sweep, where=("frequency response: ", "sweep: "))
+    shown = result if quantity == "rms" else dataclasses.replace(result, frf=frf, sweep=sweep)  # spl_db: the paths'
     if measured_run is None:
-        steps.append(("compare.png", lambda path: save_plot(result, path)))
+        def draw() -> Any:
+            from ..plotting import compare_plot  # matplotlib checked by save_figure first
+
+            return compare_plot(shown, quantity=quantity)
+
+        steps.append(("compare.png", lambda path: save_plot(result, path) if quantity == "rms" else save_figure(draw, path)))
     else:
         from ..results import compare_measured
 
         def draw_measured() -> Any:
             from ..plotting import compare_plot  # matplotlib checked by save_figure first
 
-            return compare_plot(result, measured=beside)
+            return compare_plot(shown, measured=beside, quantity=quantity)
 
         beside = compare_measured(measured_run, frf, sweep)  # the sweeps with their sound pressure (paths)
         summary += "\n" + beside.summary()
@@ -785,10 +806,12 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
               help="Also write map.md, the design summary (special points, rattle-free intervals, the search).")
 @_quiet_option
 @html_option
+@quantity_option
 def map_command(
     config: Path, output: Path, vary: tuple[str, ...], omega_points: int, workers: int | None,
     scheduler: str | None, harmonics: int | None, omega_min: float | None, omega_max: float | None,
     rpm_min: float | None, rpm_max: float | None, report: bool, quiet: bool, html: bool = False,
+    quantity: str = "rms",
 ) -> None:
     """Response map of the model in CONFIG over the --vary parameters and the frequency: map.csv,
     map.nc, map.json, map.png (map.md with --report, map.html, an interactive page, with --html) in OUTPUT.
@@ -810,6 +833,7 @@ def map_command(
     check_omega_points(omega_points)
     scheduler = check_scheduler(scheduler)
     run_config = _io().load_config(config)
+    check_quantity(quantity, run_config, "map")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
@@ -843,26 +867,29 @@ def map_command(
         "vary": list(vary), "omega_points": omega_points, "workers": workers, "scheduler": scheduler,
         "harmonics": harmonics, "omega_min": omega_min, "omega_max": omega_max, "rpm_min": rpm_min,
         "rpm_max": rpm_max, "report": True if report else None, "html": True if html else None,
+        "quantity": None if quantity == "rms" else quantity,
     })
 
     steps: list[tuple[str, Any]] = [
         ("map.csv", map_csv_writer(result)),
         ("map.nc", result.to_netcdf),
         ("map.json", map_json_writer(result, meta, t_start)),
-        *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y), path)) for name, name_y in figures],
+        *[(name, lambda path, y=name_y: save_figure(lambda: plot_map(result, y, quantity=MAP_QUANTITY[quantity]), path))
+          for name, name_y in figures],
     ]
     if report:
         steps.append(("map.md", lambda path: _io().atomic_write_text(path, map_report(result))))
     if html:
         from ..plotting import map_html
 
-        steps.append(("map.html", html_writer(lambda: map_html(result, summary=map_summary(result)))))
+        steps.append(("map.html", html_writer(lambda: map_html(result, summary=map_summary(result),
+                                                                    quantity=MAP_QUANTITY[quantity]))))
     # the set: also every map_<NAME>.png of an earlier map in OUTPUT, so that none is left beside the new one
     earlier = sorted(p.name for p in output.glob("map_*.png")) if output.is_dir() else []
     names = tuple(dict.fromkeys([*MAP_FILES, "map.html", *(name for name, _ in figures[1:]), *earlier]))
     written = write_set(output, names, steps)
     failed = [c for c in result.cells if c.status == "failed"]
-    echo_written(map_summary(result), written, output)
+    echo_written(map_summary(result) + map_largest_line(result, quantity), written, output)
     if failed and len(failed) == len(result.cells):
         raise ConvergenceError(f"every combination failed; the first: {failed[0].message}; the files written say "
                                "which (status in map.json)")

@@ -255,17 +255,23 @@ def sections(command: str, config: Path, run_config: Any, analysis: AnalysisSett
     }
 
 
-def frf_steps(result: Any, sections: dict[str, Any], t_start: float) -> list[tuple[str, Writer]]:
-    """Writers of ``frf.csv``, ``frf.json`` and ``frf.png`` (the data first, the figure last)."""
+def frf_steps(result: Any, sections: dict[str, Any], t_start: float, quantity: str = "rms") -> list[tuple[str, Writer]]:
+    """Writers of ``frf.csv``, ``frf.json`` and ``frf.png`` (the data first, the figure last; the
+    figure draws ``quantity``)."""
+    def figure(path: Path) -> bool:
+        if quantity == "rms":
+            return save_plot(result, path)
+        return save_figure(lambda: result.plot(quantity=quantity), path)
+
     return [("frf.csv", result.to_csv), ("frf.json", metadata_writer(result.metadata(), sections, t_start)),
-            ("frf.png", lambda path: save_plot(result, path))]
+            ("frf.png", figure)]
 
 
 def write_frf(result: Any, output: Path, sections: dict[str, Any], t_start: float,
-              names: Sequence[str] = FRF_FILES) -> list[str]:
+              names: Sequence[str] = FRF_FILES, quantity: str = "rms") -> list[str]:
     """Write ``frf.csv``, ``frf.json`` and ``frf.png`` into ``output`` as one set (``names``: the
     command's whole set, see :func:`write_set`); return the names written."""
-    return write_set(output, names, frf_steps(result, sections, t_start))
+    return write_set(output, names, frf_steps(result, sections, t_start, quantity))
 
 
 # --------------------------------------------------------------------------------------------

@@ -184,9 +184,9 @@ def hbm_vs_simulation_plot(
                     color=color, bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": color, "alpha": 0.9},
                     zorder=8)
     n = int(np.sum(np.asarray(sweep.direction) == "up"))
-    ax.set_title(title if title is not None else
-                 f"Figure 5 — harmonic balance (lines; H = {frf.settings.get('harmonics', frf.harmonics)}) vs "
-                 f"time-domain sweep up and down ({n} frequencies each way)")
+    ax.set_title(title if title is not None else  # two lines: one would run past the figure's left edge
+                 f"Figure 5 — harmonic balance (lines; H = {frf.settings.get('harmonics', frf.harmonics)})\n"
+                 f"vs the time-domain sweep up and down ({n} frequencies each way)")
     ax.set_ylabel("δ rms (rad)")
     place_legend(ax, "outside")
     return fig, PlotAxes.single(ax)
@@ -351,12 +351,15 @@ def point_plot(
     ax_p.set_xlabel("δ (rad)")
     ax_p.set_ylabel("δ' (rad/s)")
     ax_p.set_title("phase portrait (one period of each orbit)", fontsize=10)
-    if ax_p.get_legend_handles_labels()[0]:
-        ax_p.legend(fontsize=7.5, loc="upper left", framealpha=0.85)
+    if ax_p.get_legend_handles_labels()[0]:  # below the portrait, not over the trajectory
+        ax_p.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.13), framealpha=0.85)
     if ax_s is not None:
         ymax = max([float(np.max(s.amplitudes())) for s in orbit.solutions] + [1e-6])
         ax_s.set_yscale("log")
-        ax_s.set_ylim(max(1e-6, ymax * 1e-4), ymax * 4.0)
+        # every marker drawn inside (the smallest drawn amplitude, not a fixed 10⁻⁴ of the largest)
+        drawn = [float(np.min(y[y > 0])) for line in ax_s.get_lines()
+                 if (y := np.asarray(line.get_ydata(), dtype=float)).size and np.any(y > 0)]
+        ax_s.set_ylim(max(1e-8, min([ymax * 1e-4, *drawn]) / 2.5), ymax * 4.0)
         ax_s.set_xlim(-0.2, SPECTRUM_ORDERS + 0.2)
         ax_s.set_xticks(np.arange(0, SPECTRUM_ORDERS + 0.01, 0.5))
         ax_s.set_xlabel("frequency / Ω")
@@ -451,16 +454,21 @@ def mean_operating_point_plot(
                  fontsize=10)
     place_legend(ax, "outside")
 
+    first = min(colors)
     for b, color in colors.items():
         sel = np.flatnonzero(frf.branch == b)
         for i0, i1 in true_runs(np.asarray(frf.stable[sel], dtype=bool)):
             rows = sel[i0:i1]  # a stable stretch runs monotonically in Ω (folds end it)
-            if rows.size >= 2:
+            if rows.size >= 2 and b == first:  # one shade only: overlapping shades mix into a colour no legend names
                 ax_r.fill_between(frf.omega[rows], frf.delta_min[rows], frf.delta_max[rows], color=color,
                                   alpha=0.18, lw=0, zorder=1)
+            elif rows.size >= 2:  # another branch's range: its edges, in its colour
+                for edge in (frf.delta_min[rows], frf.delta_max[rows]):
+                    ax_r.plot(frf.omega[rows], edge, "-", color=color, lw=0.9, alpha=0.9, zorder=2)
         st = np.asarray(frf.stable[sel], dtype=bool)
         ax_r.plot(frf.omega[sel], np.where(st, frf.mean[sel], np.nan), "-", color=color, lw=1.2, zorder=3,
-                  label=f"{'δ_m and ' if b == min(colors) else ''}range of δ, {branch_label(frf, b)} (stable)")
+                  label=f"{'δ_m and ' if b == first else 'δ_m and edges of the '}range of δ, {branch_label(frf, b)} "
+                        f"(stable{', shaded' if b == first else ''})")
     lo_r = min(float(np.min(frf.delta_min[frf.stable])), float(bps.min()) if bps.size else 0.0)
     hi_r = max(float(np.max(frf.delta_max[frf.stable])), float(bps.max()) if bps.size else 0.0)
     pad = 0.05 * (hi_r - lo_r)

@@ -8,7 +8,7 @@ blocks below the plot functions in ``__all__`` (branch colours and labels, speci
 period colours, spectra) are public for that use.
 """
 
-from ._axes import PlotAxes, unwrap
+from ._axes import PlotAxes, fit_ylim, separate_texts, unwrap
 from ._compare import compare_plot
 from ._frf import (
     branch_colors, branch_label, draw_branches, draw_regions, draw_special_points, frequency_response_plot,
@@ -33,4 +33,6 @@ __all__ = [
     # building blocks (the demo's figures, the command line's summaries)
     "unwrap", "branch_colors", "branch_label", "draw_branches", "draw_regions", "draw_special_points",
     "place_legend", "true_runs", "held_runs", "amplitude_spectrum", "period_label", "PERIOD_COLORS",
+    # every point inside the axes, no label over another
+    "fit_ylim", "separate_texts",
 ]

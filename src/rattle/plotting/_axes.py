@@ -109,3 +109,87 @@ def unwrap(ax: Any) -> Any:
 
 
 __all__ = ["PlotAxes", "unwrap"]
+
+
+def fit_ylim(ax: Any, room: float = 0.0, margin: float = 0.05) -> None:
+    """Set the y limits of ``ax`` to hold every point of its data lines (those drawn in data
+    coordinates: not ``axvline``/``axhline``), with ``margin`` of the span below and above and
+    ``room`` more above (space for labels at the top). ``set_ylim`` elsewhere freezes the
+    autoscale, so a plot that adds lines after it calls this at the end."""
+    import numpy as np
+
+    lo, hi = np.inf, -np.inf
+    for line in ax.get_lines():
+        if line.get_transform() != ax.transData or not line.get_visible():
+            continue
+        y = np.asarray(line.get_ydata(), dtype=float)
+        y = y[np.isfinite(y)]
+        if y.size:
+            lo, hi = min(lo, float(y.min())), max(hi, float(y.max()))
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return
+    span = hi - lo or (abs(hi) * 0.1 or 1.0)
+    ax.set_ylim(lo - margin * span, hi + (margin + room) * span)
+
+
+#: How many times :func:`separate_texts` moves a label (by its own height) before hiding it.
+MAX_TEXT_MOVES = 4
+
+
+def separate_texts(fig: Any, axes: Iterable[Any]) -> None:
+    """Move the labels of ``axes`` (their ``ax.texts``) so that none overlaps another, a tick
+    label or the axes' title, and none sticks out of its axes sideways.
+
+    The figure's layout is done first (the labels' places in pixels depend on it). Labels are
+    taken left to right; one that overlaps something placed already is moved by its own height
+    in the direction of its attribute ``rattle_move`` (−1 down, the default for labels in the
+    upper half of the axes; +1 up below it), at most :data:`MAX_TEXT_MOVES` times, then hidden
+    (what it says is in the legend or the ring colours); one moved out of the axes is hidden too. Only labels given as an annotation
+    with an offset in points (``textcoords="offset points"``) and ``rattle_move`` other than 0 are
+    moved; the others are obstacles."""
+    from matplotlib.text import Annotation, Text
+
+    def extent(t: Any) -> Any:  # the text's box, without an annotation's arrow
+        return Text.get_window_extent(t, renderer)
+
+    axes = list(axes)
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        engine.execute(fig)
+    renderer = fig.canvas.get_renderer()
+    scale = 72.0 / fig.dpi  # pixels → points
+    for ax in axes:
+        box = ax.get_window_extent(renderer)
+        placed = [t.get_window_extent(renderer) for t in (*ax.get_xticklabels(), *ax.get_yticklabels(), ax.title,
+                                                           ax.xaxis.label, ax.yaxis.label)
+                  if t.get_visible() and t.get_text()]
+        movable, fixed = [], []
+        for t in ax.texts:
+            if not (t.get_visible() and t.get_text()):
+                continue
+            if isinstance(t, Annotation) and t.anncoords == "offset points" and getattr(t, "rattle_move", None) != 0:
+                movable.append(t)
+            else:
+                fixed.append(t)
+        placed += [extent(t) for t in fixed]
+        movable.sort(key=lambda t: extent(t).x0)
+        for t in movable:
+            bb = extent(t)
+            dx = max(0.0, box.x0 + 1.0 - bb.x0) - max(0.0, bb.x1 - (box.x1 - 1.0))  # inside the axes sideways
+            if dx:
+                t.xyann = (t.xyann[0] + dx * scale, t.xyann[1])
+            direction = getattr(t, "rattle_move", None)
+            if direction is None:
+                direction = -1 if ax.transAxes.inverted().transform(bb.get_points().mean(axis=0))[1] > 0.5 else 1
+            for _ in range(MAX_TEXT_MOVES + 1):
+                bb = extent(t).padded(1.0)
+                inside = bb.y0 >= box.y0 - 1.0 and bb.y1 <= box.y1 + 1.0
+                if inside and not any(bb.overlaps(other) for other in placed):
+                    placed.append(bb)
+                    break
+                t.xyann = (t.xyann[0], t.xyann[1] + direction * (bb.height + 2.0) * scale)
+            else:
+                t.set_visible(False)
+
+
+__all__ += ["fit_ylim", "separate_texts", "MAX_TEXT_MOVES"]

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._axes import PlotAxes
+from ._axes import PlotAxes, fit_ylim, separate_texts
 from ._frf import frequency_response_plot
 from ._orbit import window_periods
 from ._sweep import DIRECTION_STYLES, sweep_plot
@@ -73,6 +73,7 @@ def compare_plot(
     samples: int = 256,
     title: str | None = None,
     measured: "MeasuredComparison | None" = None,
+    quantity: str = "rms",
 ) -> tuple[Any, PlotAxes]:
     """Draw the frequency response (stable solid, unstable dashed) with the up (▲) and down (▼)
     sweep points over it, the examined frequencies marked (a), (b), …, and below it one panel
@@ -94,6 +95,12 @@ def compare_plot(
         response of Q (stable solid, unstable dashed), the up (▲) and down (▼) sweep points of Q
         (when the sweep carries Q) and the measured points (black ●, joined), over engine rpm
         when the model has an engine.
+    quantity : str, default "rms"
+        What the frequency-response panels draw (HB lines and sweep points): ``rms``, ``rms_ac``,
+        ``p2p``, ``acc_p2p`` (a chain: of each element), or ``spl_db`` (frf and sweep with sound
+        paths: the level at the receiver in the first panel, a chain's other elements keep their
+        rms). The time histories are δ(t) whatever the quantity. A discontinuous law's
+        comparison draws rms only.
 
     Returns
     -------
@@ -108,13 +115,19 @@ def compare_plot(
     """
     import matplotlib.pyplot as plt
 
-    from ._frf import _draw_panel, speed_axis
+    from ._frf import LABEL_ROOM, _draw_panel, speed_axis
     from ._sweep import _draw_sweep
 
     if getattr(comparison, "discontinuous", False):
         if measured is not None:
             raise ValueError("`measured` is not supported for a discontinuous law's comparison")
+        if quantity != "rms":
+            raise ValueError(f"`quantity` {quantity!r}: a discontinuous law's comparison draws the exact rms only")
         return _discontinuous_plot(comparison, fig, title)
+    from ._frf import QUANTITY_LABELS
+
+    if quantity not in ("rms", "rms_ac", "p2p", "acc_p2p", "spl_db"):
+        raise ValueError(f"`quantity` must be one of rms, rms_ac, p2p, acc_p2p, spl_db, got {quantity!r}")
     frf, sweep = comparison.frf, comparison.sweep
     names = tuple(getattr(sweep, "element_names", ()) or ())
     m = max(1, len(names))
@@ -135,34 +148,45 @@ def compare_plot(
         measured_axes = [fig.add_subplot(gs[m + k, 0]) for k in range(q)]
         rows = [[] for _ in range(m)]
     ax_frf = frf_axes[0]
-    for quantity, ax_q in zip(quantities, measured_axes):
-        _draw_measured(measured, quantity, ax_q)  # type: ignore[arg-type]
+    for measured_q, ax_q in zip(quantities, measured_axes):
+        _draw_measured(measured, measured_q, ax_q)  # type: ignore[arg-type]
 
     if not names:
-        frequency_response_plot(frf, ax=ax_frf, linear=False, title="")
-        sweep_plot(sweep, ax=ax_frf, lines=False, title="")
+        frequency_response_plot(frf, ax=ax_frf, quantity=quantity, linear=False, title="")
+        sweep_plot(sweep, ax=ax_frf, quantity=quantity, lines=False, title="")
     else:
         for k, (name, ax_k) in enumerate(zip(names, frf_axes)):
-            _draw_panel(frf, ax_k, f"{name}_rms", "rms", False, True, frf.regions, "none", element=k,
+            if k == 0 and quantity == "spl_db":  # the level at the receiver (the whole chain's)
+                frequency_response_plot(frf, ax=ax_k, quantity=quantity, linear=False, title="", legend="none")
+                sweep_plot(sweep, ax=ax_k, quantity=quantity, lines=False, title="")
+                continue
+            q_k = "rms" if quantity == "spl_db" else quantity
+            _draw_panel(frf, ax_k, f"{name}_{q_k}", q_k, False, True, frf.regions, "none", element=k,
                         label=f"{name}: ")
-            _draw_sweep(sweep, ax_k, np.asarray(sweep.element_columns[f"{name}_rms"], dtype=float), True, False,
+            _draw_sweep(sweep, ax_k, np.asarray(sweep.element_columns[f"{name}_{q_k}"], dtype=float), True, False,
                         legend=False)
-            ax_k.set_ylabel(f"{name}: δ rms (rad)")
+            ax_k.set_ylabel(f"{name}: {QUANTITY_LABELS[q_k]}")
     letters = string.ascii_lowercase
     sx = speed_axis(frf)[0]  # crankshaft rpm with an engine
     for ax_k in [*frf_axes, *measured_axes]:
         for j, w in enumerate(comparison.at):
             ax_k.axvline(w * sx, color="0.35", lw=0.9, ls="-.", zorder=0)
-            ax_k.annotate(f"({letters[j % 26]})", (w * sx, 1.0), xycoords=("data", "axes fraction"),
-                          xytext=(3, -12), textcoords="offset points", fontsize=10, fontweight="bold")
+            lo_x, hi_x = ax_k.get_xlim()
+            right = w * sx > lo_x + 0.93 * (hi_x - lo_x)  # near the right edge: the letter left of its line
+            letter = ax_k.annotate(f"({letters[j % 26]})", (w * sx, 1.0), xycoords=("data", "axes fraction"),
+                                   xytext=(-3 if right else 3, -3), textcoords="offset points", fontsize=10,
+                                   fontweight="bold", ha="right" if right else "left", va="top")
+            letter.rattle_move = 0  # stays; the band labels move out of its way
     ax_frf.set_title(
-        f"Frequency response: harmonic balance (H = {frf.harmonics}, lines) against the time-domain sweep "
-        f"({int(np.sum(sweep.direction == 'up'))} frequencies per direction)"
-        + (f" — element {names[0]}" if names else "")
-    )
+        f"Harmonic balance (H = {frf.harmonics}, lines) against the time-domain sweep "
+        f"({int(np.sum(sweep.direction == 'up'))} frequencies per direction, markers)"
+        + (f" — element {names[0]}" if names else ""), fontsize=10.5)
     for k, name in enumerate(names[1:], start=1):
         frf_axes[k].set_title(f"element {name}", fontsize=10)
-    ax_frf.legend(fontsize=8, loc="upper right", ncol=2, framealpha=0.9)
+    for ax_k in frf_axes:  # every sweep point inside the axes, room for the band labels
+        fit_ylim(ax_k, room=LABEL_ROOM)
+    # the legend beside the panel, never over the data
+    ax_frf.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, framealpha=0.9)
 
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for e in range(m):
@@ -200,11 +224,13 @@ def compare_plot(
             if j == 0:
                 ax.set_ylabel(f"{names[e]}: δ (rad)" if names else "δ (rad)")
             ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=7, loc="best", framealpha=0.85)
+            fit_ylim(ax, room=0.35)  # room for the legend above the curves
+            ax.legend(fontsize=7, loc="upper center", ncols=2, framealpha=0.85)
     if title is not None:
         fig.suptitle(title)
+    separate_texts(fig, [*frf_axes, *measured_axes])
     tags = [f"history_{letters[j]}" if j < 26 else f"history_{j}" for j in range(n)]
-    extra = {f"measured_{quantity}": ax_q for quantity, ax_q in zip(quantities, measured_axes)}
+    extra = {f"measured_{measured_q}": ax_q for measured_q, ax_q in zip(quantities, measured_axes)}
     if not names:
         return fig, PlotAxes({"frf": ax_frf, **extra, **dict(zip(tags, rows[0]))}, aliases={"histories": rows[0]})
     panels: dict[str, Any] = {f"{name}_frf": ax_k for name, ax_k in zip(names, frf_axes)}
@@ -223,7 +249,7 @@ def _discontinuous_plot(comparison: "Comparison", fig: Any, title: str | None) -
     response's rows (line) and of the sweep's (markers)."""
     import matplotlib.pyplot as plt
 
-    from ._sweep import _draw_sweep
+    from ._sweep import _draw_sweep, stick_ylim
 
     frf, sweep = comparison.frf.check, comparison.sweep  # the exact-check group: HB and exact side by side
     names = tuple(getattr(frf, "element_names", ()) or ())
@@ -256,7 +282,8 @@ def _discontinuous_plot(comparison: "Comparison", fig: Any, title: str | None) -
         _draw_sweep(sweep, ax, y, True, False, legend=False)
         ax.set_ylabel(f"{names[k]}: δ rms (rad)" if names else "δ rms (rad)")
         ax.set_xlabel("")
-        ax.legend(fontsize=8, loc="best", framealpha=0.9)
+        fit_ylim(ax)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, framealpha=0.9)
         if k:
             ax.set_title(f"element {names[k]}", fontsize=10)
     ag = comparison.agreement()
@@ -280,11 +307,12 @@ def _discontinuous_plot(comparison: "Comparison", fig: Any, title: str | None) -
                     marker, _, _ = DIRECTION_STYLES[d]
                     ax_s.plot(np.asarray(sweep.omega)[sel], np.asarray(sweep_held[k])[sel], marker, color=c, ms=4,
                               ls="none", label=f"{label}sweep {d}")
-    ax_s.set_ylim(-0.02, 1.02)
+    stick_ylim(ax_s, [np.where(matched, held[:, k], np.nan) for k in range(m)]
+               + [v for v in sweep_held if v is not None])
     ax_s.set_ylabel("stick / period")
     ax_s.set_xlabel("Ω (rad/s)")
     ax_s.grid(True, alpha=0.3)
-    ax_s.legend(fontsize=7, loc="best", ncol=2)
+    ax_s.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     if title is not None:
         fig.suptitle(title)
     if names:

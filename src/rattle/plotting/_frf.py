@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._axes import PlotAxes, unwrap
+from ._axes import PlotAxes, fit_ylim, separate_texts, unwrap
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import FrequencyResponse, Region
@@ -25,8 +25,13 @@ QUANTITY_LABELS: dict[str, str] = {
     "mean": "δ mean δ_m (rad)", "rms": "δ rms (rad)", "rms_ac": "δ rms about the mean (rad)",
     "p2p": "δ peak-to-peak (rad)", "acc_p2p": "δ'' peak-to-peak (rad/s²)",
     "delta_min": "δ min (rad)", "delta_max": "δ max (rad)",
+    "spl_db": "sound pressure level (dB re 20 µPa)",
 }
 _LEGEND_PLACES = ("outside", "inside", "none")
+#: A sub-harmonic branch narrower than this fraction of the Ω range is drawn over the markers and named.
+SHORT_BRANCH = 0.04
+#: Room above the data (a fraction of its span) for the band labels at the top of a panel.
+LABEL_ROOM = 0.12
 #: Face colour of a ``no_stable_periodic`` band (hatched).
 NO_STABLE_COLOR = "0.6"
 #: How each kind of interval without a stable computed orbit is drawn: (hatch, edge colour,
@@ -104,16 +109,29 @@ def draw_uncovered(frf: "FrequencyResponse", ax: Any) -> None:
 
 
 def draw_branches(
-    frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True, lw: float = 1.5
+    frf: "FrequencyResponse", ax: Any, quantity: str, *, labels: bool = True, lw: float = 1.5,
+    name_short: bool = False,
 ) -> dict[int, str]:
-    """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours."""
+    """Every branch of ``frf`` in its colour, stable solid and unstable dashed; returns the colours.
+
+    A sub-harmonic branch narrower than :data:`SHORT_BRANCH` of the Ω range is drawn thicker and
+    above the special points' markers (which would hide it), and with ``name_short`` named beside
+    it (an annotation below, in its colour)."""
     y_all = column(frf, quantity)
     colors = branch_colors(frf)
     x_all = np.asarray(frf.omega, dtype=float) * speed_axis(frf)[0]
+    width = float(np.ptp(x_all)) if x_all.size else 0.0
     for b, color in colors.items():
         sel = np.nonzero(frf.branch == b)[0]
         om, y, st = x_all[sel], y_all[sel], np.asarray(frf.stable[sel], dtype=bool)
         base = branch_label(frf, b)
+        short = b != min(colors) and om.size > 1 and float(np.ptp(om)) < SHORT_BRANCH * width
+        if short and name_short:  # a short branch: named beside it (its markers would hide it)
+            mid = int(np.argmin(np.abs(om - 0.5 * (om.min() + om.max()))))
+            note = ax.annotate(base, (om[mid], y[mid]), xytext=(0, -26), textcoords="offset points", ha="center",
+                               va="top", fontsize=7.5, color=color, zorder=7,
+                               arrowprops={"arrowstyle": "-", "color": color, "lw": 0.8, "shrinkA": 0, "shrinkB": 2})
+            note.rattle_move = -1
         for flag, style in ((True, "-"), (False, "--")):
             first = True
             for i0, i1 in true_runs(st == flag):
@@ -123,8 +141,8 @@ def draw_branches(
                 if labels and first:
                     lab = f"{base}, {'stable' if flag else 'unstable'}"
                     first = False
-                ax.plot(om[i0:j1], y[i0:j1], style, color=color,
-                        lw=lw if flag else 0.8 * lw, label=lab, zorder=3 if flag else 2)
+                ax.plot(om[i0:j1], y[i0:j1], style, color=color, lw=(1.8 if short else 1.0) * (lw if flag else 0.8 * lw),
+                        label=lab, zorder=(6 if short else 3) if flag else (6 if short else 2))
     return colors
 
 
@@ -184,9 +202,13 @@ def draw_regions(
             ax.axvspan(sx * r.omega_min, sx * r.omega_max, color=band, alpha=0.22, lw=0, zorder=0,
                        label=f"period {period} stable (1/{period} sub-harmonic)" if labels and key not in seen else None)
             seen.add(key)
-            ax.text(0.5 * sx * (r.omega_min + r.omega_max), 0.985, f"period {period}", transform=top,
-                    ha="center", va="top", fontsize=8, color=text_color, fontweight="bold",
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8}, zorder=6)
+            joined = _joined_bands(regions, period)  # bands of one period that touch: one label
+            if r is not next(g[0] for g in joined if r in g):
+                continue
+            group = next(g for g in joined if r in g)
+            x_mid = 0.5 * sx * (min(g.omega_min for g in group) + max(g.omega_max for g in group))
+            _band_label(ax, x_mid, 0.985, f"period {period}", top,
+                        fontsize=8, color=text_color, fontweight="bold")
         elif r.kind in UNSTABLE_REGION_STYLES:
             hatch, edge, legend_text, short = UNSTABLE_REGION_STYLES[r.kind]
             sim = [int(p) for p in r.detail.get("sweep_periods", []) or []]
@@ -200,9 +222,7 @@ def draw_regions(
                 short = f"period {2 * int(r.detail.get('period', 1))}\nlikely"
             if sim and r.kind != "no_stable_periodic":
                 short = "sim: " + ",".join(f"P{p}" if p else "none" for p in sim)
-            ax.text(0.5 * sx * (r.omega_min + r.omega_max), 0.93, short, transform=top,
-                    ha="center", va="top", fontsize=7, color="0.25",
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}, zorder=6)
+            _band_label(ax, 0.5 * sx * (r.omega_min + r.omega_max), 0.985, short, top, fontsize=7, color="0.25")
         elif r.kind == "torus":
             sim = r.detail.get("simulated_periods")
             text = ("quasi-periodic (Neimark–Sacker)" if sim is None else
@@ -211,9 +231,7 @@ def draw_regions(
                        zorder=0, label=text if labels and text not in seen else None)
             seen.add(text)
             short = "torus" if sim is None else ("sim: " + ",".join(f"P{p}" if p else "QP" for p in sim))
-            ax.text(0.5 * sx * (r.omega_min + r.omega_max), 0.86, short, transform=top, ha="center", va="top", fontsize=7,
-                    color="tab:green", bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
-                    zorder=6)
+            _band_label(ax, 0.5 * sx * (r.omega_min + r.omega_max), 0.985, short, top, fontsize=7, color="tab:green")
         elif r.kind == "superharmonic":
             i = _resonance_rows(frf, r.omega_min)
             if i is not None:
@@ -227,9 +245,34 @@ def draw_regions(
         w = float(frf.omega[i]) * sx
         level = level + 1 if w - last < 0.03 * (hi - lo) else 0
         last = w
-        ax.annotate(text, (w, y_all[i]), xytext=(0, 9 + 11 * (level % 3)), textcoords="offset points",
-                    ha="center", va="bottom", fontsize=8, color="0.15", zorder=6,
-                    arrowprops={"arrowstyle": "-", "color": "0.4", "lw": 0.6, "shrinkA": 0, "shrinkB": 1})
+        label = ax.annotate(text, (w, y_all[i]), xytext=(0, 9 + 11 * (level % 3)), textcoords="offset points",
+                            ha="center", va="bottom", fontsize=8, color="0.15", zorder=6,
+                            arrowprops={"arrowstyle": "-", "color": "0.4", "lw": 0.6, "shrinkA": 0, "shrinkB": 1})
+        label.rattle_move = 1  # moved up, away from its peak, when it overlaps another label
+
+
+def _joined_bands(regions: Sequence["Region"], period: int) -> list[list["Region"]]:
+    """The ``subharmonic`` regions of ``period`` in groups whose Ω intervals touch or overlap."""
+    bands = sorted((r for r in regions if r.kind == "subharmonic" and int(r.detail.get("period", 2)) == period),
+                   key=lambda r: r.omega_min)
+    groups: list[list[Any]] = []
+    for r in bands:
+        if groups and r.omega_min <= max(g.omega_max for g in groups[-1]) * (1.0 + 1e-9):
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    return groups
+
+
+def _band_label(ax: Any, x: float, y: float, text: str, transform: Any, **style: Any) -> Any:
+    """A band's label at ``x`` (data) and ``y`` (axes fraction), hanging from there; an annotation
+    with an offset in points, so that :func:`rattle.plotting.separate_texts` can move it down out of
+    another's way."""
+    label = ax.annotate(text, (x, y), xycoords=transform, xytext=(0, 0), textcoords="offset points", ha="center",
+                        va="top", bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
+                        zorder=6, annotation_clip=False, **style)
+    label.rattle_move = -1
+    return label
 
 
 def place_legend(ax: Any, legend: str, fontsize: float = 8) -> Any:
@@ -270,7 +313,8 @@ def frequency_response_plot(
     ax : matplotlib.axes.Axes or PlotAxes, optional
         Axes to draw into (default: a new 9.5 × 5 in figure; a :class:`PlotAxes`: its primary).
     quantity : str, default "rms"
-        One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``, ``delta_min``, ``delta_max``.
+        One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``, ``delta_min``, ``delta_max``, or
+        ``spl_db`` (a response with sound paths: the level at the receiver, one panel).
     linear : bool, default True
         Overlay the linear system (drawn only for ``mean``, ``rms`` and ``rms_ac``).
     special_points : bool, default True
@@ -317,6 +361,11 @@ def frequency_response_plot(
         shown = tuple(regions)
     names = tuple(getattr(frf, "element_names", ()) or ())
     sound = ax is None and "spl_db" in (getattr(frf, "extra_columns", {}) or {})  # [[paths]]: an SPL panel below
+    if quantity == "spl_db":  # the level at the receiver: one panel, the whole chain's
+        if "spl_db" not in (getattr(frf, "extra_columns", {}) or {}):
+            raise ValueError("`quantity` \"spl_db\" needs a response with sound paths (frf.with_sound(paths)); "
+                             "this one has no spl_db column")
+        names, sound = (), False
     if names and ax is None:  # a chain: one panel per element, sharing Ω
         fig, axes = plt.subplots(len(names) + sound, 1, figsize=(9.5, 2.2 + 2.6 * (len(names) + sound)), sharex=True,
                                  layout="constrained", squeeze=False)
@@ -330,8 +379,11 @@ def frequency_response_plot(
                 ax_k.set_xlabel("")
         if sound:
             _draw_sound_panel(frf, axes[-1, 0], special_points)
+        separate_texts(fig, axes[:, 0])
+        if sound:
             return fig, PlotAxes([*zip(names, axes[:-1, 0]), ("spl_db", axes[-1, 0])])
         return fig, PlotAxes(zip(names, axes[:, 0]))
+    own = ax is None  # a figure of its own: its labels are separated here (else by the caller)
     if ax is None and sound:
         fig, (ax, ax_spl) = plt.subplots(2, 1, figsize=(9.5, 7.6), sharex=True, layout="constrained")
     elif ax is None:
@@ -343,7 +395,10 @@ def frequency_response_plot(
     if sound:
         ax.set_xlabel("")
         _draw_sound_panel(frf, ax_spl, special_points)
+        separate_texts(fig, (ax, ax_spl))
         return fig, PlotAxes([("response", ax), ("spl_db", ax_spl)])
+    if own:
+        separate_texts(fig, (ax,))
     return fig, PlotAxes.single(ax)
 
 
@@ -352,12 +407,18 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
     draw_branches(frf, ax, "spl_db", labels=False)
     if special_points:
         draw_special_points(frf, ax, "spl_db", labels=False)
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color="tab:blue", lw=1.5, label="non-linear, stable (branch colours as above)"),
+               Line2D([], [], color="tab:blue", ls="--", lw=1.2, label="non-linear, unstable")]
     linear = frf.extra_columns.get("spl_linear_db")
-    if linear is not None:  # the linear system at each row's Ω, in Ω order (one curve)
+    if linear is not None:  # the linear system at each row's Ω, in Ω order (one curve, marked where computed)
         order = np.argsort(frf.omega, kind="stable")
-        ax.plot(np.asarray(frf.omega)[order] * speed_axis(frf)[0], np.asarray(linear)[order], color="0.55", lw=1.0,
-                label="linear system (f = δ)", zorder=1)
-        ax.legend(fontsize=8, loc="best", framealpha=0.9)
+        handles += ax.plot(np.asarray(frf.omega)[order] * speed_axis(frf)[0], np.asarray(linear)[order], color="0.55",
+                           lw=1.0, marker=".", ms=2.5, label="linear system (f = δ), at the rows' Ω", zorder=1)
+    ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+              framealpha=0.9)
+    fit_ylim(ax)
     ax.set_xlabel(speed_axis(frf)[1])
     ax.set_ylabel("sound pressure level (dB re 20 µPa)")
     ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)
@@ -367,10 +428,14 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
 def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, linear: bool, special_points: bool,
                 shown: Sequence[Any], legend: str, *, element: int = 0, label: str = "") -> None:
     """One frequency-response panel: column ``key`` (``quantity`` of element ``element``)."""
-    colors = draw_branches(frf, ax, key)
+    colors = draw_branches(frf, ax, key, name_short=special_points)
     draw_uncovered(frf, ax)
     if special_points:
         draw_special_points(frf, ax, key)
+    if linear and quantity == "spl_db" and "spl_linear_db" in frf.extra_columns:
+        order = np.argsort(frf.omega, kind="stable")
+        ax.plot(np.asarray(frf.omega)[order] * speed_axis(frf)[0], np.asarray(frf.extra_columns["spl_linear_db"])[order],
+                color="0.55", lw=1.0, marker=".", ms=2.5, label="linear system (f = δ), at the rows' Ω", zorder=1)
     if linear and quantity in ("mean", "rms", "rms_ac"):
         lin = frf.linear_response() if element == 0 else frf.linear_response(element=element)
         ax.plot(lin.omega * speed_axis(frf)[0], getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
@@ -379,9 +444,7 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
     ax.set_xlabel(speed_axis(frf)[1])
     ax.set_ylabel(QUANTITY_LABELS[quantity] if not label else QUANTITY_LABELS[quantity].replace("δ", label.strip(": ").split()[-1] + " δ", 1))
     ax.grid(True, alpha=0.3)
-    if shown:  # room for the "period p" labels at the top
-        lo, hi = ax.get_ylim()
-        ax.set_ylim(lo, hi + 0.08 * (hi - lo))
+    fit_ylim(ax, room=LABEL_ROOM if shown else 0.0)  # every point, room for the band labels at the top
     place_legend(ax, legend)
 
 

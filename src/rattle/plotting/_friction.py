@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._axes import PlotAxes
+from ._sweep import stick_ylim
 from ..results import held_runs
 from ._nonsmooth import STICK_COLOUR
 
@@ -30,7 +31,8 @@ def friction_response_plot(response: FrictionCheck) -> tuple[Any, PlotAxes]:
     primary) and ``stick``)."""
     import matplotlib.pyplot as plt
 
-    fig, (ax, ax_s) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True, gridspec_kw={"height_ratios": (3, 1)})
+    fig, (ax, ax_s) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True, gridspec_kw={"height_ratios": (3, 1)},
+                                   layout="constrained")
     w = response.omega
     matched = response.matched
     colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0", "C1", "C2", "C3"])
@@ -63,14 +65,17 @@ def friction_response_plot(response: FrictionCheck) -> tuple[Any, PlotAxes]:
         ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="an element sticks" if i == 0 else None)
         ax_s.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0)
     ax.set_ylabel("δ rms (rad)")
-    ax.legend(fontsize="x-small", ncol=2)
+    ax.set_title(f"Exact orbits of the chain (shooting) and its regularised harmonic balance "
+                 f"(ε = {response.regularisation:g}, H = {response.harmonics})", fontsize=10)
+    ax.legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax.grid(alpha=0.3)
-    ax_s.set_ylim(-0.02, 1.02)
+    stick_ylim(ax_s, [np.where(matched, response.stick_fraction[:, e], np.nan)
+                      for e in range(len(response.element_names))]
+               + [np.where(br.matched[:, None], br.stick_fraction, np.nan) for br in response.branches])
     ax_s.set_ylabel("stick / period")
     ax_s.set_xlabel("Ω (rad/s)")
-    ax_s.legend(fontsize="x-small")
+    ax_s.legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax_s.grid(alpha=0.3)
-    fig.tight_layout()
     return fig, PlotAxes({"rms": ax, "stick": ax_s})
 
 

@@ -61,9 +61,33 @@ def _outline(free: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[list[tupl
     return segs
 
 
-def _label(response_map: ResponseMap, name: str) -> str:
+#: The last word of a varied key that makes it an angle (rad): the map's y axis then has degrees too.
+ANGLE_KEYS = frozenset({"b", "breakpoints", "backlash", "clearance"})
+
+
+def _is_angle(response_map: ResponseMap, name: str) -> bool:
     key = next((p.key for p in response_map.parameters if p.name == name), name)
-    return name if name == key else f"{name} ({key})"
+    words = [w for w in key.split(".") if not w.isdigit()]
+    return bool(words) and words[-1] in ANGLE_KEYS
+
+
+#: Longest y label with the configuration key beside the NAME (a longer one is cut by the figure).
+MAX_LABEL = 40
+
+
+def _label(response_map: ResponseMap, name: str) -> str:
+    """The y label: the parameter's NAME with its key (``alpha (model.elastic.alpha)``) when that
+    is short, else the NAME alone — a dotted key without its leading ``model.`` and ``elements.``
+    (the full key is in map.json) — with its unit where it is an angle."""
+    key = next((p.key for p in response_map.parameters if p.name == name), name)
+    unit = " (rad)" if _is_angle(response_map, name) else ""
+    both = f"{name} ({key})" if key != name else name
+    if len(both + unit) <= MAX_LABEL:
+        return both + unit
+    short = name
+    for head in ("model.", "elements."):
+        short = short[len(head):] if short.startswith(head) else short
+    return short + unit
 
 
 def _panels(response_map: ResponseMap, name: str) -> list[tuple[str, list[int]]]:
@@ -102,6 +126,8 @@ def map_plot_names(response_map: ResponseMap) -> list[tuple[str, str]]:
 MAP_QUANTITIES: dict[str, tuple[str, str, str]] = {
     "rms": ("rms_max_stable", "largest stable period-1 rms of δ (rad)", "no stable period-1 solution"),
     "spl": ("spl_max_stable_db", "largest stable sound pressure level (dB re 20 µPa)", "no stable periodic solution"),
+    "rms_ac": ("rms_ac_max_stable", "rms about the mean (rms_ac) of the\nlargest stable period-1 solution (rad)",
+               "no stable period-1 solution"),
 }
 
 
@@ -129,9 +155,11 @@ def plot_map(
         Axes to draw into (one varied parameter only; default: a new figure).
     title : str, optional
         Figure title.
-    quantity : {"rms", "spl"}, default "rms"
-        The colour: ``rms_max_stable``, or ``spl_max_stable_db`` (a map computed with sound
-        paths: the largest level over the stable periodic solutions, dB re 20 µPa).
+    quantity : {"rms", "rms_ac", "spl"}, default "rms"
+        The colour: ``rms_max_stable``, ``rms_ac_max_stable`` (the motion about the mean of that
+        same solution: the rattle without the mean twist), or ``spl_max_stable_db`` (a map
+        computed with sound paths: the largest level over the stable periodic solutions, dB re
+        20 µPa).
 
     Returns
     -------
@@ -228,9 +256,15 @@ def plot_map(
         a.set_ylim(min(ye[0], ye[-1]), max(ye[0], ye[-1]))
         if panel_title:
             a.set_title(panel_title, fontsize=9)
-    for a in axes_list:
+    angle = _is_angle(response_map, parameter)
+    for k, a in enumerate(axes_list):
         a.set_xlabel("Ω (rad/s)" if rpm is None else "engine speed (rpm)")
-        a.set_ylabel(_label(response_map, parameter))
+        a.set_ylabel(_label(response_map, parameter), fontsize=9)
+        last_column = ax is not None or (k + 1) % ncols == 0 or k == len(axes_list) - 1
+        if angle and last_column:
+            # an angle: degrees on the right as well (a data sheet gives them so)
+            right = a.secondary_yaxis("right", functions=(np.degrees, np.radians))
+            right.set_ylabel("(deg)", fontsize=9)
     if mesh is not None:
         cbar = fig.colorbar(mesh, ax=axes_list, shrink=0.9)
         cbar.set_label(bar_label)
@@ -246,8 +280,11 @@ def plot_map(
         axes_list[0].legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.85)
     heading = title
     if heading is None and ax is None:
-        heading = (f"response map: {'largest stable rms' if quantity == 'rms' else 'largest stable sound pressure level'}"
-                   ", impacts hatched, rattle-free outlined")
+        shown_as = {"rms": "largest stable rms", "spl": "largest stable sound pressure level",
+                    "rms_ac": "rms about the mean (of the largest stable solution)"}[quantity]
+        heading = f"response map: {shown_as}, impacts hatched, rattle-free outlined"
+        if len(heading) > 70:  # two lines: one would run past a one-panel figure's edges
+            heading = heading.replace(", impacts", ",\nimpacts", 1)
         if len(panels) > len(shown):
             heading += f" (first {len(shown)} of {len(panels)} panels)"
     if heading:

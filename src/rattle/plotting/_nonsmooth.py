@@ -22,6 +22,7 @@ import numpy as np
 
 from ..results import held_runs
 from ._axes import PlotAxes
+from ._sweep import stick_ylim
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import NonsmoothOrbitResult, NonsmoothCheck
@@ -42,7 +43,8 @@ def nonsmooth_response_plot(response: NonsmoothCheck) -> tuple[Any, PlotAxes]:
     ``stick``)."""
     import matplotlib.pyplot as plt
 
-    fig, (ax, ax_s) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": (3, 1)})
+    fig, (ax, ax_s) = plt.subplots(2, 1, figsize=(9.5, 6), sharex=True, gridspec_kw={"height_ratios": (3, 1)},
+                                   layout="constrained")
     w = response.omega
     if np.any(np.isfinite(response.rms_hb)):  # none when followed by exact shooting
         ax.plot(w, response.rms_hb, "-", color="0.6", lw=0.8,
@@ -69,17 +71,23 @@ def nonsmooth_response_plot(response: NonsmoothCheck) -> tuple[Any, PlotAxes]:
     for i, (a, b) in enumerate(held_runs(w, held)):
         ax.axvspan(a, b, color=STICK_COLOUR, alpha=0.12, lw=0, label="exact orbit sticks or locks" if i == 0 else None)
     ax.set_ylabel("δ rms (rad)")
-    ax.legend(fontsize="small")
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax.grid(alpha=0.3)
+    ax.set_title(f"Exact orbits (shooting) and the regularised harmonic balance (ε = {response.regularisation:g}, "
+                 f"H = {response.harmonics})", fontsize=10)
     T = 2.0 * np.pi / w
     frac = np.where(matched, response.stick_time / T, np.nan)
     ax_s.plot(w, frac, "-", color=STICK_COLOUR, lw=1.2)
     ax_s.fill_between(w, 0.0, frac, where=np.isfinite(frac), color=STICK_COLOUR, alpha=_SHADE_ALPHA, lw=0)
-    ax_s.set_ylim(-0.02, 1.02)
+    stick_ylim(ax_s, [frac, *(np.where(br.matched, br.stick_time / (br.period * 2.0 * np.pi / br.omega), np.nan)
+                              for br in response.branches)])
+    if not np.any(np.nan_to_num(frac) > 0.0) and not any(
+            np.any(np.nan_to_num(br.stick_time) > 0.0) for br in response.branches):  # say so, not a row of zeros
+        ax_s.text(0.5, 0.5, "the exact orbit is never stuck or locked on this range", transform=ax_s.transAxes,
+                  ha="center", va="center", fontsize=9, color="0.3")
     ax_s.set_ylabel("stick / period")
     ax_s.set_xlabel("Ω (rad/s)")
     ax_s.grid(alpha=0.3)
-    fig.tight_layout()
     return fig, PlotAxes({"rms": ax, "stick": ax_s})
 
 

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._axes import PlotAxes, unwrap
+from ._axes import PlotAxes, fit_ylim, separate_texts, unwrap
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import SweepResult
@@ -24,7 +24,14 @@ PERIOD_COLORS: dict[int, str] = {
 _QUANTITIES = {
     "mean": "δ mean (rad)", "rms": "δ rms (rad)", "rms_ac": "δ rms about the mean (rad)",
     "p2p": "δ peak-to-peak (rad)", "acc_p2p": "δ'' peak-to-peak (rad/s²)",
+    "spl_db": "sound pressure level (dB re 20 µPa)",
 }
+
+
+def _column(sweep: "SweepResult", quantity: str) -> np.ndarray:
+    """The values of ``quantity``: a SPEC column or an extra one (``spl_db``)."""
+    extra = getattr(sweep, "extra_columns", {}) or {}
+    return np.asarray(extra[quantity] if quantity in extra else getattr(sweep, quantity), dtype=float)
 
 
 def _runs(values: np.ndarray) -> list[tuple[int, int]]:
@@ -68,7 +75,8 @@ def sweep_plot(
     ax : matplotlib.axes.Axes or PlotAxes, optional
         Axes to draw into (default: a new 8 × 5 in figure; a :class:`PlotAxes`: its primary).
     quantity : str, default "rms"
-        One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``.
+        One of ``mean``, ``rms``, ``rms_ac``, ``p2p``, ``acc_p2p``, or ``spl_db`` (a sweep with
+        sound paths: the level at the receiver, one panel).
     annotate : bool, default True
         Label each run of period ≠ 1 points with its period.
     lines : bool, default True
@@ -94,15 +102,25 @@ def sweep_plot(
     names = tuple(getattr(sweep, "element_names", ()) or ())
     extra = getattr(sweep, "extra_columns", {}) or {}
     sound = ax is None and "spl_db" in extra  # [[paths]]: an SPL panel below
+    if quantity == "spl_db":  # the level at the receiver: one panel, the whole chain's
+        if "spl_db" not in extra:
+            raise ValueError("`quantity` \"spl_db\" needs a sweep with sound paths (sweep.with_sound(paths)); this one "
+                             "has no spl_db column")
+        names, sound = (), False
     # a discontinuous law: the stick fractions in a panel below
     sticks = [k for k in extra if k.endswith("stick_fraction")] if ax is None else []
+    # a stick panel only where something sticks or locks (a pure preload that never locks: none)
+    held = [k for k in sticks if np.any(np.nan_to_num(np.asarray(extra[k], dtype=float)) > 0.0)]
+    if sticks and not held and title is None:
+        title = "Time-domain frequency sweep (steady state at each Ω)\nnever stuck or locked at any Ω"
+    sticks = held
     if sticks:
         fig, axes = plt.subplots(max(1, len(names)) + 1, 1, figsize=(8, 3.0 + 3.0 * max(1, len(names))), sharex=True,
                                  layout="constrained", squeeze=False,
                                  height_ratios=(3.0,) * max(1, len(names)) + (1.3,))
         ax_s = axes[-1, 0]
         for k, ax_k in enumerate(axes[:-1, 0]):
-            y = sweep.element_columns[f"{names[k]}_{quantity}"] if names else getattr(sweep, quantity)
+            y = sweep.element_columns[f"{names[k]}_{quantity}"] if names else _column(sweep, quantity)
             _draw_sweep(sweep, ax_k, np.asarray(y, dtype=float), annotate, lines, legend=k == 0)
             ax_k.set_ylabel(f"{names[k]}: {_QUANTITIES[quantity]}" if names else _QUANTITIES[quantity])
             first = title if title is not None else "Time-domain frequency sweep (steady state at each Ω)"
@@ -110,6 +128,7 @@ def sweep_plot(
                            else f"element {names[k]}", fontsize=10 if names else None)
             ax_k.set_xlabel("")
         _draw_stick_panel(sweep, ax_s, sticks, lines)
+        separate_texts(fig, axes[:, 0])
         tags = [*(names or ("response",)), "stick"]
         return fig, PlotAxes(zip(tags, axes[:, 0]))
     if names and ax is None:  # a chain: one panel per element, sharing Ω
@@ -125,21 +144,27 @@ def sweep_plot(
                 ax_k.set_xlabel("")
         if sound:
             _draw_sound_panel(sweep, axes[-1, 0], annotate, lines)
+        separate_texts(fig, axes[:, 0])
+        if sound:
             return fig, PlotAxes([*zip(names, axes[:-1, 0]), ("spl_db", axes[-1, 0])])
         return fig, PlotAxes(zip(names, axes[:, 0]))
+    own = ax is None  # a figure of its own: its labels are separated here (else by the caller)
     if ax is None and sound:
         fig, (ax, ax_spl) = plt.subplots(2, 1, figsize=(8, 7.6), sharex=True, layout="constrained")
     elif ax is None:
         fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
     else:
         fig = ax.figure
-    _draw_sweep(sweep, ax, np.asarray(getattr(sweep, quantity), dtype=float), annotate, lines, legend=True)
+    _draw_sweep(sweep, ax, _column(sweep, quantity), annotate, lines, legend=True)
     ax.set_ylabel(_QUANTITIES[quantity])
     ax.set_title(title if title is not None else "Time-domain frequency sweep (steady state at each Ω)")
     if sound:
         ax.set_xlabel("")
         _draw_sound_panel(sweep, ax_spl, annotate, lines)
+        separate_texts(fig, (ax, ax_spl))
         return fig, PlotAxes([("response", ax), ("spl_db", ax_spl)])
+    if own:
+        separate_texts(fig, (ax,))
     return fig, PlotAxes.single(ax)
 
 
@@ -179,11 +204,20 @@ def _draw_stick_panel(sweep: "SweepResult", ax: Any, keys: list[str], lines: boo
                 ax.plot(omega[sel], y[sel], "-", color=color, lw=0.8, alpha=0.6)
             ax.plot(omega[sel], y[sel], marker, color=color, ms=4, ls="none", alpha=1.0 if j == 0 else 0.6,
                     label=f"{who}sweep {d}")
-    ax.set_ylim(-0.02, 1.02)
+    stick_ylim(ax, [np.asarray(sweep.extra_columns[k], dtype=float) for k in keys])
     ax.set_ylabel("stick / period")
     ax.set_xlabel(xlabel)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="best", ncol=2)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, ncol=1)
+
+
+def stick_ylim(ax: Any, values: Any) -> None:
+    """y limits of a stick-fraction panel: 0 … a little above the largest fraction drawn (at
+    most 1), so that fractions of a few per cent are not flattened against a 0 … 1 axis."""
+    finite = [np.asarray(v, dtype=float)[np.isfinite(v)] for v in values]
+    top = max([float(v.max()) for v in finite if v.size] or [0.0])
+    top = min(1.0, top * 1.15) if top > 0.0 else 1.0
+    ax.set_ylim(-0.02 * top, top * 1.02)
 
 
 def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:
@@ -216,19 +250,21 @@ def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool
                 if per[i0] == 1 or per[i0] < 0:
                     continue
                 j = (i0 + i1 - 1) // 2
-                ax.annotate(
+                label = ax.annotate(
                     f"P{int(per[i0])}", (om[j], y[j]), xytext=(0, 9 if up else -9),
                     textcoords="offset points", ha="center", va="bottom" if up else "top",
                     fontsize=8, color=PERIOD_COLORS.get(int(per[i0]), "tab:gray"), fontweight="bold",
                 )
+                label.rattle_move = 1 if up else -1  # away from its points when it overlaps another label
     failed = np.flatnonzero(period < 0)  # failed rows (NaN measures: no point drawn): a dotted line at Ω
     for k, i in enumerate(failed):
         ax.axvline(omega[i], color="0.5", ls=":", lw=0.9, zorder=0,
                    label="no steady state (failed)" if k == 0 else None)
     ax.set_xlabel(xlabel)
     ax.grid(True, alpha=0.3)
+    fit_ylim(ax, room=0.06)  # every point inside, a little room for the period labels
     if legend:
-        ax.legend(fontsize=8, loc="best")
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
 
 
-__all__ = ["sweep_plot", "period_label", "DIRECTION_STYLES", "PERIOD_COLORS"]
+__all__ = ["sweep_plot", "period_label", "stick_ylim", "DIRECTION_STYLES", "PERIOD_COLORS"]
