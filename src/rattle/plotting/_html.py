@@ -388,8 +388,9 @@ def _frf_figure(frf: Any, *, quantity: str = "rms", title: str | None = None) ->
         from ._frf import QUANTITY_LABELS
 
         sound = [k for k in ("spl_db", "spl_dba") if k in (getattr(frf, "extra_columns", {}) or {})]
-        if quantity not in QUANTITY_LABELS and quantity not in sound:
-            raise ValueError(f"`quantity` must be one of {', '.join([*QUANTITY_LABELS, *sound])} (spl_db and spl_dba "
+        known = [k for k in QUANTITY_LABELS if not k.startswith("spl")]  # the levels only with sound paths
+        if quantity not in known and quantity not in sound:
+            raise ValueError(f"`quantity` must be one of {', '.join([*known, *sound])} (spl_db and spl_dba "
                              f"with sound paths: FrequencyResponse.with_sound), got {quantity!r}")
     panels = _check_panels(frf, quantity) if frf.check is not None else _hb_panels(frf, quantity)
     rows = len(panels)
