@@ -235,7 +235,7 @@ def test_cli_orbit_period_two_on_a_chain(tmp_path):
     (at the file's ε = 0.01 the HB of period 2 has none next to it, and the summary says so); at
     Ω = 1.312, where the motion has period 1, exit 1 and nothing written."""
     config = write_config(tmp_path, CHAIN_TOML)
-    result = invoke(["orbit", str(config), "--omega", "1.375", "--period", "2", "-o", "out"], tmp_path)
+    result = invoke(["orbit", str(config), "--omega", "1.375", "--period", "2", "--single", "-o", "out"], tmp_path)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     meta = json.loads((tmp_path / "out" / "orbit.json").read_text())
     assert meta["orbit"]["periods"] == 2 and meta["settings"]["period"] == 2 and meta["orbit"]["converged"]

@@ -155,7 +155,7 @@ def test_orbit_writes_the_exact_orbit_with_its_stick_phase(tmp_path):
     (a, b, kind), = orbit["phases"]
     assert kind == "stick" and b - a == pytest.approx(orbit["stick_time"], rel=1e-12)
     assert "sticks or locks 1 time(s) per period" in result.stdout
-    # every orbit at Ω beside it (the census of Ω (1 ± 0.1)): the orbit asked for is one of them,
+    # every orbit at Ω beside it (the census of Ω (1 ± 0.05)): the orbit asked for is one of them,
     # with the same rms and stability
     listed = orbit["orbits"]
     assert listed and all(o["period"] >= 1 for o in listed)

@@ -371,7 +371,7 @@ def attractor_census(model: Any, grid: FloatArray, run: RunSettings, search: Att
 #: sweep check (an exact up/down sweep over the frequencies where no computed orbit is stable),
 #: and the attractor search simulates at every grid point: a coexisting orbit needs only to be
 #: reached somewhere in the window.
-ORBIT_WINDOW = 0.1
+ORBIT_WINDOW = 0.05
 ORBIT_POINTS = 5
 #: The search's budget at one frequency: its multi-start (8 starts) and the starts displaced from
 #: the stable period-1 orbit (9) at Ω itself (one band, one point), the runs from the unstable

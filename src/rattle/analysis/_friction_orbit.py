@@ -133,7 +133,7 @@ def friction_orbit(
 
     ``every`` (default True): the result also lists every orbit at Ω, stable and unstable, of
     every period, and the non-periodic attractors there (``solutions``, ``nonperiodic``:
-    :func:`~rattle.analysis._census.exact_orbits_at`, the census of the window Ω (1 ± 0.1): a few
+    :func:`~rattle.analysis._census.exact_orbits_at`, the census of the window Ω (1 ± 0.05): a few
     seconds of exact continuation and simulation)."""
     if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period not in (1, 2):
         raise ValueError(f"`period` must be 1 or 2, got {period!r}")

@@ -409,7 +409,7 @@ def _raise_if_incomplete(sweep: Any, written: Sequence[str], output: Path) -> No
 @_omega_max_option
 @click.option("--single", is_flag=True, default=False,
               help="A discontinuous law: compute only the orbit asked for, not every orbit at W (the census of "
-                   "the window W (1 ± 0.1) costs seconds).")
+                   "the window W (1 ± 0.05) costs seconds).")
 def orbit_command(
     config: Path, output: Path, omega: float | None, period: int, harmonics: int | None,
     omega_min: float | None, omega_max: float | None, rpm: float | None = None, single: bool = False,
@@ -433,7 +433,7 @@ def orbit_command(
     element NAME_delta, NAME_velocity, NAME_stuck, NAME_delta_hb for the chain. --period above 2
     and --omega-min/--omega-max are refused there. Beside it, every orbit at W is listed (stable
     and unstable, of any period, exact; and the non-periodic attractors): the exact branches over
-    the window W (1 ± 0.1) solved at W and the attractors simulations settle on at W (orbit.json:
+    the window W (1 ± 0.05) solved at W and the attractors simulations settle on at W (orbit.json:
     "orbits", "nonperiodic"); --single skips that census.
     """
     orbit_speed(omega, rpm)
