@@ -98,6 +98,7 @@ def test_two_inertia_chain_exact_reference_equals_the_single_equation_reference(
 REFERENCE_STEPS = {"max_step": 2e-2, "max_domega": 1e-2}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("omega", [(0.45, 0.6), (0.74, 0.9)])
 def test_grounded_clutch_chain_special_points_with_neimark_sacker(omega):
     model = grounded_clutch()
@@ -112,6 +113,7 @@ def test_grounded_clutch_chain_special_points_with_neimark_sacker(omega):
             assert abs(abs(pair) - 1.0) < 1e-6 and abs(pair.imag) > 1e-3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("omega, start, kinds", [
     ((0.55, 0.65), "low", {"period_doubling"}),
     ((0.84, 0.88), "low", {"neimark_sacker"}),    # starts inside the bent resonance (amplitude continuation)
@@ -127,6 +129,7 @@ def test_driveline_special_points(omega, start, kinds):
     _match(exact, _points(frf), 1e-4)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("make, omega", [
     (grounded_clutch, (0.45, 0.9)),
     (driveline, (0.55, 1.0)),
@@ -157,6 +160,7 @@ def test_chain_orbits_measures_and_stability_against_exact_shooting(make, omega)
     assert checked >= 6
 
 
+@pytest.mark.slow
 def test_fold_and_period_doubling_in_one_step_are_not_stepped_over():
     """A random grounded three-inertia chain (three elements) where a fold and a period doubling
     lie 4e-4 apart on an unstable stretch: with one step over both, stability is the same at the

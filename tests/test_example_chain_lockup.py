@@ -38,6 +38,7 @@ def test_the_example_is_a_chain_with_a_preloaded_clutch_and_a_gear():
     assert cfg.model.frequency_scale() == pytest.approx(3.0754, abs=1e-4)  # "omega_n = 3.0754"
 
 
+@pytest.mark.slow
 def test_the_example_slips_then_locks_as_stated():
     from rattle.analysis._friction_response import friction_response
     from rattle.analysis._case import regularisation_options

@@ -47,6 +47,7 @@ def _stated_special_points(path: Path) -> list[tuple[str, float]]:
     return [(kind, float(w)) for kind, w in re.findall(r"(fold|period_doubling|neimark_sacker) ([0-9.]+)", head)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(p.name for p in EXAMPLES.glob("*.toml")))
 def test_example_states_every_special_point_it_has(name):
     """Every special point of the period-1 branch at the example's own settings is stated in its
@@ -91,6 +92,7 @@ def _stated_changes(path: Path) -> list[tuple[str, float, float]]:
             re.findall(r"(fold|period_doubling|neimark_sacker) ([0-9.]+)(?:-([0-9.]+))?", head)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("name", "omega", "stick"), [
     ("torque_converter_preload.toml", (0.58, 0.63), 0.0),
     ("clutch_friction.toml", (0.3, 0.34), 0.1),

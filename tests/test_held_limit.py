@@ -122,6 +122,7 @@ def test_bad_arguments_are_refused(lockup) -> None:  # type: ignore[no-untyped-d
         RegularisationOptions(held_harmonics=0)
 
 
+@pytest.mark.slow
 def test_the_frequency_response_narrows_its_held_rows(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """friction_response with held=True over 2.44 … 2.45 rad/s (the clutch held 45 % of the
     period): every matched row with the clutch held part of the period gets its narrowed HB rms;

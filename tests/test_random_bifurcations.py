@@ -123,6 +123,7 @@ def test_guard_recovers_hidden_pair():
     assert abs(pds[0] - 0.6401643474) < 1e-8 and abs(pds[1] - 0.6566801262) < 1e-8, pds
 
 
+@pytest.mark.slow
 def test_reference_clutch():
     model = rattle.reference_case()
     ref = exact_special_points(model, (0.1, 3.0))
@@ -134,6 +135,7 @@ def test_reference_clutch():
     _check(RandomCase(model, (0.1, 3.0), "reference clutch (rattle.reference_case())"), ref)
 
 
+@pytest.mark.slow
 def test_gear_example():
     model = rattle.Model.from_toml(EXAMPLES / "gear_backlash.toml")
     ref = exact_special_points(model, (0.1, 3.0))

@@ -81,6 +81,7 @@ def test_a_range_not_covered_exits_1_naming_the_intervals(tmp_path):
     assert not [r for r in meta["regions"] if r["omega_max"] > a + 1e-9 and r["omega_min"] < b - 1e-9]
 
 
+@pytest.mark.slow
 def test_kinks_of_the_branch_cost_one_step():
     """NLvib's two-DOF oscillator with a unilateral spring (masses 1, springs 0/1/1, dampers 0.03
     each, stop stiffness 100 at gap 1 on the first mass, force 0.1 on the second; H = 21, Ω 0.8 →

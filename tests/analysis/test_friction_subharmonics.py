@@ -27,6 +27,9 @@ from rattle.io import read_csv
 from rattle.model import Chain
 from rattle.timeint import ExactIntegrator, shoot_friction_orbit
 
+#: The period-2 branches of a chain with friction: the second tier (python3 -m pytest -m slow).
+pytestmark = pytest.mark.slow
+
 RANGE = (1.30, 1.38)
 WIDE = ContinuationOptions(max_step=0.3)
 

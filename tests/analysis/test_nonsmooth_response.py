@@ -96,6 +96,7 @@ def test_rows_carry_the_exact_measures_and_write_their_columns(tmp_path) -> None
     np.testing.assert_allclose(cols["rms"], res.rms, rtol=1e-15)
 
 
+@pytest.mark.slow
 def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     """The preload-only branch near Ω = 0.31 … 0.36 loses and regains stability several times: every
     change between matched rows carries a stability label; every change of the switching pattern
@@ -117,6 +118,7 @@ def test_stability_changes_are_labelled_from_the_crossing_multiplier() -> None:
     assert np.mean(hb_stable == res.stable[m]) >= 0.99
 
 
+@pytest.mark.slow
 def test_plot_draws_the_exact_and_hb_branches_and_the_stick_fraction(tmp_path) -> None:
     res = nonsmooth_response(_system(0.2, 0.05), (0.55, 0.65), RegularisationOptions(harmonics=64, regularisation=0.01, refine=None))
     fig, ax = FrequencyResponse.from_check(res, model=None, settings={}, timings={}).plot()

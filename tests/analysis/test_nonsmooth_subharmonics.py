@@ -160,6 +160,7 @@ def test_where_friction_sticks_the_branch_is_followed_by_exact_shooting():
     _settles_on(cfg.model, res, br, i)
 
 
+@pytest.mark.slow
 def test_a_ladder_that_leaves_the_orbit_gives_no_estimate():
     """On the period-2 branch born at Ω ≈ 0.75, just past its own period doubling (Ω ≈ 0.763), the
     ladder in ε at a few rows jumps to another orbit (its end was 17 % off the exact rms): those

@@ -86,6 +86,7 @@ def _chain_case() -> FrictionSystem:
     return chain.friction_system()
 
 
+@pytest.mark.slow
 def test_a_chain_with_friction_rows_are_exact_orbits_of_the_independent_integration():
     fs = _chain_case()
     frf = nonsmooth_response(fs, (0.6, 0.66))
@@ -139,6 +140,7 @@ def test_a_start_at_every_frequency_of_a_grid_succeeds(name):
         assert float(np.max(np.abs(problem.residual(q, float(w))))) <= 1e-9
 
 
+@pytest.mark.slow
 def test_a_chain_start_at_every_frequency_of_a_grid_succeeds():
     """The lock-up chain (every orbit unstable: the settled flow never reaches one, each start is
     Newton from the attractor or continued from a neighbouring frequency): 7 frequencies over its
@@ -181,6 +183,7 @@ def test_options_are_validated():
         ShootingOptions(check=16)  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_where_no_computed_orbit_is_stable_the_attractor_a_sweep_settles_on_is_continued():
     """A random preload (benchmarks/crossval_doors.py seed 1, case 13): the branch from Ω_min covers
     the range but is unstable over Ω 1.04–1.65, a small orbit (rms ~0.006), while exact sweeps

@@ -207,6 +207,7 @@ def test_sound_paths_with_chain_friction_are_refused():
     _refused(data, "`paths`", "`model.elements.K.friction`", "remove [[paths]]")
 
 
+@pytest.mark.slow
 def test_load_case_reads_a_chain_with_friction_with_the_chain_defaults(tmp_path):
     """load_case keeps the chain's settings; its orbit is the chain's (FrictionOrbitResult)."""
     from rattle.results import FrictionOrbitResult

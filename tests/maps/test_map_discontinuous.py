@@ -44,6 +44,7 @@ def _rows(table: dict, **match: float) -> dict[str, np.ndarray]:
     return {k: np.asarray(v)[keep] for k, v in table.items()}
 
 
+@pytest.mark.slow
 def test_map_of_the_torque_converter_over_its_preload_agrees_with_frf(tmp_path):
     """Two preloads on Ω = 0.58 … 0.66 (5 frequencies; the super-harmonic resonance, where two
     stable period-1 orbits coexist at T_p = 0.03 and an isola joins at T_p = 0.025): at sampled
@@ -86,6 +87,7 @@ def _census_starts(rest: float, omega: float) -> list[tuple[float, float]]:
     return [(rest + a, omega * v) for a in (-0.12, -0.04, 0.04, 0.12) for v in (-0.1, -0.03, 0.03, 0.1)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preload, omega, where", [
     (0.025, (0.58, 0.66), (0, 2)),   # an isola of period 1 beside the branch at Ω = 0.58
     (0.03, (0.88, 0.96), (0, 1, 3)),  # a saddle-node pair of period 3 over Ω ≲ 0.914

@@ -247,6 +247,7 @@ def _random_drag_chain(seed: int, free: bool) -> Chain:
                  speed_order=60.0 / (2.0 * math.pi * 20.0), drag=drag)  # rpm = 20 Ω: the table spans Ω 0.5 … 1.5
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed, free", [(1, True), (2, False), (3, True)])
 def test_random_chains_with_drag_agree_with_exact_shooting(seed: int, free: bool) -> None:
     """Random three-inertia chains whose drag changes along the branch: every 4th stable point of the

@@ -73,6 +73,7 @@ def test_the_configuration_refuses_naming_the_key(tmp_path, elastic, mean, words
         assert word in str(info.value)
 
 
+@pytest.mark.slow
 def test_the_single_equation_agrees_with_exact_shooting():
     """A stop 2° beyond the rest position, the mean load pressing toward it, the forcing strong
     enough to lift off and hit: the frequency response covers the range and every sampled row's

@@ -353,6 +353,7 @@ def _chromium() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser")
 
 
+@pytest.mark.slow
 @needs_plotly
 def test_the_pages_draw_in_chromium(tmp_path, smooth_frf):
     sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (pip install playwright)")
