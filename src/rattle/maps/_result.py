@@ -475,9 +475,9 @@ class ResponseMap:
         """Heat map of the largest stable rms over (parameter, Ω), impacts hatched, the
         rattle-free region outlined; returns (figure, PlotAxes). See
         :func:`rattle.plotting.plot_map`."""
-        from ..plotting import plot_map
+        from ..results import plot_with  # the plotting layer by name: maps do not import it
 
-        return plot_map(self, parameter=parameter, **kwargs)
+        return plot_with("plot_map", self, parameter=parameter, **kwargs)
 
     def rattle_free_region(self) -> list[dict[str, Any]]:
         """Per combination, its values and its rattle-free Ω intervals."""

@@ -5,6 +5,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+import numpy as np
+
 _OWN = frozenset({"_primary", "_aliases"})
 
 
@@ -193,3 +195,24 @@ def separate_texts(fig: Any, axes: Iterable[Any]) -> None:
 
 
 __all__ += ["fit_ylim", "separate_texts", "MAX_TEXT_MOVES"]
+
+
+def speed_axis(result: Any) -> tuple[float, str]:
+    """(x-axis units per rad/s, x-axis label) of a result's plots: crankshaft rpm when its model
+    has an engine (``speed_order`` q_0: rpm = Ω · 60 / (2π q_0)), else Ω in rad/s."""
+    order = getattr(getattr(result, "model", None), "speed_order", None)
+    if order is None:
+        return 1.0, "forcing frequency Ω (rad/s)"
+    return 60.0 / (2.0 * np.pi * float(order)), "engine speed (rpm)"
+
+
+def stick_ylim(ax: Any, values: Any) -> None:
+    """y limits of a stick-fraction panel: 0 … a little above the largest fraction drawn (at
+    most 1), so that fractions of a few per cent are not flattened against a 0 … 1 axis."""
+    finite = [np.asarray(v, dtype=float)[np.isfinite(v)] for v in values]
+    top = max([float(v.max()) for v in finite if v.size] or [0.0])
+    top = min(1.0, top * 1.15) if top > 0.0 else 1.0
+    ax.set_ylim(-0.02 * top, top * 1.02)
+
+
+__all__ += ["speed_axis", "stick_ylim"]

@@ -249,7 +249,8 @@ def _discontinuous_plot(comparison: "Comparison", fig: Any, title: str | None) -
     response's rows (line) and of the sweep's (markers)."""
     import matplotlib.pyplot as plt
 
-    from ._sweep import _draw_sweep, stick_ylim
+    from ._axes import stick_ylim
+    from ._sweep import _draw_sweep
 
     frf, sweep = comparison.frf.check, comparison.sweep  # the exact-check group: HB and exact side by side
     names = tuple(getattr(frf, "element_names", ()) or ())

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._axes import PlotAxes, fit_ylim, separate_texts, unwrap
+from ._axes import PlotAxes, fit_ylim, separate_texts, speed_axis, unwrap
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import FrequencyResponse, Region
@@ -52,15 +52,6 @@ SUBHARMONIC_COLORS: dict[int, tuple[str, str]] = {
 
 #: An element's column suffix for each drawable quantity (SPEC §5: NAME_min, NAME_max).
 _ELEMENT_SUFFIX = {"delta_min": "min", "delta_max": "max"}
-
-
-def speed_axis(result: Any) -> tuple[float, str]:
-    """(x-axis units per rad/s, x-axis label) of a result's plots: crankshaft rpm when its model
-    has an engine (``speed_order`` q_0: rpm = Ω · 60 / (2π q_0)), else Ω in rad/s."""
-    order = getattr(getattr(result, "model", None), "speed_order", None)
-    if order is None:
-        return 1.0, "forcing frequency Ω (rad/s)"
-    return 60.0 / (2.0 * np.pi * float(order)), "engine speed (rpm)"
 
 
 def column(frf: "FrequencyResponse", quantity: str) -> np.ndarray:

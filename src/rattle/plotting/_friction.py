@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._axes import PlotAxes
-from ._sweep import stick_ylim
+from ._axes import stick_ylim
 from ..results import held_runs
 from ._nonsmooth import STICK_COLOUR
 

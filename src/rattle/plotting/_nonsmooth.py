@@ -22,7 +22,7 @@ import numpy as np
 
 from ..results import held_runs
 from ._axes import PlotAxes
-from ._sweep import stick_ylim
+from ._axes import stick_ylim
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import NonsmoothOrbitResult, NonsmoothCheck

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._axes import PlotAxes, fit_ylim, separate_texts, unwrap
+from ._axes import PlotAxes, fit_ylim, separate_texts, speed_axis, stick_ylim, unwrap
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import SweepResult
@@ -171,7 +171,6 @@ def sweep_plot(
 def _draw_sound_panel(sweep: "SweepResult", ax: Any, annotate: bool, lines: bool) -> None:
     """The sound pressure level ``spl_db`` at the receiver of every row's simulated motion
     (``sweep.with_sound(paths)``) per direction, the linear system's level in grey."""
-    from ._frf import speed_axis
 
     _draw_sweep(sweep, ax, np.asarray(sweep.extra_columns["spl_db"], dtype=float), annotate, lines, legend=False)
     linear = sweep.extra_columns.get("spl_linear_db")
@@ -187,7 +186,6 @@ def _draw_sound_panel(sweep: "SweepResult", ax: Any, annotate: bool, lines: bool
 def _draw_stick_panel(sweep: "SweepResult", ax: Any, keys: list[str], lines: bool) -> None:
     """The fraction of each row's period held stuck or locked (a discontinuous law's sweep), per
     direction and element."""
-    from ._frf import speed_axis
 
     sx, xlabel = speed_axis(sweep)
     omega = np.asarray(sweep.omega, dtype=float) * sx
@@ -211,19 +209,9 @@ def _draw_stick_panel(sweep: "SweepResult", ax: Any, keys: list[str], lines: boo
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, ncol=1)
 
 
-def stick_ylim(ax: Any, values: Any) -> None:
-    """y limits of a stick-fraction panel: 0 … a little above the largest fraction drawn (at
-    most 1), so that fractions of a few per cent are not flattened against a 0 … 1 axis."""
-    finite = [np.asarray(v, dtype=float)[np.isfinite(v)] for v in values]
-    top = max([float(v.max()) for v in finite if v.size] or [0.0])
-    top = min(1.0, top * 1.15) if top > 0.0 else 1.0
-    ax.set_ylim(-0.02 * top, top * 1.02)
-
-
 def _draw_sweep(sweep: "SweepResult", ax: Any, y_all: np.ndarray, annotate: bool, lines: bool, legend: bool) -> None:
     """One sweep panel: ``y_all`` vs Ω per direction, period rings and labels."""
     direction = np.asarray(sweep.direction).astype(str)
-    from ._frf import speed_axis
 
     sx, xlabel = speed_axis(sweep)  # crankshaft rpm with an engine
     omega = np.asarray(sweep.omega, dtype=float) * sx

@@ -19,6 +19,7 @@ from ._sound import (
     UNCOVERED_WARNING, SoundPressure, a_weighting_db, check_sound_paths, coefficient_sound_pressure,
     linear_sound_pressure, motion_sound_pressure, sound_pressure,
 )
+from ._plotter import plot_with
 from ._speed import SpeedText, round_to_grid, rpm_of_omega
 from ._steady import METHODS as STEADY_METHODS, SteadyState
 from ._sweep import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SweepResult
@@ -31,6 +32,6 @@ __all__ = [
     "coefficient_sound_pressure", "check_sound_paths", "UNCOVERED_WARNING",
     "MeasuredRun", "MeasuredComparison", "compare_measured", "MEASURED_QUANTITIES",
     "NonsmoothCheck", "NONSMOOTH_COLUMNS", "FrictionCheck", "FRICTION_ELEMENT_COLUMNS", "FRICTION_TAIL_COLUMNS",
-    "held_runs", "SpeedText", "round_to_grid", "rpm_of_omega",
+    "held_runs", "SpeedText", "round_to_grid", "rpm_of_omega", "plot_with",
     "NonsmoothOrbitResult", "NONSMOOTH_ORBIT_COLUMNS", "FrictionOrbitResult", "FRICTION_ORBIT_ELEMENT_COLUMNS", "HeldLimitRecord",
 ]
