@@ -19,6 +19,7 @@ from rattle.model import Backlash, Chain, Element, Excitation, Link, Model, Torq
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
+@pytest.mark.slow
 def test_harmonics_are_raised_where_the_truncation_demands_it():
     """A one-sided stop 2° from rest. With a tolerance of 1e-4 on the 2H estimate, H is doubled on
     the stretches of hard contacts (the large-excursion branch) and only there; every sampled row

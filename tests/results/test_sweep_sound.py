@@ -109,6 +109,7 @@ def test_constant_path_gives_the_exact_acceleration_rms(omega):
     assert sp.spl_db[0] == pytest.approx(20 * math.log10(reference / 20e-6), abs=1e-9)
 
 
+@pytest.mark.slow
 def test_a_record_of_several_periods_gives_the_level_of_one(config, sweep):
     """The non-periodic treatment (the FFT over a window of w forcing periods, base Ω/w) of a
     periodic motion puts its harmonics on the bins k = m·w and finds the same level; also the
