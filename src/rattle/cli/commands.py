@@ -259,13 +259,6 @@ def frf_command(
     check_html(html)
     run_config = _io().load_config(config)
     check_quantity(quantity, run_config, "frf")
-    if getattr(run_config, "chain_friction", False) or run_config.discontinuous:
-        for option, given in (("--start", start != "low"), ("--fixed-harmonics", fixed_harmonics)):
-            if given:
-                raise ConfigError(f"`{option}` must be left at the default for a law with jumps or friction "
-                                  f"({_law_keys(run_config)}): it sets the harmonic balance of a continuous law; "
-                                  "such a law is solved by [analysis] method = \"shooting\" (exact shooting "
-                                  "continuation, the default) or \"hb\" (the regularised harmonic balance)")
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
