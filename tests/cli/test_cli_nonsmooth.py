@@ -259,4 +259,5 @@ def test_harmonic_balance_options_are_refused_for_a_jump_law(tmp_path, option):
     result = invoke(["frf", str(config), *option, "-o", "out"], tmp_path)
     assert result.exit_code == 2, (result.stdout, result.stderr)
     assert "must be left at the default for a law with jumps or friction" in result.stderr
+    assert result.stderr.startswith(f"rattle: error: `{option[0]}`")  # the option as the user typed it
     assert not (tmp_path / "out").exists()

@@ -31,7 +31,7 @@ __all__ = [
     "MAX_PERIOD", "DIRECTIONS", "VIRTUAL_FILESYSTEMS", "output_path", "override_analysis", "check_output_dir",
     "precheck", "as_bad_input", "check_points", "check_workers", "check_omega", "check_period", "parse_at",
     "MAX_OMEGA_POINTS", "check_omega_points", "check_scheduler", "speed_options", "check_rpm", "orbit_speed",
-    "orbit_omega",
+    "orbit_omega", "check_hb_options",
 ]
 
 #: Most grid frequencies ``rattle map --omega-points`` accepts (each is an exact solve of every
@@ -446,3 +446,17 @@ def _config_io() -> Any:
     from .. import io
 
     return io
+
+
+def check_hb_options(run_config: Any, *, start: str, fixed_harmonics: bool) -> None:
+    """Exit 2 (ConfigError naming the option) on ``rattle frf``'s options of the harmonic balance of
+    a continuous law (``--start``, ``--fixed-harmonics``) given for a law with jumps or friction
+    (one equation or a chain), which is solved by its ``[analysis] method`` instead."""
+    if not (getattr(run_config, "discontinuous", False) or getattr(run_config, "chain_friction", False)):
+        return
+    for option, given in (("--start", start != "low"), ("--fixed-harmonics", fixed_harmonics)):
+        if given:
+            raise ConfigError(f"`{option}` must be left at the default for a law with jumps or friction: it sets the "
+                              "harmonic balance of a continuous law; such a law is solved by [analysis] method = "
+                              "\"shooting\" (exact shooting continuation, the default) or \"hb\" (the regularised "
+                              "harmonic balance); leave it out")

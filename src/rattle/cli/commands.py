@@ -22,8 +22,8 @@ import click
 
 from ..errors import ConfigError, ConvergenceError
 from .checks import (
-    DIRECTIONS, MAX_PERIOD, check_omega, check_omega_points, check_period, check_scheduler, orbit_omega, orbit_speed,
-    output_path, override_analysis, parse_at, precheck, speed_options,
+    DIRECTIONS, MAX_PERIOD, check_hb_options, check_omega, check_omega_points, check_period, check_scheduler,
+    orbit_omega, orbit_speed, output_path, override_analysis, parse_at, precheck, speed_options,
 )
 from ._quantity import MAP_QUANTITY, check_quantity, map_largest_line, quantity_option, with_largest
 from .output import (
@@ -259,6 +259,7 @@ def frf_command(
     check_html(html)
     run_config = _io().load_config(config)
     check_quantity(quantity, run_config, "frf")
+    check_hb_options(run_config, start=start, fixed_harmonics=fixed_harmonics)
     w_min, w_max, labels = speed_options(run_config.model, omega_min, omega_max, rpm_min, rpm_max)
     analysis = override_analysis(
         run_config.analysis, run_config.bounds_model, labels=labels, harmonics=harmonics, omega_min=w_min,
