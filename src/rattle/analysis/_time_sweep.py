@@ -24,7 +24,6 @@ import logging
 import os
 import pickle
 import queue as queue_module
-import signal
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -33,7 +32,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .. import _limits, _validate
-from ..engines import die_with_parent
+from ..engines import die_with_parent, sigint_blocked, worker_signals
 from ..errors import ConfigError, RattleError
 from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
 from ..results import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SweepResult
@@ -225,10 +224,7 @@ def _worker_main(parent: int, messages: Any, model: Model, omegas: FloatArray, d
     workers), SIGTERM ends the process at once (the default action; a handler inherited from the
     parent is reset) — that is how the parent stops a worker.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if hasattr(signal, "SIGHUP"):
-        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    worker_signals()  # SIGINT ignored (and unblocked: it was blocked while we started), SIGTERM ends us
     die_with_parent(parent, _WATCH_INTERVAL)
     try:
         result = _run_timed(model, omegas, direction, options, lambda d: messages.put(("progress", d, None)))
@@ -289,7 +285,8 @@ def _run_parallel(
                 d = waiting.pop(0)
                 p = ctx.Process(target=_worker_main, name=f"rattle-sweep-{d}",
                                 args=(parent, messages, model, grids[d], d, options), daemon=True)
-                p.start()
+                with sigint_blocked():  # a Ctrl-C while it starts is the parent's, not a traceback of it
+                    p.start()
                 processes.append(p)
                 running[d] = p
                 logger.info("%s sweep: worker process %d started", d, p.pid)

@@ -30,13 +30,13 @@ from ._base import (
     TaskError,
     cpu_count,
 )
-from ._parent import die_with_parent
+from ._parent import die_with_parent, sigint_blocked, worker_signals
 from ._processes import MAX_RETRIES, WORKER_ENVIRONMENT, ProcessEngine
 from ._serial import SerialEngine
 
 __all__ = [
     "Engine", "EngineError", "TaskError", "SerialEngine", "ProcessEngine", "DaskEngine", "make_engine",
-    "ENGINES", "die_with_parent", "cpu_count", "MAX_RETRIES", "WORKER_ENVIRONMENT", "ResultCallback",
+    "ENGINES", "die_with_parent", "sigint_blocked", "worker_signals", "cpu_count", "MAX_RETRIES", "WORKER_ENVIRONMENT", "ResultCallback",
     "ProgressCallback", "Task", "local_cluster", "WORKER_CONFIG", "check_scheduler_address",
 ]
 

@@ -61,7 +61,7 @@ from ._base import (
     check_workers,
     cpu_count,
 )
-from ._parent import die_with_parent
+from ._parent import die_with_parent, sigint_blocked, worker_signals
 
 logger = logging.getLogger("rattle")
 
@@ -111,10 +111,7 @@ def _worker_main(parent: int, conn: Any, fn_bytes: bytes, env: dict[str, str]) -
     workers), SIGTERM and SIGHUP end the process at once (default actions; handlers inherited
     from the parent are reset) — that is how the parent stops a worker.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if hasattr(signal, "SIGHUP"):
-        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    worker_signals()
     die_with_parent(parent)
     os.environ.update(env)
     try:
@@ -216,7 +213,7 @@ class ProcessEngine:
         w = _Worker(process, parent_end, time.time())
         everyone.append(w)
         try:
-            with _environment(WORKER_ENVIRONMENT):
+            with _environment(WORKER_ENVIRONMENT), sigint_blocked():
                 process.start()
         finally:
             child_end.close()
