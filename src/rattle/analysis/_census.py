@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import time
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -464,8 +465,6 @@ def exact_orbits_at(system: NonsmoothSystem | FrictionSystem, omega: float, run:
 def with_every_orbit(system: NonsmoothSystem | FrictionSystem, result: Any) -> Any:
     """``result`` (a NonsmoothOrbitResult or FrictionOrbitResult at Ω) with every orbit at Ω
     (:func:`exact_orbits_at`) in its ``solutions`` and ``nonperiodic``."""
-    import dataclasses
-
     found = exact_orbits_at(system, float(result.omega))
     return dataclasses.replace(result, solutions=found.solutions, nonperiodic=found.nonperiodic)
 

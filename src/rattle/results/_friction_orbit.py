@@ -27,7 +27,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import Status
-from ._orbit import OrbitSolution, every_orbit_lines, solution_record
+from ._orbit import OrbitSolution, every_orbit_lines, every_orbit_records
 from ._plotter import plot_with
 
 #: The per-element columns of :meth:`FrictionOrbitResult.to_csv`, NAME_ prefixed, after ``t``.
@@ -277,9 +277,7 @@ class FrictionOrbitResult:
             "rms_error": _num(self.rms_error), "elements": elements,
             "held_limit": None if self.held_limit is None else {
                 **self.held_limit.to_dict(), "rms_error": [_num(v) for v in self.held_limit_error]},
-            "orbits": [solution_record(o) for o in self.solutions],
-            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin}
-                            for a in self.nonperiodic],
+            **every_orbit_records(self.solutions, self.nonperiodic),
         }
 
     def every_orbit_text(self) -> list[str]:

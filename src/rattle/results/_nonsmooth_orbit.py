@@ -25,7 +25,7 @@ import numpy as np
 from .._typing import ComplexArray, FloatArray
 from ..model import NonsmoothSystem
 from ..timeint import NonsmoothOrbit
-from ._orbit import OrbitSolution, every_orbit_lines, solution_record
+from ._orbit import OrbitSolution, every_orbit_lines, every_orbit_records
 from ._plotter import plot_with
 
 #: The columns of :meth:`NonsmoothOrbitResult.to_csv`.
@@ -233,9 +233,7 @@ class NonsmoothOrbitResult:
             "regime": self.regime, "start": self.start, "hb_start": self.hb_start,
             "regularisation": self.regularisation, "harmonics": self.harmonics, "message": self.message,
             "phases": [[a, b, k] for a, b, k in self.stick_intervals],
-            "orbits": [solution_record(o) for o in self.solutions],
-            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin}
-                            for a in self.nonperiodic],
+            **every_orbit_records(self.solutions, self.nonperiodic),
         }
 
     def every_orbit_text(self) -> list[str]:

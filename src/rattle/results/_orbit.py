@@ -146,6 +146,14 @@ def solution_record(s: OrbitSolution) -> dict[str, Any]:
     }
 
 
+def every_orbit_records(solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...]) -> dict[str, Any]:
+    """The ``orbits`` (:func:`solution_record` of each) and ``nonperiodic`` (rms, rms_ac, regime,
+    origin of each attractor with no period up to 8) of every orbit found at Ω, JSON-serialisable."""
+    return {"orbits": [solution_record(o) for o in solutions],
+            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin}
+                            for a in nonperiodic]}
+
+
 def every_orbit_lines(omega: float, solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...]) -> list[str]:
     """The terminal lines of every orbit found at Ω (an exact orbit's census, each orbit exact) and
     of the non-periodic attractors the simulations settled on there."""
