@@ -24,8 +24,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.optimize
 
+from .._brent import brent_root
 from .._typing import FloatArray
 from ._corrector import ArclengthCorrector, Corrected
 
@@ -80,7 +80,7 @@ def locate_on_segment(
         f0, f1 = psi(0.0), psi(length)
         if not np.sign(f0) * np.sign(f1) < 0:
             return None
-        s_star = scipy.optimize.brentq(psi, 0.0, length, xtol=xtol * length)
+        s_star = brent_root(psi, 0.0, length, xtol=xtol * length, fa=f0, fb=f1)
     except _CorrectorFailed:
         return None
     val, corr = cache[s_star] if s_star in cache else (psi(s_star), cache[s_star][1])

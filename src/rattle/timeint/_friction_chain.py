@@ -78,8 +78,8 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
-
+from .._brent import brent_root
+from .._lazy import lazy_module
 from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_omega
@@ -91,6 +91,8 @@ from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
 from ._stage_flow import Segment, StageSolution, SystemStages
+
+optimize = lazy_module("scipy.optimize")  # minimize_scalar, for the extremes of a segment
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
@@ -114,7 +116,7 @@ def _brent(fun, a: float, b: float, fa: float, fb: float) -> float:  # type: ign
         return b
     if (fa > 0.0) == (fb > 0.0):  # a sign change within round-off: the end nearer zero
         return a if abs(fa) < abs(fb) else b
-    return float(brentq(fun, a, b, xtol=4.0 * _EPS * max(abs(b), 1e-300), rtol=4.0 * _EPS, maxiter=200))
+    return brent_root(fun, a, b, xtol=4.0 * _EPS * max(abs(b), 1e-300), rtol=4.0 * _EPS, maxiter=200, fa=fa, fb=fb)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
@@ -193,7 +195,7 @@ class FrictionTrajectory(ExactTrajectory):
                 for lo_c, hi_c in ((tg[0], tg[1]), (tg[-2], tg[-1])):
                     brackets += [(float(lo_c), float(hi_c), 1.0), (float(lo_c), float(hi_c), -1.0)]
                 for lo_c, hi_c, sign in brackets:  # sign +1: a minimum of δ_e'', −1: a maximum
-                    res = minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
+                    res = optimize.minimize_scalar(lambda x, e=e, s=sign: s * seg.element_point(x, e)[2],
                                           bounds=(lo_c, hi_c), method="bounded",
                                           options={"xatol": 1e-12 * max(length, 1.0)})
                     val = seg.element_point(float(res.x), e)[2]

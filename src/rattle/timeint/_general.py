@@ -26,9 +26,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.integrate._ivp.ivp import METHODS as _IVP_METHODS
 
+from .._brent import brent_root
+from .._lazy import import_held
 from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
@@ -187,8 +187,9 @@ def integrate_general(
     t0, t1 = float(t0), float(t1)
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
         raise ValueError(f"`t0` and `t1` must be finite with t1 >= t0, got t0={t0!r}, t1={t1!r}")
-    if method not in _IVP_METHODS:
-        raise ValueError(f"`method` must be one of {', '.join(_IVP_METHODS)}, got {method!r}")
+    methods = import_held("scipy.integrate._ivp.ivp").METHODS  # scipy.integrate: loaded when first used
+    if method not in methods:
+        raise ValueError(f"`method` must be one of {', '.join(methods)}, got {method!r}")
     for name, value in (("rtol", rtol), ("atol", atol), ("max_step", max_step)):
         if not (isinstance(value, (int, float)) and value > 0.0):
             raise ValueError(f"`{name}` must be a number > 0, got {value!r}")
@@ -246,7 +247,7 @@ def integrate_general(
 
         events.append(extremum)
         if t1 > t:
-            sol = solve_ivp(rhs, (t, t1), [d, v], method=method, rtol=rtol, atol=atol, max_step=max_step,
+            sol = import_held("scipy.integrate").solve_ivp(rhs, (t, t1), [d, v], method=method, rtol=rtol, atol=atol, max_step=max_step,
                             events=events, dense_output=True)
             if sol.status < 0:
                 raise ConvergenceError(f"solve_ivp failed at t = {t!r}: {sol.message}")
@@ -295,8 +296,6 @@ def integrate_general(
 def _missed_crossing(sol: object, tx: float, kind: int, bound: float, t_seg: float) -> tuple[int, float, FloatArray]:
     """The crossing of ``bound`` before the extremum at ``tx`` that lies beyond it, located on
     the dense output within the step that holds the extremum (δ is inside at the step start)."""
-    from scipy.optimize import brentq
-
     steps = np.asarray(sol.t)  # type: ignore[attr-defined]
     k = max(int(np.searchsorted(steps, tx, side="right")) - 1, 0)
     ta = max(float(steps[k]), t_seg)
@@ -305,7 +304,7 @@ def _missed_crossing(sol: object, tx: float, kind: int, bound: float, t_seg: flo
     if gap(ta) * gap(tx) > 0.0:  # round-off at the step start: take it as the crossing
         tc = ta
     else:
-        tc = brentq(gap, ta, tx, xtol=4.0 * np.finfo(float).eps * max(abs(tx), 1.0), rtol=4.0 * np.finfo(float).eps)
+        tc = brent_root(gap, ta, tx, xtol=4.0 * np.finfo(float).eps * max(abs(tx), 1.0), rtol=4.0 * np.finfo(float).eps)
     return kind, float(tc), dense(tc)
 
 
