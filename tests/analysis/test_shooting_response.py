@@ -141,16 +141,18 @@ def test_a_start_at_every_frequency_of_a_grid_succeeds(name):
 
 
 @pytest.mark.slow
-def test_a_chain_start_at_every_frequency_of_a_grid_succeeds():
-    """The lock-up chain (every orbit unstable: the settled flow never reaches one, each start is
-    Newton from the attractor or continued from a neighbouring frequency): 7 frequencies over its
-    range (the 20-point grid takes ~55 s of the suite; measured green too)."""
-    case = rattle.load_case(EXAMPLES / "chain_lockup_clutch.toml")
+@pytest.mark.parametrize("name", ["chain_lockup_clutch.toml", "chain_clutch_friction.toml"])
+def test_a_chain_start_at_every_frequency_of_a_grid_succeeds(name):
+    """The chain examples, 20 frequencies over each range (second tier: ~20 s and ~60 s). On the
+    lock-up chain every orbit is unstable (the settled flow never reaches one): each start is Newton
+    from the attractor or continued from a neighbouring frequency."""
+    case = rattle.load_case(EXAMPLES / name)
     problem = ShootingProblem(case.model)
     lo, hi = case.analysis.omega
-    for w in np.linspace(lo, hi, 7):
+    for w in np.linspace(lo, hi, 20):
         q = start_state(problem, float(w), ShootingOptions(), NewtonOptions())
         assert q is not None, w
+        assert float(np.max(np.abs(problem.residual(q, float(w))))) <= 1e-9, w
 
 
 def test_shooting_and_the_regularised_hb_agree_where_both_apply():
