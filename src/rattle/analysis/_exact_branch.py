@@ -212,15 +212,6 @@ def _row_rms(row: ExactRow) -> FloatArray:
     return np.atleast_1d(float(traj.mean_and_rms()[1]))
 
 
-def _structure(problem: ShootingProblem, q: FloatArray, omega: float) -> tuple[int, ...]:
-    """The event structure of the orbit through q (stick/lock phases and crossings per element)."""
-    try:
-        return problem.integrator.propagate(np.asarray(q, dtype=float), 0.0, problem.orbit_period(omega),
-                                            omega).event_structure()
-    except Exception:  # noqa: BLE001 - no structure where the flow cannot be followed
-        return (-1,)
-
-
 def start_state(problem: ShootingProblem, omega: float, options: ShootingOptions, newton: NewtonOptions,
                 guess: FloatArray | None = None, continuation: ContinuationOptions | None = None,
                 bounds: tuple[float, float] | None = None) -> FloatArray | None:
@@ -314,6 +305,18 @@ class _Follower:
         self.continuation = continuation
         self.newton = newton
         self.corrector = ArclengthCorrector(problem, newton)
+        #: the rows of the last piece's accepted points, made as they were accepted (their period
+        #: was then the flow's last: no second integration, :meth:`_rows`)
+        self._made: dict[tuple[float, bytes], ExactRow] = {}
+
+    def _rows(self, pts: list[BranchPoint]) -> list[ExactRow]:
+        """The rows of the last piece's points ``pts`` (made when accepted, else now)."""
+        made, self._made = self._made, {}
+        rows = []
+        for p in pts:
+            row = made.get((p.p, p.q.tobytes()))
+            rows.append(row if row is not None else _row(self.problem, p.q, p.p))
+        return rows
 
     def _piece(self, q: FloatArray, w: float, direction: float,
                stop: Any = None) -> ContinuationStepper | None:
@@ -327,8 +330,10 @@ class _Follower:
                 return None
         floor = CRAWL_FACTOR * self.continuation.min_step
         crawl = [0]
+        made = self._made = {}
 
         def halt(pt: BranchPoint) -> str | None:
+            made[(pt.p, pt.q.tobytes())] = _row(self.problem, pt.q, pt.p)
             crawl[0] = crawl[0] + 1 if pt.step <= floor else 0
             if self.progress is not None:
                 self._report(pt.p)
@@ -402,7 +407,7 @@ class _Follower:
                 q, w, d = pending.pop(0)  # the wrong arm: try the next candidate
                 continue
             if pts:
-                rows = [_row(self.problem, p.q, p.p) for p in pts]
+                rows = self._rows(pts)
                 if branch.rows and rows and hopped:
                     graze = self._graze(pts[0], d, rows[0].structure)
                     if graze is not None:
@@ -442,7 +447,7 @@ class _Follower:
         seen: list[BranchPoint] = []
 
         def same(pt: BranchPoint) -> str | None:
-            if _structure(self.problem, pt.q, pt.p) != structure:
+            if self._made[(pt.p, pt.q.tobytes())].structure != structure:  # the row made when accepted
                 return "the structure changed"
             seen.append(pt)
             return "far enough" if len(seen) > GRAZE_POINTS else None
@@ -483,7 +488,7 @@ class _Follower:
                 # leaves the range or joins the rows of this branch, so none of it is skipped
                 stepper = self._piece(q, w, -travel, lambda pt, rows=list(branch.rows): _joins(self.problem, pt, rows, w))
             if stepper is not None and stepper.points:
-                rows = [_row(self.problem, p.q, p.p) for p in reversed(stepper.points)]
+                rows = list(reversed(self._rows(stepper.points)))
                 if rows:
                     branch.pieces.append(len(rows))
                     branch.rows.extend(rows)
