@@ -22,7 +22,8 @@ speed, the start or end of a stick or lock phase) the period map is continuous b
 blows up (the saltation matrix carries 1/v), and the corrector fails ever closer to the grazing
 point: the stepper ends with its step at the floor. The branch then goes on along the orbits of
 the other event structure: at Ω (1 ± h) next to the last point, h = ``hops`` in turn, the period
-map's fixed point is sought by Newton from the last orbit; one that differs from it by at most
+map's fixed point is sought by Newton from the last orbit (damped where plain Newton fails, within
+:data:`HOP_EVALUATIONS` period maps); one that differs from it by at most
 :data:`HOP_DISTANCE` (scaled state) and has another event structure is on the branch's other
 side. The branch is continued from it away from the grazing (Ω increasing from Ω (1 + h),
 decreasing from Ω (1 − h)); a continuation that stalls again within :data:`MIN_PIECE` points is
@@ -94,6 +95,10 @@ HOP_DISTANCE = 0.05
 #: orbit's: across a grazing the orbit changes continuously (the new crossings or stick phases are
 #: small), so a hop of h ≤ 1e-2 in Ω moves the rms by far less.
 HOP_RMS = 0.05
+#: The most period maps the damped Newton of one hop candidate integrates (measured on the examples
+#: and the bench's preload cases: the hops that landed took at most 14, the ones that never landed
+#: 176–308, half a second to 1.2 s a candidate on a chain).
+HOP_EVALUATIONS = 64
 #: A piece continued from a hop that stalls again within this many points is the wrong arm.
 MIN_PIECE = 5
 #: A piece whose last CRAWL_POINTS steps were all within CRAWL_FACTOR × the stepper's smallest
@@ -268,14 +273,15 @@ START_TRIES = 3
 
 
 def damped_newton(problem: ShootingProblem, q: FloatArray, omega: float, newton: NewtonOptions,
-                  iterations: int = 60) -> FloatArray | None:
+                  iterations: int = 60, evaluations: int | None = None) -> FloatArray | None:
     """Newton on the period map at fixed Ω with the step halved until the scaled residual
     decreases (:meth:`ShootingProblem.solve`: an unstable orbit, which the settled flow does not
-    approach, from a state of the attractor); None when it stalls. Converged as
-    :func:`~rattle.continuation.solve_fixed` (residual and step within the tolerances)."""
+    approach, from a state of the attractor); None when it stalls or has integrated ``evaluations``
+    period maps (None: no cap). Converged as :func:`~rattle.continuation.solve_fixed` (residual and
+    step within the tolerances)."""
     try:
         shot = problem.solve(q, omega, tol=newton.residual_tol, step_tol=newton.step_tol, max_iterations=iterations,
-                             max_halvings=29, least_squares=False, record=False)
+                             max_halvings=29, least_squares=False, record=False, max_evaluations=evaluations)
     except FLOW_FAILURES:  # the flow cannot be followed from q
         return None
     return shot.x if shot.converged else None
@@ -374,7 +380,8 @@ class _Follower:
                 if not self.lo <= w <= self.hi:
                     continue
                 res = solve_fixed(self.problem, last.q, w, self.newton)
-                q = res.q if res.converged else damped_newton(self.problem, last.q, w, self.newton)
+                q = res.q if res.converged else damped_newton(self.problem, last.q, w, self.newton,
+                                                              evaluations=HOP_EVALUATIONS)
                 if q is None or float(np.max(np.abs((q - last.q) / s))) > HOP_DISTANCE:
                     continue
                 try:
