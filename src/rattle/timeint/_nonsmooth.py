@@ -606,13 +606,13 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
             start = 1
             hits = np.flatnonzero(sv[start:] <= 0.0)
             i_hit = start + int(hits[0]) if hits.size else None
-            # a tangential return of σδ' towards 0 inside a cell: σδ'' from − to + (a minimum)
-            acc = sol.forcing(seg.ts + taus) - c * v - ks * d - ke
+            # a tangential return of σδ' towards 0 inside a cell: σδ'' from − to + (a minimum); only
+            # the cells before the hit's can hold one that comes first
+            top = taus.size if i_hit is None else i_hit
+            acc = sol.forcing(seg.ts + taus[:top]) - c * v[:top] - ks * d[:top] - ke
             sa = sigma * acc
-            mins = np.flatnonzero((sa[:-1] < 0.0) & (sa[1:] >= 0.0) & (sv[:-1] > 0.0) & (sv[1:] > 0.0))
+            mins = np.flatnonzero((sa[:-1] < 0.0) & (sa[1:] >= 0.0) & (sv[:top - 1] > 0.0) & (sv[1:top] > 0.0))
             for i in mins.tolist():
-                if i_hit is not None and i >= i_hit - 1:
-                    break
 
                 def accel(tau: float) -> tuple[float, float]:
                     _, vv, aa = seg.state(tau)
