@@ -22,7 +22,8 @@ speed, the start or end of a stick or lock phase) the period map is continuous b
 blows up (the saltation matrix carries 1/v), and the corrector fails ever closer to the grazing
 point: the stepper ends with its step at the floor. The branch then goes on along the orbits of
 the other event structure: at Ω (1 ± h) next to the last point, h = ``hops`` in turn, the period
-map's fixed point is sought by Newton from the last orbit; one that differs from it by at most
+map's fixed point is sought by Newton from the last orbit (damped where plain Newton fails, within
+:data:`HOP_EVALUATIONS` period maps); one that differs from it by at most
 :data:`HOP_DISTANCE` (scaled state) and has another event structure is on the branch's other
 side. The branch is continued from it away from the grazing (Ω increasing from Ω (1 + h),
 decreasing from Ω (1 − h)); a continuation that stalls again within :data:`MIN_PIECE` points is
@@ -94,6 +95,10 @@ HOP_DISTANCE = 0.05
 #: orbit's: across a grazing the orbit changes continuously (the new crossings or stick phases are
 #: small), so a hop of h ≤ 1e-2 in Ω moves the rms by far less.
 HOP_RMS = 0.05
+#: The most period maps the damped Newton of one hop candidate integrates (measured on the examples
+#: and the bench's preload cases: the hops that landed took at most 14, the ones that never landed
+#: 176–308, half a second to 1.2 s a candidate on a chain).
+HOP_EVALUATIONS = 64
 #: A piece continued from a hop that stalls again within this many points is the wrong arm.
 MIN_PIECE = 5
 #: A piece whose last CRAWL_POINTS steps were all within CRAWL_FACTOR × the stepper's smallest
@@ -212,15 +217,6 @@ def _row_rms(row: ExactRow) -> FloatArray:
     return np.atleast_1d(float(traj.mean_and_rms()[1]))
 
 
-def _structure(problem: ShootingProblem, q: FloatArray, omega: float) -> tuple[int, ...]:
-    """The event structure of the orbit through q (stick/lock phases and crossings per element)."""
-    try:
-        return problem.integrator.propagate(np.asarray(q, dtype=float), 0.0, problem.orbit_period(omega),
-                                            omega).event_structure()
-    except Exception:  # noqa: BLE001 - no structure where the flow cannot be followed
-        return (-1,)
-
-
 def start_state(problem: ShootingProblem, omega: float, options: ShootingOptions, newton: NewtonOptions,
                 guess: FloatArray | None = None, continuation: ContinuationOptions | None = None,
                 bounds: tuple[float, float] | None = None) -> FloatArray | None:
@@ -277,14 +273,15 @@ START_TRIES = 3
 
 
 def damped_newton(problem: ShootingProblem, q: FloatArray, omega: float, newton: NewtonOptions,
-                  iterations: int = 60) -> FloatArray | None:
+                  iterations: int = 60, evaluations: int | None = None) -> FloatArray | None:
     """Newton on the period map at fixed Ω with the step halved until the scaled residual
     decreases (:meth:`ShootingProblem.solve`: an unstable orbit, which the settled flow does not
-    approach, from a state of the attractor); None when it stalls. Converged as
-    :func:`~rattle.continuation.solve_fixed` (residual and step within the tolerances)."""
+    approach, from a state of the attractor); None when it stalls or has integrated ``evaluations``
+    period maps (None: no cap). Converged as :func:`~rattle.continuation.solve_fixed` (residual and
+    step within the tolerances)."""
     try:
         shot = problem.solve(q, omega, tol=newton.residual_tol, step_tol=newton.step_tol, max_iterations=iterations,
-                             max_halvings=29, least_squares=False, record=False)
+                             max_halvings=29, least_squares=False, record=False, max_evaluations=evaluations)
     except FLOW_FAILURES:  # the flow cannot be followed from q
         return None
     return shot.x if shot.converged else None
@@ -314,6 +311,18 @@ class _Follower:
         self.continuation = continuation
         self.newton = newton
         self.corrector = ArclengthCorrector(problem, newton)
+        #: the rows of the last piece's accepted points, made as they were accepted (their period
+        #: was then the flow's last: no second integration, :meth:`_rows`)
+        self._made: dict[tuple[float, bytes], ExactRow] = {}
+
+    def _rows(self, pts: list[BranchPoint]) -> list[ExactRow]:
+        """The rows of the last piece's points ``pts`` (made when accepted, else now)."""
+        made, self._made = self._made, {}
+        rows = []
+        for p in pts:
+            row = made.get((p.p, p.q.tobytes()))
+            rows.append(row if row is not None else _row(self.problem, p.q, p.p))
+        return rows
 
     def _piece(self, q: FloatArray, w: float, direction: float,
                stop: Any = None) -> ContinuationStepper | None:
@@ -327,8 +336,10 @@ class _Follower:
                 return None
         floor = CRAWL_FACTOR * self.continuation.min_step
         crawl = [0]
+        made = self._made = {}
 
         def halt(pt: BranchPoint) -> str | None:
+            made[(pt.p, pt.q.tobytes())] = _row(self.problem, pt.q, pt.p)
             crawl[0] = crawl[0] + 1 if pt.step <= floor else 0
             if self.progress is not None:
                 self._report(pt.p)
@@ -369,7 +380,8 @@ class _Follower:
                 if not self.lo <= w <= self.hi:
                     continue
                 res = solve_fixed(self.problem, last.q, w, self.newton)
-                q = res.q if res.converged else damped_newton(self.problem, last.q, w, self.newton)
+                q = res.q if res.converged else damped_newton(self.problem, last.q, w, self.newton,
+                                                              evaluations=HOP_EVALUATIONS)
                 if q is None or float(np.max(np.abs((q - last.q) / s))) > HOP_DISTANCE:
                     continue
                 try:
@@ -402,7 +414,7 @@ class _Follower:
                 q, w, d = pending.pop(0)  # the wrong arm: try the next candidate
                 continue
             if pts:
-                rows = [_row(self.problem, p.q, p.p) for p in pts]
+                rows = self._rows(pts)
                 if branch.rows and rows and hopped:
                     graze = self._graze(pts[0], d, rows[0].structure)
                     if graze is not None:
@@ -442,7 +454,7 @@ class _Follower:
         seen: list[BranchPoint] = []
 
         def same(pt: BranchPoint) -> str | None:
-            if _structure(self.problem, pt.q, pt.p) != structure:
+            if self._made[(pt.p, pt.q.tobytes())].structure != structure:  # the row made when accepted
                 return "the structure changed"
             seen.append(pt)
             return "far enough" if len(seen) > GRAZE_POINTS else None
@@ -483,7 +495,7 @@ class _Follower:
                 # leaves the range or joins the rows of this branch, so none of it is skipped
                 stepper = self._piece(q, w, -travel, lambda pt, rows=list(branch.rows): _joins(self.problem, pt, rows, w))
             if stepper is not None and stepper.points:
-                rows = [_row(self.problem, p.q, p.p) for p in reversed(stepper.points)]
+                rows = list(reversed(self._rows(stepper.points)))
                 if rows:
                     branch.pieces.append(len(rows))
                     branch.rows.extend(rows)

@@ -230,8 +230,37 @@ class NonsmoothTrajectory(ExactTrajectory):
     def mean_and_rms(self) -> tuple[float, float]:
         """(1/T)∫δ dt and sqrt((1/T)∫δ² dt) over [t0, t1]."""
         T = self.t1 - self.t0
-        m = self.integrate(lambda t, d, v, a: d) / T
-        return m, math.sqrt(max(self.integrate(lambda t, d, v, a: d * d) / T, 0.0))
+        s1, s2 = self._moments()
+        return s1 / T, math.sqrt(max(s2 / T, 0.0))
+
+    def _moments(self, panels_per_scale: int = 4) -> tuple[float, float]:
+        """∫δ dt and ∫δ² dt over [t0, t1] in one pass: :meth:`integrate`'s panels and sums, each
+        segment's δ sampled once for both."""
+        s1 = s2 = 0.0
+        sol = self.solutions
+        fast = float(sol.nw.max(initial=0.0))
+        for i in range(len(self.t_start)):
+            ta, tb = float(self.t_start[i]), float(self.t_end[i])
+            if tb <= ta:
+                continue
+            n = max(1, math.ceil((tb - ta) * panels_per_scale * fast / (2.0 * math.pi)))
+            slip = self.kind[i] == SLIP
+            if slip:
+                m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
+                scale = float(sol.time_scale[m])
+                n = 1 if not math.isfinite(scale) else max(1, math.ceil((tb - ta) * panels_per_scale / scale))
+            edges = np.linspace(ta, tb, n + 1)
+            half = 0.5 * np.diff(edges)
+            tq = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]
+            w = half[:, None] * _GAUSS_W[None, :]
+            if slip:
+                h0, h1 = self.homogeneous[i]
+                d = sol.evaluate(m, np.clip(tq, ta, tb).ravel(), ta, h0, h1, order=0)[0].reshape(tq.shape)
+            else:
+                d = np.full(tq.shape, self.x_start[i, 0])
+            s1 += float(np.sum(w * d))
+            s2 += float(np.sum(w * (d * d)))
+        return s1, s2
 
     def extremes(self, samples_per_scale: int = 16) -> tuple[float, float, float, float]:
         """(δ_min, δ_max, δ''_min, δ''_max) over [t0, t1]. δ'' jumps at the switchings: both
@@ -254,8 +283,10 @@ class NonsmoothTrajectory(ExactTrajectory):
             d, v, a, jk = sol.evaluate(m, t, ta, h0, h1, order=3)
             ks = float(sol.ks[m])
 
-            def at(x: float, m: int = m, ta: float = ta, h0: float = h0, h1: float = h1) -> list[float]:
-                return [float(y[0]) for y in sol.evaluate(m, np.array([x]), ta, h0, h1, order=3)]
+            def at(x: float, m: int = m, ta: float = ta, h0: float = h0, h1: float = h1,
+                   ks: float = ks) -> tuple[float, float, float, float]:
+                dd, vv, aa = sol.point(m, x, ta, h0, h1)
+                return dd, vv, aa, sol.force(x, 1) - c * aa - ks * vv
 
             def vel(x: float) -> tuple[float, float]:
                 y = at(x)
@@ -263,7 +294,7 @@ class NonsmoothTrajectory(ExactTrajectory):
 
             def jerk(x: float, ks: float = ks) -> tuple[float, float]:
                 y = at(x)
-                return y[3], float(sol.forcing(np.array([x]), 2)[0]) - c * y[3] - ks * y[2]
+                return y[3], sol.force(x, 2) - c * y[3] - ks * y[2]
 
             vals_d, vals_a = [float(d[0]), float(d[-1])], [float(a[0]), float(a[-1])]
             tol = 4.0 * _EPS * max(abs(tb), 1.0)
@@ -295,6 +326,10 @@ class NonsmoothTrajectory(ExactTrajectory):
 
 #: Frequencies whose stage solutions :meth:`_ScalarEventFlow.solutions` keeps.
 SOLUTION_CACHE = 4
+#: The last trajectories :meth:`_ScalarEventFlow.propagate` keeps, by their exact arguments (x0, t0,
+#: t1, Ω): a shooting continuation asks again for the period it has just integrated (the row of an
+#: accepted point after the corrector's last evaluation there, its event structure).
+MEMO = 4
 
 
 class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
@@ -308,12 +343,15 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         self.model = None  # the modes' table stands for the model (:meth:`solutions`)
         self.max_segments = self.options.budget(events=True)
         self._solution_cache: dict[float, StageSolutions] = {}
+        self._memo: dict[tuple[float, ...], NonsmoothTrajectory] = {}
+        self._template: StageSolutions | None = None
         st = system.law.stages
         self._d = st.breakpoints.tolist()
         self._s = st.slopes.tolist()
         self._e = st.offsets.tolist()
         self._J = st.jumps.tolist()
         self._r = system.law.friction_levels.tolist()
+        self._L = float(system.length_scale())
 
     def solutions(self, omega: float) -> StageSolutions:
         """The closed-form solutions of every mode at ``omega`` (the last :data:`SOLUTION_CACHE`
@@ -321,7 +359,10 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         sol = self._solution_cache.get(omega)
         if sol is not None:
             return sol
-        sol = _mode_solutions(self.system, omega, self.samples_per_scale)
+        if self._template is None:
+            sol = self._template = _mode_solutions(self.system, omega, self.samples_per_scale)
+        else:  # only the forcing's parts depend on Ω
+            sol = self._template.at_omega(omega)
         if len(self._solution_cache) >= SOLUTION_CACHE:
             del self._solution_cache[next(iter(self._solution_cache))]
         self._solution_cache[float(omega)] = sol
@@ -330,7 +371,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
     def velocity_scale(self, omega: float) -> float:
         """L ν: the length scale times the larger of Ω and the stiffest stage's natural frequency."""
         sys = self.system
-        return sys.length_scale() * max(omega, math.sqrt(sys.k * max(self._s)))
+        return self._L * max(omega, math.sqrt(sys.k * max(self._s)))
 
     # --- helpers -----------------------------------------------------------------------------
     def _f(self, j: int, d: float) -> float:
@@ -346,7 +387,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
 
     def _classify(self, sol: StageSolutions, t: float, d: float, v: float) -> tuple[int, int, int]:
         """(kind, stage or breakpoint, σ) of the state (δ, δ') at t."""
-        F = float(sol.forcing(np.asarray(t)))
+        F = sol.force(t)
         k = self.system.k
         if v == 0.0:
             if d in self._d:
@@ -375,24 +416,32 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         x0 = check_state(x0)
         omega = check_omega(omega)
         t0, t1 = check_interval(t0, t1, omega)
+        key = (float(x0[0]), float(x0[1]), t0, t1, omega)
+        memo = self._memo.get(key)
+        if memo is not None:
+            return memo
         sol = self.solutions(omega)
         rec: dict[str, list] = {k: [] for k in ("t", "kind", "stage", "sign", "x", "h", "et", "ek")}
         d, v, M = self._march_events(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
         t_start = np.asarray(rec["t"], dtype=float)
-        return NonsmoothTrajectory(
+        traj = NonsmoothTrajectory(
             system=self.system, omega=omega, t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
             sensitivity=np.array([[M[0], M[1]], [M[2], M[3]]]), t_start=t_start, t_end=np.append(t_start[1:], t1),
             kind=np.asarray(rec["kind"], dtype=np.int64), stage=np.asarray(rec["stage"], dtype=np.int64),
             sign=np.asarray(rec["sign"], dtype=np.int64), x_start=np.asarray(rec["x"], dtype=float).reshape(-1, 2),
             homogeneous=np.asarray(rec["h"], dtype=float).reshape(-1, 2),
             event_time=np.asarray(rec["et"], dtype=float), event_kind=tuple(rec["ek"]), solutions=sol)
+        if len(self._memo) >= MEMO:
+            del self._memo[next(iter(self._memo))]
+        self._memo[key] = traj
+        return traj
 
     def advance(self, x0: FloatArray, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
         """The state (δ, δ') at ``t1`` and ∂x(t1)/∂x(t0) (None when ``sensitivity`` is False): the
         period map of a shooting."""
         traj = self.propagate(x0, t0, t1, omega)
-        return traj.state1, (traj.sensitivity if sensitivity else None)
+        return traj.state1.copy(), (traj.sensitivity.copy() if sensitivity else None)
 
     # --- the march ---------------------------------------------------------------------------
     def _march_events(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
@@ -407,7 +456,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
             m22 = 0.0  # a small initial δ' dies within O(δ') time: the stick's projection
         elif kind == LOCK:
             m11 = m22 = 0.0  # near a locking jump every perturbation spirals into the lock
-        x_lock = self.options.lock_excursion * self.system.length_scale()
+        x_lock = self.options.lock_excursion * self._L
         n_events = 0
         while True:
             if kind == SLIP:
@@ -426,7 +475,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
                     d_e, v_e, _ = seg.state(tau)
                     return d_e, v_e, (m11, m12, m21, m22)
                 t = t + tau
-                F = float(sol.forcing(np.asarray(t)))
+                F = sol.force(t)
                 if j_new >= 0:  # δ reaches breakpoint i
                     up = j_new > mode
                     i = j if up else j - 1
@@ -441,7 +490,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
                             t = t - tau + tau_p
                             tau = tau_p
                             _, v_c, _ = seg.state(tau)
-                            F = float(sol.forcing(np.asarray(t)))
+                            F = sol.force(t)
                             m11, m12, m21, m22 = m_before
                             f11, f12, f21, f22 = sol.transition_scalar(mode, tau)
                             m11, m12, m21, m22 = (f11 * m11 + f12 * m21, f11 * m12 + f12 * m22,
@@ -557,17 +606,17 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
             start = 1
             hits = np.flatnonzero(sv[start:] <= 0.0)
             i_hit = start + int(hits[0]) if hits.size else None
-            # a tangential return of σδ' towards 0 inside a cell: σδ'' from − to + (a minimum)
-            acc = sol.forcing(seg.ts + taus) - c * v - ks * d - ke
+            # a tangential return of σδ' towards 0 inside a cell: σδ'' from − to + (a minimum); only
+            # the cells before the hit's can hold one that comes first
+            top = taus.size if i_hit is None else i_hit
+            acc = sol.forcing(seg.ts + taus[:top]) - c * v[:top] - ks * d[:top] - ke
             sa = sigma * acc
-            mins = np.flatnonzero((sa[:-1] < 0.0) & (sa[1:] >= 0.0) & (sv[:-1] > 0.0) & (sv[1:] > 0.0))
+            mins = np.flatnonzero((sa[:-1] < 0.0) & (sa[1:] >= 0.0) & (sv[:top - 1] > 0.0) & (sv[1:top] > 0.0))
             for i in mins.tolist():
-                if i_hit is not None and i >= i_hit - 1:
-                    break
 
                 def accel(tau: float) -> tuple[float, float]:
                     _, vv, aa = seg.state(tau)
-                    jerk = float(sol.forcing(np.asarray(seg.ts + tau), 1)) - c * aa - ks * vv
+                    jerk = sol.force(seg.ts + tau, 1) - c * aa - ks * vv
                     return aa, jerk
 
                 tau_m = bracketed_newton(accel, float(taus[i]), float(taus[i + 1]), float(acc[i]), float(acc[i + 1]),
@@ -595,13 +644,13 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         tol = 4.0 * _EPS * max(abs(t1), 1.0)
 
         def g_up(t: float) -> tuple[float, float]:
-            return float(sol.forcing(np.asarray(t))) - hi, float(sol.forcing(np.asarray(t), 1))
+            return sol.force(t) - hi, sol.force(t, 1)
 
         def g_dn(t: float) -> tuple[float, float]:
-            return lo - float(sol.forcing(np.asarray(t))), -float(sol.forcing(np.asarray(t), 1))
+            return lo - sol.force(t), -sol.force(t, 1)
 
         def dF(t: float) -> tuple[float, float]:
-            return float(sol.forcing(np.asarray(t), 1)), float(sol.forcing(np.asarray(t), 2))
+            return sol.force(t, 1), sol.force(t, 2)
 
         ta = t0
         while ta < t1:
@@ -618,7 +667,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
                     cand.append((a_, b_, False))
                 elif (F1[i] > 0.0) != (F1[i + 1] > 0.0) and F1[i] != 0.0:
                     te = bracketed_newton(dF, a_, b_, float(F1[i]), float(F1[i + 1]), tol)
-                    Fe = float(sol.forcing(np.asarray(te)))
+                    Fe = sol.force(te)
                     if Fe > hi:
                         cand.append((a_, te, True))
                     elif Fe < lo:

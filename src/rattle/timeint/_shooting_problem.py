@@ -276,7 +276,8 @@ class ShootingProblem:
     # --- Newton on the period map at fixed Ω --------------------------------------------------------
     def solve(self, q0: FloatArray, omega: float, *, tol: float, max_iterations: int, max_halvings: int,
               scale: FloatArray | None = None, step_tol: float | None = None, least_squares: bool = True,
-              hold: tuple[FloatArray, FloatArray] | None = None, record: bool = True) -> Shot:
+              hold: tuple[FloatArray, FloatArray] | None = None, record: bool = True,
+              max_evaluations: int | None = None) -> Shot:
         """Newton's method on φ_T(q) − q = 0 at fixed Ω with the exact monodromy, the step halved
         (at most ``max_halvings`` times) until the scaled residual decreases (module docstring);
         the last iterate is returned with its trajectory over one orbit period, converged or not
@@ -284,7 +285,8 @@ class ShootingProblem:
         ``step_tol`` also asks ‖Δq/s‖∞ ≤ step_tol and returns q + Δq; ``least_squares`` takes the
         least-squares step where M − I is singular (else the solve stops there); ``hold`` = (A, d)
         adds the rows A x(0) = d (scaled by L), the step then by least squares; ``record`` False
-        leaves the trajectory None when it was not recorded on the way. A failure of the flow from
+        leaves the trajectory None when it was not recorded on the way; ``max_evaluations`` caps the
+        period maps integrated (spent: the solve stops, not converged). A failure of the flow from
         ``q0`` itself is raised (:data:`FLOW_FAILURES`)."""
         s = self._scale if scale is None else np.asarray(scale, dtype=float)
         n = self.n
@@ -324,7 +326,11 @@ class ShootingProblem:
                 break
             iterations += 1
             step = 1.0
+            spent = False
             for _ in range(max_halvings + 1):
+                if max_evaluations is not None and evaluations >= max_evaluations:
+                    spent = True
+                    break
                 trial = q + step * dq
                 try:
                     out = defect(trial)
@@ -337,6 +343,8 @@ class ShootingProblem:
                 step *= 0.5
             else:
                 break  # no decrease along the Newton direction: give up (not converged)
+            if spent:
+                break  # the budget of period maps is spent (not converged)
             q = trial
             r, M, traj, res = out
         if traj is None and record:

@@ -19,6 +19,7 @@ stiffness), the one shared with the stability layer.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -49,7 +50,7 @@ class StageSolutions:
         exc = model.excitation
         c, k = model.c, model.k
         self.model = model
-        self.omega = omega
+        self.samples_per_scale = samples_per_scale
         self.c = c
         self.breakpoints = np.asarray(st.breakpoints, dtype=float)
         self.lower = np.concatenate(([-np.inf], self.breakpoints))
@@ -63,7 +64,7 @@ class StageSolutions:
         amps = np.asarray(exc.amplitudes, dtype=float)
         phases = np.asarray(exc.phases, dtype=float)
         keep = amps != 0.0
-        self.nw = exc.orders[keep].astype(float) * omega
+        self._orders = exc.orders[keep].astype(float)
         self.fc = amps[keep] * np.cos(phases[keep])
         self.fs = amps[keep] * np.sin(phases[keep])
         self.mean = float(exc.mean)
@@ -88,6 +89,33 @@ class StageSolutions:
         else:
             self.r = np.zeros_like(ks)
             self.a = np.where(stiff, 0.0, rhs)
+        self._fc_l = self.fc.tolist()
+        self._fs_l = self.fs.tolist()
+        self._stage_l = [
+            (bool(self.under[j]), float(self.wd[j]), float(self.gamma[j]), float(self.lam1[j]),
+             float(self.lam2[j]), float(ks[j]), float(ke[j]), float(self.P[j]), float(self.r[j]),
+             float(self.a[j]))
+            for j in range(self.n_stages)
+        ]
+        #: Per stage the arguments of transition_scalar but τ (the crossing search's hot loop).
+        self._trans_l = [(float(self.sigma), *self._stage_l[j][:6]) for j in range(self.n_stages)]
+        self._set_omega(omega)
+
+    def at_omega(self, omega: float) -> StageSolutions:
+        """The same stages' solutions at forcing frequency ``omega``: only what depends on Ω (the
+        forcing's particular parts and the event grid) computed afresh, equal to
+        ``StageSolutions(model, omega, samples_per_scale)``."""
+        out = copy.copy(self)
+        out._set_omega(check_omega(omega))
+        return out
+
+    def _set_omega(self, omega: float) -> None:
+        """The parts that depend on Ω: the harmonics' frequencies nΩ, the particular amplitudes X
+        and the event grid's steps."""
+        self.omega = omega
+        self.nw = self._orders * omega
+        ks, c = self.ks, self.c
+        stiff = ks > 0.0
         den = ks[:, None] - self.nw[None, :] ** 2 + 1j * c * self.nw[None, :]
         resonant = np.abs(den) <= 64.0 * _EPS * self.nw[None, :] ** 2
         if np.any(resonant):
@@ -108,21 +136,11 @@ class StageSolutions:
             scales = np.minimum(scales, 1.0 / c)
         scales = np.where(stiff, np.minimum(scales, _TWO_PI / np.sqrt(np.where(stiff, ks, 1.0))), scales)
         self.time_scale = scales
-        self.grid_step = scales / samples_per_scale
+        self.grid_step = scales / self.samples_per_scale
 
         # Python-float copies for the scalar evaluations of the crossing search.
         self._nw_l = self.nw.tolist()
-        self._fc_l = self.fc.tolist()
-        self._fs_l = self.fs.tolist()
         self._x_l = [list(zip(self.xr[j].tolist(), self.xi[j].tolist())) for j in range(self.n_stages)]
-        self._stage_l = [
-            (bool(self.under[j]), float(self.wd[j]), float(self.gamma[j]), float(self.lam1[j]),
-             float(self.lam2[j]), float(ks[j]), float(ke[j]), float(self.P[j]), float(self.r[j]),
-             float(self.a[j]))
-            for j in range(self.n_stages)
-        ]
-        #: Per stage the arguments of transition_scalar but τ (the crossing search's hot loop).
-        self._trans_l = [(float(self.sigma), *self._stage_l[j][:6]) for j in range(self.n_stages)]
 
     # --- stage lookup ------------------------------------------------------------------------
     def stage_of(self, t: float, delta: float, velocity: float) -> int:
@@ -154,6 +172,23 @@ class StageSolutions:
             pv -= nw * (xr * si + xi * co)
             force += fc * co - fs * si
         return pd, pv, force
+
+    def force(self, t: float, derivative: int = 0) -> float:
+        """F(t) or its ``derivative``-th time derivative (0 … 3) at one time, as a float (the
+        scalar form of :meth:`forcing`, for the event searches' hot loops)."""
+        out = self.mean if derivative == 0 else 0.0
+        for nw, fc, fs in zip(self._nw_l, self._fc_l, self._fs_l):
+            th = nw * t
+            co, si = math.cos(th), math.sin(th)
+            if derivative == 0:
+                out += fc * co - fs * si
+            elif derivative == 1:
+                out -= nw * (fc * si + fs * co)
+            elif derivative == 2:
+                out -= nw * nw * (fc * co - fs * si)
+            else:
+                out += nw * nw * nw * (fc * si + fs * co)
+        return out
 
     def homogeneous_start(self, j: int, ts: float, delta: float, velocity: float) -> tuple[float, float]:
         """h = x_s − p_j(t_s): the homogeneous part of a segment starting at (t_s, x_s)."""
