@@ -322,3 +322,53 @@ def test_every_orbit_at_the_speed_is_listed_beside_the_one_asked_for():
     assert len(summary["orbits"]) == len(res.solutions)
     # every=False: the one orbit (what the map and the tests of a single orbit ask for)
     assert nonsmooth_orbit(system, 0.9, every=False).solutions == ()
+
+
+def test_a_simulated_periodic_attractor_no_branch_accounts_for_is_listed(monkeypatch):
+    """A periodic attractor the census saw only by simulation (its branch not continued: the
+    search's budget spent, or the continuation failed) is an orbit at the speed too: the orbit
+    door solves it exactly from the settled state (Newton on the period map) and lists it with
+    ``source`` "simulation"; a settled state that Newton cannot bring to an exact orbit stays in
+    ``nonperiodic`` with its period. Shown on the torque converter at Ω = 0.9 with the census
+    replaced by one that holds the stable period-3 orbit as such an attractor (the state where an
+    exact simulation settles), the period-1 orbit seen as a period-2 motion (counted once, as the
+    period-1 orbit) and no branch solution."""
+    from pathlib import Path
+
+    import rattle.analysis._census as census_module
+    from rattle.analysis import steady_state
+    from rattle.analysis._attractors import Census, SimulatedAttractor
+    from rattle.io import load_config
+
+    system = load_config(Path(__file__).resolve().parents[2] / "examples" / "torque_converter_preload.toml").model
+    reference = nonsmooth_orbit(system, 0.9)
+    three = next(o for o in reference.solutions if o.period == 3 and o.stable)
+    H = three.harmonics
+    q, k = three.coefficients, np.arange(1, H + 1)
+    x0 = np.array([q[0] + q[1:H + 1].sum(), np.sum(k * (0.9 / 3) * q[H + 1:])])
+    settled = steady_state(system, 0.9, x0=x0 + 1e-4 * np.array([1.0, -1.0]))
+    assert settled.period == 3
+    one_state = steady_state(system, 0.9).state0  # from rest: the period-1 orbit
+
+    real = census_module.attractor_census
+
+    def census_without_branches(model, grid, run, search=None, **kw):  # type: ignore[no-untyped-def]
+        cell = real(model, grid, run, search, **kw)
+        j = len(grid) // 2
+        seen = [SimulatedAttractor(j, float(grid[j]), 3, settled.rms, settled.rms_ac, "impact", True, "test",
+                                   np.asarray(settled.state0, dtype=float)),
+                # Newton on the two-period map from the period-1 orbit's state: that orbit, once
+                SimulatedAttractor(j, float(grid[j]), 2, reference.rms, reference.rms, "impact", True, "test",
+                                   np.asarray(one_state, dtype=float)),
+                SimulatedAttractor(j, float(grid[j]), 2, 0.5, 0.5, "impact", True, "test",
+                                   np.array([np.nan, 0.0]))]  # no state to start from: Newton fails
+        cell.census = Census(solutions=[], simulated=seen)
+        return cell
+
+    monkeypatch.setattr(census_module, "attractor_census", census_without_branches)
+    found = census_module.exact_orbits_at(system, 0.9)
+    assert [(o.period, o.stable, o.source) for o in found.solutions] == [(3, True, "simulation"),
+                                                                           (1, True, "simulation")]
+    assert found.solutions[0].rms == pytest.approx(three.rms, rel=1e-9)
+    assert found.solutions[1].rms == pytest.approx(reference.rms, rel=1e-9)  # counted once, as period 1
+    assert [(a.period, a.rms) for a in found.nonperiodic] == [(2, 0.5)]

@@ -152,7 +152,9 @@ class SimulatedAttractor:
     branch accounts for: a non-periodic one (``period`` 0), or a periodic one whose branch could
     not be continued (the branch budget was spent, or harmonic balance did not converge to it).
     Its first element's measures (over the recorded window for period 0), its regime, and
-    whether some element impacts — a map counts it like any other attractor there."""
+    whether some element impacts — a map counts it like any other attractor there. ``state``: the
+    settled state at a whole forcing period (t ≡ 0 mod 2π/Ω; None where it was not kept), from
+    which the orbit door solves a periodic one exactly."""
 
     index: int
     omega: float
@@ -162,6 +164,7 @@ class SimulatedAttractor:
     regime: str
     impacts: bool
     origin: str
+    state: np.ndarray | None = field(default=None, repr=False, compare=False)
 
 
 #: Former name of :class:`SimulatedAttractor` (the non-periodic ones have period 0).
@@ -184,6 +187,15 @@ class Census:
 def _impacts(state: Any) -> bool:
     """Whether some element of a simulated motion crosses one of its breakpoints."""
     return any(r != "no_impact" for r in state.regimes())
+
+
+def _section_state(state: Any) -> np.ndarray | None:
+    """A periodic motion's ``state0`` (on the section, a point of its orbit); None for period 0."""
+    z = getattr(state, "state0", None)
+    if int(state.period) == 0 or z is None:
+        return None
+    z = np.array(z, dtype=float)
+    return z if np.all(np.isfinite(z)) else None
 
 
 def _coefficients(model: Any, state: Any, hb: HarmonicBalance) -> FloatArray:
@@ -263,7 +275,7 @@ class _Search:
     def record(self, j: int, state: Any, origin: str) -> None:
         self.census.simulated.append(SimulatedAttractor(
             j, float(self.grid[j]), int(state.period), float(state.rms), float(state.rms_ac), str(state.regimes()[0]),
-            _impacts(state), origin))
+            _impacts(state), origin, _section_state(state)))
 
     def add_branch(self, j: int, state: Any, origin: str) -> None:
         n = int(state.period)

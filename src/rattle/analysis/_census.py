@@ -425,6 +425,11 @@ def exact_orbits_at(system: NonsmoothSystem | FrictionSystem, omega: float, run:
     window (period 2 from its period doublings), solved at Ω by Newton on the period map, and the
     attractors the simulations settle on that no branch explains, continued by exact shooting.
 
+    A periodic attractor that the simulations settled on and that no branch accounts for (the
+    search's branch budget spent, or its continuation failed) is solved at Ω by Newton on the
+    period map from its settled state (``source`` ``"simulation"``); one whose Newton fails stays
+    in ``nonperiodic`` with its period, as the map lists it.
+
     Each orbit is solved once more at Ω for its row (exact trajectory and monodromy) and reduced
     to one copy: two orbits of the same period whose states at t = 0 (or at a whole forcing period
     later) agree to 1e-6 of the length scale are one. ``source`` says what found it first:
@@ -444,21 +449,40 @@ def exact_orbits_at(system: NonsmoothSystem | FrictionSystem, omega: float, run:
     integ = make_integrator(system)
     L = float(system.length_scale())
     kept: list[tuple[OrbitSolution, FloatArray]] = []
+    newton = NewtonOptions()
+
+    def keep(q: FloatArray, period: int, source: str, solve: bool) -> bool:
+        problem = ShootingProblem(system, period=period, integrator=integ)
+        try:
+            if solve:  # a simulated state: Newton on the period map to the exact orbit
+                res = solve_fixed(problem, np.asarray(q, dtype=float), float(omega), newton)
+                if not res.converged:
+                    return False
+                q = res.q
+            row = _row(problem, q, float(omega))
+            cycle = np.asarray(row.trajectory.states(np.arange(period) * (2.0 * math.pi / float(omega))), dtype=float)
+            # an orbit of a shorter period d | p (Newton on the p-period map may land on one) is that orbit
+            d = next((d for d in range(1, period) if period % d == 0
+                      and float(np.max(np.abs(cycle[d] - cycle[0]))) <= 1e-6 * L), period)
+            if d < period:
+                period, cycle = d, cycle[:d]
+                row = _row(ShootingProblem(system, period=d, integrator=integ), q, float(omega))
+        except FLOW_FAILURES:
+            return False
+        if not any(k.period == period and np.min(np.max(np.abs(c - cycle[0]), axis=-1)) <= 1e-6 * L
+                   for k, c in kept):
+            kept.append((_orbit_solution(system, row, period, source), cycle))
+        return True
+
     with one_blas_thread():
         for s in (s for s in cell.census.solutions if s.index == j and s.converged):
-            problem = ShootingProblem(system, period=int(s.period), integrator=integ)
-            try:
-                row = _row(problem, s.q, float(omega))
-            except FLOW_FAILURES:
-                continue
-            cycle = np.asarray(s.section, dtype=float)
-            if any(k.period == s.period and np.min(np.max(np.abs(c - cycle[0]), axis=-1)) <= 1e-6 * L
-                   for k, c in kept):
-                continue
-            source = "continuation" if s.branch < first else "simulation"
-            kept.append((_orbit_solution(system, row, int(s.period), source), cycle))
+            keep(s.q, int(s.period), "continuation" if s.branch < first else "simulation", False)
+        # periodic attractors the simulations settled on that no branch accounts for (the search's
+        # budget spent, or its continuation failed): solved at Ω from the settled state
+        unsolved = [a for a in cell.census.simulated if a.index == j and a.period > 0
+                    and not (a.state is not None and keep(a.state, int(a.period), "simulation", True))]
     solutions = sorted((k for k, _ in kept), key=lambda o: (not o.stable, -o.rms))
-    nonperiodic = tuple(a for a in cell.census.simulated if a.index == j and a.period == 0)
+    nonperiodic = tuple(a for a in cell.census.simulated if a.index == j and a.period == 0) + tuple(unsolved)
     return ExactOrbits(tuple(solutions), nonperiodic, cell)
 
 

@@ -148,10 +148,11 @@ def solution_record(s: OrbitSolution) -> dict[str, Any]:
 
 def every_orbit_records(solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...]) -> dict[str, Any]:
     """The ``orbits`` (:func:`solution_record` of each) and ``nonperiodic`` (rms, rms_ac, regime,
-    origin of each attractor with no period up to 8) of every orbit found at Ω, JSON-serialisable."""
+    origin of each attractor with no period up to 8; ``period`` of a periodic one whose exact orbit
+    was not found) of every orbit found at Ω, JSON-serialisable."""
     return {"orbits": [solution_record(o) for o in solutions],
-            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin}
-                            for a in nonperiodic]}
+            "nonperiodic": [{"rms": a.rms, "rms_ac": a.rms_ac, "regime": a.regime, "origin": a.origin,
+                             **({"period": a.period} if a.period else {})} for a in nonperiodic]}
 
 
 def every_orbit_lines(omega: float, solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...]) -> list[str]:
@@ -163,7 +164,8 @@ def every_orbit_lines(omega: float, solutions: "tuple[OrbitSolution, ...]", nonp
              f"{f', {len(nonperiodic)} non-periodic attractor(s)' if nonperiodic else ''}):"]
     lines += solution_lines(solutions)
     lines += [f"     non-periodic attractor (no period ≤ 8): rms {a.rms:.6g} rad over the recorded window, {a.regime}"
-              for a in nonperiodic]
+              if not a.period else f"     period-{a.period} attractor (simulated; its exact orbit did not converge): "
+              f"rms {a.rms:.6g} rad, {a.regime}" for a in nonperiodic]
     return lines
 
 
