@@ -86,6 +86,7 @@ def sweep_direction(
     for name in names:
         for c in SWEEP_ELEMENT_COLUMNS:
             rows[f"{name}_{c}"] = np.empty(n)
+        rows[f"{name}_regime"] = np.full(n, "", dtype=object)
     sticks = _stick_columns(model)
     for key in sticks:
         rows[key] = np.empty(n)
@@ -124,6 +125,8 @@ def sweep_direction(
                 values = getattr(em, c)
                 for k, nm in enumerate(names):
                     rows[f"{nm}_{c}"][i] = values[k]
+            for nm, regime in zip(names, s.regimes()):
+                rows[f"{nm}_regime"][i] = regime
         if sticks:
             held = np.atleast_1d(stick_fraction(s.trajectory))  # type: ignore[arg-type]
             for k, key in enumerate(sticks):
@@ -159,7 +162,7 @@ def _fail_row(rows: dict[str, np.ndarray], i: int, omega: float, reason: str) ->
             col[i] = omega
         elif key == "failure":
             col[i] = reason
-        elif key == "regime":
+        elif key == "regime" or key.endswith("_regime"):
             col[i] = ""
         elif key == "period":
             col[i] = FAILED_PERIOD
@@ -415,7 +418,7 @@ def time_sweep(
     ordered = [runs[d][0] for d in DIRECTIONS[direction]]
     columns = {name: np.concatenate([r[name] for r in ordered]) for name in ordered[0]}
     names = getattr(model, "element_names", None) or ()
-    element_columns = {f"{nm}_{c}": columns.pop(f"{nm}_{c}") for nm in names for c in SWEEP_ELEMENT_COLUMNS}
+    element_columns = {f"{nm}_{c}": columns.pop(f"{nm}_{c}") for nm in names for c in (*SWEEP_ELEMENT_COLUMNS, "regime")}
     extra_columns = {key: columns.pop(key) for key in _stick_columns(model)}
     timings = {f"{d} sweep": runs[d][1] for d in DIRECTIONS[direction]}
     timings["total"] = t_total
