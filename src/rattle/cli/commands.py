@@ -128,7 +128,12 @@ def compute_frf(
     if fixed_harmonics:
         extra["adaptive"] = None
     arguments = case_arguments(model, analysis, extra)  # the law's method: harmonics, or [analysis] method
-    logger.info("computing the frequency response over %g … %g rad/s%s", analysis.omega_min, analysis.omega_max,
+    from ..results import SpeedText
+
+    speed = SpeedText.of(model)
+    logger.info("computing the frequency response over %s%s",
+                speed.span(analysis.omega_min, analysis.omega_max, 6, unit=True)
+                + (f" (Ω = {analysis.omega_min:g} … {analysis.omega_max:g} rad/s)" if speed.engine else ""),
                 f" with {analysis.harmonics} harmonics" if "harmonics" in arguments else
                 f" ({type(arguments['options']).__name__})" if "options" in arguments else "")
     bar = ProgressBar("frequency response", enabled=True, unit="‰")  # a bar of the range reached, on a terminal
@@ -593,8 +598,11 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     from ..analysis import friction_orbit  # only now: all input has been validated
 
     system = run_config.model
-    logger.info("computing the orbit of a chain with friction at Ω = %g: regularised harmonic balance (H = %d, "
-                "ε = %g) and exact shooting", omega, options.harmonics, options.regularisation)
+    from ..results import SpeedText
+
+    logger.info("computing the orbit of a chain with friction at %s: regularised harmonic balance (H = %d, "
+                "ε = %g) and exact shooting", SpeedText.of(system).at(omega, 6, unit=True), options.harmonics,
+                options.regularisation)
     result = friction_orbit(system, omega, options, period=period, every=every)
     timings = {"friction_orbit": time.perf_counter() - t_start}
     elements = [{"name": name, "law": law.elastic.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}
