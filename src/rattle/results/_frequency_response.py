@@ -166,6 +166,9 @@ class FrequencyResponse:
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
     #: The exact-check column group of a law with jumps or friction (None for a continuous law).
     check: NonsmoothCheck | FrictionCheck | None = None
+    #: The sound paths of :meth:`with_sound` (empty without): frf.png draws the linear system's
+    #: level through them on a dense Ω grid (closed form), not only at the rows' Ω.
+    sound_paths: tuple[Any, ...] = ()
 
     @classmethod
     def from_check(cls, check: NonsmoothCheck | FrictionCheck, *, model: Any, settings: dict[str, Any],
@@ -458,7 +461,8 @@ class FrequencyResponse:
             warnings.simplefilter("ignore")
             dba = sound_pressure(self, paths, a_weighting=True, linear=False).spl_db
         return replace(self, extra_columns={**self.extra_columns, "spl_db": sp.spl_db, "spl_dba": dba,
-                                            "spl_linear_db": sp.linear_spl_db})
+                                            "spl_linear_db": sp.linear_spl_db},
+                       sound_paths=tuple(paths) if isinstance(paths, (list, tuple)) else (paths,))
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
