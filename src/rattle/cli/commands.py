@@ -477,9 +477,28 @@ def orbit_command(
     written = write_set(output, ORBIT_FILES, [
         ("orbit.csv", result.to_csv),
         ("orbit.json", metadata_writer(result.metadata(), meta, t_start)),
-        ("orbit.png", lambda path: save_plot(result, path)),
+        ("orbit.png", lambda path: save_figure(lambda: result.plot(degrees=_angles_in_degrees(run_config.source)),
+                                               path)),
     ])
     echo_written(result.summary(), written, output)
+
+
+def _angles_in_degrees(source: Any) -> bool:
+    """Whether the case file gave the angles of its law (or of a chain's elements) in degrees
+    (``b_deg``, ``breakpoints_deg``, a damper's data sheet: :func:`rattle.maps.given_in_degrees`)."""
+    from collections.abc import Mapping
+
+    from ..maps import given_in_degrees
+
+    model = source.get("model") if isinstance(source, Mapping) else None
+    if not isinstance(model, Mapping):
+        return False
+    keys = [f"model.elastic.{f}" for f in ("b", "breakpoints", "gap", "clearance")]
+    elements = model.get("elements")
+    if isinstance(elements, list):
+        keys += [f"model.elements.{i}.{f}" for i in range(1, len(elements) + 1)
+                 for f in ("b", "breakpoints", "gap", "clearance")]
+    return any(given_in_degrees(source, k) for k in keys)
 
 
 def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,

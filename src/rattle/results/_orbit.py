@@ -449,11 +449,12 @@ class PeriodicOrbit:
         return Path(path)
 
     def plot(
-        self, fig: Any = None, *, samples: int = 256, periods: int | None = None, title: str | None = None
+        self, fig: Any = None, *, samples: int = 256, periods: int | None = None, title: str | None = None,
+        degrees: bool = False,
     ) -> tuple[Any, Any]:
         """δ(t), δ'(t), δ''(t), the phase portrait and the amplitude spectrum; returns
         (figure, :class:`rattle.plotting.PlotAxes`). See :func:`rattle.plotting.orbit_plot`."""
-        return plot_with("orbit_plot", self, fig=fig, samples=samples, periods=periods, title=title)
+        return plot_with("orbit_plot", self, fig=fig, samples=samples, periods=periods, title=title, degrees=degrees)
 
 
 __all__ = ["PeriodicOrbit", "OrbitSolution", "ORBIT_SOURCES"]
