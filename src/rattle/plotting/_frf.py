@@ -402,7 +402,7 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
 
     handles = [Line2D([], [], color="tab:blue", lw=1.5, label="non-linear, stable (branch colours as above)"),
                Line2D([], [], color="tab:blue", ls="--", lw=1.2, label="non-linear, unstable")]
-    handles += _draw_linear_spl(frf, ax)
+    handles += draw_linear_spl(frf, ax)
     ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
               framealpha=0.9)
     fit_ylim(ax)
@@ -417,11 +417,12 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
 LINEAR_SPL_POINTS = 2000
 
 
-def _draw_linear_spl(frf: "FrequencyResponse", ax: Any) -> list[Any]:
-    """The linear system's level through the response's sound paths: on :data:`LINEAR_SPL_POINTS`
-    frequencies over the range (:func:`rattle.results.linear_sound_pressure`, closed form), so
-    that its resonance peak is resolved; at the rows' Ω (``spl_linear_db``, marked) when the
-    paths are not known. Returns the line drawn (for a legend), or nothing."""
+def draw_linear_spl(frf: Any, ax: Any) -> list[Any]:
+    """The linear system's level through the sound paths of a response or a sweep (its
+    ``sound_paths``): on :data:`LINEAR_SPL_POINTS` frequencies over the range
+    (:func:`rattle.results.linear_sound_pressure`, closed form), so that its resonance peak is
+    resolved; at the rows' Ω (``spl_linear_db``, marked) when the paths are not known. Returns
+    the line drawn (for a legend), or nothing."""
     import warnings
 
     sx = speed_axis(frf)[0]
@@ -451,7 +452,7 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
     if special_points:
         draw_special_points(frf, ax, key)
     if linear and quantity == "spl_db" and "spl_linear_db" in frf.extra_columns:
-        _draw_linear_spl(frf, ax)
+        draw_linear_spl(frf, ax)
     if linear and quantity in ("mean", "rms", "rms_ac"):
         lin = frf.linear_response() if element == 0 else frf.linear_response(element=element)
         ax.plot(lin.omega * speed_axis(frf)[0], getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
