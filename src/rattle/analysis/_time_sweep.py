@@ -35,7 +35,7 @@ from .. import _limits, _validate
 from ..engines import die_with_parent, sigint_blocked, worker_signals
 from ..errors import ConfigError, RattleError
 from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
-from ..results import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SweepResult
+from ..results import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SpeedText, SweepResult
 from ..timeint import FLOW_FAILURES
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
@@ -93,6 +93,7 @@ def sweep_direction(
     rows["failure"] = np.full(n, "", dtype=object)
     rows["regime"] = np.full(n, "", dtype=object)
     failures = _failures(model)
+    speed = SpeedText.of(model)  # an engine case's messages in rpm
     for i, w in enumerate(omegas):
         try:
             s = steady_state(model, float(w), x, options=options, integrator=integ)
@@ -101,8 +102,8 @@ def sweep_direction(
                 raise
             reason = _reason(exc)
             _fail_row(rows, i, float(w), reason)
-            logger.warning("%s sweep Ω = %.6g: no steady state (%s); the row is recorded as failed and the sweep "
-                           "carries on from the last state computed", direction, w, reason)
+            logger.warning("%s sweep %s: no steady state (%s); the row is recorded as failed and the sweep "
+                           "carries on from the last state computed", direction, speed.at(float(w), 6), reason)
             integ = make_integrator(model)  # a fresh one: nothing of the failed run is carried on
             if report is not None:
                 report(direction)
@@ -132,7 +133,7 @@ def sweep_direction(
             for k, key in enumerate(sticks):
                 rows[key][i] = held[k]
         x = s.final_state
-        logger.debug("%s sweep Ω = %.6g: period %d (%s), rms %.6g", direction, w, s.period, s.method, s.rms)
+        logger.debug("%s sweep %s: period %d (%s), rms %.6g", direction, speed.at(float(w), 6), s.period, s.method, s.rms)
         if report is not None:
             report(direction)
     rows["direction"] = np.full(n, direction, dtype="<U4")
