@@ -92,15 +92,21 @@ def test_chain_sweep_has_element_columns(driveline: Chain, tmp_path: Path) -> No
     cols = r.columns()
     assert list(cols)[:8] == ["direction", "omega", "mean", "rms", "rms_ac", "p2p", "acc_p2p", "period"]
     assert [k for k in cols if k.startswith("gear_")] == [
-        "gear_mean", "gear_rms", "gear_rms_ac", "gear_p2p", "gear_acc_p2p"]
+        "gear_mean", "gear_rms", "gear_rms_ac", "gear_p2p", "gear_acc_p2p", "gear_regime"]
     np.testing.assert_array_equal(r.rms, r.element_columns["clutch_rms"])
+    # one regime per element, each that of its own deflection: the first element's is `regime`
+    assert list(r.element_columns["clutch_regime"]) == list(r.regime)
+    for i, w in enumerate(r.omega[:3]):
+        s = steady_state(driveline, float(w), r.state0[i])  # the row's own steady motion
+        assert (r.element_columns["clutch_regime"][i], r.element_columns["gear_regime"][i]) == s.regimes()
     assert np.all(r.element_columns["gear_rms"] > 0)
     assert r.state0.shape == (6, 2 * driveline.system().n)
     up = r.select("up")
     assert len(up.element_columns["gear_rms"]) == 3
     path = r.to_csv(tmp_path / "sweep.csv")
     header = path.read_text().splitlines()[0].split(",")
-    assert header[:8] == list(cols)[:8] and header[-1] == "gear_acc_p2p"
+    assert header[:8] == list(cols)[:8] and header[-1] == "gear_regime"
+    assert header.index("clutch_regime") == header.index("clutch_acc_p2p") + 1
 
 
 def test_single_equation_sweep_has_no_element_columns() -> None:

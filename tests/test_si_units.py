@@ -15,6 +15,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from pathlib import Path
 
 import rattle
 from rattle.io import config_from_dict
@@ -122,3 +123,24 @@ def test_si_chain_is_the_reference_case_at_the_predicted_rpm():
     cols = si.columns()
     assert "speed_rpm" in cols and "speed_rpm" not in ref.columns()
     assert np.allclose(cols["speed_rpm"], si.omega * 60.0 / (2.0 * math.pi * ORDER), rtol=1e-15)
+
+
+def test_an_engine_case_s_continuation_messages_give_the_speed_in_rpm():
+    """The status message of an engine case's frequency response (the continuation's "last …",
+    the ranges no branch covers) names crankshaft speeds in rpm, not Ω in rad/s (issue 27)."""
+    import re
+
+    from rattle.analysis import frequency_response
+    from rattle.continuation import ContinuationOptions
+    from rattle.io import load_config
+
+    rc = load_config(Path(__file__).resolve().parents[1] / "examples" / "engine_clutch_si.toml")
+    r = frequency_response(rc.model, rc.analysis.omega, harmonics=16, adaptive=None, throw=False,
+                           continuation=ContinuationOptions(max_points=40))
+    assert r.status.name == "MAX_STEPS"
+    assert "Ω =" not in r.message, r.message
+    last = float(re.search(r"last ([0-9.]+) rpm", r.message).group(1))
+    assert last == pytest.approx(float(r.speed_rpm.max()), rel=1e-4)
+    assert re.search(r"not covered by any branch: [0-9.]+ … 1500 rpm", r.message), r.message
+    status = next(line for line in r.summary().splitlines() if line.startswith("status:"))
+    assert "rpm" in status and "Ω =" not in status

@@ -364,7 +364,17 @@ def test_frf_plot_gets_an_spl_panel(two_inertia_frf, reference_frf):
         y = np.concatenate([line.get_ydata() for line in axes["spl_db"].get_lines() if line.get_color() != "0.55"])
         assert np.nanmax(y) == pytest.approx(np.max(sp.spl_db))
         (linear,) = [line for line in axes["spl_db"].get_lines() if line.get_color() == "0.55"]
-        assert np.max(linear.get_ydata()) == pytest.approx(np.max(sp.linear_spl_db))
+        # the linear level on a dense grid over the range (closed form), not only at the rows' Ω:
+        # its peak resolved, at least the rows' largest, each point the closed form's
+        from rattle.plotting._frf import LINEAR_SPL_POINTS
+        from rattle.results import linear_sound_pressure
+
+        x, y_lin = linear.get_xdata(), linear.get_ydata()
+        assert x.size == LINEAR_SPL_POINTS and x[0] == pytest.approx(frf.omega.min()) and \
+            x[-1] == pytest.approx(frf.omega.max())
+        assert np.max(y_lin) >= np.max(sp.linear_spl_db) - 1e-9
+        np.testing.assert_allclose(y_lin[::97], linear_sound_pressure(frf.model, x[::97], [constant_path(source, 1e-3)]).spl_db,
+                                   rtol=1e-12)
         plt.close(fig)
         fig, axes = frf.plot()  # without paths: no SPL panel
         assert "spl_db" not in axes
@@ -382,3 +392,24 @@ def test_free_chain_momentum_balance_on_a_period_two_branch(two_inertia):
     np.testing.assert_allclose(sp.p_rms[sel], 0.06 / math.sqrt(2), rtol=1e-12)
     np.testing.assert_allclose(np.abs(sp.pressure[sel][:, 1]), 0.06, rtol=1e-12)
     np.testing.assert_allclose(sp.frequency_hz[sel][:, 1], frf.omega[sel] / (2 * np.pi), rtol=1e-15)
+
+
+def test_sweep_plot_draws_the_linear_level_densely_and_inside(reference_frf):
+    """sweep.png's SPL panel: the linear system's level by its closed form on a dense grid (its
+    peak resolved, not segments between the rows' Ω), every point of it inside the panel (its
+    limits were set before it was drawn: the low end was cut off)."""
+    import matplotlib.pyplot as plt
+
+    from rattle.analysis import time_sweep
+    from rattle.plotting._frf import LINEAR_SPL_POINTS
+
+    path = [constant_path("delta", 1e-3)]
+    sweep = time_sweep(reference_frf.model, (0.4, 1.6), 7, "up").with_sound(path)
+    assert sweep.sound_paths == tuple(path) and sweep.select("up").sound_paths == tuple(path)
+    fig, axes = sweep.plot()
+    (linear,) = [line for line in axes["spl_db"].get_lines() if line.get_color() == "0.55"]
+    x, y = linear.get_xdata(), linear.get_ydata()
+    assert x.size == LINEAR_SPL_POINTS and np.max(y) >= np.max(sweep.extra_columns["spl_linear_db"]) - 1e-9
+    lo, hi = axes["spl_db"].get_ylim()
+    assert lo <= np.min(y) and np.max(y) <= hi
+    plt.close(fig)

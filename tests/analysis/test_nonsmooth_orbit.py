@@ -140,7 +140,8 @@ def test_plot_shades_every_stick_phase_and_saves(sticking: NonsmoothOrbitResult,
     assert labels[:2] == ["exact orbit", "regularised HB (ε = 0.01, H = 64)"] and "jump at δ = 0" in labels
     hb = ax["delta"].get_lines()[1]
     assert hb.get_linestyle() == "--"
-    legend = [t.get_text() for t in ax["delta"].get_legend().get_texts()]
+    assert ax["delta"].get_legend() is None  # one legend, below the panels (over no data)
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "stick (friction holds)" in legend
     fig.savefig(tmp_path / "orbit.png")
     assert (tmp_path / "orbit.png").read_bytes()[:4] == b"\x89PNG"
@@ -162,11 +163,11 @@ def test_a_lock_at_the_jump_is_shaded_in_its_own_colour(locking: NonsmoothOrbitR
     F = 0.01 + 0.3 * np.cos(0.3 * np.linspace(a, b, 21) + 0.3)
     assert np.max(np.abs(F)) <= 0.27 * (1 + 1e-12)
     assert np.max(np.abs(res.multipliers)) < 1e-12  # a lock forgets everything: super-stable
-    _fig, ax = res.plot()
+    fig, ax = res.plot()
     colours = [to_rgb(p.get_facecolor()[:3]) for p in ax["delta"].patches]
     assert len(colours) == 3
     assert colours.count(to_rgb(LOCK_COLOUR)) == 1 and colours.count(to_rgb(STICK_COLOUR)) == 2
-    legend = [t.get_text() for t in ax["delta"].get_legend().get_texts()]
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]  # the one legend, below the panels
     assert "lock (held at a jump)" in legend and "stick (friction holds)" in legend
 
 

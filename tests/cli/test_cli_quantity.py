@@ -41,3 +41,21 @@ def test_help_names_the_quantities() -> None:
     for command in ("frf", "sweep", "compare", "map"):
         text = CliRunner().invoke(cli, [command, "--help"]).output
         assert "--quantity" in text and "rms_ac" in text and "spl_db" in text
+
+
+def test_an_engine_case_frf_and_orbit_print_their_speeds_in_rpm(tmp_path):
+    """rattle frf -v and rattle orbit --rpm on an engine case: every line that gives a speed
+    gives it in rpm (Ω in rad/s only beside it, in parentheses), and orbit.png's title too."""
+    import re
+
+    from _cli_helpers import invoke
+
+    config = Path(__file__).resolve().parents[2] / "examples" / "engine_clutch_si.toml"
+    frf = invoke(["frf", str(config), "-v", "-o", str(tmp_path / "frf")], tmp_path)
+    orbit = invoke(["orbit", str(config), "--rpm", "900", "-o", str(tmp_path / "orbit")], tmp_path)
+    assert frf.exit_code == 0 and orbit.exit_code == 0, (frf.stderr, orbit.stderr)
+    lines = [ln for ln in (frf.stdout + frf.stderr + orbit.stdout + orbit.stderr).splitlines()
+             if re.search(r"[0-9] rad/s|Ω = [0-9.]+ (…|rad|\)|;|,)", ln)]  # a speed in rad/s
+    assert lines  # the ranges' Ω beside the rpm
+    for ln in lines:
+        assert "rpm" in ln and re.search(r"\(Ω = [0-9.]+", ln), ln  # rpm first, Ω in parentheses

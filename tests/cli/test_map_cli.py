@@ -107,6 +107,28 @@ def test_a_chain_short_name_that_is_ambiguous_is_refused(tmp_path, fake):
     assert _nothing_written(out) and fake.calls == []
 
 
+def test_an_angle_in_degrees_is_varied_as_the_case_file_writes_it(tmp_path, fake):
+    """``--vary model.elastic.b_deg=…`` (the case file's ``b_deg``): values in degrees, converted
+    as the file converts them; the same map as the radian key's, shown in degrees (issue 27)."""
+    config = write_config(tmp_path)
+    texts = {}
+    for arg in ("model.elastic.b_deg=8,12", f"model.elastic.b={math.radians(8.0)!r},{math.radians(12.0)!r}"):
+        out = tmp_path / arg.split("=")[0]
+        result = invoke(["map", str(config), "-o", str(out), "--vary", arg, "--omega-points", "6", "--report",
+                         "-q"], tmp_path)
+        assert result.exit_code == 0, result.stderr
+        texts[arg.split("=")[0]] = {f: (out / f).read_text() for f in ("map.csv",)}
+    deg, rad = fake.calls[0]["vary"][0], fake.calls[1]["vary"][0]
+    assert (deg.name, deg.key, deg.values) == (rad.name, rad.key, rad.values)
+    assert deg.degrees  # shown in degrees: the file gave b in degrees, or the key did
+    assert texts["model.elastic.b_deg"] == texts["model.elastic.b"]  # map.csv identical (rad)
+    report = (tmp_path / "model.elastic.b_deg" / "map.md").read_text()
+    assert "8 … 12 deg" in report and "| model.elastic.b (deg) |" in report
+    bad = invoke(["map", str(config), "-o", str(tmp_path / "bad"), "--vary", "model.elastic.alpha_deg=1,2"], tmp_path)
+    assert_bad_input(bad, "`--vary`", "'model.elastic.alpha_deg'")
+    assert len(fake.calls) == 2
+
+
 # --------------------------------------------------------------------------------------------
 # The output set
 # --------------------------------------------------------------------------------------------

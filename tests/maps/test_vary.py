@@ -193,3 +193,35 @@ def test_a_free_chain_refuses_an_unbalanced_mean(chain):
     with pytest.raises(ConfigError, match="excitation.torques.1.mean = 0.1") as info:
         vary.build_all(chain, vary.parameters(chain, {"excitation.torques.1.mean": [0.05, 0.1]}))
     assert "the model refuses" in str(info.value)
+
+
+# --------------------------------------------------------------------------------------------
+# Angles named in degrees, as the case file writes them (FIELD_deg)
+# --------------------------------------------------------------------------------------------
+def test_an_angle_named_in_degrees_is_the_radian_key_converted(single, driveline):
+    import math
+
+    (deg,) = vary.parameters(single, [("model.elastic.b_deg", [8.0, 12.0])])
+    (rad,) = vary.parameters(single, [("model.elastic.b", [math.radians(8.0), math.radians(12.0)])])
+    assert (deg.name, deg.key, deg.degrees) == ("model.elastic.b", "model.elastic.b", True)
+    assert deg.values == rad.values  # x · π/180, as the case file's b_deg is converted
+    assert [deg.shown(v) for v in deg.values] == pytest.approx([8.0, 12.0], rel=1e-15)
+    # a breakpoint of a chain's element, by position and by the element's name
+    for name in ("model.elements.1.breakpoints_deg.4", "model.elements.clutch.breakpoints_deg.4"):
+        (p,) = vary.parameters(driveline, [(name, [5.0])])
+        assert p.key == "model.elements.1.breakpoints.4" and p.degrees
+        assert p.values == (math.radians(5.0),)
+    # the models built are the radian key's
+    a = vary.build_all(single, [deg])
+    b = vary.build_all(single, [rad])
+    assert [m.elastic.stages.breakpoints.tolist() for m in a] == [m.elastic.stages.breakpoints.tolist() for m in b]
+    # a Parameter handed back keeps its values (rad already)
+    assert vary.parameters(single, [deg]) == (deg,)
+    # apply() converts too
+    assert vary.apply(single, {"model.elastic.b_deg": 9.0})["model"]["elastic"]["b"] == math.radians(9.0)
+
+
+@pytest.mark.parametrize("name", ["model.elastic.alpha_deg", "model.elastic.bogus_deg", "model.elements.1.b_deg"])
+def test_a_degree_key_that_is_not_an_angle_of_the_case_is_refused_naming_it(single, name):
+    with pytest.raises(ConfigError, match=rf"`--vary` '{name}'"):
+        vary.parameters(single, [(name, [1.0])])

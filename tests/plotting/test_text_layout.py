@@ -87,3 +87,141 @@ def test_compare_sweep_points_are_inside_the_axes(reference_frf_all, crowded_swe
     fit_ylim(ax.primary)
     lo, hi = ax.primary.get_ylim()
     assert lo <= np.nanmin(big.rms) and hi >= np.nanmax(big.rms)
+
+
+# --- orbit.png on every law kind (issue 27): points inside, legends over no data, texts apart ---
+def _all_axes(fig):
+    """The figure's axes and their child axes (a secondary axis in another unit)."""
+    out = []
+    for ax in fig.axes:
+        out += [ax, *ax.child_axes]
+    return [a for a in out if a.get_visible()]
+
+
+def _texts_apart(fig):
+    """Every visible text of the figure (titles, axis labels, the tick labels drawn, legend
+    entries, the suptitle) overlaps no other, and none leaves the figure."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    texts = [fig._suptitle] if fig._suptitle is not None else []
+    for leg in fig.legends:
+        texts += leg.get_texts()
+    for ax in _all_axes(fig):
+        texts += [ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label]
+        if ax.get_legend() is not None:
+            texts += ax.get_legend().get_texts()
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            for tick in axis.get_major_ticks():
+                if lo - 1e-9 * (hi - lo) <= tick.get_loc() <= hi + 1e-9 * (hi - lo):
+                    texts += [t for t in (tick.label1, tick.label2) if t.get_visible()]
+    page = fig.bbox
+    boxes = []
+    for t in texts:
+        if t is None or not (t.get_visible() and t.get_text().strip()):
+            continue
+        bb = Text.get_window_extent(t, renderer)
+        assert bb.x0 >= page.x0 - 1 and bb.x1 <= page.x1 + 1 and bb.y0 >= page.y0 - 1 and bb.y1 <= page.y1 + 1, \
+            ("a text leaves the figure", t.get_text())
+        boxes.append((t.get_text(), bb.shrunk(0.98, 0.9)))
+    for i, (a, ba) in enumerate(boxes):
+        for b, bb in boxes[i + 1:]:
+            assert not ba.overlaps(bb), ("texts overlap", a, b)
+    return len(boxes)
+
+
+def _points_inside_and_legends_clear(fig, axes):
+    """Every point of every data line of ``axes`` (markers and vertices) inside its axes' limits,
+    and no legend inside an axes covers one of its points."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in axes:
+        (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+        pts = []
+        for line in ax.get_lines():
+            if line.get_transform() != ax.transData or not line.get_visible():
+                continue
+            x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+            ok = np.isfinite(x) & np.isfinite(y)
+            x, y = x[ok], y[ok]
+            assert np.all((x >= x0 - 1e-9 * abs(x1 - x0)) & (x <= x1 + 1e-9 * abs(x1 - x0))), \
+                ("a point left of or right of its axes", line.get_label())
+            assert np.all((y >= y0 - 1e-9 * abs(y1 - y0)) & (y <= y1 + 1e-9 * abs(y1 - y0))), \
+                ("a point below or above its axes", line.get_label(), y.min(), y.max(), (y0, y1))
+            pts.append(ax.transData.transform(np.column_stack([x, y])))
+        legend = ax.get_legend()
+        if legend is not None and pts:
+            box = legend.get_window_extent(renderer)
+            p = np.concatenate(pts)
+            inside = (p[:, 0] > box.x0) & (p[:, 0] < box.x1) & (p[:, 1] > box.y0) & (p[:, 1] < box.y1)
+            assert not inside.any(), ("a legend covers data", ax.get_title(), int(inside.sum()))
+
+
+@pytest.fixture(scope="module")
+def examples():
+    from pathlib import Path
+
+    return Path(__file__).resolve().parents[2] / "examples"
+
+
+def test_orbit_plot_of_a_smooth_law_and_a_chain(reference_model, examples) -> None:
+    from rattle.analysis import periodic_orbit
+    from rattle.io import load_config
+
+    for model in (reference_model, load_config(examples / "driveline_three_inertia.toml").model):
+        orbit = periodic_orbit(model, 0.85)
+        fig, ax = orbit.plot()
+        assert len(orbit.solutions) >= 2
+        _points_inside_and_legends_clear(fig, list(ax.values()))
+        assert _texts_apart(fig) > 20
+        plt.close(fig)
+
+
+def test_orbit_plot_of_an_engine_case_names_rpm_and_degrees(examples) -> None:
+    from rattle.analysis import periodic_orbit
+    from rattle.io import load_config
+
+    rc = load_config(examples / "engine_clutch_si.toml")  # b_deg = 4: angles given in degrees
+    omega = 900.0 * 2.0 * 2.0 * np.pi / 60.0  # 900 rpm, order 2
+    orbit = periodic_orbit(rc.model, omega, harmonics=16)
+    fig, ax = orbit.plot(degrees=True)
+    assert "900 rpm" in fig.get_suptitle()
+    labels = [a.get_ylabel() for a in _all_axes(fig)] + [a.get_xlabel() for a in _all_axes(fig)]
+    assert "(deg)" in labels and "δ (deg)" in labels  # the δ panels and the phase portrait in degrees too
+    _points_inside_and_legends_clear(fig, list(ax.values()))
+    _texts_apart(fig)  # the phase portrait's tick labels no longer run into each other
+    plt.close(fig)
+
+
+def test_orbit_plot_of_a_preload_shows_every_orbit_at_the_speed(examples) -> None:
+    """torque_converter_preload at Ω = 0.9: three orbits coexist (two of period 3); the phase
+    portrait draws each, the legend names its period and stability."""
+    from rattle.analysis import nonsmooth_orbit
+    from rattle.io import load_config
+
+    rc = load_config(examples / "torque_converter_preload.toml")
+    result = nonsmooth_orbit(rc.model, 0.9)
+    assert len(result.solutions) >= 2
+    fig, ax = result.plot()
+    legend = " | ".join(t.get_text() for t in fig.legends[0].get_texts())
+    for i, sol in enumerate(result.solutions):
+        assert f"orbit [{i}] at Ω: period {sol.period}, {'stable' if sol.stable else 'unstable'}" in legend
+    others = [s for s in result.solutions if not (s.period == result.periods and abs(s.rms - result.rms) < 1e-6 * result.rms)]
+    drawn = [line for line in ax["phase"].get_lines() if line.get_label().startswith("orbit [")
+             and len(line.get_xdata())]
+    assert len(drawn) == len(others) >= 1
+    assert not ax["delta"].get_legend() and not ax["phase"].get_legend()  # one legend, below the panels
+    _points_inside_and_legends_clear(fig, list(ax.values()))
+    _texts_apart(fig)
+    plt.close(fig)
+
+
+def test_orbit_plot_of_friction_laws(examples) -> None:
+    from rattle.analysis import nonsmooth_orbit
+    from rattle.io import load_config
+
+    rc = load_config(examples / "clutch_friction.toml")
+    fig, ax = nonsmooth_orbit(rc.model, 0.8).plot()
+    _points_inside_and_legends_clear(fig, list(ax.values()))
+    _texts_apart(fig)
+    plt.close(fig)

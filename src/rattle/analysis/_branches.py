@@ -22,7 +22,7 @@ from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, resize_harmonics, solve_harmonic_balance
 from ..model import Model
-from ..results import FrequencyResponse
+from ..results import FrequencyResponse, SpeedText
 from ..stability import FloquetMonitor
 from ..timeint import ExactIntegrator
 from ._assemble import assemble
@@ -116,6 +116,7 @@ def switch_period_doubling(
     Newton and continuation options. Returns the HB problem of period 2p and the finished stepper.
     """
     H2 = 2 * harmonics if harmonics_new is None else harmonics_new
+    speed_text = SpeedText.of(model)  # an engine case's messages in rpm
     run = _run(run, harmonics, continuation, newton)
     newton = run.newton
     hb2 = HarmonicBalance(model, run.for_harmonics(H2), period=2 * period)
@@ -138,12 +139,12 @@ def switch_period_doubling(
         prev = state["prev"]
         state["prev"] = o
         if float(o @ prev) < 0.0:
-            return f"the period-{2 * period} branch rejoined a period-{period} branch near Ω = {pt.omega:.6g}"
+            return f"the period-{2 * period} branch rejoined a period-{period} branch near {speed_text.at(pt.omega, 6)}"
         return None
 
     stepper = ContinuationStepper(
         hb2, q2, omega_pd, omega_range, run.continuation, newton, tangent=tangent, stop=rejoined,
-        monitor=FloquetMonitor(hb2),
+        monitor=FloquetMonitor(hb2), speed=speed_text.at if speed_text.engine else None,
     )
     stepper.run()
     return hb2, stepper
@@ -242,6 +243,7 @@ def branch_from_seed(
     options scaled to ``harmonics``, Newton, continuation, stability method)."""
     run = _run(run, harmonics, continuation, newton)
     newton = run.newton
+    speed_text = SpeedText.of(model)  # an engine case's messages in rpm
     hb_opts = run.for_harmonics(harmonics)
     hb = HarmonicBalance(model, hb_opts, period=period)
     res = solve_harmonic_balance(hb, q_seed, omega, newton)
@@ -283,11 +285,12 @@ def branch_from_seed(
                 prev, count["sub"] = count.get("sub"), sub
                 count["past"] = prev is not None and float(sub @ prev) < 0.0
                 if count["past"] or is_shorter_period(pt.q, n_coord, period):
-                    return f"the period-{period} branch rejoined a shorter period's branch near Ω = {pt.omega:.6g}"
+                    return f"the period-{period} branch rejoined a shorter period's branch near {speed_text.at(pt.omega, 6)}"
             return None
 
         stepper = ContinuationStepper(hb, res.q, omega, omega_range, run.continuation, newton,
-                                      tangent=tangent, stop=back_at_seed, monitor=FloquetMonitor(hb))
+                                      tangent=tangent, stop=back_at_seed, monitor=FloquetMonitor(hb),
+                                      speed=speed_text.at if speed_text.engine else None)
         stepper.run()
         # a point past the doubling is on the branch's shifted copy: the branch ends before it
         halves.append(stepper.points[:-1] if count.get("past") and len(stepper.points) > 2 else stepper.points)

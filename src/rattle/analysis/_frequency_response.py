@@ -16,7 +16,7 @@ from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper
 from ..errors import ConvergenceError, Status
 from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balance
 from ..model import Model, check_analysable_model
-from ..results import FrequencyResponse
+from ..results import FrequencyResponse, SpeedText
 from ..stability import stability_method
 from ._assemble import assemble, monitor_of
 from ._exact_branch import ShootingOptions
@@ -302,8 +302,7 @@ def _frequency_response(
         # complete) leaves the status UNCOVERED; a failure keeps its own status and reason.
         if status.success:
             status = Status.UNCOVERED
-        message = (f"{message}; not covered by any branch: "
-                   + ", ".join(f"Ω = {a:.6g} … {b:.6g}" for a, b in uncovered))
+        message = f"{message}; not covered by any branch: {SpeedText.of(model).spans(uncovered, 6)}"
     elif not status.success or status is Status.RETURNED:
         status = Status.SUCCESS  # the branches through the two ends cover the range together
     t_cont = time.perf_counter()

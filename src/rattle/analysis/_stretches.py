@@ -26,6 +26,7 @@ from ..continuation import BranchPoint, ContinuationStepper
 from ..errors import Status
 from ..hb import HarmonicBalance, resize_harmonics
 from ..model import Model
+from ..results import SpeedText
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,13 +124,15 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
 
     lo, hi = omega_range
     H0 = run.hb.harmonics
+    text = SpeedText.of(model)
+    speed = text.at if text.engine else None  # an engine case's messages in rpm
     # the coordinates share the effective harmonics of one problem (n·p·H ≤ 512, _limits.max_harmonics_for)
     top = min(adaptive.max_harmonics, _limits.max_harmonics_for(q0.size // (2 * H0 + 1), period)) if adaptive else H0
 
     def stepper_for(H: int, q: FloatArray, w: float, tangent: FloatArray | None) -> ContinuationStepper:
         hb = HarmonicBalance(model, run.for_harmonics(H), period=period)
         return ContinuationStepper(hb, q, w, (lo, hi), run.continuation, run.newton, tangent=tangent,
-                                   monitor=monitor_of(hb))
+                                   monitor=monitor_of(hb), speed=speed)
 
     def solve_with(H: int, pt: BranchPoint) -> tuple[FloatArray, float, FloatArray] | None:
         """The point ``pt`` solved with H harmonics — on the plane through it normal to its

@@ -35,7 +35,7 @@ from .. import _limits, _validate
 from ..engines import die_with_parent, sigint_blocked, worker_signals
 from ..errors import ConfigError, RattleError
 from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
-from ..results import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SweepResult
+from ..results import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SpeedText, SweepResult
 from ..timeint import FLOW_FAILURES
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
 
@@ -86,12 +86,14 @@ def sweep_direction(
     for name in names:
         for c in SWEEP_ELEMENT_COLUMNS:
             rows[f"{name}_{c}"] = np.empty(n)
+        rows[f"{name}_regime"] = np.full(n, "", dtype=object)
     sticks = _stick_columns(model)
     for key in sticks:
         rows[key] = np.empty(n)
     rows["failure"] = np.full(n, "", dtype=object)
     rows["regime"] = np.full(n, "", dtype=object)
     failures = _failures(model)
+    speed = SpeedText.of(model)  # an engine case's messages in rpm
     for i, w in enumerate(omegas):
         try:
             s = steady_state(model, float(w), x, options=options, integrator=integ)
@@ -100,8 +102,8 @@ def sweep_direction(
                 raise
             reason = _reason(exc)
             _fail_row(rows, i, float(w), reason)
-            logger.warning("%s sweep Ω = %.6g: no steady state (%s); the row is recorded as failed and the sweep "
-                           "carries on from the last state computed", direction, w, reason)
+            logger.warning("%s sweep %s: no steady state (%s); the row is recorded as failed and the sweep "
+                           "carries on from the last state computed", direction, speed.at(float(w), 6), reason)
             integ = make_integrator(model)  # a fresh one: nothing of the failed run is carried on
             if report is not None:
                 report(direction)
@@ -124,12 +126,14 @@ def sweep_direction(
                 values = getattr(em, c)
                 for k, nm in enumerate(names):
                     rows[f"{nm}_{c}"][i] = values[k]
+            for nm, regime in zip(names, s.regimes()):
+                rows[f"{nm}_regime"][i] = regime
         if sticks:
             held = np.atleast_1d(stick_fraction(s.trajectory))  # type: ignore[arg-type]
             for k, key in enumerate(sticks):
                 rows[key][i] = held[k]
         x = s.final_state
-        logger.debug("%s sweep Ω = %.6g: period %d (%s), rms %.6g", direction, w, s.period, s.method, s.rms)
+        logger.debug("%s sweep %s: period %d (%s), rms %.6g", direction, speed.at(float(w), 6), s.period, s.method, s.rms)
         if report is not None:
             report(direction)
     rows["direction"] = np.full(n, direction, dtype="<U4")
@@ -159,7 +163,7 @@ def _fail_row(rows: dict[str, np.ndarray], i: int, omega: float, reason: str) ->
             col[i] = omega
         elif key == "failure":
             col[i] = reason
-        elif key == "regime":
+        elif key == "regime" or key.endswith("_regime"):
             col[i] = ""
         elif key == "period":
             col[i] = FAILED_PERIOD
@@ -415,7 +419,7 @@ def time_sweep(
     ordered = [runs[d][0] for d in DIRECTIONS[direction]]
     columns = {name: np.concatenate([r[name] for r in ordered]) for name in ordered[0]}
     names = getattr(model, "element_names", None) or ()
-    element_columns = {f"{nm}_{c}": columns.pop(f"{nm}_{c}") for nm in names for c in SWEEP_ELEMENT_COLUMNS}
+    element_columns = {f"{nm}_{c}": columns.pop(f"{nm}_{c}") for nm in names for c in (*SWEEP_ELEMENT_COLUMNS, "regime")}
     extra_columns = {key: columns.pop(key) for key in _stick_columns(model)}
     timings = {f"{d} sweep": runs[d][1] for d in DIRECTIONS[direction]}
     timings["total"] = t_total

@@ -128,7 +128,12 @@ def compute_frf(
     if fixed_harmonics:
         extra["adaptive"] = None
     arguments = case_arguments(model, analysis, extra)  # the law's method: harmonics, or [analysis] method
-    logger.info("computing the frequency response over %g … %g rad/s%s", analysis.omega_min, analysis.omega_max,
+    from ..results import SpeedText
+
+    speed = SpeedText.of(model)
+    logger.info("computing the frequency response over %s%s",
+                speed.span(analysis.omega_min, analysis.omega_max, 6, unit=True)
+                + (f" (Ω = {analysis.omega_min:g} … {analysis.omega_max:g} rad/s)" if speed.engine else ""),
                 f" with {analysis.harmonics} harmonics" if "harmonics" in arguments else
                 f" ({type(arguments['options']).__name__})" if "options" in arguments else "")
     bar = ProgressBar("frequency response", enabled=True, unit="‰")  # a bar of the range reached, on a terminal
@@ -472,9 +477,28 @@ def orbit_command(
     written = write_set(output, ORBIT_FILES, [
         ("orbit.csv", result.to_csv),
         ("orbit.json", metadata_writer(result.metadata(), meta, t_start)),
-        ("orbit.png", lambda path: save_plot(result, path)),
+        ("orbit.png", lambda path: save_figure(lambda: result.plot(degrees=_angles_in_degrees(run_config.source)),
+                                               path)),
     ])
     echo_written(result.summary(), written, output)
+
+
+def _angles_in_degrees(source: Any) -> bool:
+    """Whether the case file gave the angles of its law (or of a chain's elements) in degrees
+    (``b_deg``, ``breakpoints_deg``, a damper's data sheet: :func:`rattle.maps.given_in_degrees`)."""
+    from collections.abc import Mapping
+
+    from ..maps import given_in_degrees
+
+    model = source.get("model") if isinstance(source, Mapping) else None
+    if not isinstance(model, Mapping):
+        return False
+    keys = [f"model.elastic.{f}" for f in ("b", "breakpoints", "gap", "clearance")]
+    elements = model.get("elements")
+    if isinstance(elements, list):
+        keys += [f"model.elements.{i}.{f}" for i in range(1, len(elements) + 1)
+                 for f in ("b", "breakpoints", "gap", "clearance")]
+    return any(given_in_degrees(source, k) for k in keys)
 
 
 def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: float, period: int,
@@ -593,8 +617,11 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     from ..analysis import friction_orbit  # only now: all input has been validated
 
     system = run_config.model
-    logger.info("computing the orbit of a chain with friction at Ω = %g: regularised harmonic balance (H = %d, "
-                "ε = %g) and exact shooting", omega, options.harmonics, options.regularisation)
+    from ..results import SpeedText
+
+    logger.info("computing the orbit of a chain with friction at %s: regularised harmonic balance (H = %d, "
+                "ε = %g) and exact shooting", SpeedText.of(system).at(omega, 6, unit=True), options.harmonics,
+                options.regularisation)
     result = friction_orbit(system, omega, options, period=period, every=every)
     timings = {"friction_orbit": time.perf_counter() - t_start}
     elements = [{"name": name, "law": law.elastic.to_dict(), "friction": [float(r) for r in system.friction_levels(e)]}

@@ -84,7 +84,8 @@ class ContinuationStepper:
     corrector rejects an iterate outside it); the default, p > 0, suits a frequency, a forcing
     scale or a width; a homotopy parameter that may take any sign passes (−inf, inf).
     ``symbol`` names the parameter in messages (default ``"Ω"``: most of rattle's branches are
-    frequency responses).
+    frequency responses); ``speed``, when given, writes a value of the parameter in them instead
+    (an engine case's crankshaft rpm: ``speed(p)`` → ``"1086 rpm"``).
     """
 
     problem: ContinuationProblem
@@ -99,6 +100,7 @@ class ContinuationStepper:
     predictor: AbstractPredictor = field(default_factory=Tangent)
     domain: tuple[float, float] = (0.0, math.inf)
     symbol: str = "Ω"
+    speed: Callable[[float], str] | None = None
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
@@ -172,7 +174,7 @@ class ContinuationStepper:
         if not res.converged:
             self._finish(
                 Status.START_FAILED,
-                f"Newton did not converge at {self.symbol} = {self.p0:g} ({res.message}, scaled residual {res.residual:.3g})",
+                f"Newton did not converge at {self._at(self.p0)} ({res.message}, scaled residual {res.residual:.3g})",
             )
             return None
         R, Rq, Rp = self.problem.residual_jacobian(res.q, self.p0)
@@ -184,7 +186,7 @@ class ContinuationStepper:
             reference[-1] = self._direction
             t0 = self.corrector.tangent(Rq, Rp, reference)
         if t0 is None:
-            self._finish(Status.START_FAILED, f"singular Jacobian at the start {self.symbol} = {self.p0:g}")
+            self._finish(Status.START_FAILED, f"singular Jacobian at the start {self._at(self.p0)}")
             return None
         self._t = t0
         self._y = self.corrector.to_scaled(res.q, self.p0)
@@ -202,10 +204,10 @@ class ContinuationStepper:
         opts = self.options
         corr_ = self.corrector
         if len(self.points) >= opts.max_points:
-            self._finish(Status.MAX_STEPS, f"{Status.MAX_STEPS.message} ({opts.max_points} points, last {self.symbol} = {self.points[-1].p:.6g})")
+            self._finish(Status.MAX_STEPS, f"{Status.MAX_STEPS.message} ({opts.max_points} points, last {self._at(self.points[-1].p)})")
             return None
         if opts.max_time is not None and time.perf_counter() - self._start_time > opts.max_time:
-            self._finish(Status.MAX_TIME, f"{Status.MAX_TIME.message} ({opts.max_time} s, last {self.symbol} = {self.points[-1].p:.6g})")
+            self._finish(Status.MAX_TIME, f"{Status.MAX_TIME.message} ({opts.max_time} s, last {self._at(self.points[-1].p)})")
             return None
         lo, hi = self.p_range
         turns: list[float] = []  # the turns of the trials rejected in a row for turning too much
@@ -248,7 +250,7 @@ class ContinuationStepper:
                 _, p = corr_.unscale(self._y)
                 self._finish(
                     Status.STEP_TOO_SMALL,
-                    f"{Status.STEP_TOO_SMALL.message}: Newton failed to converge beyond {self.symbol} = {p:.6g} "
+                    f"{Status.STEP_TOO_SMALL.message}: Newton failed to converge beyond {self._at(p)} "
                     f"with step {ds:.3g} (after {len(self.points)} points)",
                 )
                 return None
@@ -292,6 +294,10 @@ class ContinuationStepper:
             if reason:
                 self._finish(Status.STOPPED, reason)
         return pt
+
+    def _at(self, p: float) -> str:
+        """A value of the parameter in a message: ``Ω = 1.2345`` (``symbol``), or ``speed(p)``."""
+        return self.speed(float(p)) if self.speed is not None else f"{self.symbol} = {float(p):.6g}"
 
     def run(self) -> list[BranchPoint]:
         """Step until the run ends; returns all accepted points."""

@@ -21,7 +21,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(["map_report", "common_intervals", "format_intervals"], "._report"),
     **dict.fromkeys(["CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS", "MAP_COLUMNS", "INTERVAL_KINDS"],
                     "._result"),
-    **dict.fromkeys(["parse_all", "parameters", "combinations", "build_all", "mark_degrees"], "._vary"),
+    **dict.fromkeys(["parse_all", "parameters", "combinations", "build_all", "mark_degrees", "given_in_degrees"], "._vary"),
 }
 
 __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "ResponseMap", "Parameter", "GRID_COLUMNS",
@@ -31,7 +31,7 @@ __all__ = ["response_map", "map_report", "AttractorSearch", "CellResult", "Respo
            # the --vary arguments: parsed, resolved to parameters, every combination's model built
            "parse_all", "parameters", "combinations", "build_all",
            # angles the case file gave in degrees: shown in degrees by the report
-           "mark_degrees"]
+           "mark_degrees", "given_in_degrees"]
 
 
 if TYPE_CHECKING:
@@ -39,6 +39,6 @@ if TYPE_CHECKING:
     from ._map import DEFAULT_OMEGA_POINTS, CallbackError, StoreWarning, response_map
     from ._report import common_intervals, format_intervals, map_report
     from ._result import GRID_COLUMNS, INTERVAL_KINDS, MAP_COLUMNS, CellResult, Parameter, ResponseMap
-    from ._vary import build_all, combinations, mark_degrees, parameters, parse_all
+    from ._vary import build_all, combinations, given_in_degrees, mark_degrees, parameters, parse_all
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _LAZY, __all__)

@@ -342,7 +342,9 @@ def resolve(tables: Mapping[str, Any], name: str) -> str:
     tables : mapping
         The configuration tables (a parsed TOML file, or :func:`rattle.io.model_to_toml_dict`).
     name : str
-        A short name (:data:`SHORT_NAMES`) or a dotted key.
+        A short name (:data:`SHORT_NAMES`) or a dotted key; an angle field may be written in
+        degrees as in the case file (``model.elastic.b_deg``, ``model.elements.1.breakpoints_deg.4``):
+        its key is the field in rad (:func:`parameters` converts the values).
 
     Raises
     ------
@@ -357,7 +359,7 @@ def resolve(tables: Mapping[str, Any], name: str) -> str:
     if name in SHORT_NAMES:
         key = _short_on_chain(tables, name) if chain else SHORT_NAMES[name]
     else:
-        key = name
+        key = _radian_key(name)  # an angle written in degrees (FIELD_deg): the field in rad
     if key.split(".")[0] == "analysis":
         raise _err(f"{name!r}: the analysis settings are not design parameters: "
                    f"{_NOT_PARAMETERS['omega']}, and --harmonics for the harmonics")
@@ -393,11 +395,14 @@ def apply(tables: Mapping[str, Any], values: Mapping[str, float]) -> dict[str, A
     Keys are resolved as by :func:`resolve` (short names included). Nothing is ever added: a
     position beyond a list's end is refused (``excitation.amplitudes.2`` on a one-harmonic
     excitation: write the harmonic into the file first), so that a map never changes the
-    structure of the configuration it was given.
+    structure of the configuration it was given. An angle named in degrees (``FIELD_deg``, as the
+    case file writes it) sets the field in rad, value · π/180.
     """
     out = copy.deepcopy(dict(tables))
     for name, value in values.items():
         key = resolve(out, name)
+        if name not in SHORT_NAMES and _radian_key(name) != name:
+            value = math.radians(float(value))
         parts = key.split(".")
         node: Any = out
         for part in parts[:-1]:
@@ -455,6 +460,11 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
     ``(NAME, values)`` or of Parameter), each NAME resolved in ``tables``; two NAMEs setting the
     same key are refused, and so is a map of more than :data:`MAX_COMBINATIONS` combinations.
 
+    An angle NAME written in degrees as the case file writes it (``model.elastic.b_deg``,
+    ``model.elements.1.breakpoints_deg.4``) takes its values in degrees: they are converted as the
+    file converts them, x_rad = x_deg · π/180, and the parameter is the field in rad (its NAME
+    without ``_deg``, the files in rad) with ``degrees`` set (reports show degrees).
+
     Raises
     ------
     TypeError
@@ -465,6 +475,8 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
     """
     items: list[tuple[str, Sequence[float]]] = []
     in_degrees: set[str] = set()  # Parameter objects given keep their unit of display
+    given: set[str] = set()  # the NAMEs of Parameter objects (their values in rad already)
+    typed: dict[str, str] = {}  # NAME → as typed (an angle in degrees: FIELD_deg), for the refusals
     if isinstance(vary, Mapping):
         pairs: list[Any] = list(vary.items())
     elif isinstance(vary, (str, bytes, Set)) or vary is None or not isinstance(vary, Iterable):
@@ -475,6 +487,7 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
         for item in vary:
             if isinstance(item, Parameter):
                 pairs.append((item.name, item.values))
+                given.add(item.name)
                 if item.degrees:
                     in_degrees.add(item.name)
             elif isinstance(item, (tuple, list)) and len(item) == 2:
@@ -486,7 +499,16 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
         if not isinstance(n, str):
             raise TypeError(f"`vary` names must be strings (a short name or a dotted key such as 'alpha'), got {n!r} "
                             f"({type(n).__name__})")
-        items.append((n, _grid_values(n, v)))
+        vals = _grid_values(n, v)
+        typed[_radian_key(n) if n not in SHORT_NAMES else n] = n
+        if n not in SHORT_NAMES and _radian_key(n) != n:
+            # an angle in degrees (FIELD_deg, as the case file writes it): converted as the file
+            # converts it, to the field in rad (its NAME, its values), shown in degrees
+            if n not in given:  # a Parameter holds rad already
+                vals = tuple(math.radians(x) for x in vals)
+            n = _radian_key(n)
+            in_degrees.add(n)
+        items.append((n, vals))
     if not items:
         raise _err("is required: give at least one parameter, e.g. --vary alpha=0.1:0.4:7")
     out: list[Parameter] = []
@@ -498,7 +520,7 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
             raise _err(f"{name!r}: every value must be finite, got {bad[0]!r}")
         if len(set(vals)) != len(vals):
             raise _err(f"{name!r}: a value is given twice ({vals}); give every value once")
-        key = resolve(tables, name)
+        key = resolve(tables, typed.get(name, name))
         for p in out:
             if p.name == name:
                 raise _err(f"gives {name!r} twice; give every parameter once")
@@ -514,7 +536,19 @@ def parameters(tables: Mapping[str, Any], vary: Mapping[str, Sequence[float]] | 
 
 #: The angle fields of a law (rad; ``KEY_deg`` in degrees) and the keys of a damper's data sheet
 #: that give its breakpoints in degrees.
-_ANGLE_FIELDS = ("b", "breakpoints", "gap")
+_ANGLE_FIELDS = ("b", "breakpoints", "gap", "clearance")
+
+
+def _radian_key(name: str) -> str:
+    """``name`` with an angle field written in degrees as the case file writes it (``FIELD_deg``,
+    FIELD one of :data:`_ANGLE_FIELDS`: ``model.elements.1.breakpoints_deg.4``) put back to the
+    field in rad (``model.elements.1.breakpoints.4``); any other name unchanged. A map varies
+    such a key in degrees: its values are converted once, x_rad = x_deg · π/180, and shown in
+    degrees."""
+    parts = name.split(".")
+    out = [p[: -len("_deg")] if p.endswith("_deg") and p[: -len("_deg")] in _ANGLE_FIELDS and k >= 2 else p
+           for k, p in enumerate(parts)]
+    return ".".join(out) if parts[0] == "model" else name
 _DAMPER_DEGREE_KEYS = ("drive_angles_deg", "coast_angles_deg", "free_play_deg")
 
 

@@ -402,11 +402,7 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
 
     handles = [Line2D([], [], color="tab:blue", lw=1.5, label="non-linear, stable (branch colours as above)"),
                Line2D([], [], color="tab:blue", ls="--", lw=1.2, label="non-linear, unstable")]
-    linear = frf.extra_columns.get("spl_linear_db")
-    if linear is not None:  # the linear system at each row's Ω, in Ω order (one curve, marked where computed)
-        order = np.argsort(frf.omega, kind="stable")
-        handles += ax.plot(np.asarray(frf.omega)[order] * speed_axis(frf)[0], np.asarray(linear)[order], color="0.55",
-                           lw=1.0, marker=".", ms=2.5, label="linear system (f = δ), at the rows' Ω", zorder=1)
+    handles += draw_linear_spl(frf, ax)
     ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
               framealpha=0.9)
     fit_ylim(ax)
@@ -414,6 +410,38 @@ def _draw_sound_panel(frf: "FrequencyResponse", ax: Any, special_points: bool) -
     ax.set_ylabel("sound pressure level (dB re 20 µPa)")
     ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)
     ax.grid(True, alpha=0.3)
+
+
+#: Frequencies of the linear system's level drawn over the range (closed form: cheap, and a
+#: lightly damped resonance's peak needs them).
+LINEAR_SPL_POINTS = 2000
+
+
+def draw_linear_spl(frf: Any, ax: Any) -> list[Any]:
+    """The linear system's level through the sound paths of a response or a sweep (its
+    ``sound_paths``): on :data:`LINEAR_SPL_POINTS` frequencies over the range
+    (:func:`rattle.results.linear_sound_pressure`, closed form), so that its resonance peak is
+    resolved; at the rows' Ω (``spl_linear_db``, marked) when the paths are not known. Returns
+    the line drawn (for a legend), or nothing."""
+    import warnings
+
+    sx = speed_axis(frf)[0]
+    paths = getattr(frf, "sound_paths", ())
+    omega = np.asarray(frf.omega, dtype=float)
+    if paths and omega.size:
+        from ..results import linear_sound_pressure
+
+        dense = np.linspace(float(omega.min()), float(omega.max()), LINEAR_SPL_POINTS)
+        with warnings.catch_warnings():  # warned about once, by with_sound
+            warnings.simplefilter("ignore")
+            level = linear_sound_pressure(frf.model, dense, paths).spl_db
+        return ax.plot(dense * sx, level, color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)
+    linear = frf.extra_columns.get("spl_linear_db")
+    if linear is None:
+        return []
+    order = np.argsort(omega, kind="stable")  # one curve in Ω order, marked where computed
+    return ax.plot(omega[order] * sx, np.asarray(linear)[order], color="0.55", lw=1.0, marker=".", ms=2.5,
+                   label="linear system (f = δ), at the rows' Ω", zorder=1)
 
 
 def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, linear: bool, special_points: bool,
@@ -424,9 +452,7 @@ def _draw_panel(frf: "FrequencyResponse", ax: Any, key: str, quantity: str, line
     if special_points:
         draw_special_points(frf, ax, key)
     if linear and quantity == "spl_db" and "spl_linear_db" in frf.extra_columns:
-        order = np.argsort(frf.omega, kind="stable")
-        ax.plot(np.asarray(frf.omega)[order] * speed_axis(frf)[0], np.asarray(frf.extra_columns["spl_linear_db"])[order],
-                color="0.55", lw=1.0, marker=".", ms=2.5, label="linear system (f = δ), at the rows' Ω", zorder=1)
+        draw_linear_spl(frf, ax)
     if linear and quantity in ("mean", "rms", "rms_ac"):
         lin = frf.linear_response() if element == 0 else frf.linear_response(element=element)
         ax.plot(lin.omega * speed_axis(frf)[0], getattr(lin, quantity), color="0.55", lw=1.0, label="linear system (f = δ)", zorder=1)

@@ -3,7 +3,9 @@
 :func:`friction_orbit_plot`. One panel per element, stacked over one period: δ_e(t) of the exact
 orbit (solid) and of the regularised harmonic balance (dashed), every stick phase of the element
 (friction holds it, δ_e' ≡ 0) shaded in :data:`~rattle.plotting._nonsmooth.STICK_COLOUR`, one span
-per phase.
+per phase. One legend below the panels: the curves, then every orbit found at Ω (the exact census,
+``result.solutions``: period, stability, largest |μ|, the first element's rms; a filled mark
+stable, hollow unstable).
 """
 
 from __future__ import annotations
@@ -28,7 +30,9 @@ def friction_orbit_plot(result: FrictionOrbitResult) -> tuple[Any, PlotAxes]:
     import matplotlib.pyplot as plt
 
     m = result.m
-    fig, axes = plt.subplots(m, 1, figsize=(9, 1.0 + 2.4 * m), sharex=True, squeeze=False)
+    every = tuple(getattr(result, "solutions", ()) or ())
+    fig, axes = plt.subplots(m, 1, figsize=(9, 1.6 + 2.4 * m + 0.18 * len(every)), sharex=True, squeeze=False,
+                             layout="constrained")
     T = result.period
     hb_label = f"regularised HB (ε = {result.regularisation:g}, H = {result.harmonics})"
     panels: dict[str, Any] = {}
@@ -49,7 +53,6 @@ def friction_orbit_plot(result: FrictionOrbitResult) -> tuple[Any, PlotAxes]:
         ax.set_title(text, fontsize="small", loc="left")
         ax.set_ylabel(f"δ {name} (rad)")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize="x-small", loc="upper right")
         panels[name] = ax
     axes[-1, 0].set_xlabel("t (s)")
     axes[0, 0].set_xlim(0.0, T)
@@ -62,7 +65,24 @@ def friction_orbit_plot(result: FrictionOrbitResult) -> tuple[Any, PlotAxes]:
     else:
         title += ": no exact orbit (HB only)"
     fig.suptitle(title, fontsize="medium")
-    fig.tight_layout()
+    # one legend below the panels (it hides no data): the curves, then every orbit found at Ω
+    # (the exact census: index, period, stability, the first element's rms), listed
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    for a in axes[1:, 0]:
+        for h, text in zip(*a.get_legend_handles_labels()):
+            if text not in labels:
+                handles.append(h)
+                labels.append(text)
+    from matplotlib.lines import Line2D
+
+    for i, sol in enumerate(every):
+        mu = float(np.max(np.abs(sol.multipliers)))
+        # listed, not drawn (the panels show the orbit asked for): a filled mark stable, hollow unstable
+        handles.append(Line2D([], [], ls="none", marker="o", ms=5, color="0.3", mfc="0.3" if sol.stable else "white"))
+        labels.append(f"orbit [{i}] at Ω: period {sol.period}, {'stable' if sol.stable else 'unstable'} "
+                      f"(|μ|max {mu:.3g}), {result.element_names[0]} rms {sol.rms:.4g} rad")
+    fig.legend(handles, labels, loc="outside lower center", ncol=1 if every else 3, fontsize="x-small",
+               frameon=False)
     return fig, PlotAxes(panels)
 
 

@@ -591,12 +591,13 @@ def _map_figure(response_map: Any, *, quantity: str = "rms", title: str | None =
         raise ValueError("`response_map` varies no parameter; there is nothing to draw")
     name = params[0].name
     key = params[0].key
-    ylabel = name if name == key else f"{name} ({key})"
+    ylabel = (name if name == key else f"{name} ({key})") + (" (deg)" if params[0].degrees else "")
+    by_name = {q.name: q for q in params}
     omega = np.asarray(response_map.omega, dtype=float)
     N = omega.size
     rpm = getattr(response_map, "speed_rpm", None)
     x = omega if rpm is None else np.asarray(rpm, dtype=float)
-    yv = np.asarray(params[0].values, dtype=float)
+    yv = np.asarray([params[0].shown(v) for v in params[0].values], dtype=float)  # degrees where the case gave them
     xe, ye = _edges(x), _edges(yv)
     xc, yc = 0.5 * (xe[1:] + xe[:-1]), 0.5 * (ye[1:] + ye[:-1])
     every = [_values(c, field, N) for c in response_map.cells]
@@ -616,7 +617,8 @@ def _map_figure(response_map: Any, *, quantity: str = "rms", title: str | None =
             for j in range(N):
                 row.append(
                     f"{_where(omega[j], None if rpm is None else (x[j] / omega[j]))}<br>"
-                    + ", ".join(f"{nm} = {val:.5g}" for nm, val in c.values.items()) + "<br>"
+                    + ", ".join(f"{nm} = {by_name[nm].shown(val):.5g}" + (" deg" if by_name[nm].degrees else "")
+                                if nm in by_name else f"{nm} = {val:.5g}" for nm, val in c.values.items()) + "<br>"
                     + (f"{field} = {_num(v[j], unit)}" if math.isfinite(v[j]) else empty_label)
                     + f"<br>stable period-1: {int(c.n_stable[j])} of {int(c.n_solutions[j])}"
                     + f"<br>stable periods: {c.periods_stable[j] or 'none'}"

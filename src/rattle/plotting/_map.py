@@ -80,7 +80,8 @@ def _label(response_map: ResponseMap, name: str) -> str:
     is short, else the NAME alone — a dotted key without its leading ``model.`` and ``elements.``
     (the full key is in map.json) — with its unit where it is an angle."""
     key = next((p.key for p in response_map.parameters if p.name == name), name)
-    unit = " (rad)" if _is_angle(response_map, name) else ""
+    degrees = any(p.name == name and getattr(p, "degrees", False) for p in response_map.parameters)
+    unit = (" (deg)" if degrees else " (rad)") if _is_angle(response_map, name) else ""
     both = f"{name} ({key})" if key != name else name
     if len(both + unit) <= MAX_LABEL:
         return both + unit
@@ -105,7 +106,8 @@ def _panels(response_map: ResponseMap, name: str) -> list[tuple[str, list[int]]]
             for k, c in zip(others, combo):
                 index[k] = c
             cells.append(int(np.ravel_multi_index(tuple(index), shape)))
-        title = ", ".join(f"{params[k].name} = {params[k].values[c]:.4g}" for k, c in zip(others, combo))
+        title = ", ".join(f"{params[k].name} = {params[k].shown(params[k].values[c]):.4g}"
+                          + (" deg" if params[k].degrees else "") for k, c in zip(others, combo))
         out.append((title, cells))
     return out
 
@@ -201,7 +203,9 @@ def plot_map(
     if ax is not None and len(shown) > 1:
         raise ValueError(f"`ax` draws one panel, but this map has {len(shown)} (one per combination of the other "
                          "parameters); leave `ax` out")
-    yvalues = np.asarray(response_map.parameters[names.index(parameter)].values, dtype=float)
+    varied = response_map.parameters[names.index(parameter)]
+    degrees = bool(getattr(varied, "degrees", False))  # an angle the case gave in degrees: the y axis in degrees
+    yvalues = np.degrees(np.asarray(varied.values, dtype=float)) if degrees else np.asarray(varied.values, dtype=float)
     rpm = getattr(response_map, "speed_rpm", None)  # an engine: the crankshaft speed on the x axis
     omega = np.asarray(response_map.omega if rpm is None else rpm, dtype=float)
     xe, ye = _edges(omega), _edges(yvalues)
@@ -262,9 +266,9 @@ def plot_map(
         a.set_ylabel(_label(response_map, parameter), fontsize=9)
         last_column = ax is not None or (k + 1) % ncols == 0 or k == len(axes_list) - 1
         if angle and last_column:
-            # an angle: degrees on the right as well (a data sheet gives them so)
-            right = a.secondary_yaxis("right", functions=(np.degrees, np.radians))
-            right.set_ylabel("(deg)", fontsize=9)
+            # an angle: the other unit on the right as well (rad the files' unit, degrees a data sheet's)
+            right = a.secondary_yaxis("right", functions=(np.radians, np.degrees) if degrees else (np.degrees, np.radians))
+            right.set_ylabel("(rad)" if degrees else "(deg)", fontsize=9)
     if mesh is not None:
         cbar = fig.colorbar(mesh, ax=axes_list, shrink=0.9)
         cbar.set_label(bar_label)

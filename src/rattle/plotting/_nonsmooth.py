@@ -10,8 +10,11 @@ panels (their stick fraction over their own period).
 
 :func:`nonsmooth_orbit_plot`. One period of one orbit: δ(t) exact with the HB's δ(t) dashed and the
 breakpoints (where the law jumps or its friction changes) as horizontal lines; δ'(t); the phase
-portrait (δ, δ'). Every stick phase (friction holds, δ' ≡ 0) is shaded in :data:`STICK_COLOUR`,
-every lock phase (held at a jump of the preload) in :data:`LOCK_COLOUR`, one span per phase.
+portrait (δ, δ'), with every other orbit found at Ω (``result.solutions``, the exact census: its
+Fourier series over its own period, solid stable, dashed unstable, named by period, stability and
+rms in the legend). Every stick phase (friction holds, δ' ≡ 0) is shaded in :data:`STICK_COLOUR`,
+every lock phase (held at a jump of the preload) in :data:`LOCK_COLOUR`, one span per phase. One
+legend below the panels, where it hides no data.
 """
 
 from __future__ import annotations
@@ -97,7 +100,7 @@ def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tu
     In ``delta`` and ``velocity`` each stick or lock phase is one shaded span (``ax.patches``)."""
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(11, 6))
+    fig = plt.figure(figsize=(11, 6.6), layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(3, 2))
     ax_d = fig.add_subplot(grid[0, 0])
     ax_v = fig.add_subplot(grid[1, 0], sharex=ax_d)
@@ -123,6 +126,7 @@ def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tu
         ax_v.axvspan(ta, tb, color=colour, alpha=_SHADE_ALPHA, lw=0)
         held = float(result.sample(np.array([0.5 * (ta + tb)]))[0][0])
         ax_p.plot([held], [0.0], "o", color=colour, ms=7, label=label)
+    _draw_every_orbit(result, ax_p)
     law = result.system.law
     bp = law.stages.breakpoints
     jumps, levels = law.stages.jumps, law.friction_levels
@@ -142,13 +146,51 @@ def nonsmooth_orbit_plot(result: NonsmoothOrbitResult, points: int = 1024) -> tu
                   f"{'stable' if result.stable else 'unstable'}, held {result.stick_time:.3g} of {T:.3g} s")
     else:
         title += ": no exact orbit (HB only)"
+    n_every = len(getattr(result, "solutions", ()) or ())
+    if n_every > 1:
+        ax_p.set_title(f"phase portrait: every orbit at Ω ({n_every} periodic)", fontsize=10)
     fig.suptitle(title, fontsize="medium")
     for a in (ax_d, ax_v, ax_p):
         a.grid(alpha=0.3)
-    ax_d.legend(fontsize="small", loc="upper right")
-    ax_p.legend(fontsize="small", loc="upper right")
-    fig.tight_layout()
+    # one legend below the panels, where it hides no data: the curves of δ(t), then every orbit
+    # of the phase portrait (each named by its period and stability)
+    handles, labels = ax_d.get_legend_handles_labels()
+    for h, text in zip(*ax_p.get_legend_handles_labels()):
+        if text not in labels:
+            handles.append(h)
+            labels.append(text)
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize="small", frameon=False)
     return fig, PlotAxes({"delta": ax_d, "velocity": ax_v, "phase": ax_p})
+
+
+#: Colours of the other orbits at Ω in the phase portrait (the exact orbit asked for is tab:blue).
+_ORBIT_COLOURS = ("tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:orange",
+                  "tab:gray")
+
+
+def _draw_every_orbit(result: Any, ax_p: Any, samples: int = 512) -> None:
+    """Every orbit found at Ω (``result.solutions``: the exact census, each with the Fourier series
+    of its δ over its own period p·2π/Ω) as a closed curve of the phase portrait (δ, δ'), solid
+    where stable and dashed where unstable, named in the legend by its index, period, stability
+    (largest |μ|) and rms — the orbit asked for among them (drawn thick above)."""
+    from ..measures import evaluate_batch
+
+    for i, sol in enumerate(getattr(result, "solutions", ()) or ()):
+        if sol.elements:  # a chain's series hold its coordinates: drawn by its own plot
+            continue
+        t = np.linspace(0.0, sol.period * 2.0 * np.pi / sol.omega, samples * sol.period + 1)[None, :]
+        q, w = np.asarray(sol.coefficients, dtype=float)[None, :], np.array([sol.base_frequency])
+        d, v = evaluate_batch(q, w, t)[0], evaluate_batch(q, w, t, derivative=1)[0]
+        mu = float(np.max(np.abs(sol.multipliers)))
+        text = (f"orbit [{i}] at Ω: period {sol.period}, {'stable' if sol.stable else 'unstable'} (|μ|max {mu:.3g}), "
+                f"rms {sol.rms:.4g} rad")
+        asked = getattr(result, "orbit", None) is not None and sol.period == result.periods and \
+            abs(sol.rms - result.rms) <= 1e-6 * max(abs(result.rms), 1e-300)
+        if asked:  # the exact orbit drawn above: named, not drawn twice
+            ax_p.plot([], [], "-", color="tab:blue", lw=1.4, label=f"{text}: the exact orbit above")
+            continue
+        ax_p.plot(d, v, "-" if sol.stable else "--", color=_ORBIT_COLOURS[i % len(_ORBIT_COLOURS)], lw=1.0,
+                  zorder=1, label=text)
 
 
 __all__ = ["LOCK_COLOUR", "STICK_COLOUR", "nonsmooth_orbit_plot", "nonsmooth_response_plot"]

@@ -55,6 +55,7 @@ def orbit_plot(
     samples: int = 256,
     periods: int | None = None,
     title: str | None = None,
+    degrees: bool = False,
 ) -> tuple[Any, PlotAxes]:
     """Draw the HB orbits at one frequency against the simulated steady state.
 
@@ -75,7 +76,10 @@ def orbit_plot(
     periods : int, optional
         Forcing periods drawn.
     title : str, optional
-        Figure title (default names Ω and H).
+        Figure title (default names Ω and H; an engine case's crankshaft rpm first).
+    degrees : bool, default False
+        The case gave its angles in degrees: the δ panels and the phase portrait get a second
+        axis in degrees (δ · 180/π) beside the one in rad.
 
     Returns
     -------
@@ -188,18 +192,32 @@ def orbit_plot(
     for key, _ in rows[:-1]:
         plt.setp(hist_axes[key].get_xticklabels(), visible=False)
     ax_d.set_title("time histories", fontsize=10)
-    ax_p.set_xlabel("δ (rad)")
-    ax_p.set_ylabel("δ' (rad/s)")
-    ax_p.set_title("phase portrait", fontsize=10)
+    who = "" if system is None else f"{system.elements[0].name}: "  # a chain: the first element's
+    ax_p.set_xlabel(f"{who}δ (rad)")
+    ax_p.set_ylabel(f"{who}δ' (rad/s)")
+    ax_p.set_title("phase portrait" + ("" if system is None else f" of {system.elements[0].name}"), fontsize=10)
     ax_s.set_yscale("log")
     ax_s.set_xlabel("frequency / Ω")
-    ax_s.set_ylabel("amplitude of δ (rad)")
-    ax_s.set_title("amplitude spectrum of δ", fontsize=10)
+    ax_s.set_ylabel(f"{who}amplitude of δ (rad)")
+    ax_s.set_title("amplitude spectrum of δ" + ("" if system is None else f" ({system.elements[0].name})"),
+                   fontsize=10)
     ax_s.set_xlim(-0.25, SPECTRUM_ORDERS + 0.25)
     ymax = max([float(np.max(s.amplitudes())) for s in orbit.solutions] + [1e-6]) if system is None else max(
         [float(np.max(np.abs(orbit.time_history(i, samples=64)["delta"]))) for i in range(len(orbit.solutions))]
         + [1e-6])
-    ax_s.set_ylim(max(1e-7, ymax * 1e-6), ymax * 3.0)
+    # the legend sits above the stems: the top of the axis a decade per legend row over the largest
+    n_entries = len(ax_s.get_legend_handles_labels()[1])
+    ax_s.set_ylim(max(1e-7, ymax * 1e-6), ymax * 3.0 * 10.0 ** (1.0 + 0.9 * math.ceil(n_entries / 2)))
+    from matplotlib.ticker import MaxNLocator
+
+    ax_p.xaxis.set_major_locator(MaxNLocator(nbins=6))  # no crowded tick labels on a narrow panel
+    if degrees:  # the case's unit beside rad
+        for key, _ in rows:
+            if key.endswith("delta"):
+                hist_axes[key].secondary_yaxis("right", functions=(np.degrees, np.radians)).set_ylabel("(deg)")
+        top = ax_p.secondary_xaxis("top", functions=(np.degrees, np.radians))
+        top.set_xlabel("δ (deg)", fontsize=9)
+        top.xaxis.set_major_locator(MaxNLocator(nbins=6))
     for ax in axes.values():
         ax.grid(True, alpha=0.3)
     # One legend for the curves (they are the same in every panel), above the panels where it
@@ -207,9 +225,12 @@ def orbit_plot(
     handles, labels = ax_d.get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=min(3, max(1, len(labels))), fontsize=8.5,
                frameon=False)
-    ax_s.legend(fontsize=7, loc="upper right", framealpha=0.85)
+    ax_s.legend(fontsize=7, loc="upper center", ncol=2, framealpha=0.85)
     if title is None:
-        title = f"Periodic orbits at Ω = {orbit.omega:.5g} rad/s (H = {orbit.harmonics}, period {orbit.period} asked for)"
+        order = getattr(orbit.model, "speed_order", None)
+        where = (f"Ω = {orbit.omega:.5g} rad/s" if order is None
+                 else f"{orbit.omega * 60.0 / (2.0 * math.pi * float(order)):.5g} rpm (Ω = {orbit.omega:.5g} rad/s)")
+        title = f"Periodic orbits at {where} (H = {orbit.harmonics}, period {orbit.period} asked for)"
         if not orbit.solutions:
             title += ": no harmonic-balance solution found"
     fig.suptitle(title)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._axes import PlotAxes, fit_ylim, separate_texts, speed_axis, stick_ylim, unwrap
+from ._frf import draw_linear_spl
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import SweepResult
@@ -173,12 +174,9 @@ def _draw_sound_panel(sweep: "SweepResult", ax: Any, annotate: bool, lines: bool
     (``sweep.with_sound(paths)``) per direction, the linear system's level in grey."""
 
     _draw_sweep(sweep, ax, np.asarray(sweep.extra_columns["spl_db"], dtype=float), annotate, lines, legend=False)
-    linear = sweep.extra_columns.get("spl_linear_db")
-    if linear is not None:  # the linear system at each row's Ω, in Ω order (one curve)
-        order = np.argsort(sweep.omega, kind="stable")
-        ax.plot(np.asarray(sweep.omega)[order] * speed_axis(sweep)[0], np.asarray(linear)[order], color="0.55",
-                lw=1.0, label="linear system (f = δ)", zorder=1)
+    if draw_linear_spl(sweep, ax):  # the linear system, on a dense grid (closed form)
         ax.legend(fontsize=8, loc="best", framealpha=0.9)
+        fit_ylim(ax, room=0.08)  # every point of it inside too (the sweep's limits were set before it)
     ax.set_ylabel("sound pressure level (dB re 20 µPa)")
     ax.set_title("sound pressure at the receiver (paths summed harmonic by harmonic)", fontsize=10)
 

@@ -19,7 +19,7 @@ from ._nonsmooth import NonsmoothCheck
 from ..measures import acceleration_batch, evaluate_batch
 from ..model import Model, check_analysable_model
 from ._plotter import plot_with
-from ._sound import sound_pressure
+from ._sound import check_sound_paths, sound_pressure
 from ._speed import SpeedText, rpm_of_omega
 
 #: Per-element columns of a chain's ``frf.csv`` (SPEC §5): ``NAME_`` + each of these.
@@ -166,6 +166,9 @@ class FrequencyResponse:
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
     #: The exact-check column group of a law with jumps or friction (None for a continuous law).
     check: NonsmoothCheck | FrictionCheck | None = None
+    #: The sound paths of :meth:`with_sound` (empty without): frf.png draws the linear system's
+    #: level through them on a dense Ω grid (closed form), not only at the rows' Ω.
+    sound_paths: tuple[Any, ...] = ()
 
     @classmethod
     def from_check(cls, check: NonsmoothCheck | FrictionCheck, *, model: Any, settings: dict[str, Any],
@@ -383,7 +386,9 @@ class FrequencyResponse:
         return cls(
             model=model, harmonics=H, coefficients=np.concatenate([padded(p) for p in parts]), special_points=special,
             status=status or parts[0].status, message=message or parts[0].message,
-            settings=dict(settings or parts[0].settings), timings=dict(timings or parts[0].timings), **cat,
+            settings=dict(settings or parts[0].settings), timings=dict(timings or parts[0].timings),
+            sound_paths=parts[0].sound_paths if all(p.sound_paths == parts[0].sound_paths for p in parts) else (),
+            **cat,
         )
 
     def select(self, branch: int) -> "FrequencyResponse":
@@ -405,7 +410,8 @@ class FrequencyResponse:
             fields["check"] = replace(next(c for c in (self.check, *self.check.branches) if c.branch == branch),
                                       branches=())
         return type(self)(model=self.model, harmonics=self.harmonics, special_points=special, status=self.status,
-                          message=self.message, settings=self.settings, timings=self.timings, **fields)
+                          message=self.message, settings=self.settings, timings=self.timings,
+                          sound_paths=self.sound_paths, **fields)
 
     # --- derived quantities ----------------------------------------------------------------
     def base_frequency(self, index: int) -> float:
@@ -458,7 +464,8 @@ class FrequencyResponse:
             warnings.simplefilter("ignore")
             dba = sound_pressure(self, paths, a_weighting=True, linear=False).spl_db
         return replace(self, extra_columns={**self.extra_columns, "spl_db": sp.spl_db, "spl_dba": dba,
-                                            "spl_linear_db": sp.linear_spl_db})
+                                            "spl_linear_db": sp.linear_spl_db},
+                       sound_paths=tuple(check_sound_paths(paths, self.model)))
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:

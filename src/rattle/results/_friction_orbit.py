@@ -282,7 +282,7 @@ class FrictionOrbitResult:
 
     def every_orbit_text(self) -> list[str]:
         """The terminal lines of every orbit found at Ω (:attr:`solutions`, :attr:`nonperiodic`)."""
-        return every_orbit_lines(self.omega, self.solutions, self.nonperiodic)
+        return every_orbit_lines(self.omega, self.solutions, self.nonperiodic, self.speed_rpm)
 
     def summary(self) -> str:
         """A few lines: the orbit, every element's exact and HB rms and stick phases, the stability."""

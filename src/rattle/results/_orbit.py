@@ -155,12 +155,15 @@ def every_orbit_records(solutions: "tuple[OrbitSolution, ...]", nonperiodic: tup
                              **({"period": a.period} if a.period else {})} for a in nonperiodic]}
 
 
-def every_orbit_lines(omega: float, solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...]) -> list[str]:
+def every_orbit_lines(omega: float, solutions: "tuple[OrbitSolution, ...]", nonperiodic: tuple[Any, ...],
+                      speed_rpm: float | None = None) -> list[str]:
     """The terminal lines of every orbit found at Ω (an exact orbit's census, each orbit exact) and
-    of the non-periodic attractors the simulations settled on there."""
+    of the non-periodic attractors the simulations settled on there; ``speed_rpm`` the crankshaft
+    speed of an engine case (named first)."""
     if not solutions and not nonperiodic:
         return []
-    lines = [f"every orbit at Ω = {omega:.6g} rad/s (exact, {len(solutions)} periodic"
+    where = f"Ω = {omega:.6g} rad/s" if speed_rpm is None else f"{speed_rpm:.5g} rpm (Ω = {omega:.6g} rad/s)"
+    lines = [f"every orbit at {where} (exact, {len(solutions)} periodic"
              f"{f', {len(nonperiodic)} non-periodic attractor(s)' if nonperiodic else ''}):"]
     lines += solution_lines(solutions)
     lines += [f"     non-periodic attractor (no period ≤ 8): rms {a.rms:.6g} rad over the recorded window, {a.regime}"
@@ -448,11 +451,12 @@ class PeriodicOrbit:
         return Path(path)
 
     def plot(
-        self, fig: Any = None, *, samples: int = 256, periods: int | None = None, title: str | None = None
+        self, fig: Any = None, *, samples: int = 256, periods: int | None = None, title: str | None = None,
+        degrees: bool = False,
     ) -> tuple[Any, Any]:
         """δ(t), δ'(t), δ''(t), the phase portrait and the amplitude spectrum; returns
         (figure, :class:`rattle.plotting.PlotAxes`). See :func:`rattle.plotting.orbit_plot`."""
-        return plot_with("orbit_plot", self, fig=fig, samples=samples, periods=periods, title=title)
+        return plot_with("orbit_plot", self, fig=fig, samples=samples, periods=periods, title=title, degrees=degrees)
 
 
 __all__ = ["PeriodicOrbit", "OrbitSolution", "ORBIT_SOURCES"]

@@ -154,6 +154,9 @@ class SweepResult:
     extra_columns: dict[str, np.ndarray] = field(default_factory=dict)
     failure: np.ndarray | None = None
     regime: np.ndarray | None = None
+    #: The sound paths of :meth:`with_sound` (empty without): sweep.png draws the linear system's
+    #: level through them on a dense Ω grid (closed form), not only at the rows' Ω.
+    sound_paths: tuple[Any, ...] = ()
 
     def __post_init__(self) -> None:
         if self.failure is None:  # a sweep without failures: "" on every row
@@ -226,7 +229,8 @@ class SweepResult:
         values = {name: getattr(self, name)[rows] for name in _ROW_FIELDS}
         return SweepResult(model=self.model, settings=self.settings, timings=self.timings,
                            element_columns={k: v[rows] for k, v in self.element_columns.items()},
-                           extra_columns={k: v[rows] for k, v in self.extra_columns.items()}, **values)
+                           extra_columns={k: v[rows] for k, v in self.extra_columns.items()},
+                           sound_paths=self.sound_paths, **values)
 
     def __repr__(self) -> str:
         parts = []
@@ -465,7 +469,7 @@ class SweepResult:
         if worst is not None:
             _warn_uncovered(worst)
         return replace(self, extra_columns={**self.extra_columns, "spl_db": spl, "spl_dba": dba,
-                                            "spl_linear_db": linear})
+                                            "spl_linear_db": linear}, sound_paths=tuple(paths_t))
 
     # --- output delegates ------------------------------------------------------------------
     def to_csv(self, path: str | Path) -> Path:
