@@ -33,9 +33,11 @@ def _velocity_zero():
     return event
 
 
-def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float):
+def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float, max_step: float = np.inf):
     """Mode by mode with DOP853 (rtol 1e-12, atol 1e-14) and terminal events; returns the final
-    state and the solver's (t, δ, δ') samples."""
+    state and the solver's (t, δ, δ') samples. ``max_step``: the solver's largest step — events are
+    found from sign changes between steps, so a velocity that dips below zero and back within one
+    step (next to a grazing of the stick surface) is seen only with steps shorter than the dip."""
     st, r = system.law.stages, system.law.friction_levels
     bp, s, e = st.breakpoints, st.slopes, st.offsets
     k, c = system.k, system.c
@@ -77,7 +79,7 @@ def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float):
             ev = _velocity_zero()
             ev.terminal, ev.direction = True, -ss
             events.append((ev, "stop"))
-        sol = solve_ivp(rhs, (t, t1), [d, v], method="DOP853", rtol=1e-12, atol=1e-14,
+        sol = solve_ivp(rhs, (t, t1), [d, v], method="DOP853", rtol=1e-12, atol=1e-14, max_step=max_step,
                         events=[ev for ev, _ in events], dense_output=True)
         ts.append(sol.t)
         xs.append(sol.y)
@@ -99,7 +101,7 @@ def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float):
             sg = 0 if r[j] == 0 else (1 if v > 0 else -1)
 
 
-def chain_reference(fs: FrictionSystem, z0, t1, omega):
+def chain_reference(fs: FrictionSystem, z0, t1, omega, max_step: float = np.inf):
     """An independent integration of the Filippov system by scipy (DOP853, rtol 1e-12) with
     terminal events at every breakpoint, velocity zero and stick band edge; only constant friction
     levels (the mode logic written out again, one element at a time)."""
@@ -167,7 +169,7 @@ def chain_reference(fs: FrictionSystem, z0, t1, omega):
             band.direction = 1
             evs.append(("band", e, band))
         sol = solve_ivp(rhs, (t, t1), z, method="DOP853", rtol=1e-12, atol=1e-15, args=(list(S), sigma.copy()),
-                        events=[e[2] for e in evs], max_step=2 * math.pi / omega / 64)  # a held state's torque
+                        events=[e[2] for e in evs], max_step=min(max_step, 2 * math.pi / omega / 64))  # a held state's torque
         # still changes with F(t): steps no longer than the forcing allows, or a band exit is stepped over
         t, z = float(sol.t[-1]), sol.y[:, -1].copy()
         if sol.status != 1:

@@ -369,3 +369,66 @@ def test_the_interruption_line() -> None:
     assert _signals.message(int(signal.SIGINT)) == (
         "interrupted by SIGINT; temporary files were removed and no output set was left half-written")
     assert _signals.message(int(signal.SIGTERM), forced=True).startswith("interrupted by SIGTERM; a further signal")
+
+
+def _settle(seconds: float = 0.2) -> None:
+    """Run Python code for a moment (pending signal handlers run between bytecodes) and wait for a
+    signal sent again by rattle._signals to have been sent."""
+    until = time.monotonic() + seconds
+    while time.monotonic() < until or any(t.name == "rattle-signal-again" for t in threading.enumerate()):
+        if time.monotonic() > until + WAIT:
+            break
+
+
+@pytest.mark.skipif(not hasattr(signal, "raise_signal"), reason="signal.raise_signal")
+def test_a_second_signal_after_one_swallowed_by_a_finalizer_does_not_decide() -> None:
+    """SIGTERM's Interrupted swallowed in a ``__del__`` (sent again a moment later), then SIGINT
+    before it comes back: the command is interrupted by SIGTERM, the first (the swallowed signal
+    used to be forgotten, so that the SIGINT became the first: exit 130 instead of 143)."""
+
+    class Finalized:
+        def __del__(self) -> None:
+            signal.raise_signal(signal.SIGTERM)
+
+    with pytest.raises(_signals.Interrupted) as info:
+        with _signals.raising():
+            try:
+                Finalized()
+                signal.raise_signal(signal.SIGINT)
+            finally:
+                _settle()  # the SIGTERM sent again arrives during the clean-up: noted only
+    assert info.value.signum == signal.SIGTERM
+    assert _signals.interrupted_by() == signal.SIGTERM
+
+
+def test_the_first_of_two_signals_pending_together_decides() -> None:
+    """SIGTERM, then SIGINT 20 ms later, both arriving while the main thread is inside one long C
+    call (here a key derivation of ~1 s that never looks at signals): Python then runs the two
+    handlers in the order of the signals' numbers (SIGINT first); the arrival order kept by the
+    wakeup pipe makes SIGTERM decide, as it came first."""
+    import hashlib
+
+    t0 = time.perf_counter()
+    hashlib.pbkdf2_hmac("sha256", b"key", b"salt", 20_000)
+    rounds = max(20_000, int(20_000 * 1.0 / max(time.perf_counter() - t0, 1e-6)))  # ~1 s of C
+
+    def send() -> None:
+        time.sleep(0.05)
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.02)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    sender = threading.Thread(target=send)
+    with pytest.raises(_signals.Interrupted) as info:
+        with _signals.raising():
+            try:
+                sender.start()
+                hashlib.pbkdf2_hmac("sha256", b"key", b"salt", rounds)  # releases the GIL: the thread sends
+                sender.join()
+                assert sender.ident is not None
+            finally:
+                _settle()
+    if sender.is_alive():  # pragma: no cover - the C call ended before both were sent (a very busy machine)
+        sender.join()
+        pytest.skip("the two signals did not both arrive during the C call")
+    assert info.value.signum == signal.SIGTERM

@@ -85,6 +85,8 @@ class _State:
     first_at = 0.0                  # when (time.monotonic)
     reported = False                # the interruption's line is on stderr
     reporting = False               # report() is writing it now
+    swallowed = False               # the first signal's Interrupted was swallowed by a finalizer
+    arrivals: int | None = None     # read end of the wakeup pipe: signal numbers in arrival order
     hook: Any = sys.__unraisablehook__  # the unraisable hook :class:`raising` replaced
 
 
@@ -150,6 +152,7 @@ def handle(signum: int, _frame: FrameType | None) -> None:
         return
     first = _State.first
     if first is None:
+        signum = _first_arrived(signum)
         _State.first, _State.first_at = signum, time.monotonic()
         if _State.mode == "raise":
             raise Interrupted(signum)
@@ -157,6 +160,10 @@ def handle(signum: int, _frame: FrameType | None) -> None:
             _write_line(message(signum))
         exit_now(128 + signum)
         return
+    _first_arrived(signum)  # (empties the arrival pipe)
+    if _State.swallowed and _State.mode == "raise":  # the first's Interrupted did not reach the command:
+        _State.swallowed = False  # raise it now, whichever handled signal runs next (the first decides)
+        raise Interrupted(first)
     # a later signal: the first one's clean-up runs (raise mode), or the command has ended
     if _State.reporting:  # the line is being written (this handler runs nested inside report()):
         return  # it is written once, and the command ends right after
@@ -164,6 +171,71 @@ def handle(signum: int, _frame: FrameType | None) -> None:
         if not _State.reported:
             _write_line(message(first, forced=_State.mode == "raise"))
         exit_now(128 + first)
+
+
+def _first_arrived(signum: int) -> int:
+    """The handled signal that arrived first among those whose handlers are pending, or ``signum``.
+
+    Python runs the handlers of signals pending together in the order of their numbers, not of
+    their arrival: SIGTERM followed 20 ms later by SIGINT, both arriving while the main thread is
+    in one long C call (an fsync, a process start, a BLAS call), would run SIGINT's handler first
+    and SIGINT would decide. The C-level handler writes each signal's number, as it arrives, to
+    the wakeup pipe (:func:`_watch_arrivals`); its first handled number is the first signal."""
+    fd = _State.arrivals
+    if fd is None:
+        return signum
+    first = None
+    while True:
+        try:
+            data = os.read(fd, 512)
+        except (BlockingIOError, InterruptedError):
+            break
+        except OSError:  # pragma: no cover - closed
+            break
+        if not data:
+            break
+        if first is None:
+            first = next((b for b in data if b in HANDLED), None)
+    return signum if first is None else first
+
+
+def _watch_arrivals() -> Any:
+    """Have the signals' numbers written, in arrival order, to a non-blocking pipe read by
+    :func:`_first_arrived` (``signal.set_wakeup_fd``, main thread only); returns what to pass to
+    :func:`_unwatch_arrivals` (None where it could not be set: the arrival order is then the
+    handlers' order)."""
+    try:
+        r, w = os.pipe()
+    except OSError:  # pragma: no cover - no file descriptors left
+        return None
+    try:
+        os.set_blocking(r, False)
+        os.set_blocking(w, False)
+        old = _signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+    except (ValueError, OSError, AttributeError):  # not the main thread, or no pipes here
+        os.close(r)
+        os.close(w)
+        return None
+    previous = (_State.arrivals, old, r, w)
+    _State.arrivals = r
+    return previous
+
+
+def _unwatch_arrivals(token: Any) -> None:
+    """Undo :func:`_watch_arrivals` (the wakeup fd and arrival pipe that were there before)."""
+    if token is None:
+        return
+    arrivals, old, r, w = token
+    try:
+        _signal.set_wakeup_fd(old)
+    except (ValueError, OSError):  # pragma: no cover
+        pass
+    _State.arrivals = arrivals
+    for fd in (r, w):
+        try:
+            os.close(fd)
+        except OSError:  # pragma: no cover
+            pass
 
 
 def _install() -> dict[int, Any]:
@@ -232,7 +304,9 @@ def _unraisable(unraisable: Any) -> None:
     exc = unraisable.exc_value
     if isinstance(exc, Interrupted) and _State.mode == "raise" and os.getpid() == _State.owner \
             and _State.first == exc.signum:
-        _State.first = None
+        # The next handled signal's handler raises it (``swallowed``): this one sent again, or a
+        # second signal that comes first — the first signal still decides the exit status.
+        _State.swallowed = True
         # Sent from a thread a moment later: sent from here, its handler would run inside this
         # hook, which swallows it too. (Should it land in a finalizer again, it comes back here.)
         import threading
@@ -260,12 +334,14 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
         self._mode = _State.mode
         self._previous: dict[int, Any] = {}
         self._hook: Any = None
-        _State.first, _State.reported, _State.mode = None, False, "raise"
+        self._arrivals: Any = None
+        _State.first, _State.reported, _State.mode, _State.swallowed = None, False, "raise", False
         try:
             self._previous = _install()
         except ValueError:  # not the main thread: leave the signals alone
             _State.mode = self._mode
             return
+        self._arrivals = _watch_arrivals()
         self._hook = sys.unraisablehook
         if self._hook is not _unraisable:
             _State.hook = self._hook
@@ -280,6 +356,7 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
                 pass
         if self._hook is not None:
             sys.unraisablehook = self._hook
+        _unwatch_arrivals(self._arrivals)
         _State.mode = self._mode
 
 
