@@ -3,11 +3,13 @@
 The harmonic balance of a preload or friction law solves the regularised equation
 (:class:`~rattle.hb.RegularisedBalance`, smooth steps of relative width ε). This module follows
 one solution at a fixed forcing frequency Ω from a comfortable ε_0 down a geometric ladder
-ε_0 > ε_1 > … > ε_min, each solution starting Newton for the next (a homotopy in ε): where
-Newton fails the step in log ε is halved and retried. A narrower step needs more harmonics: after
-each solve the spectrum of δ is checked, and while the harmonics in the top half of the basis
+ε_0 > ε_1 > … > ε_min = the branch of R_ε(q, Ω) = 0 followed in u = log ε by
+:class:`~rattle.continuation.ContinuationStepper` on a :class:`~rattle.continuation.WidthHomotopy`
+(pseudo-arclength, the tangent's guess, the stepper's step control where Newton needs shorter
+steps), the rungs ε_k = ε_0 ratio^k its ``stations`` (each solved exactly at its ε, whatever steps
+were taken between). A narrower step needs more harmonics: at each rung the spectrum of δ is checked, and while the harmonics in the top half of the basis
 carry more than ``tail_tol`` of its fluctuation (rms) H is doubled (up to
-``max_harmonics``) and the same ε solved again.
+``max_harmonics``) and the stepper started again at that rung.
 
 The record (:class:`RegularisationLimit`) holds every rung: ε, H, rms and mean of δ, the
 spectral tail. The change of the rms between the last rungs measures what ε still does to the
@@ -159,7 +161,7 @@ def regularisation_limit(
     harmonics, or a chain's :class:`~rattle.hb.RegularisedSystemBalance` (``q0`` then its flat
     coordinate series; the spectral tail and the rms are then every element's, linearity and
     Richardson's value per element). Raises :class:`~rattle.errors.ConvergenceError` (with the
-    rungs reached) when the first solve fails, or when a step in log ε shrinks below 1 % of the requested one.
+    rungs reached) when the first solve fails, or when the stepper's step in log ε shrinks below 1 % of a rung.
     """
     if not (0 < eps_min <= eps_start) or not (0 < ratio < 1):
         raise ValueError(f"need 0 < eps_min <= eps_start and 0 < ratio < 1, got eps_min={eps_min!r}, "
