@@ -6,7 +6,10 @@
   :class:`~rattle.timeint.ExactTrajectory`, declares none of its shared fields again and answers
   ``states(t)`` and ``measures()`` (the settling loop reads nothing else);
 - one ``make_integrator``: no other function picks an integrator class by the kind of system;
-- at most two public classes named ``*Integrator`` (the flow and its scalar kernel).
+- at most two public classes named ``*Integrator`` (the flow and its scalar kernel);
+- one continuation (item 3): the ε-ladder runs on :class:`~rattle.continuation.ContinuationStepper`
+  (no loop of ``analysis._regularisation`` calls a Newton solve itself); the held-limit ladder is
+  the one hand-rolled ladder left (:data:`HAND_ROLLED_LADDERS`, docs/architecture.md says why).
 """
 
 from __future__ import annotations
@@ -28,6 +31,14 @@ INTEGRATORS = ("ExactIntegrator", "SystemIntegrator", "NonsmoothIntegrator", "Fr
 #: (``rattle.results`` may change only its import lines in this step): they should call
 #: :func:`rattle.timeint.make_integrator`.
 LADDERS_LEFT: set[tuple[str, str]] = set()
+
+#: Modules whose loops still call a Newton solve themselves (a hand-rolled continuation): the
+#: held elements' ladder, whose rungs need the damped Newton the stepper's corrector does not do
+#: (on the stepper it took 1.5–4.5× the CPU, measured; docs/architecture.md).
+HAND_ROLLED_LADDERS = {"rattle.analysis._held_limit"}
+
+#: What solves R = 0 directly: a Newton at a fixed parameter, a step of it, the corrector.
+NEWTON_CALLS = {"solve_fixed", "newton_step", "correct", "_solve", "solve_harmonic_balance"}
 
 
 def _name(path: Path) -> str:
@@ -151,3 +162,22 @@ def test_one_flow_takes_every_system() -> None:
             assert getattr(timeint, name) in (timeint.ExactIntegrator, timeint.FlowOptions)
     with pytest.raises(TypeError, match="`system`"):
         timeint.ExactIntegrator("clutch")
+
+
+def _loops_calling_newton(tree: ast.AST) -> list[int]:
+    """Line numbers of the ``for``/``while`` loops of ``tree`` that call a Newton solve
+    (:data:`NEWTON_CALLS`) themselves."""
+    return [loop.lineno for loop in ast.walk(tree) if isinstance(loop, (ast.For, ast.While))
+            and _calls(loop) & NEWTON_CALLS]
+
+
+def test_the_eps_ladder_runs_on_the_stepper() -> None:
+    """No loop of the regularisation ladder calls a Newton solve (the old ladder did: Newton at each
+    rung, its step in log ε halved by hand); it builds a ContinuationStepper on a WidthHomotopy.
+    Only the modules of HAND_ROLLED_LADDERS still loop over rungs with Newton."""
+    tree = TREES["rattle.analysis._regularisation"]
+    assert _loops_calling_newton(tree) == []
+    ladder = next(f for f in ast.walk(tree) if isinstance(f, ast.FunctionDef) and f.name == "regularisation_limit")
+    assert {"ContinuationStepper", "WidthHomotopy"} <= _calls(ladder)
+    ladders = ("rattle.analysis._regularisation", "rattle.analysis._held_limit")
+    assert {mod for mod in ladders if _loops_calling_newton(TREES[mod])} == HAND_ROLLED_LADDERS

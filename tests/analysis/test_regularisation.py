@@ -68,3 +68,43 @@ def test_richardson_is_trusted_only_where_the_last_rungs_are_linear_in_eps() -> 
     assert not ladder([1.0, 1.01], eps[:2]).linear  # two rungs do not show a line
     turn = ladder([1.0, 1.01, 1.0], eps)  # the change reverses
     assert not turn.linear
+
+
+def test_the_rungs_are_the_schedules_whatever_steps_the_stepper_takes() -> None:
+    """The ladder runs on ContinuationStepper in u = log ε with its rungs as stations: they are
+    ε_k = ε_0 ratio^k down to ε_min exactly (the old hand-made ladder inserted rungs where Newton
+    failed), each a converged orbit of its own ε."""
+    w = 0.8
+    q0 = _solve(_make(0.1, 64), w)
+    lim = regularisation_limit(_make, w, q0, eps_start=0.1, eps_min=0.01, ratio=0.5, harmonics=64, max_harmonics=64,
+                               tail_tol=np.inf)
+    assert [s.eps for s in lim.steps] == [0.1, 0.05, 0.025, 0.0125, 0.01]
+    for s in lim.steps:
+        assert np.max(np.abs(_make(s.eps, 64).residual(s.q, w))) < 1e-9
+    one = regularisation_limit(_make, w, q0, eps_start=0.1, eps_min=0.1, harmonics=64, max_harmonics=64)
+    assert [s.eps for s in one.steps] == [0.1]
+
+
+def test_stations_place_points_exactly_on_a_branch() -> None:
+    """ContinuationStepper(stations=...): every station becomes an accepted point exactly there,
+    in order; one on the range's far end ends the run (here R = q − p², followed down in p)."""
+    from rattle.continuation import ContinuationOptions, ContinuationStepper
+
+    class Parabola:
+        size, length_scale, parameter_scale, force_scale = 1, 1.0, 1.0, 1.0
+
+        def residual(self, q, p):  # type: ignore[no-untyped-def]
+            return q - p * p
+
+        def residual_jacobian(self, q, p):  # type: ignore[no-untyped-def]
+            return q - p * p, np.eye(1), np.array([-2.0 * p])
+
+    stations = (0.9, 0.55, 0.31, 0.2)
+    st = ContinuationStepper(Parabola(), np.array([1.0]), 1.0, (0.2, 1.0), ContinuationOptions(initial_step=0.05),
+                             stations=stations)
+    pts = st.run()
+    assert st.status.name == "SUCCESS" and pts[-1].p == 0.2
+    on = [pt.p for pt in pts if pt.p in stations]
+    assert on == list(stations) and all(abs(pt.q[0] - pt.p**2) < 1e-10 for pt in pts)
+    with pytest.raises(ValueError, match="stations"):
+        ContinuationStepper(Parabola(), np.array([1.0]), 1.0, (0.2, 1.0), stations=(1.5,))

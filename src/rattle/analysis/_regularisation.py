@@ -3,11 +3,13 @@
 The harmonic balance of a preload or friction law solves the regularised equation
 (:class:`~rattle.hb.RegularisedBalance`, smooth steps of relative width ε). This module follows
 one solution at a fixed forcing frequency Ω from a comfortable ε_0 down a geometric ladder
-ε_0 > ε_1 > … > ε_min, each solution starting Newton for the next (a homotopy in ε): where
-Newton fails the step in log ε is halved and retried. A narrower step needs more harmonics: after
-each solve the spectrum of δ is checked, and while the harmonics in the top half of the basis
+ε_0 > ε_1 > … > ε_min = the branch of R_ε(q, Ω) = 0 followed in u = log ε by
+:class:`~rattle.continuation.ContinuationStepper` on a :class:`~rattle.continuation.WidthHomotopy`
+(pseudo-arclength, the tangent's guess, the stepper's step control where Newton needs shorter
+steps), the rungs ε_k = ε_0 ratio^k its ``stations`` (each solved exactly at its ε, whatever steps
+were taken between). A narrower step needs more harmonics: at each rung the spectrum of δ is checked, and while the harmonics in the top half of the basis
 carry more than ``tail_tol`` of its fluctuation (rms) H is doubled (up to
-``max_harmonics``) and the same ε solved again.
+``max_harmonics``) and the stepper started again at that rung.
 
 The record (:class:`RegularisationLimit`) holds every rung: ε, H, rms and mean of δ, the
 spectral tail. The change of the rms between the last rungs measures what ε still does to the
@@ -26,7 +28,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import check_int, check_positive
-from ..continuation import NewtonOptions, solve_fixed
+from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions, WidthHomotopy
 from ..errors import ConvergenceError
 from ..hb import (
     HBOptions,
@@ -159,48 +161,70 @@ def regularisation_limit(
     harmonics, or a chain's :class:`~rattle.hb.RegularisedSystemBalance` (``q0`` then its flat
     coordinate series; the spectral tail and the rms are then every element's, linearity and
     Richardson's value per element). Raises :class:`~rattle.errors.ConvergenceError` (with the
-    rungs reached) when the first solve fails, or when a step in log ε shrinks below 1 % of the requested one.
+    rungs reached) when the first solve fails, or when the stepper's step in log ε shrinks below 1 % of a rung.
     """
     if not (0 < eps_min <= eps_start) or not (0 < ratio < 1):
         raise ValueError(f"need 0 < eps_min <= eps_start and 0 < ratio < 1, got eps_min={eps_min!r}, "
                          f"eps_start={eps_start!r}, ratio={ratio!r}")
     newton = NewtonOptions(max_iterations=30) if newton is None else newton
+    rungs = _rungs(float(eps_start), float(eps_min), float(ratio))
+    u, lo = next(iter(rungs)), min(rungs)
+    step = abs(math.log(ratio))
+    options = ladder_options(step, 0.01 * step)
     steps: list[RegularisationStep] = []
-    H, eps, q = int(harmonics), float(eps_start), np.asarray(q0, dtype=float)
-    log_step = math.log(ratio)
-    while True:
-        pb = problem(eps, H)
+    H, q = int(harmonics), np.asarray(q0, dtype=float)
+    while True:  # one run of the stepper per H: a rung whose spectral tail asks for more harmonics restarts it
+        pb = problem(rungs.get(u, math.exp(u)), H)
         chain = isinstance(pb, RegularisedSystemBalance)
         start = resize_harmonics(np.reshape(q, (pb.n_coordinates, -1)), H).reshape(-1) if chain \
             else resize_harmonics(q, H)
-        res = solve_fixed(pb, start, omega, newton)
-        if not res.converged:
-            if not steps:
-                raise ConvergenceError(f"the regularised orbit at Ω = {omega:g}, ε = {eps:g} (H = {H}) did not "
-                                       f"converge from the start given: {res.message}")
-            if abs(log_step) < 0.01 * abs(math.log(ratio)):
-                raise ConvergenceError(f"the regularisation ladder at Ω = {omega:g} stalled at ε = "
-                                       f"{steps[-1].eps:g}: Newton fails for any smaller ε (H = {H})")
-            log_step *= 0.5  # back off: a smaller step in log ε from the last good rung
-            eps = steps[-1].eps * math.exp(log_step)
-            continue
-        el_rms = None
-        if chain:
-            mean, rms, p2p, tail, el_rms = _chain_measures(pb, res.q)
-        else:
-            mean, rms, p2p, tail = _measures(pb, res.q, omega)
-        if tail > tail_tol and 2 * H <= max_harmonics:  # the step is not resolved: more harmonics, same ε
-            H *= 2
-            q = res.q
-            continue
-        q = res.q
-        steps.append(RegularisationStep(eps=eps, harmonics=H, q=q, mean=mean, rms=rms, p2p=p2p, tail=tail,
+        stepper = ContinuationStepper(WidthHomotopy(pb.with_regularisation, omega, u), start, u,
+                                      (lo, u) if u > lo else (lo - 1.0, lo), options, newton,
+                                      domain=(-math.inf, math.inf), symbol="log ε",
+                                      stations=tuple(r for r in rungs if r < u))
+        restart = False
+        for pt in iter(stepper.step, None):
+            if pt.p not in rungs:
+                continue  # a step between rungs
+            eps = rungs.get(pt.p, math.exp(pt.p))
+            at = pb.with_regularisation(eps)
+            mean, rms, p2p, tail, el_rms = _chain_measures(at, pt.q) if chain else (*_measures(at, pt.q, omega), None)
+            if tail > tail_tol and 2 * H <= max_harmonics:  # the step is not resolved: more harmonics, same ε
+                H, q, u, restart = 2 * H, pt.q, pt.p, True
+                break
+            steps.append(RegularisationStep(eps=eps, harmonics=H, q=pt.q, mean=mean, rms=rms, p2p=p2p, tail=tail,
                                             element_rms=el_rms))
+            if pt.p <= lo:
+                return RegularisationLimit(omega=float(omega), steps=tuple(steps))
+        if restart:
+            continue
+        if not steps:
+            raise ConvergenceError(f"the regularised orbit at Ω = {omega:g}, ε = {math.exp(u):g} (H = {H}) did not "
+                                   f"converge from the start given: {stepper.message}")
+        raise ConvergenceError(f"the regularisation ladder at Ω = {omega:g} stalled at ε = "
+                               f"{steps[-1].eps:g}: Newton fails for any smaller ε (H = {H}; {stepper.message})")
+
+
+def ladder_options(rung: float, smallest: float) -> ContinuationOptions:
+    """The stepper's settings on a ladder in u = log w whose rungs are ``rung`` apart in u: steps
+    in arc length of (q / L, u) from one rung to twice that (every step is cut at the next rung:
+    the stepper's ``stations``), shortened by the step control where Newton needs it, down to
+    ``smallest`` (then the ladder has stalled). A rung is one Newton solve from the tangent's
+    guess where the old hand-made ladder did one from the last rung: up to 6 iterations (the
+    target) and a turn of the tangent up to 1.2 rad per step are accepted without shortening."""
+    return ContinuationOptions(initial_step=rung, min_step=smallest, max_step=2.0 * rung, target_iterations=6,
+                               max_turn=1.2, target_turn=0.6)
+
+
+def _rungs(eps_start: float, eps_min: float, ratio: float) -> dict[float, float]:
+    """The ladder's rungs ε_k = max(ε_{k−1} ratio, ε_min) from ``eps_start`` down to ``eps_min``,
+    keyed by u = log ε_k (the stepper's stations)."""
+    eps, out = eps_start, {}
+    while True:
+        out[math.log(eps)] = eps
         if eps <= eps_min * (1 + 1e-12):
-            break
-        log_step = max(log_step * 1.5, math.log(ratio)) if log_step > math.log(ratio) else math.log(ratio)
-        eps = max(eps * math.exp(log_step), eps_min)
-    return RegularisationLimit(omega=float(omega), steps=tuple(steps))
+            return out
+        eps = max(eps * math.exp(math.log(ratio)), eps_min)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

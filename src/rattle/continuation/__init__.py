@@ -7,12 +7,14 @@ parameter, :class:`ContinuationStepper` follows its branch (predictor objects :c
 :class:`Secant`; bordered corrector :class:`ArclengthCorrector`; test-function monitoring
 :func:`check_segment`; special points located by :func:`locate_on_segment`).
 :class:`ForcingHomotopy` turns a problem at a fixed parameter into one continued in the scale λ
-of its forcing (the start of a branch where Newton alone does not converge).
+of its forcing (the start of a branch where Newton alone does not converge);
+:class:`WidthHomotopy` one continued in the logarithm of a width (the ε-ladder and the held
+elements' ladder of the regularised harmonic balance, rungs as the stepper's ``stations``).
 """
 
 from ._corrector import ArclengthCorrector, Corrected
 from ._detect import LocatedPoint, locate_on_segment
-from ._homotopy import ForcingHomotopy
+from ._homotopy import ForcingHomotopy, WidthHomotopy
 from ._monitor import Monitor, MonitorReading, SegmentVerdict, check_segment
 from ._newton import NewtonResult, solve_fixed
 from ._options import ContinuationOptions, NewtonOptions
@@ -25,4 +27,5 @@ __all__ = [
     "solve_fixed", "ContinuationStepper", "BranchPoint", "AbstractPredictor", "Tangent", "Secant",
     "PREDICTORS", "predictor", "ArclengthCorrector", "Corrected", "LocatedPoint", "locate_on_segment",
     "Monitor", "MonitorReading", "SegmentVerdict", "check_segment", "ForcingHomotopy",
+    "WidthHomotopy",
 ]

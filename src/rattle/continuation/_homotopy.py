@@ -12,9 +12,16 @@ its means: λ = 0 is the static equilibrium). :class:`ForcingHomotopy` is that f
 λ = 1 that Newton cannot reach from a guess is reached by following the branch from λ = 0 with
 :class:`~rattle.continuation.ContinuationStepper` (through any folds in λ), the last point
 placed on λ = 1 by Newton at the full forcing.
+
+:class:`WidthHomotopy` is the other family: a problem whose width w (a regularisation's ε, a
+scale of some elements' steps) is continued in u = log w at a fixed p — the ladders of the
+regularised harmonic balance towards its limit.
 """
 
 from __future__ import annotations
+
+import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -66,4 +73,68 @@ class ForcingHomotopy:
         return R + (1.0 - lam) * self.forcing, Rq, -self.forcing
 
 
-__all__ = ["ForcingHomotopy"]
+class WidthHomotopy:
+    """R(q; u) = R_w(q, p) with w = e^u: a family of problems ``family(w)`` (a regularisation
+    width ε, a scale s of some elements' widths), each at the fixed parameter ``p``, continued in
+    u = log w (dimensionless: ``parameter_scale`` 1; any sign: the stepper's ``domain`` is
+    (−inf, inf)). A ladder w_0 > w_1 > … is this branch followed down in u with the rungs as the
+    stepper's ``stations``.
+
+    ``family(w)`` returns the :class:`~rattle.continuation.ContinuationProblem` (in p) at width w,
+    all of one size and scales (``family(e^{u_0})``'s are this problem's). ∂R/∂u is not known in
+    closed form: the central difference (R_{w e^h} − R_{w e^{−h}}) / 2h with h = 1e-6 (the
+    residual is smooth in w; its error O(h²) is far below Newton's tolerance on a tangent).
+    """
+
+    __slots__ = ("family", "p", "_first")
+
+    #: The step in u of the central difference for ∂R/∂u.
+    STEP = 1e-6
+
+    def __init__(self, family: Callable[[float], ContinuationProblem], p: float, u0: float) -> None:
+        self.family = family
+        self.p = float(p)
+        self._first = family(math.exp(u0))
+
+    @property
+    def size(self) -> int:
+        return self._first.size
+
+    @property
+    def length_scale(self) -> float | FloatArray:
+        return self._first.length_scale
+
+    @property
+    def parameter_scale(self) -> float:
+        return 1.0
+
+    @property
+    def force_scale(self) -> float:
+        return self._first.force_scale
+
+    def residual(self, q: FloatArray, u: float) -> FloatArray:
+        """R_w(q, p), w = e^u, shape (N,)."""
+        return self.family(math.exp(u)).residual(q, self.p)
+
+    def residual_jacobian(self, q: FloatArray, u: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """R_w(q, p), ∂R/∂q (N, N) and ∂R/∂u (N,, the central difference)."""
+        R, Rq, _ = self.family(math.exp(u)).residual_jacobian(q, self.p)
+        h = self.STEP
+        Ru = (self.family(math.exp(u + h)).residual(q, self.p) - self.family(math.exp(u - h)).residual(q, self.p)) / (2 * h)
+        return R, Rq, Ru
+
+    def newton_step(self, q: FloatArray, u: float) -> tuple[FloatArray, FloatArray | None]:
+        """The problem's own Newton step at w = e^u (when it has one), else the full solve."""
+        pb = self.family(math.exp(u))
+        step = getattr(pb, "newton_step", None)
+        if step is not None:
+            return step(q, self.p)  # type: ignore[no-any-return]
+        R, Rq, _ = pb.residual_jacobian(q, self.p)
+        try:
+            dq = np.linalg.solve(Rq, -R)
+        except np.linalg.LinAlgError:
+            return R, None
+        return R, (dq if np.all(np.isfinite(dq)) else None)
+
+
+__all__ = ["ForcingHomotopy", "WidthHomotopy"]

@@ -24,6 +24,15 @@ y = (q / L, p / p_s) (see ``_problem`` and ``_corrector``):
 The stepper yields one accepted point per :meth:`ContinuationStepper.step`; the run ends when the
 branch leaves the parameter range (the last point is placed exactly on the bound), when an
 optional ``stop`` test fires, or with a :class:`~rattle.errors.Status` saying where and why.
+
+``stations`` p_1, p_2, … (in the order the branch reaches them) are parameters at which a point is
+placed exactly: a predicted step that passes the next station is cut there (the predictor's step
+shortened in proportion), or a corrected step that passes it is cut on its chord, and the point
+is solved at p = p_k by Newton from there; a solve that fails rejects the step (halved as any
+other). A station on
+the range's far end ends the run there. So
+a ladder (a regularisation width ε_0 > ε_1 > … followed in log ε) reports its rungs at the
+scheduled values whatever steps the step control took between them.
 """
 
 from __future__ import annotations
@@ -37,7 +46,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..errors import Status
-from ._corrector import ArclengthCorrector
+from ._corrector import ArclengthCorrector, Corrected
 from ._monitor import Monitor, MonitorReading, check_segment
 from ._newton import solve_fixed
 from ._options import ContinuationOptions, NewtonOptions
@@ -85,7 +94,9 @@ class ContinuationStepper:
     scale or a width; a homotopy parameter that may take any sign passes (−inf, inf).
     ``symbol`` names the parameter in messages (default ``"Ω"``: most of rattle's branches are
     frequency responses); ``speed``, when given, writes a value of the parameter in them instead
-    (an engine case's crankshaft rpm: ``speed(p)`` → ``"1086 rpm"``).
+    (an engine case's crankshaft rpm: ``speed(p)`` → ``"1086 rpm"``). ``stations``: parameters at
+    which a point is placed exactly (module docstring), in the order the branch reaches them; each
+    inside ``p_range``.
     """
 
     problem: ContinuationProblem
@@ -101,6 +112,7 @@ class ContinuationStepper:
     domain: tuple[float, float] = (0.0, math.inf)
     symbol: str = "Ω"
     speed: Callable[[float], str] | None = None
+    stations: tuple[float, ...] = ()
     status: Status | None = None
     message: str = ""
     points: list[BranchPoint] = field(default_factory=list)
@@ -138,6 +150,9 @@ class ContinuationStepper:
             raise TypeError(
                 f"`predictor` must be a predictor object (rattle.continuation.Tangent(), Secant()), got {self.predictor!r}"
             )
+        self.stations = tuple(float(x) for x in self.stations)
+        if any(not lo <= x <= hi for x in self.stations):
+            raise ValueError(f"`stations` must lie in `p_range` {self.p_range}, got {self.stations!r}")
         self._start_time = time.perf_counter()
         self.corrector = ArclengthCorrector(self.problem, self.newton, domain=self.domain)
         self._ds = self.options.initial_step
@@ -216,7 +231,11 @@ class ContinuationStepper:
         while True:
             ds = self._ds
             y_pred, normal = self.predictor.predict(self._y, self._t, ds, self._y_prev)
-            corr = corr_.correct(y_pred, normal)
+            cut = self._cut_at_station(y_pred, ds) if self.stations else None
+            corr = corr_.correct(y_pred, normal) if cut is None else self._solve_on_station(cut)
+            if cut is None and corr is not None and self.stations:  # the corrector passed the station
+                cut = self._cut_at_station(corr.y, None)
+                corr = corr if cut is None else self._solve_on_station(cut)
             t_new = None if corr is None else corr_.tangent(corr.Rq, corr.Rp, self._t)
             at_floor = ds <= opts.min_step * 1.0000001
             if corr is not None and t_new is not None:
@@ -256,6 +275,9 @@ class ContinuationStepper:
                 return None
             self._ds = max(opts.min_step, 0.5 * ds)
         q, p = corr_.unscale(corr.y)
+        at_station = bool(self.stations) and abs(p - self.stations[0]) <= 1e-13 * max(1.0, abs(self.stations[0]))
+        if at_station:  # on the station (to round-off of the scaling): exactly there
+            p, self.stations = self.stations[0], self.stations[1:]
         # Leaving the range: place the last point exactly on the bound and end.
         if p > hi or p < lo:
             bound = hi if p > hi else lo
@@ -289,6 +311,9 @@ class ContinuationStepper:
         if verdict is not None:
             factor = min(factor, max(verdict.factor, 0.25))
         self._ds = min(opts.max_step, max(opts.min_step, ds * factor))
+        if at_station and p == (hi if self._direction > 0 else lo if self._direction < 0 else math.nan):
+            self._finish(Status.SUCCESS)  # a station on the far end: the run ends there
+            return pt
         if self.stop is not None:
             reason = self.stop(pt)
             if reason:
@@ -298,6 +323,30 @@ class ContinuationStepper:
     def _at(self, p: float) -> str:
         """A value of the parameter in a message: ``Ω = 1.2345`` (``symbol``), or ``speed(p)``."""
         return self.speed(float(p)) if self.speed is not None else f"{self.symbol} = {float(p):.6g}"
+
+    def _cut_at_station(self, y_next: FloatArray, ds: float | None) -> FloatArray | None:
+        """None, or when the step from the last point to ``y_next`` (the prediction with step
+        ``ds``, or the corrected point with ``ds`` None) passes the next station p_k: the guess
+        there, the predictor's step (or the chord) shortened in proportion."""
+        corr_ = self.corrector
+        p_prev, p = corr_.unscale(self._y)[1], corr_.unscale(y_next)[1]
+        target = self.stations[0]
+        if not (p_prev < target <= p or p <= target < p_prev):
+            return None
+        frac = (target - p_prev) / (p - p_prev)
+        if ds is None:
+            return self._y + frac * (y_next - self._y)
+        return self.predictor.predict(self._y, self._t, ds * frac, self._y_prev)[0]
+
+    def _solve_on_station(self, y_cut: FloatArray) -> Corrected | None:
+        """Newton at the next station p_k (the problem's own step, :func:`solve_fixed`) from the
+        cut prediction, with the Jacobians there; None when it does not converge."""
+        corr_, target = self.corrector, self.stations[0]
+        res = solve_fixed(self.problem, corr_.unscale(y_cut)[0], target, self.newton)
+        if not res.converged:
+            return None
+        _, Rq, Rp = self.problem.residual_jacobian(res.q, target)
+        return Corrected(corr_.to_scaled(res.q, target), res.iterations, res.residual, Rq, Rp)
 
     def run(self) -> list[BranchPoint]:
         """Step until the run ends; returns all accepted points."""
