@@ -80,7 +80,7 @@ from types import SimpleNamespace
 import numpy as np
 from .._brent import brent_root
 from .._lazy import lazy_module
-from .._limits import check_interval
+from .._limits import MAX_PERIOD, check_interval
 from .._typing import FloatArray
 from .._validate import check_omega
 from ..errors import ConvergenceError
@@ -90,6 +90,7 @@ from ._roots import grid_chunk, polish_crossing
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
+from ._nonsmooth import MEMO
 from ._stage_flow import Segment, StageSolution, SystemStages
 
 optimize = lazy_module("scipy.optimize")  # minimize_scalar, for the extremes of a segment
@@ -314,8 +315,9 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         self.jumps = [np.asarray(law.stages.jumps, dtype=float) for law in system.laws]
         self.breakpoints = [np.asarray(law.stages.breakpoints, dtype=float) for law in system.laws]
         self._modal: dict = {}
-        self._omega: float | None = None
-        self._flows: dict = {}
+        self._flows: dict[float, dict[_Key, SystemStages]] = {}
+        self._modes: dict[_Key, SystemStages] = {}  # every mode's stages at the first Ω it was met
+        self._memo: dict[tuple, FrictionTrajectory] = {}
         self._L = float(system.length_scale())  # fixed scales: the event tolerances and grid read them
         self._wn = float(system.frequency_scale())
 
@@ -339,13 +341,26 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
                       coordinates=base.coordinates, angles=base.angles, free=base.free, load=None)
 
     def _flow(self, key: _Key, omega: float) -> SystemStages:
-        if self._omega != omega:
-            self._omega, self._flows = omega, {}
-        flow = self._flows.get(key)
+        """The mode ``key``'s stages at ``omega``: kept for the last :data:`~._nonsmooth.MEMO`
+        frequencies (a shooting alternates Ω and Ω + h, its ∂/∂Ω); a mode's system does not depend
+        on Ω without a drag by speed, and its stages at a new Ω are then made from those of the
+        first (:meth:`SystemStages.at_omega`)."""
+        flows = self._flows.get(omega)
+        if flows is None:
+            if len(self._flows) >= MEMO:
+                del self._flows[next(iter(self._flows))]
+            flows = self._flows[omega] = {}
+        flow = flows.get(key)
         if flow is None:
-            cache = self._modal.setdefault(key, {}) if self.base.load is None else None
-            flow = SystemStages(self._mode_system(key, omega), omega, self.samples_per_scale, modal_cache=cache)
-            self._flows[key] = flow
+            if self.base.load is None:
+                first = self._modes.get(key)
+                if first is None:
+                    first = self._modes[key] = SystemStages(self._mode_system(key, omega), omega,
+                                                            self.samples_per_scale, modal_cache=self._modal.setdefault(key, {}))
+                flow = first if first.omega == omega else first.at_omega(omega)
+            else:
+                flow = SystemStages(self._mode_system(key, omega), omega, self.samples_per_scale)
+            flows[key] = flow
         return flow
 
     def _base_step(self, omega: float) -> float:
@@ -490,14 +505,20 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
     def propagate(self, z0: FloatArray, t0: float, t1: float, omega: float) -> FrictionTrajectory:
         """Integrate exactly from ``z0`` = (x, x') at ``t0`` to ``t1`` ≥ t0 at forcing frequency
         ``omega``: the :class:`FrictionTrajectory` with its segments, events, final state and
-        sensitivity ∂z(t1)/∂z(t0)."""
+        sensitivity ∂z(t1)/∂z(t0). The last :data:`~._nonsmooth.MEMO` trajectories are kept by
+        their exact arguments (z0, t0, t1, Ω): a shooting continuation asks again for the period it
+        has just integrated (an accepted point's row after the corrector's last evaluation there)."""
         z = check_system_state(z0, self.n)
         omega = check_omega(omega)
         t0, t1 = check_interval(t0, t1, omega)
+        key = (z.tobytes(), t0, t1, omega)
+        traj = self._memo.get(key)
+        if traj is not None:
+            return traj
         rec: dict[str, list] = {k: [] for k in ("ts", "st", "sk", "lk", "seg", "et", "ee", "ek", "ev")}
         z1, M = self._march(z, t0, t1, omega, rec)
         ts = np.asarray(rec["ts"], dtype=float)
-        return FrictionTrajectory(
+        traj = FrictionTrajectory(
             system=self.system, omega=omega, t0=t0, t1=t1, state0=z, state1=z1, sensitivity=M, t_start=ts,
             t_end=np.append(ts[1:], t1), stages=np.asarray(rec["st"], dtype=np.int64).reshape(-1, self.m),
             stuck=np.asarray(rec["sk"], dtype=bool).reshape(-1, self.m), segments=tuple(rec["seg"]),
@@ -505,12 +526,22 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
             event_kinds=np.asarray(rec["ek"], dtype=np.int64), event_values=np.asarray(rec["ev"], dtype=float),
             locked=np.asarray(rec["lk"], dtype=bool).reshape(-1, self.m),
         )
+        if len(self._memo) >= MEMO:
+            del self._memo[next(iter(self._memo))]
+        self._memo[key] = traj
+        return traj
 
     def advance(self, z0: FloatArray, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[FloatArray, FloatArray]:
-        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path; the
-        ``sensitivity`` is there for the common signature: M is always computed)."""
-        return self._march(np.asarray(z0, dtype=float).copy(), float(t0), float(t1), float(omega), None)
+        """The state at ``t1`` and ∂z(t1)/∂z(t0) (copies; the ``sensitivity`` is there for the
+        common signature: M is always computed): the period map of a shooting, recorded and kept
+        (:meth:`propagate`) over at most an orbit's longest period (``MAX_PERIOD`` forcing
+        periods), else marched without a record (a long settling)."""
+        t0, t1, omega = float(t0), float(t1), float(omega)
+        if (t1 - t0) * omega / (2.0 * math.pi) <= MAX_PERIOD + 0.5:
+            traj = self.propagate(z0, t0, t1, omega)
+            return traj.state1.copy(), traj.sensitivity.copy()
+        return self._march(np.asarray(z0, dtype=float).copy(), t0, t1, omega, None)
 
     def _march(self, z: FloatArray, t0: float, t1: float, omega: float,
                rec: dict[str, list] | None) -> tuple[FloatArray, FloatArray]:

@@ -38,6 +38,7 @@ evaluated vectorised for the crossing search and at single points for the root r
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -125,7 +126,8 @@ class SystemStages:
         cos = np.asarray(system.cos, dtype=float).reshape(-1, n)
         sin = np.asarray(system.sin, dtype=float).reshape(-1, n)
         keep = np.any(cos != 0.0, axis=1) | np.any(sin != 0.0, axis=1)
-        self.hw = (np.arange(1, cos.shape[0] + 1, dtype=float) * self.omega)[keep]
+        self._orders, self._keep = np.arange(1, cos.shape[0] + 1, dtype=float), keep
+        self.hw = (self._orders * self.omega)[keep]
         self.fc = cos[keep]
         self.fs = sin[keep]
         rows = system.element_rows.reshape(m, n)
@@ -137,13 +139,32 @@ class SystemStages:
         self.lower = [np.concatenate(([-np.inf], np.asarray(e.breakpoints, dtype=float))) for e in system.elements]
         self.upper = [np.concatenate((np.asarray(e.breakpoints, dtype=float), [np.inf])) for e in system.elements]
         self._cache: dict[tuple[int, ...], StageSolution] = {}
+        #: a solution per stage combination at any Ω, shared with the copies of :meth:`at_omega`
+        #: (the Ω-independent parts of their solutions)
+        self._bases: dict[tuple[int, ...], StageSolution] = {}
+
+    def at_omega(self, omega: float) -> SystemStages:
+        """The same system's stages at forcing frequency ``omega``, equal to ``SystemStages(system,
+        omega, …)`` for a system whose mean forcing does not depend on Ω (no ``load``): its stage
+        solutions are made from those of any frequency (:meth:`StageSolution.at_omega`: only the
+        harmonic particular solutions and the time scales afresh)."""
+        if self.system.load is not None:
+            raise ValueError("at_omega needs a mean forcing independent of Ω (a system without `load`)")
+        out = copy.copy(self)  # shares the stage data, the modal cache and the bases
+        out.omega = float(omega)
+        out.hw = (self._orders * out.omega)[self._keep]
+        out._cache = {}
+        return out
 
     def solution(self, stages: tuple[int, ...]) -> StageSolution:
-        """The :class:`StageSolution` of the stage combination ``stages`` (cached)."""
+        """The :class:`StageSolution` of the stage combination ``stages`` (cached; from the same
+        stages' solution at another Ω where there is one)."""
         sol = self._cache.get(stages)
         if sol is None:
-            sol = StageSolution(self, stages)
+            base = self._bases.get(stages)
+            sol = StageSolution(self, stages) if base is None else base.at_omega(self)
             self._cache[stages] = sol
+            self._bases.setdefault(stages, sol)
         return sol
 
     def forcing(self, t: FloatArray | float, derivative: int = 0) -> FloatArray:
@@ -230,8 +251,48 @@ class StageSolution:
         lam = np.linalg.eigvals(A) if cached is None else cached["eigenvalues"]
         self.eigenvalues = lam
         rho = float(np.max(np.abs(lam))) if lam.size else 0.0
+        self._rho = rho
+        self._set_omega(flow)  # the harmonic particular solutions and the time scales
 
-        # Harmonic particular solutions.
+        # Block-modal form of exp(Ā τ).
+        if cached is None:
+            self.method = "modal"
+            try:
+                self._block_modal_form(Abar, rho)
+            except (np.linalg.LinAlgError, ValueError):
+                self.method = "expm"
+            cached = {"eigenvalues": lam, "method": self.method}
+            if self.method == "modal":
+                cached.update({k: getattr(self, k) for k in _MODAL_FIELDS})
+            flow.modal_cache[key] = cached
+        else:
+            for k, v in cached.items():
+                if k != "eigenvalues":
+                    setattr(self, k, v)
+        if self.method == "modal":
+            self.Pinv_1 = self.Pinv[:, -1]
+        self._set_bases()
+        self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
+        self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
+        self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
+
+    def at_omega(self, flow: SystemStages) -> StageSolution:
+        """The same stage combination's solution in ``flow`` (the same system at another Ω, a mean
+        forcing independent of Ω): the stage matrices and their modal form shared, the harmonic
+        particular solutions, time scales and mode amplitudes' bases made afresh — equal to
+        ``StageSolution(flow, stages)``."""
+        out = copy.copy(self)
+        out.flow = flow
+        out.__dict__.pop("_omega_xy", None)
+        out._set_omega(flow)
+        out._set_bases()
+        return out
+
+    def _set_omega(self, flow: SystemStages) -> None:
+        """The parts that depend on Ω: the harmonic particular amplitudes Z_h (refused at an exact
+        resonance of an undamped stage), the time scales, the grid step and the longest segment."""
+        n = flow.n
+        A, lam, rho, stages = self.A, self.eigenvalues, self._rho, self.stages
         hw = flow.hw
         if hw.size:
             dist = np.abs(lam[None, :] - 1j * hw[:, None])
@@ -264,37 +325,21 @@ class StageSolution:
         self.grid_step = scale / flow.samples_per_scale
         self.max_segment = _SEGMENT_SCALES * scale
 
-        # Block-modal form of exp(Ā τ).
-        if cached is None:
-            self.method = "modal"
-            try:
-                self._block_modal_form(Abar, rho)
-            except (np.linalg.LinAlgError, ValueError):
-                self.method = "expm"
-            cached = {"eigenvalues": lam, "method": self.method}
-            if self.method == "modal":
-                cached.update({k: getattr(self, k) for k in _MODAL_FIELDS})
-            flow.modal_cache[key] = cached
-        else:
-            for k, v in cached.items():
-                if k != "eigenvalues":
-                    setattr(self, k, v)
+    def _set_bases(self) -> None:
+        """The modes (the diagonalised eigenvalues, then the harmonics ihΩ) and a segment's mode
+        amplitudes' bases: coef[:, None] * base (coef: modal coordinates, then the harmonics'
+        phase factors at its start)."""
+        flow = self.flow
+        hw = flow.hw
+        self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
         if self.method == "modal":
             self.modes = np.concatenate((self.lam, 1j * hw))
-        self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
-        # A segment's mode amplitudes are coef[:, None] * base (coef: modal coordinates, then the
-        # harmonics' phase factors at its start).
-        if self.method == "modal":
             self.base_d = np.concatenate((self.Pd_modal.T, self.Zh_d), axis=0)  # (K, 2m)
             self.base_z = np.concatenate((self.Pz_modal.T, self.Zh), axis=0)  # (K, 2n)
-            self.Pinv_1 = self.Pinv[:, -1]
         else:
             self.modes = 1j * hw
             self.base_d, self.base_z = self.Zh_d, self.Zh
         self.modes_l = self.modes.tolist()
-        self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
-        self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
-        self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
 
     def _block_modal_form(self, Abar: np.ndarray, rho: float) -> None:
         """Ā = P diag(μ_1 I + N_1, …, μ_c I + N_c, Λ) P⁻¹: clusters of eigenvalues closer than
