@@ -318,6 +318,9 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         self._flows: dict[float, dict[_Key, SystemStages]] = {}
         self._modes: dict[_Key, SystemStages] = {}  # every mode's stages at the first Ω it was met
         self._memo: dict[tuple, FrictionTrajectory] = {}
+        # per held set S: (A_S B_S)⁻¹ A_S and B_S (A_S B_S)⁻¹; per (stages, σ): y's constant part, Cᵀ, K_sᵀ
+        self._held: dict[tuple, FloatArray] = {}
+        self._parts: dict[tuple, tuple[FloatArray, FloatArray, FloatArray]] = {}
         self._L = float(system.length_scale())  # fixed scales: the event tolerances and grid read them
         self._wn = float(system.frequency_scale())
 
@@ -397,17 +400,23 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,)
         (z: t.shape + (2n,)); o_ej the law's own offsets (jumps included)."""
         n = self.n
-        base = self.base
         x, v = z[..., :n], z[..., n:]
-        const = np.zeros(n)
-        for e in range(self.m):
-            const += (self.offsets[e][stages[e]] + key[1][e] * self.levels[e][stages[e]]) * self.B[:, e]
-        return base.forcing(t, omega) - v @ base.damping.T - x @ base.stage_stiffness(stages).T - const
+        parts = self._parts.get((stages, key[1]))
+        if parts is None:
+            const = np.zeros(n)
+            for e in range(self.m):
+                const += (self.offsets[e][stages[e]] + key[1][e] * self.levels[e][stages[e]]) * self.B[:, e]
+            parts = self._parts[(stages, key[1])] = (const, self.base.damping.T, self.base.stage_stiffness(stages).T)
+        const, CT, KT = parts
+        return self.base.forcing(t, omega) - v @ CT - x @ KT - const
 
     def _lambdas(self, S: list[int], y: FloatArray) -> FloatArray:
         """λ = (A_S B_S)⁻¹ A_S y for y (..., n): shape (..., |S|)."""
-        AS, BS = self.A[S], self.B[:, S]
-        return y @ np.linalg.solve(AS @ BS, AS).T
+        X = self._held.get(("lambda", *S))
+        if X is None:
+            AS, BS = self.A[S], self.B[:, S]
+            X = self._held[("lambda", *S)] = np.linalg.solve(AS @ BS, AS).T
+        return y @ X
 
     def _band(self, e: int, stage: int, locked: bool) -> tuple[float, float]:
         """The band [lo, hi] of a held element's torque λ_e: ±r_ej when stuck on stage j; when
@@ -456,8 +465,11 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
     def _hold_columns(self, S: list[int]) -> FloatArray:
         """W = B_S (A_S B_S)⁻¹ (n, |S|): column w_e moves element e alone (a_e·w_e = 1, a_k·w_e = 0 for
         the other held k) along the constraint forces."""
-        AS, BS = self.A[S], self.B[:, S]
-        return BS @ np.linalg.inv(AS @ BS)
+        W = self._held.get(("hold", *S))
+        if W is None:
+            AS, BS = self.A[S], self.B[:, S]
+            W = self._held[("hold", *S)] = BS @ np.linalg.inv(AS @ BS)
+        return W.copy()
 
     def _initial_key(self, t: float, z: FloatArray, stages: tuple[int, ...],
                      omega: float) -> tuple[_Key, tuple[int, ...], tuple[bool, ...]]:
@@ -864,8 +876,12 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         def acc(tau: float) -> float:
             return s * seg.element_point(tau, e)[2]
 
+        # only the cells that can decide: σ δ' ≤ 0 at their end, or a minimum of σ δ' inside
+        cells = (np.flatnonzero((sv[1:] <= 0.0) | ((sa[:-1] < 0.0) & (sa[1:] > 0.0))) + 1).tolist()
+        if not cells:
+            return None
         floor = 64.0 * _EPS * max(float(np.max(np.abs(sv))), self.velocity_scale(seg.sol.flow.omega))
-        for i in range(1, taus.size):
+        for i in cells:
             lo_v, hi_v = float(sv[i - 1]), float(sv[i])
             if hi_v <= 0.0:
                 if lo_v > floor or (lo_v > 0.0 and i > 1):

@@ -53,6 +53,8 @@ _CLUSTER = 1e-4  # eigenvalues closer than this × spectral radius share a Taylo
 _MAX_CONDITION = 1e6  # condition number of P beyond which the stage falls back to expm
 _SEGMENT_SCALES = 64.0  # longest segment, in stage time scales (a new segment starts beyond it)
 _MAX_TAYLOR = 200
+#: exp(Ā τ) a fallback stage keeps by τ (:meth:`StageSolution.expm`)
+EXPM_KEPT = 16
 
 
 def _taylor_terms(T: np.ndarray, c: np.ndarray, tau_max: float) -> np.ndarray:
@@ -246,6 +248,7 @@ class StageSolution:
         Abar[: 2 * n, : 2 * n] = A
         Abar[: 2 * n, 2 * n] = g
         self.Abar = Abar
+        self._expm_kept: dict[tuple[float, bool], FloatArray] = {}  # shared with the at_omega copies
         key = stages if flow._cache_tag is None else (stages, flow._cache_tag)
         cached = flow.modal_cache.get(key)
         lam = np.linalg.eigvals(A) if cached is None else cached["eigenvalues"]
@@ -425,6 +428,20 @@ class StageSolution:
         ph = np.exp(1j * hw * t)
         return ((X * t + Y) * ph[:, None]).sum(axis=0).real
 
+    def expm(self, tau: float, batch: bool = False) -> FloatArray:
+        """exp(Ā τ) (2n+1, 2n+1) by ``scipy.linalg.expm`` (of Ā τ, or with ``batch`` of the stack
+        of one Ā τ, as a vector of times gives it), the last :data:`EXPM_KEPT` kept by their exact τ
+        (Ā does not depend on Ω: kept across :meth:`at_omega`)."""
+        kept = self._expm_kept
+        key = (tau, batch)
+        E = kept.get(key)
+        if E is None:
+            E = sla.expm(self.Abar[None] * np.array([tau])[:, None, None])[0] if batch else sla.expm(self.Abar * tau)
+            if len(kept) >= EXPM_KEPT:
+                del kept[next(iter(kept))]
+            kept[key] = E
+        return E
+
     def transition(self, tau: float) -> FloatArray:
         """exp(A_s τ) (2n, 2n), exact to round-off."""
         if self.method == "expm":
@@ -532,28 +549,31 @@ class Segment:
         if self.w0 is not None:
             d, v = self.floors()
             return float(d[e]), float(v[e])
-        self.element_point(0.0, e)  # builds the element's terms
+        self._element_terms(e)
         return self._ef[e]
 
     # --- evaluation -----------------------------------------------------------------------------
     def _expm_w(self, taus: FloatArray) -> np.ndarray:
         """w(τ) = exp(Ā τ) w0 (fallback stages), shape (N, 2n+1): scipy's expm, stepped by one
-        expm of the grid step where ``taus`` is an equally spaced grid."""
-        Abar = self.sol.Abar
+        expm of the grid step where ``taus`` is an equally spaced grid; every exp(Ā τ) is kept by
+        its exact τ (:meth:`StageSolution.expm`: a grid's step and ends recur)."""
+        sol = self.sol
         if taus.size > 3:
             h = taus[1] - taus[0]
             inner = taus[1:-1] - taus[0]
             if h > 0.0 and np.allclose(np.diff(inner), h, rtol=1e-12, atol=0.0):
-                E = sla.expm(Abar * h)
+                E = sol.expm(float(h))
                 out = np.empty((taus.size, self.w0.size))
-                w = sla.expm(Abar * taus[0]) @ self.w0
+                w = sol.expm(float(taus[0])) @ self.w0
                 out[0] = w
                 for i in range(1, taus.size - 1):
                     w = E @ w
                     out[i] = w
-                out[-1] = sla.expm(Abar * taus[-1]) @ self.w0
+                out[-1] = sol.expm(float(taus[-1])) @ self.w0
                 return out
-        E = sla.expm(Abar[None] * taus[:, None, None])
+        if taus.size == 1:
+            return sol.expm(float(taus[0]), batch=True)[None] @ self.w0
+        E = sla.expm(sol.Abar[None] * taus[:, None, None])
         return E @ self.w0
 
     def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -605,8 +625,10 @@ class Segment:
 
     def end_state(self, tau: float) -> FloatArray:
         """z = (x, x') at one local time ``tau`` (2n,)."""
-        if self.w0 is not None:
-            return self.state(np.array([tau]))[0][0]
+        if self.w0 is not None:  # as state() computes z (not z')
+            t = np.array([tau])
+            z = (np.exp(np.multiply.outer(t, self.mu)) @ self.Bz).real if self.mu.size else np.zeros((1, self.z0.size))
+            return (z + self._expm_w(t)[:, :-1])[0]
         sol = self.sol
         z = (np.exp(self.mu * tau) * self.coef) @ sol.base_z
         z = z.real.copy()
@@ -617,17 +639,13 @@ class Segment:
             z += (sol.Pz[:, a:b] @ u).real
         return z
 
-    def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
-        """(δ_e, δ_e', δ_e'') at local time ``tau`` (a scalar)."""
-        if self.w0 is not None:
-            z, zd = self.state(np.array([tau]))
-            a = self.sol.flow.rows[e]
-            n = self.sol.flow.n
-            return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
+    def _element_terms(self, e: int) -> list[tuple[complex, complex, complex]]:
+        """Python numbers of element ``e``'s terms (μ, its δ and δ' amplitudes; the polynomial
+        blocks' in ``_qd_l``) and its round-off floors (``_ef``), built on first use."""
         if self._bd_l is None:
             self._bd_l, self._qd_l, self._ef = {}, {}, {}
         terms = self._bd_l.get(e)
-        if terms is None:  # Python numbers of this element's terms, built on first use
+        if terms is None:
             m = self.sol.flow.m
             terms = self._bd_l[e] = list(zip(self._mu_l, self.Bd[:, e].tolist(), self.Bd[:, m + e].tolist()))
             poly = self._qd_l[e] = [(complex(mu), Qd[:, e].tolist(), Qd[:, m + e].tolist())
@@ -640,6 +658,16 @@ class Segment:
                 dmag += grow * sum(abs(q) * T**k for k, q in enumerate(qd))
                 vmag += grow * sum(abs(q) * T**k for k, q in enumerate(qv))
             self._ef[e] = (8.0 * _EPS * dmag, 8.0 * _EPS * vmag)
+        return terms
+
+    def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
+        """(δ_e, δ_e', δ_e'') at local time ``tau`` (a scalar)."""
+        if self.w0 is not None:
+            z, zd = self.state(np.array([tau]))
+            a = self.sol.flow.rows[e]
+            n = self.sol.flow.n
+            return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
+        terms = self._element_terms(e)
         d = v = a = 0.0
         exp, cos, sin = math.exp, math.cos, math.sin
         for mu, b0, b1 in terms:
