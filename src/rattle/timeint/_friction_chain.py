@@ -321,6 +321,7 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         # per held set S: (A_S B_S)⁻¹ A_S and B_S (A_S B_S)⁻¹; per (stages, σ): y's constant part, Cᵀ, K_sᵀ
         self._held: dict[tuple, FloatArray] = {}
         self._parts: dict[tuple, tuple[FloatArray, FloatArray, FloatArray]] = {}
+        self._watch: dict[tuple, tuple] = {}  # per (mode, stages, locked): _watched
         self._L = float(system.length_scale())  # fixed scales: the event tolerances and grid read them
         self._wn = float(system.frequency_scale())
 
@@ -805,31 +806,26 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         of a slipping element with friction (kind STICK, refined to a stick or a reversal by the
         caller) or a held element's torque leaving its band (±r stuck, [−r_i, J_i + r_i+1] locked:
         RELEASE, +1 above the band, −1 below); element −1 if none."""
-        n, m = self.n, self.m
-        stuck, sigma = key
-        slip = [e for e in range(m) if self.has_friction[e] and not stuck[e] and sigma[e]]
-        S = [e for e in range(m) if stuck[e]]
+        n = self.n
+        setup = self._watch.get((key, stages, locked))
+        if setup is None:
+            setup = self._watch[(key, stages, locked)] = self._watched(key, stages, locked)
+        slip, S, lo_S, hi_S, sg, AslT = setup
         if tau_end <= 0.0 or not (slip or S):
             return tau_end, -1, -1, 0
         step = min(sol.grid_step, self._base_step(omega))
-        lk = (False,) * m if locked is None else locked
-        bands = [self._band(e, stages[e], lk[e]) for e in S]
-        lo_S = np.array([b[0] for b in bands])
-        hi_S = np.array([b[1] for b in bands])
         if S:
 
             def lam_at(taus: FloatArray, z: FloatArray) -> FloatArray:
                 return self._lambdas(S, self._free_acceleration(key, stages, seg.ts + taus, z, omega))
-        sl = np.array(slip, dtype=np.intp)
-        sg = np.array([sigma[e] for e in slip], dtype=float)
         tau_a = 0.0
         while tau_a < tau_end:
             taus = grid_chunk(tau_a, tau_end, step, _CHUNK)
             z, zd = seg.state(taus)
             best = (math.inf, -1, -1, 0)
             if slip:
-                sv = (z[:, n:] @ self.A[sl].T) * sg  # σ δ' (k+1, |slip|)
-                sa = (zd[:, n:] @ self.A[sl].T) * sg  # σ δ''
+                sv = (z[:, n:] @ AslT) * sg  # σ δ' (k+1, |slip|)
+                sa = (zd[:, n:] @ AslT) * sg  # σ δ''
                 for j, e in enumerate(slip):
                     hit = self._velocity_zero(seg, e, sg[j], taus, sv[:, j], sa[:, j])
                     if hit is not None and hit < best[0]:
@@ -862,6 +858,21 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
                 return best[0], best[1], best[2], best[3]
             tau_a = float(taus[-1])
         return tau_end, -1, -1, 0
+
+    def _watched(self, key: _Key, stages: tuple[int, ...], locked: tuple[bool, ...] | None) -> tuple:
+        """What :meth:`_friction_event` watches in a mode: the slipping elements with friction, the
+        held set S, its torques' bands (lo, hi), the slip signs σ and (a_e for the slipping)ᵀ."""
+        m = self.m
+        stuck, sigma = key
+        slip = [e for e in range(m) if self.has_friction[e] and not stuck[e] and sigma[e]]
+        S = [e for e in range(m) if stuck[e]]
+        lk = (False,) * m if locked is None else locked
+        bands = [self._band(e, stages[e], lk[e]) for e in S]
+        lo_S = np.array([b[0] for b in bands])
+        hi_S = np.array([b[1] for b in bands])
+        sl = np.array(slip, dtype=np.intp)
+        sg = np.array([sigma[e] for e in slip], dtype=float)
+        return slip, S, lo_S, hi_S, sg, self.A[sl].T
 
     def _velocity_zero(self, seg: Segment, e: int, s: float, taus: FloatArray, sv: FloatArray,
                        sa: FloatArray) -> float | None:

@@ -314,16 +314,18 @@ class StageSolution:
         else:
             self.Zh = np.zeros((0, 2 * n), dtype=complex)
 
-        # Time scales.
-        scale = math.inf
-        if hw.size:
-            scale = min(scale, _TWO_PI / float(np.max(hw)))
-        im = float(np.max(np.abs(lam.imag))) if lam.size else 0.0
-        re = float(np.max(np.abs(lam.real))) if lam.size else 0.0
-        if im > 0.0:
-            scale = min(scale, _TWO_PI / im)
-        if re > 0.0:
-            scale = min(scale, 0.5 / re)
+        # Time scales: the highest harmonic's and the stage's own (its fastest oscillation and decay).
+        own = getattr(self, "_own_scale", None)
+        if own is None:
+            own = math.inf
+            im = float(np.max(np.abs(lam.imag))) if lam.size else 0.0
+            re = float(np.max(np.abs(lam.real))) if lam.size else 0.0
+            if im > 0.0:
+                own = min(own, _TWO_PI / im)
+            if re > 0.0:
+                own = min(own, 0.5 / re)
+            self._own_scale = own
+        scale = min(_TWO_PI / float(np.max(hw)), own) if hw.size else own
         self.time_scale = scale
         self.grid_step = scale / flow.samples_per_scale
         self.max_segment = _SEGMENT_SCALES * scale
