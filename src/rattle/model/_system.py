@@ -136,7 +136,8 @@ class System:
         against ``t``)."""
         t = np.asarray(t, dtype=float)
         if self.load is None:
-            out = np.broadcast_to(self.mean, t.shape + (self.n,)).copy()
+            out = np.empty(t.shape + (self.n,))
+            out[...] = self.mean
         else:
             out = np.broadcast_to(self.mean_at(np.broadcast_to(omega, t.shape)), t.shape + (self.n,)).copy()
         for h in range(1, self.forced_harmonics + 1):

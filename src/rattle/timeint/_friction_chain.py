@@ -80,7 +80,7 @@ from types import SimpleNamespace
 import numpy as np
 from .._brent import brent_root
 from .._lazy import lazy_module
-from .._limits import check_interval
+from .._limits import MAX_PERIOD, check_interval
 from .._typing import FloatArray
 from .._validate import check_omega
 from ..errors import ConvergenceError
@@ -90,6 +90,7 @@ from ._roots import grid_chunk, polish_crossing
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
+from ._nonsmooth import MEMO
 from ._stage_flow import Segment, StageSolution, SystemStages
 
 optimize = lazy_module("scipy.optimize")  # minimize_scalar, for the extremes of a segment
@@ -314,8 +315,13 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         self.jumps = [np.asarray(law.stages.jumps, dtype=float) for law in system.laws]
         self.breakpoints = [np.asarray(law.stages.breakpoints, dtype=float) for law in system.laws]
         self._modal: dict = {}
-        self._omega: float | None = None
-        self._flows: dict = {}
+        self._flows: dict[float, dict[_Key, SystemStages]] = {}
+        self._modes: dict[_Key, SystemStages] = {}  # every mode's stages at the first Ω it was met
+        self._memo: dict[tuple, FrictionTrajectory] = {}
+        # per held set S: (A_S B_S)⁻¹ A_S and B_S (A_S B_S)⁻¹; per (stages, σ): y's constant part, Cᵀ, K_sᵀ
+        self._held: dict[tuple, FloatArray] = {}
+        self._parts: dict[tuple, tuple[FloatArray, FloatArray, FloatArray]] = {}
+        self._watch: dict[tuple, tuple] = {}  # per (mode, stages, locked): _watched
         self._L = float(system.length_scale())  # fixed scales: the event tolerances and grid read them
         self._wn = float(system.frequency_scale())
 
@@ -339,13 +345,26 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
                       coordinates=base.coordinates, angles=base.angles, free=base.free, load=None)
 
     def _flow(self, key: _Key, omega: float) -> SystemStages:
-        if self._omega != omega:
-            self._omega, self._flows = omega, {}
-        flow = self._flows.get(key)
+        """The mode ``key``'s stages at ``omega``: kept for the last :data:`~._nonsmooth.MEMO`
+        frequencies (a shooting alternates Ω and Ω + h, its ∂/∂Ω); a mode's system does not depend
+        on Ω without a drag by speed, and its stages at a new Ω are then made from those of the
+        first (:meth:`SystemStages.at_omega`)."""
+        flows = self._flows.get(omega)
+        if flows is None:
+            if len(self._flows) >= MEMO:
+                del self._flows[next(iter(self._flows))]
+            flows = self._flows[omega] = {}
+        flow = flows.get(key)
         if flow is None:
-            cache = self._modal.setdefault(key, {}) if self.base.load is None else None
-            flow = SystemStages(self._mode_system(key, omega), omega, self.samples_per_scale, modal_cache=cache)
-            self._flows[key] = flow
+            if self.base.load is None:
+                first = self._modes.get(key)
+                if first is None:
+                    first = self._modes[key] = SystemStages(self._mode_system(key, omega), omega,
+                                                            self.samples_per_scale, modal_cache=self._modal.setdefault(key, {}))
+                flow = first if first.omega == omega else first.at_omega(omega)
+            else:
+                flow = SystemStages(self._mode_system(key, omega), omega, self.samples_per_scale)
+            flows[key] = flow
         return flow
 
     def _base_step(self, omega: float) -> float:
@@ -382,17 +401,23 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         """y = F(t) − C x' − K_s x − Σ b_e o_ej − Σ_slip b_e σ_e r_ej, shape t.shape + (n,)
         (z: t.shape + (2n,)); o_ej the law's own offsets (jumps included)."""
         n = self.n
-        base = self.base
         x, v = z[..., :n], z[..., n:]
-        const = np.zeros(n)
-        for e in range(self.m):
-            const += (self.offsets[e][stages[e]] + key[1][e] * self.levels[e][stages[e]]) * self.B[:, e]
-        return base.forcing(t, omega) - v @ base.damping.T - x @ base.stage_stiffness(stages).T - const
+        parts = self._parts.get((stages, key[1]))
+        if parts is None:
+            const = np.zeros(n)
+            for e in range(self.m):
+                const += (self.offsets[e][stages[e]] + key[1][e] * self.levels[e][stages[e]]) * self.B[:, e]
+            parts = self._parts[(stages, key[1])] = (const, self.base.damping.T, self.base.stage_stiffness(stages).T)
+        const, CT, KT = parts
+        return self.base.forcing(t, omega) - v @ CT - x @ KT - const
 
     def _lambdas(self, S: list[int], y: FloatArray) -> FloatArray:
         """λ = (A_S B_S)⁻¹ A_S y for y (..., n): shape (..., |S|)."""
-        AS, BS = self.A[S], self.B[:, S]
-        return y @ np.linalg.solve(AS @ BS, AS).T
+        X = self._held.get(("lambda", *S))
+        if X is None:
+            AS, BS = self.A[S], self.B[:, S]
+            X = self._held[("lambda", *S)] = np.linalg.solve(AS @ BS, AS).T
+        return y @ X
 
     def _band(self, e: int, stage: int, locked: bool) -> tuple[float, float]:
         """The band [lo, hi] of a held element's torque λ_e: ±r_ej when stuck on stage j; when
@@ -441,8 +466,11 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
     def _hold_columns(self, S: list[int]) -> FloatArray:
         """W = B_S (A_S B_S)⁻¹ (n, |S|): column w_e moves element e alone (a_e·w_e = 1, a_k·w_e = 0 for
         the other held k) along the constraint forces."""
-        AS, BS = self.A[S], self.B[:, S]
-        return BS @ np.linalg.inv(AS @ BS)
+        W = self._held.get(("hold", *S))
+        if W is None:
+            AS, BS = self.A[S], self.B[:, S]
+            W = self._held[("hold", *S)] = BS @ np.linalg.inv(AS @ BS)
+        return W.copy()
 
     def _initial_key(self, t: float, z: FloatArray, stages: tuple[int, ...],
                      omega: float) -> tuple[_Key, tuple[int, ...], tuple[bool, ...]]:
@@ -490,14 +518,20 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
     def propagate(self, z0: FloatArray, t0: float, t1: float, omega: float) -> FrictionTrajectory:
         """Integrate exactly from ``z0`` = (x, x') at ``t0`` to ``t1`` ≥ t0 at forcing frequency
         ``omega``: the :class:`FrictionTrajectory` with its segments, events, final state and
-        sensitivity ∂z(t1)/∂z(t0)."""
+        sensitivity ∂z(t1)/∂z(t0). The last :data:`~._nonsmooth.MEMO` trajectories are kept by
+        their exact arguments (z0, t0, t1, Ω): a shooting continuation asks again for the period it
+        has just integrated (an accepted point's row after the corrector's last evaluation there)."""
         z = check_system_state(z0, self.n)
         omega = check_omega(omega)
         t0, t1 = check_interval(t0, t1, omega)
+        key = (z.tobytes(), t0, t1, omega)
+        traj = self._memo.get(key)
+        if traj is not None:
+            return traj
         rec: dict[str, list] = {k: [] for k in ("ts", "st", "sk", "lk", "seg", "et", "ee", "ek", "ev")}
         z1, M = self._march(z, t0, t1, omega, rec)
         ts = np.asarray(rec["ts"], dtype=float)
-        return FrictionTrajectory(
+        traj = FrictionTrajectory(
             system=self.system, omega=omega, t0=t0, t1=t1, state0=z, state1=z1, sensitivity=M, t_start=ts,
             t_end=np.append(ts[1:], t1), stages=np.asarray(rec["st"], dtype=np.int64).reshape(-1, self.m),
             stuck=np.asarray(rec["sk"], dtype=bool).reshape(-1, self.m), segments=tuple(rec["seg"]),
@@ -505,12 +539,22 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
             event_kinds=np.asarray(rec["ek"], dtype=np.int64), event_values=np.asarray(rec["ev"], dtype=float),
             locked=np.asarray(rec["lk"], dtype=bool).reshape(-1, self.m),
         )
+        if len(self._memo) >= MEMO:
+            del self._memo[next(iter(self._memo))]
+        self._memo[key] = traj
+        return traj
 
     def advance(self, z0: FloatArray, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[FloatArray, FloatArray]:
-        """The state at ``t1`` and ∂z(t1)/∂z(t0) only (no record: the shooting's hot path; the
-        ``sensitivity`` is there for the common signature: M is always computed)."""
-        return self._march(np.asarray(z0, dtype=float).copy(), float(t0), float(t1), float(omega), None)
+        """The state at ``t1`` and ∂z(t1)/∂z(t0) (copies; the ``sensitivity`` is there for the
+        common signature: M is always computed): the period map of a shooting, recorded and kept
+        (:meth:`propagate`) over at most an orbit's longest period (``MAX_PERIOD`` forcing
+        periods), else marched without a record (a long settling)."""
+        t0, t1, omega = float(t0), float(t1), float(omega)
+        if (t1 - t0) * omega / (2.0 * math.pi) <= MAX_PERIOD + 0.5:
+            traj = self.propagate(z0, t0, t1, omega)
+            return traj.state1.copy(), traj.sensitivity.copy()
+        return self._march(np.asarray(z0, dtype=float).copy(), t0, t1, omega, None)
 
     def _march(self, z: FloatArray, t0: float, t1: float, omega: float,
                rec: dict[str, list] | None) -> tuple[FloatArray, FloatArray]:
@@ -762,31 +806,26 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         of a slipping element with friction (kind STICK, refined to a stick or a reversal by the
         caller) or a held element's torque leaving its band (±r stuck, [−r_i, J_i + r_i+1] locked:
         RELEASE, +1 above the band, −1 below); element −1 if none."""
-        n, m = self.n, self.m
-        stuck, sigma = key
-        slip = [e for e in range(m) if self.has_friction[e] and not stuck[e] and sigma[e]]
-        S = [e for e in range(m) if stuck[e]]
+        n = self.n
+        setup = self._watch.get((key, stages, locked))
+        if setup is None:
+            setup = self._watch[(key, stages, locked)] = self._watched(key, stages, locked)
+        slip, S, lo_S, hi_S, sg, AslT = setup
         if tau_end <= 0.0 or not (slip or S):
             return tau_end, -1, -1, 0
         step = min(sol.grid_step, self._base_step(omega))
-        lk = (False,) * m if locked is None else locked
-        bands = [self._band(e, stages[e], lk[e]) for e in S]
-        lo_S = np.array([b[0] for b in bands])
-        hi_S = np.array([b[1] for b in bands])
         if S:
 
             def lam_at(taus: FloatArray, z: FloatArray) -> FloatArray:
                 return self._lambdas(S, self._free_acceleration(key, stages, seg.ts + taus, z, omega))
-        sl = np.array(slip, dtype=np.intp)
-        sg = np.array([sigma[e] for e in slip], dtype=float)
         tau_a = 0.0
         while tau_a < tau_end:
             taus = grid_chunk(tau_a, tau_end, step, _CHUNK)
             z, zd = seg.state(taus)
             best = (math.inf, -1, -1, 0)
             if slip:
-                sv = (z[:, n:] @ self.A[sl].T) * sg  # σ δ' (k+1, |slip|)
-                sa = (zd[:, n:] @ self.A[sl].T) * sg  # σ δ''
+                sv = (z[:, n:] @ AslT) * sg  # σ δ' (k+1, |slip|)
+                sa = (zd[:, n:] @ AslT) * sg  # σ δ''
                 for j, e in enumerate(slip):
                     hit = self._velocity_zero(seg, e, sg[j], taus, sv[:, j], sa[:, j])
                     if hit is not None and hit < best[0]:
@@ -820,6 +859,21 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
             tau_a = float(taus[-1])
         return tau_end, -1, -1, 0
 
+    def _watched(self, key: _Key, stages: tuple[int, ...], locked: tuple[bool, ...] | None) -> tuple:
+        """What :meth:`_friction_event` watches in a mode: the slipping elements with friction, the
+        held set S, its torques' bands (lo, hi), the slip signs σ and (a_e for the slipping)ᵀ."""
+        m = self.m
+        stuck, sigma = key
+        slip = [e for e in range(m) if self.has_friction[e] and not stuck[e] and sigma[e]]
+        S = [e for e in range(m) if stuck[e]]
+        lk = (False,) * m if locked is None else locked
+        bands = [self._band(e, stages[e], lk[e]) for e in S]
+        lo_S = np.array([b[0] for b in bands])
+        hi_S = np.array([b[1] for b in bands])
+        sl = np.array(slip, dtype=np.intp)
+        sg = np.array([sigma[e] for e in slip], dtype=float)
+        return slip, S, lo_S, hi_S, sg, self.A[sl].T
+
     def _velocity_zero(self, seg: Segment, e: int, s: float, taus: FloatArray, sv: FloatArray,
                        sa: FloatArray) -> float | None:
         """The first τ in (taus[0], taus[-1]] where σ δ_e' reaches 0 (``sv`` its samples, ``sa``
@@ -833,8 +887,12 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         def acc(tau: float) -> float:
             return s * seg.element_point(tau, e)[2]
 
+        # only the cells that can decide: σ δ' ≤ 0 at their end, or a minimum of σ δ' inside
+        cells = (np.flatnonzero((sv[1:] <= 0.0) | ((sa[:-1] < 0.0) & (sa[1:] > 0.0))) + 1).tolist()
+        if not cells:
+            return None
         floor = 64.0 * _EPS * max(float(np.max(np.abs(sv))), self.velocity_scale(seg.sol.flow.omega))
-        for i in range(1, taus.size):
+        for i in cells:
             lo_v, hi_v = float(sv[i - 1]), float(sv[i])
             if hi_v <= 0.0:
                 if lo_v > floor or (lo_v > 0.0 and i > 1):

@@ -38,6 +38,7 @@ evaluated vectorised for the crossing search and at single points for the root r
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -52,6 +53,8 @@ _CLUSTER = 1e-4  # eigenvalues closer than this × spectral radius share a Taylo
 _MAX_CONDITION = 1e6  # condition number of P beyond which the stage falls back to expm
 _SEGMENT_SCALES = 64.0  # longest segment, in stage time scales (a new segment starts beyond it)
 _MAX_TAYLOR = 200
+#: exp(Ā τ) a fallback stage keeps by τ (:meth:`StageSolution.expm`)
+EXPM_KEPT = 16
 
 
 def _taylor_terms(T: np.ndarray, c: np.ndarray, tau_max: float) -> np.ndarray:
@@ -125,7 +128,8 @@ class SystemStages:
         cos = np.asarray(system.cos, dtype=float).reshape(-1, n)
         sin = np.asarray(system.sin, dtype=float).reshape(-1, n)
         keep = np.any(cos != 0.0, axis=1) | np.any(sin != 0.0, axis=1)
-        self.hw = (np.arange(1, cos.shape[0] + 1, dtype=float) * self.omega)[keep]
+        self._orders, self._keep = np.arange(1, cos.shape[0] + 1, dtype=float), keep
+        self.hw = (self._orders * self.omega)[keep]
         self.fc = cos[keep]
         self.fs = sin[keep]
         rows = system.element_rows.reshape(m, n)
@@ -137,13 +141,32 @@ class SystemStages:
         self.lower = [np.concatenate(([-np.inf], np.asarray(e.breakpoints, dtype=float))) for e in system.elements]
         self.upper = [np.concatenate((np.asarray(e.breakpoints, dtype=float), [np.inf])) for e in system.elements]
         self._cache: dict[tuple[int, ...], StageSolution] = {}
+        #: a solution per stage combination at any Ω, shared with the copies of :meth:`at_omega`
+        #: (the Ω-independent parts of their solutions)
+        self._bases: dict[tuple[int, ...], StageSolution] = {}
+
+    def at_omega(self, omega: float) -> SystemStages:
+        """The same system's stages at forcing frequency ``omega``, equal to ``SystemStages(system,
+        omega, …)`` for a system whose mean forcing does not depend on Ω (no ``load``): its stage
+        solutions are made from those of any frequency (:meth:`StageSolution.at_omega`: only the
+        harmonic particular solutions and the time scales afresh)."""
+        if self.system.load is not None:
+            raise ValueError("at_omega needs a mean forcing independent of Ω (a system without `load`)")
+        out = copy.copy(self)  # shares the stage data, the modal cache and the bases
+        out.omega = float(omega)
+        out.hw = (self._orders * out.omega)[self._keep]
+        out._cache = {}
+        return out
 
     def solution(self, stages: tuple[int, ...]) -> StageSolution:
-        """The :class:`StageSolution` of the stage combination ``stages`` (cached)."""
+        """The :class:`StageSolution` of the stage combination ``stages`` (cached; from the same
+        stages' solution at another Ω where there is one)."""
         sol = self._cache.get(stages)
         if sol is None:
-            sol = StageSolution(self, stages)
+            base = self._bases.get(stages)
+            sol = StageSolution(self, stages) if base is None else base.at_omega(self)
             self._cache[stages] = sol
+            self._bases.setdefault(stages, sol)
         return sol
 
     def forcing(self, t: FloatArray | float, derivative: int = 0) -> FloatArray:
@@ -225,13 +248,54 @@ class StageSolution:
         Abar[: 2 * n, : 2 * n] = A
         Abar[: 2 * n, 2 * n] = g
         self.Abar = Abar
+        self._expm_kept: dict[tuple[float, bool], FloatArray] = {}  # shared with the at_omega copies
         key = stages if flow._cache_tag is None else (stages, flow._cache_tag)
         cached = flow.modal_cache.get(key)
         lam = np.linalg.eigvals(A) if cached is None else cached["eigenvalues"]
         self.eigenvalues = lam
         rho = float(np.max(np.abs(lam))) if lam.size else 0.0
+        self._rho = rho
+        self._set_omega(flow)  # the harmonic particular solutions and the time scales
 
-        # Harmonic particular solutions.
+        # Block-modal form of exp(Ā τ).
+        if cached is None:
+            self.method = "modal"
+            try:
+                self._block_modal_form(Abar, rho)
+            except (np.linalg.LinAlgError, ValueError):
+                self.method = "expm"
+            cached = {"eigenvalues": lam, "method": self.method}
+            if self.method == "modal":
+                cached.update({k: getattr(self, k) for k in _MODAL_FIELDS})
+            flow.modal_cache[key] = cached
+        else:
+            for k, v in cached.items():
+                if k != "eigenvalues":
+                    setattr(self, k, v)
+        if self.method == "modal":
+            self.Pinv_1 = self.Pinv[:, -1]
+        self._set_bases()
+        self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
+        self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
+        self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
+
+    def at_omega(self, flow: SystemStages) -> StageSolution:
+        """The same stage combination's solution in ``flow`` (the same system at another Ω, a mean
+        forcing independent of Ω): the stage matrices and their modal form shared, the harmonic
+        particular solutions, time scales and mode amplitudes' bases made afresh — equal to
+        ``StageSolution(flow, stages)``."""
+        out = copy.copy(self)
+        out.flow = flow
+        out.__dict__.pop("_omega_xy", None)
+        out._set_omega(flow)
+        out._set_bases()
+        return out
+
+    def _set_omega(self, flow: SystemStages) -> None:
+        """The parts that depend on Ω: the harmonic particular amplitudes Z_h (refused at an exact
+        resonance of an undamped stage), the time scales, the grid step and the longest segment."""
+        n = flow.n
+        A, lam, rho, stages = self.A, self.eigenvalues, self._rho, self.stages
         hw = flow.hw
         if hw.size:
             dist = np.abs(lam[None, :] - 1j * hw[:, None])
@@ -250,51 +314,37 @@ class StageSolution:
         else:
             self.Zh = np.zeros((0, 2 * n), dtype=complex)
 
-        # Time scales.
-        scale = math.inf
-        if hw.size:
-            scale = min(scale, _TWO_PI / float(np.max(hw)))
-        im = float(np.max(np.abs(lam.imag))) if lam.size else 0.0
-        re = float(np.max(np.abs(lam.real))) if lam.size else 0.0
-        if im > 0.0:
-            scale = min(scale, _TWO_PI / im)
-        if re > 0.0:
-            scale = min(scale, 0.5 / re)
+        # Time scales: the highest harmonic's and the stage's own (its fastest oscillation and decay).
+        own = getattr(self, "_own_scale", None)
+        if own is None:
+            own = math.inf
+            im = float(np.max(np.abs(lam.imag))) if lam.size else 0.0
+            re = float(np.max(np.abs(lam.real))) if lam.size else 0.0
+            if im > 0.0:
+                own = min(own, _TWO_PI / im)
+            if re > 0.0:
+                own = min(own, 0.5 / re)
+            self._own_scale = own
+        scale = min(_TWO_PI / float(np.max(hw)), own) if hw.size else own
         self.time_scale = scale
         self.grid_step = scale / flow.samples_per_scale
         self.max_segment = _SEGMENT_SCALES * scale
 
-        # Block-modal form of exp(Ā τ).
-        if cached is None:
-            self.method = "modal"
-            try:
-                self._block_modal_form(Abar, rho)
-            except (np.linalg.LinAlgError, ValueError):
-                self.method = "expm"
-            cached = {"eigenvalues": lam, "method": self.method}
-            if self.method == "modal":
-                cached.update({k: getattr(self, k) for k in _MODAL_FIELDS})
-            flow.modal_cache[key] = cached
-        else:
-            for k, v in cached.items():
-                if k != "eigenvalues":
-                    setattr(self, k, v)
+    def _set_bases(self) -> None:
+        """The modes (the diagonalised eigenvalues, then the harmonics ihΩ) and a segment's mode
+        amplitudes' bases: coef[:, None] * base (coef: modal coordinates, then the harmonics'
+        phase factors at its start)."""
+        flow = self.flow
+        hw = flow.hw
+        self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
         if self.method == "modal":
             self.modes = np.concatenate((self.lam, 1j * hw))
-        self.Zh_d = self.Zh @ flow.G.T  # (H, 2m)
-        # A segment's mode amplitudes are coef[:, None] * base (coef: modal coordinates, then the
-        # harmonics' phase factors at its start).
-        if self.method == "modal":
             self.base_d = np.concatenate((self.Pd_modal.T, self.Zh_d), axis=0)  # (K, 2m)
             self.base_z = np.concatenate((self.Pz_modal.T, self.Zh), axis=0)  # (K, 2n)
-            self.Pinv_1 = self.Pinv[:, -1]
         else:
             self.modes = 1j * hw
             self.base_d, self.base_z = self.Zh_d, self.Zh
         self.modes_l = self.modes.tolist()
-        self.lo = np.array([flow.lower[e][j] for e, j in enumerate(stages)])
-        self.hi = np.array([flow.upper[e][j] for e, j in enumerate(stages)])
-        self.bounded = bool(np.any(np.isfinite(self.lo)) or np.any(np.isfinite(self.hi)))
 
     def _block_modal_form(self, Abar: np.ndarray, rho: float) -> None:
         """Ā = P diag(μ_1 I + N_1, …, μ_c I + N_c, Λ) P⁻¹: clusters of eigenvalues closer than
@@ -379,6 +429,20 @@ class StageSolution:
         X, Y = XY
         ph = np.exp(1j * hw * t)
         return ((X * t + Y) * ph[:, None]).sum(axis=0).real
+
+    def expm(self, tau: float, batch: bool = False) -> FloatArray:
+        """exp(Ā τ) (2n+1, 2n+1) by ``scipy.linalg.expm`` (of Ā τ, or with ``batch`` of the stack
+        of one Ā τ, as a vector of times gives it), the last :data:`EXPM_KEPT` kept by their exact τ
+        (Ā does not depend on Ω: kept across :meth:`at_omega`)."""
+        kept = self._expm_kept
+        key = (tau, batch)
+        E = kept.get(key)
+        if E is None:
+            E = sla.expm(self.Abar[None] * np.array([tau])[:, None, None])[0] if batch else sla.expm(self.Abar * tau)
+            if len(kept) >= EXPM_KEPT:
+                del kept[next(iter(kept))]
+            kept[key] = E
+        return E
 
     def transition(self, tau: float) -> FloatArray:
         """exp(A_s τ) (2n, 2n), exact to round-off."""
@@ -487,28 +551,31 @@ class Segment:
         if self.w0 is not None:
             d, v = self.floors()
             return float(d[e]), float(v[e])
-        self.element_point(0.0, e)  # builds the element's terms
+        self._element_terms(e)
         return self._ef[e]
 
     # --- evaluation -----------------------------------------------------------------------------
     def _expm_w(self, taus: FloatArray) -> np.ndarray:
         """w(τ) = exp(Ā τ) w0 (fallback stages), shape (N, 2n+1): scipy's expm, stepped by one
-        expm of the grid step where ``taus`` is an equally spaced grid."""
-        Abar = self.sol.Abar
+        expm of the grid step where ``taus`` is an equally spaced grid; every exp(Ā τ) is kept by
+        its exact τ (:meth:`StageSolution.expm`: a grid's step and ends recur)."""
+        sol = self.sol
         if taus.size > 3:
             h = taus[1] - taus[0]
             inner = taus[1:-1] - taus[0]
             if h > 0.0 and np.allclose(np.diff(inner), h, rtol=1e-12, atol=0.0):
-                E = sla.expm(Abar * h)
+                E = sol.expm(float(h))
                 out = np.empty((taus.size, self.w0.size))
-                w = sla.expm(Abar * taus[0]) @ self.w0
+                w = sol.expm(float(taus[0])) @ self.w0
                 out[0] = w
                 for i in range(1, taus.size - 1):
                     w = E @ w
                     out[i] = w
-                out[-1] = sla.expm(Abar * taus[-1]) @ self.w0
+                out[-1] = sol.expm(float(taus[-1])) @ self.w0
                 return out
-        E = sla.expm(Abar[None] * taus[:, None, None])
+        if taus.size == 1:
+            return sol.expm(float(taus[0]), batch=True)[None] @ self.w0
+        E = sla.expm(sol.Abar[None] * taus[:, None, None])
         return E @ self.w0
 
     def scan(self, taus: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -560,8 +627,10 @@ class Segment:
 
     def end_state(self, tau: float) -> FloatArray:
         """z = (x, x') at one local time ``tau`` (2n,)."""
-        if self.w0 is not None:
-            return self.state(np.array([tau]))[0][0]
+        if self.w0 is not None:  # as state() computes z (not z')
+            t = np.array([tau])
+            z = (np.exp(np.multiply.outer(t, self.mu)) @ self.Bz).real if self.mu.size else np.zeros((1, self.z0.size))
+            return (z + self._expm_w(t)[:, :-1])[0]
         sol = self.sol
         z = (np.exp(self.mu * tau) * self.coef) @ sol.base_z
         z = z.real.copy()
@@ -572,17 +641,13 @@ class Segment:
             z += (sol.Pz[:, a:b] @ u).real
         return z
 
-    def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
-        """(δ_e, δ_e', δ_e'') at local time ``tau`` (a scalar)."""
-        if self.w0 is not None:
-            z, zd = self.state(np.array([tau]))
-            a = self.sol.flow.rows[e]
-            n = self.sol.flow.n
-            return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
+    def _element_terms(self, e: int) -> list[tuple[complex, complex, complex]]:
+        """Python numbers of element ``e``'s terms (μ, its δ and δ' amplitudes; the polynomial
+        blocks' in ``_qd_l``) and its round-off floors (``_ef``), built on first use."""
         if self._bd_l is None:
             self._bd_l, self._qd_l, self._ef = {}, {}, {}
         terms = self._bd_l.get(e)
-        if terms is None:  # Python numbers of this element's terms, built on first use
+        if terms is None:
             m = self.sol.flow.m
             terms = self._bd_l[e] = list(zip(self._mu_l, self.Bd[:, e].tolist(), self.Bd[:, m + e].tolist()))
             poly = self._qd_l[e] = [(complex(mu), Qd[:, e].tolist(), Qd[:, m + e].tolist())
@@ -595,6 +660,16 @@ class Segment:
                 dmag += grow * sum(abs(q) * T**k for k, q in enumerate(qd))
                 vmag += grow * sum(abs(q) * T**k for k, q in enumerate(qv))
             self._ef[e] = (8.0 * _EPS * dmag, 8.0 * _EPS * vmag)
+        return terms
+
+    def element_point(self, tau: float, e: int) -> tuple[float, float, float]:
+        """(δ_e, δ_e', δ_e'') at local time ``tau`` (a scalar)."""
+        if self.w0 is not None:
+            z, zd = self.state(np.array([tau]))
+            a = self.sol.flow.rows[e]
+            n = self.sol.flow.n
+            return float(a @ z[0, :n]), float(a @ z[0, n:]), float(a @ zd[0, n:])
+        terms = self._element_terms(e)
         d = v = a = 0.0
         exp, cos, sin = math.exp, math.cos, math.sin
         for mu, b0, b1 in terms:
