@@ -18,6 +18,7 @@ from _filippov import chain_reference, single_reference  # tests/ is on sys.path
 
 import rattle
 from rattle.analysis import RegularisationOptions, ShootingOptions
+from rattle.errors import Status
 from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._exact_branch import start_state
 from rattle.continuation import NewtonOptions
@@ -236,3 +237,26 @@ def test_progress_reports_the_share_of_the_range_reached():
     assert all(t == 1000 for _, t in seen) and done == sorted(done) and done[-1] >= 900
     with pytest.raises(TypeError, match="progress"):
         nonsmooth_response(system, omega, progress=3)  # type: ignore[arg-type]
+
+
+def test_a_branch_that_turns_back_at_its_start_is_a_success_when_the_other_end_covers_the_range():
+    """A preload (found by benchmarks/crossval_shooting_stability.py, case 12) whose branch from
+    Ω_min turns at a fold 0.5 % into the range and leaves it where it started (RETURNED); the branch
+    followed down from Ω_max covers the rest. The range is covered, so the response is a success
+    (it was reported 'returned': `rattle frf` exit 1 on a complete answer)."""
+    from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
+
+    system = NonsmoothSystem(damping=0.0466905493687573, stiffness=1.0,
+                             law=NonsmoothLaw(elastic=Preload(preload=0.012658012081765974, clearance=0.0,
+                                                              slope=1.2245173475023938)),
+                             excitation=Excitation(mean=0.04022804749269272,
+                                                   amplitudes=(0.06456084894156201, 0.013303750724586439),
+                                                   phases=(0.0, 3.4661445697704405)))
+    lo, hi = 0.39240141644239235, 0.7848028328847847
+    frf = rattle.frequency_response(system, omega=(lo, hi))
+    first = frf.check
+    assert float(np.max(first.omega)) < lo * 1.01 and "fold" in list(first.labels)  # it turned back
+    assert frf.status is Status.SUCCESS, frf.message
+    assert "covered with the branch followed from the other end" in frf.message
+    om = np.asarray(frf.omega, dtype=float)
+    assert om.min() <= lo * (1 + 1e-9) and om.max() >= hi * (1 - 1e-9)

@@ -708,8 +708,8 @@ def _missed_branches(follower: _Follower, found: list[ExactBranch], check: Sweep
 
 
 def _coverage(branches: list[ExactBranch], lo: float, hi: float) -> None:
-    """A primary branch that ended early (a stall) while the branches together cover the range is a
-    success: its status says so, its message keeps why it ended; else the uncovered frequencies are
+    """A primary branch that ended early (a stall, or it turned back and left the range at Ω_min)
+    while the branches together cover the range is a success: its status says so, its message keeps why it ended; else the uncovered frequencies are
     named in its message."""
     spans: list[tuple[float, float]] = []
     for b in branches:
@@ -729,7 +729,8 @@ def _coverage(branches: list[ExactBranch], lo: float, hi: float) -> None:
     if reach < hi * (1.0 - 1e-9):
         gaps.append((reach, hi))
     first = branches[0]
-    if not gaps and not first.status.success and first.status is not Status.START_FAILED:
+    ended_early = not first.status.success or first.status is Status.RETURNED  # turned back: the top not reached
+    if not gaps and ended_early and first.status is not Status.START_FAILED:
         first.message = f"{first.message}; the range is covered with the branch followed from the other end"
         first.status = Status.SUCCESS
     elif gaps:
