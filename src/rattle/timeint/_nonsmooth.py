@@ -152,17 +152,18 @@ class NonsmoothTrajectory(ExactTrajectory):
                 d[sel] = self.x_start[i, 0]
         return d.reshape(t.shape), v.reshape(t.shape), a.reshape(t.shape)
 
-    def integrate(self, fun, panels_per_scale: int = 4) -> float:  # type: ignore[no-untyped-def]
-        """∫_{t0}^{t1} fun(t, δ, δ', δ'') dt by Gauss–Legendre panels inside every segment (the
-        integrand is smooth there; ``panels_per_scale`` panels per time scale of the mode)."""
-        total = 0.0
+    def _panels(self, panels_per_scale: int):  # type: ignore[no-untyped-def]
+        """Every segment's Gauss–Legendre panels: (i, ta, tb, mode m of a slip or None, tq, half)
+        with the nodes tq (panels, 16) and the half widths; a slip's mode has ``panels_per_scale``
+        panels per its time scale, a stick or lock (δ, δ', δ'' constant) as many per forcing period."""
         sol = self.solutions
+        fast = float(sol.nw.max(initial=0.0))
         for i in range(len(self.t_start)):
             ta, tb = float(self.t_start[i]), float(self.t_end[i])
             if tb <= ta:
                 continue
-            # a stick or lock: δ, δ', δ'' constant, the forcing's period sets the panels of fun(t, …)
-            n = max(1, math.ceil((tb - ta) * panels_per_scale * float(sol.nw.max(initial=0.0)) / (2.0 * math.pi)))
+            n = max(1, math.ceil((tb - ta) * panels_per_scale * fast / (2.0 * math.pi)))
+            m = None
             if self.kind[i] == SLIP:
                 m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
                 scale = float(sol.time_scale[m])
@@ -170,6 +171,13 @@ class NonsmoothTrajectory(ExactTrajectory):
             edges = np.linspace(ta, tb, n + 1)
             half = 0.5 * np.diff(edges)
             tq = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]
+            yield i, ta, tb, m, tq, half
+
+    def integrate(self, fun, panels_per_scale: int = 4) -> float:  # type: ignore[no-untyped-def]
+        """∫_{t0}^{t1} fun(t, δ, δ', δ'') dt by Gauss–Legendre panels inside every segment (the
+        integrand is smooth there; ``panels_per_scale`` panels per time scale of the mode)."""
+        total = 0.0
+        for _i, ta, tb, _m, tq, half in self._panels(panels_per_scale):
             d, v, a = self.sample(np.clip(tq, ta, tb))
             total += float(np.sum(half[:, None] * _GAUSS_W[None, :] * fun(tq, d, v, a)))
         return total
@@ -238,22 +246,9 @@ class NonsmoothTrajectory(ExactTrajectory):
         segment's δ sampled once for both."""
         s1 = s2 = 0.0
         sol = self.solutions
-        fast = float(sol.nw.max(initial=0.0))
-        for i in range(len(self.t_start)):
-            ta, tb = float(self.t_start[i]), float(self.t_end[i])
-            if tb <= ta:
-                continue
-            n = max(1, math.ceil((tb - ta) * panels_per_scale * fast / (2.0 * math.pi)))
-            slip = self.kind[i] == SLIP
-            if slip:
-                m = 3 * int(self.stage[i]) + int(self.sign[i]) + 1
-                scale = float(sol.time_scale[m])
-                n = 1 if not math.isfinite(scale) else max(1, math.ceil((tb - ta) * panels_per_scale / scale))
-            edges = np.linspace(ta, tb, n + 1)
-            half = 0.5 * np.diff(edges)
-            tq = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * _GAUSS_X[None, :]
+        for i, ta, tb, m, tq, half in self._panels(panels_per_scale):
             w = half[:, None] * _GAUSS_W[None, :]
-            if slip:
+            if m is not None:
                 h0, h1 = self.homogeneous[i]
                 d = sol.evaluate(m, np.clip(tq, ta, tb).ravel(), ta, h0, h1, order=0)[0].reshape(tq.shape)
             else:
