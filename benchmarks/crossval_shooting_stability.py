@@ -82,9 +82,9 @@ def chain_case():  # the friction chain of tests/analysis/test_shooting_response
 STEPS_PER_PERIOD = 1000
 #: ... and where that reference does not find a row periodic (its defect above 1e-8 of the scales:
 #: a dip shorter than a thousandth of the period, next to a grazing), the row is integrated again
-#: with steps of T/50000 (measured: a row 4e-6 in Ω from a grazing, |μ| 10.42, defect 2.2e-4 with
+#: with steps of T/20000 (measured: a row 4e-6 in Ω from a grazing, |μ| 10.42, defect 2.2e-4 with
 #: T/1000 and 2.9e-11 with T/50000, |μ| 10.422 as rattle's).
-FINE_STEPS_PER_PERIOD = 50_000
+FINE_STEPS_PER_PERIOD = 20_000
 #: The central differences' step, relative to the length (velocity) scale: short enough that the
 #: perturbed orbits keep the event structure of a row 1e-6 from a grazing (measured: the last row of
 #: a branch that ends at a grazing, |μ| 0.3085 and 1.4674 exactly, gave 0.6728 with steps 1e-6 and
@@ -104,7 +104,7 @@ class Reference:
         self.steps = STEPS_PER_PERIOD
 
     def resolve(self, z: np.ndarray, w: float) -> None:
-        """Steps of T/1000, or T/50000 where the orbit z at w is not periodic with the former."""
+        """Steps of T/1000, or T/20000 where the orbit z at w is not periodic with the former."""
         self.steps = STEPS_PER_PERIOD
         if np.max(np.abs((self.map(z, w) - z) / self.s)) > 1e-8:
             self.steps = FINE_STEPS_PER_PERIOD
@@ -126,15 +126,15 @@ class Reference:
 
     def settle(self, start: np.ndarray, w: float) -> np.ndarray | None:
         """The orbit at w by Newton from ``start`` with steps of T/1000, checked by one period with
-        T/50000 steps (solved again with those where it is not periodic there); ``steps`` is left
-        at what the orbit needs."""
+        T/20000 steps (solved again with those, at most 4 Newton steps, where it is not periodic
+        there); ``steps`` is left at what the orbit needs."""
         self.steps = STEPS_PER_PERIOD
         z = self.solve(start, w)
         self.steps = FINE_STEPS_PER_PERIOD
         if z is not None and np.max(np.abs((self.map(z, w) - z) / self.s)) <= 1e-8:
             self.steps = STEPS_PER_PERIOD
             return z
-        return self.solve(start, w)
+        return self.solve(start, w, iterations=4)
 
     def monodromy(self, z: np.ndarray, w: float) -> np.ndarray:
         M = np.empty((self.dim, self.dim))
