@@ -67,7 +67,9 @@ def test_the_example_slips_then_locks_as_stated():
     # "locked 27 % of the period at 2.099, its exact rms 0.0012 rad, mean 0.0008 rad"
     assert np.any(locked)
     i = np.flatnonzero(locked)[0]
-    assert r.omega[i] > 2.09 and 0.25 < stick[i] < 0.30  # measured 26.7 %
+    # the first locked row: 2.083 (26.6 %) since the width ladder runs on the stepper (2.099, 26.7 %,
+    # before, when the ladder at 2.083 did not match); either way past the onset row 2.066
+    assert r.omega[i] > 2.07 and 0.25 < stick[i] < 0.30
     assert r.rms[i, 0] < 0.002 and abs(r.mean[i, 0]) < 0.002
     assert r.rms_hb[i, 0] > 3.0 * r.rms[i, 0]  # the HB at eps resolves the lock only to its width
     assert r.bifurcation[i] == "grazing_sliding"
