@@ -91,6 +91,7 @@ from ._exact_flow import ExactIntegrator, FlowOptions
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
 from ._nonsmooth import MEMO
+from ._recent import Recent
 from ._stage_flow import Segment, StageSolution, SystemStages
 
 optimize = lazy_module("scipy.optimize")  # minimize_scalar, for the extremes of a segment
@@ -315,9 +316,9 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         self.jumps = [np.asarray(law.stages.jumps, dtype=float) for law in system.laws]
         self.breakpoints = [np.asarray(law.stages.breakpoints, dtype=float) for law in system.laws]
         self._modal: dict = {}
-        self._flows: dict[float, dict[_Key, SystemStages]] = {}
+        self._flows: Recent = Recent(MEMO)  # Ω → {mode: SystemStages}
         self._modes: dict[_Key, SystemStages] = {}  # every mode's stages at the first Ω it was met
-        self._memo: dict[tuple, FrictionTrajectory] = {}
+        self._memo: Recent = Recent(MEMO)  # (z0, t0, t1, Ω) → FrictionTrajectory
         # per held set S: (A_S B_S)⁻¹ A_S and B_S (A_S B_S)⁻¹; per (stages, σ): y's constant part, Cᵀ, K_sᵀ
         self._held: dict[tuple, FloatArray] = {}
         self._parts: dict[tuple, tuple[FloatArray, FloatArray, FloatArray]] = {}
@@ -351,9 +352,7 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
         first (:meth:`SystemStages.at_omega`)."""
         flows = self._flows.get(omega)
         if flows is None:
-            if len(self._flows) >= MEMO:
-                del self._flows[next(iter(self._flows))]
-            flows = self._flows[omega] = {}
+            flows = self._flows.put(omega, {})
         flow = flows.get(key)
         if flow is None:
             if self.base.load is None:
@@ -539,10 +538,7 @@ class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
             event_kinds=np.asarray(rec["ek"], dtype=np.int64), event_values=np.asarray(rec["ev"], dtype=float),
             locked=np.asarray(rec["lk"], dtype=bool).reshape(-1, self.m),
         )
-        if len(self._memo) >= MEMO:
-            del self._memo[next(iter(self._memo))]
-        self._memo[key] = traj
-        return traj
+        return self._memo.put(key, traj)
 
     def advance(self, z0: FloatArray, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[FloatArray, FloatArray]:

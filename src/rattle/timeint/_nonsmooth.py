@@ -61,6 +61,7 @@ from ..model import NonsmoothSystem, Stages
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
+from ._recent import Recent
 from ._roots import bracketed_newton, grid_chunk, polish_crossing
 from ._stage_solutions import StageSolutions
 
@@ -337,8 +338,8 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         ExactIntegrator.__init__(self, system, options)
         self.model = None  # the modes' table stands for the model (:meth:`solutions`)
         self.max_segments = self.options.budget(events=True)
-        self._solution_cache: dict[float, StageSolutions] = {}
-        self._memo: dict[tuple[float, ...], NonsmoothTrajectory] = {}
+        self._solution_cache: Recent = Recent(SOLUTION_CACHE)  # Ω → StageSolutions
+        self._memo: Recent = Recent(MEMO)  # (x0, t0, t1, Ω) → NonsmoothTrajectory
         self._template: StageSolutions | None = None
         st = system.law.stages
         self._d = st.breakpoints.tolist()
@@ -358,10 +359,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
             sol = self._template = _mode_solutions(self.system, omega, self.samples_per_scale)
         else:  # only the forcing's parts depend on Ω
             sol = self._template.at_omega(omega)
-        if len(self._solution_cache) >= SOLUTION_CACHE:
-            del self._solution_cache[next(iter(self._solution_cache))]
-        self._solution_cache[float(omega)] = sol
-        return sol
+        return self._solution_cache.put(float(omega), sol)
 
     def velocity_scale(self, omega: float) -> float:
         """L ν: the length scale times the larger of Ω and the stiffest stage's natural frequency."""
@@ -426,10 +424,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
             sign=np.asarray(rec["sign"], dtype=np.int64), x_start=np.asarray(rec["x"], dtype=float).reshape(-1, 2),
             homogeneous=np.asarray(rec["h"], dtype=float).reshape(-1, 2),
             event_time=np.asarray(rec["et"], dtype=float), event_kind=tuple(rec["ek"]), solutions=sol)
-        if len(self._memo) >= MEMO:
-            del self._memo[next(iter(self._memo))]
-        self._memo[key] = traj
-        return traj
+        return self._memo.put(key, traj)
 
     def advance(self, x0: FloatArray, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:

@@ -46,6 +46,7 @@ import scipy.linalg as sla
 
 from .._typing import FloatArray
 from ..model import System
+from ._recent import Recent
 
 _EPS = float(np.finfo(float).eps)
 _TWO_PI = 2.0 * math.pi
@@ -248,7 +249,7 @@ class StageSolution:
         Abar[: 2 * n, : 2 * n] = A
         Abar[: 2 * n, 2 * n] = g
         self.Abar = Abar
-        self._expm_kept: dict[tuple[float, bool], FloatArray] = {}  # shared with the at_omega copies
+        self._expm_kept = Recent(EXPM_KEPT)  # (τ, batch) → exp(Ā τ); shared with the at_omega copies
         key = stages if flow._cache_tag is None else (stages, flow._cache_tag)
         cached = flow.modal_cache.get(key)
         lam = np.linalg.eigvals(A) if cached is None else cached["eigenvalues"]
@@ -439,9 +440,7 @@ class StageSolution:
         E = kept.get(key)
         if E is None:
             E = sla.expm(self.Abar[None] * np.array([tau])[:, None, None])[0] if batch else sla.expm(self.Abar * tau)
-            if len(kept) >= EXPM_KEPT:
-                del kept[next(iter(kept))]
-            kept[key] = E
+            kept.put(key, E)
         return E
 
     def transition(self, tau: float) -> FloatArray:
