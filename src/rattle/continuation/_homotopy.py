@@ -26,6 +26,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .._typing import FloatArray
+from ._newton import newton_step
 from ._problem import ContinuationProblem
 
 
@@ -124,17 +125,9 @@ class WidthHomotopy:
         return R, Rq, Ru
 
     def newton_step(self, q: FloatArray, u: float) -> tuple[FloatArray, FloatArray | None]:
-        """The problem's own Newton step at w = e^u (when it has one), else the full solve."""
-        pb = self.family(math.exp(u))
-        step = getattr(pb, "newton_step", None)
-        if step is not None:
-            return step(q, self.p)  # type: ignore[no-any-return]
-        R, Rq, _ = pb.residual_jacobian(q, self.p)
-        try:
-            dq = np.linalg.solve(Rq, -R)
-        except np.linalg.LinAlgError:
-            return R, None
-        return R, (dq if np.all(np.isfinite(dq)) else None)
+        """One Newton step of the problem at w = e^u (:func:`~rattle.continuation._newton.newton_step`:
+        its own step when it has one, else the full solve)."""
+        return newton_step(self.family(math.exp(u)), q, self.p)
 
 
 __all__ = ["ForcingHomotopy", "WidthHomotopy"]

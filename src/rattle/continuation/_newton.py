@@ -19,6 +19,14 @@ def _full_step(problem: ContinuationProblem, q: FloatArray, p: float) -> tuple[F
     return R, (dq if info == 0 and np.all(np.isfinite(dq)) else None)
 
 
+def newton_step(problem: ContinuationProblem, q: FloatArray, p: float) -> tuple[FloatArray, FloatArray | None]:
+    """(R, Δq) of one Newton step at the fixed parameter p: the problem's own ``newton_step`` when
+    it has one (:class:`~rattle.continuation.SupportsNewtonStep`), else the full LAPACK solve from
+    ``residual_jacobian``; Δq None where the step cannot be taken (a singular or non-finite solve)."""
+    own = getattr(problem, "newton_step", None)
+    return own(q, p) if own is not None else _full_step(problem, q, p)
+
+
 @dataclass(frozen=True, slots=True)
 class NewtonResult:
     """Outcome of a Newton solve: the last iterate ``q``, how it ended (``status``, a
@@ -59,10 +67,9 @@ def solve_fixed(
     q = np.array(q0, dtype=float, copy=True)
     Fs, L = problem.force_scale, problem.length_scale
     uniform = np.ndim(L) == 0
-    step = getattr(problem, "newton_step", None) or (lambda q, p: _full_step(problem, q, p))
     res = np.inf
     for it in range(1, options.max_iterations + 1):
-        R, dq = step(q, parameter)
+        R, dq = newton_step(problem, q, parameter)
         res = float(np.max(np.abs(R))) / Fs
         if not np.isfinite(res):
             return NewtonResult(q, Status.NON_FINITE, it, res)
