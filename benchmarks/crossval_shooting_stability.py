@@ -40,38 +40,21 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
+from _cases import friction_chain, random_preload  # noqa: E402  (the tests' random cases)
 from _filippov import chain_reference, single_reference  # noqa: E402  (the tests' independent reference)
 
 import rattle  # noqa: E402
-from rattle.model import (  # noqa: E402
-    Backlash, Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, NonsmoothSystem, Preload, Torque,
-)
+from rattle.model import NonsmoothSystem  # noqa: E402
 
 
 def single_case(seed: int) -> tuple[NonsmoothSystem, tuple[float, float]]:
-    rng = np.random.default_rng(1000 + seed)
-    b = [0.0, 0.05][seed % 2]
-    fr = None if seed % 3 == 0 else Friction(levels=tuple(rng.uniform(0.0, 0.01, 3 if b else 2)))
-    law = NonsmoothLaw(elastic=Preload(preload=rng.uniform(0.005, 0.03), clearance=b, slope=rng.uniform(0.6, 1.4)),
-                       friction=fr)
-    system = NonsmoothSystem(damping=rng.uniform(0.03, 0.1), stiffness=1.0, law=law,
-                             excitation=Excitation(mean=rng.uniform(-0.02, 0.05),
-                                                   amplitudes=(rng.uniform(0.03, 0.1), rng.uniform(0.0, 0.02)),
-                                                   phases=(0.0, rng.uniform(0.0, 6.0))))
-    w = rng.uniform(0.3, 1.0)
-    return system, (w, 2.0 * w)
+    """The tests' random preload (tests/_cases.py), its numbers from seed 1000 + ``seed``, Ω from Ω₀ in
+    0.3–1 to 2 Ω₀."""
+    return random_preload(seed, omega=(0.3, 1.0), span=2.0, offset=1000)
 
 
-def chain_case():  # the friction chain of tests/analysis/test_shooting_response.py
-    chain = Chain(
-        inertias=(1.0, 0.5, 2.0),
-        links=(Link(between=(2, 3), stiffness=0.6, damping=0.03), Link(between=(3, 0), stiffness=0.4, damping=0.04)),
-        elements=(Element(name="clutch", between=(1, 2), stiffness=1.5, law=Clutch(alpha=0.2, b=0.05),
-                          friction=Friction(levels=0.02)),
-                  Element(name="gear", between=(2, 3), stiffness=2.0, law=Backlash(b=0.02))),
-        torques=(Torque(inertia=1, mean=0.02, amplitudes=(0.25,), phases=(0.0,)),),
-    )
-    return chain.friction_system(), (0.6, 0.72)
+def chain_case():  # the friction chain of the exact-shooting tests (tests/_cases.py)
+    return friction_chain(), (0.6, 0.72)
 
 
 #: The reference's largest step, per forcing period: its events are sign changes between steps, so

@@ -7,7 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from rattle.hb import FourierBasis
-from rattle.model import Backlash, Chain, Clutch, Element, Friction, Link, Preload, Torque
+from rattle.model import (
+    Backlash, Chain, Clutch, Element, Excitation, Friction, FrictionSystem, Link, NonsmoothLaw, NonsmoothSystem, Preload,
+    Torque,
+)
 
 
 def lockup_chain() -> Chain:
@@ -105,3 +108,38 @@ def hb_chain_state0(frf, i):
     basis = FourierBasis(H, 4 * (2 * H + 1))
     w = float(frf.omega[i] / frf.period[i])
     return np.array([basis.evaluate(r, w, 0.0, derivative=k) for k in (0, 1) for r in Q], dtype=float)
+
+
+def random_preload(seed: int, omega: tuple[float, float] = (0.4, 1.6), span: float = 1.1, offset: int = 0
+                   ) -> tuple[NonsmoothSystem, tuple[float, float]]:
+    """A random preload law (a clearance on odd seeds, friction per stage on two of three seeds),
+    forcing with a second harmonic, and the range (Ω₀, ``span`` Ω₀) for Ω₀ drawn from ``omega``;
+    the numbers from the generator of ``offset + seed``: the random cases of the exact-shooting
+    tests (offset 0) and of benchmarks/crossval_shooting_stability.py (offset 1000)."""
+    rng = np.random.default_rng(offset + seed)
+    b = [0.0, 0.05][seed % 2]
+    fr = None if seed % 3 == 0 else Friction(levels=tuple(rng.uniform(0.0, 0.01, 3 if b else 2)))
+    law = NonsmoothLaw(elastic=Preload(preload=rng.uniform(0.005, 0.03), clearance=b, slope=rng.uniform(0.6, 1.4)),
+                       friction=fr)
+    system = NonsmoothSystem(damping=rng.uniform(0.03, 0.1), stiffness=1.0, law=law,
+                             excitation=Excitation(mean=rng.uniform(-0.02, 0.05),
+                                                   amplitudes=(rng.uniform(0.03, 0.1), rng.uniform(0.0, 0.02)),
+                                                   phases=(0.0, rng.uniform(0.0, 6.0))))
+    w = rng.uniform(*omega)
+    return system, (w, span * w)
+
+
+def friction_chain() -> FrictionSystem:
+    """Three inertias, a clutch with Coulomb friction and a gear backlash: the friction chain of the
+    exact-shooting tests and of benchmarks/crossval_shooting_stability.py."""
+    chain = Chain(
+        inertias=(1.0, 0.5, 2.0),
+        links=(Link(between=(2, 3), stiffness=0.6, damping=0.03), Link(between=(3, 0), stiffness=0.4, damping=0.04)),
+        elements=(
+            Element(name="clutch", between=(1, 2), stiffness=1.5, law=Clutch(alpha=0.2, b=0.05),
+                    friction=Friction(levels=0.02)),
+            Element(name="gear", between=(2, 3), stiffness=2.0, law=Backlash(b=0.02)),
+        ),
+        torques=(Torque(inertia=1, mean=0.02, amplitudes=(0.25,), phases=(0.0,)),),
+    )
+    return chain.friction_system()

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _filippov import chain_reference, single_reference  # tests/ is on sys.path through its conftest
+from _cases import friction_chain, random_preload  # tests/ is on sys.path through its conftest
+from _filippov import chain_reference, single_reference
 
 import rattle
 from rattle.analysis import RegularisationOptions, ShootingOptions
@@ -22,30 +23,11 @@ from rattle.errors import Status
 from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._exact_branch import start_state
 from rattle.continuation import NewtonOptions
-from rattle.model import (
-    Backlash, Chain, Clutch, Element, Excitation, Friction, FrictionSystem, Link, NonsmoothLaw, NonsmoothSystem,
-    Preload, Torque,
-)
+from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
 from rattle.results import FrictionCheck, NonsmoothCheck
 from rattle.timeint import ShootingProblem
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-
-
-def _random_single(seed: int) -> tuple[NonsmoothSystem, tuple[float, float]]:
-    """A preload (with a clearance on odd seeds) and friction on two of three seeds, forcing with a
-    second harmonic; a 10 % range around a random Ω."""
-    rng = np.random.default_rng(seed)
-    b = [0.0, 0.05][seed % 2]
-    fr = None if seed % 3 == 0 else Friction(levels=tuple(rng.uniform(0.0, 0.01, 3 if b else 2)))
-    law = NonsmoothLaw(elastic=Preload(preload=rng.uniform(0.005, 0.03), clearance=b, slope=rng.uniform(0.6, 1.4)),
-                       friction=fr)
-    system = NonsmoothSystem(damping=rng.uniform(0.03, 0.1), stiffness=1.0, law=law,
-                             excitation=Excitation(mean=rng.uniform(-0.02, 0.05),
-                                                   amplitudes=(rng.uniform(0.03, 0.1), rng.uniform(0.0, 0.02)),
-                                                   phases=(0.0, rng.uniform(0.0, 6.0))))
-    w = rng.uniform(0.4, 1.6)
-    return system, (w, 1.1 * w)
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -55,7 +37,7 @@ def test_every_row_is_an_exact_orbit_of_the_independent_integration(seed):
     periodic to the reference's accuracy) and follow the row's trajectory at the reference's own
     output times to 1e-7 of the length scale: the same orbit, so the same rms (the rms is the
     trajectory's exact integral)."""
-    system, omega = _random_single(seed)
+    system, omega = random_preload(seed)
     frf = nonsmooth_response(system, omega)
     assert isinstance(frf, NonsmoothCheck) and frf.followed == "exact shooting"
     assert frf.status.success, frf.message
@@ -73,23 +55,9 @@ def test_every_row_is_an_exact_orbit_of_the_independent_integration(seed):
         assert frf.rms[i] == pytest.approx(traj.mean_and_rms()[1], rel=1e-12)
 
 
-def _chain_case() -> FrictionSystem:
-    chain = Chain(
-        inertias=(1.0, 0.5, 2.0),
-        links=(Link(between=(2, 3), stiffness=0.6, damping=0.03), Link(between=(3, 0), stiffness=0.4, damping=0.04)),
-        elements=(
-            Element(name="clutch", between=(1, 2), stiffness=1.5, law=Clutch(alpha=0.2, b=0.05),
-                    friction=Friction(levels=0.02)),
-            Element(name="gear", between=(2, 3), stiffness=2.0, law=Backlash(b=0.02)),
-        ),
-        torques=(Torque(inertia=1, mean=0.02, amplitudes=(0.25,), phases=(0.0,)),),
-    )
-    return chain.friction_system()
-
-
 @pytest.mark.slow
 def test_a_chain_with_friction_rows_are_exact_orbits_of_the_independent_integration():
-    fs = _chain_case()
+    fs = friction_chain()
     frf = nonsmooth_response(fs, (0.6, 0.66))
     assert isinstance(frf, FrictionCheck) and frf.followed == "exact shooting" and frf.status.success
     L = fs.length_scale()
@@ -161,7 +129,7 @@ def test_shooting_and_the_regularised_hb_agree_where_both_apply():
     the shooting branch's state interpolated to that Ω converges to the HB row's exact orbit."""
     from rattle.analysis._exact_branch import damped_newton
 
-    system, omega = _random_single(4)
+    system, omega = random_preload(4)
     shot = nonsmooth_response(system, omega)
     hb = nonsmooth_response(system, omega, RegularisationOptions(harmonics=64, refine=None))
     problem = ShootingProblem(system)
@@ -229,7 +197,7 @@ def test_the_cli_default_for_a_preload_is_exact_shooting(tmp_path):
 
 
 def test_progress_reports_the_share_of_the_range_reached():
-    system, omega = _random_single(1)
+    system, omega = random_preload(1)
     seen: list[tuple[int, int]] = []
     frf = nonsmooth_response(system, omega, progress=lambda done, total: seen.append((done, total)))
     assert frf.status.success and seen
@@ -244,8 +212,6 @@ def test_a_branch_that_turns_back_at_its_start_is_a_success_when_the_other_end_c
     Ω_min turns at a fold 0.5 % into the range and leaves it where it started (RETURNED); the branch
     followed down from Ω_max covers the rest. The range is covered, so the response is a success
     (it was reported 'returned': `rattle frf` exit 1 on a complete answer)."""
-    from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
-
     system = NonsmoothSystem(damping=0.0466905493687573, stiffness=1.0,
                              law=NonsmoothLaw(elastic=Preload(preload=0.012658012081765974, clearance=0.0,
                                                               slope=1.2245173475023938)),
