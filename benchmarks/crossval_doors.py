@@ -152,14 +152,20 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=40, help="sweep frequencies per direction")
     ap.add_argument("--rtol", type=float, default=0.01)
     ap.add_argument("--keep", type=Path, help="keep the case files and outputs here")
+    ap.add_argument("--kinds", default=",".join(KINDS),
+                    help=f"comma-separated law kinds taken in turn (default: all, {','.join(KINDS)})")
     args = ap.parse_args()
+    kinds = tuple(k.strip() for k in args.kinds.split(",") if k.strip())
+    unknown = [k for k in kinds if k not in KINDS]
+    if unknown or not kinds:
+        ap.error(f"--kinds: unknown kind(s) {unknown or args.kinds!r}; choose from {', '.join(KINDS)}")
     rng = np.random.default_rng(args.seed)
     work = args.keep or Path(tempfile.mkdtemp(prefix="crossval-doors-"))
     work.mkdir(parents=True, exist_ok=True)
     total = {k: [0, 0, 0, 0.0, 0.0] for k in KINDS}  # rows, explained, sub-harmonic rows, frf CPU, sweep CPU
     print(f"{'case':24s} {'frf':>5s} {'P1 rows':>8s} {'explained':>9s} {'P≥2':>4s} {'frf s':>6s} {'sweep s':>7s}  missed Ω")
     for n in range(args.cases):
-        kind = KINDS[n % len(KINDS)]
+        kind = kinds[n % len(kinds)]
         name = f"{n:02d}-{kind}"
         path = work / f"{name}.toml"
         path.write_text(case_text(kind, rng))

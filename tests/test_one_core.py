@@ -7,9 +7,9 @@
   ``states(t)`` and ``measures()`` (the settling loop reads nothing else);
 - one ``make_integrator``: no other function picks an integrator class by the kind of system;
 - at most two public classes named ``*Integrator`` (the flow and its scalar kernel);
-- one continuation (item 3): the ε-ladder runs on :class:`~rattle.continuation.ContinuationStepper`
-  (no loop of ``analysis._regularisation`` calls a Newton solve itself); the held-limit ladder is
-  the one hand-rolled ladder left (:data:`HAND_ROLLED_LADDERS`, docs/architecture.md says why).
+- one continuation (item 3): the ε-ladder and the held elements' ladder run on
+  :class:`~rattle.continuation.ContinuationStepper` (no loop of ``analysis._regularisation`` or
+  ``analysis._held_limit`` calls a Newton solve itself: :data:`HAND_ROLLED_LADDERS` is empty).
 """
 
 from __future__ import annotations
@@ -32,10 +32,10 @@ INTEGRATORS = ("ExactIntegrator", "SystemIntegrator", "NonsmoothIntegrator", "Fr
 #: :func:`rattle.timeint.make_integrator`.
 LADDERS_LEFT: set[tuple[str, str]] = set()
 
-#: Modules whose loops still call a Newton solve themselves (a hand-rolled continuation): the
-#: held elements' ladder, whose rungs need the damped Newton the stepper's corrector does not do
-#: (on the stepper it took 1.5–4.5× the CPU, measured; docs/architecture.md).
-HAND_ROLLED_LADDERS = {"rattle.analysis._held_limit"}
+#: Modules whose loops still call a Newton solve themselves (a hand-rolled continuation): none.
+#: The held elements' ladder was the last (its rungs needed a damped Newton: the stepper's
+#: corrector now damps when ``NewtonOptions.damped``, with the natural predictor).
+HAND_ROLLED_LADDERS: set[str] = set()
 
 #: What solves R = 0 directly: a Newton at a fixed parameter, a step of it, the corrector.
 NEWTON_CALLS = {"solve_fixed", "newton_step", "correct", "_solve", "solve_harmonic_balance"}
@@ -171,13 +171,15 @@ def _loops_calling_newton(tree: ast.AST) -> list[int]:
             and _calls(loop) & NEWTON_CALLS]
 
 
-def test_the_eps_ladder_runs_on_the_stepper() -> None:
-    """No loop of the regularisation ladder calls a Newton solve (the old ladder did: Newton at each
-    rung, its step in log ε halved by hand); it builds a ContinuationStepper on a WidthHomotopy.
-    Only the modules of HAND_ROLLED_LADDERS still loop over rungs with Newton."""
-    tree = TREES["rattle.analysis._regularisation"]
-    assert _loops_calling_newton(tree) == []
-    ladder = next(f for f in ast.walk(tree) if isinstance(f, ast.FunctionDef) and f.name == "regularisation_limit")
-    assert {"ContinuationStepper", "WidthHomotopy"} <= _calls(ladder)
+def test_the_ladders_run_on_the_stepper() -> None:
+    """No loop of the regularisation ladder or of the held elements' ladder calls a Newton solve
+    (the old ladders did: Newton at each rung, the step in log ε or log s halved by hand); each
+    builds a ContinuationStepper on a WidthHomotopy."""
+    for mod, name in (("rattle.analysis._regularisation", "regularisation_limit"),
+                      ("rattle.analysis._held_limit", "held_limit")):
+        tree = TREES[mod]
+        assert _loops_calling_newton(tree) == [], mod
+        ladder = next(f for f in ast.walk(tree) if isinstance(f, ast.FunctionDef) and f.name == name)
+        assert {"ContinuationStepper", "WidthHomotopy"} <= _calls(ladder), mod
     ladders = ("rattle.analysis._regularisation", "rattle.analysis._held_limit")
     assert {mod for mod in ladders if _loops_calling_newton(TREES[mod])} == HAND_ROLLED_LADDERS

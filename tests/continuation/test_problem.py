@@ -12,7 +12,8 @@ import pytest
 
 import rattle
 from rattle.continuation import (
-    ContinuationOptions, ContinuationProblem, ContinuationStepper, NewtonOptions, Secant, Tangent, locate_on_segment,
+    ContinuationOptions, ContinuationProblem, ContinuationStepper, Natural, NewtonOptions, Secant, Tangent,
+    locate_on_segment, solve_fixed,
     predictor, solve_fixed,
 )
 from rattle.errors import Status
@@ -85,8 +86,8 @@ def test_predictor_objects_and_names():
         ContinuationStepper(hb, hb.linear_solution(0.2), 0.2, (0.2, 2.0), predictor="secant")  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("method", [Tangent(), Secant()])
-def test_both_predictors_follow_the_linear_branch(method):
+@pytest.mark.parametrize("method", [Tangent(), Secant(), Natural()])
+def test_the_predictors_follow_the_linear_branch(method):
     model = Model(inertia=2.0, damping=0.1, stiffness=2.0, elastic=Linear(), excitation=Excitation(mean=0.1, amplitudes=(0.03,)))
     hb = HarmonicBalance(model, HBOptions(harmonics=2))
     stepper = ContinuationStepper(hb, hb.linear_solution(0.2), 0.2, (0.2, 2.0), predictor=method)
@@ -94,6 +95,56 @@ def test_both_predictors_follow_the_linear_branch(method):
     assert stepper.status is Status.SUCCESS and points[-1].omega == 2.0
     for p in points:  # HB is exact for a linear law: every point is the linear solution
         np.testing.assert_allclose(p.q, hb.linear_solution(p.omega), rtol=0, atol=1e-9)
+
+
+class _Arctan:
+    """R(q, p) = arctan(q − p): one root q = p; plain Newton from |q − p| > 1.3917 overshoots and
+    diverges (the classic example), Newton with backtracking converges from anywhere."""
+
+    size, length_scale, parameter_scale, force_scale = 1, 1.0, 1.0, 1.0
+
+    def residual(self, q, p):  # type: ignore[no-untyped-def]
+        return np.arctan(q - p)
+
+    def residual_jacobian(self, q, p):  # type: ignore[no-untyped-def]
+        with np.errstate(over="ignore"):  # the diverging full step goes to ±inf
+            d = 1.0 / (1.0 + (q - p) ** 2)
+        return np.arctan(q - p), d.reshape(1, 1), -d
+
+
+def test_the_damped_newton_converges_where_the_full_step_diverges():
+    pb = _Arctan()
+    plain = solve_fixed(pb, np.array([2.0]), 0.5, NewtonOptions(max_iterations=40))  # 1.5 from the root
+    assert not plain.converged
+    damped = solve_fixed(pb, np.array([2.0]), 0.5, NewtonOptions(max_iterations=40, damped=True))
+    assert damped.converged and abs(damped.q[0] - 0.5) < 1e-10
+    near = solve_fixed(pb, np.array([0.6]), 0.5, NewtonOptions(damped=True))  # the full step where it descends
+    assert near.converged and near.iterations == solve_fixed(pb, np.array([0.6]), 0.5).iterations
+    with pytest.raises(TypeError, match="damped"):
+        NewtonOptions(damped=1)  # type: ignore[arg-type]
+
+
+def test_the_natural_predictor_keeps_q_and_the_damped_corrector_follows_from_afar():
+    """A natural step moves the parameter only (its plane: p fixed); along R = arctan(q − p) the
+    stepper with steps of 2 in p — each guess 2 from the root, where plain Newton diverges — reaches
+    the far end on every point's root, with the damped corrector."""
+    y, t = np.array([1.0, 2.0]), np.array([0.6, -0.8])
+    pred, d = Natural().predict(y, t, 0.5, None)
+    np.testing.assert_array_equal(pred, [1.0, 1.5])
+    np.testing.assert_array_equal(d, [0.0, -1.0])
+    pb = _Arctan()
+    opts = ContinuationOptions(initial_step=2.0, min_step=2.0, max_step=2.0)
+    plain = ContinuationStepper(pb, np.array([0.0]), 0.0, (0.0, 10.0), opts, NewtonOptions(max_iterations=40),
+                                predictor=Natural(), domain=(-np.inf, np.inf), stations=(2.0, 4.0, 6.0, 8.0, 10.0))
+    plain.run()
+    assert plain.status is Status.STEP_TOO_SMALL
+    stepper = ContinuationStepper(pb, np.array([0.0]), 0.0, (0.0, 10.0), opts,
+                                  NewtonOptions(max_iterations=40, damped=True), predictor=Natural(),
+                                  domain=(-np.inf, np.inf), stations=(2.0, 4.0, 6.0, 8.0, 10.0))
+    points = stepper.run()
+    assert stepper.status is Status.SUCCESS and [p.p for p in points] == [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+    for p in points:
+        assert abs(p.q[0] - p.p) < 1e-9
 
 
 def test_shooting_problem_through_the_stepper_finds_the_hb_fold(reference_model, reference_frf):

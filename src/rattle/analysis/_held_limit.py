@@ -13,13 +13,17 @@ narrow. With a scale s on the held elements (1 on the others, the chain's ε kep
 
 1. the orbit at s = 1 with H = ``harmonics`` (raised from the given orbit's) and N = ``samples``
    AFT samples per period;
-2. each rung divides s by ``ratio``, solved by damped Newton (backtracking on ‖R‖₂) from the last
-   rung; where Newton fails the factor shrinks (√, down to 1.02), and then N doubles (a step much
+2. the rungs s_k = ``ratio``^−k are the stations of a
+   :class:`~rattle.continuation.ContinuationStepper` on the
+   :class:`~rattle.continuation.WidthHomotopy` in u = log s, each corrected at its s from the last
+   rung's q (the :class:`~rattle.continuation.Natural` predictor) by damped Newton
+   (``NewtonOptions(damped=True)``: backtracking on ‖R‖₂); where Newton fails the stepper shortens
+   the step (a rung between), and where the steps fall below 1 % of a rung N doubles (a step much
    narrower in time than T/N is not resolved by the samples, and Newton stalls), up to
-   ``max_samples``;
+   ``max_samples``, the stepper going on from the last rung;
 3. it stops when every held element's rms moved by less than ``tol`` (relative) since the last
    rung at least twice as wide (``"converged"``: the regularisation no longer leads the error; what
-   is left is the truncation at H), when Newton fails at the smallest factor with the most samples
+   is left is the truncation at H), when the steps fall below 1 % of a rung with the most samples
    (``"stalled"``), or at s = ``min_scale`` (``"floor"``).
 
 Measured on the lock-up chain of the tests (docs/nonsmooth.md, "A held element's own
@@ -29,14 +33,15 @@ steps"): the held clutch's HB rms, 26–60 % off at ε = 1e-3 with the chain's w
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._typing import FloatArray
-from ..continuation import NewtonOptions
+from ..continuation import ContinuationOptions, ContinuationStepper, Natural, NewtonOptions, WidthHomotopy
 from ..errors import ConvergenceError
 from ..hb import HBOptions, RegularisedSystemBalance
 from ..hb import MAX_SAMPLES
@@ -44,12 +49,12 @@ from ..hb import MAX_SAMPLES
 #: Statuses of :class:`HeldLimit`.
 HELD_STATUSES = ("converged", "stalled", "floor")
 
-#: The smallest factor between rungs before N doubles (or the ladder stalls).
+#: The smallest ``ratio`` between rungs accepted.
 MIN_RATIO = 1.02
 
-#: Damped Newton: iterations per rung, and the smallest step fraction of the backtracking.
+#: Damped Newton: iterations per rung at most, and what the step control aims for.
 NEWTON_ITERATIONS = 40
-SMALLEST_STEP = 2.0**-10
+TARGET_ITERATIONS = 12
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -89,31 +94,14 @@ class HeldLimit:
         return self.status == "converged"
 
 
-def _solve(pb: RegularisedSystemBalance, q: FloatArray, omega: float, newton: NewtonOptions) -> FloatArray | None:
-    """Damped Newton on R(q, Ω) = 0 from ``q``: the full step, halved while ‖R‖₂ does not fall by
-    a quarter of the step fraction; converged on :class:`NewtonOptions`' scaled tolerances. None
-    when it does not converge."""
-    Fs, L = pb.force_scale, pb.length_scale
-    q = np.array(q, dtype=float, copy=True)
-    for _ in range(NEWTON_ITERATIONS):
-        R, dq = pb.newton_step(q, omega)
-        if dq is None or not np.all(np.isfinite(R)):
-            return None
-        r0 = float(np.linalg.norm(R))
-        if float(np.max(np.abs(R))) / Fs <= newton.residual_tol and float(np.max(np.abs(dq))) / L <= newton.step_tol:
-            return q
-        lam = 1.0
-        while True:
-            trial = q + lam * dq
-            r1 = float(np.linalg.norm(pb.residual(trial, omega)))
-            if np.isfinite(r1) and r1 < (1.0 - 0.25 * lam) * r0:
-                break
-            lam *= 0.5
-            if lam < SMALLEST_STEP:
-                return None
-        q = trial
-    R = pb.residual(q, omega)
-    return q if float(np.max(np.abs(R))) / Fs <= newton.residual_tol else None
+def _rung_options(rung: float) -> ContinuationOptions:
+    """The stepper's settings on the held elements' ladder, rungs ``rung`` apart in u = log s: a
+    step from one rung to the next (cut there: the stepper's ``stations``), up to two rungs,
+    shortened by the step control only where Newton needs more than :data:`TARGET_ITERATIONS`
+    iterations, down to 1 % of a rung (then the samples double, or the ladder has stalled). The
+    natural predictor keeps q: the tangent's turn says nothing of its guess, and is not limited."""
+    return ContinuationOptions(initial_step=rung, min_step=0.01 * rung, max_step=2.0 * rung,
+                               target_iterations=TARGET_ITERATIONS, max_turn=1.5, target_turn=1.5)
 
 
 def _change(scales: list[float], rms: list[FloatArray], held: Sequence[int]) -> float:
@@ -165,50 +153,63 @@ def held_limit(
     if not 4 * H + 2 <= N <= max_samples <= MAX_SAMPLES:
         raise ValueError(f"need 4H + 2 <= samples <= max_samples <= {MAX_SAMPLES}, got H = {H}, samples = {N}, "
                          f"max_samples = {max_samples}")
-    newton = NewtonOptions() if newton is None else newton
+    newton = dataclasses.replace(NewtonOptions() if newton is None else newton, max_iterations=NEWTON_ITERATIONS,
+                                 damped=True)
     base = problem if H == problem.basis.harmonics else RegularisedSystemBalance(
         problem.fsys, regularisation=problem.eps, options=HBOptions(harmonics=H), period=problem.period)
     scales0 = problem.element_scales
+    q = problem.resize(q, H) if H != problem.basis.harmonics else np.asarray(q, dtype=float)
+    step = math.log(float(ratio))
+    u_min = math.log(float(min_scale))
+    rungs = [-k * step for k in range(1, math.ceil(-u_min / step - 1e-9))] + [u_min]
+    options = _rung_options(step)
+
+    def family(pb: RegularisedSystemBalance) -> Callable[[float], RegularisedSystemBalance]:
+        def at(s: float) -> RegularisedSystemBalance:
+            scales = scales0.copy()
+            scales[list(elements)] *= s
+            return pb.with_element_scales(scales)
+        return at
+
+    scales: list[float] = []
+    rms: list[FloatArray] = []
+    Ns: list[int] = []
+    status, change, u = "stalled", math.nan, 0.0
     pb = base.with_element_scales(scales0).with_samples(N)
-    q0 = problem.resize(q, H) if H != problem.basis.harmonics else np.asarray(q, dtype=float)
-    sol = _solve(pb, q0, omega, newton)
-    if sol is None:
-        raise ConvergenceError(f"the held elements' ladder at Ω = {omega:g}: no orbit at the chain's widths with "
-                               f"H = {H}, N = {N} from the orbit given")
-    q = sol
-    s = 1.0
-    scales, rms, Ns = [s], [pb.element_rms(q)], [N]
-    f = float(ratio)
-    status, change = "floor", math.nan
-    while True:
-        if s <= min_scale * (1.0 + 1e-12):
-            status = "floor"
-            break
-        s_new = max(s / f, min_scale)
-        trial_scales = scales0.copy()
-        trial_scales[list(elements)] *= s_new
-        trial = pb.with_element_scales(trial_scales)
-        sol = _solve(trial, q, omega, newton)
-        if sol is None:
-            f = math.sqrt(f)
-            if f >= MIN_RATIO:
+    while True:  # one run of the stepper per N: where it stalls, the steps are narrower than the samples resolve
+        at = family(pb)
+        stepper = ContinuationStepper(WidthHomotopy(at, omega, u), q, u, (u_min, u), options, newton,
+                                      predictor=Natural(), domain=(-math.inf, math.inf), symbol="log s",
+                                      stations=tuple(r for r in rungs if r < u))
+        done = False
+        for pt in iter(stepper.step, None):
+            if scales and pt.p == u:  # a restart with more samples: the same rung, solved again
+                q = pt.q
                 continue
-            if 2 * N > max_samples:
-                status = "stalled"
+            if pt.p != u and pt.p not in rungs:
+                continue  # a step between rungs
+            q, u = pt.q, pt.p
+            scales.append(math.exp(u))
+            rms.append(at(math.exp(u)).element_rms(q))
+            Ns.append(N)
+            change = _change(scales, rms, elements)
+            if change < tol:
+                status, done = "converged", True
                 break
-            N *= 2  # the steps are narrower in time than the samples resolve
-            pb = pb.with_samples(N)
-            f = math.sqrt(float(ratio))
-            continue
-        pb, q, s = trial, sol, s_new
-        scales.append(s)
-        rms.append(pb.element_rms(q))
-        Ns.append(N)
-        f = min(f * f, float(ratio))  # a step that worked: widen the next one again
-        change = _change(scales, rms, elements)
-        if change < tol:
-            status = "converged"
+            if u <= u_min:
+                status, done = "floor", True
+                break
+        if done:
             break
+        if not scales:
+            raise ConvergenceError(f"the held elements' ladder at Ω = {omega:g}: no orbit at the chain's widths with "
+                                   f"H = {H}, N = {N} from the orbit given ({stepper.message})")
+        if 2 * N > max_samples:
+            status = "stalled"
+            break
+        N *= 2
+        pb = pb.with_samples(N)
+    pb = family(pb)(scales[-1])
     return HeldLimit(omega=float(omega), elements=elements, scales=np.array(scales), element_rms=np.array(rms),
                      samples=np.array(Ns, dtype=int), harmonics=H, status=status, change=float(change), q=q,
                      problem=pb)

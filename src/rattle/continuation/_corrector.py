@@ -6,7 +6,8 @@ unit direction t, the corrector solves
 
     R(q, p) = 0,    t · (y − y_p) = 0
 
-by Newton on the bordered Jacobian [∂R/∂q L, ∂R/∂p p_s; tᵀ]; the tangent at a solution is the
+by Newton on the bordered Jacobian [∂R/∂q L, ∂R/∂p p_s; tᵀ] (damped by backtracking when
+:attr:`NewtonOptions.damped`); the tangent at a solution is the
 null vector of [∂R/∂q L, ∂R/∂p p_s], normalised and oriented along a reference direction.
 An iterate whose parameter leaves the problem's open ``domain`` (default p > 0) fails the
 correction: the residual is not evaluated there.
@@ -21,6 +22,7 @@ import numpy as np
 import scipy.linalg
 
 from .._typing import FloatArray
+from ._newton import backtrack
 from ._options import NewtonOptions
 from ._problem import ContinuationProblem
 
@@ -89,6 +91,15 @@ class ArclengthCorrector:
         tau = self.bordered_solve(Rq, Rp, reference, rhs)
         return None if tau is None else tau / np.linalg.norm(tau)
 
+    def _merit(self, y: FloatArray, y_pred: FloatArray, t: FloatArray) -> float:
+        """‖(R(q, p) / F_s, t·(y − y_pred))‖₂ at the scaled point y (inf outside the domain): what a
+        damped correction lowers."""
+        q, p = self.unscale(y)
+        if not self.domain[0] < p < self.domain[1]:
+            return math.inf
+        r = float(np.linalg.norm(self.problem.residual(q, p))) / self.problem.force_scale
+        return math.hypot(r, float(t @ (y - y_pred)))
+
     def correct(self, y_pred: FloatArray, t: FloatArray) -> Corrected | None:
         """Newton on R = 0, t·(y − y_pred) = 0 from y_pred; None when it fails."""
         problem, opts = self.problem, self.newton
@@ -120,6 +131,14 @@ class ArclengthCorrector:
             dy = self.bordered_solve(Rq, Rp, t, rhs)
             if dy is None:
                 return None
+            if opts.damped and not (res <= opts.residual_tol and float(np.max(np.abs(dy))) <= opts.step_tol):
+                # the step's fraction that lowers R and the plane condition together (a last step
+                # within the tolerances is taken whole: at round-off no fraction descends)
+                lam = backtrack(lambda x: self._merit(x, y_pred, t), y, dy, math.hypot(
+                    float(np.linalg.norm(R)) / Fs, float(rhs[n])))
+                if lam is None:
+                    return None
+                dy *= lam
             y += dy
             step_norm = float(np.max(np.abs(dy)))
         return None  # pragma: no cover

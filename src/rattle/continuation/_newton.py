@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +27,23 @@ def newton_step(problem: ContinuationProblem, q: FloatArray, p: float) -> tuple[
     ``residual_jacobian``; Δq None where the step cannot be taken (a singular or non-finite solve)."""
     own = getattr(problem, "newton_step", None)
     return own(q, p) if own is not None else _full_step(problem, q, p)
+
+
+#: The smallest fraction of a damped Newton step (:attr:`NewtonOptions.damped`).
+SMALLEST_FRACTION = 2.0**-10
+
+
+def backtrack(merit: Callable[[FloatArray], float], x: FloatArray, dx: FloatArray, m0: float) -> float | None:
+    """The fraction λ of a damped Newton step (:attr:`NewtonOptions.damped`): the largest of 1, 1/2,
+    1/4, … ≥ :data:`SMALLEST_FRACTION` with merit(x + λ dx) < (1 − λ/4) m0 (Armijo's rule on a
+    residual norm m0 = merit(x)); None when none descends."""
+    lam = 1.0
+    while lam >= SMALLEST_FRACTION:
+        m1 = merit(x + lam * dx)
+        if math.isfinite(m1) and m1 < (1.0 - 0.25 * lam) * m0:
+            return lam
+        lam /= 2.0
+    return None
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,11 +94,18 @@ def solve_fixed(
             return NewtonResult(q, Status.NON_FINITE, it, res)
         if dq is None:
             return NewtonResult(q, Status.SINGULAR, it, res)
-        q += dq
         size = float(np.max(np.abs(dq))) / L if uniform else float(np.max(np.abs(dq) / L))
         if res <= options.residual_tol and size <= options.step_tol:
+            q += dq
             res = float(np.max(np.abs(problem.residual(q, parameter)))) / Fs
             return NewtonResult(q, Status.CONVERGED, it, res)
+        if options.damped:
+            lam = backtrack(lambda x: float(np.linalg.norm(problem.residual(x, parameter))), q, dq,
+                            float(np.linalg.norm(R)))
+            if lam is None:
+                return NewtonResult(q, Status.MAX_ITERATIONS, it, res)
+            dq = lam * dq
+        q += dq
     res = float(np.max(np.abs(problem.residual(q, parameter)))) / Fs
     ok = res <= options.residual_tol
     return NewtonResult(q, Status.CONVERGED if ok else Status.MAX_ITERATIONS, options.max_iterations, res)

@@ -81,11 +81,19 @@ class NewtonOptions:
     ``length_scale``, see :class:`~rattle.continuation.ContinuationProblem`; for harmonic
     balance F_s = |F_m| + Σ|F_pn| and L the model's length scale). At most ``max_iterations``
     corrections.
+
+    ``damped``: each correction Δ is taken as λ Δ with the largest λ = 1, 1/2, 1/4, … ≥ 2⁻¹⁰ for
+    which the residual's 2-norm falls, ‖R(x + λ Δ)‖₂ < (1 − λ/4) ‖R(x)‖₂ (Armijo backtracking; at
+    a fixed parameter on R, in the corrector on R and the plane condition together); no such λ
+    fails the solve. For problems whose Newton steps overshoot from a guess far from the solution
+    (a regularised step narrowed: :func:`rattle.analysis._held_limit.held_limit`). Default False:
+    the full step, as every continuation of a branch takes it.
     """
 
     residual_tol: float = 1e-10
     step_tol: float = 1e-8
     max_iterations: int = 12
+    damped: bool = False
 
     def __post_init__(self) -> None:
         for name in ("residual_tol", "step_tol"):
@@ -100,6 +108,8 @@ class NewtonOptions:
                 "iterations where it converges at all, and every iteration is a dense solve; use e.g. 12"
             )
         object.__setattr__(self, "max_iterations", m)
+        if not isinstance(self.damped, bool):
+            raise TypeError(f"`damped` must be True or False, got {self.damped!r}")
 
 
 __all__ = ["ContinuationOptions", "NewtonOptions"]

@@ -11,6 +11,11 @@ small frozen object the :class:`~rattle.continuation.ContinuationStepper` takes 
 * :class:`Secant`: y_pred = y_i + Δs d, d = (y_i − y_{i−1}) / |y_i − y_{i−1}| — the chord
   through the last two points (the tangent at the first step); it needs no tangent accuracy
   and follows the branch's curvature less tightly.
+* :class:`Natural`: y_pred = (q_i, p_i ± Δs), d = the parameter's axis — natural-parameter
+  continuation: every point corrected at a fixed parameter from the last one (no extrapolation
+  of q); it cannot pass a fold in p, and is for families known to have none where a linear
+  prediction of q overshoots (a width narrowed towards its limit: the held elements' ladder of
+  :mod:`rattle.analysis._held_limit`).
 """
 
 from __future__ import annotations
@@ -66,7 +71,21 @@ class Secant(AbstractPredictor):
         return y + step * d, d
 
 
+@dataclass(frozen=True, slots=True)
+class Natural(AbstractPredictor):
+    """Natural-parameter predictor: the last point's q at the parameter moved by Δs (in scaled
+    units) the way the tangent goes; the corrector's plane is p = that value (module docstring)."""
+
+    def predict(
+        self, y: FloatArray, tangent: FloatArray, step: float, previous: FloatArray | None
+    ) -> tuple[FloatArray, FloatArray]:
+        d = np.zeros_like(y)
+        d[-1] = 1.0 if tangent[-1] >= 0.0 else -1.0
+        return y + step * d, d
+
+
 #: Predictor names accepted at the boundary (configuration, command line) → class.
+#: (not :class:`Natural`: a frequency response has folds it cannot pass).
 PREDICTORS: dict[str, type[AbstractPredictor]] = {"tangent": Tangent, "secant": Secant}
 
 
@@ -83,4 +102,4 @@ def predictor(value: object, name: str = "predictor") -> AbstractPredictor:
     )
 
 
-__all__ = ["AbstractPredictor", "Tangent", "Secant", "PREDICTORS", "predictor"]
+__all__ = ["AbstractPredictor", "Tangent", "Secant", "Natural", "PREDICTORS", "predictor"]
