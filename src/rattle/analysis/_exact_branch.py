@@ -752,6 +752,9 @@ SEED_GAP = 1e-3
 #: max-norm): the orbit born at the doubling, not another one Newton reached from a push (measured:
 #: from a push at the end of a period-4 branch, an unrelated period-8 orbit with |μ| ≈ 500).
 SEED_REACH = 0.5
+#: The most branches :func:`subharmonic_branches` follows from period doublings in one call (the
+#: map's branch budget, :class:`~rattle.analysis.AttractorSearch` ``max_branches``).
+DOUBLING_BRANCHES = 16
 #: Newton iterations of the shooting of a pushed start over 2p forcing periods.
 SEED_ITERATIONS = 40
 
@@ -811,7 +814,7 @@ def subharmonic_branches(
     (:func:`_both_ways`) until it rejoins an orbit of a period dividing 2p (:func:`_rejoin_stop`)
     or leaves the range. ``build(branch, number, period)`` makes each branch's response
     (numbered from ``first``); a doubling at an end of a branch of period 2p already found (its
-    other end) starts none."""
+    other end) starts none; at most :data:`DOUBLING_BRANCHES` branches."""
     lo, hi = omega
     newton = newton or NewtonOptions()
     cont = continuation or ContinuationOptions()
@@ -830,6 +833,8 @@ def subharmonic_branches(
             follower = _Follower(problem, (lo, hi), options, cont, newton)
             labels = np.asarray(parent.bifurcation, dtype=object)
             for i in np.flatnonzero(labels == "period_doubling"):
+                if len(out) >= DOUBLING_BRANCHES:
+                    break
                 w_pd = float(parent.omega[i])
                 if any(int(b.period) == 2 * p and abs(w_pd - float(b.omega[j])) <= 1e-3 * w_pd
                        for b in out if len(b.omega) for j in (0, -1)):
@@ -1007,5 +1012,5 @@ def branch_through(
         return branch
 
 
-__all__ = ["ExactBranch", "ExactRow", "ShootingOptions", "branch_through", "doubled_orbit", "exact_branches",
+__all__ = ["DOUBLING_BRANCHES", "ExactBranch", "ExactRow", "ShootingOptions", "branch_through", "doubled_orbit", "exact_branches",
            "start_state", "subharmonic_branches"]

@@ -74,8 +74,8 @@ from ..timeint import (
 )
 from .._limits import MAX_PERIOD
 from ._attractors import AttractorSearch
-from ._census import SUBHARMONIC_SEARCH, subharmonic_attractors
-from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
+from ._census import SUBHARMONIC_POINTS, SUBHARMONIC_SEARCH, subharmonic_attractors
+from ._exact_branch import DOUBLING_BRANCHES, ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
 from ._friction_response import exact_friction_response, friction_response, shooting_friction_response
 from ._friction_subharmonics import friction_subharmonics
 from ._period_two import branches_at_doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
@@ -346,6 +346,10 @@ def discontinuous_response(
     chain = isinstance(system, FrictionSystem)
     opts = options if options is not None else ShootingOptions()
     settings = {**method_settings(opts, chain), "subharmonics": subharmonics}
+    if subharmonics and isinstance(opts, ShootingOptions):
+        settings.update(max_period=MAX_PERIOD, doubling_branches=DOUBLING_BRANCHES,
+                        subharmonic_search=None if chain else {"points": SUBHARMONIC_POINTS,
+                                                               **dataclasses.asdict(SUBHARMONIC_SEARCH)})
     result = FrequencyResponse.from_check(check, model=system, settings=settings,
                                           timings={"frequency_response": time.perf_counter() - t0})
     if throw and not result.status.success:
@@ -374,10 +378,10 @@ def shooting_response(
     an exact orbit of its period p with the multipliers of the p-period map: those born at the
     period doublings located on the period-1 branches, and recursively on theirs, up to period
     ``max_period`` (:func:`~rattle.analysis._exact_branch.subharmonic_branches`); then, with
-    ``search`` (an :class:`AttractorSearch` budget; None: none), those through the periodic
-    attractors of period 2 … ``max_period`` that exact simulations settle on and no branch accounts
-    for (:func:`~rattle.analysis._census.subharmonic_attractors`), with the branches born at their
-    own period doublings. ``progress(done, total)``: called with the share of the range reached
+    ``search`` (an :class:`AttractorSearch` budget; None: none; a chain has none), those through
+    the periodic attractors of period 2 … ``max_period`` that exact simulations settle on and no
+    branch accounts for (:func:`~rattle.analysis._census.subharmonic_attractors`), with the
+    branches born at their own period doublings. ``progress(done, total)``: called with the share of the range reached
     (the CLI draws a bar; the library draws nothing)."""
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
@@ -386,6 +390,7 @@ def shooting_response(
         primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
                                              progress=progress)
         build = lambda b, k, p: exact_friction_response(system, b, number=k, period=p)  # noqa: E731
+        search = None  # a chain's simulations take seconds each: its attractor search is the map's (rattle map)
     elif isinstance(system, NonsmoothSystem):
         found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
         parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
