@@ -195,7 +195,9 @@ class _ExactSearch(_Search):
     branches born at period doublings come with the response."""
 
     def __init__(self, system: NonsmoothSystem | FrictionSystem, response: Any, grid: FloatArray, run: RunSettings,
-                 options: AttractorSearch, solutions: list[GridSolution], shooting: ShootingOptions) -> None:
+                 options: AttractorSearch, solutions: list[GridSolution], shooting: ShootingOptions,
+                 min_period: int = 1) -> None:
+        self.min_period = min_period
         self.frf = response
         self.model = self.system = system
         self.grid = np.asarray(grid, dtype=float)
@@ -231,6 +233,9 @@ class _ExactSearch(_Search):
         w = float(self.grid[j])
         record: dict[str, Any] = {"omega": w, "period": n, "origin": origin, "branch": None, "rms": float(state.rms)}
         self.census.found.append(record)
+        if n < self.min_period:
+            record["note"] = f"period below {self.min_period}: not continued here"
+            return
         if self.counts["branches"] >= self.opts.max_branches:
             record["note"] = "branch budget spent: not continued"
             self.counts["not_continued"] += 1
@@ -288,15 +293,42 @@ class _ExactSearch(_Search):
 def find_exact_attractors(system: NonsmoothSystem | FrictionSystem, response: Any, grid: FloatArray,
                           run: RunSettings, options: AttractorSearch | None = None,
                           solutions: list[GridSolution] | None = None,
-                          shooting: ShootingOptions | None = None) -> Census:
+                          shooting: ShootingOptions | None = None, min_period: int = 1) -> Census:
     """The attractors on ``grid`` that the exact branches of ``response`` (a NonsmoothCheck or
     FrictionCheck of ``system``) do not explain, found by exact simulation and continued by
-    exact shooting (:class:`_ExactSearch`), with every branch's solutions on the grid."""
+    exact shooting (:class:`_ExactSearch`; those of a period below ``min_period`` only recorded),
+    with every branch's solutions on the grid."""
     options = options or AttractorSearch()
     if solutions is None:
         solutions = exact_solutions_on_grid(system, response_parts(response), grid, run.newton)
-    search = _ExactSearch(system, response, grid, run, options, solutions, shooting or ShootingOptions())
+    search = _ExactSearch(system, response, grid, run, options, solutions, shooting or ShootingOptions(), min_period)
     return run_search(search, options)
+
+
+#: The attractor search of a frequency response with sub-harmonics on a law with jumps or friction
+#: (:func:`subharmonic_attractors`): the map's budget (:class:`AttractorSearch`) but for its new
+#: branches, at most 4 (the sweep check's, :class:`~._sweep_check.SweepCheck`), on
+#: :data:`SUBHARMONIC_POINTS` equally spaced frequencies.
+SUBHARMONIC_SEARCH = AttractorSearch(max_branches=4)
+SUBHARMONIC_POINTS = 48
+
+
+def subharmonic_attractors(system: NonsmoothSystem | FrictionSystem, response: Any, omega: tuple[float, float],
+                           shooting: ShootingOptions, continuation: Any, newton: NewtonOptions | None,
+                           search: AttractorSearch = SUBHARMONIC_SEARCH,
+                           points: int = SUBHARMONIC_POINTS) -> list[Any]:
+    """The branches of period p ≥ 2 through the periodic attractors that exact simulations settle
+    on over ``omega`` and that no branch of ``response`` (a NonsmoothCheck or FrictionCheck of
+    ``system`` with its branches) accounts for: the map's attractor search
+    (:func:`find_exact_attractors`) on ``points`` equally spaced frequencies with the budget
+    ``search``, each such attractor of period p continued by exact shooting continuation over p
+    forcing periods (:func:`~._exact_branch.branch_through`: both ways until it leaves the range,
+    closes on itself or rejoins an orbit of a period dividing p). Numbered after the response's
+    branches."""
+    grid = np.linspace(float(omega[0]), float(omega[1]), points)
+    run = RunSettings.make(HBOptions(), newton, continuation)
+    census = find_exact_attractors(system, response, grid, run, search, shooting=shooting, min_period=2)
+    return list(census.branches)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -345,7 +377,8 @@ def attractor_census(model: Any, grid: FloatArray, run: RunSettings, search: Att
     discontinuous = isinstance(model, (NonsmoothSystem, FrictionSystem))
     if discontinuous:
         response = nonsmooth_response(model, (lo, hi), ShootingOptions(), continuation=run.continuation,
-                                      newton=run.newton, subharmonics=max_period >= 2)
+                                      newton=run.newton, subharmonics=max_period >= 2, max_period=max_period,
+                                      search=None)  # the search below is the fuller one, on the map's grid
     else:
         response = _frequency_response(model, (lo, hi), run, subharmonics=True, max_period=max_period, throw=False)
     status, message = ("ok", "") if response.status.success else ("partial", response.message)
@@ -493,5 +526,6 @@ def with_every_orbit(system: NonsmoothSystem | FrictionSystem, result: Any) -> A
     return dataclasses.replace(result, solutions=found.solutions, nonperiodic=found.nonperiodic)
 
 
-__all__ = ["CellCensus", "ExactOrbits", "attractor_census", "exact_orbits_at", "with_every_orbit", "exact_solutions_on_grid", "find_exact_attractors", "special_points",
+__all__ = ["CellCensus", "ExactOrbits", "SUBHARMONIC_POINTS", "SUBHARMONIC_SEARCH", "subharmonic_attractors",
+           "attractor_census", "exact_orbits_at", "with_every_orbit", "exact_solutions_on_grid", "find_exact_attractors", "special_points",
            "response_parts", "first_rms", "branch_count"]

@@ -78,11 +78,13 @@ from ..continuation import (
     locate_on_segment,
     solve_fixed,
 )
+from .._limits import MAX_PERIOD
 from .._threads import one_blas_thread
 from ..errors import Status
 from ..model import FrictionSystem, NonsmoothSystem
 from ..stability import classify_loss
 from ..timeint import FLOW_FAILURES, ShootingProblem, monodromy_multipliers
+from ._period_two import pushed_starts
 from ._sweep_check import SweepCheck
 
 #: |μ| up to 1 + UNIT_TOL counts as inside the unit circle: an element stuck the whole period
@@ -185,7 +187,7 @@ class ExactRow:
 class ExactBranch:
     """The rows of one continued exact branch (in continuation order), how it ended (``status``,
     ``message``), the ``pieces`` it was followed in (rows per piece: grazings passed between
-    them), ``origin`` (where it was started) and the ``bridges``: the Ω intervals between a stall
+    them), ``origin`` (where it was started), its ``period`` p (T = p 2π/Ω) and the ``bridges``: the Ω intervals between a stall
     and the hop past its grazing (the branch is continuous across them)."""
 
     rows: list[ExactRow] = field(default_factory=list)
@@ -194,6 +196,7 @@ class ExactBranch:
     pieces: list[int] = field(default_factory=list)
     origin: str = ""
     bridges: list[tuple[float, float]] = field(default_factory=list)
+    period: int = 1
 
     @property
     def omega(self) -> FloatArray:
@@ -742,50 +745,117 @@ def _coverage(branches: list[ExactBranch], lo: float, hi: float) -> None:
 #: A period-p orbit whose one-period map returns within this scaled distance is a period-1 orbit
 #: run p times: the sub-harmonic branch rejoined a period-1 branch.
 REJOIN_TOL = 1e-7
+#: A period-2p seed counts (it is not the period-p orbit run twice) when its p-period map moves it
+#: by more than this share of the orbit's peak-to-peak (scaled by the length scale L).
+SEED_GAP = 1e-3
+#: ... and when it lies within this share of the orbit's peak-to-peak of the period-p orbit (scaled
+#: max-norm): the orbit born at the doubling, not another one Newton reached from a push (measured:
+#: from a push at the end of a period-4 branch, an unrelated period-8 orbit with |μ| ≈ 500).
+SEED_REACH = 0.5
+#: The most branches :func:`subharmonic_branches` follows from period doublings in one call (the
+#: map's branch budget, :class:`~rattle.analysis.AttractorSearch` ``max_branches``).
+DOUBLING_BRANCHES = 16
+#: Newton iterations of the shooting of a pushed start over 2p forcing periods.
+SEED_ITERATIONS = 40
+
+
+def doubled_orbit(half: ShootingProblem, omega: float, state: FloatArray, newton: NewtonOptions) -> FloatArray | None:
+    """z(0) of an exact orbit of period 2p next to the exact orbit of period p = ``half.period``
+    through ``state`` at ``omega``, one of whose multipliers lies near −1: the period-p orbit
+    (Newton on its period map from ``state``) pushed along the eigenvector of its negative real
+    multiplier nearest −1 (:func:`~._period_two.pushed_starts`: by 2 %, 10 % and 30 % of its
+    largest coordinate peak-to-peak, either way) and shot over 2p forcing periods; the first
+    converged orbit whose p-period defect R_p(z(0), Ω) = (φ_{p 2π/Ω}(z(0)) − z(0)) / s exceeds
+    :data:`SEED_GAP` × (peak-to-peak / L) — not the period-p orbit run twice — and whose z(0) lies
+    within :data:`SEED_REACH` × (peak-to-peak / L) of the period-p orbit's. None when none is."""
+    q = damped_newton(half, np.asarray(state, dtype=float), omega, newton, iterations=30)
+    if q is None:
+        return None
+    double = ShootingProblem(half.system, period=2 * half.period, integrator=half.integrator)
+    try:
+        row = _row(half, q, omega)
+        n = half.size // 2
+        x = np.asarray(row.trajectory.states(np.linspace(0.0, half.orbit_period(omega), 64 * half.period + 1)),
+                       dtype=float)[:, :n]
+    except FLOW_FAILURES:
+        return None
+    L = float(half.length_scale[0])
+    size = max(float(np.max(np.ptp(x, axis=0))), 1e-12 * L)
+    for z0 in pushed_starts(row.M, q, half.state_scale(omega), size, L):
+        z2 = damped_newton(double, z0, omega, newton, iterations=SEED_ITERATIONS)
+        if z2 is None:
+            continue
+        try:
+            gap = float(np.max(np.abs(half.residual(z2, omega))))
+        except FLOW_FAILURES:
+            continue
+        if gap > SEED_GAP * size / L and float(np.max(np.abs((z2 - q) / half.length_scale))) <= SEED_REACH * size / L:
+            return z2
+    return None
 
 
 def subharmonic_branches(
     system: NonsmoothSystem | FrictionSystem,
-    primary: Any,
+    parents: list[Any],
     omega: tuple[float, float],
     options: ShootingOptions,
     continuation: ContinuationOptions | None,
     newton: NewtonOptions | None,
-    seed: Any,
-) -> list[ExactBranch]:
-    """The period-2 branches born at the period doublings located on the exact ``primary``
-    branch (a response with ``omega``, ``states``, ``bifurcation``), each followed by exact
-    shooting continuation over two forcing periods both ways from its seed until it rejoins a
-    period-1 orbit (its one-period map returns within :data:`REJOIN_TOL`) or leaves the range.
-    ``seed(Ω, z(0))`` gives an exact period-2 orbit (``state0``, ``omega``) next to the period-1
-    orbit through z(0) at Ω, or None; it is tried at the rows either side of the located point.
-    A doubling at an end of a branch already found starts none."""
+    build: Any,
+    *,
+    first: int = 1,
+    max_period: int = MAX_PERIOD,
+) -> list[Any]:
+    """The branches of period 2p born at the period doublings located on the exact branches
+    ``parents`` (responses with ``omega``, ``states``, ``bifurcation`` and ``period`` p), 2p ≤
+    ``max_period``, recursively: each branch found is a parent too. At a doubling the exact
+    period-2p orbit next to the row on either side of the located point (:func:`doubled_orbit`)
+    is followed by exact shooting continuation over 2p forcing periods both ways
+    (:func:`_both_ways`) until it rejoins an orbit of a period dividing 2p (:func:`_rejoin_stop`)
+    or leaves the range. ``build(branch, number, period)`` makes each branch's response
+    (numbered from ``first``); a doubling at an end of a branch of period 2p already found (its
+    other end) starts none; at most :data:`DOUBLING_BRANCHES` branches."""
     lo, hi = omega
     newton = newton or NewtonOptions()
     cont = continuation or ContinuationOptions()
-    out: list[ExactBranch] = []
+    out: list[Any] = []
+    queue = [p for p in parents if 2 * int(p.period) <= max_period and p.states is not None]
     with one_blas_thread():
-        problem = ShootingProblem(system, period=2)
-        shorter = [ShootingProblem(system, period=1, integrator=problem.integrator)]
-        follower = _Follower(problem, (lo, hi), options, cont, newton)
-        labels = primary.bifurcation
-        for i in np.flatnonzero(labels == "period_doubling"):
-            w_pd = float(primary.omega[i])
-            if any(abs(w_pd - float(b.omega[j])) <= 1e-3 * w_pd for b in out if b.rows for j in (0, -1)):
-                continue
-            orbit = None
-            for j in (i + 1, i - 1):
-                if 0 <= j < len(primary) and np.all(np.isfinite(primary.states[j])):
-                    orbit = seed(float(primary.omega[j]), primary.states[j])
-                    if orbit is not None:
-                        break
-            if orbit is None:
-                continue
-
-            branch = _both_ways(follower, shorter, np.asarray(orbit.state0, dtype=float), float(orbit.omega),
-                                f"period doubling at Ω = {w_pd:.6g}", options.locate)
-            if len(branch.rows) >= 2:
-                out.append(branch)
+        integ = None
+        while queue:
+            parent = queue.pop(0)
+            p = int(parent.period)
+            if integ is None:
+                integ = ShootingProblem(system).integrator
+            half = ShootingProblem(system, period=p, integrator=integ)
+            problem = ShootingProblem(system, period=2 * p, integrator=integ)
+            shorter = [ShootingProblem(system, period=d, integrator=integ) for d in range(1, 2 * p) if 2 * p % d == 0]
+            follower = _Follower(problem, (lo, hi), options, cont, newton)
+            labels = np.asarray(parent.bifurcation, dtype=object)
+            for i in np.flatnonzero(labels == "period_doubling"):
+                if len(out) >= DOUBLING_BRANCHES:
+                    break
+                w_pd = float(parent.omega[i])
+                if any(int(b.period) == 2 * p and abs(w_pd - float(b.omega[j])) <= 1e-3 * w_pd
+                       for b in out if len(b.omega) for j in (0, -1)):
+                    continue
+                z2 = None
+                for j in (i + 1, i - 1):
+                    if 0 <= j < len(parent.omega) and np.all(np.isfinite(parent.states[j])):
+                        z2 = doubled_orbit(half, float(parent.omega[j]), parent.states[j], newton)
+                        if z2 is not None:
+                            w0 = float(parent.omega[j])
+                            break
+                if z2 is None:
+                    continue
+                branch = _both_ways(follower, shorter, z2, w0,
+                                    f"period doubling of branch {int(parent.branch)} at Ω = {w_pd:.6g}", options.locate)
+                branch.period = 2 * p
+                if len(branch.rows) >= 2:
+                    part = build(branch, first + len(out), 2 * p)
+                    out.append(part)
+                    if 4 * p <= max_period:
+                        queue.append(part)
     return out
 
 
@@ -793,8 +863,11 @@ def _rejoin_stop(shorter: list[ShootingProblem], period: int) -> Any:
     """The stop of one side of a branch of period p ≥ 2: it has rejoined an orbit of a period d
     dividing p (``shorter``: the period-d problems) when the d-period map's scaled defect falls
     below :data:`REJOIN_TOL`, or, for d = p/2, flips sign (past the period doubling the branch
-    would go on along its own copy shifted by d forcing periods: a closed loop)."""
+    would go on along its own copy shifted by d forcing periods: a closed loop). The points found
+    on an orbit of period d are kept in its ``shorter_points`` ((Ω, z(0) bytes)): they are no rows
+    of the period-p branch."""
     prev: dict[int, FloatArray] = {}
+    shorter_points: set[tuple[float, bytes]] = set()
 
     def rejoined(pt: BranchPoint) -> str | None:
         for k, once in enumerate(shorter):
@@ -804,10 +877,14 @@ def _rejoin_stop(shorter: list[ShootingProblem], period: int) -> Any:
             # the sign flip marks a period doubling of the period-d orbit (d = p/2) only
             flipped = 2 * once.period == period and k in prev and float(r @ prev[k]) < 0.0
             prev[k] = r
-            if flipped or float(np.max(np.abs(r))) < REJOIN_TOL:
+            on_shorter = float(np.max(np.abs(r))) < REJOIN_TOL
+            if on_shorter:  # an orbit of period d, not p: no row of this branch
+                shorter_points.add((pt.p, pt.q.tobytes()))
+            if flipped or on_shorter:
                 return f"the period-{period} branch rejoined a period-{once.period} branch near Ω = {pt.p:.6g}"
         return None
 
+    rejoined.shorter_points = shorter_points  # type: ignore[attr-defined]
     return rejoined
 
 
@@ -864,9 +941,12 @@ def _both_ways(follower: _Follower, shorter: list[ShootingProblem], z0: FloatArr
     order of the continuation (down reversed, then up; the pieces of both sides kept, the two
     through ``w0`` one piece); its special points located with ``locate``."""
     period = follower.problem.period
+    marks: list[set[tuple[float, bytes]]] = []  # each side's points on an orbit of a shorter period
 
     def stop() -> Any:
         inner = _rejoin_stop(shorter, period) if shorter else None
+        if inner is not None:
+            marks.append(inner.shorter_points)
         inner = _close_stop(follower.problem, z0, w0, inner) if close else inner
         extra = also() if also is not None else None
         if inner is None or extra is None:
@@ -878,6 +958,12 @@ def _both_ways(follower: _Follower, shorter: list[ShootingProblem], z0: FloatArr
         up = ExactBranch(rows=down.rows[:1], pieces=[1])
     else:
         up = follower.follow(z0, w0, 1.0, stop=stop())
+    dropped = set().union(*marks)
+    for side in (down, up):  # an end on an orbit of a shorter period is no row of this branch
+        if len(side.rows) > 1 and (side.rows[-1].omega, side.rows[-1].q.tobytes()) in dropped:
+            side.rows.pop()
+            if side.pieces:
+                side.pieces[-1] -= 1
     branch = ExactBranch(origin=origin, bridges=[*down.bridges, *up.bridges])
     branch.rows = list(reversed(down.rows[1:])) + up.rows
     sides = [*reversed(down.pieces or [len(down.rows)]), *(up.pieces or [len(up.rows)])]
@@ -920,9 +1006,11 @@ def branch_through(
         shorter = [ShootingProblem(system, period=d, integrator=problem.integrator)
                    for d in range(1, period) if period % d == 0]
         follower = _Follower(problem, (lo, hi), opts, continuation or ContinuationOptions(), newton or NewtonOptions())
-        return _both_ways(follower, shorter, np.asarray(state, dtype=float), float(omega0), origin, opts.locate,
-                          close=True)
+        branch = _both_ways(follower, shorter, np.asarray(state, dtype=float), float(omega0), origin, opts.locate,
+                            close=True)
+        branch.period = int(period)
+        return branch
 
 
-__all__ = ["ExactBranch", "ExactRow", "ShootingOptions", "branch_through", "exact_branches", "start_state",
-           "subharmonic_branches"]
+__all__ = ["DOUBLING_BRANCHES", "ExactBranch", "ExactRow", "ShootingOptions", "branch_through", "doubled_orbit", "exact_branches",
+           "start_state", "subharmonic_branches"]

@@ -70,11 +70,14 @@ from ..results import FrequencyResponse, FrictionCheck, NonsmoothCheck
 from ..stability import regularised_multipliers
 from ..timeint import (
     FLOW_FAILURES, ExactIntegrator, NonsmoothOrbit, NonsmoothTrajectory, monodromy_multipliers,
-    make_integrator, shoot_nonsmooth_orbit,
+    shoot_nonsmooth_orbit,
 )
-from ._exact_branch import ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
+from .._limits import MAX_PERIOD
+from ._attractors import AttractorSearch
+from ._census import SUBHARMONIC_POINTS, SUBHARMONIC_SEARCH, subharmonic_attractors
+from ._exact_branch import DOUBLING_BRANCHES, ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
 from ._friction_response import exact_friction_response, friction_response, shooting_friction_response
-from ._friction_subharmonics import friction_subharmonics, period_two_orbit
+from ._friction_subharmonics import friction_subharmonics
 from ._period_two import branches_at_doublings, follow_both_ways, follow_exactly, period_two_hb, pushed_starts
 from ._regularisation import (
     RegularisationLimit,
@@ -240,6 +243,8 @@ def nonsmooth_response(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
+    max_period: int = MAX_PERIOD,
+    search: AttractorSearch | None = SUBHARMONIC_SEARCH,
     progress: Callable[[int, int], None] | None = None,
 ) -> NonsmoothCheck | FrictionCheck:
     """The exact-check group (:class:`~rattle.results.NonsmoothCheck`, a chain's
@@ -250,14 +255,15 @@ def nonsmooth_response(
     :class:`RegularisationOptions`, the regularised harmonic balance with every row checked by
     exact shooting (module docstring); with ``subharmonics`` also the
     period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
-    ``branches``. A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
+    ``branches`` (by exact shooting: the sub-harmonic branches of :func:`shooting_response`, up to
+    ``max_period``, with the attractor search ``search``). A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
     :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionCheck`),
     with ``subharmonics`` also to :func:`~rattle.analysis._friction_subharmonics.friction_subharmonics`."""
     if not isinstance(subharmonics, bool):
         raise TypeError(f"`subharmonics` must be True or False, got {subharmonics!r}")
     if options is None or isinstance(options, ShootingOptions):  # the default: exact shooting continuation
         return shooting_response(system, omega, options, continuation=continuation, newton=newton,
-                                 subharmonics=subharmonics, progress=progress)
+                                 subharmonics=subharmonics, max_period=max_period, search=search, progress=progress)
     if isinstance(system, FrictionSystem):
         chain = friction_response(system, omega, options, continuation=continuation, newton=newton)
         if subharmonics:
@@ -340,6 +346,10 @@ def discontinuous_response(
     chain = isinstance(system, FrictionSystem)
     opts = options if options is not None else ShootingOptions()
     settings = {**method_settings(opts, chain), "subharmonics": subharmonics}
+    if subharmonics and isinstance(opts, ShootingOptions):
+        settings.update(max_period=MAX_PERIOD, doubling_branches=DOUBLING_BRANCHES,
+                        subharmonic_search=None if chain else {"points": SUBHARMONIC_POINTS,
+                                                               **dataclasses.asdict(SUBHARMONIC_SEARCH)})
     result = FrequencyResponse.from_check(check, model=system, settings=settings,
                                           timings={"frequency_response": time.perf_counter() - t0})
     if throw and not result.status.success:
@@ -356,14 +366,22 @@ def shooting_response(
     continuation: ContinuationOptions | None = None,
     newton: NewtonOptions | None = None,
     subharmonics: bool = False,
+    max_period: int = MAX_PERIOD,
+    search: AttractorSearch | None = SUBHARMONIC_SEARCH,
     progress: Callable[[int, int], None] | None = None,
 ) -> NonsmoothCheck | FrictionCheck:
     """The period-1 branch over ``omega`` by exact shooting continuation
     (:func:`~rattle.analysis._exact_branch.exact_branches`: every row an exact orbit, the special
     points located and labelled; ``followed`` "exact shooting", the HB columns nan). A second
     branch followed down from Ω_max, where the first left frequencies uncovered, is the first of
-    ``branches``; with ``subharmonics`` the period-2 branches born at the located period doublings
-    follow (numbered on). ``progress(done, total)``: called with the share of the range reached
+    ``branches``. With ``subharmonics`` the sub-harmonic branches follow (numbered on), every row
+    an exact orbit of its period p with the multipliers of the p-period map: those born at the
+    period doublings located on the period-1 branches, and recursively on theirs, up to period
+    ``max_period`` (:func:`~rattle.analysis._exact_branch.subharmonic_branches`); then, with
+    ``search`` (an :class:`AttractorSearch` budget; None: none; a chain has none), those through
+    the periodic attractors of period 2 … ``max_period`` that exact simulations settle on and no
+    branch accounts for (:func:`~rattle.analysis._census.subharmonic_attractors`), with the
+    branches born at their own period doublings. ``progress(done, total)``: called with the share of the range reached
     (the CLI draws a bar; the library draws nothing)."""
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
@@ -371,24 +389,28 @@ def shooting_response(
     if isinstance(system, FrictionSystem):
         primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
                                              progress=progress)
-        chain_integ = make_integrator(system)
-        seed = lambda w, z: period_two_orbit(system, chain_integ, w, z)  # noqa: E731
-        build = lambda b, k: exact_friction_response(system, b, number=k, period=2)  # noqa: E731
+        build = lambda b, k, p: exact_friction_response(system, b, number=k, period=p)  # noqa: E731
+        search = None  # a chain's simulations take seconds each: its attractor search is the map's (rattle map)
     elif isinstance(system, NonsmoothSystem):
         found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
         parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
         primary = dataclasses.replace(parts[0], branches=tuple(parts[1:])) if len(parts) > 1 else parts[0]
-        integ = make_integrator(system)
-        seed = lambda w, z: _period_two_orbit(system, integ, w, z)  # noqa: E731
-        build = lambda b, k: _exact_response(b, number=k, period=2)  # noqa: E731
+        build = lambda b, k, p: _exact_response(b, number=k, period=p)  # noqa: E731
     else:
         raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
                         f"friction, Chain.friction_system()), got {system!r}")
     if not subharmonics or not len(primary):
         return primary
     extra = list(primary.branches)
-    for b in subharmonic_branches(system, primary, (lo, hi), opts, continuation, newton, seed):
-        extra.append(build(b, len(extra) + 1))
+    extra += subharmonic_branches(system, [primary, *primary.branches], (lo, hi), opts, continuation, newton, build,
+                                  first=len(extra) + 1, max_period=max_period)
+    if search is not None:
+        found = subharmonic_attractors(system, dataclasses.replace(primary, branches=tuple(extra)), (lo, hi), opts,
+                                       continuation, newton, search)
+        found = [b for b in found if int(b.period) <= max_period]
+        extra += found
+        extra += subharmonic_branches(system, found, (lo, hi), opts, continuation, newton, build,
+                                      first=len(extra) + 1, max_period=max_period)
     return dataclasses.replace(primary, branches=tuple(extra))
 
 
