@@ -67,6 +67,44 @@ def test_random_cases_match_solve_ivp(case: int) -> None:
     assert len(traj.event_time) > 0  # switching happened
 
 
+def test_compiled_march_is_the_python_march() -> None:
+    """The compiled event march (timeint._event_kernel) takes the Python march's steps: the same
+    events, event times and segments, the same end state and sensitivity (to the last bit where
+    numpy's complex matrix product sums by fused multiply-adds, as OpenBLAS' kernels on x86-64
+    with FMA do; to round-off elsewhere), on random preload/clearance/friction laws with two
+    harmonics, sticks, locks and reversals over several periods."""
+    from rattle.timeint import _event_kernel
+
+    if not _event_kernel.AVAILABLE:
+        pytest.skip("numba is not installed")
+    kinds = set()
+    locking = _system(Preload(preload=0.1), Friction(levels=0.02), mean=0.02, amps=(0.15,))  # chatter into a lock
+    for sysx, x0, w in _random_cases(12) + [(locking, (0.1, 0.0), 0.3)]:
+        compiled, python = ExactIntegrator(sysx), ExactIntegrator(sysx)
+        python._compiled = False
+        a = compiled.propagate(x0, 0.0, 40.0, w)
+        b = python.propagate(x0, 0.0, 40.0, w)
+        assert compiled._compiled
+        assert a.event_kind == b.event_kind
+        kinds |= set(a.event_kind)
+        np.testing.assert_array_equal(a.kind, b.kind)
+        np.testing.assert_array_equal(a.stage, b.stage)
+        np.testing.assert_array_equal(a.sign, b.sign)
+        np.testing.assert_allclose(a.event_time, b.event_time, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(a.x_start, b.x_start, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(a.state1, b.state1, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(a.sensitivity, b.sensitivity, rtol=1e-8, atol=1e-10)
+    assert {"crossing", "reversal", "stick", "unstick", "lock", "unlock"} <= kinds
+
+
+def test_near_critical_damping_keeps_the_python_march() -> None:
+    # a stage with its two real modes within 1 % of each other: no modal form, the Python march
+    sysx = _system(Preload(preload=0.02), Friction(levels=0.005), c=2.0 * 1.00001)
+    integ = ExactIntegrator(sysx)
+    traj = integ.propagate((0.05, 0.0), 0.0, 20.0, 0.7)
+    assert integ._compiled is False and len(traj.event_time) > 0
+
+
 def test_stick_phases_match_solve_ivp() -> None:
     # Friction on the reference clutch at low frequency: the orbit sticks and reverses.
     sysx = NonsmoothSystem.from_model(reference_case(), friction=Friction(levels=(0.005, 0.02, 0.005)))

@@ -58,6 +58,7 @@ from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import NonsmoothSystem, Stages
+from . import _event_kernel
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
@@ -348,6 +349,12 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         self._J = st.jumps.tolist()
         self._r = system.law.friction_levels.tolist()
         self._L = float(system.length_scale())
+        # the compiled march (:mod:`._event_kernel`) where every mode's segment has the modal form
+        # (decided with the first stage solutions: :meth:`_use_compiled`)
+        self._compiled: bool | None = None if _event_kernel.AVAILABLE else False
+        self._stage_table: FloatArray | None = None
+        self._law_arrays = tuple(np.asarray(x, dtype=float) for x in (self._d, self._s, self._e, self._J, self._r))
+        self._capacity = 64  # segments and events of a record (grown when a march needs more)
 
     def solutions(self, omega: float) -> StageSolutions:
         """The closed-form solutions of every mode at ``omega`` (the last :data:`SOLUTION_CACHE`
@@ -414,8 +421,11 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         if memo is not None:
             return memo
         sol = self.solutions(omega)
-        rec: dict[str, list] = {k: [] for k in ("t", "kind", "stage", "sign", "x", "h", "et", "ek")}
-        d, v, M = self._march_events(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
+        if self._use_compiled(sol):
+            d, v, M, rec = self._march_compiled(sol, float(x0[0]), float(x0[1]), t0, t1)
+        else:
+            rec = {k: [] for k in ("t", "kind", "stage", "sign", "x", "h", "et", "ek")}
+            d, v, M = self._march_events(sol, float(x0[0]), float(x0[1]), t0, t1, omega, rec)
         t_start = np.asarray(rec["t"], dtype=float)
         traj = NonsmoothTrajectory(
             system=self.system, omega=omega, t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
@@ -434,6 +444,53 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
         return traj.state1.copy(), (traj.sensitivity.copy() if sensitivity else None)
 
     # --- the march ---------------------------------------------------------------------------
+    def _use_compiled(self, sol: StageSolutions) -> bool:
+        """Whether the march runs compiled: numba there and every mode's segment in modal form
+        (the mode table's Ω-independent rows, ``sol._stage_l``, decide once)."""
+        if self._compiled is None:
+            self._stage_table = np.array([[float(x) for x in row] for row in sol._stage_l], dtype=float)
+            self._compiled = _event_kernel.supported(self._stage_table, float(sol.sigma))
+        return self._compiled
+
+    def _budget_error(self, t0: float, t1: float) -> ConvergenceError:
+        return ConvergenceError(
+            f"more than `max_events` = {self.max_segments} switching events between t0 = {t0!r} "
+            f"and t1 = {t1!r} (a chattering approach to a lock?): raise `max_events` or `lock_excursion`, "
+            "or shorten the interval")
+
+    def _march_compiled(self, sol: StageSolutions, d: float, v: float, t0: float,
+                        t1: float) -> tuple[float, float, tuple[float, float, float, float], dict]:
+        """:meth:`_march_events` by the compiled march (:mod:`._event_kernel`, the same steps):
+        the final state, the sensitivity and the record (arrays, as the Python march's lists)."""
+        kept = sol.__dict__.get("_kernel_args")  # an at_omega copy starts with its template's: Ω tells
+        if kept is not None and kept[0] == sol.omega:
+            args = kept[1]
+        else:
+            args = (
+                np.ascontiguousarray(self._stage_table), float(sol.sigma), np.ascontiguousarray(sol.xr),
+                np.ascontiguousarray(sol.xi), np.ascontiguousarray(sol.nw, dtype=float),
+                np.ascontiguousarray(sol.fc, dtype=float), np.ascontiguousarray(sol.fs, dtype=float),
+                float(sol.mean), np.ascontiguousarray(sol.grid_step, dtype=float), float(self.samples_per_scale))
+            sol._kernel_args = (sol.omega, args)
+        kind, j, sigma = self._classify(sol, t0, d, v)
+        cap = self._capacity
+        while True:
+            rec_t, rec_i, rec_x = np.empty(cap), np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4))
+            ev_t, ev_k = np.empty(cap), np.empty(cap, dtype=np.int64)
+            status, ns, ne, d1, v1, m11, m12, m21, m22 = _event_kernel.march(
+                *args, *self._law_arrays, self.system.k, self.system.c, self.options.lock_excursion * self._L,
+                self.max_segments, kind, j, sigma, d, v, t0, t1, rec_t, rec_i, rec_x, ev_t, ev_k)
+            if status != _event_kernel.FULL:
+                break
+            cap *= 4  # a longer record than any so far: again with room for it
+            self._capacity = cap
+        if status == _event_kernel.BUDGET:
+            raise self._budget_error(t0, t1)
+        names = _event_kernel.EVENT_NAMES
+        rec = {"t": rec_t[:ns], "kind": rec_i[:ns, 0], "stage": rec_i[:ns, 1], "sign": rec_i[:ns, 2],
+               "x": rec_x[:ns, :2], "h": rec_x[:ns, 2:], "et": ev_t[:ne], "ek": [names[e] for e in ev_k[:ne].tolist()]}
+        return d1, v1, (m11, m12, m21, m22), rec
+
     def _march_events(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
                rec: dict[str, list]) -> tuple[float, float, tuple[float, float, float, float]]:
         k, c = self.system.k, self.system.c
@@ -537,10 +594,7 @@ class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
                 kind, v = SLIP, 0.0
             n_events += 1
             if n_events > self.max_segments:
-                raise ConvergenceError(
-                    f"more than `max_events` = {self.max_segments} switching events between t0 = {t0!r} "
-                    f"and t1 = {t1!r} (a chattering approach to a lock?): raise `max_events` or `lock_excursion`, "
-                    "or shorten the interval")
+                raise self._budget_error(t0, t1)
 
     @staticmethod
     def _record(rec: dict[str, list], t: float, kind: int, j: int, sigma: int, d: float, v: float,
