@@ -58,13 +58,17 @@ from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import NonsmoothSystem, Stages
-from . import _event_kernel
+from .._lazy import lazy_module
 from ._exact_flow import ExactIntegrator, FlowOptions
 from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
 from ._recent import Recent
 from ._roots import bracketed_newton, grid_chunk, polish_crossing
 from ._stage_solutions import StageSolutions
+
+#: the compiled march, imported where a discontinuous law is first integrated (the smooth laws'
+#: commands do not pay its import)
+_event_kernel = lazy_module("rattle.timeint._event_kernel")
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
