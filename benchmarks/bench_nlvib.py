@@ -23,7 +23,9 @@ uses 2^10 too):
 * rattle in-process (``time.process_time``, best of ``--repeat`` after a warm-up run, so numba's
   compilation is excluded): ``rattle.frequency_response`` as it always runs (exact Floquet stability
   of every point, special points located, SPEC measures, adaptive H, the exact up/down sweep
-  check); the same with ``check=None``; and the bare continuation without stability
+  check); the same with ``check=None``; the same with steps about as coarse as NLvib's
+  (``COARSE``: about 225 points instead of about 830, the special points checked to be the same);
+  and the bare continuation without stability
   (``rattle.continuation.ContinuationStepper`` on ``rattle.hb.HarmonicBalance`` with no monitor —
   ``frequency_response`` has no switch to turn stability off).
 * Ratios NLvib CPU / rattle CPU; agreement: at every NLvib point, rattle's HB solution at the
@@ -37,8 +39,8 @@ dampers 0.03 each, a unilateral spring of stiffness 100 at gap 1 on the first ma
 second; H = 21, N = 2^10, Ω = 0.8 → 0.5, ds = 0.0085) — its HB continuation with the example's
 parameters (``benchmarks/nlvib/nlvib_unilateral.m``), and rattle's chain with a ``Unilateral``
 element (as ``tests/analysis/test_coverage.py`` writes it, issue 24): ``frequency_response``
-started at the high end, default and with ``adaptive=None`` (issue 24's setting), and the bare
-continuation. Points, rejected steps, times, ratios, folds and the stop's rms at NLvib's points.
+started at the high end, default, with ``adaptive=None`` (issue 24's setting), with ``adaptive=None,
+check=None`` (no exact sweep check), and the bare continuation. Points, rejected steps, times, ratios, folds and the stop's rms at NLvib's points.
 Two things are set that an Octave user of NLvib must set: the solver options are passed as
 ``optimset('fsolve')`` (NLvib's default line calls ``optimset(@fsolve)``, which Octave refuses),
 and dsmin = ds/100 (with NLvib's ds/5, Octave's fsolve fails near Ω = 0.58 and NLvib stops).
@@ -65,13 +67,16 @@ if __name__ == "__main__":  # one thread for numpy's BLAS, as for Octave (set be
 import numpy as np  # noqa: E402
 
 import rattle  # noqa: E402
-from rattle.continuation import ContinuationStepper, solve_fixed  # noqa: E402
+from rattle.continuation import ContinuationOptions, ContinuationStepper, solve_fixed  # noqa: E402
 from rattle.hb import HarmonicBalance, HBOptions, resize_harmonics  # noqa: E402
 from rattle.model import Chain, Element, Link, Torque, Unilateral  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 DRIVERS = Path(__file__).resolve().parent / "nlvib"
 CLUTCH = ROOT / "examples" / "reference_clutch.toml"
+#: Steps about as coarse as NLvib's on the clutch (≈ 225 points instead of ≈ 830; the default targets 3 Newton
+#: iterations and a tangent turn of 0.1 rad per step, at most 0.08 in scaled arc length).
+COARSE = ContinuationOptions(max_step=0.3, target_turn=0.3, max_turn=0.6, target_iterations=5)
 SAMPLES = 1024  # AFT samples per period on both sides (rattle's default_samples for H = 20 and 32)
 HOW_TO = """\
 bench_nlvib: skipped — {missing}.
@@ -219,6 +224,15 @@ def unilateral_chain() -> Chain:
     )
 
 
+def special_difference(a, b) -> float:
+    """Largest |ΔΩ| between the special points of two runs (inf when their kinds or numbers differ)."""
+    pa = sorted((p.kind, p.omega) for p in a.special_points)
+    pb = sorted((p.kind, p.omega) for p in b.special_points)
+    if [k for k, _ in pa] != [k for k, _ in pb]:
+        return float("inf")
+    return max((abs(x - y) for (_, x), (_, y) in zip(pa, pb)), default=0.0)
+
+
 def folds_of(frf) -> list[float]:
     return sorted(round(p.omega, 4) for p in frf.special_points if p.kind == "fold")
 
@@ -239,6 +253,8 @@ def clutch_case(exe: str, nlvib: Path, tmp: Path, args) -> None:
         t_full, frf = best_cpu(lambda: rattle.frequency_response(model, omega=(lo, hi), harmonics=H), args.repeat)
         t_nochk, _ = best_cpu(lambda: rattle.frequency_response(model, omega=(lo, hi), harmonics=H, check=None),
                               args.repeat)
+        t_coarse, frf_coarse = best_cpu(lambda: rattle.frequency_response(model, omega=(lo, hi), harmonics=H,
+                                                                          continuation=COARSE), args.repeat)
         t_bare, stepper = best_cpu(lambda: bare_continuation(model, H, (lo, hi), lo), args.repeat)
         frfs[H] = frf
         other = 32 if H != 32 else 20
@@ -249,6 +265,7 @@ def clutch_case(exe: str, nlvib: Path, tmp: Path, args) -> None:
               f"  {nl.cpu / npts * 1e3:6.2f} ms/point")
         for label, t, pts in (("rattle frequency_response       ", t_full, len(frf)),
                               ("rattle frequency_response check=None", t_nochk, len(frf)),
+                              ("rattle frequency_response coarse steps", t_coarse, len(frf_coarse)),
                               ("rattle bare continuation, no stab.", t_bare, len(stepper.points))):
             print(f"    {label:34s}{pts:5d} points  CPU {t:7.3f} s  {t / pts * 1e3:6.2f} ms/point  "
                   f"ratio NLvib/rattle {nl.cpu / t:6.1f} x  (per point {nl.cpu / npts / (t / pts):6.1f} x)")
@@ -257,7 +274,9 @@ def clutch_case(exe: str, nlvib: Path, tmp: Path, args) -> None:
               f"(relative; NLvib's fsolve tolerance); it lies on rattle's computed branch within {ag['branch']:.1e} "
               f"(relative, to the polyline of its rows); HB truncation, rms H = {H} vs {other} there: {ag['truncation']:.1e}")
         print(f"    folds: NLvib's Ω reversals {[round(float(w), 4) for w in sorted(reversals(nl.X[:, -1]))]}")
-        print(f"           rattle's located    {folds_of(frf)}")
+        print(f"           rattle's located    {folds_of(frf)}; coarse steps: the same "
+              f"{len(frf.special_points)} special points within "
+              f"{special_difference(frf, frf_coarse):.1e} in Ω")
 
 
 def unilateral_case(exe: str, nlvib: Path, tmp: Path, args) -> None:
@@ -271,6 +290,8 @@ def unilateral_case(exe: str, nlvib: Path, tmp: Path, args) -> None:
                            args.repeat)
     t_fixed, frf_fixed = best_cpu(lambda: rattle.frequency_response(chain, omega=(lo, hi), harmonics=H, start="high",
                                                                     adaptive=None), args.repeat)
+    t_nochk, frf_nochk = best_cpu(lambda: rattle.frequency_response(chain, omega=(lo, hi), harmonics=H, start="high",
+                                                                    adaptive=None, check=None), args.repeat)
     t_bare, stepper = best_cpu(lambda: bare_continuation(chain, H, (lo, hi), hi), args.repeat)
     npts = nl.X.shape[0]
     print(f"    NLvib solve_and_continue (HB_residual)  {npts:5d} points  CPU {nl.cpu:7.3f} s  (wall {nl.wall:.3f} s)"
@@ -278,6 +299,7 @@ def unilateral_case(exe: str, nlvib: Path, tmp: Path, args) -> None:
     for label, t, pts, extra in (
             ("rattle frequency_response (default)", t_full, len(frf), ""),
             ("rattle frequency_response adaptive=None", t_fixed, len(frf_fixed), ""),
+            ("rattle … adaptive=None, check=None", t_nochk, len(frf_nochk), ""),
             ("rattle bare continuation, no stab.", t_bare, len(stepper.points), f", {stepper.rejected} rejected")):
         print(f"    {label:40s}{pts:5d} points{extra}  CPU {t:7.3f} s  ratio NLvib/rattle {nl.cpu / t:6.2f} x")
     ag = agreement(chain, frf_fixed, nl.X, H, n=2)
