@@ -226,3 +226,29 @@ def test_a_branch_that_turns_back_at_its_start_is_a_success_when_the_other_end_c
     assert "covered with the branch followed from the other end" in frf.message
     om = np.asarray(frf.omega, dtype=float)
     assert om.min() <= lo * (1 + 1e-9) and om.max() >= hi * (1 - 1e-9)
+
+
+@pytest.mark.slow
+def test_the_branch_from_the_other_end_goes_on_where_it_is_another_orbit():
+    """A random preload (benchmarks/crossval_doors.py --kinds preload,preload_friction --seed 11,
+    case 04) over Ω 0.4–1: the branch from Ω_min (two crossings of the jump a period) ends at a
+    grazing at Ω 0.47603; the branch from Ω_max (four crossings) reaches lower frequencies and
+    carries there the stable orbit a run-up settles on at Ω 0.4744 (rms 0.056755, beside the first
+    branch's 0.05765). It was stopped on entering the frequencies the first branch covered; now
+    only where it joins it, so the stable orbit is on the response — and the exact simulation
+    settles back on the row (rms to 1e-6)."""
+    from rattle.analysis import SteadyStateOptions, steady_state
+
+    system = NonsmoothSystem(damping=0.0465, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.0287)),
+                             excitation=Excitation(mean=0.0681, amplitudes=(0.0447,)))
+    w = 0.4744
+    run_up = rattle.time_sweep(system, omega=(0.3, w), points=4, direction="up")
+    assert int(run_up.period[-1]) == 1 and float(run_up.rms[-1]) == pytest.approx(0.056755, rel=1e-4)
+    res = nonsmooth_response(system, (0.4, 1.0))
+    rows = [(b, i) for b in (res, *res.branches) for i in np.flatnonzero(
+        b.stable & (np.abs(b.omega - w) < 2e-3) & (np.abs(b.rms - float(run_up.rms[-1])) < 0.01 * float(run_up.rms[-1])))]
+    assert len(rows) >= 2, "the stable orbit of the run-up at Ω 0.4744 is not on the response"
+    b, i = min(rows, key=lambda r: abs(float(r[0].omega[r[1]]) - w))
+    settled = steady_state(system, float(b.omega[i]), x0=tuple(b.states[i] * (1.0 + 1e-3)),
+                           options=SteadyStateOptions(max_period_multiple=1))
+    assert settled.period == 1 and settled.rms == pytest.approx(float(b.rms[i]), rel=1e-6)

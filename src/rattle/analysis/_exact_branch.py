@@ -43,7 +43,12 @@ phase appears or vanishes, ``grazing`` where a pair of crossings does.
 
 **Coverage.** A branch followed from Ω_min that turns back and leaves the range at Ω_min, or ends
 early, leaves the frequencies above it uncovered: the branch through Ω_max is then followed down
-from there (a second branch) until it reaches the frequencies covered.
+from there (a second branch) until it joins the first among the frequencies covered (its orbit
+within :data:`JOIN_DISTANCE` of the first branch's there). Where it does not join, it is another
+orbit — measured: a preload whose branch from Ω_min ended at a grazing where the branch from Ω_max,
+another event structure (four crossings of the jump where the first had two), went on below the
+first's top frequency and carried the stable motion a sweep settles on there — and it is followed
+on (at most :data:`SEEDED_POINTS` points below the first's top).
 
 **Where no computed orbit is stable.** A bounded, damped motion settles on some attractor at every
 Ω; where no row of the branches is stable (nor unstable only by a period doubling, whose
@@ -57,7 +62,18 @@ exact orbit and followed both ways as a branch of its own until it leaves the ra
 already computed (:func:`_missed_branches`, at most ``check.max_branches`` branches of at most
 :data:`SEEDED_POINTS` points each way). Intervals narrower than :data:`MIN_GAP` of the range
 are left (a stability change and its jump). Sub-harmonic and non-periodic attractors are not
-continued here (``subharmonics=True``).
+continued here (``subharmonics=True``). On one coordinate (a flow of ~10 ms a frequency) the
+sweep runs over the whole range, as for the smooth laws, so that a stable attractor beside a stable
+computed one is found too (measured: a preload whose branch from Ω_min was unstable over its first
+1.3 % of the range — too narrow an interval — while a run-up from rest settles at Ω_min on a
+stable orbit of 1.26× its rms); on a chain only over those intervals.
+
+**Arms a hop skipped.** Where the follower hops a grazing (or restarts past a stall) onto an arm
+that goes on back beyond the hop with its own event structure, that stretch was never followed
+(measured: a preload's stable arm, rms 0.0316, from the hop at Ω 0.3891 down to its fold at
+0.3808, where a run-down settles): each such arm is followed back as a branch of its own until it
+joins rows already computed, leaves the range, or stays unstable for :data:`ARM_UNSTABLE_POINTS`
+points (:func:`_skipped_arms`).
 """
 
 from __future__ import annotations
@@ -111,6 +127,10 @@ CRAWL_FACTOR = 8.0
 CRAWLING = "crawling towards a grazing"
 #: A hop's grazing point is sought this many points back along the arm hopped onto.
 GRAZE_POINTS = 40
+#: The most arms a hop skipped followed as branches of their own (:func:`_skipped_arms`), and
+#: how many unstable points in a row end one (the stable motion it carried has ended there).
+MAX_ARMS = 4
+ARM_UNSTABLE_POINTS = 20
 #: Relative frequency steps to a restart past a stall that no hop passes (:meth:`_Follower._restart`).
 RESTART_STEPS = (0.005, 0.02, 0.05)
 #: A restart past a stall whose orbit's rms is within this relative distance of the stall's is the
@@ -317,6 +337,9 @@ class _Follower:
         #: the rows of the last piece's accepted points, made as they were accepted (their period
         #: was then the flow's last: no second integration, :meth:`_rows`)
         self._made: dict[tuple[float, bytes], ExactRow] = {}
+        #: arms hopped onto that go on against the direction of travel beyond the grazing (the
+        #: stretch a hop skipped): (z(0), Ω, direction) to follow as branches of their own
+        self.arms: list[tuple[FloatArray, float, float]] = []
 
     def _rows(self, pts: list[BranchPoint]) -> list[ExactRow]:
         """The rows of the last piece's points ``pts`` (made when accepted, else now)."""
@@ -463,6 +486,12 @@ class _Follower:
             return "far enough" if len(seen) > GRAZE_POINTS else None
 
         stepper = self._piece(start.q, start.p, -direction, same)
+        if stepper is not None and (len(seen) > GRAZE_POINTS or len(seen) >= 2 and stepper.status in (
+                Status.SUCCESS, Status.RETURNED)):
+            # the arm goes on back beyond the stall with its structure: not a grazing next to the
+            # hop but a stretch of orbits the hop skipped (measured: a preload's stable arm from
+            # Ω 0.3891 down past 0.387, where a run-down settles on it) — followed afterwards
+            self.arms.append((start.q, start.p, -direction))
         if stepper is None or len(seen) < 2 or len(seen) > GRAZE_POINTS:
             return None
         return _row(self.problem, seen[-1].q, seen[-1].p)
@@ -489,9 +518,19 @@ class _Follower:
                 return "reached the stall" if (pt.p - w_stall) * travel <= 0 else None
 
             restart_rms = _row_rms(_row(self.problem, q, w))
-            stall_rms = _row_rms(branch.rows[-1])
+            stall = branch.rows[-1]
+            stall_rms = _row_rms(stall)
             if np.all(np.abs(restart_rms - stall_rms) <= RESTART_RMS * np.abs(stall_rms)):
                 stepper = self._piece(q, w, -travel, back)
+                if stepper is not None and stepper.message == "reached the stall":
+                    # one step past the stall: the same orbit is within that step's arc length of
+                    # the stall's; farther, the restart is on another orbit of a like rms that goes
+                    # on beyond (measured: a preload's stable arm, rms 0.0316 beside the stall's
+                    # unstable 0.0296, at a scaled distance of 0.38) — followed on afterwards
+                    last = stepper.points[-1]
+                    if float(np.max(np.abs(last.q - stall.q) / self.problem.length_scale)) > \
+                            2.0 * self.continuation.max_step:
+                        self.arms.append((last.q, last.p, -travel))
             else:
                 # another branch (the stall's branch turned back at a grazing we could not pass, or
                 # ended): followed back past the stall's frequency — over its own folds — until it
@@ -610,21 +649,69 @@ def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float
     if top < hi * (1.0 - 1e-9):
         q1 = start_state(problem, hi, opts, newton, continuation=cont, bounds=(lo, hi))
         if q1 is not None:
+            below, known = [0], list(first.rows)
+
             def covered(pt: BranchPoint) -> str | None:
-                return "reached the frequencies already covered" if pt.p < top else None
+                """Below the frequencies the first branch reached: joined it, or a branch of its own
+                (another orbit there: followed on, at most SEEDED_POINTS points)."""
+                if pt.p >= top:
+                    return None
+                below[0] += 1
+                if _joins(problem, pt, known, hi):
+                    return "reached the frequencies already covered (joined the branch there)"
+                if below[0] > SEEDED_POINTS:
+                    return (f"the budget of {SEEDED_POINTS} points below the frequencies already covered was "
+                            "spent (another orbit than the branch there)")
+                return None
 
             second = follower.follow(q1, hi, -1.0, stop=covered)
             second.origin = f"Ω = {hi:.6g}"
             if second.rows:
                 out.append(second)
+    out.extend(_skipped_arms(follower, out))
     if opts.check is not None and period == 1 and any(b.rows for b in out):
-        gaps = _unstable_intervals(out, lo, hi)
+        # one coordinate: the exact sweep costs ~10 ms a frequency, so it runs over the whole range
+        # (as for the smooth laws: a stable attractor beside a stable computed one is found too);
+        # a chain's flow costs 10–1000× that: only where no computed orbit is stable
+        gaps = [(lo, hi)] if problem.size == 2 else _unstable_intervals(out, lo, hi)
         if gaps:
             out.extend(_missed_branches(follower, out, opts.check, gaps))
     if opts.locate:
         for b in out:
             follower.locate(b)
     _coverage(out, lo, hi)
+    return out
+
+
+def _skipped_arms(follower: _Follower, found: list[ExactBranch]) -> list[ExactBranch]:
+    """The arms the follower hopped onto that go on back beyond their hop (:attr:`_Follower.arms`),
+    each followed back as a branch of its own until it leaves the range or joins rows already
+    computed, or its last :data:`ARM_UNSTABLE_POINTS` points were all unstable (at most
+    :data:`SEEDED_POINTS` points; at most :data:`MAX_ARMS` arms, arms found while following these
+    included)."""
+    out: list[ExactBranch] = []
+    done = 0
+    while follower.arms and done < MAX_ARMS:
+        q, w, d = follower.arms.pop(0)
+        done += 1
+        known = [r for b in (*found, *out) for r in b.rows]
+        seen, unstable = [0], [0]
+
+        def stop(pt: BranchPoint, known: list[ExactRow] = known, w0: float = w) -> str | None:
+            seen[0] += 1
+            row = follower._made.get((pt.p, pt.q.tobytes()))
+            unstable[0] = unstable[0] + 1 if row is not None and row.unstable_count else 0
+            if seen[0] > SEEDED_POINTS:
+                return f"the budget of {SEEDED_POINTS} points of an arm a hop skipped was spent"
+            if unstable[0] > ARM_UNSTABLE_POINTS:
+                return f"the arm a hop skipped stayed unstable for {ARM_UNSTABLE_POINTS} points"
+            return _joins(follower.problem, pt, known, w0)
+
+        branch = follower.follow(q, w, d, stop=stop)
+        if len(branch.rows) >= 2:
+            branch.origin = f"the arm a hop skipped at Ω = {w:.6g}"
+            out.append(branch)
+    follower.arms.clear()
     return out
 
 
