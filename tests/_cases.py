@@ -8,7 +8,7 @@ import numpy as np
 
 from rattle.hb import FourierBasis
 from rattle.model import (
-    Backlash, Chain, Clutch, Element, Excitation, Friction, FrictionSystem, Link, NonsmoothLaw, NonsmoothSystem, Preload,
+    Backlash, Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, NonsmoothSystem, Preload,
     Torque,
 )
 
@@ -129,7 +129,7 @@ def random_preload(seed: int, omega: tuple[float, float] = (0.4, 1.6), span: flo
     return system, (w, span * w)
 
 
-def friction_chain() -> FrictionSystem:
+def friction_chain() -> System:
     """Three inertias, a clutch with Coulomb friction and a gear backlash: the friction chain of the
     exact-shooting tests and of benchmarks/crossval_shooting_stability.py."""
     chain = Chain(

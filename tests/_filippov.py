@@ -16,7 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rattle.model import FrictionSystem, NonsmoothSystem
+from rattle.model import NonsmoothSystem
 
 
 def _surface(d):
@@ -101,11 +101,11 @@ def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float, max_s
             sg = 0 if r[j] == 0 else (1 if v > 0 else -1)
 
 
-def chain_reference(fs: FrictionSystem, z0, t1, omega, max_step: float = np.inf):
+def chain_reference(fs: System, z0, t1, omega, max_step: float = np.inf):
     """An independent integration of the Filippov system by scipy (DOP853, rtol 1e-12) with
     terminal events at every breakpoint, velocity zero and stick band edge; only constant friction
     levels (the mode logic written out again, one element at a time)."""
-    sysm = fs.system
+    sysm = fs.continuous()
     n, m = sysm.n, sysm.m
     A = sysm.element_rows
     B = sysm.element_columns

@@ -1,6 +1,6 @@
 """Time-domain steady states and stepped sweeps of the discontinuous laws: ``steady_state`` and
 ``time_sweep`` on a :class:`NonsmoothSystem` (jumps, Coulomb friction) and on a
-:class:`FrictionSystem` (a chain with friction on its elements), checked against independent
+a :class:`System` with its elements' whole laws (a chain with friction on its elements), checked against independent
 exact shooting (``shoot_nonsmooth_orbit`` / ``shoot_friction_orbit``)."""
 
 from __future__ import annotations

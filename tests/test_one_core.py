@@ -145,12 +145,12 @@ def test_one_flow_takes_every_system() -> None:
     """ExactIntegrator(system) is the flow of every kind of system (its paths are private
     subclasses), built for that system; the folded names are gone from the public lists."""
     import rattle
-    from rattle.model import Friction, FrictionSystem, NonsmoothSystem
+    from rattle.model import Friction, NonsmoothSystem
 
     model = rattle.reference_case()
     chain = model.system()
     systems = (model, chain, NonsmoothSystem.from_model(model, friction=Friction(levels=0.01)),
-               FrictionSystem.from_system(chain, (0.01,)))
+               chain.with_friction((0.01,)))
     for system in systems:
         integ = timeint.ExactIntegrator(system)
         assert isinstance(integ, timeint.ExactIntegrator) and type(integ) is not timeint.ExactIntegrator

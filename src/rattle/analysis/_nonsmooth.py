@@ -65,7 +65,7 @@ from .._validate import check_range
 from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
-from ..model import Chain, FrictionSystem, NonsmoothSystem
+from ..model import Chain, NonsmoothSystem, System
 from ..results import FrequencyResponse, FrictionCheck, NonsmoothCheck
 from ..stability import regularised_multipliers
 from ..timeint import (
@@ -233,7 +233,7 @@ def balance_factory(system: NonsmoothSystem, period: int = 1) -> Callable[[float
 
 
 def nonsmooth_response(
-    system: NonsmoothSystem | FrictionSystem,
+    system: NonsmoothSystem | System,
     omega: tuple[float, float],
     options: ShootingOptions | RegularisationOptions | None = None,
     *,
@@ -250,7 +250,7 @@ def nonsmooth_response(
     :class:`RegularisationOptions`, the regularised harmonic balance with every row checked by
     exact shooting (module docstring); with ``subharmonics`` also the
     period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
-    ``branches``. A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
+    ``branches``. A chain with friction (:class:`~rattle.model.System` with its elements' whole laws) goes to
     :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionCheck`),
     with ``subharmonics`` also to :func:`~rattle.analysis._friction_subharmonics.friction_subharmonics`."""
     if not isinstance(subharmonics, bool):
@@ -258,14 +258,14 @@ def nonsmooth_response(
     if options is None or isinstance(options, ShootingOptions):  # the default: exact shooting continuation
         return shooting_response(system, omega, options, continuation=continuation, newton=newton,
                                  subharmonics=subharmonics, progress=progress)
-    if isinstance(system, FrictionSystem):
+    if isinstance(system, System) and system.discontinuous:
         chain = friction_response(system, omega, options, continuation=continuation, newton=newton)
         if subharmonics:
             chain = dataclasses.replace(chain, branches=friction_subharmonics(
                 system, chain, omega, options, continuation=continuation, newton=newton))
         return chain
     if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a System with its elements' whole laws (a chain with "
                         f"friction, Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = RegularisationOptions() if options is None else options
@@ -337,7 +337,7 @@ def discontinuous_response(
     t0 = time.perf_counter()
     check = nonsmooth_response(system, omega, options, continuation=continuation, newton=newton,
                                subharmonics=subharmonics, progress=progress)
-    chain = isinstance(system, FrictionSystem)
+    chain = isinstance(system, System) and system.discontinuous
     opts = options if options is not None else ShootingOptions()
     settings = {**method_settings(opts, chain), "subharmonics": subharmonics}
     result = FrequencyResponse.from_check(check, model=system, settings=settings,
@@ -349,7 +349,7 @@ def discontinuous_response(
 
 
 def shooting_response(
-    system: NonsmoothSystem | FrictionSystem,
+    system: NonsmoothSystem | System,
     omega: tuple[float, float],
     options: ShootingOptions | None = None,
     *,
@@ -368,7 +368,7 @@ def shooting_response(
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
     primary: NonsmoothCheck | FrictionCheck
-    if isinstance(system, FrictionSystem):
+    if isinstance(system, System) and system.discontinuous:
         primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
                                              progress=progress)
         chain_integ = make_integrator(system)
@@ -382,7 +382,7 @@ def shooting_response(
         seed = lambda w, z: _period_two_orbit(system, integ, w, z)  # noqa: E731
         build = lambda b, k: _exact_response(b, number=k, period=2)  # noqa: E731
     else:
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a System with its elements' whole laws (a chain with "
                         f"friction, Chain.friction_system()), got {system!r}")
     if not subharmonics or not len(primary):
         return primary

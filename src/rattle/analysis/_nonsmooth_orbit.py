@@ -35,7 +35,7 @@ from .._typing import FloatArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..hb import RegularisedBalance
-from ..model import FrictionSystem, NonsmoothSystem
+from ..model import NonsmoothSystem, System
 from ..results import FrictionOrbitResult, NonsmoothOrbitResult
 from ..timeint import FLOW_FAILURES, ExactIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
 from ._nonsmooth import RegularisationOptions, balance_factory
@@ -81,7 +81,7 @@ def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, int
 
 
 def nonsmooth_orbit(
-    system: NonsmoothSystem | FrictionSystem,
+    system: NonsmoothSystem | System,
     omega: float,
     options: RegularisationOptions | None = None,
     *,
@@ -103,7 +103,7 @@ def nonsmooth_orbit(
     in :func:`~rattle.analysis._friction_orbit.friction_orbit`): found from the exact flow, its HB of
     period 2 solved from its spectrum.
 
-    A chain with friction on its elements (:class:`~rattle.model.FrictionSystem`) goes to
+    A chain with friction on its elements (:class:`~rattle.model.System` with its elements' whole laws) goes to
     :func:`~rattle.analysis._friction_orbit.friction_orbit` (a :class:`FrictionOrbitResult`;
     ``x0`` then the chain's state (x, x'), 2n values).
 
@@ -116,7 +116,7 @@ def nonsmooth_orbit(
         raise ValueError(f"`period` must be 1 or 2 (a period-2 sub-harmonic orbit), got {period!r}")
     if not isinstance(every, bool):
         raise TypeError(f"`every` must be True or False, got {every!r}")
-    if isinstance(system, FrictionSystem):
+    if isinstance(system, System) and system.discontinuous:
         from ._friction_orbit import friction_orbit
 
         return friction_orbit(system, omega, options, x0=x0, period=period, every=every)
@@ -125,7 +125,7 @@ def nonsmooth_orbit(
 
         return with_every_orbit(system, nonsmooth_orbit(system, omega, options, x0=x0, period=period, every=False))
     if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a System with its elements' whole laws (a chain with "
                         f"friction on its elements; rattle.model), got {system!r}")
     omega = check_omega(omega)
     opts = RegularisationOptions() if options is None else options

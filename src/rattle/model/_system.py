@@ -26,6 +26,16 @@ the equation is linear:
 
 and its first-order form z = (x, x') has the stage matrix A_s = [[0, I], [−K_s, −C]].
 
+A system may carry every element's whole law (``laws``, one :class:`~rattle.model.NonsmoothLaw`
+per element: jumps — a preload — and Coulomb friction levels r_ej per stage),
+
+    x'' + C x' + K x + Σ_e b_e [f_e(a_e·x) + r_e(a_e·x) sgn(a_e·x')] = F(t),
+
+its elements then carry the continuous part of their law (the same breakpoints and slopes, no
+jumps): every smooth analysis reads that part (:meth:`System.continuous`), the exact event flow
+and the regularised harmonic balance the whole law. Whether a system needs them is a property
+(:attr:`System.discontinuous`, :attr:`System.has_friction`, :attr:`System.has_jumps`), not a class.
+
 A speed-dependent mean load (a drag torque tabulated by speed, :mod:`rattle.model._drag`) makes
 the mean forcing a function of the forcing frequency, F_0(Ω) = F_0 + d(Ω) u (``load``): every
 analysis at frequency Ω uses :meth:`System.mean_at` (the forcing, the static equilibrium, the
@@ -34,6 +44,7 @@ exact flow), and the harmonic balance carries d(Ω) and d'(Ω) in its residual.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass, field
 
@@ -41,6 +52,7 @@ import numpy as np
 
 from .._limits import bounded_scale
 from .._typing import FloatArray
+from ._discontinuous import Friction, NonsmoothLaw
 from ._drag import SpeedLoad
 from ._elastic import AbstractElastic
 
@@ -77,6 +89,12 @@ class System:
     ``coordinates`` names the coordinates; ``angles`` Z (N, n) maps x to the inertias' angles
     (relative to the last inertia for a free chain, ``free`` True); ``load`` an optional
     Ω-dependent part of the mean forcing (:class:`~rattle.model.SpeedLoad`, a drag by speed).
+
+    ``laws`` every element's whole law (one :class:`~rattle.model.NonsmoothLaw` per element, in
+    order, with the element's breakpoints and slopes: jumps and friction), None for the continuous
+    laws of the elements; ``speed_order`` the engine order of Ω (rpm in results), None without an
+    engine. Built with laws by :meth:`rattle.model.Chain.friction_system` and
+    :meth:`with_friction`.
     """
 
     damping: FloatArray
@@ -89,7 +107,103 @@ class System:
     angles: FloatArray
     free: bool = False
     load: SpeedLoad | None = None
+    laws: tuple[NonsmoothLaw, ...] | None = None
+    speed_order: float | None = None
     _stiffness_cache: dict = field(default_factory=dict, repr=False, compare=False)
+    _continuous: System | None = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.laws is None:
+            return
+        laws = tuple(self.laws)
+        if len(laws) != len(self.elements):
+            raise ValueError(f"`laws` must hold one law per element ({len(self.elements)}), got {len(laws)}")
+        for e, (law, el) in enumerate(zip(laws, self.elements)):
+            if not isinstance(law, NonsmoothLaw):
+                raise TypeError(f"`laws[{e}]` must be a NonsmoothLaw, got {law!r}")
+            st = law.stages
+            if not (np.array_equal(st.breakpoints, el.breakpoints) and np.array_equal(st.slopes, el.slopes)):
+                raise ValueError(f"`laws[{e}]` must have the stages of element {el.name!r} of the system")
+        object.__setattr__(self, "laws", laws)
+
+    # --- the elements' whole laws -----------------------------------------------------------
+    def with_laws(self, laws: tuple[NonsmoothLaw, ...], speed_order: float | None = None) -> System:
+        """This system with every element's whole law ``laws`` (one
+        :class:`~rattle.model.NonsmoothLaw` per element, with its breakpoints and slopes) and
+        ``speed_order``; its :meth:`continuous` part is this system's."""
+        base = self.continuous()
+        out = dataclasses.replace(base, laws=tuple(laws), speed_order=speed_order)
+        object.__setattr__(out, "_continuous", base)
+        return out
+
+    def with_friction(self, levels: tuple[object, ...], *, elastic: tuple[object, ...] | None = None,
+                      speed_order: float | None = None) -> System:
+        """This system with friction ``levels`` per element (None, a number, or one per stage) and
+        optionally ``elastic`` laws per element (None: the element's own law; a law with jumps,
+        :class:`~rattle.model.Preload` or :class:`~rattle.model.PiecewiseJump`, with the element's
+        breakpoints and slopes: the elements keep its continuous part)."""
+        if len(levels) != self.m:
+            raise ValueError(f"`levels` must hold one entry per element ({self.m}), got {len(levels)}")
+        if elastic is None:
+            elastic = (None,) * self.m
+        if len(elastic) != self.m:
+            raise ValueError(f"`elastic` must hold one entry per element ({self.m}), got {len(elastic)}")
+        laws = tuple(NonsmoothLaw(elastic=el.law if law is None else law,  # type: ignore[arg-type]
+                                  friction=None if r is None else Friction(levels=r))  # type: ignore[arg-type]
+                     for el, r, law in zip(self.elements, levels, elastic))
+        return self.with_laws(laws, speed_order=speed_order)
+
+    def continuous(self) -> System:
+        """The same equations with the continuous part of every law (no jumps, no friction): the
+        system itself when it carries no whole ``laws``; what every smooth analysis reads."""
+        if self.laws is None:
+            return self
+        if self._continuous is None:
+            object.__setattr__(self, "_continuous", dataclasses.replace(self, laws=None, speed_order=None))
+        return self._continuous  # type: ignore[return-value]
+
+    @property
+    def discontinuous(self) -> bool:
+        """True when the system carries its elements' whole laws (jumps and friction, possibly
+        none): the front ends solve it on the exact event flow, or regularised and checked
+        exactly; False for the continuous laws (the smooth analyses)."""
+        return self.laws is not None
+
+    @property
+    def has_friction(self) -> bool:
+        """Some element's law has a friction level > 0."""
+        return self.laws is not None and any(bool(np.any(law.friction_levels > 0)) for law in self.laws)
+
+    @property
+    def has_jumps(self) -> bool:
+        """Some element's law jumps (a preload)."""
+        return self.laws is not None and any(bool(np.any(law.stages.jumps > 0)) for law in self.laws)
+
+    @property
+    def element_names(self) -> tuple[str, ...]:
+        return tuple(e.name for e in self.elements)
+
+    def friction_levels(self, e: int) -> FloatArray:
+        """r_ej on every stage j of element ``e`` (zeros without ``laws``)."""
+        if self.laws is None:
+            return np.zeros(len(self.elements[e].slopes))
+        return self.laws[e].friction_levels
+
+    def jumps(self, e: int) -> FloatArray:
+        """J_ei ≥ 0 at every breakpoint i of element ``e`` (zeros for a continuous law)."""
+        if self.laws is None:
+            return np.zeros(len(self.elements[e].breakpoints))
+        return self.laws[e].stages.jumps
+
+    def frequency_scale(self) -> float:
+        """ω_n, the highest natural frequency over the stage combinations (rad/s)."""
+        return self.stiffest_frequency()
+
+    def speed_rpm(self, omega: object) -> object:
+        """Crankshaft speed (rpm) at forcing frequency ``omega``, or None without an engine."""
+        if self.speed_order is None:
+            return None
+        return np.asarray(omega, dtype=float) * (60.0 / (2.0 * np.pi * self.speed_order))
 
     # --- sizes --------------------------------------------------------------------------------
     @property
@@ -282,6 +396,23 @@ class System:
         return max(float(np.max(amp)), 1e-300)
 
     def length_scale(self) -> float:
+        """A characteristic deflection (rad): :meth:`_smooth_length_scale` of the continuous laws;
+        with whole ``laws``, the largest deflection of an element's friction and jumps,
+        (Σ_i J_ei + max_j r_ej) / min_j s_ej (the widths of its stick and lock bands in
+        deflection, as the single equation counts them), when larger."""
+        base = self._smooth_length_scale()
+        if self.laws is None:
+            return base
+        fr = 0.0
+        for law in self.laws:
+            s = law.stages.slopes
+            pos = s[s > 0]
+            if pos.size:
+                width = float(np.sum(law.stages.jumps)) + float(np.max(law.friction_levels))
+                fr = max(fr, width / float(np.min(pos)))
+        return max(base, fr)
+
+    def _smooth_length_scale(self) -> float:
         """A characteristic deflection (rad): the static deflection, the breakpoints and the
         quasi-static dynamic amplitude, whichever is largest.
 

@@ -24,7 +24,7 @@ The data-sheet shapes (damper, spline, gear pair, loose gear) are first rewritte
 tables (:mod:`._table_shapes`). ``[[model.elements]] friction`` (Coulomb levels, one or one per
 stage of the element's law, relative to its stiffness K_e, or in N m with ``units = "SI"``) and
 ``[[model.elements]] type = "preload"`` (a torque jump, ``preload``, ``clearance``, ``slope``, the
-jump relative to K_e or in N m) make the model the chain's :class:`FrictionSystem`.
+jump relative to K_e or in N m) make the model the chain's :class:`System` with its elements' whole laws.
 
 The run's own tables, ``[analysis]`` and ``[[paths]]``, are known here by name only: the
 configuration reader (:mod:`rattle.io`) reads them and, from an ``[engine]``'s speed range
@@ -58,10 +58,10 @@ from ._drag import Drag
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Piecewise
 from ._engine import engine_torque
 from ._excitation import Excitation
-from ._friction_system import FrictionSystem
 from ._model import Model
 from ._nonsmooth_system import NonsmoothSystem
 from ._readers import register_reader
+from ._system import System
 from .._table_checks import (
     _EXAMPLES,
     ANGLE_KEYS,
@@ -135,9 +135,9 @@ class ModelTables:
 
     Attributes
     ----------
-    model : Model, Chain, NonsmoothSystem or FrictionSystem
+    model : Model, Chain, NonsmoothSystem or System (a chain's whole laws)
         A :class:`NonsmoothSystem` when ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or
-        a ``friction`` level > 0); a :class:`FrictionSystem` (``Chain.friction_system()``) for a
+        a ``friction`` level > 0); a :class:`System` with its elements' whole laws (``Chain.friction_system()``) for a
         chain with a ``friction`` level > 0 on some ``[[model.elements]]``; else a Model or a Chain.
     units : str
         ``[model] units``: ``"dimensionless"`` or ``"SI"``.
@@ -161,8 +161,8 @@ class ModelTables:
     @property
     def discontinuous(self) -> bool:
         """True when :attr:`model` is a :class:`NonsmoothSystem` (a jump or friction) or a
-        :class:`FrictionSystem` (a chain with friction on its elements)."""
-        return isinstance(self.model, (NonsmoothSystem, FrictionSystem))
+        :class:`System` with its elements' whole laws (a chain with friction on its elements)."""
+        return isinstance(self.model, NonsmoothSystem) or (isinstance(self.model, System) and self.model.discontinuous)
 
 
 def model_tables(data: Mapping[str, Any], source_name: str = "<dict>") -> ModelTables:

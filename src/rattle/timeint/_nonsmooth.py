@@ -58,7 +58,7 @@ from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import NonsmoothSystem, Stages
-from ._exact_flow import ExactIntegrator, FlowOptions
+from ._exact_flow import ExactIntegrator, FlowOptions, takes_single_equation
 from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
 from ._recent import Recent
@@ -328,7 +328,7 @@ SOLUTION_CACHE = 4
 MEMO = 4
 
 
-class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
+class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="a NonsmoothSystem"):
     """The scalar path of :class:`~rattle.timeint.ExactIntegrator` with events: δ'' + c δ' +
     k [f(δ) + r(δ) sgn δ'] = F(t) (module docstring) for a
     :class:`~rattle.model.NonsmoothSystem`; the δ-crossings by the scalar path's own search
