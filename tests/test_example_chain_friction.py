@@ -21,7 +21,7 @@ def test_the_example_is_a_chain_with_friction_per_stage():
     np.testing.assert_array_equal(cfg.model.friction_levels(0), [0.004, 0.002, 0.001, 0.002, 0.004])
     assert (cfg.analysis.harmonics, cfg.analysis.regularisation, cfg.analysis.refine) == (32, 0.001, 0.005)
     # "twisting the damper to 0.09 rad at rest": f(0.09) = 0.08·0.05 + 0.4·0.04 = 0.02, the mean torque
-    law = cfg.model.system.elements[0].law
+    law = cfg.model.continuous().elements[0].law
     assert float(law.force(np.array([0.09]))[0]) == pytest.approx(0.02, abs=1e-15)
 
 

@@ -53,7 +53,7 @@ def test_friction_on_an_element_makes_the_chain_a_friction_system(friction, leve
     # the chain without its friction sets the bounds (its smooth system is the whole-law System's continuous part)
     assert isinstance(rc.continuous_model, Chain) and not rc.continuous_model.has_friction
     assert rc.bounds_model is rc.continuous_model
-    assert rc.model.system.n == rc.continuous_model.system().n == 2
+    assert rc.model.continuous().n == rc.continuous_model.system().n == 2
     # the settings of a discontinuous law: the regularised HB's defaults
     assert (rc.analysis.harmonics, rc.analysis.regularisation, rc.analysis.refine) == (128, 0.001, 0.005)
 
@@ -110,7 +110,7 @@ def test_a_damper_and_a_spline_take_friction_per_stage_of_their_law():
     rc = config_from_dict(data)
     np.testing.assert_allclose(rc.model.friction_levels(0), np.array([5.0, 1.0, 2.0, 5.0]) / 200.0, rtol=1e-15)
     np.testing.assert_allclose(rc.model.friction_levels(1), [1.0 / 500.0] * 3, rtol=1e-15)
-    np.testing.assert_allclose(rc.model.system.elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
+    np.testing.assert_allclose(rc.model.continuous().elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
     bad = copy.deepcopy(data)
     bad["model"]["elements"][0]["friction"] = [1.0, 2.0]
     _refused(bad, "`model.elements.1.friction` must hold one level (every stage) or one per stage of the damper",

@@ -258,8 +258,8 @@ def shoot_system_orbit(
     SystemOrbit
         Check ``converged``: a failed solve is returned, not raised (the last iterate).
     """
-    if not isinstance(system, System):
-        raise TypeError(f"`system` must be a rattle.model.System, got {system!r}")
+    if not isinstance(system, System) or system.discontinuous:
+        raise TypeError(f"`system` must be a rattle.model.System with continuous laws, got {system!r}")
     omega = check_omega(omega)
     z = check_system_state(z0, system.n)
     check_shooting(period, tol, max_iterations)

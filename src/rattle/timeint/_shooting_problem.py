@@ -156,7 +156,7 @@ class ShootingProblem:
         self.system = system
         self.period = int(period)
         self.integrator = integ
-        self._smooth = isinstance(system, System)
+        self._smooth = isinstance(system, System) and not system.discontinuous
         # the flows whose record costs next to nothing: their Newton iterates are recorded as they go
         self._records = isinstance(integ, _ScalarFlow)
         n, L, omega_s = _scales(system)
