@@ -12,16 +12,7 @@ import pytest
 from _filippov import chain_reference as _reference  # tests/ is on sys.path through its conftest
 
 from rattle.model import (
-    Backlash,
-    Chain,
-    Clutch,
-    Element,
-    Excitation,
-    Friction,
-    Link,
-    NonsmoothLaw,
-    NonsmoothSystem,
-    Torque,
+    Backlash, Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, System, Torque,
 )
 from rattle.model._system import single_equation_system
 from rattle.timeint import (
@@ -32,7 +23,7 @@ from rattle.timeint import (
 def _single(levels, law=None):
     law = Backlash(b=0.05) if law is None else law
     sys1 = single_equation_system(0.05, 1.0, law, 0.01, (0.3,), (0.3,))
-    ns = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=Friction(levels=levels)),
+    ns = System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=Friction(levels=levels)),
                          excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
     return sys1.with_friction((levels,)), ns
 

@@ -14,17 +14,7 @@ from scipy.integrate import solve_ivp
 
 from rattle.errors import ConvergenceError
 from rattle.model import (
-    Backlash,
-    Chain,
-    Element,
-    Excitation,
-    Friction,
-    Link,
-    NonsmoothLaw,
-    NonsmoothSystem,
-    PiecewiseJump,
-    Preload,
-    Torque,
+    Backlash, Chain, Element, Excitation, Friction, Link, NonsmoothLaw, PiecewiseJump, Preload, System, Torque,
 )
 from rattle.model._system import single_equation_system
 from rattle.timeint import ExactIntegrator, FlowOptions, shoot_friction_orbit
@@ -42,11 +32,11 @@ def _counts(traj):
 
 def _single(law, levels, omega_amp=0.3):
     """The same one-coordinate equation as a System with its elements' whole laws (n = m = 1; its elements carry the
-    continuous part of the law) and as the single equation's NonsmoothSystem."""
+    continuous part of the law) and as the single equation's System."""
     cont = Element(name="x", between=(1, 2), stiffness=1.0, law=law).continuous_law()
     sys1 = single_equation_system(0.05, 1.0, cont, 0.01, (omega_amp,), (0.3,))
     fr = None if levels is None else Friction(levels=levels)
-    ns = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=fr),
+    ns = System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=fr),
                          excitation=Excitation(mean=0.01, amplitudes=(omega_amp,), phases=(0.3,)))
     return sys1.with_friction((levels,), elastic=(law,)), ns
 

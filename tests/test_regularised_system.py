@@ -28,18 +28,7 @@ from rattle.hb import (
     RegularisedSystemBalance,
 )
 from rattle.model import (
-    Backlash,
-    Chain,
-    Clutch,
-    Drag,
-    Element,
-    Excitation,
-    Friction,
-    Linear,
-    Link,
-    NonsmoothLaw,
-    NonsmoothSystem,
-    Torque,
+    Backlash, Chain, Clutch, Drag, Element, Excitation, Friction, Linear, Link, NonsmoothLaw, System, Torque,
 )
 from rattle.model._system import single_equation_system
 
@@ -160,7 +149,7 @@ def _single_equation_pair() -> tuple[RegularisedSystemBalance, RegularisedBalanc
     fs = single_equation_system(c, k, law, mean, amps, phases).with_friction((CLUTCH_R,))
     opts = HBOptions(harmonics=24)
     pb = RegularisedSystemBalance(fs, regularisation=0.02, options=opts)
-    nsys = NonsmoothSystem(damping=c, stiffness=k, law=NonsmoothLaw(elastic=law, friction=Friction(levels=CLUTCH_R)),
+    nsys = System.single(damping=c, stiffness=k, law=NonsmoothLaw(elastic=law, friction=Friction(levels=CLUTCH_R)),
                            excitation=Excitation(mean=mean, amplitudes=amps, phases=phases))
     L_ns = nsys.length_scale()  # the scalar problem's own scale: ε rescaled to the same widths
     ref = RegularisedBalance(c, nsys, mean, amps, phases, regularisation=0.02 * pb.length_scale / L_ns,
@@ -185,7 +174,7 @@ def test_two_inertia_free_chain_agrees_with_the_single_equation() -> None:
     fs = _chain("f2").friction_system()
     pb = RegularisedSystemBalance(fs, regularisation=0.02, options=HBOptions(harmonics=32))
     c, k, mean = 0.05 * 3.0, 1.0 * 3.0, 0.05 + 0.05 / 0.5
-    nsys = NonsmoothSystem(damping=c, stiffness=k,
+    nsys = System.single(damping=c, stiffness=k,
                            law=NonsmoothLaw(elastic=Clutch(alpha=0.2, b=0.1), friction=Friction(levels=CLUTCH_R)),
                            excitation=Excitation(mean=mean, amplitudes=(0.3,), phases=(0.4,)))
     L_ns = nsys.length_scale()

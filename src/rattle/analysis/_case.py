@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..io import AnalysisSettings, RunConfig, load_config
-from ..model import Model, NonsmoothSystem, System
+from ..model import Model, System
 from ._compare import compare
 from ._frequency_response import frequency_response
 from ._exact_branch import ShootingOptions
@@ -63,9 +63,9 @@ class Case:
     config: RunConfig
 
     @property
-    def model(self) -> Model | NonsmoothSystem | System:
+    def model(self) -> Model | System:
         """The model: a :class:`~rattle.model.Model` (or chain), a
-        :class:`~rattle.model.NonsmoothSystem` when the law has a preload or friction, or a
+        single-equation :class:`~rattle.model.System` when the law has a preload or friction, or a
         :class:`~rattle.model.System` with its elements' whole laws for a chain with friction on its elements."""
         return self.config.model
 

@@ -2,7 +2,7 @@
 exact orbit.
 
 For a law with torque jumps (a preload) or Coulomb friction, on the single equation
-(:class:`~rattle.model.NonsmoothSystem`) or on a chain (:class:`~rattle.model.System` with its elements' whole laws),
+(single-equation :class:`~rattle.model.System`) or on a chain (:class:`~rattle.model.System` with its elements' whole laws),
 the periodic orbits of period T = p·2π/Ω are the zeros of the scaled period-map defect
 
     R(z(0), Ω) = (φ_T(z(0); Ω) − z(0)) / s        (:class:`~rattle.timeint.ShootingProblem`),
@@ -80,7 +80,7 @@ from ..continuation import (
 )
 from .._threads import one_blas_thread
 from ..errors import Status
-from ..model import System, NonsmoothSystem
+from ..model import System
 from ..stability import classify_loss
 from ..timeint import FLOW_FAILURES, ShootingProblem, monodromy_multipliers
 from ._sweep_check import SweepCheck
@@ -564,7 +564,7 @@ def _label(a: ExactRow, b: ExactRow) -> str:
 
 
 def exact_branches(
-    system: NonsmoothSystem | System,
+    system: System,
     omega: tuple[float, float],
     options: ShootingOptions | None = None,
     *,
@@ -587,7 +587,7 @@ def exact_branches(
         return _exact_branches(system, omega, opts, continuation, newton, period, progress)
 
 
-def _exact_branches(system: NonsmoothSystem | System, omega: tuple[float, float], opts: ShootingOptions,
+def _exact_branches(system: System, omega: tuple[float, float], opts: ShootingOptions,
                     continuation: ContinuationOptions | None, newton: NewtonOptions | None,
                     period: int, progress: Any = None) -> list[ExactBranch]:
     lo, hi = omega
@@ -745,7 +745,7 @@ REJOIN_TOL = 1e-7
 
 
 def subharmonic_branches(
-    system: NonsmoothSystem | System,
+    system: System,
     primary: Any,
     omega: tuple[float, float],
     options: ShootingOptions,
@@ -893,7 +893,7 @@ def _both_ways(follower: _Follower, shorter: list[ShootingProblem], z0: FloatArr
 
 
 def branch_through(
-    system: NonsmoothSystem | System,
+    system: System,
     state: FloatArray,
     omega0: float,
     period: int,

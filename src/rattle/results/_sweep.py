@@ -112,7 +112,7 @@ class SweepResult:
     written after the SPEC columns; the states are z = (x, x') of its n coordinates ((P, 2n)),
     the multipliers (P, 2n).
 
-    A discontinuous law (:class:`~rattle.model.NonsmoothSystem`: jumps and Coulomb friction on
+    A discontinuous law (single-equation :class:`~rattle.model.System`: jumps and Coulomb friction on
     the single equation; :class:`~rattle.model.System` with its elements' whole laws: a chain with friction on its
     elements): the same columns, from its exact event-driven trajectories, and in
     ``extra_columns`` the fraction of each row's orbit (of its record for period 0) held stuck or

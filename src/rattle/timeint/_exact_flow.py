@@ -20,12 +20,15 @@ system (predicate)                          path (module)
 ==========================================  ====================================================
 a :class:`~rattle.model.Model`              the compiled scalar path: one coordinate, one
 (:func:`takes_model`)                       element, modal closed form (:mod:`._integrator`)
-a :class:`~rattle.model.NonsmoothSystem`    the same scalar path with the Filippov events:
-(:func:`takes_single_equation`)             jumps, stick, slip, lock (:mod:`._nonsmooth`)
+the single equation's                       the same scalar path with the Filippov events:
+:class:`~rattle.model.System` (n = m = 1,   jumps, stick, slip, lock (:mod:`._nonsmooth`)
+``is_single_equation``;
+:func:`takes_single_equation`)
 a :class:`~rattle.model.System`, not        the stage-matrix path: n coordinates, m elements,
 ``discontinuous`` (:func:`takes_continuous`)  continuous laws (:mod:`._flow`)
 a :class:`~rattle.model.System`,            the stage-matrix path with the Filippov events and
-``discontinuous`` (:func:`takes_discontinuous`)  the active-set choice of the held elements
+``discontinuous``, not the single          the active-set choice of the held elements
+equation's (:func:`takes_discontinuous`)
                                             (:mod:`._friction_chain`)
 ==========================================  ====================================================
 
@@ -44,7 +47,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..model import Chain, Model, NonsmoothSystem, System
+from ..model import Chain, Model, System
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -90,8 +93,10 @@ def takes_model(system: Any) -> bool:
 
 
 def takes_single_equation(system: Any) -> bool:
-    """The scalar event path's systems: the single equation with its whole (discontinuous) law."""
-    return isinstance(system, NonsmoothSystem)
+    """The scalar event path's systems: the single equation with its whole law, a
+    :class:`~rattle.model.System` with n = m = 1 in the single-equation form
+    (:attr:`~rattle.model.System.is_single_equation`: :meth:`~rattle.model.System.single`)."""
+    return isinstance(system, System) and system.is_single_equation
 
 
 def takes_continuous(system: Any) -> bool:
@@ -101,8 +106,8 @@ def takes_continuous(system: Any) -> bool:
 
 def takes_discontinuous(system: Any) -> bool:
     """The Filippov chain path's systems: a :class:`~rattle.model.System` carrying its elements'
-    whole laws (``discontinuous``: jumps and friction)."""
-    return isinstance(system, System) and system.discontinuous
+    whole laws (``discontinuous``: jumps and friction), but the single equation's."""
+    return isinstance(system, System) and system.discontinuous and not system.is_single_equation
 
 
 def _reduced(system: Any) -> Any:
@@ -116,8 +121,8 @@ def _reduced(system: Any) -> Any:
 
 class ExactIntegrator:
     """The exact flow of ``system`` (module docstring): a :class:`~rattle.model.Model`,
-    :class:`~rattle.model.Chain`, :class:`~rattle.model.System` (continuous laws, or carrying its
-    elements' whole laws) or :class:`~rattle.model.NonsmoothSystem`.
+    :class:`~rattle.model.Chain` or :class:`~rattle.model.System` (continuous laws, or carrying its
+    elements' whole laws; the single equation's included).
 
     Parameters
     ----------
@@ -158,7 +163,7 @@ class ExactIntegrator:
         for takes, path in ExactIntegrator._PATHS:
             if takes(system):
                 return super().__new__(path)
-        raise TypeError(f"`system` must be a rattle Model, Chain, System or NonsmoothSystem, got {system!r}")
+        raise TypeError(f"`system` must be a rattle Model, Chain or System, got {system!r}")
 
     def __init__(self, system: Any, options: FlowOptions | None = None) -> None:
         system = _reduced(system)
