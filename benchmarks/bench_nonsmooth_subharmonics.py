@@ -89,7 +89,7 @@ def main() -> None:
         t0 = time.perf_counter()
         primary = nonsmooth_response(cfg.model, cfg.analysis.omega, opts)
         t1 = time.perf_counter()
-        follow = friction_subharmonics if cfg.model.discontinuous else nonsmooth_subharmonics
+        follow = nonsmooth_subharmonics if cfg.model.is_single_equation else friction_subharmonics
         branches = follow(cfg.model, primary, cfg.analysis.omega, opts)
         t2 = time.perf_counter()
         print(f"{path.name}: Ω = {cfg.analysis.omega[0]:g} … {cfg.analysis.omega[1]:g}, H = {opts.harmonics}, "
