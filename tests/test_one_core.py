@@ -186,7 +186,7 @@ def _isinstance_types(tree: ast.AST) -> list[str]:
 
 def test_one_problem_type() -> None:
     """No isinstance dispatch on a folded model type, no class of them defined; every model type
-    dispatched on is Model, Chain or System (the old tree dispatched 28 times on NonsmoothSystem
+    dispatched on is Model, Chain or System (the old tree had 40 isinstance calls naming NonsmoothSystem
     and FrictionSystem, five model types)."""
     used = {name for tree in TREES.values() for name in _isinstance_types(tree)}
     folded = [(mod, name) for mod, tree in TREES.items() for name in _isinstance_types(tree) if name in FOLDED_TYPES]
