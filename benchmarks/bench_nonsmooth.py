@@ -27,7 +27,7 @@ from rattle.hb import HBOptions
 from rattle.hb._regularised import RegularisedBalance
 from rattle.model import Excitation
 from rattle.model._discontinuous import Friction, NonsmoothLaw, Preload
-from rattle.model._nonsmooth_system import NonsmoothSystem
+from rattle.model import System
 from rattle.timeint import ExactIntegrator, shoot_nonsmooth_orbit
 
 C, FM, FP, PHASE = 0.05, 0.01, 0.3, 0.3
@@ -43,7 +43,7 @@ CASES = [  # (T_p, r, Ω)
 def main() -> None:
     for tp, r, w in CASES:
         law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r))
-        sysx = NonsmoothSystem(damping=C, stiffness=1.0, law=law,
+        sysx = System.single(damping=C, stiffness=1.0, law=law,
                                excitation=Excitation(mean=FM, amplitudes=(FP,), phases=(PHASE,)))
         integ = ExactIntegrator(sysx)
         T = 2 * math.pi / w
@@ -61,7 +61,7 @@ def main() -> None:
 
         q0 = tr.fourier(32)
 
-        def problem(eps: float, harmonics: int, sysx: NonsmoothSystem = sysx) -> RegularisedBalance:
+        def problem(eps: float, harmonics: int, sysx: System = sysx) -> RegularisedBalance:
             return RegularisedBalance(C, sysx, FM, (FP,), (PHASE,), regularisation=eps, length_scale=0.3,
                                       frequency_scale=1.0, options=HBOptions(harmonics=harmonics))
 

@@ -66,7 +66,7 @@ import numpy as np
 import rattle.analysis._nonsmooth as _ns
 from rattle.analysis import RegularisationOptions
 from rattle.analysis._nonsmooth import nonsmooth_response  # the builder under rattle.frequency_response
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, Friction, NonsmoothLaw, Preload, System
 
 LAWS = [(0.05, 0.0), (0.05, 0.02), (0.2, 0.05)]
 if len(sys.argv) > 3:  # a subset, e.g. "0" for the first law only
@@ -107,7 +107,7 @@ def main() -> None:
     eps = float(sys.argv[2]) if len(sys.argv) > 2 else 0.01
     for tp, r in LAWS:
         law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r) if r else None)
-        sysx = NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+        sysx = System.single(damping=0.05, stiffness=1.0, law=law,
                                excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
         SHOTS.clear()
         t0 = time.perf_counter()

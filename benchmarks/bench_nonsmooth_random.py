@@ -31,12 +31,12 @@ import numpy as np
 from rattle.analysis._regularisation import regularisation_limit
 from rattle.errors import RattleError
 from rattle.hb import HBOptions, RegularisedBalance
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, Friction, NonsmoothLaw, Preload, System
 from rattle.stability import regularised_multipliers
 from rattle.timeint import ExactIntegrator, shoot_nonsmooth_orbit
 
 
-def draw(rng: np.random.Generator) -> tuple[NonsmoothSystem, float]:
+def draw(rng: np.random.Generator) -> tuple[System, float]:
     tp = float(rng.uniform(0.0, 0.3))
     b = 0.0 if rng.random() < 0.5 else float(rng.uniform(0.0, 0.2))
     el = Preload(preload=tp, clearance=b)
@@ -46,7 +46,7 @@ def draw(rng: np.random.Generator) -> tuple[NonsmoothSystem, float]:
     law = NonsmoothLaw(elastic=el, friction=Friction(levels=levels) if max(levels) > 0 else None)
     exc = Excitation(mean=float(rng.uniform(0.0, 0.05)), amplitudes=(float(rng.uniform(0.1, 0.5)),),
                      phases=(float(rng.uniform(0, 2 * math.pi)),))
-    sysx = NonsmoothSystem(damping=float(rng.uniform(0.02, 0.1)), stiffness=1.0, law=law, excitation=exc)
+    sysx = System.single(damping=float(rng.uniform(0.02, 0.1)), stiffness=1.0, law=law, excitation=exc)
     return sysx, float(rng.uniform(0.3, 2.0))
 
 
@@ -60,7 +60,7 @@ def main() -> None:
         L = sysx.length_scale()
         wn = math.sqrt(sysx.k * float(np.max(sysx.law.stages.slopes)))
 
-        def make(eps: float, H: int, sysx: NonsmoothSystem = sysx, exc: Excitation = exc, L: float = L,
+        def make(eps: float, H: int, sysx: System = sysx, exc: Excitation = exc, L: float = L,
                  wn: float = wn) -> RegularisedBalance:
             return RegularisedBalance(sysx.c, sysx, exc.mean, exc.amplitudes, exc.phases, regularisation=eps,
                                       length_scale=L, frequency_scale=wn, options=HBOptions(harmonics=H))

@@ -44,7 +44,7 @@ from rattle.analysis._friction_subharmonics import friction_subharmonics
 from rattle.analysis._nonsmooth import nonsmooth_response, nonsmooth_subharmonics  # the builders under rattle.frequency_response
 from rattle.analysis._case import regularisation_options
 from rattle.io import load_config
-from rattle.model import FrictionSystem
+from rattle.model import System
 from rattle.results import held_runs as _held_runs
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -89,7 +89,7 @@ def main() -> None:
         t0 = time.perf_counter()
         primary = nonsmooth_response(cfg.model, cfg.analysis.omega, opts)
         t1 = time.perf_counter()
-        follow = friction_subharmonics if isinstance(cfg.model, FrictionSystem) else nonsmooth_subharmonics
+        follow = nonsmooth_subharmonics if cfg.model.is_single_equation else friction_subharmonics
         branches = follow(cfg.model, primary, cfg.analysis.omega, opts)
         t2 = time.perf_counter()
         print(f"{path.name}: Ω = {cfg.analysis.omega[0]:g} … {cfg.analysis.omega[1]:g}, H = {opts.harmonics}, "

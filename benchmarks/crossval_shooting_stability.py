@@ -44,10 +44,10 @@ from _cases import friction_chain, random_preload  # noqa: E402  (the tests' ran
 from _filippov import chain_reference, single_reference  # noqa: E402  (the tests' independent reference)
 
 import rattle  # noqa: E402
-from rattle.model import NonsmoothSystem  # noqa: E402
+from rattle.model import System  # noqa: E402
 
 
-def single_case(seed: int) -> tuple[NonsmoothSystem, tuple[float, float]]:
+def single_case(seed: int) -> tuple[System, tuple[float, float]]:
     """The tests' random preload (tests/_cases.py), its numbers from seed 1000 + ``seed``, Ω from Ω₀ in
     0.3–1 to 2 Ω₀."""
     return random_preload(seed, omega=(0.3, 1.0), span=2.0, offset=1000)
@@ -81,7 +81,7 @@ class Reference:
 
     def __init__(self, system, period: int = 1) -> None:
         self.system, self.period = system, period
-        self.chain = not isinstance(system, NonsmoothSystem)
+        self.chain = not system.is_single_equation
         self.L = float(system.length_scale())
         self.s = np.concatenate([np.full(self.dim // 2, self.L), np.full(self.dim // 2, self.L * self.frequency())])
         self.steps = STEPS_PER_PERIOD

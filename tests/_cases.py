@@ -8,8 +8,7 @@ import numpy as np
 
 from rattle.hb import FourierBasis
 from rattle.model import (
-    Backlash, Chain, Clutch, Element, Excitation, Friction, FrictionSystem, Link, NonsmoothLaw, NonsmoothSystem, Preload,
-    Torque,
+    Backlash, Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, Preload, System, Torque,
 )
 
 
@@ -111,7 +110,7 @@ def hb_chain_state0(frf, i):
 
 
 def random_preload(seed: int, omega: tuple[float, float] = (0.4, 1.6), span: float = 1.1, offset: int = 0
-                   ) -> tuple[NonsmoothSystem, tuple[float, float]]:
+                   ) -> tuple[System, tuple[float, float]]:
     """A random preload law (a clearance on odd seeds, friction per stage on two of three seeds),
     forcing with a second harmonic, and the range (Ω₀, ``span`` Ω₀) for Ω₀ drawn from ``omega``;
     the numbers from the generator of ``offset + seed``: the random cases of the exact-shooting
@@ -121,7 +120,7 @@ def random_preload(seed: int, omega: tuple[float, float] = (0.4, 1.6), span: flo
     fr = None if seed % 3 == 0 else Friction(levels=tuple(rng.uniform(0.0, 0.01, 3 if b else 2)))
     law = NonsmoothLaw(elastic=Preload(preload=rng.uniform(0.005, 0.03), clearance=b, slope=rng.uniform(0.6, 1.4)),
                        friction=fr)
-    system = NonsmoothSystem(damping=rng.uniform(0.03, 0.1), stiffness=1.0, law=law,
+    system = System.single(damping=rng.uniform(0.03, 0.1), stiffness=1.0, law=law,
                              excitation=Excitation(mean=rng.uniform(-0.02, 0.05),
                                                    amplitudes=(rng.uniform(0.03, 0.1), rng.uniform(0.0, 0.02)),
                                                    phases=(0.0, rng.uniform(0.0, 6.0))))
@@ -129,7 +128,7 @@ def random_preload(seed: int, omega: tuple[float, float] = (0.4, 1.6), span: flo
     return system, (w, span * w)
 
 
-def friction_chain() -> FrictionSystem:
+def friction_chain() -> System:
     """Three inertias, a clutch with Coulomb friction and a gear backlash: the friction chain of the
     exact-shooting tests and of benchmarks/crossval_shooting_stability.py."""
     chain = Chain(

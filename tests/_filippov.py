@@ -16,7 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rattle.model import FrictionSystem, NonsmoothSystem
+from rattle.model import System
 
 
 def _surface(d):
@@ -33,7 +33,7 @@ def _velocity_zero():
     return event
 
 
-def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float, max_step: float = np.inf):
+def single_reference(system: System, x0, t1: float, omega: float, max_step: float = np.inf):
     """Mode by mode with DOP853 (rtol 1e-12, atol 1e-14) and terminal events; returns the final
     state and the solver's (t, δ, δ') samples. ``max_step``: the solver's largest step — events are
     found from sign changes between steps, so a velocity that dips below zero and back within one
@@ -101,11 +101,11 @@ def single_reference(system: NonsmoothSystem, x0, t1: float, omega: float, max_s
             sg = 0 if r[j] == 0 else (1 if v > 0 else -1)
 
 
-def chain_reference(fs: FrictionSystem, z0, t1, omega, max_step: float = np.inf):
+def chain_reference(fs: System, z0, t1, omega, max_step: float = np.inf):
     """An independent integration of the Filippov system by scipy (DOP853, rtol 1e-12) with
     terminal events at every breakpoint, velocity zero and stick band edge; only constant friction
     levels (the mode logic written out again, one element at a time)."""
-    sysm = fs.system
+    sysm = fs.continuous()
     n, m = sysm.n, sysm.m
     A = sysm.element_rows
     B = sysm.element_columns

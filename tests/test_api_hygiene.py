@@ -62,7 +62,7 @@ PUBLIC_API = {
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
     "shoot_periodic_orbit", "periodic_orbit", "PeriodicOrbit", "OrbitSolution", "compare", "Comparison",
     "response_map", "ResponseMap", "AttractorSearch",
-    "NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction",
+    "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction",
     "ShootingOptions", "RegularisationOptions", "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     "ContinuationProblem", "HarmonicBalance", "ShootingProblem", "ContinuationStepper", "ExactIntegrator",
     "sound_pressure", "linear_sound_pressure", "SoundPressure", "SoundPath",

@@ -1,5 +1,5 @@
 """examples/chain_clutch_friction.toml: a chain with friction per stage on its clutch damper parses
-into a FrictionSystem, and on a part of its range the stability changes and the stick it states
+into a and on a part of its range the stability changes and the stick it states
 hold (at its own harmonics and regularisation), as tests/test_examples.py does for the single
 equation's discontinuous examples."""
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rattle.io import load_config
-from rattle.model import FrictionSystem
+from rattle.model import System
 from test_examples import EXAMPLES, _stated_changes  # tests/ is on sys.path through its conftest
 
 NAME = "chain_clutch_friction.toml"
@@ -17,11 +17,11 @@ NAME = "chain_clutch_friction.toml"
 
 def test_the_example_is_a_chain_with_friction_per_stage():
     cfg = load_config(EXAMPLES / NAME)
-    assert isinstance(cfg.model, FrictionSystem) and cfg.chain_friction
+    assert cfg.model.discontinuous and cfg.chain_friction
     np.testing.assert_array_equal(cfg.model.friction_levels(0), [0.004, 0.002, 0.001, 0.002, 0.004])
     assert (cfg.analysis.harmonics, cfg.analysis.regularisation, cfg.analysis.refine) == (32, 0.001, 0.005)
     # "twisting the damper to 0.09 rad at rest": f(0.09) = 0.08·0.05 + 0.4·0.04 = 0.02, the mean torque
-    law = cfg.model.system.elements[0].law
+    law = cfg.model.continuous().elements[0].law
     assert float(law.force(np.array([0.09]))[0]) == pytest.approx(0.02, abs=1e-15)
 
 

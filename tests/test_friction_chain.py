@@ -12,17 +12,7 @@ import pytest
 from _filippov import chain_reference as _reference  # tests/ is on sys.path through its conftest
 
 from rattle.model import (
-    Backlash,
-    Chain,
-    Clutch,
-    Element,
-    Excitation,
-    Friction,
-    FrictionSystem,
-    Link,
-    NonsmoothLaw,
-    NonsmoothSystem,
-    Torque,
+    Backlash, Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, System, Torque,
 )
 from rattle.model._system import single_equation_system
 from rattle.timeint import (
@@ -33,9 +23,9 @@ from rattle.timeint import (
 def _single(levels, law=None):
     law = Backlash(b=0.05) if law is None else law
     sys1 = single_equation_system(0.05, 1.0, law, 0.01, (0.3,), (0.3,))
-    ns = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=Friction(levels=levels)),
+    ns = System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=Friction(levels=levels)),
                          excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
-    return FrictionSystem.from_system(sys1, (levels,)), ns
+    return sys1.with_friction((levels,)), ns
 
 
 def _chain(levels=((0.02, 0.06, 0.02), None), torque=0.25, grounded=True):
@@ -83,7 +73,7 @@ def test_single_equation_agrees_with_its_own_exact_integrator(levels, omega):
 def test_without_friction_it_is_the_smooth_chain(grounded):
     ch = _chain(levels=(None, None), grounded=grounded)
     sysm = ch.system()
-    fs = FrictionSystem.from_system(sysm, (None, None))
+    fs = sysm.with_friction((None, None))
     omega = 0.7
     z0 = np.linspace(0.01, 0.05, 2 * sysm.n)
     T = 2 * math.pi / omega
@@ -176,7 +166,7 @@ def test_friction_on_elements_is_validated():
     assert ch.has_friction
     with pytest.raises(ValueError, match="friction"):
         ch.system()
-    assert isinstance(ExactIntegrator(ch).system, FrictionSystem)  # the one flow takes its reduced form
+    assert ExactIntegrator(ch).system.discontinuous  # the one flow takes its reduced form
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3, 4])
@@ -242,5 +232,5 @@ def test_a_fully_stuck_element_gives_a_family_of_orbits_held_by_its_deflection()
     assert not np.allclose(orbits[0].state0, orbits[1].state0)
     # a start in the stick removes a δ_e' perturbation (the entry saltation S = I − b aᵀ/(a·b) on
     # the velocities: the slip along b that a relative velocity starts is undone at once)
-    b = fs.system.element_columns[:, 0]
+    b = fs.continuous().element_columns[:, 0]
     assert np.allclose(orbits[0].monodromy[:, 3:] @ b, 0.0, atol=1e-12)

@@ -11,7 +11,7 @@ checks each row against the exact event-driven orbit (Filippov sticking, saltati
   the exact and the HB orbit's stability agree on every row;
 - light friction (30 rows): the clutch slips throughout; the HB at ε = 0.01 within 0.5 % directly
   (measured ≤ 0.018 %; max |μ| of the two agree to 3e-8);
-- without friction the FrictionSystem's branch is the smooth chain's: the exact rms equal to
+- without friction the whole-law System's branch is the smooth chain's: the exact rms equal to
   :func:`rattle.timeint.shoot_system_orbit`'s to 1e-9 and the HB within 0.5 % (measured 1.2e-5).
 """
 
@@ -30,7 +30,7 @@ from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._friction_response import _start, friction_balance_factory
 from rattle.analysis._regularisation import regularisation_limit
 from rattle.continuation import ContinuationOptions
-from rattle.model import Chain, FrictionSystem
+from rattle.model import Chain
 from rattle.results import FrequencyResponse, FrictionCheck
 from rattle.timeint import shoot_friction_orbit, shoot_system_orbit
 
@@ -93,7 +93,7 @@ def test_slipping_rows_match_the_exact_orbit_at_eps(slipping: FrictionCheck) -> 
 def test_without_friction_it_is_the_smooth_chains_exact_orbit() -> None:
     chain = _chain(None, 0.2)
     system = chain.system()
-    fs = FrictionSystem.from_system(system, (0.0, 0.0))
+    fs = system.with_friction((0.0, 0.0))
     assert not fs.has_friction
     r = friction_response(fs, (1.28, 1.3), RegularisationOptions(harmonics=32), continuation=WIDE)
     assert np.all(r.matched) and np.all(r.stick_fraction == 0.0)
@@ -106,7 +106,7 @@ def test_without_friction_it_is_the_smooth_chains_exact_orbit() -> None:
     assert np.all(np.abs(r.element_rms_error) <= 0.005)
 
 
-def _hb_state(fs: FrictionSystem, omega: float) -> np.ndarray:
+def _hb_state(fs: System, omega: float) -> np.ndarray:
     """A start for the smooth shooting: the regularised HB orbit's state at t = 0."""
     make = friction_balance_factory(fs)
     lad = regularisation_limit(make, omega, make(0.1, 32).linear_solution(omega), eps_start=0.1, eps_min=0.01,
@@ -193,7 +193,7 @@ def test_bad_arguments_are_refused() -> None:
     fs = _chain(SLIP, 0.2).friction_system()
     with pytest.raises(TypeError, match="`system`"):
         friction_response(_chain(SLIP, 0.2), (1.28, 1.3))  # type: ignore[arg-type]
-    with pytest.raises(TypeError, match="FrictionSystem"):
+    with pytest.raises(TypeError, match="whole laws"):
         nonsmooth_response("chain", (1.28, 1.3))  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="`options`"):
         friction_response(fs, (1.28, 1.3), {"harmonics": 32})  # type: ignore[arg-type]

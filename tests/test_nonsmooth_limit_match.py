@@ -11,18 +11,18 @@ import pytest
 import rattle.analysis._nonsmooth as ns
 from rattle.analysis import RegularisationOptions
 from rattle.analysis._nonsmooth import nonsmooth_response
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, Friction, NonsmoothLaw, Preload, System
 
 OPTIONS = RegularisationOptions(harmonics=128, regularisation=0.01, refine=0.005)
 OMEGA = (0.525, 0.53)
 
 
-def _heavy() -> NonsmoothSystem:
+def _heavy() -> System:
     """A heavy preload with Coulomb friction (T_p = 0.2, r = 0.05, c = 0.05, k = 1,
     F = 0.01 + 0.3 cos(Ωt + 0.3)): near Ω = 0.53 δ sticks ~5 % of the period and the HB at
     ε = 0.01 misses the exact rms by ~13 %."""
     law = NonsmoothLaw(elastic=Preload(preload=0.2), friction=Friction(levels=0.05))
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+    return System.single(damping=0.05, stiffness=1.0, law=law,
                            excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
 
 
@@ -63,7 +63,7 @@ def test_rows_the_plain_check_matches_are_not_taken_to_the_limit(monkeypatch: py
     """A law whose rows all match plainly (friction without a held lock-up near Ω = 1.2): the limit
     check is never run, so those rows are the plain check's."""
     law = NonsmoothLaw(elastic=Preload(preload=0.05), friction=Friction(levels=0.02))
-    system = NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+    system = System.single(damping=0.05, stiffness=1.0, law=law,
                              excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
 
     def never(*args, **kwargs):  # type: ignore[no-untyped-def]

@@ -1,6 +1,6 @@
 """Time-domain steady states and stepped sweeps of the discontinuous laws: ``steady_state`` and
-``time_sweep`` on a :class:`NonsmoothSystem` (jumps, Coulomb friction) and on a
-:class:`FrictionSystem` (a chain with friction on its elements), checked against independent
+``time_sweep`` on a :class:`System` (jumps, Coulomb friction) and on a
+a :class:`System` with its elements' whole laws (a chain with friction on its elements), checked against independent
 exact shooting (``shoot_nonsmooth_orbit`` / ``shoot_friction_orbit``)."""
 
 from __future__ import annotations
@@ -16,15 +16,17 @@ import pytest
 from rattle.analysis import SteadyStateOptions, steady_state, time_sweep
 from rattle.analysis._steady import static_state, stick_fraction
 from rattle.errors import Status
-from rattle.model import Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, NonsmoothSystem, Preload, Torque
+from rattle.model import (
+    Chain, Clutch, Element, Excitation, Friction, Link, NonsmoothLaw, Preload, System, Torque,
+)
 from rattle.timeint import ExactIntegrator, shoot_friction_orbit, shoot_nonsmooth_orbit
 
 
-def _preload(friction: float | None = 0.02) -> NonsmoothSystem:
+def _preload(friction: float | None = 0.02) -> System:
     """The torque converter's preloaded spring (T_p = 0.03, c = 0.05, F = 0.05 + 0.03 cos Ωt),
     optionally with Coulomb friction r on both stages."""
     law = NonsmoothLaw(elastic=Preload(preload=0.03), friction=None if friction is None else Friction(levels=friction))
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law, excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
+    return System.single(damping=0.05, stiffness=1.0, law=law, excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
 
 
 def _two_inertias():

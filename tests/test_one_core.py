@@ -10,6 +10,10 @@
 - one continuation (item 3): the ε-ladder and the held elements' ladder run on
   :class:`~rattle.continuation.ContinuationStepper` (no loop of ``analysis._regularisation`` or
   ``analysis._held_limit`` calls a Newton solve itself: :data:`HAND_ROLLED_LADDERS` is empty).
+- one problem type (item 1): the numerics dispatch on three model types — the user-facing
+  ``Model`` and ``Chain`` and the reduced :class:`~rattle.model.System`, which carries its
+  elements' whole laws (jumps, friction; the single equation is n = m = 1) — and on no class of a
+  discontinuous law; the exact flow picks its path by a predicate on the system's properties.
 """
 
 from __future__ import annotations
@@ -145,12 +149,12 @@ def test_one_flow_takes_every_system() -> None:
     """ExactIntegrator(system) is the flow of every kind of system (its paths are private
     subclasses), built for that system; the folded names are gone from the public lists."""
     import rattle
-    from rattle.model import Friction, FrictionSystem, NonsmoothSystem
+    from rattle.model import Friction, System
 
     model = rattle.reference_case()
     chain = model.system()
-    systems = (model, chain, NonsmoothSystem.from_model(model, friction=Friction(levels=0.01)),
-               FrictionSystem.from_system(chain, (0.01,)))
+    systems = (model, chain, System.from_model(model, friction=Friction(levels=0.01)),
+               chain.with_friction((0.01,)))
     for system in systems:
         integ = timeint.ExactIntegrator(system)
         assert isinstance(integ, timeint.ExactIntegrator) and type(integ) is not timeint.ExactIntegrator
@@ -162,6 +166,57 @@ def test_one_flow_takes_every_system() -> None:
             assert getattr(timeint, name) in (timeint.ExactIntegrator, timeint.FlowOptions)
     with pytest.raises(TypeError, match="`system`"):
         timeint.ExactIntegrator("clutch")
+
+
+#: The model types the numerics may dispatch on (``isinstance``): what a law needs is a property.
+MODEL_TYPES = {"Model", "Chain", "System"}
+#: The model types folded into System (issue 23 item 1).
+FOLDED_TYPES = {"NonsmoothSystem", "FrictionSystem"}
+
+
+def _isinstance_types(tree: ast.AST) -> list[str]:
+    """The names given as the class (or in the tuple of classes) of every ``isinstance`` call."""
+    names = []
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id == "isinstance" and len(n.args) == 2:
+            kinds = n.args[1].elts if isinstance(n.args[1], ast.Tuple) else [n.args[1]]
+            names += [k.id if isinstance(k, ast.Name) else k.attr for k in kinds if isinstance(k, (ast.Name, ast.Attribute))]
+    return names
+
+
+def test_one_problem_type() -> None:
+    """No isinstance dispatch on a folded model type, no class of them defined; every model type
+    dispatched on is Model, Chain or System (the old tree had 40 isinstance calls naming NonsmoothSystem
+    and FrictionSystem, five model types)."""
+    used = {name for tree in TREES.values() for name in _isinstance_types(tree)}
+    folded = [(mod, name) for mod, tree in TREES.items() for name in _isinstance_types(tree) if name in FOLDED_TYPES]
+    assert folded == [], folded
+    defined = {n.name for tree in TREES.values() for n in ast.walk(tree) if isinstance(n, ast.ClassDef)}
+    assert not defined & FOLDED_TYPES
+    model_types = {n for n in used if n.endswith("System") or n in {"Model", "Chain"}} - {"RegularisedSystemBalance"}
+    assert model_types == MODEL_TYPES, model_types
+    # the exact flow's paths are chosen by predicates on the system, not by its class
+    from rattle.timeint._exact_flow import ExactIntegrator
+
+    assert ExactIntegrator._PATHS and all(not isinstance(takes, type) for takes, _ in ExactIntegrator._PATHS)
+
+
+def test_what_a_law_needs_is_a_property_of_the_system() -> None:
+    """The single equation and a chain with friction are Systems; the path follows the properties."""
+    import rattle
+    from rattle.model import Friction, System
+
+    model = rattle.reference_case()
+    single = System.from_model(model, friction=Friction(levels=0.01))
+    chain = model.system().with_friction((0.01,))
+    assert single.is_single_equation and single.discontinuous and single.has_friction and not single.has_jumps
+    assert (single.n, single.m, single.c, single.k) == (1, 1, model.c, model.k)
+    assert not chain.is_single_equation and chain.discontinuous and chain.continuous().laws is None
+    assert chain.continuous() is chain.continuous() and not chain.continuous().discontinuous
+    assert not model.system().discontinuous
+    with pytest.raises(ValueError, match="single equation"):
+        chain.c  # noqa: B018
+    assert pickle.loads(pickle.dumps(single)) == single  # the single equation compares by value
 
 
 def _loops_calling_newton(tree: ast.AST) -> list[int]:

@@ -61,7 +61,7 @@ def test_the_command_line_has_no_law_branch_in_frf() -> None:
     assert "nonsmooth" not in output and "friction" not in output
 
 
-def _preload(omega: tuple[float, float]) -> rattle.NonsmoothSystem:
+def _preload(omega: tuple[float, float]) -> rattle.System:
     from rattle.io import load_config
 
     path = Path(tempfile.mkdtemp()) / "case.toml"
@@ -144,6 +144,6 @@ def test_sub_harmonic_branches_are_rows_with_their_branch_and_period() -> None:
 
 def test_rattle_exports_what_every_law_needs() -> None:
     for name in ("frequency_response", "FrequencyResponse", "ShootingOptions", "RegularisationOptions",
-                 "NonsmoothSystem", "NonsmoothLaw", "Preload", "Friction", "Chain"):
+                 "System", "NonsmoothLaw", "Preload", "Friction", "Chain"):
         assert name in rattle.__all__
     assert isinstance(RegularisationOptions(), rattle.RegularisationOptions)

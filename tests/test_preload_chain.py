@@ -1,5 +1,5 @@
 """Torque jumps (preload) on a chain's elements, solved by the exact event-driven integrator
-(rattle.timeint.ExactIntegrator): the model (Chain, FrictionSystem), one coordinate against
+(rattle.timeint.ExactIntegrator): the model (Chain), one coordinate against
 the single equation's own integrator, chains against an independent scipy event integration of
 the same Filippov system (jumps, locks, sticks), finite differences of the period map against the
 saltation monodromy (jump crossings, locks entered, left and started in), and shooting."""
@@ -14,18 +14,7 @@ from scipy.integrate import solve_ivp
 
 from rattle.errors import ConvergenceError
 from rattle.model import (
-    Backlash,
-    Chain,
-    Element,
-    Excitation,
-    Friction,
-    FrictionSystem,
-    Link,
-    NonsmoothLaw,
-    NonsmoothSystem,
-    PiecewiseJump,
-    Preload,
-    Torque,
+    Backlash, Chain, Element, Excitation, Friction, Link, NonsmoothLaw, PiecewiseJump, Preload, System, Torque,
 )
 from rattle.model._system import single_equation_system
 from rattle.timeint import ExactIntegrator, FlowOptions, shoot_friction_orbit
@@ -42,14 +31,14 @@ def _counts(traj):
 
 
 def _single(law, levels, omega_amp=0.3):
-    """The same one-coordinate equation as a FrictionSystem (n = m = 1; its System carries the
-    continuous part of the law) and as the single equation's NonsmoothSystem."""
+    """The same one-coordinate equation as a System with its elements' whole laws (n = m = 1; its elements carry the
+    continuous part of the law) and as the single equation's System."""
     cont = Element(name="x", between=(1, 2), stiffness=1.0, law=law).continuous_law()
     sys1 = single_equation_system(0.05, 1.0, cont, 0.01, (omega_amp,), (0.3,))
     fr = None if levels is None else Friction(levels=levels)
-    ns = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=fr),
+    ns = System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=law, friction=fr),
                          excitation=Excitation(mean=0.01, amplitudes=(omega_amp,), phases=(0.3,)))
-    return FrictionSystem.from_system(sys1, (levels,), elastic=(law,)), ns
+    return sys1.with_friction((levels,), elastic=(law,)), ns
 
 
 @pytest.mark.parametrize("law,levels,omega,amp,locks", [
@@ -144,7 +133,7 @@ def _random_chain(seed):
     return fs, omega, z0
 
 
-def _reference(fs: FrictionSystem, z0, t1, omega, lock_excursion=1e-13):
+def _reference(fs: System, z0, t1, omega, lock_excursion=1e-13):
     """An independent integration of the Filippov chain with jumps by scipy (DOP853, rtol 1e-12),
     constant friction levels, the mode logic written out again: every element slips on a stage
     (its law's own offsets, jumps included), sticks (band ±r) or is locked at a jump above its
@@ -152,7 +141,7 @@ def _reference(fs: FrictionSystem, z0, t1, omega, lock_excursion=1e-13):
     breakpoints, velocity zeros and band edges; at a crossing of a jump whose next excursion
     v²/(2|a⁺|) is at most lock_excursion · L with the band holding, the lock, with the chatter's
     momentum removed along B_H (A_H B_H)⁻¹ ê_e."""
-    sysm = fs.system
+    sysm = fs.continuous()
     n, m = sysm.n, sysm.m
     A, B = sysm.element_rows, sysm.element_columns
     r = np.array([fs.friction_levels(e)[0] for e in range(m)])
@@ -365,7 +354,7 @@ def test_lock_entry_removes_the_chatter_momentum_along_the_elements_column():
     assert seen >= 2
     # total momentum: the lock is internal to the chain, so Σ I_i θ_i' is continuous across it
     inertias = np.array([1.0, 0.5, 2.0])
-    Z = fs.system.angles
+    Z = fs.continuous().angles
     for tl in traj.event_times[traj.event_kinds == LOCK]:
         before, _ = traj.sample(np.array([tl - 1e-9]))
         after, _ = traj.sample(np.array([tl + 1e-9]))
@@ -385,8 +374,8 @@ def test_start_in_a_lock_and_shooting():
     assert not np.any(o.trajectory.event_kinds == LOCK)  # locked from t = 0: no entry event
     mu = np.sort(np.abs(o.multipliers))
     assert mu[0] <= 1e-12 and mu[1] <= 1e-12 and mu[-1] < 1.0
-    a = fs.system.element_rows[0]
-    b = fs.system.element_columns[:, 0]
+    a = fs.continuous().element_rows[0]
+    b = fs.continuous().element_columns[:, 0]
     assert np.abs(o.monodromy[:, 3:] @ b).max() <= 1e-12  # a relative velocity of the clutch dies in the lock
     assert abs(a @ o.state0[:3]) <= 1e-13 and abs(a @ o.state0[3:]) <= 1e-13  # on the jump, at rest
     # the start's saltation against differences of the period map. A displacement ε of δ_e from the
@@ -438,7 +427,7 @@ def test_model_takes_a_jump_law_on_an_element():
         ch.system()
     fs = ch.friction_system()
     assert fs.has_jumps and not fs.has_friction
-    el = fs.system.elements[0]
+    el = fs.continuous().elements[0]
     nl = fs.laws[0]
     assert nl.elastic is law and nl.friction is None
     # the smooth system carries the continuous part: same breakpoints and slopes, no jumps
@@ -467,9 +456,9 @@ def test_bad_jump_laws_and_mismatched_stages_are_refused():
     ch = _chain(Preload(preload=0.1), None)
     fs = ch.friction_system()
     with pytest.raises(ValueError, match="stages of element"):
-        FrictionSystem(system=fs.system, laws=(NonsmoothLaw(elastic=Preload(preload=0.1, clearance=0.01)), fs.laws[1]))
+        fs.continuous().with_laws((NonsmoothLaw(elastic=Preload(preload=0.1, clearance=0.01)), fs.laws[1]))
     with pytest.raises(ValueError, match="`elastic` must hold one entry per element"):
-        FrictionSystem.from_system(fs.system, (None, None), elastic=(None,))
+        fs.continuous().with_friction((None, None), elastic=(None,))
 
 
 def test_a_release_with_a_round_off_velocity_against_its_slip_keeps_slipping():

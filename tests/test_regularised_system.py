@@ -28,19 +28,7 @@ from rattle.hb import (
     RegularisedSystemBalance,
 )
 from rattle.model import (
-    Backlash,
-    Chain,
-    Clutch,
-    Drag,
-    Element,
-    Excitation,
-    Friction,
-    FrictionSystem,
-    Linear,
-    Link,
-    NonsmoothLaw,
-    NonsmoothSystem,
-    Torque,
+    Backlash, Chain, Clutch, Drag, Element, Excitation, Friction, Linear, Link, NonsmoothLaw, System, Torque,
 )
 from rattle.model._system import single_equation_system
 
@@ -139,7 +127,7 @@ def test_jacobians_match_finite_differences(kind: str, scaled: bool) -> None:
 def test_without_friction_it_is_the_smooth_harmonic_balance(kind: str) -> None:
     chain = _chain(kind, friction=False)
     system = chain.system()
-    fs = FrictionSystem.from_system(system, (0.0,) * system.m)  # friction levels 0 given explicitly
+    fs = system.with_friction((0.0,) * system.m)  # friction levels 0 given explicitly
     opts = HBOptions(harmonics=8, samples=128)
     pb = RegularisedSystemBalance(fs, regularisation=0.01, options=opts)
     hb = HarmonicBalance(chain, opts)
@@ -158,10 +146,10 @@ def _single_equation_pair() -> tuple[RegularisedSystemBalance, RegularisedBalanc
     """δ'' + c δ' + k g(δ, δ') = F(t) as an n = 1 chain problem and as the scalar problem, with the
     same widths of the smooth steps (H = 24, ε = 0.02 for the chain)."""
     c, k, law, mean, amps, phases = 0.15, 3.0, Clutch(alpha=0.2, b=0.1), 0.15, (0.3, 0.1), (0.4, -1.0)
-    fs = FrictionSystem.from_system(single_equation_system(c, k, law, mean, amps, phases), (CLUTCH_R,))
+    fs = single_equation_system(c, k, law, mean, amps, phases).with_friction((CLUTCH_R,))
     opts = HBOptions(harmonics=24)
     pb = RegularisedSystemBalance(fs, regularisation=0.02, options=opts)
-    nsys = NonsmoothSystem(damping=c, stiffness=k, law=NonsmoothLaw(elastic=law, friction=Friction(levels=CLUTCH_R)),
+    nsys = System.single(damping=c, stiffness=k, law=NonsmoothLaw(elastic=law, friction=Friction(levels=CLUTCH_R)),
                            excitation=Excitation(mean=mean, amplitudes=amps, phases=phases))
     L_ns = nsys.length_scale()  # the scalar problem's own scale: ε rescaled to the same widths
     ref = RegularisedBalance(c, nsys, mean, amps, phases, regularisation=0.02 * pb.length_scale / L_ns,
@@ -186,7 +174,7 @@ def test_two_inertia_free_chain_agrees_with_the_single_equation() -> None:
     fs = _chain("f2").friction_system()
     pb = RegularisedSystemBalance(fs, regularisation=0.02, options=HBOptions(harmonics=32))
     c, k, mean = 0.05 * 3.0, 1.0 * 3.0, 0.05 + 0.05 / 0.5
-    nsys = NonsmoothSystem(damping=c, stiffness=k,
+    nsys = System.single(damping=c, stiffness=k,
                            law=NonsmoothLaw(elastic=Clutch(alpha=0.2, b=0.1), friction=Friction(levels=CLUTCH_R)),
                            excitation=Excitation(mean=mean, amplitudes=(0.3,), phases=(0.4,)))
     L_ns = nsys.length_scale()
@@ -202,10 +190,10 @@ def test_two_inertia_free_chain_agrees_with_the_single_equation() -> None:
     np.testing.assert_allclose(q, res.q, rtol=0, atol=1e-11 * pb.length_scale)
 
 
-def _regularised_rhs(fs: FrictionSystem, widths: tuple[float, float], omega: float):  # type: ignore[no-untyped-def]
+def _regularised_rhs(fs: System, widths: tuple[float, float], omega: float):  # type: ignore[no-untyped-def]
     """z' = f(t, z) of the regularised equations and ∂f/∂z, written out from the formula
     g_ε = f(δ) + r_ε(δ) tanh(δ'/ε_v), r_ε = r_0 + Σ_i (r_{i+1} − r_i)(1 + tanh((δ − d_i)/ε_δ))/2."""
-    s = fs.system
+    s = fs.continuous()
     n, A, B, C, K = s.n, s.element_rows, s.element_columns, s.damping, s.stiffness
     ed, ev = widths
     laws = [(tuple(el.breakpoints), tuple(el.slopes), tuple(el.offsets), tuple(fs.friction_levels(e)))
@@ -269,7 +257,7 @@ def test_solution_is_the_steady_state_of_the_regularised_equations() -> None:
                     rtol=1e-10, atol=1e-12 * pb.length_scale, dense_output=True)
     assert sol.success
     t = (P - 1) * T + np.arange(pb.basis.samples) * (T / pb.basis.samples)
-    delta = fs.system.element_rows @ sol.sol(t)[: fs.n]
+    delta = fs.continuous().element_rows @ sol.sol(t)[: fs.n]
     rms = np.sqrt(np.mean(delta**2, axis=1))
     np.testing.assert_allclose(pb.element_rms(q), rms, rtol=3e-6)
     # The state on the section: the start of the exact shooting (pointwise, so a looser bound).
@@ -288,7 +276,7 @@ def test_views_and_helpers() -> None:
     q = _random_q(pb, w)
     Q = pb.coordinate_series(q)
     assert Q.shape == (n, S) and np.shares_memory(Q, q)
-    A = fs.system.element_rows
+    A = fs.continuous().element_rows
     np.testing.assert_allclose(pb.element_series(q), A @ Q)
     d = pb.element_samples(q)
     assert d.shape == (m, N)
@@ -310,7 +298,7 @@ def test_views_and_helpers() -> None:
     assert np.max(np.abs(other.residual(q, w) - pb.residual(q, w))) > 0
     L, wn = fs.length_scale(), fs.frequency_scale()
     assert pb.widths == pytest.approx((0.05 * L, 0.05 * L * wn))
-    assert pb.force_scale == fs.system.force_scale() and pb.parameter_scale == wn
+    assert pb.force_scale == fs.continuous().force_scale() and pb.parameter_scale == wn
     # newton_step: the full solve of the Jacobian.
     R, dq = pb.newton_step(q, w)
     _, J, _ = pb.residual_jacobian(q, w)
@@ -320,7 +308,7 @@ def test_views_and_helpers() -> None:
 def test_bad_arguments_are_refused() -> None:
     fs = _chain("f3").friction_system()
     with pytest.raises(TypeError, match="`fsys`"):
-        RegularisedSystemBalance(fs.system, regularisation=0.1)  # type: ignore[arg-type]
+        RegularisedSystemBalance(fs.continuous(), regularisation=0.1)  # type: ignore[arg-type]
     for bad in (0.0, -0.1, float("nan"), float("inf"), True, "0.1"):
         with pytest.raises(ValueError, match="`regularisation`"):
             RegularisedSystemBalance(fs, regularisation=bad)  # type: ignore[arg-type]

@@ -16,7 +16,7 @@ from rattle.analysis import SteadyStateOptions, steady_state, time_sweep
 from rattle.analysis._steady import static_state
 from rattle.cli import cli
 from rattle.errors import ConfigError, ConvergenceError, Status
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload, SoundPath, reference_case
+from rattle.model import Excitation, Friction, NonsmoothLaw, Preload, SoundPath, System, reference_case
 from rattle.results._sweep import FAILED_PERIOD, SWEEP_FAILED
 from rattle.timeint import ExactIntegrator, FlowOptions
 
@@ -29,11 +29,11 @@ _BUDGET = 4
 _GRID = (0.3, 3.0)  # ten points: 0.3, 0.6, …, 3.0
 
 
-def _preload() -> NonsmoothSystem:
+def _preload() -> System:
     """The preloaded spring with Coulomb friction (T_p = 0.03, r = 0.02, c = 0.05,
     F = 0.05 + 0.03 cos Ωt): it sticks part of every period."""
     law = NonsmoothLaw(elastic=Preload(preload=0.03), friction=Friction(levels=0.02))
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law, excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
+    return System.single(damping=0.05, stiffness=1.0, law=law, excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
 
 
 @pytest.fixture

@@ -68,7 +68,7 @@ _LAZY: dict[str, str] = {
         ["ExactIntegrator", "ShootingProblem", "shoot_periodic_orbit"], ".timeint",
     ),
     **dict.fromkeys(["SoundPath", "Drag"], ".model"),
-    **dict.fromkeys(["NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction"], ".model"),
+    **dict.fromkeys(["NonsmoothLaw", "Preload", "PiecewiseJump", "Friction"], ".model"),
     **dict.fromkeys(["clutch_damper", "hub_spline", "gear_pair", "loose_gear"], ".model"),
     **dict.fromkeys(["SoundPressure", "linear_sound_pressure", "sound_pressure"], ".results"),
 }
@@ -92,8 +92,8 @@ __all__ = [
     "linear_frequency_response", "time_sweep", "SweepResult", "steady_state", "SteadyStateOptions",
     "shoot_periodic_orbit", "periodic_orbit", "PeriodicOrbit", "OrbitSolution", "compare", "Comparison",
     "response_map", "ResponseMap", "AttractorSearch",
-    # laws with torque jumps or friction (one equation; a Chain's elements take them too)
-    "NonsmoothSystem", "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction",
+    # laws with torque jumps or friction (System.single: one equation; a Chain's elements take them too)
+    "NonsmoothLaw", "Preload", "PiecewiseJump", "Friction",
     # options and method objects (ShootingOptions, RegularisationOptions: the method for jumps or friction)
     "ShootingOptions", "RegularisationOptions", "HBOptions", "NewtonOptions", "ContinuationOptions", "Monodromy", "Hill",
     # extension points: problems, the stepper, the integrators
@@ -145,6 +145,6 @@ if TYPE_CHECKING:  # static checkers and IDEs see the eager imports
     from .stability import Hill, Monodromy
     from .timeint import ExactIntegrator, ShootingProblem, shoot_periodic_orbit
     from .model import Drag, SoundPath
-    from .model import Friction, NonsmoothLaw, NonsmoothSystem, PiecewiseJump, Preload
+    from .model import Friction, NonsmoothLaw, PiecewiseJump, Preload
     from .model import clutch_damper, gear_pair, hub_spline, loose_gear
     from .results import SoundPressure, linear_sound_pressure, sound_pressure

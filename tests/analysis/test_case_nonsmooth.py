@@ -9,7 +9,7 @@ import pytest
 
 import rattle
 from rattle.errors import ConfigError
-from rattle.model import NonsmoothSystem
+from rattle.model import System
 from rattle.results import FrequencyResponse, NonsmoothCheck, NonsmoothOrbitResult
 
 CASE = """
@@ -38,7 +38,7 @@ def test_load_case_runs_the_discontinuous_front_ends_on_the_file_settings(tmp_pa
     path = tmp_path / "case.toml"
     path.write_text(CASE)
     case = rattle.load_case(path)
-    assert case.discontinuous and isinstance(case.model, NonsmoothSystem)
+    assert case.discontinuous and case.model.is_single_equation
     opts = case.regularisation_options()
     assert (opts.harmonics, opts.regularisation, opts.refine) == (32, 0.02, None)
     frf = case.frequency_response()

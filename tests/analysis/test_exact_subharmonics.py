@@ -19,16 +19,16 @@ from _filippov import single_reference  # tests/ is on sys.path through its conf
 
 import rattle
 from rattle.analysis._nonsmooth import nonsmooth_response
-from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, NonsmoothLaw, Preload, System
 from rattle.timeint import ShootingProblem
 
 
-def _torque_converter() -> NonsmoothSystem:
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.03)),
+def _torque_converter() -> System:
+    return System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.03)),
                            excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
 
 
-def _reference_rms(system: NonsmoothSystem, z0: np.ndarray, omega: float, period: int) -> tuple[np.ndarray, float]:
+def _reference_rms(system: System, z0: np.ndarray, omega: float, period: int) -> tuple[np.ndarray, float]:
     """The reference's state after ``period`` forcing periods from ``z0`` and the rms of δ over
     them (trapezoidal rule on steps of at most T/4000: error ~1e-9 relative here)."""
     T = 2.0 * math.pi / omega
@@ -36,7 +36,7 @@ def _reference_rms(system: NonsmoothSystem, z0: np.ndarray, omega: float, period
     return z1, math.sqrt(float(np.trapezoid(xs[0] ** 2, ts)) / (period * T))
 
 
-def _settled(system: NonsmoothSystem, z0: np.ndarray, omega: float, periods: int, steps: int | None = None) -> np.ndarray:
+def _settled(system: System, z0: np.ndarray, omega: float, periods: int, steps: int | None = None) -> np.ndarray:
     """The reference's state after ``periods`` forcing periods from ``z0`` (``steps``: at least so
     many solver steps a period, for an orbit next to a grazing, whose velocity dip an unbounded
     step passes over)."""

@@ -1,6 +1,6 @@
 """The period-2 branches of a chain with friction on its elements
 (:func:`rattle.analysis.friction_subharmonics`, ``nonsmooth_response(..., subharmonics=True)`` on a
-FrictionSystem, ``rattle frf --subharmonics`` on such a chain).
+``rattle frf --subharmonics`` on such a chain).
 
 The chain is tests/test_friction_response.py's sticking chain (a clutch with friction
 0.02/0.05/0.02 per stage and a gear with backlash; the clutch sticks 12–17 % of the period). Its
@@ -137,7 +137,7 @@ def test_arguments_are_checked():
     system = _chain().friction_system()
     with pytest.raises(TypeError, match="`primary` must be the FrictionCheck"):
         friction_subharmonics(system, None, RANGE)  # type: ignore[arg-type]
-    with pytest.raises(TypeError, match="`system` must be a rattle.model.FrictionSystem"):
+    with pytest.raises(TypeError, match="`system` must be a rattle.model.System with its elements' whole laws"):
         friction_subharmonics(None, None, RANGE)  # type: ignore[arg-type]
 
 

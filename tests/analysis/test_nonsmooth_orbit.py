@@ -11,7 +11,7 @@ import pytest
 from rattle.analysis import RegularisationOptions, nonsmooth_orbit
 from rattle.errors import Status
 from rattle.files import read_csv
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, Friction, NonsmoothLaw, Preload, System
 from rattle.results import (
     NONSMOOTH_ORBIT_COLUMNS,
     NonsmoothOrbitResult,
@@ -22,9 +22,9 @@ from rattle.timeint import ExactIntegrator, shoot_nonsmooth_orbit
 OPTS = RegularisationOptions(harmonics=64, regularisation=0.01)
 
 
-def _system(tp: float, r: float, fp: float = 0.3) -> NonsmoothSystem:
+def _system(tp: float, r: float, fp: float = 0.3) -> System:
     law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r) if r else None)
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+    return System.single(damping=0.05, stiffness=1.0, law=law,
                            excitation=Excitation(mean=0.01, amplitudes=(fp,), phases=(0.3,)))
 
 

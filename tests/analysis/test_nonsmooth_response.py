@@ -11,14 +11,14 @@ from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.results import FrequencyResponse
 from rattle.continuation import solve_fixed
 from rattle.hb import HBOptions, RegularisedBalance
-from rattle.model import Excitation, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, Friction, NonsmoothLaw, Preload, System
 from rattle.stability import regularised_multipliers
 from rattle.timeint import shoot_nonsmooth_orbit
 
 
-def _system(tp: float, r: float) -> NonsmoothSystem:
+def _system(tp: float, r: float) -> System:
     law = NonsmoothLaw(elastic=Preload(preload=tp), friction=Friction(levels=r) if r else None)
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=law,
+    return System.single(damping=0.05, stiffness=1.0, law=law,
                            excitation=Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,)))
 
 

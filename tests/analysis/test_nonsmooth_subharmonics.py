@@ -13,7 +13,7 @@ import pytest
 
 from rattle.analysis import RegularisationOptions
 from rattle.analysis._nonsmooth import nonsmooth_response, nonsmooth_subharmonics
-from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, NonsmoothLaw, Preload, System
 from rattle.timeint import ExactIntegrator
 
 #: The period-1 branch loses stability by period doubling at Ω ≈ 0.545 and regains it at ≈ 0.562.
@@ -21,8 +21,8 @@ RANGE = (0.53, 0.575)
 OPTIONS = RegularisationOptions(harmonics=64, regularisation=0.01)
 
 
-def _system() -> NonsmoothSystem:
-    return NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.03)),
+def _system() -> System:
+    return System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.03)),
                            excitation=Excitation(mean=0.05, amplitudes=(0.03,)))
 
 
@@ -78,7 +78,7 @@ def test_every_row_is_a_genuine_period_two_orbit(response):
         assert abs(d[2] - d[0]) < 1e-8 * size, (w, d)
 
 
-def _settles_on(system: NonsmoothSystem, primary, br, i: int) -> None:
+def _settles_on(system: System, primary, br, i: int) -> None:
     """The exact flow started on the period-1 orbit next to row ``i`` of ``br``, nudged, settles
     after 300 forcing periods onto that row's period-2 orbit: its rms within 1e-6 relative, and
     one of its two stroboscopic states the row's state at t = 0."""

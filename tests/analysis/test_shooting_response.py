@@ -23,7 +23,7 @@ from rattle.errors import Status
 from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._exact_branch import start_state
 from rattle.continuation import NewtonOptions
-from rattle.model import Excitation, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Excitation, NonsmoothLaw, Preload, System
 from rattle.results import FrictionCheck, NonsmoothCheck
 from rattle.timeint import ShootingProblem
 
@@ -165,7 +165,7 @@ def test_where_no_computed_orbit_is_stable_the_attractor_a_sweep_settles_on_is_c
     from rattle.analysis import SteadyStateOptions, steady_state
 
     law = NonsmoothLaw(elastic=Preload(preload=0.0431))
-    system = NonsmoothSystem(damping=0.0713, stiffness=1.0, law=law,
+    system = System.single(damping=0.0713, stiffness=1.0, law=law,
                              excitation=Excitation(mean=0.0215, amplitudes=(0.0369,)))
     res = nonsmooth_response(system, (0.3, 2.0))
     found = [b for b in (res, *res.branches)
@@ -212,7 +212,7 @@ def test_a_branch_that_turns_back_at_its_start_is_a_success_when_the_other_end_c
     Ω_min turns at a fold 0.5 % into the range and leaves it where it started (RETURNED); the branch
     followed down from Ω_max covers the rest. The range is covered, so the response is a success
     (it was reported 'returned': `rattle frf` exit 1 on a complete answer)."""
-    system = NonsmoothSystem(damping=0.0466905493687573, stiffness=1.0,
+    system = System.single(damping=0.0466905493687573, stiffness=1.0,
                              law=NonsmoothLaw(elastic=Preload(preload=0.012658012081765974, clearance=0.0,
                                                               slope=1.2245173475023938)),
                              excitation=Excitation(mean=0.04022804749269272,
@@ -239,7 +239,7 @@ def test_the_branch_from_the_other_end_goes_on_where_it_is_another_orbit():
     settles back on the row (rms to 1e-6)."""
     from rattle.analysis import SteadyStateOptions, steady_state
 
-    system = NonsmoothSystem(damping=0.0465, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.0287)),
+    system = System.single(damping=0.0465, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.0287)),
                              excitation=Excitation(mean=0.0681, amplitudes=(0.0447,)))
     w = 0.4744
     run_up = rattle.time_sweep(system, omega=(0.3, w), points=4, direction="up")

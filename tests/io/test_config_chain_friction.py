@@ -1,5 +1,5 @@
 """``[[model.elements]] friction``: Coulomb friction per stage on a chain's elements, read into the
-chain's FrictionSystem (levels relative to the element's stiffness K_e, or N m with units = "SI"),
+chain's System with its elements' whole laws (levels relative to the element's stiffness K_e, or N m with units = "SI"),
 with the refusals naming the key, showing the value, stating the rule and the fix."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import pytest
 from rattle.analysis import load_case
 from rattle.errors import ConfigError
 from rattle.io import config_from_dict, dumps_toml
-from rattle.model import Chain, FrictionSystem
+from rattle.model import Chain
 
 
 def _chain(friction=None, **element) -> dict:
@@ -46,14 +46,14 @@ def _refused(data: dict, *fragments: str) -> str:
                                               ([0.04], [0.04, 0.04, 0.04])])
 def test_friction_on_an_element_makes_the_chain_a_friction_system(friction, levels):
     rc = config_from_dict(_chain(friction))
-    assert isinstance(rc.model, FrictionSystem)
+    assert rc.model.discontinuous
     assert rc.discontinuous and rc.chain_friction
     np.testing.assert_array_equal(rc.model.friction_levels(0), levels)
     assert rc.model.element_names == ("clutch",)
-    # the chain without its friction sets the bounds (its smooth system is the FrictionSystem's)
+    # the chain without its friction sets the bounds (its smooth system is the whole-law System's continuous part)
     assert isinstance(rc.continuous_model, Chain) and not rc.continuous_model.has_friction
     assert rc.bounds_model is rc.continuous_model
-    assert rc.model.system.n == rc.continuous_model.system().n == 2
+    assert rc.model.continuous().n == rc.continuous_model.system().n == 2
     # the settings of a discontinuous law: the regularised HB's defaults
     assert (rc.analysis.harmonics, rc.analysis.regularisation, rc.analysis.refine) == (128, 0.001, 0.005)
 
@@ -85,7 +85,7 @@ def test_the_resolved_configuration_round_trips_through_toml():
 
     rc = config_from_dict(_chain([0.0, 0.03, 0.01]))
     again = config_from_dict(tomllib.loads(dumps_toml(rc.to_dict())))
-    assert isinstance(again.model, FrictionSystem)
+    assert again.model.discontinuous
     np.testing.assert_array_equal(again.model.friction_levels(0), [0.0, 0.03, 0.01])
     assert again.continuous_model.to_dict() == rc.continuous_model.to_dict()
     assert again.to_dict() == rc.to_dict()
@@ -110,7 +110,7 @@ def test_a_damper_and_a_spline_take_friction_per_stage_of_their_law():
     rc = config_from_dict(data)
     np.testing.assert_allclose(rc.model.friction_levels(0), np.array([5.0, 1.0, 2.0, 5.0]) / 200.0, rtol=1e-15)
     np.testing.assert_allclose(rc.model.friction_levels(1), [1.0 / 500.0] * 3, rtol=1e-15)
-    np.testing.assert_allclose(rc.model.system.elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
+    np.testing.assert_allclose(rc.model.continuous().elements[0].slopes, [0.75, 0.075, 0.1, 1.0], rtol=1e-15)
     bad = copy.deepcopy(data)
     bad["model"]["elements"][0]["friction"] = [1.0, 2.0]
     _refused(bad, "`model.elements.1.friction` must hold one level (every stage) or one per stage of the damper",
@@ -152,7 +152,7 @@ def test_a_preload_element_makes_the_chain_a_friction_system_with_its_jump():
     from rattle.model import Preload
 
     rc = config_from_dict(_preload_chain(friction=0.01, clearance_deg=1.0, slope=0.5))
-    assert isinstance(rc.model, FrictionSystem) and rc.model.has_jumps and rc.chain_friction
+    assert rc.model.discontinuous and rc.model.has_jumps and rc.chain_friction
     b = math.radians(1.0)
     assert rc.model.laws[0].elastic == Preload(preload=0.05, clearance=b, slope=0.5)
     np.testing.assert_array_equal(rc.model.friction_levels(0), [0.01, 0.01, 0.01])
@@ -166,7 +166,7 @@ def test_a_preload_element_makes_the_chain_a_friction_system_with_its_jump():
     assert chain_regularisation(rc.model) == 0.01 and chain_regularisation(config_from_dict(_chain(0.01)).model) == 0.001
     # without friction, the jump alone
     rc = config_from_dict(_preload_chain())
-    assert isinstance(rc.model, FrictionSystem) and rc.model.has_jumps and not rc.model.has_friction
+    assert rc.model.discontinuous and rc.model.has_jumps and not rc.model.has_friction
     # a zero preload without friction is the continuous chain
     rc = config_from_dict(_preload_chain(preload=0.0))
     assert isinstance(rc.model, Chain) and not rc.model.discontinuous
@@ -215,7 +215,7 @@ def test_load_case_reads_a_chain_with_friction_with_the_chain_defaults(tmp_path)
     path = tmp_path / "case.toml"
     path.write_text(dumps_toml(config_from_dict(_chain([0.0, 0.03, 0.0])).to_dict()), encoding="utf-8")
     case = load_case(path)
-    assert case.discontinuous and isinstance(case.model, FrictionSystem)
+    assert case.discontinuous and case.model.discontinuous
     opts = case.regularisation_options()
     assert (opts.harmonics, opts.regularisation, opts.refine, opts.limit_harmonics) == (128, 0.001, 0.005, 128)
     orbit = case.periodic_orbit(1.0, options=type(opts)(harmonics=16, regularisation=0.01))

@@ -13,7 +13,7 @@ from rattle.errors import ConfigError
 from rattle.io import config_from_dict
 from rattle.model import Model
 from rattle.model._discontinuous import Preload
-from rattle.model._nonsmooth_system import NonsmoothSystem
+from rattle.model import System
 
 
 def _base(elastic: dict, **analysis: object) -> dict:
@@ -27,8 +27,8 @@ def _base(elastic: dict, **analysis: object) -> dict:
 def test_preload_builds_the_jump_law_with_the_model_coefficients():
     cfg = config_from_dict(_base({"type": "preload", "preload": 0.05}))
     system = cfg.model
-    assert isinstance(system, NonsmoothSystem) and cfg.discontinuous
-    assert (system.damping, system.stiffness) == (0.05, 1.5)  # C/I, K/I
+    assert system.is_single_equation and cfg.discontinuous
+    assert (system.c, system.k) == (0.05, 1.5)  # C/I, K/I
     st = system.law.stages
     np.testing.assert_array_equal(st.breakpoints, [0.0])
     np.testing.assert_array_equal(st.slopes, [1.0, 1.0])
@@ -75,7 +75,7 @@ def test_si_torques_are_divided_by_the_stiffness():
     assert law.elastic.preload == pytest.approx(10.0 / 200.0, rel=1e-15)
     np.testing.assert_allclose(law.friction_levels, [2.0 / 200.0, 0.0, 4.0 / 200.0], rtol=1e-15)
     np.testing.assert_allclose(law.stages.jumps, [0.05, 0.05], rtol=1e-15)
-    assert (cfg.model.damping, cfg.model.stiffness) == (5.0, 2000.0)
+    assert (cfg.model.c, cfg.model.k) == (5.0, 2000.0)
     # the torque jump K T_p in N m is the preload as written
     assert 200.0 * law.elastic.preload == pytest.approx(10.0, rel=1e-15)
     # the resolved tables give the torques back in N m, and read back the same system

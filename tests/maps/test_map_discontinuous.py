@@ -148,7 +148,7 @@ def test_map_of_a_preload_with_friction_through_the_command_line(tmp_path):
 
 
 def test_map_of_a_chain_with_friction_through_the_library(tmp_path):
-    """A chain with friction on an element's idle stage (a FrictionSystem) mapped over that level
+    """A chain with friction on an element's idle stage (a System with its elements' whole laws) mapped over that level
     with a small search: every cell ``ok``, its stable rms at Ω_min that of the exact branch's
     first row (:func:`rattle.frequency_response`, what ``rattle frf`` runs)."""
     import rattle

@@ -60,7 +60,7 @@ def _cycle(edges: dict[str, set[str]]) -> list[str] | None:
 
 def test_the_modules_of_the_model_import_one_way() -> None:
     edges = _edges()
-    assert {"_tables", "_model", "_chain", "_discontinuous", "_nonsmooth_system"} <= set(edges)
+    assert {"_tables", "_model", "_chain", "_discontinuous", "_system"} <= set(edges)
     assert edges["_model"] & {"_tables", "_chain"} == set(), edges["_model"]
     assert edges["_chain"] & {"_tables", "_model"} == set(), edges["_chain"]
     assert edges["_discontinuous"] <= {"_elastic"}, edges["_discontinuous"]

@@ -10,16 +10,16 @@ import pytest
 
 import rattle
 from rattle._limits import MAX_RECORDED_PERIODS
-from rattle.model import FrictionSystem, Friction, NonsmoothLaw, NonsmoothSystem, Preload
+from rattle.model import Friction, NonsmoothLaw, Preload, System
 from rattle.timeint import ExactIntegrator
 
 
 def _integrators():
     model = rattle.reference_case()
     system = model.system()
-    ns = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.05), friction=Friction(levels=0.01)),
+    ns = System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=0.05), friction=Friction(levels=0.01)),
                          excitation=rattle.Excitation(mean=0.01, amplitudes=(0.1,)))
-    fs = FrictionSystem.from_system(system, (None,))
+    fs = system.with_friction((None,))
     return [("exact", ExactIntegrator(model), (0.0, 0.0)), ("system", ExactIntegrator(system), np.zeros(2)),
             ("nonsmooth", ExactIntegrator(ns), (0.0, 0.0)), ("friction", ExactIntegrator(fs), np.zeros(2))]
 

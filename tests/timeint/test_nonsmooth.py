@@ -23,7 +23,7 @@ from rattle.model._discontinuous import (
     PiecewiseJump,
     Preload,
 )
-from rattle.model._nonsmooth_system import NonsmoothSystem
+from rattle.model import System
 from rattle.timeint import ExactIntegrator
 from rattle.timeint import ExactIntegrator, FlowOptions, shoot_nonsmooth_orbit
 
@@ -32,8 +32,8 @@ from rattle.timeint import ExactIntegrator, FlowOptions, shoot_nonsmooth_orbit
 # Independent reference
 # ---------------------------------------------------------------------------------------------
 
-def _system(elastic, friction=None, c=0.05, mean=0.05, amps=(0.03,), phases=None) -> NonsmoothSystem:
-    return NonsmoothSystem(damping=c, stiffness=1.0, law=NonsmoothLaw(elastic=elastic, friction=friction),
+def _system(elastic, friction=None, c=0.05, mean=0.05, amps=(0.03,), phases=None) -> System:
+    return System.single(damping=c, stiffness=1.0, law=NonsmoothLaw(elastic=elastic, friction=friction),
                            excitation=Excitation(mean=mean, amplitudes=amps, phases=phases))
 
 
@@ -107,7 +107,7 @@ def test_near_critical_damping_keeps_the_python_march() -> None:
 
 def test_stick_phases_match_solve_ivp() -> None:
     # Friction on the reference clutch at low frequency: the orbit sticks and reverses.
-    sysx = NonsmoothSystem.from_model(reference_case(), friction=Friction(levels=(0.005, 0.02, 0.005)))
+    sysx = System.from_model(reference_case(), friction=Friction(levels=(0.005, 0.02, 0.005)))
     traj = ExactIntegrator(sysx).propagate((0.1, 0.05), 0.0, 40.0, 0.4)
     assert {"stick", "unstick", "reversal", "crossing"} <= set(traj.event_kind)
     _, t_ref, y_ref = _reference(sysx, (0.1, 0.05), 40.0, 0.4)
@@ -119,21 +119,21 @@ def test_stick_phases_match_solve_ivp() -> None:
 def test_zero_preload_and_friction_recover_the_exact_integrator(omega: float) -> None:
     m = reference_case()
     ref = ExactIntegrator(m).propagate((0.1, 0.05), 0.0, 50.0, omega)
-    for sysx in (NonsmoothSystem.from_model(m), NonsmoothSystem.from_model(m, friction=Friction(levels=0.0))):
+    for sysx in (System.from_model(m), System.from_model(m, friction=Friction(levels=0.0))):
         traj = ExactIntegrator(sysx).propagate((0.1, 0.05), 0.0, 50.0, omega)
         assert np.array_equal(traj.state1, ref.state1)  # the same stage solutions and crossings
         np.testing.assert_allclose(traj.sensitivity, ref.sensitivity, rtol=0, atol=1e-13)
     # Preload(T_p = 0) is the linear law; T_p → 0 converges linearly to it
     lin = Model(inertia=1.0, damping=0.05, stiffness=1.0, elastic=Linear(), excitation=m.excitation)
     ref = ExactIntegrator(lin).propagate((0.1, 0.05), 0.0, 50.0, omega)
-    zero = ExactIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=0.0)))
+    zero = ExactIntegrator(System.from_model(lin, elastic=Preload(preload=0.0)))
     assert np.max(np.abs(zero.propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) < 1e-14
-    errs = [np.max(np.abs(ExactIntegrator(NonsmoothSystem.from_model(lin, elastic=Preload(preload=tp)))
+    errs = [np.max(np.abs(ExactIntegrator(System.from_model(lin, elastic=Preload(preload=tp)))
                           .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for tp in (1e-6, 1e-7)]
     assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
     # r → 0 likewise on the clutch (the reversals' saltations vanish with r)
     ref = ExactIntegrator(m).propagate((0.1, 0.05), 0.0, 50.0, omega)
-    errs = [np.max(np.abs(ExactIntegrator(NonsmoothSystem.from_model(m, friction=Friction(levels=r)))
+    errs = [np.max(np.abs(ExactIntegrator(System.from_model(m, friction=Friction(levels=r)))
                           .propagate((0.1, 0.05), 0.0, 50.0, omega).state1 - ref.state1)) for r in (1e-6, 1e-7)]
     assert 5.0 < errs[0] / errs[1] < 20.0 and errs[0] < 1e-4
 
@@ -212,12 +212,12 @@ def _fd_sensitivity(integ, x0, T, w, h=1e-6):
 def test_monodromy_matches_finite_differences(case: str) -> None:
     m = reference_case()
     sysx, x0, w = {
-        "jump": (NonsmoothSystem.from_model(m, elastic=Preload(preload=0.02)), (0.13, 0.05), 0.8),
-        "jump_clearance_friction": (NonsmoothSystem.from_model(m, elastic=Preload(preload=0.02, clearance=0.1),
+        "jump": (System.from_model(m, elastic=Preload(preload=0.02)), (0.13, 0.05), 0.8),
+        "jump_clearance_friction": (System.from_model(m, elastic=Preload(preload=0.02, clearance=0.1),
                                                                friction=Friction(levels=0.005)), (0.13, 0.05), 0.8),
-        "stage_friction": (NonsmoothSystem.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))),
+        "stage_friction": (System.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))),
                            (0.1, 0.05), 1.5),
-        "stick": (NonsmoothSystem.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))), (0.1, 0.05), 0.4),
+        "stick": (System.from_model(m, friction=Friction(levels=(0.005, 0.02, 0.005))), (0.1, 0.05), 0.4),
     }[case]
     integ = ExactIntegrator(sysx)
     T = 2 * math.pi / w * (2 if case == "stick" else 1)
@@ -236,7 +236,7 @@ def test_monodromy_matches_finite_differences(case: str) -> None:
 
 
 def test_shooting_stick_slip_orbit_has_a_zero_multiplier() -> None:
-    sysx = NonsmoothSystem.from_model(reference_case(), friction=Friction(levels=0.01))
+    sysx = System.from_model(reference_case(), friction=Friction(levels=0.01))
     orbit = shoot_nonsmooth_orbit(sysx, 0.4, (0.1, 0.05))
     assert orbit.converged and orbit.stable
     assert "stick" in orbit.trajectory.event_kind
@@ -249,7 +249,7 @@ def test_shooting_stick_slip_orbit_has_a_zero_multiplier() -> None:
 
 
 def test_shooting_preload_orbit_is_periodic_with_exact_multipliers() -> None:
-    sysx = NonsmoothSystem.from_model(reference_case(), elastic=Preload(preload=0.02))
+    sysx = System.from_model(reference_case(), elastic=Preload(preload=0.02))
     orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
     assert orbit.converged
     T = 2 * math.pi / 0.8
@@ -339,7 +339,7 @@ def test_invalid_laws_are_refused() -> None:
     with pytest.raises(ValueError, match="one per stage"):
         NonsmoothLaw(elastic=Piecewise(breakpoints=(-0.1, 0.1), slopes=(1.0, 0.2, 1.0)), friction=Friction(levels=(0.1, 0.2)))
     with pytest.raises(TypeError, match="`law`"):
-        NonsmoothSystem(damping=0.1, stiffness=1.0, law=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,)))
+        System.single(damping=0.1, stiffness=1.0, law=Linear(), excitation=Excitation(mean=0.0, amplitudes=(0.1,)))
     with pytest.raises(ValueError, match="`lock_excursion`"):
         FlowOptions(lock_excursion=-1.0)
 
@@ -420,7 +420,7 @@ def test_stiff_first_stage_clutch_tends_to_the_preload_orbit() -> None:
 
     tp, w = 0.05, 1.2
     exc = Excitation(mean=0.01, amplitudes=(0.3,), phases=(0.3,))
-    sysx = NonsmoothSystem(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=tp)), excitation=exc)
+    sysx = System.single(damping=0.05, stiffness=1.0, law=NonsmoothLaw(elastic=Preload(preload=tp)), excitation=exc)
     ref = shoot_nonsmooth_orbit(sysx, w, (0.3, 0.0))
     ref = shoot_nonsmooth_orbit(sysx, w, ref.state0)
     assert ref.converged
@@ -440,7 +440,7 @@ def test_orbit_measures_match_the_exact_integrator_without_jumps(omega: float) -
     from rattle.timeint import shoot_periodic_orbit
 
     m = reference_case()
-    orbit = shoot_nonsmooth_orbit(NonsmoothSystem.from_model(m), omega, (0.1, 0.05))
+    orbit = shoot_nonsmooth_orbit(System.from_model(m), omega, (0.1, 0.05))
     ref = shoot_periodic_orbit(m, omega, orbit.state0)
     d_lo, d_hi, a_lo, a_hi = orbit.trajectory.extremes()
     got = np.array([orbit.mean, orbit.rms, d_lo, d_hi, a_lo, a_hi])
@@ -450,7 +450,7 @@ def test_orbit_measures_match_the_exact_integrator_without_jumps(omega: float) -
 
 
 def test_extremes_include_the_one_sided_accelerations_at_a_jump() -> None:
-    sysx = NonsmoothSystem.from_model(reference_case(), elastic=Preload(preload=0.02), friction=Friction(levels=0.01))
+    sysx = System.from_model(reference_case(), elastic=Preload(preload=0.02), friction=Friction(levels=0.01))
     orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
     tr = orbit.trajectory
     d_lo, d_hi, a_lo, a_hi = tr.extremes()
@@ -464,7 +464,7 @@ def test_extremes_include_the_one_sided_accelerations_at_a_jump() -> None:
 def test_fourier_coefficients_of_an_orbit() -> None:
     # against a 2^16-point FFT of the exact samples (aliasing of the k⁻³ tail below 1e-15) and
     # Parseval: the rms of the series tends to the orbit's rms (tail beyond H = 64 ~ 1e-9)
-    sysx = NonsmoothSystem.from_model(reference_case(), elastic=Preload(preload=0.02), friction=Friction(levels=0.01))
+    sysx = System.from_model(reference_case(), elastic=Preload(preload=0.02), friction=Friction(levels=0.01))
     orbit = shoot_nonsmooth_orbit(sysx, 0.8, (0.1, 0.05))
     tr = orbit.trajectory
     H = 64

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..io import AnalysisSettings, RunConfig, load_config
-from ..model import FrictionSystem, Model, NonsmoothSystem
+from ..model import Model, System
 from ._compare import compare
 from ._frequency_response import frequency_response
 from ._exact_branch import ShootingOptions
@@ -63,17 +63,17 @@ class Case:
     config: RunConfig
 
     @property
-    def model(self) -> Model | NonsmoothSystem | FrictionSystem:
+    def model(self) -> Model | System:
         """The model: a :class:`~rattle.model.Model` (or chain), a
-        :class:`~rattle.model.NonsmoothSystem` when the law has a preload or friction, or a
-        :class:`~rattle.model.FrictionSystem` for a chain with friction on its elements."""
+        single-equation :class:`~rattle.model.System` when the law has a preload or friction, or a
+        :class:`~rattle.model.System` with its elements' whole laws for a chain with friction on its elements."""
         return self.config.model
 
     @property
     def discontinuous(self) -> bool:
         """True when the law has a jump or friction, or the chain friction on an element (the front
         ends of :mod:`._nonsmooth`)."""
-        return isinstance(self.config.model, (NonsmoothSystem, FrictionSystem))
+        return self.config.discontinuous
 
     def regularisation_options(self) -> RegularisationOptions:
         """The file's ``harmonics``, ``regularisation``, ``refine`` and ``limit_harmonics`` for a

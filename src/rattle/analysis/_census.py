@@ -8,8 +8,8 @@ branches miss, for every law.
   branch solved again by harmonic balance at the grid frequencies
   (:func:`~rattle.analysis._grid.solutions_on_grid`) and the attractor search
   (:func:`~rattle.analysis._attractors.find_attractors`);
-* a discontinuous law (a torque jump or friction: :class:`~rattle.model.NonsmoothSystem`, or a
-  chain with friction, :class:`~rattle.model.FrictionSystem`): the exact shooting continuation
+* a discontinuous law (a torque jump or friction: single-equation :class:`~rattle.model.System`, or a
+  chain with friction, :class:`~rattle.model.System` with its elements' whole laws): the exact shooting continuation
   that ``rattle frf`` runs at its defaults (:func:`~rattle.analysis.frequency_response` with
   :class:`~rattle.analysis.ShootingOptions`, the period-2 branches born at its period doublings
   too), every branch solved exactly at the grid frequencies (:func:`exact_solutions_on_grid`:
@@ -38,7 +38,7 @@ from .._threads import one_blas_thread
 from .._typing import FloatArray
 from ..continuation import NewtonOptions, solve_fixed
 from ..errors import Status
-from ..model import FrictionSystem, NonsmoothSystem
+from ..model import System
 from ..hb import FourierBasis, HBOptions
 from ..results import FrequencyResponse, OrbitSolution, SteadyState
 from ..timeint import FLOW_FAILURES, ShootingProblem, make_integrator
@@ -95,9 +95,9 @@ def special_points(parts: list[Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _exact_part(system: NonsmoothSystem | FrictionSystem, branch: ExactBranch, number: int, period: int) -> Any:
+def _exact_part(system: System, branch: ExactBranch, number: int, period: int) -> Any:
     """The response of an exact branch (every row an exact orbit), as ``rattle frf`` builds it."""
-    if isinstance(system, FrictionSystem):
+    if not system.is_single_equation:
         from ._friction_response import exact_friction_response
 
         return exact_friction_response(system, branch, number=number, period=period)
@@ -109,21 +109,21 @@ def _exact_part(system: NonsmoothSystem | FrictionSystem, branch: ExactBranch, n
 # ---------------------------------------------------------------------------------------------
 # Exact branches at the grid frequencies
 # ---------------------------------------------------------------------------------------------
-def _orbit_state(system: NonsmoothSystem | FrictionSystem, row: ExactRow, period: int) -> SteadyState:
+def _orbit_state(system: System, row: ExactRow, period: int) -> SteadyState:
     """The exact orbit of ``row`` as a :class:`~rattle.results.SteadyState` (what a simulation
     that settled on it reports): its measures and regimes are then those of the attractors the
     search sees, computed by the same functions."""
     traj = row.trajectory
     t = np.arange(period) * (2.0 * math.pi / row.omega)
     measures, cycle = traj.measures(), traj.states(t)
-    names = system.element_names if isinstance(system, FrictionSystem) else ()
+    names = () if system.is_single_equation else system.element_names
     return SteadyState(omega=float(row.omega), period=int(period), status=Status.CONVERGED, periods=0,
                        shooting_periods=0, state0=row.q, final_state=row.q, cycle=cycle, poincare=cycle[:1],
                        trajectory=traj, measures=measures, multipliers=row.multipliers, residual=0.0,
                        element_names=names)
 
 
-def exact_solutions_on_grid(system: NonsmoothSystem | FrictionSystem, parts: list[Any], grid: FloatArray,
+def exact_solutions_on_grid(system: System, parts: list[Any], grid: FloatArray,
                             newton: NewtonOptions | None = None) -> list[GridSolution]:
     """Every solution of the exact branches ``parts`` (responses with ``omega``, ``states``,
     ``period``, ``branch``) at the frequencies ``grid``.
@@ -194,7 +194,7 @@ class _ExactSearch(_Search):
     starts (section 3 there) become simulations (:meth:`hb_subharmonics`); the period-2
     branches born at period doublings come with the response."""
 
-    def __init__(self, system: NonsmoothSystem | FrictionSystem, response: Any, grid: FloatArray, run: RunSettings,
+    def __init__(self, system: System, response: Any, grid: FloatArray, run: RunSettings,
                  options: AttractorSearch, solutions: list[GridSolution], shooting: ShootingOptions,
                  min_period: int = 1) -> None:
         self.min_period = min_period
@@ -290,7 +290,7 @@ class _ExactSearch(_Search):
                     self.simulate(j, x0, f"sub-harmonic start at Ω = {w:.6g}")
 
 
-def find_exact_attractors(system: NonsmoothSystem | FrictionSystem, response: Any, grid: FloatArray,
+def find_exact_attractors(system: System, response: Any, grid: FloatArray,
                           run: RunSettings, options: AttractorSearch | None = None,
                           solutions: list[GridSolution] | None = None,
                           shooting: ShootingOptions | None = None, min_period: int = 1) -> Census:
@@ -313,7 +313,7 @@ SUBHARMONIC_SEARCH = AttractorSearch(max_branches=4)
 SUBHARMONIC_POINTS = 48
 
 
-def subharmonic_attractors(system: NonsmoothSystem | FrictionSystem, response: Any, omega: tuple[float, float],
+def subharmonic_attractors(system: System, response: Any, omega: tuple[float, float],
                            shooting: ShootingOptions, continuation: Any, newton: NewtonOptions | None,
                            search: AttractorSearch = SUBHARMONIC_SEARCH,
                            points: int = SUBHARMONIC_POINTS) -> list[Any]:
@@ -374,7 +374,7 @@ def attractor_census(model: Any, grid: FloatArray, run: RunSettings, search: Att
     search = search or AttractorSearch()
     lo, hi = float(grid[0]), float(grid[-1])
     t0 = time.perf_counter()
-    discontinuous = isinstance(model, (NonsmoothSystem, FrictionSystem))
+    discontinuous = isinstance(model, System) and model.discontinuous
     if discontinuous:
         response = nonsmooth_response(model, (lo, hi), ShootingOptions(), continuation=run.continuation,
                                       newton=run.newton, subharmonics=max_period >= 2, max_period=max_period,
@@ -427,7 +427,7 @@ class ExactOrbits:
     census: CellCensus
 
 
-def _orbit_solution(system: NonsmoothSystem | FrictionSystem, row: ExactRow, period: int, source: str) -> OrbitSolution:
+def _orbit_solution(system: System, row: ExactRow, period: int, source: str) -> OrbitSolution:
     """An exact orbit as the orbit door's :class:`~rattle.results.OrbitSolution`: its measures
     (the trajectory's own quadrature), multipliers (exact monodromy with saltation matrices) and
     the Fourier series x_k(t) = a_0 + Σ a_h cos(hωt) + b_h sin(hωt), ω = Ω/period, h ≤
@@ -439,7 +439,7 @@ def _orbit_solution(system: NonsmoothSystem | FrictionSystem, row: ExactRow, per
     x = np.asarray(row.trajectory.states(basis.times(period * 2.0 * math.pi / row.omega)), dtype=float)[:, :n]
     regimes = st.regimes()
     elements = {}
-    if isinstance(system, FrictionSystem):
+    if not system.is_single_equation:
         elements = {name: {**st.element(name), "regime": regimes[e]} for e, name in enumerate(system.element_names)}
     coefficients = basis.analyze(x.T).reshape(-1) if elements else basis.analyze(x[:, 0])
     return OrbitSolution(omega=float(row.omega), period=int(period), coefficients=coefficients,
@@ -449,7 +449,7 @@ def _orbit_solution(system: NonsmoothSystem | FrictionSystem, row: ExactRow, per
                          delta_max=st.delta_max, regime=regimes[0], source=source, elements=elements)
 
 
-def exact_orbits_at(system: NonsmoothSystem | FrictionSystem, omega: float, run: RunSettings | None = None, *,
+def exact_orbits_at(system: System, omega: float, run: RunSettings | None = None, *,
                     window: float = ORBIT_WINDOW, points: int = ORBIT_POINTS,
                     search: AttractorSearch | None = None, max_period: int = 4) -> ExactOrbits:
     """Every periodic orbit at Ω = ``omega`` of a discontinuous law, and the non-periodic
@@ -519,7 +519,7 @@ def exact_orbits_at(system: NonsmoothSystem | FrictionSystem, omega: float, run:
     return ExactOrbits(tuple(solutions), nonperiodic, cell)
 
 
-def with_every_orbit(system: NonsmoothSystem | FrictionSystem, result: Any) -> Any:
+def with_every_orbit(system: System, result: Any) -> Any:
     """``result`` (a NonsmoothOrbitResult or FrictionOrbitResult at Ω) with every orbit at Ω
     (:func:`exact_orbits_at`) in its ``solutions`` and ``nonperiodic``."""
     found = exact_orbits_at(system, float(result.omega))

@@ -21,8 +21,8 @@ Frequencies picked automatically (``at=None``), at most one per rule, on the swe
    Not the largest rms: that holds the mean twist, which a drag growing with speed makes
    largest at the end of the range whether or not anything rattles there.
 
-A discontinuous law (:class:`~rattle.model.NonsmoothSystem`: jumps and Coulomb friction) or a
-chain with friction on its elements (:class:`~rattle.model.FrictionSystem`): the frequency
+A discontinuous law (single-equation :class:`~rattle.model.System`: jumps and Coulomb friction) or a
+chain with friction on its elements (:class:`~rattle.model.System` with its elements' whole laws): the frequency
 response is the regularised harmonic balance checked row by row by exact shooting
 (:func:`nonsmooth_response`), the sweep runs on the exact event-driven integrator, and the two are
 set side by side without detailed orbits (``at`` is refused): every settled period-1 row of the
@@ -42,7 +42,7 @@ import numpy as np
 from .. import _limits, _validate
 from ..continuation import ContinuationOptions
 from ..hb import HBOptions, NewtonOptions
-from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
+from ..model import Model, System, check_analysable_model
 from ..results import Comparison, FrequencyResponse, PeriodicOrbit, SteadyState, SweepResult
 from ._frequency_response import frequency_response
 from ._frequency_response import check_range
@@ -199,7 +199,7 @@ def compare(
 
     Parameters
     ----------
-    model : Model, Chain, NonsmoothSystem or FrictionSystem
+    model : Model, Chain or System (continuous, or with its whole laws: the single equation's or a chain's)
         A discontinuous law (the last two): the regularised harmonic balance checked by exact
         shooting (:func:`nonsmooth_response` with ``regularisation``) against the exact sweep,
         without detailed orbits (``at`` must be None; ``harmonics`` is then
@@ -231,7 +231,7 @@ def compare(
     -------
     Comparison
     """
-    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+    if isinstance(model, System) and model.discontinuous:
         if samples is not None or hb is not None or stability != "monodromy":
             raise ValueError("`samples`, `hb` and `stability` do not apply to a discontinuous law: give its "
                              "harmonic-balance settings as `regularisation` (RegularisationOptions)")
@@ -241,7 +241,7 @@ def compare(
         return _compare_discontinuous(model, omega, points, at, regularisation, newton, continuation, options,
                                       workers, callback)
     if regularisation is not None:
-        raise ValueError("`regularisation` applies only to a discontinuous law (a NonsmoothSystem or FrictionSystem)")
+        raise ValueError("`regularisation` applies only to a discontinuous law (a System with its whole laws)")
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file
     # (all of them before the frequency response, so that a bad `points` is not found after it).
     check_analysable_model(model)
@@ -301,7 +301,7 @@ def compare(
 
 
 def _compare_discontinuous(
-    model: NonsmoothSystem | FrictionSystem, omega: tuple[float, float], points: int, at: Sequence[float] | None,
+    model: System, omega: tuple[float, float], points: int, at: Sequence[float] | None,
     regularisation: RegularisationOptions | None, newton: NewtonOptions | None,
     continuation: ContinuationOptions | None, options: SteadyStateOptions | None, workers: int,
     callback: Callable[[int, int], None] | None,
@@ -324,7 +324,7 @@ def _compare_discontinuous(
     t1 = time.perf_counter()
     frf = FrequencyResponse.from_check(
         check, model=model, timings={"frequency_response": t1 - t0},
-        settings={**method_settings(regularisation or ShootingOptions(), isinstance(model, FrictionSystem)),
+        settings={**method_settings(regularisation or ShootingOptions(), not model.is_single_equation),
                   "subharmonics": False})
     sweep = time_sweep(model, omega=(lo, hi), points=points, direction="both", options=options,
                        workers=workers, callback=callback)

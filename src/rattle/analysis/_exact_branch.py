@@ -2,7 +2,7 @@
 exact orbit.
 
 For a law with torque jumps (a preload) or Coulomb friction, on the single equation
-(:class:`~rattle.model.NonsmoothSystem`) or on a chain (:class:`~rattle.model.FrictionSystem`),
+(single-equation :class:`~rattle.model.System`) or on a chain (:class:`~rattle.model.System` with its elements' whole laws),
 the periodic orbits of period T = p·2π/Ω are the zeros of the scaled period-map defect
 
     R(z(0), Ω) = (φ_T(z(0); Ω) − z(0)) / s        (:class:`~rattle.timeint.ShootingProblem`),
@@ -97,7 +97,7 @@ from ..continuation import (
 from .._limits import MAX_PERIOD
 from .._threads import one_blas_thread
 from ..errors import Status
-from ..model import FrictionSystem, NonsmoothSystem
+from ..model import System
 from ..stability import classify_loss
 from ..timeint import FLOW_FAILURES, ShootingProblem, monodromy_multipliers
 from ._period_two import pushed_starts
@@ -606,7 +606,7 @@ def _label(a: ExactRow, b: ExactRow) -> str:
 
 
 def exact_branches(
-    system: NonsmoothSystem | FrictionSystem,
+    system: System,
     omega: tuple[float, float],
     options: ShootingOptions | None = None,
     *,
@@ -629,7 +629,7 @@ def exact_branches(
         return _exact_branches(system, omega, opts, continuation, newton, period, progress)
 
 
-def _exact_branches(system: NonsmoothSystem | FrictionSystem, omega: tuple[float, float], opts: ShootingOptions,
+def _exact_branches(system: System, omega: tuple[float, float], opts: ShootingOptions,
                     continuation: ContinuationOptions | None, newton: NewtonOptions | None,
                     period: int, progress: Any = None) -> list[ExactBranch]:
     lo, hi = omega
@@ -882,7 +882,7 @@ def doubled_orbit(half: ShootingProblem, omega: float, state: FloatArray, newton
 
 
 def subharmonic_branches(
-    system: NonsmoothSystem | FrictionSystem,
+    system: System,
     parents: list[Any],
     omega: tuple[float, float],
     options: ShootingOptions,
@@ -1066,7 +1066,7 @@ def _both_ways(follower: _Follower, shorter: list[ShootingProblem], z0: FloatArr
 
 
 def branch_through(
-    system: NonsmoothSystem | FrictionSystem,
+    system: System,
     state: FloatArray,
     omega0: float,
     period: int,

@@ -116,7 +116,7 @@ def frequency_response(
 
     The method follows from the law. A continuous law (the model's ``discontinuous`` false):
     harmonic balance, below. A law with torque jumps or friction (a
-    :class:`~rattle.model.NonsmoothSystem`, a :class:`~rattle.model.FrictionSystem`, or a
+    single-equation :class:`~rattle.model.System`, a :class:`~rattle.model.System` with its elements' whole laws, or a
     :class:`~rattle.model.Chain` with friction or jumps on an element, solved on its
     ``friction_system()``): ``options`` chooses the method (SPEC §8) — None or a
     :class:`~rattle.analysis.ShootingOptions`, exact shooting continuation on the event-driven

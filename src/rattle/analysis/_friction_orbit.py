@@ -1,7 +1,7 @@
 """One periodic orbit of a chain with Coulomb friction at one forcing frequency.
 
 For x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t)
-(:class:`~rattle.model.FrictionSystem`, n coordinates, m elements, δ_e = a_e · x) at Ω:
+(:class:`~rattle.model.System` with its elements' whole laws, n coordinates, m elements, δ_e = a_e · x) at Ω:
 
 1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedSystemBalance`, smooth steps
    of relative width ε, H harmonics) at Ω: started from the linearised chain's steady state at
@@ -45,7 +45,7 @@ from .._typing import FloatArray
 from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import RegularisedSystemBalance
-from ..model import FrictionSystem
+from ..model import System
 from ..results import FrictionOrbitResult, HeldLimitRecord
 from ..stability import regularised_system_multipliers
 from ..timeint import FLOW_FAILURES, ExactIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
@@ -81,7 +81,7 @@ def _check_x0(value: object, n: int) -> FloatArray:
     return z.copy()
 
 
-def _shoot(system: FrictionSystem, omega: float, z0: FloatArray, integ: ExactIntegrator,
+def _shoot(system: System, omega: float, z0: FloatArray, integ: ExactIntegrator,
            hold: dict[int, float] | None = None, period: int = 1) -> tuple[FrictionOrbit | None, str]:
     """The exact orbit of ``period`` forcing periods from ``z0`` (``hold`` the elements held), or
     (None, why)."""
@@ -108,7 +108,7 @@ def _gap(orbit: FrictionOrbit, pb: RegularisedSystemBalance, E: FloatArray, omeg
 
 
 def friction_orbit(
-    system: FrictionSystem,
+    system: System,
     omega: float,
     options: RegularisationOptions | None = None,
     *,
@@ -127,7 +127,7 @@ def friction_orbit(
 
     A failed exact shooting is reported in the result (``converged`` False, ``message``); a failed
     HB leaves nan series. Raises :class:`~rattle.errors.ConvergenceError` when neither is found,
-    TypeError/ValueError on bad arguments (``system`` not a FrictionSystem, ``omega`` not finite
+    TypeError/ValueError on bad arguments (``system`` not a System, ``omega`` not finite
     and > 0, ``options`` not a RegularisationOptions or with too few harmonics for the
     excitation, ``x0`` not a finite state of shape (2n,), ``period`` not 1 or 2).
 
@@ -145,8 +145,9 @@ def friction_orbit(
         return with_every_orbit(system, friction_orbit(system, omega, options, x0=x0, period=period, every=False))
     if period == 2:
         return _period_two(system, omega, options, x0)
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    if not (isinstance(system, System) and system.discontinuous):
+        raise TypeError(f"`system` must be a rattle.model.System with its elements' whole laws "
+                        f"(Chain.friction_system()), got {system!r}")
     omega = check_omega(omega)
     opts = chain_options(system) if options is None else options
     if not isinstance(opts, RegularisationOptions):
@@ -212,7 +213,7 @@ def friction_orbit(
             if orbit is None:
                 stuck = _stuck_elements(_hb_flow(integ, settled, omega))
                 if stuck:
-                    rows = system.system.element_rows.reshape(m, n)
+                    rows = system.element_rows.reshape(m, n)
                     hold = {e: float(rows[e] @ settled[:n]) for e in stuck}
                     orbit, why = _shoot(system, omega, settled, integ, hold)
                     if orbit is not None:
@@ -245,7 +246,7 @@ def friction_orbit(
                    held_record=record)
 
 
-def _held(system: FrictionSystem, make, omega: float, opts: RegularisationOptions,  # type: ignore[no-untyped-def]
+def _held(system: System, make, omega: float, opts: RegularisationOptions,  # type: ignore[no-untyped-def]
           orbit: FrictionOrbit | None, q: FloatArray | None, notes: list[str]) -> HeldLimitRecord | None:
     """The HB with the steps of the elements the exact orbit holds part of the period (0 < stick
     fraction < 1) narrowed to their limit: the chain's ε first continued to ``limit_eps`` (if
@@ -275,7 +276,7 @@ def _held(system: FrictionSystem, make, omega: float, opts: RegularisationOption
                            samples=int(hl.samples[-1]), change=hl.change, seconds=time.perf_counter() - t0)
 
 
-def _period_two(system: FrictionSystem, omega: float, options: RegularisationOptions | None,
+def _period_two(system: System, omega: float, options: RegularisationOptions | None,
                 x0: FloatArray | None) -> FrictionOrbitResult:
     """The period-2 orbit of the chain at ``omega``: the exact one first, then its regularised HB
     of period 2.
@@ -348,7 +349,7 @@ def _start_from(make, q0: FloatArray, omega: float, eps: float, H: int) -> Float
                                 tail_tol=math.inf).last.q
 
 
-def _result(system: FrictionSystem, problem: RegularisedSystemBalance, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
+def _result(system: System, problem: RegularisedSystemBalance, omega: float, opts: RegularisationOptions, orbit: FrictionOrbit | None,
             q: FloatArray | None, E: FloatArray | None, hb_flow: FrictionTrajectory | None, start: str,
             hb_start: str, held: dict[int, float], notes: list[str], periods: int = 1,
             held_record: HeldLimitRecord | None = None) -> FrictionOrbitResult:

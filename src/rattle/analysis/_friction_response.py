@@ -1,7 +1,7 @@
 """Frequency response of a chain with Coulomb friction: regularised HB, checked exactly row by row.
 
 For the chain x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t)
-(:class:`~rattle.model.FrictionSystem`, n coordinates, m elements, δ_e = a_e · x), as
+(:class:`~rattle.model.System` with its elements' whole laws, n coordinates, m elements, δ_e = a_e · x), as
 :mod:`rattle.analysis._nonsmooth` does for the single equation:
 
 1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedSystemBalance`, steps of
@@ -70,7 +70,7 @@ from .._validate import check_range
 from ..continuation import ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedSystemBalance
-from ..model import FrictionSystem
+from ..model import System
 from ..results import FrictionCheck
 from ..stability import regularised_system_multipliers
 from ..timeint import ExactIntegrator, FrictionOrbit, FrictionTrajectory, shoot_friction_orbit
@@ -95,13 +95,13 @@ CHAIN_REGULARISATION = 0.001
 JUMP_CHAIN_REGULARISATION = 0.01
 
 
-def chain_regularisation(system: FrictionSystem) -> float:
+def chain_regularisation(system: System) -> float:
     """The default ε of a chain with friction or jumps on its elements:
     :data:`JUMP_CHAIN_REGULARISATION` when a law jumps, else :data:`CHAIN_REGULARISATION`."""
     return JUMP_CHAIN_REGULARISATION if system.has_jumps else CHAIN_REGULARISATION
 
 
-def chain_options(system: FrictionSystem) -> RegularisationOptions:
+def chain_options(system: System) -> RegularisationOptions:
     """The settings of a chain with friction or jumps when none are given: ε =
     :func:`chain_regularisation`, and the ladder keeping its H (``limit_harmonics`` = ``harmonics``):
     each doubling multiplies a dense Jacobian of n(2H + 1) unknowns, at n = 3 about 40 s a row at
@@ -118,7 +118,7 @@ MATCH_SAMPLES = 64
 UNIT_TOL = 1e-8
 
 
-def friction_balance_factory(system: FrictionSystem, period: int = 1) -> Callable[[float, int], RegularisedSystemBalance]:
+def friction_balance_factory(system: System, period: int = 1) -> Callable[[float, int], RegularisedSystemBalance]:
     """``make(ε, H)``: the regularised HB of the chain ``system`` at relative width ε with H
     harmonics, of solution period ``period`` forcing periods (one problem built per H; another ε
     shares its matrices)."""
@@ -215,7 +215,7 @@ def _departure_at_limit(make: Callable[[float, int], RegularisedSystemBalance], 
     return float(np.max(gap[elements] / size[elements])) if elements else 0.0
 
 
-def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], system: FrictionSystem,
+def _match_at_limit(make: Callable[[float, int], RegularisedSystemBalance], system: System,
                     integ: ExactIntegrator, omega: float, lad: RegularisationLimit, t: FloatArray,
                     d_hb: FloatArray, size_hb: FloatArray, match: float) -> tuple[FrictionTrajectory, float] | None:
     """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` and its departure
@@ -324,7 +324,7 @@ def _exact_spectrum(pb: RegularisedSystemBalance, omega: float) -> FloatArray | 
     """The start's last fallback: the Fourier series (pb's H) of the exact periodic orbit reached
     by simulating :data:`SETTLE_PERIODS` periods from the linear solution's state and shooting;
     None when that fails."""
-    fs: FrictionSystem = pb.fsys
+    fs: System = pb.fsys
     integ = ExactIntegrator(fs)
     try:
         z = _settled(integ, pb.state_at_zero(pb.linear_solution(omega), omega), omega, SETTLE_PERIODS)
@@ -388,7 +388,7 @@ def _ladder(make: Callable[[float, int], RegularisedSystemBalance], omega: float
 
 
 def friction_response(
-    system: FrictionSystem,
+    system: System,
     omega: tuple[float, float],
     options: RegularisationOptions | None = None,
     *,
@@ -401,8 +401,9 @@ def friction_response(
     ``match``, ``refine``, ``limit``, ``limit_eps``, ``limit_harmonics``, ``deep_eps``,
     ``deep_harmonics``, ``stability``: how the HB orbit's own multipliers are found, see the
     module docstring)."""
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    if not (isinstance(system, System) and system.discontinuous):
+        raise TypeError(f"`system` must be a rattle.model.System with its elements' whole laws "
+                        f"(Chain.friction_system()), got {system!r}")
     if isinstance(options, ShootingOptions):
         return shooting_friction_response(system, omega, options, continuation=continuation, newton=newton)
     lo, hi = check_range(omega)
@@ -425,7 +426,7 @@ def friction_response(
 
 
 def shooting_friction_response(
-    system: FrictionSystem,
+    system: System,
     omega: tuple[float, float],
     options: ShootingOptions | None = None,
     *,
@@ -438,8 +439,9 @@ def shooting_friction_response(
     the special points located and labelled; ``followed`` "exact shooting", the HB columns nan).
     A second branch followed down from Ω_max, where the first left frequencies uncovered, is the
     first of ``branches`` (the sub-harmonic ones: :func:`rattle.analysis._nonsmooth.shooting_response`)."""
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    if not (isinstance(system, System) and system.discontinuous):
+        raise TypeError(f"`system` must be a rattle.model.System with its elements' whole laws "
+                        f"(Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
     found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
@@ -447,7 +449,7 @@ def shooting_friction_response(
     return dataclasses.replace(parts[0], branches=tuple(parts[1:])) if len(parts) > 1 else parts[0]
 
 
-def exact_friction_response(system: FrictionSystem, branch: ExactBranch, *, number: int,
+def exact_friction_response(system: System, branch: ExactBranch, *, number: int,
                             period: int = 1) -> FrictionCheck:
     """The :class:`FrictionCheck` of an exact branch of the chain: every row an exact orbit."""
     n, m, P = system.n, system.m, len(branch.rows)
@@ -503,7 +505,7 @@ def exact_measures(traj: FrictionTrajectory, omega: float,
 REPEAT_TOL = 1e-6
 
 
-def check_branch(system: FrictionSystem, make: Callable[[float, int], RegularisedSystemBalance],
+def check_branch(system: System, make: Callable[[float, int], RegularisedSystemBalance],
                  points: list, opts: RegularisationOptions, integ: ExactIntegrator, *,  # type: ignore[type-arg]
                  status: Status, message: str, branch: int = 0, origin: str = "") -> FrictionCheck:
     """The rows of a continued HB branch ``points`` (:class:`~rattle.continuation.ContinuationPoint`

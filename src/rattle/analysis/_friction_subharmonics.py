@@ -40,7 +40,7 @@ from .._typing import FloatArray
 from .._validate import check_range
 from ..continuation import ContinuationOptions, NewtonOptions
 from ..errors import Status
-from ..model import FrictionSystem
+from ..model import System
 from ..results import FrictionCheck
 from ..timeint import FLOW_FAILURES, ExactIntegrator, FrictionOrbit, shoot_friction_orbit
 from ._friction_response import (
@@ -66,7 +66,7 @@ SEED_GAP = 1e-3
 EXACT_ITERATIONS = 20
 
 
-def period_two_orbit(system: FrictionSystem, integ: ExactIntegrator, omega: float,
+def period_two_orbit(system: System, integ: ExactIntegrator, omega: float,
                      state: FloatArray) -> FrictionOrbit | None:
     """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``,
     one of whose multipliers lies near −1 (module docstring, step 1); None when every shot
@@ -101,7 +101,7 @@ def _period_two_start(make2, orbit: FrictionOrbit, omega: float, eps: float, H2:
 
 
 def friction_subharmonics(
-    system: FrictionSystem,
+    system: System,
     primary: FrictionCheck,
     omega: tuple[float, float],
     options: RegularisationOptions | None = None,
@@ -117,8 +117,9 @@ def friction_subharmonics(
     alone over the primary's frequencies (``followed`` "exact shooting", no HB values). A doubling
     that lies on a branch already found (its other end) starts none; one where no exact period-2
     orbit is found next to it starts none either."""
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a rattle.model.FrictionSystem (Chain.friction_system()), got {system!r}")
+    if not (isinstance(system, System) and system.discontinuous):
+        raise TypeError(f"`system` must be a rattle.model.System with its elements' whole laws "
+                        f"(Chain.friction_system()), got {system!r}")
     if not isinstance(primary, FrictionCheck):
         raise TypeError(f"`primary` must be the FrictionCheck of `system`, got {primary!r}")
     lo, hi = check_range(omega)
@@ -152,7 +153,7 @@ def friction_subharmonics(
     return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
-def _exact_branch(system: FrictionSystem, integ: ExactIntegrator, seed: FrictionOrbit, omega: float,
+def _exact_branch(system: System, integ: ExactIntegrator, seed: FrictionOrbit, omega: float,
                   grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> FrictionCheck:
     """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
     ``grid`` each way by Newton shooting over two periods from the orbit at the previous frequency

@@ -1,6 +1,6 @@
 """Frequency response of a discontinuous law (preload, friction): regularised HB, checked exactly.
 
-For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.NonsmoothSystem`):
+For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (single-equation :class:`~rattle.model.System`):
 
 1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedBalance`, smooth steps of
    relative width ε, H harmonics) is continued over Ω by pseudo-arclength
@@ -65,7 +65,7 @@ from .._validate import check_range
 from ..continuation import BranchPoint, ContinuationOptions, ContinuationStepper, NewtonOptions
 from ..errors import ConvergenceError, RattleError, Status
 from ..hb import HBOptions, RegularisedBalance
-from ..model import Chain, FrictionSystem, NonsmoothSystem
+from ..model import Chain, System
 from ..results import FrequencyResponse, FrictionCheck, NonsmoothCheck
 from ..stability import regularised_multipliers
 from ..timeint import (
@@ -165,7 +165,7 @@ def _holds(flow: NonsmoothTrajectory | None, orbit: NonsmoothOrbit | None) -> bo
     return any(tr is not None and tr.stick_time > 0.0 for tr in trajs)
 
 
-def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: NonsmoothSystem,
+def _match_at_limit(make: Callable[[float, int], RegularisedBalance], system: System,
                     integ: ExactIntegrator, omega: float, lad: RegularisationLimit,
                     L: float) -> tuple[NonsmoothOrbit, float] | None:
     """The exact orbit shot from the HB state at the end of the ε ladder ``lad`` (one that stayed
@@ -221,7 +221,7 @@ def _deeper(make: Callable[[float, int], RegularisedBalance], lad: Regularisatio
     return RegularisationLimit(omega=lad.omega, steps=lad.steps + more.steps[1:])
 
 
-def balance_factory(system: NonsmoothSystem, period: int = 1) -> Callable[[float, int], RegularisedBalance]:
+def balance_factory(system: System, period: int = 1) -> Callable[[float, int], RegularisedBalance]:
     """``make(ε, H)``: the regularised HB of ``system`` at relative width ε with H harmonics of
     Ω/``period``, on the scales every front end uses (the law's length scale L, ω_n = √(k s_max))."""
     exc = system.excitation
@@ -236,7 +236,7 @@ def balance_factory(system: NonsmoothSystem, period: int = 1) -> Callable[[float
 
 
 def nonsmooth_response(
-    system: NonsmoothSystem | FrictionSystem,
+    system: System,
     omega: tuple[float, float],
     options: ShootingOptions | RegularisationOptions | None = None,
     *,
@@ -256,7 +256,7 @@ def nonsmooth_response(
     exact shooting (module docstring); with ``subharmonics`` also the
     period-2 branches born at its period doublings (:func:`nonsmooth_subharmonics`), in its
     ``branches`` (by exact shooting: the sub-harmonic branches of :func:`shooting_response`, up to
-    ``max_period``, with the attractor search ``search``). A chain with friction (:class:`~rattle.model.FrictionSystem`) goes to
+    ``max_period``, with the attractor search ``search``). A chain with friction (:class:`~rattle.model.System` with its elements' whole laws) goes to
     :func:`~rattle.analysis._friction_response.friction_response` (a :class:`FrictionCheck`),
     with ``subharmonics`` also to :func:`~rattle.analysis._friction_subharmonics.friction_subharmonics`."""
     if not isinstance(subharmonics, bool):
@@ -264,14 +264,14 @@ def nonsmooth_response(
     if options is None or isinstance(options, ShootingOptions):  # the default: exact shooting continuation
         return shooting_response(system, omega, options, continuation=continuation, newton=newton,
                                  subharmonics=subharmonics, max_period=max_period, search=search, progress=progress)
-    if isinstance(system, FrictionSystem):
+    if isinstance(system, System) and system.discontinuous and not system.is_single_equation:
         chain = friction_response(system, omega, options, continuation=continuation, newton=newton)
         if subharmonics:
             chain = dataclasses.replace(chain, branches=friction_subharmonics(
                 system, chain, omega, options, continuation=continuation, newton=newton))
         return chain
-    if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+    if not (isinstance(system, System) and system.is_single_equation):
+        raise TypeError(f"`system` must be a System with its whole laws: the single equation's (System.single) or a chain's ("
                         f"friction, Chain.friction_system()), got {system!r}")
     lo, hi = check_range(omega)
     opts = RegularisationOptions() if options is None else options
@@ -343,7 +343,7 @@ def discontinuous_response(
     t0 = time.perf_counter()
     check = nonsmooth_response(system, omega, options, continuation=continuation, newton=newton,
                                subharmonics=subharmonics, progress=progress)
-    chain = isinstance(system, FrictionSystem)
+    chain = isinstance(system, System) and system.discontinuous and not system.is_single_equation
     opts = options if options is not None else ShootingOptions()
     settings = {**method_settings(opts, chain), "subharmonics": subharmonics}
     if subharmonics and isinstance(opts, ShootingOptions):
@@ -359,7 +359,7 @@ def discontinuous_response(
 
 
 def shooting_response(
-    system: NonsmoothSystem | FrictionSystem,
+    system: System,
     omega: tuple[float, float],
     options: ShootingOptions | None = None,
     *,
@@ -386,18 +386,18 @@ def shooting_response(
     lo, hi = check_range(omega)
     opts = ShootingOptions() if options is None else options
     primary: NonsmoothCheck | FrictionCheck
-    if isinstance(system, FrictionSystem):
+    if isinstance(system, System) and system.discontinuous and not system.is_single_equation:
         primary = shooting_friction_response(system, (lo, hi), opts, continuation=continuation, newton=newton,
                                              progress=progress)
         build = lambda b, k, p: exact_friction_response(system, b, number=k, period=p)  # noqa: E731
         search = None  # a chain's simulations take seconds each: its attractor search is the map's (rattle map)
-    elif isinstance(system, NonsmoothSystem):
+    elif isinstance(system, System) and system.is_single_equation:
         found = exact_branches(system, (lo, hi), opts, continuation=continuation, newton=newton, progress=progress)
         parts = [_exact_response(b, number=k) for k, b in enumerate(found)]
         primary = dataclasses.replace(parts[0], branches=tuple(parts[1:])) if len(parts) > 1 else parts[0]
         build = lambda b, k, p: _exact_response(b, number=k, period=p)  # noqa: E731
     else:
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+        raise TypeError(f"`system` must be a System with its whole laws: the single equation's (System.single) or a chain's ("
                         f"friction, Chain.friction_system()), got {system!r}")
     if not subharmonics or not len(primary):
         return primary
@@ -483,7 +483,7 @@ def _response(rows: dict[str, list], **fields: object) -> NonsmoothCheck:
     )
 
 
-def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], RegularisedBalance],
+def _check_branch(system: System, make: Callable[[float, int], RegularisedBalance],
                   opts: RegularisationOptions, points: list[BranchPoint], status: Status, message: str, *,
                   branch: int = 0, origin: str = "") -> NonsmoothCheck:
     """Steps 2–4 of the module docstring on the continued ``points`` of one branch (of the period
@@ -587,7 +587,7 @@ def _check_branch(system: NonsmoothSystem, make: Callable[[float, int], Regulari
     )
 
 
-def _period_two_orbit(system: NonsmoothSystem, integ: ExactIntegrator, omega: float,
+def _period_two_orbit(system: System, integ: ExactIntegrator, omega: float,
                       state: FloatArray) -> NonsmoothOrbit | None:
     """An exact period-2 orbit next to the exact period-1 orbit through ``state`` at ``omega``, one
     of whose multipliers lies near −1: shot over two forcing periods from the period-1 state pushed
@@ -629,7 +629,7 @@ def _period_two_start(make2: Callable[[float, int], RegularisedBalance], orbit: 
 
 
 def nonsmooth_subharmonics(
-    system: NonsmoothSystem,
+    system: System,
     primary: NonsmoothCheck,
     omega: tuple[float, float],
     options: RegularisationOptions | None = None,
@@ -654,8 +654,8 @@ def nonsmooth_subharmonics(
     A period doubling that lies on a branch already found (its other end) starts none. A
     doubling where no exact period-2 orbit is found next to it starts none either; the
     returned branches are what was found, numbered 1, 2, … in order of Ω."""
-    if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation), got {system!r}")
+    if not (isinstance(system, System) and system.is_single_equation):
+        raise TypeError(f"`system` must be the single equation's System (System.single), got {system!r}")
     if not isinstance(primary, NonsmoothCheck):
         raise TypeError(f"`primary` must be the NonsmoothCheck of `system`, got {primary!r}")
     lo, hi = check_range(omega)
@@ -685,7 +685,7 @@ def nonsmooth_subharmonics(
     return branches_at_doublings(primary, lo, hi, seed, from_seed, exact)
 
 
-def _exact_branch(system: NonsmoothSystem, integ: ExactIntegrator, seed: NonsmoothOrbit, omega: float,
+def _exact_branch(system: System, integ: ExactIntegrator, seed: NonsmoothOrbit, omega: float,
                   grid: FloatArray, opts: RegularisationOptions, *, branch: int, origin: str) -> NonsmoothCheck:
     """The exact period-2 branch through ``seed`` (at ``omega``) followed over the frequencies
     ``grid`` each way by Newton shooting over two periods from the orbit at the previous

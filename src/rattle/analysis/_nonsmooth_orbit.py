@@ -1,6 +1,6 @@
 """One periodic orbit of a discontinuous law (preload, friction) at one forcing frequency.
 
-For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (:class:`~rattle.model.NonsmoothSystem`) at Ω:
+For δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (single-equation :class:`~rattle.model.System`) at Ω:
 
 1. the regularised harmonic balance (:class:`~rattle.hb.RegularisedBalance`, smooth steps of
    relative width ε, H harmonics) is solved at Ω from rest where the steps are wide (ε = 0.1) and
@@ -35,7 +35,7 @@ from .._typing import FloatArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..hb import RegularisedBalance
-from ..model import FrictionSystem, NonsmoothSystem
+from ..model import System
 from ..results import FrictionOrbitResult, NonsmoothOrbitResult
 from ..timeint import FLOW_FAILURES, ExactIntegrator, NonsmoothOrbit, shoot_nonsmooth_orbit
 from ._nonsmooth import RegularisationOptions, balance_factory
@@ -56,7 +56,7 @@ def _hb_orbit(make: Callable[[float, int], RegularisedBalance], omega: float, q0
     return q, np.array([d0, v0])
 
 
-def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: ExactIntegrator, period: int = 1,
+def _shoot(system: System, omega: float, x0: FloatArray, integ: ExactIntegrator, period: int = 1,
            max_iterations: int = 30) -> tuple[NonsmoothOrbit | None, str]:
     """The exact orbit of ``period`` forcing periods from ``x0``, or (None, why)."""
     try:
@@ -69,7 +69,7 @@ def _shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: ExactIn
     return orbit, ""
 
 
-def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, integ: ExactIntegrator,
+def _settle_and_shoot(system: System, omega: float, x0: FloatArray, integ: ExactIntegrator,
                       period: int = 1, max_iterations: int = 30) -> tuple[NonsmoothOrbit | None, str]:
     """The exact flow run for :data:`SETTLE_PERIODS` orbit periods (× ``period`` forcing periods)
     from ``x0``, then shot over ``period`` forcing periods; or (None, why)."""
@@ -81,7 +81,7 @@ def _settle_and_shoot(system: NonsmoothSystem, omega: float, x0: FloatArray, int
 
 
 def nonsmooth_orbit(
-    system: NonsmoothSystem | FrictionSystem,
+    system: System,
     omega: float,
     options: RegularisationOptions | None = None,
     *,
@@ -103,7 +103,7 @@ def nonsmooth_orbit(
     in :func:`~rattle.analysis._friction_orbit.friction_orbit`): found from the exact flow, its HB of
     period 2 solved from its spectrum.
 
-    A chain with friction on its elements (:class:`~rattle.model.FrictionSystem`) goes to
+    A chain with friction on its elements (:class:`~rattle.model.System` with its elements' whole laws) goes to
     :func:`~rattle.analysis._friction_orbit.friction_orbit` (a :class:`FrictionOrbitResult`;
     ``x0`` then the chain's state (x, x'), 2n values).
 
@@ -116,16 +116,16 @@ def nonsmooth_orbit(
         raise ValueError(f"`period` must be 1 or 2 (a period-2 sub-harmonic orbit), got {period!r}")
     if not isinstance(every, bool):
         raise TypeError(f"`every` must be True or False, got {every!r}")
-    if isinstance(system, FrictionSystem):
+    if isinstance(system, System) and system.discontinuous and not system.is_single_equation:
         from ._friction_orbit import friction_orbit
 
         return friction_orbit(system, omega, options, x0=x0, period=period, every=every)
-    if every and isinstance(system, NonsmoothSystem):  # the orbit asked for, then every orbit at Ω beside it
+    if every and isinstance(system, System) and system.is_single_equation:  # the orbit asked for, then every orbit at Ω beside it
         from ._census import with_every_orbit
 
         return with_every_orbit(system, nonsmooth_orbit(system, omega, options, x0=x0, period=period, every=False))
-    if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem (one equation) or a FrictionSystem (a chain with "
+    if not (isinstance(system, System) and system.is_single_equation):
+        raise TypeError(f"`system` must be a System with its whole laws: the single equation's (System.single) or a chain's ("
                         f"friction on its elements; rattle.model), got {system!r}")
     omega = check_omega(omega)
     opts = RegularisationOptions() if options is None else options
@@ -185,7 +185,7 @@ def nonsmooth_orbit(
                                 settle_periods=SETTLE_PERIODS)
 
 
-def _period_two(system: NonsmoothSystem, omega: float, opts: RegularisationOptions,
+def _period_two(system: System, omega: float, opts: RegularisationOptions,
                 x0: FloatArray | None) -> NonsmoothOrbitResult:
     """The period-2 orbit at ``omega``: the exact one first, then its regularised HB of period 2.
 

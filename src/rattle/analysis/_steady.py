@@ -63,7 +63,7 @@ from .._typing import FloatArray
 from .._validate import check_int, check_positive, check_state, numerical_failures
 from ..errors import Status
 from ..errors import ConvergenceError
-from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System, check_analysable_model
+from ..model import Chain, Model, System, check_analysable_model
 from ..results import STEADY_METHODS as METHODS, SteadyState
 from ..timeint import (
     ExactIntegrator, ExactMeasures, ExactTrajectory, FrictionTrajectory, NonsmoothTrajectory, ShootingProblem, Shot,
@@ -178,7 +178,7 @@ class _Flow:
     lock phase contributes an exact zero multiplier), so the acceptance tests of the
     acceleration hold unchanged."""
 
-    def __init__(self, system: Model | System | NonsmoothSystem | FrictionSystem, integ: Any, omega: float) -> None:
+    def __init__(self, system: Model | System, integ: Any, omega: float) -> None:
         self.system, self.integ, self.omega = system, integ, omega
         # one ShootingProblem per period multiple; the first gives the scales
         self._problems: dict[int, ShootingProblem] = {1: ShootingProblem(system, period=1, integrator=integ)}
@@ -424,7 +424,7 @@ class _Settler:
         return self.unsettled()
 
 
-def _nonsmooth_rest(system: NonsmoothSystem) -> float:
+def _nonsmooth_rest(system: System) -> float:
     """δ_s of the law at rest, k f(δ_s) = F_m with f's jumps (friction aside): on a stage with
     positive slope, or at a breakpoint whose jump spans F_m/k (the lock band without friction)."""
     st = system.law.stages
@@ -443,24 +443,25 @@ def _nonsmooth_rest(system: NonsmoothSystem) -> float:
     return 0.0
 
 
-def static_state(model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
+def static_state(model: Model | Chain | System,
                  omega: float | None = None) -> FloatArray:
     """The static equilibrium at rest as a state: (δ_s, 0) for the single equation, (x_s, 0)
     (2n,) for a chain or System (under the mean torques at ``omega`` when they depend on it).
-    A :class:`~rattle.model.NonsmoothSystem`: k f(δ_s) = F_m with the law's jumps (at a
+    The single equation's :class:`~rattle.model.System` (:meth:`~rattle.model.System.single`):
+    k f(δ_s) = F_m with the law's jumps (at a
     breakpoint whose jump spans F_m/k, δ_s is the breakpoint); a
-    :class:`~rattle.model.FrictionSystem`: the equilibrium of its smooth System."""
+    :class:`~rattle.model.System` with its elements' whole laws: the equilibrium of its smooth System."""
     if isinstance(model, Model):
         return np.array([model.static_equilibrium(), 0.0])
-    if isinstance(model, NonsmoothSystem):
+    if isinstance(model, System) and model.is_single_equation:
         return np.array([_nonsmooth_rest(model), 0.0])
-    if isinstance(model, FrictionSystem):
-        model = model.system
+    if isinstance(model, System):
+        model = model.continuous()
     system = model.system() if isinstance(model, Chain) else model
     return np.concatenate((system.static_equilibrium(omega), np.zeros(system.n)))
 
 
-def _checked_integrator(integrator: object, system: Model | System | NonsmoothSystem | FrictionSystem) -> Any:
+def _checked_integrator(integrator: object, system: Model | System) -> Any:
     """``integrator``, or :func:`make_integrator` of ``system`` when None: refused (TypeError)
     when not an exact flow (:class:`ExactIntegrator`), (ValueError) when built for another
     system."""
@@ -476,7 +477,7 @@ def _checked_integrator(integrator: object, system: Model | System | NonsmoothSy
 
 @numerical_failures
 def steady_state(
-    model: Model | Chain | System | NonsmoothSystem | FrictionSystem,
+    model: Model | Chain | System,
     omega: float,
     x0: FloatArray | tuple[float, float] | None = None,
     *,
@@ -497,17 +498,17 @@ def steady_state(
     fields: the first).
 
     The discontinuous laws run on the event-driven paths of the same flow, the same loop on top:
-    δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (a :class:`~rattle.model.NonsmoothSystem`: jumps
+    δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) (the single equation's :class:`~rattle.model.System`: jumps
     and Coulomb friction, Filippov sticking, locks at jumps), state (δ, δ'), scaled by (L, L ν);
     a chain with friction x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn δ_e'] = F(t) (a
-    :class:`~rattle.model.FrictionSystem`), state (x, x'), with the measures of every element. Their shooting
+    :class:`~rattle.model.System` with its elements' whole laws), state (x, x'), with the measures of every element. Their shooting
     uses the exact monodromy with the saltation matrices (a stick or lock phase gives an exact
     zero multiplier, a stable direction); the measures come from the exact trajectories, the
     extremes of δ'' with their one-sided values at the switchings.
 
     Parameters
     ----------
-    model : Model, Chain, System, NonsmoothSystem or FrictionSystem
+    model : Model, Chain or System (continuous laws, or its whole laws: the single equation's or a chain's)
         The equations of motion.
     omega : float
         Forcing frequency Ω (rad/s), > 0.
@@ -529,22 +530,22 @@ def steady_state(
     opts = SteadyStateOptions() if options is None else options
     if not isinstance(opts, SteadyStateOptions):
         raise TypeError(f"`options` must be a SteadyStateOptions, got {options!r}")
-    if isinstance(model, (System, NonsmoothSystem, FrictionSystem)):
+    if isinstance(model, System):
         from .._validate import check_omega
 
         omega = check_omega(omega)
-        system: Model | System | NonsmoothSystem | FrictionSystem = model
+        system: Model | System = model
     else:
         check_analysable_model(model)
         omega = _limits.check_frequency(model, omega)
         system = model if isinstance(model, Model) else model.system()
-    if isinstance(system, (Model, NonsmoothSystem)):
+    if isinstance(system, Model) or system.is_single_equation:
         x = check_state(x0) if x0 is not None else static_state(system)
         names: tuple[str, ...] = ()
     else:
         n = system.n
         x = check_system_state(x0, n, "x0") if x0 is not None else static_state(system, omega)
-        names = system.element_names if isinstance(system, FrictionSystem) else tuple(e.name for e in system.elements)
+        names = system.element_names
     flow = _Flow(system, _checked_integrator(integrator, system), omega)
     return _Settler(flow, omega, x.copy(), opts, names).run()
 

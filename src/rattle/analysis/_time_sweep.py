@@ -12,8 +12,8 @@ resonance drops near its upper fold, the down sweep jumps up near the lower fold
 
 The discontinuous laws sweep the same way on their event-driven exact integrators: the single
 equation with torque jumps and Coulomb friction, δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t)
-(:class:`~rattle.model.NonsmoothSystem`), and a chain with friction on its elements
-(:class:`~rattle.model.FrictionSystem`); their rows also carry the fraction of the orbit (or of
+(single-equation :class:`~rattle.model.System`), and a chain with friction on its elements
+(:class:`~rattle.model.System` with its elements' whole laws); their rows also carry the fraction of the orbit (or of
 the record, period 0) held stuck or locked: ``stick_fraction`` (the single equation) or
 ``NAME_stick_fraction`` per element, as extra columns.
 """
@@ -34,7 +34,7 @@ from .._typing import FloatArray
 from .. import _limits, _validate
 from ..engines import die_with_parent, sigint_blocked, worker_signals
 from ..errors import ConfigError, RattleError
-from ..model import FrictionSystem, Model, NonsmoothSystem, check_analysable_model
+from ..model import Model, System, check_analysable_model
 from ..results import FAILED_PERIOD, SWEEP_ELEMENT_COLUMNS, SWEEP_FAILED, SpeedText, SweepResult
 from ..timeint import FLOW_FAILURES
 from ._steady import SteadyStateOptions, make_integrator, static_state, steady_state, stick_fraction
@@ -145,7 +145,7 @@ def _failures(model: object) -> tuple[type[BaseException], ...]:
     rattle's own (:class:`~rattle.errors.RattleError`), and for the discontinuous laws also what
     their event-driven flow raises when it cannot be followed (:data:`FLOW_FAILURES`: a singular
     step, a loop of stuck elements, values beyond double precision)."""
-    return FLOW_FAILURES if isinstance(model, (NonsmoothSystem, FrictionSystem)) else (RattleError,)
+    return FLOW_FAILURES if _discontinuous(model) else (RattleError,)
 
 
 def _reason(exc: BaseException) -> str:
@@ -177,14 +177,19 @@ def _fail_row(rows: dict[str, np.ndarray], i: int, omega: float, reason: str) ->
             col[i] = np.nan
 
 
+def _discontinuous(model: object) -> bool:
+    """A law with jumps or friction: the single equation's or a chain's (its whole laws)."""
+    return isinstance(model, System) and model.discontinuous
+
+
 def _stick_columns(model: object) -> tuple[str, ...]:
     """The stick-fraction columns of a discontinuous law's rows: ``stick_fraction`` for the single
     equation, ``NAME_stick_fraction`` per element of a chain with friction; none otherwise."""
-    if isinstance(model, NonsmoothSystem):
+    if not _discontinuous(model):
+        return ()
+    if model.is_single_equation:  # type: ignore[attr-defined]
         return ("stick_fraction",)
-    if isinstance(model, FrictionSystem):
-        return tuple(f"{nm}_stick_fraction" for nm in model.element_names)
-    return ()
+    return tuple(f"{nm}_stick_fraction" for nm in model.element_names)  # type: ignore[attr-defined]
 
 
 class _Bounds:
@@ -192,12 +197,12 @@ class _Bounds:
     the smooth System of a chain with friction; for the single equation its stiffest stage's
     natural frequency sqrt(k s_max) and damping rate c."""
 
-    def __init__(self, model: NonsmoothSystem | FrictionSystem) -> None:
+    def __init__(self, model: System) -> None:
         self.model = model
 
     def system(self) -> Any:
-        if isinstance(self.model, FrictionSystem):
-            return self.model.system
+        if not self.model.is_single_equation:
+            return self.model.continuous()
         from types import SimpleNamespace
 
         ws = float(np.sqrt(self.model.k * float(np.max(self.model.law.stages.slopes))))
@@ -353,11 +358,11 @@ def time_sweep(
 
     Parameters
     ----------
-    model : Model, Chain, NonsmoothSystem or FrictionSystem
+    model : Model, Chain or System (continuous, or with its whole laws: the single equation's or a chain's)
         The model; a chain is simulated on all its coordinates (state (x, x')), its rows measure
         the first clearance element and ``element_columns`` every element. A discontinuous law
-        (jumps and Coulomb friction: :class:`~rattle.model.NonsmoothSystem`, or a chain with
-        friction on its elements: :class:`~rattle.model.FrictionSystem`) runs on its event-driven
+        (jumps and Coulomb friction: single-equation :class:`~rattle.model.System`, or a chain with
+        friction on its elements: :class:`~rattle.model.System` with its elements' whole laws) runs on its event-driven
         exact integrator; its rows also carry the stick fraction (``extra_columns``:
         ``stick_fraction``, or ``NAME_stick_fraction`` per element).
     omega : (float, float)
@@ -387,7 +392,7 @@ def time_sweep(
         the last state computed: ``complete`` is then False and ``message`` names them.
     """
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
-    if isinstance(model, (NonsmoothSystem, FrictionSystem)):
+    if _discontinuous(model):
         lo, hi = _limits.check_frequency_range(_Bounds(model), *_validate.check_range(omega, "omega"), simulate=True)
     else:
         check_analysable_model(model)

@@ -463,7 +463,8 @@ def orbit_command(
     )
     check_omega(omega, option, model=run_config.model)
     model = run_config.model
-    forced = len(model.excitation.amplitudes) if hasattr(model, "excitation") else int(model.forced_harmonics)
+    forced = len(model.excitation.amplitudes) if getattr(model, "excitation", None) is not None \
+        else int(model.forced_harmonics)
     check_period(period, analysis.harmonics, forced)
     t_start = time.perf_counter()
     from ..analysis import periodic_orbit  # only now: all input has been validated

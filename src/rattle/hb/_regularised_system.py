@@ -1,6 +1,6 @@
 """Harmonic balance of a chain with Coulomb friction on its elements, by regularisation.
 
-The chain's equations with friction (:class:`~rattle.model.FrictionSystem`), n coordinates and
+The chain's equations with friction (:class:`~rattle.model.System` with its elements' whole laws), n coordinates and
 m clearance elements,
 
     x'' + C x' + K x + Σ_e b_e g_e(δ_e, δ_e') = F(t),   δ_e = a_e · x,
@@ -14,8 +14,8 @@ to the element stiffness, which b_e carries):
     sgn(δ') → tanh(δ' / ε_v),   steps of r_e at breakpoints → H_ε(δ − d_i) of width ε_δ,
     ε_δ = ε L,   ε_v = ε L ω_n,
 
-L the system's length scale with friction (:meth:`FrictionSystem.length_scale`) and ω_n its
-highest natural frequency (:meth:`FrictionSystem.frequency_scale`); both are fixed (the law
+L the system's length scale with friction (:meth:`System.length_scale`) and ω_n its
+highest natural frequency (:meth:`System.frequency_scale`); both are fixed (the law
 does not depend on Ω), so ε is the only knob. An element may have narrower steps of its own
 (:meth:`RegularisedSystemBalance.with_element_scales`): element e's widths are then s_e ε_δ and
 s_e ε_v (s_e = 1 by default), which resolves an element whose own motion is much smaller than L
@@ -51,7 +51,7 @@ import numpy as np
 import scipy.linalg
 
 from .._typing import FloatArray
-from ..model import FrictionSystem
+from ..model import System
 from ._basis import FourierBasis, resize_harmonics
 from ._options import HBOptions
 from ._residual import (
@@ -76,7 +76,7 @@ class RegularisedSystemBalance:
     Parameters
     ----------
     fsys
-        The chain's equations with friction (:class:`~rattle.model.FrictionSystem`).
+        The chain's equations with friction (:class:`~rattle.model.System` with its elements' whole laws).
     regularisation
         ε > 0, the relative width of the smooth steps (ε_δ = ε L, ε_v = ε L ω_n).
     options
@@ -85,11 +85,11 @@ class RegularisedSystemBalance:
         p: the solution's period is p forcing periods.
     """
 
-    def __init__(self, fsys: FrictionSystem, *, regularisation: float, options: HBOptions | None = None,
+    def __init__(self, fsys: System, *, regularisation: float, options: HBOptions | None = None,
                  period: int = 1) -> None:
-        if not isinstance(fsys, FrictionSystem):
-            raise TypeError(f"`fsys` must be a rattle.model.FrictionSystem (Chain.friction_system() or "
-                            f"FrictionSystem.from_system), got {fsys!r}")
+        if not (isinstance(fsys, System) and fsys.discontinuous):
+            raise TypeError(f"`fsys` must be a rattle.model.System with its elements' whole laws "
+                            f"(Chain.friction_system() or System.with_friction), got {fsys!r}")
         eps = _check_regularisation(regularisation)
         if options is None:
             options = HBOptions()
@@ -98,7 +98,7 @@ class RegularisedSystemBalance:
         if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
             raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
         period = int(period)
-        system = fsys.system
+        system = fsys.continuous()
         H = options.harmonics
         check_forced_harmonics(system, H, period)
         L, wn = float(fsys.length_scale()), float(fsys.frequency_scale())
@@ -168,12 +168,12 @@ class RegularisedSystemBalance:
 
     @property
     def length_scale(self) -> float:
-        """L (rad): :meth:`FrictionSystem.length_scale`."""
+        """L (rad): :meth:`System.length_scale`."""
         return self._L
 
     @property
     def parameter_scale(self) -> float:
-        """ω_n (rad/s): :meth:`FrictionSystem.frequency_scale`."""
+        """ω_n (rad/s): :meth:`System.frequency_scale`."""
         return self._wn
 
     @property

@@ -51,7 +51,7 @@ from .. import _limits
 from ..errors import ConfigError
 from ..files import read_toml
 from ..model import Model, Preload, check_analysable_model, forcing_frequency
-from ..model import FrictionSystem, NonsmoothSystem, model_tables
+from ..model import System, model_tables
 from .._table_checks import (
     _EXAMPLES,
     _Checker,
@@ -208,11 +208,11 @@ class RunConfig:
 
     Attributes
     ----------
-    model : Model, Chain, NonsmoothSystem or FrictionSystem
-        The ``[model]`` and ``[excitation]`` tables: a :class:`~rattle.model.NonsmoothSystem` when
+    model : Model, Chain or System (continuous, or with its whole laws: the single equation's or a chain's)
+        The ``[model]`` and ``[excitation]`` tables: a single-equation :class:`~rattle.model.System` when
         ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or a ``friction`` level > 0; only
         ``rattle frf``, ``rattle orbit`` and :func:`rattle.frequency_response` solve it), a
-        :class:`~rattle.model.FrictionSystem` for a chain with a ``friction`` level > 0 on some
+        :class:`~rattle.model.System` with its elements' whole laws for a chain with a ``friction`` level > 0 on some
         ``[[model.elements]]`` (only ``rattle frf``, ``rattle orbit``, ``frequency_response`` and
         ``nonsmooth_orbit``), else a Model or a
         Chain.
@@ -241,15 +241,16 @@ class RunConfig:
 
     @property
     def discontinuous(self) -> bool:
-        """True when :attr:`model` is a :class:`~rattle.model.NonsmoothSystem` (a jump or friction)
-        or a :class:`~rattle.model.FrictionSystem` (a chain with friction on its elements)."""
-        return isinstance(self.model, (NonsmoothSystem, FrictionSystem))
+        """True when :attr:`model` is a :class:`~rattle.model.System` with its whole laws: the single
+        equation's (a jump or friction) or a chain's (friction or a jump on its elements)."""
+        return isinstance(self.model, System) and self.model.discontinuous
 
     @property
     def chain_friction(self) -> bool:
-        """True when :attr:`model` is a :class:`~rattle.model.FrictionSystem`: a chain with Coulomb
-        friction on some ``[[model.elements]]`` (``rattle frf`` and ``rattle orbit`` solve it)."""
-        return isinstance(self.model, FrictionSystem)
+        """True when :attr:`model` is a chain's :class:`~rattle.model.System` with its elements' whole
+        laws: Coulomb friction or a jump on some ``[[model.elements]]`` (``rattle frf`` and ``rattle
+        orbit`` solve it)."""
+        return self.discontinuous and not self.model.is_single_equation
 
     @property
     def bounds_model(self) -> Any:
@@ -261,7 +262,7 @@ class RunConfig:
         """The resolved configuration (defaults filled in) as a TOML-shaped dict (angles in rad, an
         ``[engine]`` resolved into its torque and ``[model] speed_order``; a discontinuous law with
         its preload and friction as written: relative to K, or in N m with ``units = "SI"``)."""
-        if isinstance(self.model, FrictionSystem):
+        if self.chain_friction:
             out = _friction_chain_to_toml_dict(self.model, self.continuous_model, self.analysis, self.units)
         elif self.discontinuous:
             out = _nonsmooth_to_toml_dict(self.model, self.continuous_model, self.analysis, self.units)
@@ -400,7 +401,7 @@ def config_from_dict(data: Mapping[str, Any], source_name: str = "<dict>") -> Ru
 # --------------------------------------------------------------------------------------------
 # Discontinuous laws, the rules of model and analysis together, [analysis]
 # --------------------------------------------------------------------------------------------
-def _nonsmooth_to_toml_dict(system: NonsmoothSystem, model: Model | None, analysis: AnalysisSettings,
+def _nonsmooth_to_toml_dict(system: System, model: Model | None, analysis: AnalysisSettings,
                             units: str) -> dict[str, Any]:
     """The tables of a discontinuous configuration (round trip through :func:`config_from_dict`):
     the preload and friction as written (× K back to N m with ``units = "SI"``)."""
@@ -417,7 +418,7 @@ def _nonsmooth_to_toml_dict(system: NonsmoothSystem, model: Model | None, analys
     return out
 
 
-def _friction_chain_to_toml_dict(system: FrictionSystem, chain: Any, analysis: AnalysisSettings,
+def _friction_chain_to_toml_dict(system: System, chain: Any, analysis: AnalysisSettings,
                                  units: str) -> dict[str, Any]:
     """The tables of a chain with friction or preloads (round trip through
     :func:`config_from_dict`): the chain without them (``chain``, every law's continuous part),
@@ -439,7 +440,7 @@ def _friction_chain_to_toml_dict(system: FrictionSystem, chain: Any, analysis: A
 
 def check_harmonics(model: Model, harmonics: int, name: str = "analysis.harmonics") -> None:
     """The harmonic balance must hold every excitation harmonic: ``harmonics`` >= their count."""
-    if hasattr(model, "excitation"):
+    if getattr(model, "excitation", None) is not None:
         needed, where = len(model.excitation.amplitudes), f"`excitation.amplitudes` has {len(model.excitation.amplitudes)}"
     else:
         needed, where = model.forced_harmonics, f"the longest `excitation.torques` amplitudes list has {model.forced_harmonics}"

@@ -61,11 +61,11 @@ def _source_of(model: Any) -> tuple[Any, Any, tuple[Any, ...], Any]:
 
 
 def _discontinuous(model: Any) -> bool:
-    """A law with a torque jump or friction (a NonsmoothSystem, a FrictionSystem): solved by exact
+    """A law with a torque jump or friction (a System with its whole laws): solved by exact
     shooting (:func:`rattle.analysis.attractor_census`)."""
-    from ..model import FrictionSystem, NonsmoothSystem
+    from ..model import System
 
-    return isinstance(model, (NonsmoothSystem, FrictionSystem))
+    return isinstance(model, System) and model.discontinuous
 
 
 def _paths_fingerprint(paths: tuple[Any, ...]) -> list[dict[str, Any]]:
@@ -140,8 +140,8 @@ def response_map(
     wherever nothing stable is known and a multi-start per band; every new periodic attractor
     continued as a branch). Summarised per grid frequency as SPEC §7's ``map.csv`` columns.
 
-    A law with a torque jump or friction (a NonsmoothSystem, or a chain with them: a
-    FrictionSystem) is mapped on the exact flow (:func:`rattle.analysis.attractor_census`): the
+    A law with a torque jump or friction (the single equation's System, or a chain with them: a
+    System) is mapped on the exact flow (:func:`rattle.analysis.attractor_census`): the
     exact shooting continuation of ``rattle frf`` with its period-2 branches, every branch solved
     exactly on the grid, the search by exact simulation; give it as its Case or RunConfig (or
     with ``tables``). Its ``[analysis] method = "hb"`` and sound ``paths`` are refused

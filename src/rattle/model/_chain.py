@@ -27,7 +27,6 @@ from .._typing import FloatArray
 from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw
 from ._drag import Drag, drag_load
 from ._elastic import AbstractElastic, Piecewise, _check_real, _check_real_sequence
-from ._friction_system import FrictionSystem
 from ._readers import read_tables
 from ._system import ReducedElement, System
 
@@ -139,7 +138,7 @@ class Element:
     def continuous_law(self) -> AbstractElastic:
         """The law without its jumps: the same breakpoints and slopes, continuous, f(0) = 0 (the law
         itself when it is continuous). The smooth equations of a chain carry it for an element with
-        jumps; the jumps are the :class:`~rattle.model.FrictionSystem`'s (:meth:`Chain.friction_system`)."""
+        jumps; the jumps are in the whole law of :meth:`Chain.friction_system`."""
         if isinstance(self.law, AbstractElastic):
             return self.law
         st = self.law.stages
@@ -457,13 +456,15 @@ class Chain:
         is solved on :meth:`friction_system`."""
         return self.has_friction or self.has_jumps
 
-    def friction_system(self) -> FrictionSystem:
-        """The equations of motion with every element's friction and torque jumps
-        (:class:`FrictionSystem`): its ``system`` holds the continuous part of every law (the law
-        without its jumps), its ``laws`` the whole law (:class:`NonsmoothLaw`: jumps and friction)."""
+    def friction_system(self) -> System:
+        """The equations of motion with every element's friction and torque jumps: the
+        :class:`System` of :meth:`system` carrying every element's whole law (``laws``,
+        :class:`NonsmoothLaw`: jumps and friction) and the chain's ``speed_order``; its
+        :meth:`System.continuous` part is the continuous part of every law (the law without its
+        jumps). Kept apart from :meth:`system`, which refuses such a chain for the smooth analyses."""
         assert self._system is not None
         laws = tuple(NonsmoothLaw(elastic=e.law, friction=e.friction) for e in self.elements)
-        return FrictionSystem(system=self._system, laws=laws, speed_order=self.speed_order)
+        return self._system.with_laws(laws, speed_order=self.speed_order)
 
     def _check_scales(self) -> None:
         sysm = self._system

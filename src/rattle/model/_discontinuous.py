@@ -1,8 +1,9 @@
 """Discontinuous laws: a torque jump (preload) and Coulomb friction (hysteresis) of one coordinate.
 
 The law g of the single equation of SPEC §1 (c = C/I, k = K/I; the equation itself is
-:class:`~rattle.model.NonsmoothSystem`, :mod:`._nonsmooth_system`) and of every element of a chain
-with friction (:mod:`._friction_system`),
+the single equation's :class:`~rattle.model.System`, :meth:`~rattle.model.System.single`) and of
+every element of a chain with friction (a :class:`~rattle.model.System` with its elements' whole
+laws, :mod:`._system`),
 
     δ'' + c δ' + k g(δ, δ') = F(t) = F_m + Σ_n F_pn cos(n Ω t + φ_n),
     g(δ, δ') = f(δ) + r(δ) sgn(δ'),

@@ -154,8 +154,9 @@ class Model:
 
     @property
     def discontinuous(self) -> bool:
-        """False: a Model's law is continuous (a law with jumps or friction is a
-        :class:`~rattle.model.NonsmoothSystem`); the front ends choose their method by this."""
+        """False: a Model's law is continuous (a law with jumps or friction makes the single
+        equation's :class:`~rattle.model.System`, :meth:`~rattle.model.System.from_model`); the
+        front ends choose their method by this."""
         return False
 
     def system(self) -> System:
@@ -169,8 +170,8 @@ class Model:
     def from_toml(cls, path: str | Path) -> Model:
         """Read the ``[model]`` and ``[excitation]`` tables of a SPEC §2 TOML file.
 
-        A file whose law has a preload or friction describes a
-        :class:`~rattle.model.NonsmoothSystem`, not a Model: ConfigError, pointing to
+        A file whose law has a preload or friction describes the single equation's
+        :class:`~rattle.model.System` with its whole law, not a Model: ConfigError, pointing to
         ``rattle.load_case(path).model``.
 
         The model tables are read as :func:`rattle.io.load_config` reads them (the same rules and
@@ -182,7 +183,7 @@ class Model:
             return tables.chain  # type: ignore[return-value]
         if tables.discontinuous:
             raise ConfigError(f"{path}: the law has a preload or friction (`model.elastic.preload`/`friction`), "
-                              f"which makes a NonsmoothSystem, not a Model: read it with "
+                              f"which makes the single equation's System with its whole law, not a Model: read it with "
                               f"`rattle.load_case({str(path)!r}).model`")
         return tables.model
 

@@ -26,6 +26,26 @@ the equation is linear:
 
 and its first-order form z = (x, x') has the stage matrix A_s = [[0, I], [−K_s, −C]].
 
+A system may carry every element's whole law (``laws``, one :class:`~rattle.model.NonsmoothLaw`
+per element: jumps — a preload — and Coulomb friction levels r_ej per stage),
+
+    x'' + C x' + K x + Σ_e b_e [f_e(a_e·x) + r_e(a_e·x) sgn(a_e·x')] = F(t),
+
+its elements then carry the continuous part of their law (the same breakpoints and slopes, no
+jumps): every smooth analysis reads that part (:meth:`System.continuous`), the exact event flow
+and the regularised harmonic balance the whole law. Whether a system needs them is a property
+(:attr:`System.discontinuous`, :attr:`System.has_friction`, :attr:`System.has_jumps`), not a class.
+
+The single equation with a discontinuous law (a preload, Coulomb friction),
+
+    δ'' + c δ' + k g(δ, δ') = F(t),      g(δ, δ') = f(δ) + r(δ) sgn(δ'),
+
+is the system with n = m = 1, C = [[c]], K = [[0]], a = [1], b = [k] and the element's whole law
+g (:meth:`System.single`, :meth:`System.from_model`); it keeps its
+:class:`~rattle.model.Excitation` (``excitation``, :attr:`System.is_single_equation`), and the
+exact flow and the analyses take their scalar paths on it (the coefficients ``c``, ``k`` and the
+law ``law`` read there).
+
 A speed-dependent mean load (a drag torque tabulated by speed, :mod:`rattle.model._drag`) makes
 the mean forcing a function of the forcing frequency, F_0(Ω) = F_0 + d(Ω) u (``load``): every
 analysis at frequency Ω uses :meth:`System.mean_at` (the forcing, the static equilibrium, the
@@ -34,6 +54,7 @@ exact flow), and the harmonic balance carries d(Ω) and d'(Ω) in its residual.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass, field
 
@@ -41,8 +62,10 @@ import numpy as np
 
 from .._limits import bounded_scale
 from .._typing import FloatArray
+from ._discontinuous import AbstractJumpLaw, Friction, NonsmoothLaw
 from ._drag import SpeedLoad
-from ._elastic import AbstractElastic
+from ._elastic import AbstractElastic, Piecewise, _check_real
+from ._excitation import Excitation
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -77,6 +100,15 @@ class System:
     ``coordinates`` names the coordinates; ``angles`` Z (N, n) maps x to the inertias' angles
     (relative to the last inertia for a free chain, ``free`` True); ``load`` an optional
     Ω-dependent part of the mean forcing (:class:`~rattle.model.SpeedLoad`, a drag by speed).
+
+    ``laws`` every element's whole law (one :class:`~rattle.model.NonsmoothLaw` per element, in
+    order, with the element's breakpoints and slopes: jumps and friction), None for the continuous
+    laws of the elements; ``speed_order`` the engine order of Ω (rpm in results), None without an
+    engine. Built with laws by :meth:`rattle.model.Chain.friction_system` and
+    :meth:`with_friction`. ``excitation`` the single equation's
+    :class:`~rattle.model.Excitation` (:meth:`single`, :meth:`from_model`; None for any other
+    system): set, the system is the single equation δ'' + c δ' + k g(δ, δ') = F(t) (n = m = 1,
+    K = 0, a = [1], b = [k], ``laws`` its whole law g) and its analyses take the scalar paths.
     """
 
     damping: FloatArray
@@ -89,7 +121,200 @@ class System:
     angles: FloatArray
     free: bool = False
     load: SpeedLoad | None = None
+    laws: tuple[NonsmoothLaw, ...] | None = None
+    speed_order: float | None = None
+    excitation: Excitation | None = None
     _stiffness_cache: dict = field(default_factory=dict, repr=False, compare=False)
+    _continuous: System | None = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.excitation is not None and (self.laws is None or len(self.elements) != 1 or self.n != 1):
+            raise ValueError("`excitation` is the single equation's (n = m = 1, with its whole law in `laws`): "
+                             "build it with System.single or System.from_model")
+        if self.laws is None:
+            return
+        laws = tuple(self.laws)
+        if len(laws) != len(self.elements):
+            raise ValueError(f"`laws` must hold one law per element ({len(self.elements)}), got {len(laws)}")
+        for e, (law, el) in enumerate(zip(laws, self.elements)):
+            if not isinstance(law, NonsmoothLaw):
+                raise TypeError(f"`laws[{e}]` must be a NonsmoothLaw, got {law!r}")
+            st = law.stages
+            if not (np.array_equal(st.breakpoints, el.breakpoints) and np.array_equal(st.slopes, el.slopes)):
+                raise ValueError(f"`laws[{e}]` must have the stages of element {el.name!r} of the system")
+        object.__setattr__(self, "laws", laws)
+
+    # --- equality: the single equation's by value, any other system by identity -------------
+    def __eq__(self, other: object) -> bool:
+        if self is other:
+            return True
+        if not isinstance(other, System):
+            return NotImplemented
+        if self.excitation is None or other.excitation is None:
+            return False
+        return (self.c, self.k, self.law, self.excitation) == (other.c, other.k, other.law, other.excitation)
+
+    def __hash__(self) -> int:
+        if self.excitation is None:
+            return object.__hash__(self)
+        return hash((self.c, self.k, self.law, self.excitation))
+
+    # --- the single equation ----------------------------------------------------------------
+    @classmethod
+    def single(cls, *, damping: float, stiffness: float, law: NonsmoothLaw, excitation: Excitation) -> System:
+        """The single equation δ'' + c δ' + k g(δ, δ') = F(t), per unit inertia: ``damping``
+        c = C/I ≥ 0 (1/s), ``stiffness`` k = K/I > 0 (1/s²), ``law`` g (a
+        :class:`~rattle.model.NonsmoothLaw`: its jumps and friction) and ``excitation`` F; the
+        system with n = m = 1, C = [[c]], K = [[0]], a = [1], b = [k]."""
+        c = _check_real("damping", damping)
+        k = _check_real("stiffness", stiffness)
+        if c < 0:
+            raise ValueError(f"`damping` (c = C/I) must be >= 0, got {c!r}")
+        if k <= 0:
+            raise ValueError(f"`stiffness` (k = K/I) must be > 0, got {k!r}")
+        if not isinstance(law, NonsmoothLaw):
+            raise TypeError(f"`law` must be a NonsmoothLaw, got {law!r}")
+        if not isinstance(excitation, Excitation):
+            raise TypeError(f"`excitation` must be an Excitation, got {excitation!r}")
+        el = law.elastic
+        if isinstance(el, AbstractJumpLaw):  # the element carries the law's continuous part
+            st = el.stages
+            el = Piecewise(breakpoints=tuple(st.breakpoints.tolist()), slopes=tuple(st.slopes.tolist()))
+        base = single_equation_system(c, k, el, excitation.mean, excitation.amplitudes, excitation.phases or ())
+        out = dataclasses.replace(base, laws=(law,), excitation=excitation)
+        object.__setattr__(out, "_continuous", base)
+        return out
+
+    @classmethod
+    def from_model(cls, model: object, *, elastic: AbstractElastic | AbstractJumpLaw | None = None,
+                   friction: Friction | None = None) -> System:
+        """The single equation of a :class:`~rattle.model.Model` (its c, k and excitation) with its
+        law (or ``elastic``: a law with jumps, :class:`~rattle.model.Preload` …) and ``friction``."""
+        # (read by its fields: the Model builds on this module, which does not import it back)
+        if not all(hasattr(model, a) for a in ("c", "k", "elastic", "excitation")) or not callable(
+                getattr(model, "static_equilibrium", None)):
+            raise TypeError(f"`model` must be a rattle Model, got {model!r}")
+        law = NonsmoothLaw(elastic=model.elastic if elastic is None else elastic, friction=friction)
+        return cls.single(damping=model.c, stiffness=model.k, law=law, excitation=model.excitation)
+
+    @property
+    def is_single_equation(self) -> bool:
+        """True for the single equation with its whole law (:meth:`single`): n = m = 1, K = 0,
+        a = [1], its ``excitation`` kept; the exact flow and the analyses take their scalar paths."""
+        return self.excitation is not None
+
+    def _single(self, what: str) -> None:
+        if self.excitation is None:
+            raise ValueError(f"`{what}` is the single equation's (System.single, System.from_model); this system "
+                             f"has n = {self.n} coordinates and m = {self.m} elements: read `damping`, "
+                             "`stiffness`, `elements` and `laws`")
+
+    @property
+    def c(self) -> float:
+        """c = C/I (1/s) of the single equation (:meth:`single`; ValueError on any other system)."""
+        self._single("c")
+        return float(self.damping[0, 0])
+
+    @property
+    def k(self) -> float:
+        """k = K/I (1/s²) of the single equation (:meth:`single`; ValueError on any other system)."""
+        self._single("k")
+        return float(self.elements[0].b[0])
+
+    @property
+    def law(self) -> NonsmoothLaw:
+        """The single equation's whole law g (:meth:`single`; ValueError on any other system)."""
+        self._single("law")
+        return self.laws[0]  # type: ignore[index]
+
+    def regularised(self, delta: FloatArray, velocity: FloatArray, width: float,
+                    velocity_width: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """k g_ε and its partials (per unit inertia) of the single equation: the
+        ``RegularisedForce`` of :mod:`rattle.hb._regularised`."""
+        g, gd, gv = self.law.regularised(delta, velocity, width, velocity_width)
+        return self.k * g, self.k * gd, self.k * gv
+
+    # --- the elements' whole laws -----------------------------------------------------------
+    def with_laws(self, laws: tuple[NonsmoothLaw, ...], speed_order: float | None = None) -> System:
+        """This system with every element's whole law ``laws`` (one
+        :class:`~rattle.model.NonsmoothLaw` per element, with its breakpoints and slopes) and
+        ``speed_order``; its :meth:`continuous` part is this system's."""
+        base = self.continuous()
+        out = dataclasses.replace(base, laws=tuple(laws), speed_order=speed_order)
+        object.__setattr__(out, "_continuous", base)
+        return out
+
+    def with_friction(self, levels: tuple[object, ...], *, elastic: tuple[object, ...] | None = None,
+                      speed_order: float | None = None) -> System:
+        """This system with friction ``levels`` per element (None, a number, or one per stage) and
+        optionally ``elastic`` laws per element (None: the element's own law; a law with jumps,
+        :class:`~rattle.model.Preload` or :class:`~rattle.model.PiecewiseJump`, with the element's
+        breakpoints and slopes: the elements keep its continuous part)."""
+        if len(levels) != self.m:
+            raise ValueError(f"`levels` must hold one entry per element ({self.m}), got {len(levels)}")
+        if elastic is None:
+            elastic = (None,) * self.m
+        if len(elastic) != self.m:
+            raise ValueError(f"`elastic` must hold one entry per element ({self.m}), got {len(elastic)}")
+        laws = tuple(NonsmoothLaw(elastic=el.law if law is None else law,  # type: ignore[arg-type]
+                                  friction=None if r is None else Friction(levels=r))  # type: ignore[arg-type]
+                     for el, r, law in zip(self.elements, levels, elastic))
+        return self.with_laws(laws, speed_order=speed_order)
+
+    def continuous(self) -> System:
+        """The same equations with the continuous part of every law (no jumps, no friction): the
+        system itself when it carries no whole ``laws``; what every smooth analysis reads."""
+        if self.laws is None:
+            return self
+        if self._continuous is None:
+            object.__setattr__(self, "_continuous", dataclasses.replace(self, laws=None, speed_order=None, excitation=None))
+        return self._continuous  # type: ignore[return-value]
+
+    @property
+    def discontinuous(self) -> bool:
+        """True when the system carries its elements' whole laws (jumps and friction, possibly
+        none): the front ends solve it on the exact event flow, or regularised and checked
+        exactly; False for the continuous laws (the smooth analyses)."""
+        return self.laws is not None
+
+    @property
+    def has_friction(self) -> bool:
+        """Some element's law has a friction level > 0."""
+        return self.laws is not None and any(bool(np.any(law.friction_levels > 0)) for law in self.laws)
+
+    @property
+    def has_jumps(self) -> bool:
+        """Some element's law jumps (a preload)."""
+        return self.laws is not None and any(bool(np.any(law.stages.jumps > 0)) for law in self.laws)
+
+    @property
+    def element_names(self) -> tuple[str, ...]:
+        """The elements' names, as the per-element result columns carry them (NAME_rms …); none
+        for the single equation (:attr:`is_single_equation`: its measures are the columns
+        themselves, as a Model's)."""
+        return () if self.excitation is not None else tuple(e.name for e in self.elements)
+
+    def friction_levels(self, e: int) -> FloatArray:
+        """r_ej on every stage j of element ``e`` (zeros without ``laws``)."""
+        if self.laws is None:
+            return np.zeros(len(self.elements[e].slopes))
+        return self.laws[e].friction_levels
+
+    def jumps(self, e: int) -> FloatArray:
+        """J_ei ≥ 0 at every breakpoint i of element ``e`` (zeros for a continuous law)."""
+        if self.laws is None:
+            return np.zeros(len(self.elements[e].breakpoints))
+        return self.laws[e].stages.jumps
+
+    def frequency_scale(self) -> float:
+        """ω_n, the highest natural frequency over the stage combinations (rad/s)."""
+        return self.stiffest_frequency()
+
+    def speed_rpm(self, omega: object) -> object:
+        """Crankshaft speed (rpm) at forcing frequency ``omega``, or None without an engine."""
+        if self.speed_order is None:
+            return None
+        return np.asarray(omega, dtype=float) * (60.0 / (2.0 * np.pi * self.speed_order))
 
     # --- sizes --------------------------------------------------------------------------------
     @property
@@ -282,6 +507,38 @@ class System:
         return max(float(np.max(amp)), 1e-300)
 
     def length_scale(self) -> float:
+        """A characteristic deflection (rad): :meth:`_smooth_length_scale` of the continuous laws;
+        with whole ``laws``, the largest deflection of an element's friction and jumps,
+        (Σ_i J_ei + max_j r_ej) / min_j s_ej (the widths of its stick and lock bands in
+        deflection, as the single equation counts them), when larger."""
+        if self.excitation is not None:
+            return self._single_length_scale()
+        base = self._smooth_length_scale()
+        if self.laws is None:
+            return base
+        fr = 0.0
+        for law in self.laws:
+            s = law.stages.slopes
+            pos = s[s > 0]
+            if pos.size:
+                width = float(np.sum(law.stages.jumps)) + float(np.max(law.friction_levels))
+                fr = max(fr, width / float(np.min(pos)))
+        return max(base, fr)
+
+    def _single_length_scale(self) -> float:
+        """The single equation's L (rad): breakpoints, the jumps' and friction's deflections and
+        the quasi-static dynamic amplitude (|F_m| + Σ|F_pn|) / (k s_min), whichever is largest."""
+        law = self.law
+        st = law.stages
+        s_pos = st.slopes[st.slopes > 0]
+        exc = self.excitation
+        assert exc is not None
+        dyn = (abs(exc.mean) + exc.amplitude_scale) / (self.k * float(np.min(s_pos)))
+        bp = float(np.max(np.abs(st.breakpoints))) if st.breakpoints.size else 0.0
+        jump = float(np.sum(st.jumps) + np.max(law.friction_levels)) / float(np.min(s_pos))
+        return max(bp, dyn, jump, 1e-300)
+
+    def _smooth_length_scale(self) -> float:
         """A characteristic deflection (rad): the static deflection, the breakpoints and the
         quasi-static dynamic amplitude, whichever is largest.
 

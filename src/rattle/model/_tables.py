@@ -24,7 +24,7 @@ The data-sheet shapes (damper, spline, gear pair, loose gear) are first rewritte
 tables (:mod:`._table_shapes`). ``[[model.elements]] friction`` (Coulomb levels, one or one per
 stage of the element's law, relative to its stiffness K_e, or in N m with ``units = "SI"``) and
 ``[[model.elements]] type = "preload"`` (a torque jump, ``preload``, ``clearance``, ``slope``, the
-jump relative to K_e or in N m) make the model the chain's :class:`FrictionSystem`.
+jump relative to K_e or in N m) make the model the chain's :class:`System` with its elements' whole laws.
 
 The run's own tables, ``[analysis]`` and ``[[paths]]``, are known here by name only: the
 configuration reader (:mod:`rattle.io`) reads them and, from an ``[engine]``'s speed range
@@ -58,10 +58,9 @@ from ._drag import Drag
 from ._elastic import ELASTIC_LAWS, AbstractElastic, Piecewise
 from ._engine import engine_torque
 from ._excitation import Excitation
-from ._friction_system import FrictionSystem
 from ._model import Model
-from ._nonsmooth_system import NonsmoothSystem
 from ._readers import register_reader
+from ._system import System
 from .._table_checks import (
     _EXAMPLES,
     ANGLE_KEYS,
@@ -135,9 +134,9 @@ class ModelTables:
 
     Attributes
     ----------
-    model : Model, Chain, NonsmoothSystem or FrictionSystem
-        A :class:`NonsmoothSystem` when ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or
-        a ``friction`` level > 0); a :class:`FrictionSystem` (``Chain.friction_system()``) for a
+    model : Model, Chain or System (the single equation's or a chain's whole laws)
+        The single equation's :class:`System` (:meth:`System.from_model`) when ``[model.elastic]`` is discontinuous (a ``preload`` > 0 or
+        a ``friction`` level > 0); a :class:`System` with its elements' whole laws (``Chain.friction_system()``) for a
         chain with a ``friction`` level > 0 on some ``[[model.elements]]``; else a Model or a Chain.
     units : str
         ``[model] units``: ``"dimensionless"`` or ``"SI"``.
@@ -160,9 +159,9 @@ class ModelTables:
 
     @property
     def discontinuous(self) -> bool:
-        """True when :attr:`model` is a :class:`NonsmoothSystem` (a jump or friction) or a
-        :class:`FrictionSystem` (a chain with friction on its elements)."""
-        return isinstance(self.model, (NonsmoothSystem, FrictionSystem))
+        """True when :attr:`model` is a :class:`System` with its whole laws: the single equation's
+        (a jump or friction) or a chain's (friction or a jump on its elements)."""
+        return isinstance(self.model, System) and self.model.discontinuous
 
 
 def model_tables(data: Mapping[str, Any], source_name: str = "<dict>") -> ModelTables:
@@ -304,8 +303,8 @@ def _friction(check: _Checker, elastic: Any, friction_t: Any, key: str) -> Frict
 
 
 def _nonsmooth_system(check: _Checker, model: Model, elastic: Any, friction_t: Any,
-                      units: str) -> NonsmoothSystem | None:
-    """The :class:`NonsmoothSystem` of a law with a jump (``preload`` > 0) or ``friction`` (a level
+                      units: str) -> System | None:
+    """The single equation's :class:`System` (:meth:`System.from_model`) of a law with a jump (``preload`` > 0) or ``friction`` (a level
     > 0); None for a continuous law. Preload and friction are torques relative to K (the torque
     jump is K T_p, the friction torque K r); with ``units = "SI"`` they are given in N m and
     divided here by ``model.stiffness`` K."""
@@ -320,7 +319,7 @@ def _nonsmooth_system(check: _Checker, model: Model, elastic: Any, friction_t: A
             elastic = Preload(preload=elastic.preload / K, clearance=elastic.clearance, slope=elastic.slope)
         if friction is not None:
             friction = Friction(levels=tuple(r / K for r in friction.levels))
-    return check.build(NonsmoothSystem.from_model, {"model": "model", "elastic": "model.elastic",
+    return check.build(System.from_model, {"model": "model", "elastic": "model.elastic",
                                                    "friction": "model.elastic.friction"},
                        model=model, elastic=elastic, friction=friction)
 

@@ -48,8 +48,8 @@ class Comparison:
     settings, timings : dict
         Provenance.
 
-    A discontinuous law (:class:`~rattle.model.NonsmoothSystem`, or a chain with friction:
-    :class:`~rattle.model.FrictionSystem`): ``frf`` is its :class:`NonsmoothCheck` or
+    A discontinuous law (single-equation :class:`~rattle.model.System`, or a chain with friction:
+    :class:`~rattle.model.System` with its elements' whole laws): ``frf`` is its :class:`NonsmoothCheck` or
     :class:`FrictionCheck` (exact rms per row, ``stable``, ``matched``), ``at``, ``orbits`` and
     ``simulations`` are empty, and :meth:`agreement` sets the sweep's settled period-1 rows against
     the response's exact rms.

@@ -175,8 +175,8 @@ class FrequencyResponse:
                    timings: dict[str, float]) -> "FrequencyResponse":
         """The response of a law with jumps or friction from its exact-check group ``check`` (the
         primary branch, its sub-harmonic branches in ``check.branches``): one row per row of each,
-        the primary's first; ``model`` the system solved (a :class:`~rattle.model.NonsmoothSystem`
-        or :class:`~rattle.model.FrictionSystem`), ``settings`` the method's (JSON-able: written to
+        the primary's first; ``model`` the system solved (a single-equation :class:`~rattle.model.System`
+        or :class:`~rattle.model.System` with its elements' whole laws), ``settings`` the method's (JSON-able: written to
         ``frf.json``; ``subharmonics`` and ``refine`` read by :meth:`summary`)."""
         parts = (check, *check.branches)
 

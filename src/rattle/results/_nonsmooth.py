@@ -218,7 +218,7 @@ class NonsmoothCheck:
         labels = self.bifurcation
         return {
             "settings": dict(settings),
-            "system": {"damping": system.damping, "stiffness": system.stiffness, "law": system.law.to_dict(),
+            "system": {"damping": system.c, "stiffness": system.k, "law": system.law.to_dict(),
                        "excitation": system.excitation.to_dict()},
             "status": self.status.name.lower(),
             "message": self.message or self.status.message,

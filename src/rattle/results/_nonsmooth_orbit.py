@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import ComplexArray, FloatArray
-from ..model import NonsmoothSystem
+from ..model import System
 from ..timeint import NonsmoothOrbit
 from ._orbit import OrbitSolution, every_orbit_lines, every_orbit_records
 from ._plotter import plot_with
@@ -55,7 +55,7 @@ class NonsmoothOrbitResult:
     (:attr:`matched`); ``periods`` p: the orbit repeats after p forcing periods (2: a sub-harmonic
     orbit; its HB series then holds harmonics of Ω/2, and "per period" means over p 2π/Ω)."""
 
-    system: NonsmoothSystem
+    system: System
     omega: float
     orbit: NonsmoothOrbit | None
     message: str

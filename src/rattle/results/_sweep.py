@@ -112,8 +112,8 @@ class SweepResult:
     written after the SPEC columns; the states are z = (x, x') of its n coordinates ((P, 2n)),
     the multipliers (P, 2n).
 
-    A discontinuous law (:class:`~rattle.model.NonsmoothSystem`: jumps and Coulomb friction on
-    the single equation; :class:`~rattle.model.FrictionSystem`: a chain with friction on its
+    A discontinuous law (single-equation :class:`~rattle.model.System`: jumps and Coulomb friction on
+    the single equation; :class:`~rattle.model.System` with its elements' whole laws: a chain with friction on its
     elements): the same columns, from its exact event-driven trajectories, and in
     ``extra_columns`` the fraction of each row's orbit (of its record for period 0) held stuck or
     locked — ``stick_fraction``, or ``NAME_stick_fraction`` per element of the chain.
@@ -504,6 +504,8 @@ def _regimes_from_extremes(result: SweepResult) -> np.ndarray:
     n = int(np.size(result.omega))
     out = np.full(n, "", dtype=object)
     model = result.model
+    if getattr(model, "discontinuous", False):  # jumps or friction: the regimes come with the rows, if at all
+        return out
     try:
         system = model if hasattr(model, "elements") and not hasattr(model, "system") else model.system()
         d = np.asarray(system.elements[0].breakpoints, dtype=float)

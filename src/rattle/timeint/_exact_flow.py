@@ -9,21 +9,28 @@ transition matrices exp(A_s τ) and, where the field jumps, the saltation matric
 S = I + (φ⁺ − φ⁻) nᵀ / (nᵀ φ⁻).
 
 ``ExactIntegrator(system)`` takes any system and picks the path that computes this flow fastest
-(the class it returns is a private subclass, so ``isinstance(integ, ExactIntegrator)`` holds):
+(the class it returns is a private subclass, so ``isinstance(integ, ExactIntegrator)`` holds). Every
+path declares the systems it takes by a predicate on the system's properties (``takes``), not by
+its class; a :class:`~rattle.model.Chain` is first reduced to its
+:class:`~rattle.model.System` (:meth:`~rattle.model.Chain.friction_system` when it is
+discontinuous):
 
-=====================================  =========================================================
-system                                 path (module)
-=====================================  =========================================================
-:class:`~rattle.model.Model`           the compiled scalar path: one coordinate, one element,
-                                       modal closed form (:mod:`._integrator`)
-:class:`~rattle.model.NonsmoothSystem`  the same scalar path with the Filippov events: jumps,
-                                       stick, slip, lock (:mod:`._nonsmooth`)
-:class:`~rattle.model.System`,         the stage-matrix path: n coordinates, m elements,
-:class:`~rattle.model.Chain`           continuous laws (:mod:`._flow`)
-:class:`~rattle.model.FrictionSystem`  the stage-matrix path with the Filippov events and the
-                                       active-set choice of the held elements
-                                       (:mod:`._friction_chain`)
-=====================================  =========================================================
+==========================================  ====================================================
+system (predicate)                          path (module)
+==========================================  ====================================================
+a :class:`~rattle.model.Model`              the compiled scalar path: one coordinate, one
+(:func:`takes_model`)                       element, modal closed form (:mod:`._integrator`)
+the single equation's                       the same scalar path with the Filippov events:
+:class:`~rattle.model.System` (n = m = 1,   jumps, stick, slip, lock (:mod:`._nonsmooth`)
+``is_single_equation``;
+:func:`takes_single_equation`)
+a :class:`~rattle.model.System`, not        the stage-matrix path: n coordinates, m elements,
+``discontinuous`` (:func:`takes_continuous`)  continuous laws (:mod:`._flow`)
+a :class:`~rattle.model.System`,            the stage-matrix path with the Filippov events and
+``discontinuous``, not the single          the active-set choice of the held elements
+equation's (:func:`takes_discontinuous`)
+                                            (:mod:`._friction_chain`)
+==========================================  ====================================================
 
 All answer ``advance(z0, t0, t1, Ω, sensitivity)`` → (z1, ∂z1/∂z0) (the period map of a
 shooting, no record) and ``propagate(z0, t0, t1, Ω)`` → an
@@ -35,11 +42,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
 
-from ..model import Chain
+from ..model import Chain, Model, System
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -79,9 +87,33 @@ class FlowOptions:
         return 200_000 if events else 1_000_000
 
 
+def takes_model(system: Any) -> bool:
+    """The compiled scalar path's systems: a :class:`~rattle.model.Model` (continuous law)."""
+    return isinstance(system, Model)
+
+
+def takes_single_equation(system: Any) -> bool:
+    """The scalar event path's systems: the single equation with its whole law, a
+    :class:`~rattle.model.System` with n = m = 1 in the single-equation form
+    (:attr:`~rattle.model.System.is_single_equation`: :meth:`~rattle.model.System.single`)."""
+    return isinstance(system, System) and system.is_single_equation
+
+
+def takes_continuous(system: Any) -> bool:
+    """The stage-matrix path's systems: a :class:`~rattle.model.System` with continuous laws."""
+    return isinstance(system, System) and not system.discontinuous
+
+
+def takes_discontinuous(system: Any) -> bool:
+    """The Filippov chain path's systems: a :class:`~rattle.model.System` carrying its elements'
+    whole laws (``discontinuous``: jumps and friction), but the single equation's."""
+    return isinstance(system, System) and system.discontinuous and not system.is_single_equation
+
+
 def _reduced(system: Any) -> Any:
-    """A :class:`~rattle.model.Chain`'s reduced form: its FrictionSystem when it has friction or a
-    torque jump on an element, else its System; any other object as it is."""
+    """A :class:`~rattle.model.Chain`'s reduced form: its System with the whole laws
+    (:meth:`~rattle.model.Chain.friction_system`) when it has friction or a torque jump on an
+    element, else its System; any other object as it is."""
     if isinstance(system, Chain):
         return system.friction_system() if system.discontinuous else system.system()
     return system
@@ -89,14 +121,14 @@ def _reduced(system: Any) -> Any:
 
 class ExactIntegrator:
     """The exact flow of ``system`` (module docstring): a :class:`~rattle.model.Model`,
-    :class:`~rattle.model.Chain`, :class:`~rattle.model.System`,
-    :class:`~rattle.model.NonsmoothSystem` or :class:`~rattle.model.FrictionSystem`.
+    :class:`~rattle.model.Chain` or :class:`~rattle.model.System` (continuous laws, or carrying its
+    elements' whole laws; the single equation's included).
 
     Parameters
     ----------
     system
-        The equations of motion (a Chain: its System, or its FrictionSystem when an element has
-        friction or a torque jump).
+        The equations of motion (a Chain: its System, with the elements' whole laws when an
+        element has friction or a torque jump).
     options
         :class:`FlowOptions` (the event grid, the event budget, the lock snap).
 
@@ -108,34 +140,35 @@ class ExactIntegrator:
         The :class:`FlowOptions`.
     """
 
-    #: The kind of system each path takes, in the order they are tried (filled by the paths).
-    _PATHS: ClassVar[list[tuple[type, type]]] = []
-    #: The kind of system this path takes (set on the path's class).
-    _for: ClassVar[type | None] = None
+    #: Each path's predicate on the systems it takes, and the path (filled by the paths).
+    _PATHS: ClassVar[list[tuple[Callable[[Any], bool], type]]] = []
+    #: The predicate of the systems this path takes (set on the path's class) and their name.
+    _takes: ClassVar[Callable[[Any], bool] | None] = None
+    _kind: ClassVar[str] = "rattle system"
 
     system: Any
     options: FlowOptions
 
-    def __init_subclass__(cls, /, for_system: type | None = None, **kwargs: Any) -> None:
+    def __init_subclass__(cls, /, takes: Callable[[Any], bool] | None = None, kind: str = "", **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
-        if for_system is not None:
-            cls._for = for_system
-            ExactIntegrator._PATHS.append((for_system, cls))
+        if takes is not None:
+            cls._takes = staticmethod(takes)  # type: ignore[assignment]
+            cls._kind = kind
+            ExactIntegrator._PATHS.append((takes, cls))
 
     def __new__(cls, system: Any = None, options: FlowOptions | None = None) -> ExactIntegrator:
         if cls is not ExactIntegrator:  # a path itself (or unpickling one: no arguments)
             return super().__new__(cls)
         system = _reduced(system)
-        for kind, path in ExactIntegrator._PATHS:
-            if isinstance(system, kind):
+        for takes, path in ExactIntegrator._PATHS:
+            if takes(system):
                 return super().__new__(path)
-        raise TypeError("`system` must be a rattle Model, Chain, System, NonsmoothSystem or FrictionSystem, "
-                        f"got {system!r}")
+        raise TypeError(f"`system` must be a rattle Model, Chain or System, got {system!r}")
 
     def __init__(self, system: Any, options: FlowOptions | None = None) -> None:
         system = _reduced(system)
-        if self._for is None or not isinstance(system, self._for):
-            raise TypeError(f"`system` must be a {getattr(self._for, '__name__', 'rattle system')}, got {system!r}")
+        if self._takes is None or not self._takes(system):
+            raise TypeError(f"`system` must be {self._kind}, got {system!r}")
         if options is not None and not isinstance(options, FlowOptions):
             raise TypeError(f"`options` must be a FlowOptions (or None), got {options!r}")
         self.system = system
@@ -144,7 +177,7 @@ class ExactIntegrator:
 
     def built_for(self, system: Any) -> bool:
         """True when this flow was built for ``system`` (the same object, or an equal one)."""
-        return isinstance(system, self._for) and (self.system is system or bool(self.system == system))
+        return self._takes is not None and self._takes(system) and (self.system is system or bool(self.system == system))
 
     def advance(self, z0: Any, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[Any, Any]:  # pragma: no cover - every path defines it
@@ -157,4 +190,5 @@ class ExactIntegrator:
         raise NotImplementedError
 
 
-__all__ = ["ExactIntegrator", "FlowOptions"]
+__all__ = ["ExactIntegrator", "FlowOptions", "takes_model", "takes_single_equation", "takes_continuous",
+           "takes_discontinuous"]

@@ -28,7 +28,7 @@ from .._validate import as_float_array, check_omega
 from ..errors import ConvergenceError
 from ..model import System
 from ._events import first_exit, vector_bracketed_newton
-from ._exact_flow import ExactIntegrator, FlowOptions
+from ._exact_flow import ExactIntegrator, FlowOptions, takes_continuous
 from ._trajectory import ExactTrajectory
 from ._stage_flow import Segment, SystemStages
 
@@ -314,7 +314,7 @@ class SystemTrajectory(ExactTrajectory):
 # ---------------------------------------------------------------------------------------------
 # Integrator
 # ---------------------------------------------------------------------------------------------
-class _StageFlow(ExactIntegrator, for_system=System):
+class _StageFlow(ExactIntegrator, takes=takes_continuous, kind="a rattle System with continuous laws"):
     """The stage-matrix path of :class:`~rattle.timeint.ExactIntegrator`: a
     :class:`~rattle.model.System` with continuous laws (module docstring); the grid of
     ``options.samples_per_scale`` points per fastest time scale of a stage combination brackets

@@ -1,6 +1,6 @@
 """Event-driven exact integration of a chain with Coulomb friction and torque jumps on its elements (Filippov).
 
-The equations (:class:`~rattle.model.FrictionSystem`; x ∈ ℝⁿ, m elements, δ_e = a_e·x)
+The equations (a :class:`~rattle.model.System` with its elements' whole laws; x ∈ ℝⁿ, m elements, δ_e = a_e·x)
 
     x'' + C x' + K x + Σ_e b_e [f_e(δ_e) + r_e(δ_e) sgn(δ_e')] = F(t),
 
@@ -84,10 +84,10 @@ from .._limits import MAX_PERIOD, check_interval
 from .._typing import FloatArray
 from .._validate import check_omega
 from ..errors import ConvergenceError
-from ..model import FrictionSystem, ReducedElement, System
+from ..model import ReducedElement, System
 from ._events import first_exit
 from ._roots import grid_chunk, polish_crossing
-from ._exact_flow import ExactIntegrator, FlowOptions
+from ._exact_flow import ExactIntegrator, FlowOptions, takes_discontinuous
 from ._trajectory import ExactTrajectory
 from ._flow import SystemMeasures, check_system_state
 from ._nonsmooth import MEMO
@@ -131,7 +131,7 @@ class FrictionTrajectory(ExactTrajectory):
     ``event_elements``, ``event_kinds`` indexing :data:`EVENT_NAMES`, ``event_values``: the
     breakpoint crossed, locked on or left)."""
 
-    system: FrictionSystem
+    system: System
     stages: np.ndarray
     stuck: np.ndarray
     segments: tuple[Segment, ...]
@@ -158,7 +158,7 @@ class FrictionTrajectory(ExactTrajectory):
         if not T > 0.0:
             raise ValueError("measures need a trajectory of positive duration (t1 > t0)")
         fsys = self.system
-        A = fsys.system.element_rows
+        A = fsys.element_rows
         n, m = fsys.n, A.shape[0]
         mean, rms = self.element_mean_and_rms()
         ms_ac = self.integrate(lambda z: (z[:, :n] @ A.T - mean) ** 2) / T
@@ -223,7 +223,7 @@ class FrictionTrajectory(ExactTrajectory):
     def element_samples(self, t: FloatArray | float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """δ, δ' and δ'' of every element at times ``t``: shapes t.shape + (m,)."""
         z, zd = self.sample(t)
-        A = self.system.system.element_rows
+        A = self.system.element_rows
         n = self.system.n
         return z[..., :n] @ A.T, z[..., n:] @ A.T, zd[..., n:] @ A.T
 
@@ -248,7 +248,7 @@ class FrictionTrajectory(ExactTrajectory):
 
     def element_mean_and_rms(self) -> tuple[FloatArray, FloatArray]:
         """The time mean and rms of every element's deflection over [t0, t1] (m,) each."""
-        A = self.system.system.element_rows
+        A = self.system.element_rows
         n = self.system.n
         T = self.t1 - self.t0
         s = self.integrate(lambda z: np.concatenate((z[:, :n] @ A.T, (z[:, :n] @ A.T) ** 2), axis=1)) / T
@@ -295,16 +295,17 @@ class FrictionTrajectory(ExactTrajectory):
         return np.unique(self.event_values[sel])
 
 
-class _FilippovFlow(ExactIntegrator, for_system=FrictionSystem):
+class _FilippovFlow(ExactIntegrator, takes=takes_discontinuous,
+                    kind="a rattle System carrying its elements' whole laws (Chain.friction_system())"):
     """The stage-matrix path of :class:`~rattle.timeint.ExactIntegrator` with the Filippov
-    events: a :class:`~rattle.model.FrictionSystem` (module docstring); ``options`` the event
+    events: a :class:`~rattle.model.System` carrying its elements' whole laws (module docstring); ``options`` the event
     grid, budget and lock snap (:class:`~rattle.timeint.FlowOptions`)."""
 
-    def __init__(self, system: FrictionSystem, options: FlowOptions | None = None) -> None:
+    def __init__(self, system: System, options: FlowOptions | None = None) -> None:
         super().__init__(system, options)
         self.max_events = self.options.budget(events=True)
         system = self.system  # a Chain's reduced form
-        base = system.system
+        base = system.continuous()
         self.base = base
         self.n, self.m = base.n, base.m
         self.A = base.element_rows.reshape(self.m, self.n)

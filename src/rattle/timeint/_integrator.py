@@ -31,7 +31,7 @@ from .._typing import FloatArray
 from .._validate import check_state
 from ..errors import ConvergenceError
 from ..model import Model, transition_scalar
-from ._exact_flow import ExactIntegrator, FlowOptions
+from ._exact_flow import ExactIntegrator, FlowOptions, takes_model
 from ._roots import grid_chunk, resolve_cell
 from ._stage_solutions import StageSolutions
 from ._trajectory import Trajectory
@@ -121,7 +121,7 @@ class _Segment:
 # ---------------------------------------------------------------------------------------------
 # Integrator
 # ---------------------------------------------------------------------------------------------
-class _ScalarFlow(ExactIntegrator, for_system=Model):
+class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
     """The compiled scalar path of :class:`~rattle.timeint.ExactIntegrator`: δ'' + c δ' + k f(δ) = F(t)
     for a model with a continuous piecewise-linear law (see the module docstring); the grid of
     ``options.samples_per_scale`` points per fastest time scale of a stage brackets the crossings,

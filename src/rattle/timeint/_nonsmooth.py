@@ -57,9 +57,9 @@ from .._limits import check_interval
 from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
-from ..model import NonsmoothSystem, Stages
+from ..model import Stages, System
 from .._lazy import lazy_module
-from ._exact_flow import ExactIntegrator, FlowOptions
+from ._exact_flow import ExactIntegrator, FlowOptions, takes_single_equation
 from ._integrator import _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
 from ._recent import Recent
@@ -83,7 +83,7 @@ def _chunk(start: float, end: float, step: float) -> FloatArray:
     return grid_chunk(start, end, step, _CHUNK)
 
 
-def _mode_solutions(system: NonsmoothSystem, omega: float, samples_per_scale: int) -> StageSolutions:
+def _mode_solutions(system: System, omega: float, samples_per_scale: int) -> StageSolutions:
     """Stage solutions of every mode m = 3 j + σ + 1 (stage j, σ ∈ {−1, 0, 1}): slope s_j and
     offset e_j + σ r_j; the mode's δ-range is its stage's (``lower``/``upper``)."""
     st = system.law.stages
@@ -110,7 +110,7 @@ class NonsmoothTrajectory(ExactTrajectory):
     the switching events ``event_time`` with ``event_kind`` (``crossing``, ``reversal``,
     ``stick``, ``unstick``, ``lock``, ``unlock``)."""
 
-    system: NonsmoothSystem
+    system: System
     kind: IntArray
     stage: IntArray
     sign: IntArray
@@ -333,13 +333,13 @@ SOLUTION_CACHE = 4
 MEMO = 4
 
 
-class _ScalarEventFlow(_ScalarFlow, for_system=NonsmoothSystem):
+class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the single equation's System (System.single)"):
     """The scalar path of :class:`~rattle.timeint.ExactIntegrator` with events: δ'' + c δ' +
     k [f(δ) + r(δ) sgn δ'] = F(t) (module docstring) for a
-    :class:`~rattle.model.NonsmoothSystem`; the δ-crossings by the scalar path's own search
+    the single equation's :class:`~rattle.model.System`; the δ-crossings by the scalar path's own search
     (``_first_exit`` on the mode table)."""
 
-    def __init__(self, system: NonsmoothSystem, options: FlowOptions | None = None) -> None:
+    def __init__(self, system: System, options: FlowOptions | None = None) -> None:
         ExactIntegrator.__init__(self, system, options)
         self.model = None  # the modes' table stands for the model (:meth:`solutions`)
         self.max_segments = self.options.budget(events=True)

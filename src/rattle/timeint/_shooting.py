@@ -31,7 +31,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from .._validate import check_omega, check_shooting, check_state
-from ..model import FrictionSystem, Model, NonsmoothSystem, System
+from ..model import Model, System
 from ._flow import SystemMeasures, SystemTrajectory, check_system_state
 from ._friction_chain import FrictionTrajectory
 from ._nonsmooth import NonsmoothTrajectory
@@ -258,8 +258,8 @@ def shoot_system_orbit(
     SystemOrbit
         Check ``converged``: a failed solve is returned, not raised (the last iterate).
     """
-    if not isinstance(system, System):
-        raise TypeError(f"`system` must be a rattle.model.System, got {system!r}")
+    if not isinstance(system, System) or system.discontinuous:
+        raise TypeError(f"`system` must be a rattle.model.System with continuous laws, got {system!r}")
     omega = check_omega(omega)
     z = check_system_state(z0, system.n)
     check_shooting(period, tol, max_iterations)
@@ -295,15 +295,15 @@ class NonsmoothOrbit(ShotOrbit):
         return _regime(self.trajectory.crossed_breakpoints, strict=False)
 
 
-def shoot_nonsmooth_orbit(system: NonsmoothSystem, omega: float, x0: FloatArray | tuple[float, float], *,
+def shoot_nonsmooth_orbit(system: System, omega: float, x0: FloatArray | tuple[float, float], *,
                           period: int = 1, tol: float = 1e-12, max_iterations: int = 50,
                           integrator: ExactIntegrator | None = None) -> NonsmoothOrbit:
     """Periodic orbit of δ'' + c δ' + k [f(δ) + r(δ) sgn δ'] = F(t) by Newton shooting: r(x0) =
     φ(x0; 0 → T) − x0 = 0 with the Jacobian M − I, M the exact monodromy (stage transition and
     saltation matrices). The residual is scaled by (L, L ν) (:func:`~rattle.timeint.state_scale`).
     A failed solve is returned with ``converged`` False."""
-    if not isinstance(system, NonsmoothSystem):
-        raise TypeError(f"`system` must be a NonsmoothSystem, got {system!r}")
+    if not (isinstance(system, System) and system.is_single_equation):
+        raise TypeError(f"`system` must be the single equation's System (System.single), got {system!r}")
     omega = check_omega(omega)
     check_shooting(period, tol, max_iterations)
     integ = ExactIntegrator(system) if integrator is None else integrator
@@ -329,7 +329,7 @@ class FrictionOrbit(ShotOrbit):
     stick_fraction: FloatArray
 
 
-def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *, period: int = 1,
+def shoot_friction_orbit(system: System, omega: float, z0: FloatArray, *, period: int = 1,
                          tol: float = 1e-12, max_iterations: int = 50,
                          integrator: ExactIntegrator | None = None,
                          hold: dict[int, float] | None = None) -> FrictionOrbit:
@@ -343,8 +343,9 @@ def shoot_friction_orbit(system: FrictionSystem, omega: float, z0: FloatArray, *
     singular); the one whose held deflection is the given one is found, by Gauss–Newton on the
     shooting equations with a_e·x0 = d_e added. The start is moved onto the holds: δ_e = d_e and
     δ_e' = 0."""
-    if not isinstance(system, FrictionSystem):
-        raise TypeError(f"`system` must be a FrictionSystem, got {system!r}")
+    if not (isinstance(system, System) and system.discontinuous and not system.is_single_equation):
+        raise TypeError(f"`system` must be a rattle System with its elements' whole laws "
+                        f"(Chain.friction_system(), System.with_friction), got {system!r}")
     omega = check_omega(omega)
     check_shooting(period, tol, max_iterations)
     integ = ExactIntegrator(system) if integrator is None else integrator

@@ -2,8 +2,8 @@
 
 For any of rattle's equations of motion — the single equation (a :class:`~rattle.model.Model`), a
 smooth :class:`~rattle.model.System`, the single equation with a discontinuous law
-(:class:`~rattle.model.NonsmoothSystem`) or a chain with
-torque jumps and Coulomb friction on its elements (:class:`~rattle.model.FrictionSystem`) — a
+(the single equation's :class:`~rattle.model.System`, :meth:`~rattle.model.System.single`) or a chain with
+torque jumps and Coulomb friction on its elements (a :class:`~rattle.model.System` with their whole laws) — a
 periodic orbit of period T = p·2π/Ω is a fixed point of the exact period map
 z(0) ↦ φ_T(z(0); Ω), z = (x, x'). With the unknowns q = z(0) (2n numbers) and the parameter Ω
 the residual is the scaled defect
@@ -56,7 +56,7 @@ import numpy as np
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import RattleError
-from ..model import Chain, FrictionSystem, Model, NonsmoothSystem, System
+from ..model import Chain, Model, System
 from . import _flow, _friction_chain, _nonsmooth  # noqa: F401  (the paths register themselves)
 from ._exact_flow import ExactIntegrator
 from ._integrator import _ScalarFlow
@@ -72,7 +72,7 @@ OMEGA_STEP = math.sqrt(np.finfo(float).eps)
 #: Scaled distance within which a discontinuous law's ∂φ_T/∂Ω is taken again (:meth:`ShootingProblem._omega_derivative`).
 REUSE_DISTANCE = 1e-4
 
-Shootable = Model | System | NonsmoothSystem | FrictionSystem
+Shootable = Model | System
 
 def monodromy_multipliers(M: FloatArray) -> ComplexArray:
     """The Floquet multipliers: the eigenvalues of the monodromy matrix ``M``, largest modulus
@@ -94,12 +94,12 @@ def built_for(integrator: object, system: Shootable) -> bool:
 
 def _scales(system: Shootable) -> tuple[int, float, float]:
     """n, L and ω_s of ``system``."""
-    if isinstance(system, System):
-        return system.n, float(system.length_scale()), float(system.stiffest_frequency())
-    if isinstance(system, (Model, NonsmoothSystem)):
+    if isinstance(system, Model) or (isinstance(system, System) and system.is_single_equation):
         s = system.elastic.stages.slopes if isinstance(system, Model) else system.law.stages.slopes
         return 1, float(system.length_scale()), math.sqrt(system.k * float(np.max(s)))
-    return system.n, float(system.length_scale()), float(system.frequency_scale())
+    if isinstance(system, System):
+        return system.n, float(system.length_scale()), float(system.stiffest_frequency())
+    raise TypeError(f"`system` must be a rattle Model or System, got {system!r}")
 
 
 def state_scale(system: Shootable, omega: float) -> FloatArray:
@@ -137,8 +137,8 @@ class ShootingProblem:
     ----------
     system
         The equations of motion: a :class:`~rattle.model.Model` (the single equation), a
-        :class:`~rattle.model.System`, a :class:`~rattle.model.NonsmoothSystem` or a
-        :class:`~rattle.model.FrictionSystem`.
+        :class:`~rattle.model.System` (continuous laws, or with its elements' whole laws: a chain's
+        or the single equation's).
     period
         The orbit's period as a multiple p of the forcing period (T = p·2π/Ω), ≥ 1.
     integrator
@@ -146,9 +146,8 @@ class ShootingProblem:
     """
 
     def __init__(self, system: Shootable, *, period: int = 1, integrator: Any = None) -> None:
-        if not isinstance(system, (Model, System, NonsmoothSystem, FrictionSystem)):
-            raise TypeError("`system` must be a rattle Model, System, NonsmoothSystem or FrictionSystem, "
-                            f"got {system!r}")
+        if not isinstance(system, (Model, System)):
+            raise TypeError(f"`system` must be a rattle Model or System, got {system!r}")
         if isinstance(period, bool) or not isinstance(period, (int, np.integer)) or period < 1:
             raise ValueError(f"`period` must be an integer >= 1, got {period!r}")
         integ = make_integrator(system) if integrator is None else integrator
@@ -157,7 +156,7 @@ class ShootingProblem:
         self.system = system
         self.period = int(period)
         self.integrator = integ
-        self._smooth = isinstance(system, System)
+        self._smooth = isinstance(system, System) and not system.discontinuous
         # the flows whose record costs next to nothing: their Newton iterates are recorded as they go
         self._records = isinstance(integ, _ScalarFlow)
         n, L, omega_s = _scales(system)
