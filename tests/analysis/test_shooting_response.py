@@ -223,7 +223,7 @@ def test_a_branch_that_turns_back_at_its_start_is_a_success_when_the_other_end_c
     first = frf.check
     assert float(np.max(first.omega)) < lo * 1.01 and "fold" in list(first.labels)  # it turned back
     assert frf.status is Status.SUCCESS, frf.message
-    assert "covered with the branch followed from the other end" in frf.message
+    assert "the range is covered with the other branches" in frf.message
     om = np.asarray(frf.omega, dtype=float)
     assert om.min() <= lo * (1 + 1e-9) and om.max() >= hi * (1 - 1e-9)
 
@@ -252,3 +252,42 @@ def test_the_branch_from_the_other_end_goes_on_where_it_is_another_orbit():
     settled = steady_state(system, float(b.omega[i]), x0=tuple(b.states[i] * (1.0 + 1e-3)),
                            options=SteadyStateOptions(max_period_multiple=1))
     assert settled.period == 1 and settled.rms == pytest.approx(float(b.rms[i]), rel=1e-6)
+
+
+def _preload_case(preload, damping, mean, amplitude, clearance=0.0, friction=None):
+    law = NonsmoothLaw(elastic=Preload(preload=preload, clearance=clearance),
+                       friction=None if friction is None else rattle.Friction(levels=friction))
+    return System.single(damping=damping, stiffness=1.0, law=law,
+                           excitation=Excitation(mean=mean, amplitudes=(amplitude,)))
+
+
+@pytest.mark.slow
+def test_an_attractor_next_to_an_unstable_orbit_is_found_and_continued():
+    """A random preload (benchmarks/crossval_doors.py seed 21, case 03): beside the unstable rows
+    of the branch from Ω_min (|μ| 5–20 over Ω 0.339–0.346) a stable orbit of eight crossings a
+    period (rms 0.0299) lives over Ω 0.344–0.353, between the sweep check's frequencies. The
+    unstable orbit pushed along its unstable eigenvector settles on it; it is continued, and the
+    exact simulation started next to a row settles back on that row (rms to 1e-6)."""
+    from rattle.analysis import SteadyStateOptions, steady_state
+
+    system = _preload_case(0.0277, 0.0455, 0.0311, 0.0482)
+    res = nonsmooth_response(system, (0.3, 2.0))
+    rows = [(b, i) for b in (res, *res.branches) for i in np.flatnonzero(
+        b.stable & (b.omega > 0.345) & (b.omega < 0.352) & (np.abs(b.rms - 0.0299) < 0.01 * 0.0299))]
+    assert len(rows) >= 3, "the stable orbit of rms 0.0299 over Ω 0.344–0.353 is not on the response"
+    b, i = rows[len(rows) // 2]
+    settled = steady_state(system, float(b.omega[i]), x0=tuple(b.states[i] * (1.0 + 1e-3)),
+                           options=SteadyStateOptions(max_period_multiple=1))
+    assert settled.period == 1 and settled.rms == pytest.approx(float(b.rms[i]), rel=1e-6)
+
+
+@pytest.mark.slow
+def test_frequencies_no_branch_covers_are_started_in():
+    """A random preload with stage friction (crossval_doors.py seed 21, case 14): the branch from
+    Ω_min cannot start past a grazing at Ω 0.3529 and the branches the sweep check seeded each
+    spent their budget, leaving Ω 0.988–1.0005 uncovered (exit 1). An exact start in the middle of
+    what is uncovered, followed both ways until it joins, covers it: a success."""
+    system = _preload_case(0.0431, 0.0311, 0.0281, 0.038, clearance=0.0435, friction=(0.0036, 0.0034, 0.0032))
+    frf = rattle.frequency_response(system, omega=(0.3, 2.0))
+    assert frf.status is Status.SUCCESS, frf.message
+    assert not frf.uncovered
