@@ -432,3 +432,23 @@ def test_the_first_of_two_signals_pending_together_decides() -> None:
         sender.join()
         pytest.skip("the two signals did not both arrive during the C call")
     assert info.value.signum == signal.SIGTERM
+
+
+@pytest.mark.skipif(not hasattr(signal, "raise_signal"), reason="signal.raise_signal")
+def test_a_signal_printed_and_swallowed_by_c_code_is_delivered_again(capsys) -> None:  # type: ignore[no-untyped-def]
+    """C code that prints an exception and goes on (``PyErr_Print``, which calls
+    ``sys.excepthook``: measured, an import made while a compiled kernel was built on a fresh
+    install, the run then ending with status 0 after a SIGHUP) would lose the first signal's
+    Interrupted and print a traceback: it is delivered again, nothing printed."""
+    hook = sys.excepthook
+    deadline = time.monotonic() + WAIT
+    with pytest.raises(_signals.Interrupted) as info:
+        with _signals.raising():
+            try:
+                signal.raise_signal(signal.SIGHUP)
+            except _signals.Interrupted:
+                sys.excepthook(*sys.exc_info())  # what PyErr_Print does with it
+            while time.monotonic() < deadline:  # the signal sent again is raised in this loop
+                pass
+    assert info.value.signum == signal.SIGHUP and time.monotonic() < deadline
+    assert sys.excepthook is hook and "Traceback" not in capsys.readouterr().err

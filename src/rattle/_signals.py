@@ -88,6 +88,7 @@ class _State:
     swallowed = False               # the first signal's Interrupted was swallowed by a finalizer
     arrivals: int | None = None     # read end of the wakeup pipe: signal numbers in arrival order
     hook: Any = sys.__unraisablehook__  # the unraisable hook :class:`raising` replaced
+    excepthook: Any = sys.__excepthook__  # and the exception hook
 
 
 def signal_name(signum: int) -> str:
@@ -304,17 +305,37 @@ def _unraisable(unraisable: Any) -> None:
     exc = unraisable.exc_value
     if isinstance(exc, Interrupted) and _State.mode == "raise" and os.getpid() == _State.owner \
             and _State.first == exc.signum:
-        # The next handled signal's handler raises it (``swallowed``): this one sent again, or a
-        # second signal that comes first — the first signal still decides the exit status.
-        _State.swallowed = True
-        # Sent from a thread a moment later: sent from here, its handler would run inside this
-        # hook, which swallows it too. (Should it land in a finalizer again, it comes back here.)
-        import threading
-
-        threading.Thread(target=_send_again, args=(os.getpid(), exc.signum), name="rattle-signal-again",
-                         daemon=True).start()
+        # The next handled signal's handler raises it: this one sent again, or a second signal
+        # that comes first — the first signal still decides the exit status. (Should it land in
+        # a finalizer again, it comes back here.)
+        _swallowed(exc.signum)
         return
     _State.hook(unraisable)
+
+
+def _excepthook(kind: type[BaseException], value: BaseException, tb: TracebackType | None) -> None:
+    """``sys.excepthook`` while a command runs: C code that prints an exception and goes on
+    (``PyErr_Print``: an import that C code makes, e.g. while a compiled kernel is built) would
+    print the first signal's :class:`Interrupted` as a traceback and swallow it — measured: a
+    SIGHUP 800 ms into a fresh install's first sweep, the run then ended with status 0. It is
+    delivered again instead, as from a finalizer (:func:`_unraisable`), and nothing is printed.
+    Anything else goes to the hook that was there before."""
+    if isinstance(value, Interrupted) and _State.mode == "raise" and os.getpid() == _State.owner \
+            and _State.first == value.signum:
+        _swallowed(value.signum)
+        return
+    _State.excepthook(kind, value, tb)
+
+
+def _swallowed(signum: int) -> None:
+    """The first signal's Interrupted did not reach the command: the next handled signal's handler
+    raises it (``swallowed``), this one sent again from a thread a moment later (sent from here,
+    its handler would run inside the code that swallowed it)."""
+    _State.swallowed = True
+    import threading
+
+    threading.Thread(target=_send_again, args=(os.getpid(), signum), name="rattle-signal-again",
+                     daemon=True).start()
 
 
 def _send_again(pid: int, signum: int) -> None:
@@ -346,6 +367,10 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
         if self._hook is not _unraisable:
             _State.hook = self._hook
         sys.unraisablehook = _unraisable
+        self._excepthook = sys.excepthook
+        if self._excepthook is not _excepthook:
+            _State.excepthook = self._excepthook
+        sys.excepthook = _excepthook
 
     def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
                  tb: TracebackType | None) -> None:
@@ -356,6 +381,7 @@ class raising:  # noqa: N801 - used as a function: ``with raising():``
                 pass
         if self._hook is not None:
             sys.unraisablehook = self._hook
+            sys.excepthook = self._excepthook
         _unwatch_arrivals(self._arrivals)
         _State.mode = self._mode
 

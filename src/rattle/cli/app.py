@@ -126,7 +126,11 @@ class RattleGroup(click.Group):
         try:
             try:
                 with _signals.raising(), _warnings_as_lines():
-                    return self._invoke(args, prog_name, complete_var, **extra)
+                    code = self._invoke(args, prog_name, complete_var, **extra)
+                    late = _signals.interrupted_by()
+                    if late is not None:  # a signal came and its Interrupted never reached the command
+                        raise Interrupted(late)  # (swallowed by code that went on): the signal decides
+                    return code
             finally:
                 reset_verbose()
         except KeyboardInterrupt as exc:  # a signal while the command ran (a later one is noted only)
