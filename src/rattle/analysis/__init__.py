@@ -2,7 +2,8 @@
 
 from ._attractors import AttractorSearch, Census
 from ._case import Case, case_arguments, load_case, method_options, regularisation_options
-from ._census import CellCensus, attractor_census, special_points
+from ._census import CellCensus, attractor_census
+from ._exact_search import special_points
 from ._compare import compare
 from ._frequency_response import assemble, frequency_response, start_solution
 from ._friction_orbit import friction_orbit

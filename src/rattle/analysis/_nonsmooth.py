@@ -74,7 +74,7 @@ from ..timeint import (
 )
 from .._limits import MAX_PERIOD
 from ._attractors import AttractorSearch
-from ._census import SUBHARMONIC_POINTS, SUBHARMONIC_SEARCH, subharmonic_attractors
+from ._exact_search import SUBHARMONIC_POINTS, SUBHARMONIC_SEARCH, subharmonic_attractors
 from ._exact_branch import DOUBLING_BRANCHES, ExactBranch, ShootingOptions, exact_branches, subharmonic_branches
 from ._friction_response import exact_friction_response, friction_response, shooting_friction_response
 from ._friction_subharmonics import friction_subharmonics
@@ -380,7 +380,7 @@ def shooting_response(
     ``max_period`` (:func:`~rattle.analysis._exact_branch.subharmonic_branches`); then, with
     ``search`` (an :class:`AttractorSearch` budget; None: none; a chain has none), those through
     the periodic attractors of period 2 … ``max_period`` that exact simulations settle on and no
-    branch accounts for (:func:`~rattle.analysis._census.subharmonic_attractors`), with the
+    branch accounts for (:func:`~rattle.analysis._exact_search.subharmonic_attractors`), with the
     branches born at their own period doublings. ``progress(done, total)``: called with the share of the range reached
     (the CLI draws a bar; the library draws nothing)."""
     lo, hi = check_range(omega)
@@ -406,7 +406,7 @@ def shooting_response(
                                   first=len(extra) + 1, max_period=max_period)
     if search is not None:
         found = subharmonic_attractors(system, dataclasses.replace(primary, branches=tuple(extra)), (lo, hi), opts,
-                                       continuation, newton, search)
+                                       continuation, newton, build, search)
         found = [b for b in found if int(b.period) <= max_period]
         extra += found
         extra += subharmonic_branches(system, found, (lo, hi), opts, continuation, newton, build,
