@@ -690,6 +690,22 @@ def _exact_branches(system: System, omega: tuple[float, float], opts: ShootingOp
     return out
 
 
+def _joining(problem: ShootingProblem, known: list[ExactRow], w0: float, what: str) -> Any:
+    """``also`` of :func:`_both_ways` for a branch started at ``w0`` beside the rows ``known``: a
+    stop made afresh for each side, at the point budget (:data:`SEEDED_POINTS` a way) or where the
+    branch joins those rows."""
+    def joins() -> Any:
+        seen = [0]
+
+        def stop(pt: BranchPoint) -> str | None:
+            seen[0] += 1
+            if seen[0] > SEEDED_POINTS:
+                return f"the budget of {SEEDED_POINTS} points a way of {what} was spent"
+            return _joins(problem, pt, known, w0)
+        return stop
+    return joins
+
+
 def _fill_gaps(follower: _Follower, found: list[ExactBranch], opts: ShootingOptions, newton: NewtonOptions,
                continuation: ContinuationOptions) -> list[ExactBranch]:
     """Branches through the frequencies no branch of ``found`` covers (:func:`_gaps`): an exact start
@@ -703,18 +719,7 @@ def _fill_gaps(follower: _Follower, found: list[ExactBranch], opts: ShootingOpti
         q = start_state(problem, w, opts, newton, continuation=continuation, bounds=(follower.lo, follower.hi))
         if q is None:
             continue
-        known = [r for b in (*found, *out) for r in b.rows]
-
-        def joins(known: list[ExactRow] = known, w0: float = w) -> Any:
-            seen = [0]
-
-            def stop(pt: BranchPoint) -> str | None:
-                seen[0] += 1
-                if seen[0] > SEEDED_POINTS:
-                    return f"the budget of {SEEDED_POINTS} points a way of a branch started in a gap was spent"
-                return _joins(problem, pt, known, w0)
-            return stop
-
+        joins = _joining(problem, [r for b in (*found, *out) for r in b.rows], w, "a branch started in a gap")
         branch = _both_ways(follower, [], q, w, f"a start in the uncovered Ω = {a:.6g} … {c:.6g}", locate=False,
                             also=joins)
         if len(branch.rows) >= 2:
@@ -896,18 +901,7 @@ def _seed(follower: _Follower, found: list[ExactBranch], out: list[ExactBranch],
     row = _row(problem, res.q, w)
     if row.unstable_count or _explained([*found, *out], row, _row_rms(row), check.rtol):
         return
-    known = [r for b in (*found, *out) for r in b.rows]
-
-    def joins(known: list[ExactRow] = known, w0: float = w) -> Any:
-        """A stop for one side: the point budget, or joined rows already computed."""
-        seen = [0]
-
-        def stop(pt: BranchPoint) -> str | None:
-            seen[0] += 1
-            if seen[0] > SEEDED_POINTS:
-                return f"the budget of {SEEDED_POINTS} points a way of a branch found by the sweep was spent"
-            return _joins(problem, pt, known, w0)
-        return stop
+    joins = _joining(problem, [r for b in (*found, *out) for r in b.rows], w, "a branch found by the sweep")
 
     branch = _both_ways(follower, [], res.q, w, origin, locate=False, also=joins)
     if len(branch.rows) >= 2:
