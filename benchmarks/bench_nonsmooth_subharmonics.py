@@ -44,7 +44,6 @@ from rattle.analysis._friction_subharmonics import friction_subharmonics
 from rattle.analysis._nonsmooth import nonsmooth_response, nonsmooth_subharmonics  # the builders under rattle.frequency_response
 from rattle.analysis._case import regularisation_options
 from rattle.io import load_config
-from rattle.model import System
 from rattle.results import held_runs as _held_runs
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

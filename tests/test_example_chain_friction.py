@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from rattle.io import load_config
-from rattle.model import System
 from test_examples import EXAMPLES, _stated_changes  # tests/ is on sys.path through its conftest
 
 NAME = "chain_clutch_friction.toml"

@@ -30,7 +30,7 @@ from rattle.analysis._nonsmooth import nonsmooth_response
 from rattle.analysis._friction_response import _start, friction_balance_factory
 from rattle.analysis._regularisation import regularisation_limit
 from rattle.continuation import ContinuationOptions
-from rattle.model import Chain
+from rattle.model import Chain, System
 from rattle.results import FrequencyResponse, FrictionCheck
 from rattle.timeint import shoot_friction_orbit, shoot_system_orbit
 

@@ -9,7 +9,6 @@ import pytest
 
 import rattle
 from rattle.errors import ConfigError
-from rattle.model import System
 from rattle.results import FrequencyResponse, NonsmoothCheck, NonsmoothOrbitResult
 
 CASE = """

@@ -13,8 +13,7 @@ import pytest
 import rattle
 from rattle.continuation import (
     ContinuationOptions, ContinuationProblem, ContinuationStepper, Natural, NewtonOptions, Secant, Tangent,
-    locate_on_segment, solve_fixed,
-    predictor, solve_fixed,
+    locate_on_segment, predictor, solve_fixed,
 )
 from rattle.errors import Status
 from rattle.hb import HarmonicBalance, HBOptions

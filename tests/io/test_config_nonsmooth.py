@@ -13,7 +13,6 @@ from rattle.errors import ConfigError
 from rattle.io import config_from_dict
 from rattle.model import Model
 from rattle.model._discontinuous import Preload
-from rattle.model import System
 
 
 def _base(elastic: dict, **analysis: object) -> dict:

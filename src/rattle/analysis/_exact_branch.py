@@ -879,7 +879,7 @@ def _probed_branches(follower: _Follower, found: list[ExactBranch], check: Sweep
                 return out
             z0 = row.q + sign * PROBE_PUSH * v / size
             try:
-                settled = steady_state(problem.system, row.omega, x0=z0, options=settle)
+                settled = steady_state(problem.system, row.omega, x0=z0, options=settle, integrator=problem.integrator)
             except RattleError:  # the push left the flow's reach: no attractor from there
                 continue
             if settled.period != 1:

@@ -130,7 +130,7 @@ def _seg_init(S, st, sigma, xr, xi, nw, m, ts, delta, velocity):
     """The segment of mode m from (δ, δ') at ts into S (rows μ re/im, A, μA, μ²A re/im): its
     number of terms K, homogeneous part (h0, h1) and round-off floors (as _Segment.__init__)."""
     under = st[m, 0] != 0.0
-    wd, gamma, lam1, lam2 = st[m, 1], st[m, 2], st[m, 3], st[m, 4]
+    wd, lam1, lam2 = st[m, 1], st[m, 3], st[m, 4]
     P, r, a = st[m, 7], st[m, 8], st[m, 9]
     # homogeneous_start: x_s − p(t_s) (StageSolutions._particular_scalar at τ = 0)
     tau = 0.0
