@@ -291,3 +291,40 @@ def test_frequencies_no_branch_covers_are_started_in():
     frf = rattle.frequency_response(system, omega=(0.3, 2.0))
     assert frf.status is Status.SUCCESS, frf.message
     assert not frf.uncovered
+
+
+@pytest.mark.slow
+def test_a_window_of_periodic_motion_between_chaotic_ones_is_found():
+    """The same case: run-ups and run-downs settle on a stable orbit of rms 0.0582 at Ω 0.474,
+    inside a stretch of non-periodic motion (Ω ≈ 0.39–0.52) that the sweep check's 16 frequencies
+    a way see as non-periodic only (missed before). Its steps with a motion that is not period 1
+    are swept again more finely, the state carried: the window's orbit is found and continued,
+    and the exact simulation from next to its row settles back on it."""
+    from rattle.analysis import SteadyStateOptions, steady_state
+
+    system = _preload_case(0.0431, 0.0311, 0.0281, 0.038, clearance=0.0435, friction=(0.0036, 0.0034, 0.0032))
+    res = nonsmooth_response(system, (0.3, 2.0))
+    rows = [(b, i) for b in (res, *res.branches) for i in np.flatnonzero(
+        b.stable & (np.abs(b.omega - 0.47435) < 0.004) & (np.abs(b.rms - 0.058222) < 0.01 * 0.058222))]
+    assert rows, "the stable orbit of rms 0.0582 at Ω 0.474 is not on the response"
+    b, i = rows[len(rows) // 2]
+    settled = steady_state(system, float(b.omega[i]), x0=tuple(b.states[i] * (1.0 + 1e-3)),
+                           options=SteadyStateOptions(max_period_multiple=1))
+    assert settled.period == 1 and settled.rms == pytest.approx(float(b.rms[i]), rel=1e-6)
+
+
+@pytest.mark.slow
+def test_a_branch_that_retraces_its_own_arms_ends_there():
+    """A random preload with stage friction (crossval_doors.py seed 31, case 09): over Ω
+    0.357–0.388 the branch from Ω_min snakes through grazings, and the follower, hopping each,
+    followed the same arms over and over until its piece budget (2000 rows, 20 s CPU, the range
+    above left uncovered). A piece that runs on rows of the branch's earlier pieces ends it (the
+    branch closed on itself); the other rules then cover the rest, and the motion a run-up
+    settles on at Ω 0.3436 (rms 0.0978) is on a stable stretch."""
+    system = _preload_case(0.0459, 0.06, 0.0577, 0.0446, clearance=0.073, friction=(0.0043, 0.0028, 0.0024))
+    frf = rattle.frequency_response(system, omega=(0.3, 2.0))
+    first = frf.omega[frf.branch == 0]
+    assert first.size < 600, first.size  # 2000+ rows when it went round
+    assert np.any(frf.stable & (np.abs(frf.omega - 0.34358) < 0.003) & (np.abs(frf.rms - 0.097835) < 0.01 * 0.097835))
+    # what is left uncovered is named, never a success
+    assert frf.status.success == (not frf.uncovered), frf.message

@@ -74,6 +74,16 @@ that goes on back beyond the hop with its own event structure, that stretch was 
 0.3808, where a run-down settles): each such arm is followed back as a branch of its own until it
 joins rows already computed, leaves the range, or stays unstable for :data:`ARM_UNSTABLE_POINTS`
 points (:func:`_skipped_arms`).
+
+**Windows of periodic motion.** On one coordinate, between two of the sweep check's frequencies
+where the motion was not period 1 (non-periodic, sub-harmonic, failed), the sweep goes on at up to
+:data:`REFINE_POINTS` frequencies inside the step, the state carried (:func:`_refined`): a window
+of period-1 motion inside a chaotic stretch is often narrower than the check's spacing.
+
+**A branch that closes on itself.** A piece whose points run on the rows of the branch's earlier
+pieces (:data:`RETRACE_POINTS` in a row) ends the branch (:meth:`_Follower._retrace`): where
+grazings follow one another closely, hopping each can lead back onto arms already followed. What
+the branch leaves uncovered gets starts of its own, the gaps taken again after each start.
 """
 
 from __future__ import annotations
@@ -125,6 +135,10 @@ MIN_PIECE = 5
 CRAWL_POINTS = 4
 CRAWL_FACTOR = 8.0
 CRAWLING = "crawling towards a grazing"
+#: A piece whose RETRACE_POINTS points in a row lie on rows of the branch's earlier pieces (within
+#: :data:`JOIN_DISTANCE`) retraces an arm already followed: the branch closed on itself and ends.
+RETRACE_POINTS = 3
+CLOSED = "the branch closed on itself (it retraced an arm already followed)"
 #: A hop's grazing point is sought this many points back along the arm hopped onto.
 GRAZE_POINTS = 40
 #: Unstable stretches probed for an attractor next to them (:func:`_probed_branches`), and the
@@ -147,6 +161,11 @@ JOIN_DISTANCE = 1e-2
 SEEDED_POINTS = 200
 #: Intervals without a stable row narrower than this share of the range are not swept.
 MIN_GAP = 0.02
+#: Frequencies the sweep check adds, a direction, inside its steps where a motion was not period 1
+#: (:func:`_refined`): REFINE_BUDGET × its points in all, at most REFINE_POINTS a step (its spacing
+#: there divided by up to REFINE_POINTS + 1); ~20 ms each on one coordinate.
+REFINE_BUDGET = 3
+REFINE_POINTS = 7
 #: Multipliers that move by less than this across a located point left the unit circle
 #: continuously (a smooth bifurcation); a larger jump is the event structure's.
 CONTINUOUS_JUMP = 1e-3
@@ -437,7 +456,7 @@ class _Follower:
         pending: list[tuple[FloatArray, float, float]] = []
         hopped = False
         while True:
-            stepper = self._piece(q, w, d, stop)
+            stepper = self._piece(q, w, d, self._retrace(branch, stop))
             pts = [] if stepper is None else stepper.points
             stalled = stepper is not None and stepper.status is Status.STEP_TOO_SMALL
             if pending and (not pts or stalled and len(pts) < MIN_PIECE):
@@ -475,6 +494,24 @@ class _Follower:
                 branch.bridges.append((min(last.p, candidates[0][1]), max(last.p, candidates[0][1])))
             q, w, d = candidates[0]
             pending = candidates[1:]
+
+    def _retrace(self, branch: ExactBranch, stop: Any) -> Any:
+        """The stop of the branch's next piece: the caller's ``stop``, and the branch closing on
+        itself — :data:`RETRACE_POINTS` points in a row on the rows of a piece before the last one
+        (measured: a preload with stage friction whose branch, hopping grazings in a snaking
+        stretch of Ω 0.357–0.388, followed the same arms over and over until ``max_pieces``: 2000
+        rows, 20 s, and the range above left uncovered)."""
+        earlier = branch.rows[: len(branch.rows) - branch.pieces[-1]] if len(branch.pieces) >= 2 else []
+        if not earlier:
+            return stop
+        on = [0]
+
+        def halt(pt: BranchPoint) -> str | None:
+            on[0] = on[0] + 1 if _joins(self.problem, pt, earlier, math.nan) else 0
+            if on[0] >= RETRACE_POINTS:
+                return CLOSED
+            return None if stop is None else stop(pt)
+        return halt
 
     def _graze(self, start: BranchPoint, direction: float, structure: tuple[int, ...]) -> ExactRow | None:
         """The grazing point a hop passed, on the arm hopped onto: that arm followed back (against
@@ -711,11 +748,19 @@ def _fill_gaps(follower: _Follower, found: list[ExactBranch], opts: ShootingOpti
     """Branches through the frequencies no branch of ``found`` covers (:func:`_gaps`): an exact start
     in the middle of each (settled, then shot), followed both ways until it joins rows already
     computed or leaves the gap's neighbourhood (:data:`SEEDED_POINTS` points a way; at most
-    :data:`MAX_ARMS` gaps). Measured: a preload with stage friction whose seeded branches each
+    :data:`MAX_ARMS` starts, the gaps taken again after each). Measured: a preload with stage friction whose seeded branches each
     spent their budget 1 % short of one another left Ω 0.988–1.0005 uncovered (exit 1)."""
     problem, out = follower.problem, []
-    for a, c in _gaps(found, follower.lo, follower.hi)[:MAX_ARMS]:
+    tried: list[float] = []
+    for _ in range(MAX_ARMS):
+        # the gaps left by what is computed so far: a start may cover a gap in part only
+        # (measured: a start at Ω 0.400 in the gap 0.388–0.412 covered 0.3996–0.426)
+        fresh = [(a, c) for a, c in _gaps([*found, *out], follower.lo, follower.hi) if 0.5 * (a + c) not in tried]
+        if not fresh:
+            break
+        a, c = fresh[0]
         w = 0.5 * (a + c)
+        tried.append(w)
         q = start_state(problem, w, opts, newton, continuation=continuation, bounds=(follower.lo, follower.hi))
         if q is None:
             continue
@@ -833,12 +878,49 @@ def _missed_branches(follower: _Follower, found: list[ExactBranch], check: Sweep
     for a, c in gaps:
         points = max(3, math.ceil(check.points * (c - a) / width))
         sweep = time_sweep(problem.system, omega=(a, c), points=points, direction="both", options=settle)
-        for j in range(len(sweep.omega)):
-            if int(sweep.period[j]) != 1 or len(out) >= check.max_branches:
-                continue
-            w = float(sweep.omega[j])
-            _seed(follower, found, out, np.asarray(sweep.state0[j], dtype=float), w, check,
-                  f"the attractor an exact sweep settled on at Ω = {w:.6g}")
+        settled = [(float(sweep.omega[j]), np.asarray(sweep.state0[j], dtype=float))
+                   for j in range(len(sweep.omega)) if int(sweep.period[j]) == 1]
+        if problem.size == 2:
+            settled += _refined(problem, sweep, settle, REFINE_BUDGET * check.points)
+        for w, state in settled:
+            if len(out) >= check.max_branches:
+                break
+            _seed(follower, found, out, state, w, check, f"the attractor an exact sweep settled on at Ω = {w:.6g}")
+    return out
+
+
+def _refined(problem: ShootingProblem, sweep: Any, settle: Any, budget: int) -> list[tuple[float, FloatArray]]:
+    """The period-1 motions the sweep settles on between two of its frequencies where one of the
+    two did not settle on a period-1 orbit (non-periodic, sub-harmonic or failed): a window of
+    periodic motion inside a chaotic or sub-harmonic region is often narrower than the sweep's
+    spacing (measured: a preload with stage friction whose run-ups settle on a stable single-sided
+    orbit, |μ| 0.993, over Ω ≈ 0.425–0.445 between non-periodic motions, missed at 16 frequencies a
+    way over Ω 0.3–2). Inside each such step the sweep goes on at evenly spaced frequencies as a
+    finer run-up or run-down would, the state carried from the step's first frequency: ``budget``
+    frequencies a direction shared among its steps (at most :data:`REFINE_POINTS` a step). Returns
+    (Ω, the orbit's state) of each that settled on a period-1 orbit."""
+    from ._steady import steady_state
+
+    out: list[tuple[float, FloatArray]] = []
+    for d in dict.fromkeys(str(x) for x in sweep.direction):
+        rows = [j for j in range(len(sweep.omega)) if str(sweep.direction[j]) == d]
+        steps = [(j, k) for j, k in zip(rows, rows[1:])
+                 if not (int(sweep.period[j]) == 1 and int(sweep.period[k]) == 1) and np.all(np.isfinite(sweep.final_state[j]))]
+        if not steps:
+            continue
+        inner = max(1, min(REFINE_POINTS, budget // len(steps)))
+        for j, k in steps[: budget // inner]:
+            x = np.asarray(sweep.final_state[j], dtype=float)
+            w0, w1 = float(sweep.omega[j]), float(sweep.omega[k])
+            for i in range(1, inner + 1):
+                w = w0 + (w1 - w0) * i / (inner + 1)
+                try:
+                    s = steady_state(problem.system, w, x0=x, options=settle, integrator=problem.integrator)
+                except RattleError:  # the flow failed here: the finer sweep of this step ends
+                    break
+                x = np.asarray(s.final_state, dtype=float)
+                if s.period == 1:
+                    out.append((w, np.asarray(s.state0, dtype=float)))
     return out
 
 
