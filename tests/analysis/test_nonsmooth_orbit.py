@@ -4,6 +4,7 @@ and lock phases, its table and its plot (issue 11: "the plots show stick phases"
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -373,3 +374,29 @@ def test_a_simulated_periodic_attractor_no_branch_accounts_for_is_listed(monkeyp
     assert found.solutions[0].rms == pytest.approx(three.rms, rel=1e-9)
     assert found.solutions[1].rms == pytest.approx(reference.rms, rel=1e-9)  # counted once, as period 1
     assert [(a.period, a.rms) for a in found.nonperiodic] == [(2, 0.5)]
+
+
+def test_periodic_orbit_is_the_door_for_every_law(monkeypatch) -> None:
+    """``rattle.periodic_orbit`` answers a law with jumps or friction as ``frequency_response``
+    does (before: TypeError "`model` must be a rattle Model or Chain"): the exact orbits of
+    ``nonsmooth_orbit`` with its options, x0 and period; a chain with friction on its
+    ``friction_system()``; the harmonic-balance arguments refused by name; ``options`` refused for
+    a continuous law."""
+    import rattle
+    from rattle.analysis import _nonsmooth_orbit
+
+    calls = []
+    monkeypatch.setattr(_nonsmooth_orbit, "nonsmooth_orbit",
+                        lambda system, omega, options=None, **kw: calls.append((system, omega, options, kw)) or "exact")
+    system = _system(0.2, 0.05)
+    assert rattle.periodic_orbit(system, 0.6, options=OPTS, x0=(0.1, 0.0), period=2) == "exact"
+    assert calls[-1] == (system, 0.6, OPTS, {"x0": (0.1, 0.0), "period": 2})
+    chain = rattle.Chain.from_toml(Path(__file__).resolve().parents[2] / "examples" / "chain_clutch_friction.toml")
+    assert isinstance(chain, rattle.Chain) and chain.discontinuous
+    assert rattle.periodic_orbit(chain, 0.9) == "exact"
+    solved = calls[-1][0]
+    assert isinstance(solved, System) and np.array_equal(solved.damping, chain.friction_system().damping)
+    with pytest.raises(TypeError, match="`harmonics`, `stability` must be left at the default"):
+        rattle.periodic_orbit(system, 0.6, harmonics=16, stability="hill")
+    with pytest.raises(TypeError, match="leave `options` None"):
+        rattle.periodic_orbit(rattle.reference_case(), 0.6, options=OPTS)

@@ -348,8 +348,19 @@ def periodic_orbit(
     newton: NewtonOptions | None = None,
     continuation: ContinuationOptions | None = None,
     steady_options: SteadyStateOptions | None = None,
-) -> PeriodicOrbit:
-    """Every harmonic-balance periodic orbit at the forcing frequency ``omega``, with stability.
+    options: Any = None,
+) -> PeriodicOrbit | Any:
+    """Every harmonic-balance periodic orbit at the forcing frequency ``omega``, with stability;
+    for a law with torque jumps or friction, every exact orbit.
+
+    A law with jumps or friction (a single-equation :class:`~rattle.model.System` with a
+    discontinuous law, a :class:`~rattle.model.System` with its elements' whole laws, or a
+    :class:`~rattle.model.Chain` with friction or jumps on an element, solved on its
+    ``friction_system()``) is the same door as :func:`frequency_response`: its orbits are found by
+    :func:`rattle.analysis.nonsmooth_orbit` (exact shooting; every orbit at Ω, stable and
+    unstable, of every period, and the non-periodic attractors), ``options`` its
+    :class:`~rattle.analysis.RegularisationOptions` (the HB beside the exact orbit), ``x0`` and
+    ``period`` apply, and the harmonic-balance arguments must be left at their defaults.
 
     See the module docstring for how the coexisting solutions are found (primary branch through
     Ω, simulation seed, sub-harmonic branch).
@@ -407,6 +418,25 @@ def periodic_orbit(
     ConvergenceError
         If no periodic solution could be found at all.
     """
+    if getattr(model, "discontinuous", False):  # a law with jumps or friction: the exact orbits
+        given = [name for name, value, default in (
+            ("harmonics", harmonics, DEFAULT_HARMONICS), ("hb", hb, None), ("stability", stability, "monodromy"),
+            ("simulate", simulate, True), ("search_range", search_range, None), ("frf", frf, None),
+            ("samples", samples, None), ("newton", newton, None), ("continuation", continuation, None),
+            ("steady_options", steady_options, None)) if not (value is default or value == default)]
+        if given:
+            raise TypeError(
+                f"{', '.join(f'`{k}`' for k in given)} must be left at the default for a law with jumps or friction "
+                "(they set the harmonic balance of a continuous law); its orbits are exact, and `options` "
+                "(RegularisationOptions(harmonics=…, regularisation=…)) sets the harmonic balance beside them")
+        from ..model import Chain
+        from ._nonsmooth_orbit import nonsmooth_orbit
+
+        system = model.friction_system() if isinstance(model, Chain) else model
+        return nonsmooth_orbit(system, omega, options, x0=x0, period=period)
+    if options is not None:
+        raise TypeError(f"`options` sets the harmonic balance of a law with jumps or friction; this law is continuous "
+                        f"(`harmonics`, `hb`, …), so leave `options` None, got {options!r}")
     # Argument checks: the rules of rattle._limits / rattle._validate, shared with the file.
     check_analysable_model(model)
     W = _limits.check_frequency(model, omega, simulate=False)
