@@ -328,3 +328,19 @@ def test_a_branch_that_retraces_its_own_arms_ends_there():
     assert np.any(frf.stable & (np.abs(frf.omega - 0.34358) < 0.003) & (np.abs(frf.rms - 0.097835) < 0.01 * 0.097835))
     # what is left uncovered is named, never a success
     assert frf.status.success == (not frf.uncovered), frf.message
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("params, rms", [
+    # crossval_doors.py seed 11 case 06: a run-up from rest at Ω_min settles after 1424 periods
+    # (μ = −0.96) on a stable orbit the check's 200 periods did not see
+    ((0.0288, 0.0452, 0.022, 0.018), 0.007525),
+    # seed 31 case 08: a run-down settles at Ω_min on a stable orbit (rms 0.03103) beside the
+    # unstable one of rms 0.03111 the branch had there; the end row's push settles on it
+    ((0.0351, 0.0322, 0.0455, 0.0401), 0.031032),
+], ids=["from_rest", "end_row"])
+def test_the_attractors_at_the_range_s_end_are_found(params, rms):
+    system = _preload_case(*params)
+    frf = rattle.frequency_response(system, omega=(0.3, 2.0))
+    at = frf.stable & (frf.omega <= 0.3 + 1e-9) & (np.abs(frf.rms - rms) < 0.01 * rms)
+    assert at.any(), f"the stable orbit of rms {rms} at Ω_min is not on the response"

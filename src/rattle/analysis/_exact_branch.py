@@ -84,6 +84,11 @@ of period-1 motion inside a chaotic stretch is often narrower than the check's s
 pieces (:data:`RETRACE_POINTS` in a row) ends the branch (:meth:`_Follower._retrace`): where
 grazings follow one another closely, hopping each can lead back onto arms already followed. What
 the branch leaves uncovered gets starts of its own, the gaps taken again after each start.
+
+**The range's ends.** The check's first frequency each way starts from rest, the longest
+transient: where it did not settle in ``check.max_periods`` it goes on to the default budget
+(:func:`_from_rest`); and the unstable rows at Ω_min and Ω_max are probed as the middle rows of
+unstable stretches are (:func:`_probed_branches`).
 """
 
 from __future__ import annotations
@@ -882,10 +887,39 @@ def _missed_branches(follower: _Follower, found: list[ExactBranch], check: Sweep
                    for j in range(len(sweep.omega)) if int(sweep.period[j]) == 1]
         if problem.size == 2:
             settled += _refined(problem, sweep, settle, REFINE_BUDGET * check.points)
+            settled += _from_rest(problem, sweep)
         for w, state in settled:
             if len(out) >= check.max_branches:
                 break
             _seed(follower, found, out, state, w, check, f"the attractor an exact sweep settled on at Ω = {w:.6g}")
+    return out
+
+
+def _from_rest(problem: ShootingProblem, sweep: Any) -> list[tuple[float, FloatArray]]:
+    """The first frequency of each sweep direction starts from rest: its transient is the longest
+    (measured: a random preload whose run-up from rest at Ω_min settles after 1424 periods on a
+    stable orbit, μ = −0.96, that the check's 200 periods did not see). Where it did not settle, the
+    simulation goes on from where it stopped up to the default budget of
+    :class:`~rattle.analysis.SteadyStateOptions`. Returns (Ω, the orbit's state) where it settled
+    on a period-1 orbit."""
+    from ._steady import SteadyStateOptions, steady_state
+
+    out: list[tuple[float, FloatArray]] = []
+    budget = SteadyStateOptions().max_periods
+    for d in dict.fromkeys(str(x) for x in sweep.direction):
+        j = next(j for j in range(len(sweep.omega)) if str(sweep.direction[j]) == d)
+        spent = int(sweep.periods[j])
+        if int(sweep.period[j]) != 0 or spent >= budget or not np.all(np.isfinite(sweep.final_state[j])):
+            continue
+        w = float(sweep.omega[j])
+        more = SteadyStateOptions(max_periods=budget - spent, max_period_multiple=1, record_periods=1)
+        try:
+            s = steady_state(problem.system, w, x0=np.asarray(sweep.final_state[j], dtype=float), options=more,
+                             integrator=problem.integrator)
+        except RattleError:
+            continue
+        if s.period == 1:
+            out.append((w, np.asarray(s.state0, dtype=float)))
     return out
 
 
@@ -948,9 +982,14 @@ def _probed_branches(follower: _Follower, found: list[ExactBranch], check: Sweep
                 stretches.append(run)
                 run = []
     stretches.sort(key=len, reverse=True)
+    lo, hi = follower.lo, follower.hi
+    # the middle rows of the longest stretches, and the rows at the range's ends of any: at an end
+    # only what is already there is known (measured: a random preload whose run-down settles at
+    # Ω_min on a stable orbit of rms 0.03103 next to the unstable 0.03111 the branch had there)
+    rows = [run[len(run) // 2] for run in stretches[:PROBES]]
+    rows += [r for run in stretches for r in (run[0], run[-1]) if min(abs(r.omega - lo), abs(r.omega - hi)) <= 1e-9 * hi]
     out: list[ExactBranch] = []
-    for run in stretches[:PROBES]:
-        row = run[len(run) // 2]
+    for row in {id(r): r for r in rows}.values():
         mu, vecs = np.linalg.eig(row.M)
         v = np.real(vecs[:, int(np.argmax(np.abs(mu)))])
         size = float(np.max(np.abs(v / s)))
