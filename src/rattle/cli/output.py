@@ -62,8 +62,9 @@ def loading() -> Iterator[None]:
     (``gc.freeze()``: kept for the rest of the run and never searched for cycles again).
 
     An import creates some 10⁵ objects that live as long as the process; the collector would
-    search each of them at least once and find nothing (``rattle frf`` on the reference case:
-    0.12 s of CPU in some 40 collections, 0.015 s with this). The computation itself runs with
+    search each of them at least once and find nothing (``rattle frf`` on the reference case,
+    ``benchmarks/bench_command.py``: the collector's CPU 0.08 s in some 40 collections, 0.006 s
+    with this). The computation itself runs with
     the collector on. Outside the command-line process (the CLI's functions called by another
     program, ``CliRunner``) and when the collector is off already, the body runs as it is."""
     from .. import _signals
