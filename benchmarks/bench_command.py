@@ -19,9 +19,14 @@ that a change of load on a shared machine falls on both:
 * **ratio** = command / computation, from the best of ``--repeat`` runs of each (target ≤ 2), and
   the median ratio;
 * **PNG**: the CPU time of drawing and writing ``frf.png`` as the command does
-  (``rattle.cli.output.save_plot``) in a warm process, best of ``--repeat``; and where the
-  command's CPU goes, from one ``-X importtime`` run (import of the numerics, of matplotlib) and
-  the difference to the computation.
+  (``rattle.cli.output.save_plot``) in a warm process, best of ``--repeat``;
+* **phases**: where the command's CPU goes, best of ``--repeat`` runs of the command with its
+  functions timed (a child that runs ``python -m rattle frf`` as the command line does, the
+  process's ``sys.orig_argv`` saying so): up to the computation (interpreter, click, the
+  configuration, the imports of numpy, scipy, numba and rattle), the computation in the command
+  (numba's cached kernels loaded), the output set (frf.csv, frf.json, frf.png with matplotlib's
+  import) and the exit; and the cyclic collector's share of it all; then one ``-X importtime``
+  run (import of the numerics, of matplotlib).
 
 The best of several runs is the figure that measures the code on a shared machine; the median is
 printed beside it.
@@ -75,6 +80,56 @@ print(json.dumps({"computation": comp, "png": png, "points": int(len(frf.omega))
 """
 
 
+#: ``python -m rattle frf …`` in a child whose functions are timed: the CPU time when the
+#: computation starts and ends, when the output set starts and ends, at exit, and the collector's.
+_PHASES = r"""
+import atexit, gc, importlib.abc, importlib.util, json, runpy, sys, time
+out, args = sys.argv[1], sys.argv[2:]
+marks, collector = {}, {"cpu": 0.0, "start": 0.0}
+def timed(module, name, label):
+    function = getattr(module, name)
+    def wrapper(*a, **k):
+        marks.setdefault(label + " start", time.process_time())
+        try:
+            return function(*a, **k)
+        finally:
+            marks[label + " end"] = time.process_time()
+    setattr(module, name, wrapper)
+class Hook(importlib.abc.MetaPathFinder):
+    targets = {"rattle.analysis": ("frequency_response", "computation"), "rattle.cli.output": ("write_set", "output")}
+    def find_spec(self, fullname, path, target=None):
+        if fullname not in self.targets:
+            return None
+        sys.meta_path.remove(self)
+        try:
+            spec = importlib.util.find_spec(fullname)
+        finally:
+            sys.meta_path.insert(0, self)
+        run = spec.loader.exec_module
+        def exec_module(module):
+            run(module)
+            timed(module, *self.targets[fullname])
+        spec.loader.exec_module = exec_module
+        return spec
+def on_collection(phase, info):
+    if phase == "start":
+        collector["start"] = time.process_time()
+    else:
+        collector["cpu"] += time.process_time() - collector["start"]
+def report():
+    marks["exit"] = time.process_time()
+    marks["collector"] = collector["cpu"]
+    with open(out, "w") as f:
+        json.dump(marks, f)
+sys.meta_path.insert(0, Hook())
+gc.callbacks.append(on_collection)
+atexit.register(report)
+sys.orig_argv = [sys.executable, "-m", "rattle", *args]  # the command line, as rattle._signals reads it
+sys.argv = ["rattle", *args]
+runpy.run_module("rattle", run_name="__main__", alter_sys=True)
+"""
+
+
 def _env(src: Path) -> dict[str, str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = str(src)
@@ -104,6 +159,26 @@ def computation_cpu(src: Path, case: Path, repeat: int) -> dict:
     out = subprocess.run([sys.executable, "-c", _CHILD, str(case), str(repeat)], env=_env(src), check=True,
                          capture_output=True, text=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def phases(src: Path, case: Path) -> dict[str, float]:
+    """CPU seconds of the command's phases in one timed run (:data:`_PHASES`): ``to computation``,
+    ``computation``, ``output set``, ``exit`` (the rest, from the kernel's accounting of the
+    finished child), their sum ``command``, and ``collector`` (the cyclic garbage collector's
+    share of the whole)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        marks_file = Path(tmp) / "marks.json"
+        proc = subprocess.Popen([sys.executable, "-c", _PHASES, str(marks_file), "frf", str(case), "-o",
+                                 str(Path(tmp) / "out")], env=_env(src), stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        _pid, status, usage = os.wait4(proc.pid, 0)
+        if os.waitstatus_to_exitcode(status) != 0:
+            raise SystemExit(f"the timed rattle frf failed with {src}")
+        m = json.loads(marks_file.read_text())
+    total = usage.ru_utime + usage.ru_stime
+    return {"to computation": m["computation start"], "computation": m["computation end"] - m["computation start"],
+            "output set": m["output end"] - m["output start"], "exit": total - m["exit"],
+            "command": total, "collector": m["collector"]}
 
 
 def import_costs(src: Path, case: Path) -> dict[str, float]:
@@ -150,6 +225,13 @@ def report(trees: dict[str, Path], case: Path, repeat: int) -> bool:
         print(f"{label:<40} {fmt(cmd):>15} {fmt(comp):>15} {ratio:6.2f} "
               f"({statistics.median(cmd) / statistics.median(comp):4.2f}) {fmt(png):>15}  "
               f"{'ok' if good else 'MISSED'} (≤ {TARGET:g})")
+    print(f"\nthe command's phases (CPU s, best of {repeat} timed runs; 'to computation': interpreter, click, the "
+          "configuration, the imports of numpy, scipy, numba and rattle; 'output set': frf.csv, frf.json, frf.png "
+          "with matplotlib's import; 'collector': the cyclic garbage collector's share of the command):")
+    for label, src in trees.items():
+        runs = [phases(src, case) for _ in range(repeat)]
+        best = {key: min(run[key] for run in runs) for key in runs[0]}
+        print(f"  {label:<38} " + ", ".join(f"{k} {v:.3f}" for k, v in best.items()))
     print("\nwhere the command's time goes (one -X importtime run, wall s: numpy, scipy, numba, matplotlib "
           "where the command first imports them, rattle's own modules; numba's kernels load at the first "
           "call, not here):")

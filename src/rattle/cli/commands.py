@@ -27,7 +27,8 @@ from .checks import (
 )
 from ._quantity import MAP_QUANTITY, check_quantity, map_largest_line, quantity_option, with_largest
 from .output import (
-    COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, echo_written, logger,
+    COMPARE_FILES, FRF_FILES, MAP_FILES, ORBIT_FILES, SWEEP_FILES, MapProgress, ProgressBar, _io, echo_written, loading,
+    logger,
     frf_steps, map_csv_writer, map_json_writer, map_summary, metadata_writer, one_line, save_figure, save_plot, sections,
     set_verbose, warning,
     write_frf, write_set,
@@ -49,14 +50,6 @@ DEFAULT_OUTPUT = "rattle-out"
 #: The output sets with the interactive page (``--html``); without it a page of an earlier run is removed.
 FRF_PAGE_FILES = (*FRF_FILES, "frf.html")
 COMPARE_PAGE_FILES = (*COMPARE_FILES, "compare.html")
-
-
-def _io() -> Any:
-    """``rattle.io`` (numpy, the model and the configuration reader), imported on first use so
-    that ``--help``, ``--version`` and options click refuses need none of it."""
-    from .. import io
-
-    return io
 
 
 # --------------------------------------------------------------------------------------------
@@ -120,7 +113,8 @@ def compute_frf(
     written (frf.csv, frf.json, frf.png, as the command's whole set ``names``: files of an
     earlier run that the partial set does not replace are removed) and the error re-raised
     naming the files."""
-    from ..analysis import case_arguments, frequency_response  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import case_arguments, frequency_response
 
     extra: dict[str, Any] = {"subharmonics": True} if subharmonics else {}
     if start != "low":
@@ -364,7 +358,8 @@ def sweep_command(
     analysis = override_analysis(run_config.analysis, run_config.bounds_model, labels=labels, omega_min=w_min,
                                  omega_max=w_max)
     t_start = time.perf_counter()
-    from ..analysis import time_sweep  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import time_sweep
 
     bar = ProgressBar(f"sweep {direction}", enabled=not quiet)
     try:
@@ -467,7 +462,8 @@ def orbit_command(
         else int(model.forced_harmonics)
     check_period(period, analysis.harmonics, forced)
     t_start = time.perf_counter()
-    from ..analysis import periodic_orbit  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import periodic_orbit
 
     result = periodic_orbit(run_config.model, omega, period=period, harmonics=analysis.harmonics,
                             search_range=analysis.omega)
@@ -514,7 +510,8 @@ def run_nonsmooth_orbit(run_config: Any, config: Path, output: Path, omega: floa
     """
     analysis, options = _nonsmooth_orbit_settings(run_config, omega, period, harmonics, omega_min, omega_max)
     t_start = time.perf_counter()
-    from ..analysis import nonsmooth_orbit  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import nonsmooth_orbit
 
     logger.info("computing the orbit of a discontinuous law at Ω = %g: regularised harmonic balance (H = %d, ε = %g) "
                 "and exact shooting", omega, options.harmonics, options.regularisation)
@@ -615,7 +612,8 @@ def run_friction_orbit(run_config: Any, config: Path, output: Path, omega: float
     """
     analysis, options = _nonsmooth_orbit_settings(run_config, omega, period, harmonics, omega_min, omega_max)
     t_start = time.perf_counter()
-    from ..analysis import friction_orbit  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import friction_orbit
 
     system = run_config.model
     from ..results import SpeedText
@@ -722,7 +720,8 @@ def compare_command(
         measured_table, speed_order=getattr(run_config.model, "speed_order", None),
         omega_range=(analysis.omega_min, analysis.omega_max), has_paths=bool(run_config.paths))
     t_start = time.perf_counter()
-    from ..analysis import compare  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import compare
 
     bar = ProgressBar("sweep up+down", enabled=not quiet)
     try:
@@ -780,7 +779,8 @@ def run_discontinuous_compare(run_config: Any, config: Path, analysis: AnalysisS
     down sweep, written as frf.csv (the response's columns), sweep.csv, compare.json, compare.png (and
     compare.html with ``html``)."""
     t_start = time.perf_counter()
-    from ..analysis import compare  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..analysis import compare
     from ..analysis import regularisation_options
 
     reg = regularisation_options(analysis)
@@ -877,7 +877,8 @@ def map_command(
     params = mark_degrees(parameters(tables, parsed), run_config.source)  # angles given in degrees: shown so
     build_all(tables, params)  # every combination's model, before any work
     t_start = time.perf_counter()
-    from ..maps import response_map  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from ..maps import response_map
 
     logger.info("response map: %d combinations × %d frequencies over %g … %g rad/s",
                 len(list(combinations(params))), omega_points, analysis.omega_min, analysis.omega_max)
@@ -947,7 +948,8 @@ def demo_command(output: Path, quiet: bool) -> None:
     the computed numbers.
     """
     precheck(None, output)
-    from .. import demo  # only now: all input has been validated
+    with loading():  # only now: all input has been validated
+        from .. import demo
 
     t_start = time.perf_counter()
     model, analysis = demo.demo_case()

@@ -21,10 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-try:  # numba is a dependency; the array code stays the fallback (and the reference)
-    import numba
-except ImportError:  # pragma: no cover - exercised only without numba
-    numba = None
+from .._jit import njit, numba  # numba is a dependency; the array code stays the fallback (and the reference)
 
 try:  # numpy >= 2: the pocketfft gufuncs behind numpy.fft
     from numpy.fft import _pocketfft_umath as _pfu
@@ -156,10 +153,9 @@ def _fill_spectrum(D, n, spec):
 
 
 if AVAILABLE:
-    _jit = numba.njit(cache=True, error_model="numpy", nogil=True)
-    force_samples = _jit(_force_samples)
-    residual_jacobian = _jit(_residual_jacobian)
-    fill_spectrum = _jit(_fill_spectrum)
+    force_samples = njit(_force_samples)
+    residual_jacobian = njit(_residual_jacobian)
+    fill_spectrum = njit(_fill_spectrum)
 else:  # pragma: no cover
     force_samples = residual_jacobian = fill_spectrum = None
 
