@@ -41,6 +41,8 @@ from ._floquet import (
 
 #: Difference step in scaled arc length for the test functions' derivative.
 EPSILON = 1e-7
+#: Orbits whose monodromy a monitor remembers (readings, test functions); all are forgotten when full.
+MEMO = 20000
 
 
 def hb_system(hb: HarmonicBalance) -> System:
@@ -66,6 +68,7 @@ class FloquetMonitor:
         self.names = TEST_FUNCTIONS[:2] if system.n == 1 else TEST_FUNCTIONS
         self._cache: dict = {}
         self._buffers: dict = {}
+        self._memo: dict = {}
         # The single element of the single equation: the closed-form path on q itself.
         self._single = system.n == 1 and system.m == 1 and float(system.element_rows[0, 0]) == 1.0
         if self._single:
@@ -77,7 +80,34 @@ class FloquetMonitor:
 
     def monodromy_and_crossings(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
         """Monodromies (P, 2n, 2n) and crossings (P, m, k_max) of the orbits ``Q`` (P, n·(2H+1))
-        at forcing frequencies ``Om`` (P,) (arrays)."""
+        at forcing frequencies ``Om`` (P,) (arrays).
+
+        The one or two orbits of a reading or a test function are remembered by their exact
+        (Ω, q) (up to ``MEMO`` of them); a batch (P > 2: the multipliers of a branch's points,
+        which were the readings' points) takes the remembered ones and computes the rest."""
+        P = Q.shape[0]
+        if P > 2 and self._memo:
+            return self._batch_from_memo(Q, Om)
+        M, counts = self._compute(Q, Om)
+        if len(self._memo) >= MEMO:
+            self._memo.clear()
+        for i in range(P):
+            self._memo[(float(Om[i]), Q[i].tobytes())] = (M[i].copy(), counts[i].copy())
+        return M, counts
+
+    def _batch_from_memo(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
+        """:meth:`monodromy_and_crossings` of a batch: remembered orbits read, the others computed."""
+        found = [self._memo.get((float(w), q.tobytes())) for q, w in zip(Q, Om)]
+        missing = [i for i, f in enumerate(found) if f is None]
+        if len(missing) == len(found):
+            return self._compute(Q, Om)
+        if missing:
+            M_new, counts_new = self._compute(Q[missing], Om[missing])
+            for j, i in enumerate(missing):
+                found[i] = (M_new[j], counts_new[j])
+        return np.stack([f[0] for f in found]), np.stack([f[1] for f in found])
+
+    def _compute(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
         hb = self.hb
         w = Om / hb.period
         if self._single:
