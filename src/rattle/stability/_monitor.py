@@ -83,15 +83,20 @@ class FloquetMonitor:
         at forcing frequencies ``Om`` (P,) (arrays).
 
         The one or two orbits of a reading or a test function are remembered by their exact
-        (Ω, q) (up to ``MEMO`` of them); a batch (P > 2: the multipliers of a branch's points,
-        which were the readings' points) takes the remembered ones and computes the rest."""
+        (Ω, q) (up to ``MEMO`` of them); one orbit or a batch (P ≠ 2: a test function at a branch
+        point, the multipliers of a branch's points, which were the readings' points) takes the
+        remembered ones and computes the rest."""
         P = Q.shape[0]
-        if P > 2 and self._memo:
+        if P != 2 and self._memo:
             return self._batch_from_memo(Q, Om)
-        M, counts = self._compute(Q, Om)
+        return self._remember(Q, Om, *self._compute(Q, Om))
+
+    def _remember(self, Q: FloatArray, Om: FloatArray, M: FloatArray, counts: np.ndarray) -> tuple[FloatArray, np.ndarray]:
+        """Keep the monodromies and crossings of the orbits (Q, Ω) (all forgotten once ``MEMO``
+        are kept); returns (M, counts)."""
         if len(self._memo) >= MEMO:
             self._memo.clear()
-        for i in range(P):
+        for i in range(Q.shape[0]):
             self._memo[(float(Om[i]), Q[i].tobytes())] = (M[i].copy(), counts[i].copy())
         return M, counts
 
@@ -100,7 +105,7 @@ class FloquetMonitor:
         found = [self._memo.get((float(w), q.tobytes())) for q, w in zip(Q, Om)]
         missing = [i for i, f in enumerate(found) if f is None]
         if len(missing) == len(found):
-            return self._compute(Q, Om)
+            return self._remember(Q, Om, *self._compute(Q, Om)) if Q.shape[0] == 1 else self._compute(Q, Om)
         if missing:
             M_new, counts_new = self._compute(Q[missing], Om[missing])
             for j, i in enumerate(missing):
