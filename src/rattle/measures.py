@@ -18,7 +18,7 @@ grids (resolution T_p / (64 N); δ'' has kinks at breakpoint crossings).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -220,11 +220,29 @@ def _sample_forcing(system: System, omega: FloatArray, forcing_omega: FloatArray
     return system.forcing(np.arange(N) * (2 * np.pi / N), p)[None]
 
 
+#: Orbits measured together: the tables of one chunk (samples, phasors) stay in the cache; the rows
+#: are independent, so the chunking changes no number.
+CHUNK = 128
+
+
 def system_measures_batch(model: object, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: int) -> tuple[Measures, ...]:
     """SPEC §1 measures of every element's deflection, one :class:`Measures` per element, for P
     orbits with coefficient blocks Qx (P, n, 2H+1) (coordinate-major), base frequencies ω (P,),
-    forcing frequencies Ω (P,), evaluated on ``samples`` points per period."""
+    forcing frequencies Ω (P,), evaluated on ``samples`` points per period (``CHUNK`` orbits at a
+    time)."""
+    P = Qx.shape[0]
+    if P <= CHUNK:
+        return _measures_of_rows(_system_of(model), Qx, omega, forcing_omega, samples)
     system = _system_of(model)
+    parts = [_measures_of_rows(system, Qx[i : i + CHUNK], omega[i : i + CHUNK], forcing_omega[i : i + CHUNK], samples)
+             for i in range(0, P, CHUNK)]
+    names = [f.name for f in fields(Measures)]
+    return tuple(Measures(**{name: np.concatenate([getattr(part[e], name) for part in parts]) for name in names})
+                 for e in range(len(parts[0])))
+
+
+def _measures_of_rows(system: System, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: int) -> tuple[Measures, ...]:
+    """:func:`system_measures_batch` of one chunk of orbits."""
     P, n, L = Qx.shape
     H = (L - 1) // 2
     N = samples
