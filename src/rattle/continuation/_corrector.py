@@ -120,10 +120,12 @@ class ArclengthCorrector:
         step_norm = np.inf
         n = problem.size
         rhs = np.empty(n + 1)
+        rhs_q = rhs[:n]
         first_res = None
         p_lo, p_hi = self.domain
+        scale_q, scale_p = self._unscale_q, self._unscale_p
         for it in range(opts.max_iterations + 1):
-            q, p = self.unscale(y)
+            q, p = y[:-1] * scale_q, float(y[-1] * scale_p)  # unscale(y)
             if not p_lo < p < p_hi:  # outside the problem's domain (e.g. a frequency <= 0)
                 return None
             R, Rq, Rp = problem.residual_jacobian(q, p)
@@ -138,7 +140,7 @@ class ArclengthCorrector:
                 return Corrected(y, it, res, Rq, Rp)
             if it == opts.max_iterations:
                 return None
-            rhs[:n] = -R
+            np.negative(R, out=rhs_q)
             rhs[n] = -float(t @ (y - y_pred))
             dy = self.bordered_solve(Rq, Rp, t, rhs)
             if dy is None:
