@@ -48,6 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._lazy import import_held
 from .._typing import FloatArray
 
 #: A multiplier within this distance of its critical value (+1, −1) is "near the unit circle":
@@ -152,12 +153,12 @@ def _floats(values: FloatArray) -> list[float]:
 
 
 def _scan():
-    """The compiled Hermite scan (loaded on first use: numba's cached kernel), else the array code."""
+    """The compiled Hermite scan (loaded on first use, in the middle of a run: the stop signals
+    held during the import, ``import_held``), else the array code."""
     global _SCAN
     if _SCAN is None:
-        from . import _kernels
-
-        _SCAN = _kernels.hermite_scan if _kernels.AVAILABLE else _margins_array
+        kernels = import_held("rattle.continuation._kernels")
+        _SCAN = kernels.hermite_scan if kernels.AVAILABLE else _margins_array
     return _SCAN
 
 
