@@ -18,7 +18,7 @@ grids (resolution T_p / (64 N); δ'' has kinks at breakpoint crossings).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -71,16 +71,33 @@ def evaluate_batch(Q: FloatArray, omega: FloatArray, t: FloatArray, derivative: 
     return np.sum(scale * (-c * b + s * a), axis=2)
 
 
+def _phasors(omega: FloatArray, t: FloatArray, H: int) -> np.ndarray:
+    """e^{ikωt}, k = 1 … H, for base frequencies ω (P,) and times t (P, m): (P, m, H) complex, the
+    powers of e^{iωt} by a running product (one cos and one sin per time instead of H; the error
+    grows like k ε, as the rounding of the phase kωt does in a direct evaluation)."""
+    th = omega[:, None] * t
+    z = np.empty((H,) + th.shape, dtype=complex)  # one contiguous slab per k: the products vectorise
+    np.cos(th, out=z[0].real)
+    np.sin(th, out=z[0].imag)
+    for k in range(1, H):
+        np.multiply(z[k - 1], z[0], out=z[k])
+    return z.transpose(1, 2, 0)
+
+
+def _series_at(Z: np.ndarray, coef: np.ndarray) -> FloatArray:
+    """Re Σ_k coef_k Z_k for phasors Z (P, m, H) and complex coefficients coef (P, H): (P, m)."""
+    return np.matmul(Z, coef[:, :, None])[..., 0].real
+
+
 def _position_velocity(Q: FloatArray, omega: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """δ(t) and δ'(t) from one evaluation of the trigonometric table, times t (P, m)."""
+    """δ(t) and δ'(t) from one table of phasors, times t (P, m):
+    δ = a_0 + Re Σ (a_k − i b_k) e^{ikωt},  δ' = Re Σ kω (b_k + i a_k) e^{ikωt}."""
     H = (Q.shape[1] - 1) // 2
+    Z = _phasors(omega, t, H)
+    a, b = Q[:, 1 : H + 1], Q[:, H + 1 :]
     kw = np.arange(1, H + 1)[None, :] * omega[:, None]  # (P, H)
-    ph = t[:, :, None] * kw[:, None, :]
-    c, s = np.cos(ph), np.sin(ph)
-    a, b = Q[:, None, 1 : H + 1], Q[:, None, H + 1 :]
-    delta = Q[:, None, 0] + np.einsum("pmh,pmh->pm", c, np.broadcast_to(a, c.shape)) + np.einsum("pmh,pmh->pm", s, np.broadcast_to(b, s.shape))
-    ka, kb = kw[:, None, :] * a, kw[:, None, :] * b
-    vel = np.einsum("pmh,pmh->pm", c, np.broadcast_to(kb, c.shape)) - np.einsum("pmh,pmh->pm", s, np.broadcast_to(ka, s.shape))
+    delta = Q[:, :1] + _series_at(Z, a - 1j * b)
+    vel = _series_at(Z, kw * (b + 1j * a))
     return delta, vel
 
 
@@ -108,22 +125,22 @@ def _refine_grid(func, t_best: FloatArray, half_width: FloatArray, sign: float, 
 
 def _refine_smooth_extreme(Q: FloatArray, omega: FloatArray, t: FloatArray, dt: FloatArray) -> FloatArray:
     """δ at the root of δ' near the sampled extreme t (within ±dt): Newton on δ' = 0 with
-    δ'' from the series (δ is C², its extremes are smooth), kept inside the bracket."""
+    δ'' from the series (δ is C², its extremes are smooth), kept inside the bracket:
+    δ' = Re Σ kω (b_k + i a_k) e^{ikωt}, δ'' = −Re Σ (kω)² (a_k − i b_k) e^{ikωt}."""
     lo, hi = t - dt, t + dt
     H = (Q.shape[1] - 1) // 2
-    kw = np.arange(1, H + 1)[None, None, :] * omega[:, None, None]
-    a, b = Q[:, None, 1 : H + 1], Q[:, None, H + 1 :]
-    kw2 = kw**2
+    kw = np.arange(1, H + 1)[None, :] * omega[:, None]
+    a, b = Q[:, 1 : H + 1], Q[:, H + 1 :]
+    c_vel = kw * (b + 1j * a)
+    c_acc = -(kw**2) * (a - 1j * b)
     for _ in range(6):
-        # δ' and δ'' from one table of cos, sin (evaluate_batch's formulas, derivatives 1 and 2)
-        ph = kw * t[:, None, None]
-        c, s = np.cos(ph), np.sin(ph)
-        v = np.sum(kw * (c * b - s * a), axis=2)[:, 0]
-        acc = np.sum(kw2 * (-c * a - s * b), axis=2)[:, 0]
+        Z = _phasors(omega, t[:, None], H)
+        v = _series_at(Z, c_vel)[:, 0]
+        acc = _series_at(Z, c_acc)[:, 0]
         with np.errstate(divide="ignore", invalid="ignore"):
             t_new = t - v / acc
         t = np.where(np.isfinite(t_new) & (t_new > lo) & (t_new < hi), t_new, t)
-    return evaluate_batch(Q, omega, t[:, None])[:, 0]
+    return Q[:, 0] + _series_at(_phasors(omega, t[:, None], H), a - 1j * b)[:, 0]
 
 
 def regime_of(model: Model, delta_min: FloatArray, delta_max: FloatArray) -> np.ndarray:
@@ -203,11 +220,29 @@ def _sample_forcing(system: System, omega: FloatArray, forcing_omega: FloatArray
     return system.forcing(np.arange(N) * (2 * np.pi / N), p)[None]
 
 
+#: Orbits measured together: the tables of one chunk (samples, phasors) stay in the cache; the rows
+#: are independent, so the chunking changes no number.
+CHUNK = 128
+
+
 def system_measures_batch(model: object, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: int) -> tuple[Measures, ...]:
     """SPEC §1 measures of every element's deflection, one :class:`Measures` per element, for P
     orbits with coefficient blocks Qx (P, n, 2H+1) (coordinate-major), base frequencies ω (P,),
-    forcing frequencies Ω (P,), evaluated on ``samples`` points per period."""
+    forcing frequencies Ω (P,), evaluated on ``samples`` points per period (``CHUNK`` orbits at a
+    time)."""
+    P = Qx.shape[0]
+    if P <= CHUNK:
+        return _measures_of_rows(_system_of(model), Qx, omega, forcing_omega, samples)
     system = _system_of(model)
+    parts = [_measures_of_rows(system, Qx[i : i + CHUNK], omega[i : i + CHUNK], forcing_omega[i : i + CHUNK], samples)
+             for i in range(0, P, CHUNK)]
+    names = [f.name for f in fields(Measures)]
+    return tuple(Measures(**{name: np.concatenate([getattr(part[e], name) for part in parts]) for name in names})
+                 for e in range(len(parts[0])))
+
+
+def _measures_of_rows(system: System, Qx: FloatArray, omega: FloatArray, forcing_omega: FloatArray, samples: int) -> tuple[Measures, ...]:
+    """:func:`system_measures_batch` of one chunk of orbits."""
     P, n, L = Qx.shape
     H = (L - 1) // 2
     N = samples

@@ -150,3 +150,31 @@ def test_a_step_over_which_two_test_functions_change_sign_is_rejected():
     assert check_segment(MonitorReading(np.array([0.3, -0.2]), np.array([-1.0, -1.0]), (2,), 0.2), one, 0.5,
                          tolerance=0.5, max_change=1.0, resolved=False).accept
     assert check_segment(a, b, 0.5, tolerance=0.5, max_change=1.0, resolved=True).accept
+
+
+def test_compiled_hermite_scan_is_the_array_code_to_the_last_bit(monkeypatch):
+    # The step control reads the cubic model through the compiled scan (continuation._kernels):
+    # the same floating-point operations as the array code, so the same verdicts and factors —
+    # a continuation path depends on every bit of them.
+    from rattle.continuation import _kernels, _monitor
+
+    if not _kernels.AVAILABLE:
+        pytest.skip("numba not available: the array code is used")
+    rng = np.random.default_rng(7)
+    for _ in range(3000):
+        pa, ga, pb, gb = rng.standard_normal(4) * 10.0 ** rng.integers(-8, 4, 4)
+        length = 10.0 ** rng.uniform(-5, 0)
+        sign = 1.0 if pa > 0 else -1.0
+        args = (pa, ga, pb, gb, length, sign, 0.5, _monitor._X, _monitor._X2)
+        assert tuple(_kernels.hermite_scan(*args)) == _monitor._margins_array(*args)
+    # NaN (an overflowing model) propagates through the minima as numpy.min does.
+    args = (1e308, 1e308, -1e308, 1e308, 1.0, 1.0, 0.5, _monitor._X, _monitor._X2)
+    with np.errstate(all="ignore"):
+        got, ref = _kernels.hermite_scan(*args), _monitor._margins_array(*args)
+    assert any(np.isnan(ref))
+    assert [repr(x) for x in got] == [repr(x) for x in ref]
+    # check_segment gives the same verdicts by either.
+    cases = [((0.16, -1.0), (0.24, 1.0), 1.0), ((2.0, -0.5), (1.2, -0.3), 0.4), ((1e-3, -1e-2), (2e-3, 3e-2), 0.05)]
+    verdicts = [check_segment(_reading(*a), _reading(*b), L, **OPTS) for a, b, L in cases]
+    monkeypatch.setattr(_monitor, "_SCAN", _monitor._margins_array)
+    assert [check_segment(_reading(*a), _reading(*b), L, **OPTS) for a, b, L in cases] == verdicts

@@ -210,3 +210,48 @@ def test_frequency_response_without_the_compiled_kernels_is_the_same(monkeypatch
     # are roots of the test functions, the same to the locator's tolerance.
     np.testing.assert_allclose([s.omega for s in compiled.special_points], [s.omega for s in array.special_points],
                                rtol=0, atol=1e-9)
+
+
+def test_compiled_monodromy_finds_a_crossing_between_the_last_sample_and_the_period(monkeypatch):
+    """A crossing between the last sample t_{N−1} and T (the samples' wrap) is found by the
+    compiled scan as by the array code, with the same monodromy."""
+    from rattle.hb import FourierBasis
+    from rattle.stability import _kernels, monodromy_and_crossings_batch
+
+    if not _kernels.AVAILABLE:
+        pytest.skip("numba not installed: only the array code runs")
+    H, N = 4, 64
+    basis = FourierBasis(H, N)
+    phi = 0.3 * 2 * np.pi / N  # δ = 0.15 sin(ωt + φ) crosses 0 upwards at T − φ/ω, after t_{N−1}
+    Q = np.zeros((1, 2 * H + 1))
+    Q[0, 1], Q[0, H + 1] = 0.15 * np.sin(phi), 0.15 * np.cos(phi)
+    w, bp, kappa = np.array([0.7]), np.array([0.0, 0.1]), np.array([1.0, 2.0, 3.0])
+    X = basis.synthesize(Q)
+    assert X[0, -1] < 0.0 < X[0, 0]
+    M_k, n_k = _kernels.monodromies(Q, w, X, bp, kappa, 0.05)
+    monkeypatch.setattr(_kernels, "AVAILABLE", False)
+    M_a, n_a = monodromy_and_crossings_batch(Q, w, X, bp, kappa, 0.05)
+    np.testing.assert_array_equal(n_k, [[2, 2]])
+    np.testing.assert_array_equal(n_k, n_a)
+    np.testing.assert_allclose(M_k, M_a, rtol=0, atol=1e-12 * np.abs(M_a).max())
+
+
+def test_a_batch_reads_the_monodromies_the_readings_computed(reference_frf):
+    """FloquetMonitor remembers the orbits of its readings and test functions: a batch over
+    them (the multipliers of a branch's points) takes those monodromies, identical to a fresh
+    computation, and computes the orbits it has not seen."""
+    from rattle.stability import FloquetMonitor
+
+    frf = reference_frf
+    hb = HarmonicBalance(frf.model, HBOptions(harmonics=32))
+    mon = FloquetMonitor(hb)
+    d = np.linspace(-1.0, 1.0, frf.coefficients.shape[1]) * 1e-3
+    seen = list(range(0, len(frf), 50))
+    for i in seen:
+        mon(frf.coefficients[i], frf.omega[i], d, 1e-3)
+    assert len(mon._memo) >= len(seen)
+    rows = np.arange(0, len(frf), 25)  # half of them seen
+    M, counts = mon.monodromy_and_crossings(frf.coefficients[rows], frf.omega[rows])
+    M0, counts0 = FloquetMonitor(hb).monodromy_and_crossings(frf.coefficients[rows], frf.omega[rows])
+    np.testing.assert_array_equal(M, M0)
+    np.testing.assert_array_equal(counts, counts0)

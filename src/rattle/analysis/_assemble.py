@@ -39,20 +39,20 @@ def monitor_of(hb: HarmonicBalance) -> FloquetMonitor:
     return mon
 
 
-def _test_function(kind: str, hb: HarmonicBalance, corrector: ArclengthCorrector):
-    """ψ(q, Ω, corrected, d) whose sign change marks a ``kind`` point (see continuation._detect):
-    det(M − I) (fold), det(M + I) (period doubling), det(M ⊙ M − I) (Neimark–Sacker), from the
-    exact monodromy of the orbit (``FloquetMonitor.test_function``)."""
-    psi = monitor_of(hb).test_function(kind)
-
-    def test(q, w, corr, d):
-        return psi(q, w)
-    return test
+def _test_function(kind: str, hb: HarmonicBalance):
+    """ψ(q, Ω) whose sign change marks a ``kind`` point (see continuation._detect): det(M − I)
+    (fold), det(M + I) (period doubling), det(M ⊙ M − I) (Neimark–Sacker), from the exact
+    monodromy of the orbit (``FloquetMonitor.test_function``)."""
+    return monitor_of(hb).test_function(kind)
 
 
 def _locate_with(hb: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:
+    """The ``kind`` point between two points of the branch (qa, wa), (qb, wb): the zero of its ψ
+    on the branch, ψ at the two points evaluated there (they are solutions: not corrected again;
+    a branch point's monodromy is the monitor's, remembered)."""
     corrector = ArclengthCorrector(hb, newton)
-    return locate_on_segment(corrector, qa, wa, qb, wb, _test_function(kind, hb, corrector))
+    psi = _test_function(kind, hb)
+    return locate_on_segment(corrector, qa, wa, qb, wb, lambda q, w, corr, d: psi(q, w), ends=(psi(qa, wa), psi(qb, wb)))
 
 
 def _refine(hb: HarmonicBalance, hb2: HarmonicBalance, newton: NewtonOptions, kind: str, qa, wa, qb, wb) -> LocatedPoint | None:

@@ -134,9 +134,10 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
         return ContinuationStepper(hb, q, w, (lo, hi), run.continuation, run.newton, tangent=tangent,
                                    monitor=monitor_of(hb), speed=speed)
 
-    def solve_with(H: int, pt: BranchPoint) -> tuple[FloatArray, float, FloatArray] | None:
+    def solve_with(H: int, pt: BranchPoint, tangent: bool = True) -> tuple[FloatArray, float, FloatArray | None] | None:
         """The point ``pt`` solved with H harmonics — on the plane through it normal to its
-        tangent (bordered Newton: also at a fold tip, where Ω cannot be held) — and its tangent."""
+        tangent (bordered Newton: also at a fold tip, where Ω cannot be held) — and its tangent
+        (None without ``tangent``: an estimate reads only the solution; see ``with_tangent``)."""
         if H not in problems:
             hb = HarmonicBalance(model, run.for_harmonics(H), period=period)
             problems[H] = (hb, ArclengthCorrector(hb, run.newton))
@@ -149,10 +150,24 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
         q_new, p_new = corrector.unscale(res.y)
         if not lo <= p_new <= hi:
             return None
+        if not tangent:
+            pending[:] = [corrector, res, t]
+            return q_new, p_new, None
+        t_new = corrector.tangent(res.Rq, res.Rp, t)
+        return q_new, p_new, (t if t_new is None else t_new)
+
+    def with_tangent(found: tuple[FloatArray, float, FloatArray | None]) -> tuple[FloatArray, float, FloatArray]:
+        """The last estimate's solution (``solve_with(..., tangent=False)``) with its tangent, when
+        the branch goes on from it."""
+        q_new, p_new, t_new = found
+        if t_new is not None:
+            return q_new, p_new, t_new
+        corrector, res, t = pending
         t_new = corrector.tangent(res.Rq, res.Rp, t)
         return q_new, p_new, (t if t_new is None else t_new)
 
     problems: dict[int, tuple[HarmonicBalance, ArclengthCorrector]] = {}
+    pending: list[Any] = []  # the last estimate's corrector, result and plane normal: its tangent if needed
     H = H0
     stepper = stepper_for(H, q0, omega0, None)
     n_coord = stepper.problem.size // (2 * H0 + 1)  # type: ignore[attr-defined]
@@ -197,7 +212,7 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
             continue
         err = np.inf
         if 2 * H <= top:
-            fine = solve_with(2 * H, pt)
+            fine = solve_with(2 * H, pt, tangent=False)
             if fine is None:
                 # the finer problem has no solution near this point: once is a grazing point, twice
                 # in a row says the truncation is off here (a solution with H the 2H one is not near)
@@ -214,7 +229,7 @@ def follow_branch(model: Model, run: Any, q0: FloatArray, omega0: float, omega_r
                 start = solve_with(2 * H, stepper.points[good])
                 keep = stepper.points[: good + 1]
                 if start is None and np.isfinite(err):
-                    start, keep = fine, stepper.points
+                    start, keep = with_tangent(fine), stepper.points
                 if start is None:  # no 2H solution to go on from: keep H here
                     missed = 0
                     continue

@@ -60,6 +60,12 @@ class ArclengthCorrector:
         self.scale[n] = problem.parameter_scale
         # ∂R/∂q L: one number scales every column (the common case), else one per column.
         self._q_scale = self.scale[0] if np.ndim(L) == 0 else self.scale[:n]
+        self._unscale_q = self.scale[:n]
+        self._unscale_p = self.scale[n]
+        # The bordered matrix, Fortran-ordered for LAPACK, filled and factorised in place by each
+        # solve (a corrector serves one caller at a time), and its blocks' views.
+        self._bordered = np.empty((n + 1, n + 1), order="F")
+        self._blocks = (self._bordered[:n, :n], self._bordered[:n, n], self._bordered[n])
 
     def to_scaled(self, q: FloatArray, p: float) -> FloatArray:
         """y = (q / L, p / p_s) of the point (q, p)."""
@@ -70,17 +76,23 @@ class ArclengthCorrector:
 
     def unscale(self, y: FloatArray) -> tuple[FloatArray, float]:
         """(q, p) of the scaled point y."""
-        return y[:-1] * self.scale[:-1], float(y[-1] * self.scale[-1])
+        return y[:-1] * self._unscale_q, float(y[-1] * self._unscale_p)
 
     def bordered_solve(self, Rq: FloatArray, Rp: FloatArray, t: FloatArray, rhs: FloatArray) -> FloatArray | None:
         """Solve [∂R/∂q L, ∂R/∂p p_s; tᵀ] x = rhs (LAPACK gesv; None if singular)."""
-        n = Rq.shape[0]
-        A = np.empty((n + 1, n + 1), order="F")
-        np.multiply(Rq, self._q_scale, out=A[:n, :n])
-        np.multiply(Rp, self.scale[n], out=A[:n, n])
-        A[n] = t
+        A = self._bordered
+        if A.shape[0] != Rq.shape[0] + 1:  # a caller with another size (not the problem's)
+            n = Rq.shape[0]
+            A = np.empty((n + 1, n + 1), order="F")
+            blocks = (A[:n, :n], A[:n, n], A[n])
+        else:
+            blocks = self._blocks
+        Aq, Ap, At = blocks
+        np.multiply(Rq, self._q_scale, out=Aq)
+        np.multiply(Rp, self._unscale_p, out=Ap)
+        At[...] = t
         _, _, x, info = _gesv(A, rhs, overwrite_a=1, overwrite_b=0)
-        if info != 0 or not np.all(np.isfinite(x)):
+        if info != 0 or not np.isfinite(x).all():
             return None
         return x
 
@@ -108,14 +120,16 @@ class ArclengthCorrector:
         step_norm = np.inf
         n = problem.size
         rhs = np.empty(n + 1)
+        rhs_q = rhs[:n]
         first_res = None
         p_lo, p_hi = self.domain
+        scale_q, scale_p = self._unscale_q, self._unscale_p
         for it in range(opts.max_iterations + 1):
-            q, p = self.unscale(y)
+            q, p = y[:-1] * scale_q, float(y[-1] * scale_p)  # unscale(y)
             if not p_lo < p < p_hi:  # outside the problem's domain (e.g. a frequency <= 0)
                 return None
             R, Rq, Rp = problem.residual_jacobian(q, p)
-            res = float(np.max(np.abs(R))) / Fs
+            res = float(np.abs(R).max()) / Fs
             if not math.isfinite(res):
                 return None
             if first_res is None:
@@ -126,12 +140,12 @@ class ArclengthCorrector:
                 return Corrected(y, it, res, Rq, Rp)
             if it == opts.max_iterations:
                 return None
-            rhs[:n] = -R
+            np.negative(R, out=rhs_q)
             rhs[n] = -float(t @ (y - y_pred))
             dy = self.bordered_solve(Rq, Rp, t, rhs)
             if dy is None:
                 return None
-            if opts.damped and not (res <= opts.residual_tol and float(np.max(np.abs(dy))) <= opts.step_tol):
+            if opts.damped and not (res <= opts.residual_tol and float(np.abs(dy).max()) <= opts.step_tol):
                 # the step's fraction that lowers R and the plane condition together (a last step
                 # within the tolerances is taken whole: at round-off no fraction descends)
                 lam = backtrack(lambda x: self._merit(x, y_pred, t), y, dy, math.hypot(
@@ -140,7 +154,7 @@ class ArclengthCorrector:
                     return None
                 dy *= lam
             y += dy
-            step_norm = float(np.max(np.abs(dy)))
+            step_norm = float(np.abs(dy).max())
         return None  # pragma: no cover
 
 

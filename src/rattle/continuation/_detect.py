@@ -56,9 +56,15 @@ def locate_on_segment(
     test: Callable[[FloatArray, float, Corrected, FloatArray], float],
     *,
     xtol: float = 1e-10,
+    ends: tuple[float, float] | None = None,
 ) -> LocatedPoint | None:
     """Root of ``test(q, p, corrected, d)`` on the branch between two points (q_a, p_a) and
-    (q_b, p_b), or None if the test function has no sign change there or a correction fails."""
+    (q_b, p_b), or None if the test function has no sign change there or a correction fails.
+
+    ``ends``: the test function's values at the two points when the caller has them (points
+    already on the branch, e.g. from the monitor's readings): the ends are then not corrected
+    and evaluated again (two corrector solves fewer); otherwise each end is corrected in the
+    plane normal to the secant and ψ evaluated there."""
     y_a = corrector.to_scaled(q_a, p_a)
     y_b = corrector.to_scaled(q_b, p_b)
     length = float(np.linalg.norm(y_b - y_a))
@@ -77,7 +83,7 @@ def locate_on_segment(
         return val
 
     try:
-        f0, f1 = psi(0.0), psi(length)
+        f0, f1 = (psi(0.0), psi(length)) if ends is None else (float(ends[0]), float(ends[1]))
         if not np.sign(f0) * np.sign(f1) < 0:
             return None
         s_star = brent_root(psi, 0.0, length, xtol=xtol * length, fa=f0, fb=f1)

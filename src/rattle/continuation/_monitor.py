@@ -48,6 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._lazy import import_held
 from .._typing import FloatArray
 
 #: A multiplier within this distance of its critical value (+1, −1) is "near the unit circle":
@@ -127,6 +128,40 @@ def _model_and_error(pa: float, ga: float, pb: float, gb: float, L: float) -> tu
     return coef, p, err
 
 
+def _margins_array(pa: float, ga: float, pb: float, gb: float, L: float, sign: float, tolerance: float,
+                   X: FloatArray, X2: FloatArray) -> tuple[float, float, float, bool]:
+    """What the step control reads of the model of a test function that keeps its sign (``sign``):
+    min sign·p, min over the interior of sign·p − e, min over the interior points with e > 0 of
+    θ sign·p / e (inf without such a point), and whether there is one — by the array code
+    (the reference of the compiled ``_kernels.hermite_scan``, which is used when numba is there)."""
+    _, p, err = _model_and_error(pa, ga, pb, gb, L)
+    sp = sign * p
+    inner = slice(1, -1)
+    e = err[inner]
+    gap = sp - err
+    positive = e > 0.0
+    ratio = float(np.min(tolerance * sp[inner][positive] / e[positive])) if positive.any() else math.inf
+    return float(np.min(sp)), float(np.min(gap[inner])), ratio, bool(positive.any())
+
+
+_SCAN = None
+
+
+def _floats(values: FloatArray) -> list[float]:
+    """The entries of a reading's array as Python floats."""
+    return np.asarray(values, dtype=float).tolist()
+
+
+def _scan():
+    """The compiled Hermite scan (loaded on first use, in the middle of a run: the stop signals
+    held during the import, ``import_held``), else the array code."""
+    global _SCAN
+    if _SCAN is None:
+        kernels = import_held("rattle.continuation._kernels")
+        _SCAN = kernels.hermite_scan if kernels.AVAILABLE else _margins_array
+    return _SCAN
+
+
 def check_segment(
     a: MonitorReading,
     b: MonitorReading,
@@ -144,10 +179,10 @@ def check_segment(
     floor (then nothing is rejected; the factor still applies). See the module docstring.
     """
     factor = 2.0
+    scan = _scan()
     smooth = a.structure == b.structure
     crossed = 0  # test functions that change sign over the step
-    for pa, ga, pb, gb in zip(a.values, a.slopes, b.values, b.slopes):
-        pa, ga, pb, gb = float(pa), float(ga), float(pb), float(gb)
+    for pa, ga, pb, gb in zip(_floats(a.values), _floats(a.slopes), _floats(b.values), _floats(b.slopes)):
         if not (math.isfinite(pa) and math.isfinite(pb)):
             continue  # no information (an overflowing, strongly unstable monodromy): nothing to bound
         kinked = not smooth or not (math.isfinite(ga) and math.isfinite(gb))  # no usable slope
@@ -176,21 +211,19 @@ def check_segment(
             if not change and reach >= min(abs(pa), abs(pb)) and not resolved:
                 return SegmentVerdict(False, 0.5, "non-smooth test function near zero")
             continue
-        coef, p, err = _model_and_error(pa, ga, pb, gb, length)
         if change:
-            if _roots_inside(coef) >= 3 and not resolved:
+            if not resolved and _roots_inside(_hermite_coefficients(pa, ga, pb, gb, length)) >= 3:
                 return SegmentVerdict(False, 0.5, "more than one test-function zero in one step")
             continue
         sign = 1.0 if pa > 0 else -1.0
-        gap = sign * p - err  # distance from zero that the model guarantees, x ∈ [0, 1]
-        if (np.min(sign * p) <= 0.0 or np.min(gap[1:-1]) <= 0.0) and not resolved:
-            reason = "hidden pair of test-function zeros" if np.min(sign * p) <= 0.0 else "test function not resolved"
+        # min sign·p, min of the distance from zero that the model guarantees (sign·p − e, inside
+        # the step), min θ sign·p / e: on the grid x ∈ [0, 1] (_model_and_error), compiled
+        min_p, min_gap, ratio, has_error = scan(pa, ga, pb, gb, length, sign, tolerance, _X, _X2)
+        if (min_p <= 0.0 or min_gap <= 0.0) and not resolved:
+            reason = "hidden pair of test-function zeros" if min_p <= 0.0 else "test function not resolved"
             return SegmentVerdict(False, 0.5, reason)
-        inner = slice(1, -1)
-        e = err[inner]
-        if np.any(e > 0.0):
+        if has_error:
             # err grows like L^3: aim for err <= theta x (the model's distance from zero), pointwise.
-            ratio = np.min(tolerance * (sign * p[inner])[e > 0] / e[e > 0])
             factor = min(factor, float(max(ratio, 0.0)) ** (1.0 / 3.0))
     if b.distance < NEAR_CRITICAL and factor > 1.0:
         # Near the unit circle the step grows only while, at the present rate, no test function

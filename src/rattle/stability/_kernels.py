@@ -91,6 +91,19 @@ def _refine(a0, a, b, w, lvl, fa, fb, ta, tb, t, tol):
     return t
 
 
+def _next_change(x, lvl, start):
+    """The first j ≥ ``start`` where the periodic samples x change side of ``lvl`` between x_j
+    and x_{j+1} (x_N = x_0), else N: a plain loop the compiler keeps tight (the crossings are
+    few, the samples many)."""
+    N = x.size
+    for j in range(start, N - 1):
+        if (x[j] > lvl) != (x[j + 1] > lvl):
+            return j
+    if start <= N - 1 and (x[N - 1] > lvl) != (x[0] > lvl):
+        return N - 1
+    return N
+
+
 def _monodromies(Q, omega, samples, bp, kappa, sigma, under, wd, gamma, lam1, lam2, M, counts):
     """Fill M (P, 2, 2) and counts (P, k) for the orbits Q (P, 2H+1) with samples (P, N); the
     stages' exp(A τ) from their constants (:func:`rattle.model._stage_matrix.stage_constants`)."""
@@ -111,25 +124,22 @@ def _monodromies(Q, omega, samples, bp, kappa, sigma, under, wd, gamma, lam1, la
         for i in range(k):
             lvl = bp[i]
             c_i = 0
-            above_first = x[0] > lvl
-            above = above_first
-            for j in range(N):
-                above_next = x[j + 1] > lvl if j + 1 < N else above_first
-                if above != above_next:
-                    fa = x[j] - lvl
-                    fb = x[(j + 1) % N] - lvl
-                    ta = j * dt
-                    tb = ta + dt
-                    t = ta + dt * fa / (fa - fb)
-                    t = _refine(a0, a, b, w, lvl, fa, fb, ta, tb, t, tol)
-                    if n == times.size:
-                        grown = np.empty(2 * n)
-                        grown[:n] = times[:n]
-                        times = grown
-                    times[n] = t % T
-                    n += 1
-                    c_i += 1
-                above = above_next
+            j = _next_change(x, lvl, 0)
+            while j < N:
+                fa = x[j] - lvl
+                fb = x[(j + 1) % N] - lvl
+                ta = j * dt
+                tb = ta + dt
+                t = ta + dt * fa / (fa - fb)
+                t = _refine(a0, a, b, w, lvl, fa, fb, ta, tb, t, tol)
+                if n == times.size:
+                    grown = np.empty(2 * n)
+                    grown[:n] = times[:n]
+                    times = grown
+                times[n] = t % T
+                n += 1
+                c_i += 1
+                j = _next_change(x, lvl, j + 1)
             counts[p, i] = c_i
         order = np.argsort(times[:n], kind="mergesort")
         m00, m01, m10, m11 = 1.0, 0.0, 0.0, 1.0
@@ -161,6 +171,7 @@ if AVAILABLE:
     _transition = _jit(transition_scalar)  # the one closed form of exp(A τ), compiled
     _series = _jit(_series)
     _refine = _jit(_refine)
+    _next_change = _jit(_next_change)
     _monodromies = _jit(_monodromies)
 else:  # pragma: no cover - the array code is taken then
     _transition = transition_scalar

@@ -33,6 +33,7 @@ from ..continuation import MonitorReading
 from ..hb import HarmonicBalance
 from .. import hb as fft  # its compiled rfft/irfft
 from ..model import System
+from . import _kernels
 from ._classify import critical_distance
 from ._floquet import (
     TEST_FUNCTIONS, element_monodromy_batch, floquet_test_functions, monodromy_and_crossings_batch,
@@ -41,6 +42,8 @@ from ._floquet import (
 
 #: Difference step in scaled arc length for the test functions' derivative.
 EPSILON = 1e-7
+#: Orbits whose monodromy a monitor remembers (readings, test functions); all are forgotten when full.
+MEMO = 20000
 
 
 def hb_system(hb: HarmonicBalance) -> System:
@@ -66,23 +69,61 @@ class FloquetMonitor:
         self.names = TEST_FUNCTIONS[:2] if system.n == 1 else TEST_FUNCTIONS
         self._cache: dict = {}
         self._buffers: dict = {}
+        self._memo: dict = {}
         # The single element of the single equation: the closed-form path on q itself.
         self._single = system.n == 1 and system.m == 1 and float(system.element_rows[0, 0]) == 1.0
         if self._single:
             e = system.elements[0]
-            self._breakpoints = np.asarray(e.breakpoints, dtype=float)
+            self._breakpoints = np.ascontiguousarray(np.atleast_1d(np.asarray(e.breakpoints, dtype=float)))
             self._stiffness = np.array([system.stage_stiffness((j,))[0, 0] for j in range(len(e.slopes))])
             self._damping = float(system.damping[0, 0])
         self._rows = system.element_rows
 
     def monodromy_and_crossings(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
         """Monodromies (P, 2n, 2n) and crossings (P, m, k_max) of the orbits ``Q`` (P, n·(2H+1))
-        at forcing frequencies ``Om`` (P,) (arrays)."""
+        at forcing frequencies ``Om`` (P,) (arrays).
+
+        The monitor remembers the monodromy of every point it has read (the first of a reading's
+        two orbits, P = 2) and of every single orbit (a test function), by its exact (Ω, q), up
+        to ``MEMO`` of them; one orbit or a batch (the multipliers of a branch's points, which
+        were the readings' points) takes the remembered ones and computes the rest."""
+        if Q.shape[0] == 2:  # a reading: the point and its neighbour along the tangent
+            M, counts = self._compute(Q, Om)
+            self._remember(Q[0], float(Om[0]), M[0], counts[0])
+            return M, counts
+        memo = self._memo
+        found = [memo.get((float(w), q.tobytes())) for q, w in zip(Q, Om)]
+        missing = [i for i, f in enumerate(found) if f is None]
+        if not missing:
+            return np.stack([f[0] for f in found]), np.stack([f[1] for f in found])
+        if len(missing) == len(found):
+            M, counts = self._compute(Q, Om)
+        else:
+            M_new, counts_new = self._compute(Q[missing], Om[missing])
+            for j, i in enumerate(missing):
+                found[i] = (M_new[j], counts_new[j])
+            M, counts = np.stack([f[0] for f in found]), np.stack([f[1] for f in found])
+        if Q.shape[0] == 1:
+            self._remember(Q[0], float(Om[0]), M[0], counts[0])
+        return M, counts
+
+    def _remember(self, q: FloatArray, omega: float, M: FloatArray, counts: np.ndarray) -> None:
+        """Keep the monodromy and crossings of the orbit (q, Ω) (all forgotten once ``MEMO`` are
+        kept)."""
+        if len(self._memo) >= MEMO:
+            self._memo.clear()
+        self._memo[(omega, q.tobytes())] = (M.copy(), counts.copy())
+
+    def _compute(self, Q: FloatArray, Om: FloatArray) -> tuple[FloatArray, np.ndarray]:
         hb = self.hb
         w = Om / hb.period
         if self._single:
-            M, counts = monodromy_and_crossings_batch(Q, w, self._samples(Q), self._breakpoints,
-                                                      self._stiffness, self._damping)
+            samples = self._samples(Q)
+            if _kernels.AVAILABLE:  # the compiled kernel, straight (as monodromy_and_crossings_batch)
+                M, counts = _kernels.monodromies(Q, w, samples, self._breakpoints, self._stiffness, self._damping)
+            else:
+                M, counts = monodromy_and_crossings_batch(Q, w, samples, self._breakpoints, self._stiffness,
+                                                          self._damping)
             return M, counts[:, None, :]
         S = np.einsum("en,pnk->pek", self._rows, Q.reshape(Q.shape[0], self.system.n, -1))
         return element_monodromy_batch(self.system, S, w, hb.basis.synthesize(S), cache=self._cache)
