@@ -619,10 +619,11 @@ def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offse
                     ev_t[ne], ev_k[ne] = t, _LOCK
                     ne += 1
                 else:
-                    a_m = F - c * v - k * ((slope[j] * d + offset[j]) + fric[j] * sgn)
-                    a_p = F - c * v - k * ((slope[jn] * d + offset[jn]) + fric[jn] * sn)
-                    q = (a_p - a_m) / v if v != 0.0 else 0.0
-                    m21, m22 = m21 + q * m11, m22 + q * m12
+                    if jump[i] > 0.0 or fric[i] != fric[i + 1]:  # the field jumps: the saltation matrix
+                        a_m = F - c * v - k * ((slope[j] * d + offset[j]) + fric[j] * sgn)
+                        a_p = F - c * v - k * ((slope[jn] * d + offset[jn]) + fric[jn] * sn)
+                        q = (a_p - a_m) / v if v != 0.0 else 0.0
+                        m21, m22 = m21 + q * m11, m22 + q * m12
                     j, sgn = jn, sn
                     ev_t[ne], ev_k[ne] = t, _CROSSING
                     ne += 1
