@@ -1,5 +1,9 @@
-"""Compiled event march of the single equation with a discontinuous law (numba): the loop of
-:meth:`~._nonsmooth._ScalarEventFlow._march_events` in scalar loops.
+"""Compiled march of the single equation (numba): the loop of
+:meth:`~._nonsmooth._ScalarEventFlow._march_events` in scalar loops, for a discontinuous law and
+for a continuous one (:class:`~._integrator._ScalarFlow`: the law without jumps or friction, its
+stages the modes σ = 0; the saltation at a breakpoint where the field is continuous — no jump, the
+same friction level on both sides — is the identity, as in the Python marches). One compiled
+march for both scalar paths: one dispatcher whose cache a command loads.
 
 The equation, its modes (slip on a stage with friction sign σ, stick, lock), its events and
 their saltation matrices are those of :mod:`._nonsmooth` (its module docstring). On a shooting
@@ -20,10 +24,10 @@ The grid scans sum the modes in a fixed order where numpy's matrix product may n
 value may differ from the array code's in its last bits; it only seeds a regula falsi start,
 and the roots are the same to round-off. A segment near critical damping (the modal amplitudes
 blow up; :class:`_Segment` falls back to the transition-matrix form) is not covered: such a law
-keeps the Python march (:data:`SUPPORTED` decides per mode table).
+keeps the Python march (:func:`supported` decides per mode table).
 
-``AVAILABLE`` is False when numba cannot be imported; the flow then keeps the Python march (the
-reference).
+``AVAILABLE`` is False when numba cannot be imported; the flows then keep their Python marches (the
+references: :meth:`~._integrator._ScalarFlow._march`, :meth:`~._nonsmooth._ScalarEventFlow._march_events`).
 """
 
 from __future__ import annotations

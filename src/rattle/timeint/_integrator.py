@@ -5,8 +5,17 @@ On every stage j of the law, f(δ) = s_j δ + e_j, the equation is linear and it
 state x_s = (δ_s, δ'_s) at t_s is x(t) = p(t) + Φ_j(τ) (x_s − p(t_s)), Φ_j(τ) = exp(A_j τ),
 τ = t − t_s, in closed form (:mod:`._stage_solutions`), so nothing here is approximated: the only
 numerical step is locating the times where δ(t) reaches a breakpoint, which is done to
-round-off. The segment is evaluated in modal form with Python floats (:class:`_Segment`), the
-one-coordinate, one-element fast path.
+round-off. The segment is evaluated in modal form (:class:`_Segment`), the one-coordinate,
+one-element fast path.
+
+The march runs compiled: it is the event march of :mod:`._event_kernel` (numba, imported at the
+flow's first march), the law seen as a discontinuous one without jumps or friction — stage j is
+the kernel's mode 3 j + 1 (friction sign σ = 0), no stop of δ' is searched, no lock can occur, and
+the saltation at a breakpoint of a continuous field is the identity. It takes this module's steps
+with the same floating-point operations (the same states, crossing times and sensitivities, bit
+for bit on this machine's OpenBLAS). The Python march (:meth:`_ScalarFlow._march`, Python floats)
+stays the reference and the fallback: without numba, or for a stage near critical damping, whose
+segment has no modal form (:func:`~._event_kernel.supported`).
 
 Crossings are bracketed on a grid of ``samples_per_scale`` points per fastest time scale of the
 stage (the period of the highest forcing harmonic, the stage's natural period and the damping
