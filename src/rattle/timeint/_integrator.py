@@ -42,6 +42,7 @@ from .._validate import check_state
 from ..errors import ConvergenceError
 from ..model import Model, transition_scalar
 from ._exact_flow import ExactIntegrator, FlowOptions, takes_model
+from ._recent import Recent
 from ._roots import grid_chunk, resolve_cell
 from ._stage_solutions import StageSolutions
 from ._trajectory import Trajectory
@@ -50,6 +51,9 @@ _EPS = float(np.finfo(float).eps)
 _FIRST_CHUNK = 48  # grid cells scanned at once for the first crossing; doubled up to _MAX_CHUNK
 _MAX_CHUNK = 4096
 _SLIP = 0  # the compiled march's kind of motion of a continuous law (no stick, no lock)
+#: Frequencies whose stage solutions a scalar flow keeps (:meth:`_ScalarFlow.solutions`): a shooting
+#: continuation evaluates the period map at Ω and at Ω + h.
+SOLUTION_CACHE = 4
 
 #: the compiled march, imported at the first march of a flow (a command that builds no flow does not
 #: pay its import)
@@ -157,18 +161,20 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
         super().__init__(system, options)
         self.model = self.system
         self.max_segments = self.options.budget(events=False)
-        self._cache: tuple[float, StageSolutions] | None = None
         st = self.model.elastic.stages
         n = len(st.slopes)
         # breakpoints, slopes, offsets, jumps (none), friction levels (none): the compiled march's law
         self._law_arrays = (np.array(st.breakpoints, dtype=float), np.array(st.slopes, dtype=float),
                             np.array(st.offsets, dtype=float), np.zeros(n - 1), np.zeros(n))
         self._x_lock = 0.0  # no jumps: no locks
-        self._init_compiled()
+        self._init_scalar()
 
-    def _init_compiled(self) -> None:
-        """The compiled march's state: decided at the first march (:meth:`_use_compiled`; the kernel
-        module is imported there, not when the flow is built)."""
+    def _init_scalar(self) -> None:
+        """What both scalar paths keep: the stage solutions of the last :data:`SOLUTION_CACHE`
+        frequencies, and the compiled march's state, decided at the first march
+        (:meth:`_use_compiled`; the kernel module is imported there, not when the flow is built)."""
+        self._solution_cache: Recent = Recent(SOLUTION_CACHE)  # Ω → StageSolutions
+        self._template: StageSolutions | None = None
         self._compiled: bool | None = None
         self._stage_table: FloatArray | None = None
         self._kernel: tuple | None = None  # (march, FULL, BUDGET) of the kernel module
@@ -176,12 +182,21 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
         self._buffers: tuple | None = None  # the record's arrays, written by every march
 
     def solutions(self, omega: float) -> StageSolutions:
-        """The closed-form stage solutions at forcing frequency ``omega`` (the last one is cached)."""
-        if self._cache is not None and self._cache[0] == omega:
-            return self._cache[1]
-        sol = StageSolutions(self.model, omega, self.samples_per_scale)
-        self._cache = (float(omega), sol)
-        return sol
+        """The closed-form stage solutions at forcing frequency ``omega`` (those of the last
+        :data:`SOLUTION_CACHE` frequencies kept; a new one made from the first ones, only what
+        depends on Ω afresh: :meth:`StageSolutions.at_omega`)."""
+        sol = self._solution_cache.get(omega)
+        if sol is not None:
+            return sol
+        if self._template is None:
+            sol = self._template = self._stage_solutions(omega)
+        else:
+            sol = self._template.at_omega(omega)
+        return self._solution_cache.put(float(omega), sol)
+
+    def _stage_solutions(self, omega: float) -> StageSolutions:
+        """The flow's first stage solutions (its law's stages)."""
+        return StageSolutions(self.model, omega, self.samples_per_scale)
 
     def propagate(self, x0: FloatArray | tuple[float, float], t0: float, t1: float, omega: float) -> Trajectory:
         """Integrate exactly from state ``x0`` = (δ, δ') (rad, rad/s) at ``t0`` to ``t1`` ≥ t0 (s)

@@ -322,8 +322,6 @@ class NonsmoothTrajectory(ExactTrajectory):
         return np.unique(np.asarray(hit, dtype=float))
 
 
-#: Frequencies whose stage solutions :meth:`_ScalarEventFlow.solutions` keeps.
-SOLUTION_CACHE = 4
 #: The last trajectories :meth:`_ScalarEventFlow.propagate` keeps, by their exact arguments (x0, t0,
 #: t1, Ω): a shooting continuation asks again for the period it has just integrated (the row of an
 #: accepted point after the corrector's last evaluation there, its event structure).
@@ -342,9 +340,7 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
         ExactIntegrator.__init__(self, system, options)
         self.model = None  # the modes' table stands for the model (:meth:`solutions`)
         self.max_segments = self.options.budget(events=True)
-        self._solution_cache: Recent = Recent(SOLUTION_CACHE)  # Ω → StageSolutions
         self._memo: Recent = Recent(MEMO)  # (x0, t0, t1, Ω) → NonsmoothTrajectory
-        self._template: StageSolutions | None = None
         st = system.law.stages
         self._d = st.breakpoints.tolist()
         self._s = st.slopes.tolist()
@@ -354,19 +350,12 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
         self._L = float(system.length_scale())
         self._law_arrays = tuple(np.asarray(x, dtype=float) for x in (self._d, self._s, self._e, self._J, self._r))
         self._x_lock = self.options.lock_excursion * self._L
-        self._init_compiled()  # the compiled march where every mode's segment has the modal form
+        self._init_scalar()  # the solutions kept, the compiled march where every mode has the modal form
 
-    def solutions(self, omega: float) -> StageSolutions:
-        """The closed-form solutions of every mode at ``omega`` (the last :data:`SOLUTION_CACHE`
-        frequencies cached: a shooting continuation evaluates the period map at Ω and at Ω + h)."""
-        sol = self._solution_cache.get(omega)
-        if sol is not None:
-            return sol
-        if self._template is None:
-            sol = self._template = _mode_solutions(self.system, omega, self.samples_per_scale)
-        else:  # only the forcing's parts depend on Ω
-            sol = self._template.at_omega(omega)
-        return self._solution_cache.put(float(omega), sol)
+    def _stage_solutions(self, omega: float) -> StageSolutions:
+        """The closed-form solutions of every mode (:func:`_mode_solutions`): the first of
+        :meth:`solutions`, the others made from it."""
+        return _mode_solutions(self.system, omega, self.samples_per_scale)
 
     def velocity_scale(self, omega: float) -> float:
         """L ν: the length scale times the larger of Ω and the stiffest stage's natural frequency."""
