@@ -382,3 +382,31 @@ def test_compiled_march_needs_the_modal_form() -> None:
         integ = ExactIntegrator(model)
         assert integ.propagate((0.3, -0.5), 0.0, 20.0, 0.7).n_segments > 1
         assert integ._compiled is False
+
+
+def test_segment_budget_is_kept_by_both_marches() -> None:
+    """More crossings than ``max_events`` in one march: ConvergenceError naming the budget, from the
+    compiled march and the Python march alike; a march that fits is not refused."""
+    from rattle.errors import ConvergenceError
+
+    model = reference_case()
+    for compiled in (True, False):
+        integ = ExactIntegrator(model, FlowOptions(max_events=20))
+        if not compiled:
+            integ._compiled = False
+        with pytest.raises(ConvergenceError, match="max_segments` = 20"):
+            integ.propagate((0.4, 0.14), 0.0, 200.0, 0.7)
+        with pytest.raises(ConvergenceError, match="max_segments` = 20"):
+            integ.advance(np.array([0.4, 0.14]), 0.0, 200.0, 0.7)
+        assert integ.propagate((0.4, 0.14), 0.0, 20.0, 0.7).n_segments <= 21
+
+
+def test_compiled_record_grows_past_its_capacity() -> None:
+    """A march of more segments than the record holds (64 at first) is run again with room for
+    them: the same trajectory as the Python march's, and the flow's record kept for the next."""
+    model = reference_case()
+    a, b, compiled, _ = _compiled_and_python(model, (0.4, 0.14), 0.0, 100 * 2 * np.pi / 0.8, 0.8)
+    assert a.n_segments > 64 and compiled._capacity > 64
+    _assert_same_march(a, b)
+    again = compiled.propagate((0.4, 0.14), 0.0, 2 * np.pi / 0.8, 0.8)  # the kept record, shorter
+    np.testing.assert_array_equal(again.t_start, a.t_start[: again.n_segments])
