@@ -410,3 +410,9 @@ def test_compiled_record_grows_past_its_capacity() -> None:
     _assert_same_march(a, b)
     again = compiled.propagate((0.4, 0.14), 0.0, 2 * np.pi / 0.8, 0.8)  # the kept record, shorter
     np.testing.assert_array_equal(again.t_start, a.t_start[: again.n_segments])
+    # advance keeps no record: the same end, and no record made or grown
+    fresh = ExactIntegrator(model)
+    x1, M = fresh.advance(np.array([0.4, 0.14]), 0.0, 100 * 2 * np.pi / 0.8, 0.8)
+    np.testing.assert_array_equal(x1, a.state1)
+    np.testing.assert_array_equal(M, a.sensitivity)
+    assert fresh._compiled and fresh._buffers is None and fresh._capacity == 64

@@ -54,6 +54,10 @@ _SLIP = 0  # the compiled march's kind of motion of a continuous law (no stick, 
 #: Frequencies whose stage solutions a scalar flow keeps (:meth:`_ScalarFlow.solutions`): a shooting
 #: continuation evaluates the period map at Ω and at Ω + h.
 SOLUTION_CACHE = 4
+#: The compiled march's record when only its end is asked for (:meth:`_ScalarFlow.advance`): empty
+#: arrays, nothing kept
+_NO_RECORD = (np.empty(0), np.empty((0, 3), dtype=np.int64), np.empty((0, 4)), np.empty(0),
+              np.empty(0, dtype=np.int64))
 
 #: the compiled march, imported at the first march of a flow (a command that builds no flow does not
 #: pay its import)
@@ -237,7 +241,8 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
         sol = self.solutions(omega)
         d0, v0, t0 = float(x0[0]), float(x0[1]), float(t0)
         if self._use_compiled(sol):
-            _, _, d, v, m, *_ = self._run_compiled(sol, _SLIP, sol.stage_of(t0, d0, v0), 0, d0, v0, t0, float(t1))
+            _, _, d, v, m, *_ = self._run_compiled(sol, _SLIP, sol.stage_of(t0, d0, v0), 0, d0, v0, t0, float(t1),
+                                                   keep=False)
         else:
             d, v, m = self._march(sol, d0, v0, t0, float(t1), None)
         return np.array([d, v]), (np.array([[m[0], m[1]], [m[2], m[3]]]) if sensitivity else None)
@@ -263,13 +268,14 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
         )
 
     def _run_compiled(self, sol: StageSolutions, kind: int, j: int, sigma: int, d: float, v: float, t0: float,
-                      t1: float) -> tuple:
+                      t1: float, keep: bool = True) -> tuple:
         """The compiled march (:func:`~._event_kernel.march`) from (δ, δ') = (d, v) at t0 in the
         state (``kind``: slip, stick or lock; stage or breakpoint ``j``; friction sign ``sigma``) to t1:
         (segments, events, δ, δ', (Φ11, Φ12, Φ21, Φ22), the record's arrays: segment starts,
         (kind, stage, σ), (δ, δ', h0, h1) of each segment, event times and codes). The record is
         grown and the march run again when it did not fit; the budget exceeded raises. The record's
-        arrays are the flow's, written again by the next march: a caller that keeps them copies."""
+        arrays are the flow's, written again by the next march: a caller that keeps them copies.
+        Not ``keep``: no record (empty arrays), the end state and the sensitivity only."""
         kept = sol.__dict__.get("_kernel_args")  # an at_omega copy starts with its template's: Ω tells
         if kept is not None and kept[0] == sol.omega:
             args = kept[1]
@@ -284,7 +290,7 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
             sol._kernel_args = (sol.omega, args)
         march, full, budget = self._kernel
         while True:
-            record = self._buffers
+            record = self._buffers if keep else _NO_RECORD
             if record is None:
                 cap = self._capacity
                 record = self._buffers = (np.empty(cap), np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4)),
