@@ -416,3 +416,29 @@ def test_compiled_record_grows_past_its_capacity() -> None:
     np.testing.assert_array_equal(x1, a.state1)
     np.testing.assert_array_equal(M, a.sensitivity)
     assert fresh._compiled and fresh._buffers is None and fresh._capacity == 64
+
+
+@pytest.mark.skipif(not hasattr(__import__("signal"), "pthread_sigmask"), reason="no signal masks here")
+def test_the_first_compiled_march_of_a_process_holds_the_stopping_signals(monkeypatch) -> None:
+    """numba loads (or compiles) the kernel at its first call: SIGINT, SIGTERM and SIGHUP are held
+    during that call (rattle._lazy.call_held), not during the later ones."""
+    import signal
+
+    from rattle.timeint import _integrator
+
+    integ = ExactIntegrator(reference_case())
+    integ.advance(np.array([0.1, 0.05]), 0.0, 1.0, 0.7)  # decides the compiled march
+    march, full, budget = integ._kernel
+    masks = []
+
+    def spy(*args):
+        masks.append(signal.pthread_sigmask(signal.SIG_BLOCK, []))
+        return march(*args)
+
+    integ._kernel = (spy, full, budget)
+    monkeypatch.setattr(_integrator, "_KERNEL_LOADED", [False])
+    for _ in range(2):
+        integ.advance(np.array([0.1, 0.05]), 0.0, 1.0, 0.7)
+    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+    assert held <= set(masks[0]) and not held & set(masks[1])
+    assert not held & set(signal.pthread_sigmask(signal.SIG_BLOCK, []))

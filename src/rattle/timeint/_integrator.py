@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from .._lazy import lazy_module
+from .._lazy import call_held, lazy_module
 from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_state
@@ -62,6 +62,9 @@ _NO_RECORD = (np.empty(0), np.empty((0, 3), dtype=np.int64), np.empty((0, 4)), n
 #: the compiled march, imported at the first march of a flow (a command that builds no flow does not
 #: pay its import)
 _event_kernel = lazy_module("rattle.timeint._event_kernel")
+#: Whether this process has called the compiled march: its first call loads the cached code (or
+#: compiles it), with the stopping signals held (:func:`~rattle._lazy.call_held`)
+_KERNEL_LOADED = [False]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -295,7 +298,12 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
                 cap = self._capacity
                 record = self._buffers = (np.empty(cap), np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4)),
                                          np.empty(cap), np.empty(cap, dtype=np.int64))
-            status, ns, ne, d1, v1, m11, m12, m21, m22 = march(*args, kind, j, sigma, d, v, t0, t1, *record)
+            if _KERNEL_LOADED[0]:
+                status, ns, ne, d1, v1, m11, m12, m21, m22 = march(*args, kind, j, sigma, d, v, t0, t1, *record)
+            else:  # numba loads the kernel: a stop is not to land half-way in its machinery
+                status, ns, ne, d1, v1, m11, m12, m21, m22 = call_held(march, *args, kind, j, sigma, d, v, t0, t1,
+                                                                       *record)
+                _KERNEL_LOADED[0] = True
             if status != full:
                 break
             self._capacity *= 4  # a longer record than any so far: again with room for it
