@@ -5,8 +5,9 @@ Run:  python benchmarks/bench_system_flow.py  [--repeat 5] [--periods 100]
 Prints, best of ``--repeat`` runs, the time to integrate ``--periods`` forcing periods:
 
 (a) n = 1: the paper's clutch (reference case) as a System (``ExactIntegrator(model.system())``:
-    the stage-matrix path) next to ``ExactIntegrator(model)`` (the compiled scalar path), at Ω = 0.3, 0.8, 1.6, and the largest
-    difference of their final states;
+    the stage-matrix path) next to ``ExactIntegrator(model)`` (the compiled scalar path: the event
+    kernel's march, ``timeint/_event_kernel.py``) and that path's Python march (the reference,
+    ``_compiled = False``), at Ω = 0.3, 0.8, 1.6, and the largest differences of their final states;
 (b) n = 3: a grounded 3-inertia chain (M = diag(1, 2, 1.5), clutch between 1 and 2, gear
     backlash between 2 and 3, two forcing harmonics) and n = 2: the free version of that chain
     (relative coordinates; inside the gear gap an undamped rigid relative mode: a defective
@@ -67,16 +68,20 @@ def main() -> None:
     P = args.periods
 
     print(f"(a) n = 1, reference case, {P} periods from (0.01, 0)")
-    print("    Omega       scalar path    stage-matrix path   ratio   segments   max |dz|")
+    print("    Omega   scalar, compiled   scalar, Python march   stage-matrix path   Python/compiled   segments"
+          "   max |dz| Python, stage-matrix")
     model = rattle.reference_case()
     system = model.system()
     for om in (0.3, 0.8, 1.6):
         T = 2 * math.pi / om
-        ex, si = ExactIntegrator(model), ExactIntegrator(system)
+        ex, py, si = ExactIntegrator(model), ExactIntegrator(model), ExactIntegrator(system)
+        py._compiled = False  # the scalar path's Python march (the reference)
         te, a = best_of(args.repeat, lambda: ex.propagate([0.01, 0.0], 0.0, P * T, om))
+        tp, c = best_of(args.repeat, lambda: py.propagate([0.01, 0.0], 0.0, P * T, om))
         ts, b = best_of(args.repeat, lambda: si.propagate([0.01, 0.0], 0.0, P * T, om))
-        print(f"    {om:5.2f}   {1e3 * te:10.1f} ms   {1e3 * ts:11.1f} ms   {ts / te:5.2f}   {b.n_segments:8d}"
-              f"   {np.abs(a.state1 - b.state1).max():.1e}")
+        dz_python, dz_stage = np.abs(a.state1 - c.state1).max(), np.abs(a.state1 - b.state1).max()
+        print(f"    {om:5.2f}   {1e3 * te:13.1f} ms   {1e3 * tp:17.1f} ms   {1e3 * ts:14.1f} ms   {tp / te:15.1f}"
+              f"   {b.n_segments:8d}   {dz_python:.1e}, {dz_stage:.1e}")
 
     print(f"\n(b) chains, {P} periods from the static equilibrium at rest")
     print("    system              Omega   stage-matrix path   segments   per segment   solve_ivp (5 periods)")

@@ -57,11 +57,20 @@ def import_held(name: str) -> types.ModuleType:
     module = sys.modules.get(name)
     if module is not None:
         return module
+    return call_held(importlib.import_module, name)
+
+
+def call_held(fn: Callable[..., Any], *args: Any) -> Any:
+    """``fn(*args)`` with SIGINT, SIGTERM and SIGHUP held until it returns (:func:`import_held`'s
+    rule for any call that must not be cut in half: the first call of a compiled kernel, which
+    loads its cached code — or compiles it on a fresh install — in numba's machinery, where a
+    stop raised half-way can be swallowed and the run go on). Where signal masks do not exist
+    (Windows) it is a plain call."""
     if not _HELD or not hasattr(signal, "pthread_sigmask"):
-        return importlib.import_module(name)
+        return fn(*args)
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
     try:
-        return importlib.import_module(name)
+        return fn(*args)
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
@@ -94,4 +103,4 @@ def lazy_module(name: str) -> Any:
     return LazyModule(name)
 
 
-__all__ = ["LazyModule", "import_held", "lazy_exports", "lazy_module"]
+__all__ = ["LazyModule", "call_held", "import_held", "lazy_exports", "lazy_module"]

@@ -10,7 +10,9 @@ import scipy.linalg
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rattle.model import Backlash, Clutch, Excitation, Linear, Model, Piecewise, backlash_case, reference_case
+from rattle.model import (
+    Backlash, Clutch, Excitation, Linear, Model, Piecewise, Unilateral, backlash_case, reference_case,
+)
 from rattle.timeint import ExactIntegrator, FlowOptions, StageSolutions
 
 
@@ -288,3 +290,155 @@ def test_start_on_breakpoint_follows_direction_of_motion():
     assert integ.propagate((b, -0.1), 0.0, 0.5, 1.0).stage[0] == 1
     # At rest on the breakpoint: F(0) = F_m + F_p1 > 0 pushes into the outer stage.
     assert integ.propagate((b, 0.0), 0.0, 0.5, 1.0).stage[0] == 2
+
+
+# --- the compiled march against the Python march (the reference) ------------------------------------
+def _random_continuous(rng: np.random.Generator, i: int) -> Model:
+    """A random continuous law (piecewise with a free stage, clutch, backlash, unilateral stop),
+    under-damped or (every fourth) over-damped, forced by up to three harmonics with phases."""
+    kind = i % 4
+    if kind == 0:
+        k = int(rng.integers(1, 5))
+        bps = np.sort(rng.uniform(-0.3, 0.3, k))
+        slopes = rng.uniform(0.2, 1.5, k + 1)
+        if k > 1:
+            slopes[rng.integers(1, k)] = 0.0  # an inner free stage
+        elastic = Piecewise(breakpoints=tuple(bps), slopes=tuple(slopes))
+    elif kind == 1:
+        elastic = Clutch(alpha=rng.uniform(0.0, 0.6), b=rng.uniform(0.02, 0.2))
+    elif kind == 2:
+        elastic = Backlash(b=rng.uniform(0.02, 0.2))
+    else:
+        elastic = Unilateral(gap=rng.uniform(0.0, 0.1), side="positive")
+    h = int(rng.integers(1, 4))
+    damping = 3.0 if i % 4 == 3 else rng.uniform(0.01, 0.3)  # over-damped: c² > 4 k s on every stage
+    mean = rng.uniform(0.01, 0.08) if kind == 3 else rng.uniform(-0.05, 0.05)  # the stop needs a mean load
+    return _model(elastic, damping=damping, stiffness=rng.uniform(0.5, 1.5), mean=mean,
+                  amplitudes=tuple(rng.uniform(0.02, 0.3, h)), phases=tuple(rng.uniform(0.0, 6.0, h)))
+
+
+def _compiled_and_python(model: Model, x0, t0: float, t1: float, omega: float):
+    compiled, python = ExactIntegrator(model), ExactIntegrator(model)
+    python._compiled = False  # the Python march
+    a, b = compiled.propagate(x0, t0, t1, omega), python.propagate(x0, t0, t1, omega)
+    assert compiled._compiled
+    return a, b, compiled, python
+
+
+def _assert_same_march(a, b) -> None:
+    """The same segments and stages, crossing times, states and sensitivity to round-off."""
+    np.testing.assert_array_equal(a.stage, b.stage)
+    scale = max(1.0, float(np.max(np.abs(b.x_start))))
+    np.testing.assert_allclose(a.t_start, b.t_start, rtol=1e-13, atol=1e-13 * max(1.0, abs(b.t1)))
+    np.testing.assert_allclose(a.x_start, b.x_start, rtol=1e-13, atol=1e-13 * scale)
+    np.testing.assert_allclose(a.homogeneous, b.homogeneous, rtol=1e-13, atol=1e-13 * scale)
+    np.testing.assert_allclose(a.state1, b.state1, rtol=1e-13, atol=1e-13 * scale)
+    np.testing.assert_allclose(a.sensitivity, b.sensitivity, rtol=1e-12,
+                               atol=1e-13 * max(1.0, float(np.max(np.abs(b.sensitivity)))))
+
+
+@pytest.mark.parametrize("seed", [3, 17])
+def test_compiled_march_is_the_python_march(seed: int) -> None:
+    """The compiled march (timeint._event_kernel, the law as a discontinuous one without jumps or
+    friction) takes the Python march's steps on random continuous laws: the same stages, crossing
+    times, states, homogeneous parts and sensitivity to round-off, over ten periods from a random
+    state; ``advance`` gives propagate's end."""
+    rng = np.random.default_rng(seed)
+    crossings = 0
+    for i in range(16):
+        model = _random_continuous(rng, i)
+        omega = rng.uniform(0.3, 2.5)
+        x0 = (rng.uniform(-0.4, 0.4), rng.uniform(-0.3, 0.3))
+        t0 = rng.uniform(0.0, 50.0)
+        t1 = t0 + 10 * 2 * np.pi / omega
+        a, b, compiled, _ = _compiled_and_python(model, x0, t0, t1, omega)
+        _assert_same_march(a, b)
+        crossings += a.n_segments - 1
+        x1, M = compiled.advance(np.array(x0), t0, t1, omega)
+        np.testing.assert_array_equal(x1, a.state1)
+        np.testing.assert_array_equal(M, a.sensitivity)
+    assert crossings > 100
+
+
+@pytest.mark.parametrize("eps", [1e-9, 1e-12, 0.0, -1e-9])
+@pytest.mark.parametrize("t_top", [1.7, 3.2117, 5.0031])
+def test_compiled_march_resolves_grazes_as_the_python_march(eps: float, t_top: float) -> None:
+    """A stage-1 peak ε above, on or below the breakpoint, anywhere in a grid cell: the compiled
+    march finds the short excursion (two crossings) or none, as the Python march."""
+    b = 0.1
+    model = _model(Clutch(alpha=0.25, b=b), mean=0.0, amplitudes=(0.0,))
+    x0 = _grazing_start(model, 1, np.array([b + eps, 0.0]), t_top, 0.0)
+    a, ref, _, _ = _compiled_and_python(model, x0, 0.0, t_top + 2.0, 1.0)
+    _assert_same_march(a, ref)
+    assert list(a.stage[-3:] if eps > 0.0 else a.stage[-1:]) == ([1, 2, 1] if eps > 0.0 else [1])
+    assert (2 in a.stage) == (eps > 0.0)
+
+
+def test_compiled_march_needs_the_modal_form() -> None:
+    """A stage near critical damping (the modal form's amplitudes blow up) or free without
+    damping (a double zero eigenvalue) keeps the Python march."""
+    for model in (_model(Clutch(alpha=0.25, b=0.05), damping=2.0, amplitudes=(0.3,)),
+                  _model(Backlash(b=0.1), damping=0.0, mean=0.02, amplitudes=(0.05,))):
+        integ = ExactIntegrator(model)
+        assert integ.propagate((0.3, -0.5), 0.0, 20.0, 0.7).n_segments > 1
+        assert integ._compiled is False
+
+
+def test_segment_budget_is_kept_by_both_marches() -> None:
+    """More crossings than ``max_events`` in one march: ConvergenceError naming the budget, from the
+    compiled march and the Python march alike; a march that fits is not refused."""
+    from rattle.errors import ConvergenceError
+
+    model = reference_case()
+    for compiled in (True, False):
+        integ = ExactIntegrator(model, FlowOptions(max_events=20))
+        if not compiled:
+            integ._compiled = False
+        with pytest.raises(ConvergenceError, match="max_segments` = 20"):
+            integ.propagate((0.4, 0.14), 0.0, 200.0, 0.7)
+        with pytest.raises(ConvergenceError, match="max_segments` = 20"):
+            integ.advance(np.array([0.4, 0.14]), 0.0, 200.0, 0.7)
+        assert integ.propagate((0.4, 0.14), 0.0, 20.0, 0.7).n_segments <= 21
+
+
+def test_compiled_record_grows_past_its_capacity() -> None:
+    """A march of more segments than the record holds (64 at first) is run again with room for
+    them: the same trajectory as the Python march's, and the flow's record kept for the next."""
+    model = reference_case()
+    a, b, compiled, _ = _compiled_and_python(model, (0.4, 0.14), 0.0, 100 * 2 * np.pi / 0.8, 0.8)
+    assert a.n_segments > 64 and compiled._capacity > 64
+    _assert_same_march(a, b)
+    again = compiled.propagate((0.4, 0.14), 0.0, 2 * np.pi / 0.8, 0.8)  # the kept record, shorter
+    np.testing.assert_array_equal(again.t_start, a.t_start[: again.n_segments])
+    # advance keeps no record: the same end, and no record made or grown
+    fresh = ExactIntegrator(model)
+    x1, M = fresh.advance(np.array([0.4, 0.14]), 0.0, 100 * 2 * np.pi / 0.8, 0.8)
+    np.testing.assert_array_equal(x1, a.state1)
+    np.testing.assert_array_equal(M, a.sensitivity)
+    assert fresh._compiled and fresh._buffers is None and fresh._capacity == 64
+
+
+@pytest.mark.skipif(not hasattr(__import__("signal"), "pthread_sigmask"), reason="no signal masks here")
+def test_the_first_compiled_march_of_a_process_holds_the_stopping_signals(monkeypatch) -> None:
+    """numba loads (or compiles) the kernel at its first call: SIGINT, SIGTERM and SIGHUP are held
+    during that call (rattle._lazy.call_held), not during the later ones."""
+    import signal
+
+    from rattle.timeint import _integrator
+
+    integ = ExactIntegrator(reference_case())
+    integ.advance(np.array([0.1, 0.05]), 0.0, 1.0, 0.7)  # decides the compiled march
+    march, full, budget = integ._kernel
+    masks = []
+
+    def spy(*args):
+        masks.append(signal.pthread_sigmask(signal.SIG_BLOCK, []))
+        return march(*args)
+
+    integ._kernel = (spy, full, budget)
+    monkeypatch.setattr(_integrator, "_KERNEL_LOADED", [False])
+    for _ in range(2):
+        integ.advance(np.array([0.1, 0.05]), 0.0, 1.0, 0.7)
+    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+    assert held <= set(masks[0]) and not held & set(masks[1])
+    assert not held & set(signal.pthread_sigmask(signal.SIG_BLOCK, []))

@@ -265,9 +265,12 @@ class _Settler:
     def step(self) -> None:
         i = self.i + 1
         self.X[i] = x = self.flow.advance(self.X[i - 1], self.T)
-        self.P[i] = x / self.scale
+        p = self.P[i]
+        np.divide(x, self.scale, out=p)
         n = min(self.N, i)
-        self.d[i, 1 : n + 1] = np.max(np.abs(self.P[i] - self.P[i - n : i][::-1]), axis=1)
+        # d[i, m] = ‖P_i − P_{i−m}‖ for m = n … 1 from the rows i − n … i − 1 (array methods: the
+        # loop's cost per period is numpy's per call, ~1 µs less than np.max's dispatch)
+        self.d[i, n:0:-1] = np.abs(self.P[i - n : i] - p).max(axis=1)
         self.i = i
 
     def shoot(self, x: FloatArray, n: int) -> Shot:
@@ -347,7 +350,7 @@ class _Settler:
             shot, n = found
             self.candidate = _Candidate(shot, n, self.cycle_points(shot, n), i)
         cand = self.candidate
-        dist = np.max(np.abs((cand.cycle - self.X[i]) / self.scale), axis=1)
+        dist = np.abs((cand.cycle - self.X[i]) / self.scale).max(axis=1)
         k = int(np.argmin(dist))
         if dist[k] > self.opts.capture_distance:
             if i - cand.created > max(64, 8 * cand.period):

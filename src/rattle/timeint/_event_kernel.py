@@ -1,5 +1,9 @@
-"""Compiled event march of the single equation with a discontinuous law (numba): the loop of
-:meth:`~._nonsmooth._ScalarEventFlow._march_events` in scalar loops.
+"""Compiled march of the single equation (numba): the loop of
+:meth:`~._nonsmooth._ScalarEventFlow._march_events` in scalar loops, for a discontinuous law and
+for a continuous one (:class:`~._integrator._ScalarFlow`: the law without jumps or friction, its
+stages the modes σ = 0; the saltation at a breakpoint where the field is continuous — no jump, the
+same friction level on both sides — is the identity, as in the Python marches). One compiled
+march for both scalar paths: one dispatcher whose cache a command loads.
 
 The equation, its modes (slip on a stage with friction sign σ, stick, lock), its events and
 their saltation matrices are those of :mod:`._nonsmooth` (its module docstring). On a shooting
@@ -20,10 +24,10 @@ The grid scans sum the modes in a fixed order where numpy's matrix product may n
 value may differ from the array code's in its last bits; it only seeds a regula falsi start,
 and the roots are the same to round-off. A segment near critical damping (the modal amplitudes
 blow up; :class:`_Segment` falls back to the transition-matrix form) is not covered: such a law
-keeps the Python march (:data:`SUPPORTED` decides per mode table).
+keeps the Python march (:func:`supported` decides per mode table).
 
-``AVAILABLE`` is False when numba cannot be imported; the flow then keeps the Python march (the
-reference).
+``AVAILABLE`` is False when numba cannot be imported; the flows then keep their Python marches (the
+references: :meth:`~._integrator._ScalarFlow._march`, :meth:`~._nonsmooth._ScalarEventFlow._march_events`).
 """
 
 from __future__ import annotations
@@ -68,7 +72,7 @@ _MAX_CHUNK = _I(4096)
 SLIP, STICK, LOCK = 0, 1, 2
 #: event codes of :func:`march` (the names of NonsmoothTrajectory.event_kind)
 EVENT_NAMES = ("crossing", "reversal", "stick", "unstick", "lock", "unlock")
-_CROSSING, _REVERSAL, _STICK, _UNSTICK, _LOCK, _UNLOCK = range(6)
+_CROSSING, _REVERSAL, _STICK, _UNSTICK, _LOCK, _UNLOCK = (_I(i) for i in range(6))
 #: status of :func:`march`: done, the event budget exceeded, the record's capacity exceeded
 DONE, BUDGET, FULL = 0, 1, 2
 
@@ -526,12 +530,34 @@ def _band_exit(t0, t1, lo, hi, sps, nw, fc, fs, mean, S, taus, F, F1):
 
 
 # --- the march ---------------------------------------------------------------------------------
+def _keep_segment(rec_t, rec_i, rec_x, ns, t, kind, j, sgn, d, v, h0, h1):
+    """Segment ``ns`` into the record (one of zero length before it, at the same t, replaced): the
+    new count; nothing kept when the record is empty (a march for its end only)."""
+    if rec_t.size == 0:
+        return ns
+    if ns > 0 and rec_t[ns - 1] == t:
+        ns -= 1
+    rec_t[ns] = t
+    rec_i[ns, 0], rec_i[ns, 1], rec_i[ns, 2] = kind, j, sgn
+    rec_x[ns, 0], rec_x[ns, 1], rec_x[ns, 2], rec_x[ns, 3] = d, v, h0, h1
+    return ns + 1
+
+
+def _keep_event(ev_t, ev_k, ne, t, code):
+    """Event ``ne`` (time, code) into the record: the new count (nothing kept in an empty record)."""
+    if ev_t.size == 0:
+        return ne
+    ev_t[ne], ev_k[ne] = t, code
+    return ne + 1
+
+
 def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offset, jump, fric, k, c, x_lock,
            max_events, kind, j, sgn, d, v, t0, t1, rec_t, rec_i, rec_x, ev_t, ev_k):
     """The march of _ScalarEventFlow._march_events from (δ, δ') = (d, v) at t0 in the state
     (kind, stage or breakpoint j, friction sign sgn) to t1, recording the segments (start time;
     kind, stage, sign; start state and homogeneous part) and events (time, code of
-    :data:`EVENT_NAMES`). Returns (status, segments, events, δ, δ', Φ11, Φ12, Φ21, Φ22)."""
+    :data:`EVENT_NAMES`) — none when the record's arrays are empty (the end state only).
+    Returns (status, segments, events, δ, δ', Φ11, Φ12, Φ21, Φ22)."""
     H = nw.size
     S = np.empty((8, H + 2))
     taus = np.empty(_MAX_CHUNK + 1)
@@ -553,19 +579,14 @@ def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offse
         m11 = m22 = 0.0
     n_events = 0
     while True:
-        if ns >= cap or ne >= cap:
+        if cap > 0 and (ns >= cap or ne >= cap):
             return FULL, ns, ne, d, v, m11, m12, m21, m22
         if kind == SLIP:
             mode = 3 * j + sgn + 1
             K, h0, h1, d_floor, v_floor = _seg_init(S, st, sigma, xr, xi, nw, mode, t, d, v)
             P, r, a = st[mode, 7], st[mode, 8], st[mode, 9]
             ks, ke = st[mode, 5], st[mode, 6]
-            if ns > 0 and rec_t[ns - 1] == t:
-                ns -= 1
-            rec_t[ns] = t
-            rec_i[ns, 0], rec_i[ns, 1], rec_i[ns, 2] = SLIP, j, sgn
-            rec_x[ns, 0], rec_x[ns, 1], rec_x[ns, 2], rec_x[ns, 3] = d, v, h0, h1
-            ns += 1
+            ns = _keep_segment(rec_t, rec_i, rec_x, ns, t, kind, j, sgn, d, v, h0, h1)
             tau_end = t1 - t
             step = grid_step[mode]
             tau_v = math.nan
@@ -616,16 +637,15 @@ def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offse
                         m11, m12, m21, m22 = 0.0, 0.0, 0.0, 0.0
                     else:
                         m21, m22 = 0.0, 0.0
-                    ev_t[ne], ev_k[ne] = t, _LOCK
-                    ne += 1
+                    ne = _keep_event(ev_t, ev_k, ne, t, _LOCK)
                 else:
-                    a_m = F - c * v - k * ((slope[j] * d + offset[j]) + fric[j] * sgn)
-                    a_p = F - c * v - k * ((slope[jn] * d + offset[jn]) + fric[jn] * sn)
-                    q = (a_p - a_m) / v if v != 0.0 else 0.0
-                    m21, m22 = m21 + q * m11, m22 + q * m12
+                    if jump[i] > 0.0 or fric[i] != fric[i + 1]:  # the field jumps: the saltation matrix
+                        a_m = F - c * v - k * ((slope[j] * d + offset[j]) + fric[j] * sgn)
+                        a_p = F - c * v - k * ((slope[jn] * d + offset[jn]) + fric[jn] * sn)
+                        q = (a_p - a_m) / v if v != 0.0 else 0.0
+                        m21, m22 = m21 + q * m11, m22 + q * m12
                     j, sgn = jn, sn
-                    ev_t[ne], ev_k[ne] = t, _CROSSING
-                    ne += 1
+                    ne = _keep_event(ev_t, ev_k, ne, t, _CROSSING)
             else:  # δ' = 0 inside stage j with friction
                 d = _seg_state(S, K, P, r, a, tau)[0]
                 v = 0.0
@@ -633,23 +653,16 @@ def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offse
                 if abs(R) <= k * fric[j]:
                     kind = STICK
                     m21, m22 = 0.0, 0.0
-                    ev_t[ne], ev_k[ne] = t, _STICK
-                    ne += 1
+                    ne = _keep_event(ev_t, ev_k, ne, t, _STICK)
                 else:
                     sn = 1 if R > 0.0 else -1
                     a_m, a_p = R - k * fric[j] * sgn, R - k * fric[j] * sn
                     if a_m != 0.0:
                         m21, m22 = m21 * (a_p / a_m), m22 * (a_p / a_m)
                     sgn = sn
-                    ev_t[ne], ev_k[ne] = t, _REVERSAL
-                    ne += 1
+                    ne = _keep_event(ev_t, ev_k, ne, t, _REVERSAL)
         else:
-            if ns > 0 and rec_t[ns - 1] == t:
-                ns -= 1
-            rec_t[ns] = t
-            rec_i[ns, 0], rec_i[ns, 1], rec_i[ns, 2] = kind, j, 0
-            rec_x[ns, 0], rec_x[ns, 1], rec_x[ns, 2], rec_x[ns, 3] = d, 0.0, 0.0, 0.0
-            ns += 1
+            ns = _keep_segment(rec_t, rec_i, rec_x, ns, t, kind, j, 0, d, 0.0, 0.0, 0.0)
             if kind == STICK:
                 fd = k * (slope[j] * d + offset[j])
                 lo, hi = fd - k * fric[j], fd + k * fric[j]
@@ -663,12 +676,11 @@ def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offse
             t = t_exit
             if kind == STICK:
                 sgn = 1 if up else -1
-                ev_t[ne], ev_k[ne] = t, _UNSTICK
+                ne = _keep_event(ev_t, ev_k, ne, t, _UNSTICK)
             else:
                 j = j + 1 if up else j
                 sgn = 0 if fric[j] == 0.0 else (1 if up else -1)
-                ev_t[ne], ev_k[ne] = t, _UNLOCK
-            ne += 1
+                ne = _keep_event(ev_t, ev_k, ne, t, _UNLOCK)
             kind, v = SLIP, 0.0
         n_events += 1
         if n_events > max_events:
@@ -682,6 +694,7 @@ if AVAILABLE:
     _fx, _newton, _polish = _jit(_fx), _jit(_newton), _jit(_polish)
     _first_stop, _resolve_cell, _first_exit, _band_exit = (_jit(_first_stop), _jit(_resolve_cell), _jit(_first_exit),
                                                            _jit(_band_exit))
+    _keep_segment, _keep_event = _jit(_keep_segment), _jit(_keep_event)
     march = _jit(_march)
 else:  # pragma: no cover
     march = None

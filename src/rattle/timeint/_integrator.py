@@ -5,8 +5,17 @@ On every stage j of the law, f(δ) = s_j δ + e_j, the equation is linear and it
 state x_s = (δ_s, δ'_s) at t_s is x(t) = p(t) + Φ_j(τ) (x_s − p(t_s)), Φ_j(τ) = exp(A_j τ),
 τ = t − t_s, in closed form (:mod:`._stage_solutions`), so nothing here is approximated: the only
 numerical step is locating the times where δ(t) reaches a breakpoint, which is done to
-round-off. The segment is evaluated in modal form with Python floats (:class:`_Segment`), the
-one-coordinate, one-element fast path.
+round-off. The segment is evaluated in modal form (:class:`_Segment`), the one-coordinate,
+one-element fast path.
+
+The march runs compiled: it is the event march of :mod:`._event_kernel` (numba, imported at the
+flow's first march), the law seen as a discontinuous one without jumps or friction — stage j is
+the kernel's mode 3 j + 1 (friction sign σ = 0), no stop of δ' is searched, no lock can occur, and
+the saltation at a breakpoint of a continuous field is the identity. It takes this module's steps
+with the same floating-point operations (the same states, crossing times and sensitivities, bit
+for bit on this machine's OpenBLAS). The Python march (:meth:`_ScalarFlow._march`, Python floats)
+stays the reference and the fallback: without numba, or for a stage near critical damping, whose
+segment has no modal form (:func:`~._event_kernel.supported`).
 
 Crossings are bracketed on a grid of ``samples_per_scale`` points per fastest time scale of the
 stage (the period of the highest forcing harmonic, the stage's natural period and the damping
@@ -26,12 +35,14 @@ import math
 
 import numpy as np
 
+from .._lazy import call_held, lazy_module
 from .._limits import check_interval
 from .._typing import FloatArray
 from .._validate import check_state
 from ..errors import ConvergenceError
 from ..model import Model, transition_scalar
 from ._exact_flow import ExactIntegrator, FlowOptions, takes_model
+from ._recent import Recent
 from ._roots import grid_chunk, resolve_cell
 from ._stage_solutions import StageSolutions
 from ._trajectory import Trajectory
@@ -39,6 +50,21 @@ from ._trajectory import Trajectory
 _EPS = float(np.finfo(float).eps)
 _FIRST_CHUNK = 48  # grid cells scanned at once for the first crossing; doubled up to _MAX_CHUNK
 _MAX_CHUNK = 4096
+_SLIP = 0  # the compiled march's kind of motion of a continuous law (no stick, no lock)
+#: Frequencies whose stage solutions a scalar flow keeps (:meth:`_ScalarFlow.solutions`): a shooting
+#: continuation evaluates the period map at Ω and at Ω + h.
+SOLUTION_CACHE = 4
+#: The compiled march's record when only its end is asked for (:meth:`_ScalarFlow.advance`): empty
+#: arrays, nothing kept
+_NO_RECORD = (np.empty(0), np.empty((0, 3), dtype=np.int64), np.empty((0, 4)), np.empty(0),
+              np.empty(0, dtype=np.int64))
+
+#: the compiled march, imported at the first march of a flow (a command that builds no flow does not
+#: pay its import)
+_event_kernel = lazy_module("rattle.timeint._event_kernel")
+#: Whether this process has called the compiled march: its first call loads the cached code (or
+#: compiles it), with the stopping signals held (:func:`~rattle._lazy.call_held`)
+_KERNEL_LOADED = [False]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -126,21 +152,58 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
     for a model with a continuous piecewise-linear law (see the module docstring); the grid of
     ``options.samples_per_scale`` points per fastest time scale of a stage brackets the crossings,
     ``options.max_events`` is the budget of segments of one ``propagate`` call (exceeded:
-    ``ConvergenceError``)."""
+    ``ConvergenceError``).
+
+    The march runs compiled (:meth:`_run_compiled`: the event march of :mod:`._event_kernel`, the
+    law seen as a discontinuous one without jumps or friction) where numba is there and every stage's
+    segment has the modal form; else in Python (:meth:`_march`, the reference)."""
+
+    #: rows of the compiled march's mode table per row of :meth:`solutions`: its modes are
+    #: m = 3 j + σ + 1 (stage j, friction sign σ); a continuous law has σ = 0 only, so stage j is
+    #: row 3 j + 1 of its stages' rows repeated three times (the mode table of the same law as a
+    #: discontinuous one, :func:`~._nonsmooth._mode_solutions`, with no friction)
+    _MODE_ROWS = 3
 
     def __init__(self, system: Model, options: FlowOptions | None = None) -> None:
         super().__init__(system, options)
         self.model = self.system
         self.max_segments = self.options.budget(events=False)
-        self._cache: tuple[float, StageSolutions] | None = None
+        st = self.model.elastic.stages
+        n = len(st.slopes)
+        # breakpoints, slopes, offsets, jumps (none), friction levels (none): the compiled march's law
+        self._law_arrays = (np.array(st.breakpoints, dtype=float), np.array(st.slopes, dtype=float),
+                            np.array(st.offsets, dtype=float), np.zeros(n - 1), np.zeros(n))
+        self._x_lock = 0.0  # no jumps: no locks
+        self._init_scalar()
+
+    def _init_scalar(self) -> None:
+        """What both scalar paths keep: the stage solutions of the last :data:`SOLUTION_CACHE`
+        frequencies, and the compiled march's state, decided at the first march
+        (:meth:`_use_compiled`; the kernel module is imported there, not when the flow is built)."""
+        self._solution_cache: Recent = Recent(SOLUTION_CACHE)  # Ω → StageSolutions
+        self._template: StageSolutions | None = None
+        self._compiled: bool | None = None
+        self._stage_table: FloatArray | None = None
+        self._kernel: tuple | None = None  # (march, FULL, BUDGET) of the kernel module
+        self._capacity = 64  # segments and events of a record (grown when a march needs more)
+        self._buffers: tuple | None = None  # the record's arrays, written by every march
 
     def solutions(self, omega: float) -> StageSolutions:
-        """The closed-form stage solutions at forcing frequency ``omega`` (the last one is cached)."""
-        if self._cache is not None and self._cache[0] == omega:
-            return self._cache[1]
-        sol = StageSolutions(self.model, omega, self.samples_per_scale)
-        self._cache = (float(omega), sol)
-        return sol
+        """The closed-form stage solutions at forcing frequency ``omega`` (those of the last
+        :data:`SOLUTION_CACHE` frequencies kept; a new one made from the first ones, only what
+        depends on Ω afresh: :meth:`StageSolutions.at_omega`)."""
+        sol = self._solution_cache.get(omega)
+        if sol is not None:
+            return sol
+        if self._template is None:
+            sol = self._template = self._stage_solutions(omega)
+        else:
+            sol = self._template.at_omega(omega)
+        return self._solution_cache.put(float(omega), sol)
+
+    def _stage_solutions(self, omega: float) -> StageSolutions:
+        """The flow's first stage solutions (its law's stages)."""
+        return StageSolutions(self.model, omega, self.samples_per_scale)
 
     def propagate(self, x0: FloatArray | tuple[float, float], t0: float, t1: float, omega: float) -> Trajectory:
         """Integrate exactly from state ``x0`` = (δ, δ') (rad, rad/s) at ``t0`` to ``t1`` ≥ t0 (s)
@@ -151,33 +214,106 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
         x0 = check_state(x0)
         t0, t1 = check_interval(t0, t1, omega)
         sol = self.solutions(omega)
-        starts: list[float] = []
-        stages: list[int] = []
-        states: list[tuple[float, float]] = []
-        homog: list[tuple[float, float]] = []
-        d, v, m = self._march(sol, float(x0[0]), float(x0[1]), t0, t1, (starts, stages, states, homog))
-        t_start = np.asarray(starts)
-        t_end = np.append(t_start[1:], t1)
+        d0, v0 = float(x0[0]), float(x0[1])
+        if self._use_compiled(sol):
+            ns, _, d, v, m, rec_t, rec_i, rec_x, _, _ = self._run_compiled(
+                sol, _SLIP, sol.stage_of(t0, d0, v0), 0, d0, v0, t0, t1)
+            if ns > 1 and rec_t[ns - 1] >= t1:
+                ns -= 1  # a crossing rounded onto t1: no segment of zero length at the end
+            t_start, stage = rec_t[:ns].copy(), rec_i[:ns, 1].copy()
+            x_start, homog = rec_x[:ns, :2].copy(), rec_x[:ns, 2:].copy()
+        else:
+            starts: list[float] = []
+            stages: list[int] = []
+            states: list[tuple[float, float]] = []
+            homs: list[tuple[float, float]] = []
+            d, v, m = self._march(sol, d0, v0, t0, t1, (starts, stages, states, homs))
+            t_start, stage = np.asarray(starts), np.asarray(stages, dtype=np.int64)
+            x_start = np.asarray(states, dtype=float).reshape(-1, 2)
+            homog = np.asarray(homs, dtype=float).reshape(-1, 2)
         return Trajectory(
             omega=float(omega), t0=t0, t1=t1, state0=x0.copy(), state1=np.array([d, v]),
-            sensitivity=np.array([[m[0], m[1]], [m[2], m[3]]]), t_start=t_start, t_end=t_end,
-            stage=np.asarray(stages, dtype=np.int64), x_start=np.asarray(states, dtype=float).reshape(-1, 2),
-            solutions=sol, homogeneous=np.asarray(homog, dtype=float).reshape(-1, 2),
+            sensitivity=np.array([[m[0], m[1]], [m[2], m[3]]]), t_start=t_start, t_end=np.append(t_start[1:], t1),
+            stage=stage, x_start=x_start, solutions=sol, homogeneous=homog,
         )
 
     def advance(self, x0: FloatArray, t0: float, t1: float, omega: float,
                 sensitivity: bool = True) -> tuple[FloatArray, FloatArray | None]:
         """The state (δ, δ') at ``t1`` and the sensitivity ∂x(t1)/∂x(t0) (None when
         ``sensitivity`` is False) only — no record kept, no checks: the period map of a shooting."""
-        d, v, m = self._march(self.solutions(omega), float(x0[0]), float(x0[1]), float(t0), float(t1), None)
+        sol = self.solutions(omega)
+        d0, v0, t0 = float(x0[0]), float(x0[1]), float(t0)
+        if self._use_compiled(sol):
+            _, _, d, v, m, *_ = self._run_compiled(sol, _SLIP, sol.stage_of(t0, d0, v0), 0, d0, v0, t0, float(t1),
+                                                   keep=False)
+        else:
+            d, v, m = self._march(sol, d0, v0, t0, float(t1), None)
         return np.array([d, v]), (np.array([[m[0], m[1]], [m[2], m[3]]]) if sensitivity else None)
 
-    def _advance(self, delta: float, velocity: float, t0: float, t1: float, omega: float) -> tuple[float, float]:
-        """The state (δ, δ') at t1 only, from (δ, δ') at t0 (no checks, no record): the hot path of
-        a simulation that only needs its Poincaré points."""
-        d, v, _ = self._march(self.solutions(omega), delta, velocity, t0, t1, None)
-        return d, v
+    # --- the compiled march ------------------------------------------------------------------
+    def _use_compiled(self, sol: StageSolutions) -> bool:
+        """Whether the march runs compiled: numba there and every mode's segment in modal form
+        (decided once, on the Ω-independent rows of the stage table, ``sol._stage_l``)."""
+        if self._compiled is None:
+            if not _event_kernel.AVAILABLE:
+                self._compiled = False
+            else:
+                table = np.array([[float(x) for x in row] for row in sol._stage_l], dtype=float)
+                self._stage_table = np.repeat(table, self._MODE_ROWS, axis=0)
+                self._compiled = bool(_event_kernel.supported(self._stage_table, float(sol.sigma)))
+                self._kernel = (_event_kernel.march, _event_kernel.FULL, _event_kernel.BUDGET)
+        return self._compiled
 
+    def _budget_error(self, t0: float, t1: float) -> ConvergenceError:
+        return ConvergenceError(
+            f"more than `max_segments` = {self.max_segments} segments between t0 = {t0!r} and "
+            f"t1 = {t1!r}: raise `max_segments` or shorten the interval"
+        )
+
+    def _run_compiled(self, sol: StageSolutions, kind: int, j: int, sigma: int, d: float, v: float, t0: float,
+                      t1: float, keep: bool = True) -> tuple:
+        """The compiled march (:func:`~._event_kernel.march`) from (δ, δ') = (d, v) at t0 in the
+        state (``kind``: slip, stick or lock; stage or breakpoint ``j``; friction sign ``sigma``) to t1:
+        (segments, events, δ, δ', (Φ11, Φ12, Φ21, Φ22), the record's arrays: segment starts,
+        (kind, stage, σ), (δ, δ', h0, h1) of each segment, event times and codes). The record is
+        grown and the march run again when it did not fit; the budget exceeded raises. The record's
+        arrays are the flow's, written again by the next march: a caller that keeps them copies.
+        Not ``keep``: no record (empty arrays), the end state and the sensitivity only."""
+        kept = sol.__dict__.get("_kernel_args")  # an at_omega copy starts with its template's: Ω tells
+        if kept is not None and kept[0] == sol.omega:
+            args = kept[1]
+        else:
+            rows = self._MODE_ROWS
+            args = (
+                self._stage_table, float(sol.sigma), np.repeat(sol.xr, rows, axis=0), np.repeat(sol.xi, rows, axis=0),
+                np.array(sol.nw, dtype=float), np.array(sol.fc, dtype=float), np.array(sol.fs, dtype=float),
+                float(sol.mean), np.repeat(np.asarray(sol.grid_step, dtype=float), rows),
+                float(self.samples_per_scale), *self._law_arrays, float(self.system.k), float(self.system.c),
+                self._x_lock, self.max_segments)
+            sol._kernel_args = (sol.omega, args)
+        march, full, budget = self._kernel
+        while True:
+            record = self._buffers if keep else _NO_RECORD
+            if record is None:
+                cap = self._capacity
+                record = self._buffers = (np.empty(cap), np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4)),
+                                         np.empty(cap), np.empty(cap, dtype=np.int64))
+            if _KERNEL_LOADED[0]:
+                status, ns, ne, d1, v1, m11, m12, m21, m22 = march(*args, kind, j, sigma, d, v, t0, t1, *record)
+            else:  # numba loads the kernel: a stop is not to land half-way in its machinery
+                status, ns, ne, d1, v1, m11, m12, m21, m22 = call_held(march, *args, kind, j, sigma, d, v, t0, t1,
+                                                                       *record)
+                _KERNEL_LOADED[0] = True
+            if status != full:
+                break
+            self._capacity *= 4  # a longer record than any so far: again with room for it
+            self._buffers = None
+        if status == budget:
+            raise self._budget_error(t0, t1)
+        rec_t, rec_i, rec_x, ev_t, ev_k = record
+        return ns, ne, d1, v1, (m11, m12, m21, m22), rec_t, rec_i, rec_x, ev_t, ev_k
+
+    # --- the Python march (the reference) ----------------------------------------------------
     def _march(
         self, sol: StageSolutions, d: float, v: float, t0: float, t1: float,
         record: tuple[list, list, list, list] | None,
@@ -210,10 +346,7 @@ class _ScalarFlow(ExactIntegrator, takes=takes_model, kind="a rattle Model"):
             v = v_c
             j, t = j_new, t + tau_c
             if n_seg > self.max_segments:
-                raise ConvergenceError(
-                    f"more than `max_segments` = {self.max_segments} segments between t0 = {t0!r} and "
-                    f"t1 = {t1!r}: raise `max_segments` or shorten the interval"
-                )
+                raise self._budget_error(t0, t1)
 
     # --- crossing search -----------------------------------------------------------------------
     def _first_exit(self, seg: _Segment, tau_end: float) -> tuple[float, int, float, float]:

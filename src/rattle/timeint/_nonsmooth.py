@@ -22,7 +22,8 @@ the δ-crossings by the crossing search of :class:`~rattle.timeint.ExactIntegrat
 - δ reaches a breakpoint in slip: the next stage; a jump (or a change of friction level) makes the
   field discontinuous, the crossing is transversal (the surface δ = d_i has normal n = (1, 0),
   nᵀφ = δ' the same on both sides) and its saltation matrix is
-  S = I + (φ⁺ − φ⁻) nᵀ / (nᵀ φ⁻) = [[1, 0], [(a⁺ − a⁻)/δ', 1]];
+  S = I + (φ⁺ − φ⁻) nᵀ / (nᵀ φ⁻) = [[1, 0], [(a⁺ − a⁻)/δ', 1]]; where neither (a breakpoint of a
+  continuous law) the field is continuous and S = I exactly, not the round-off of f(d_i⁺) − f(d_i⁻);
 - δ' reaches 0 in slip with friction: with R = F − k f(δ) (the force friction must balance),
   stick if |R| ≤ k r_j, with saltation [[1, 0], [0, 0]] (entry into the sliding surface δ' = 0,
   whose own flow is [[1, 0], [0, 0]]: δ-perturbations stay, δ'-perturbations are removed); else
@@ -58,17 +59,13 @@ from .._typing import FloatArray, IntArray
 from .._validate import check_omega, check_state
 from ..errors import ConvergenceError
 from ..model import Stages, System
-from .._lazy import lazy_module
 from ._exact_flow import ExactIntegrator, FlowOptions, takes_single_equation
-from ._integrator import _ScalarFlow, _Segment
+from ._integrator import _event_kernel, _ScalarFlow, _Segment
 from ._trajectory import ExactMeasures, ExactTrajectory
 from ._recent import Recent
 from ._roots import bracketed_newton, grid_chunk, polish_crossing
 from ._stage_solutions import StageSolutions
 
-#: the compiled march, imported where a discontinuous law is first integrated (the smooth laws'
-#: commands do not pay its import)
-_event_kernel = lazy_module("rattle.timeint._event_kernel")
 
 _EPS = float(np.finfo(float).eps)
 _CHUNK = 64
@@ -325,8 +322,6 @@ class NonsmoothTrajectory(ExactTrajectory):
         return np.unique(np.asarray(hit, dtype=float))
 
 
-#: Frequencies whose stage solutions :meth:`_ScalarEventFlow.solutions` keeps.
-SOLUTION_CACHE = 4
 #: The last trajectories :meth:`_ScalarEventFlow.propagate` keeps, by their exact arguments (x0, t0,
 #: t1, Ω): a shooting continuation asks again for the period it has just integrated (the row of an
 #: accepted point after the corrector's last evaluation there, its event structure).
@@ -339,13 +334,13 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
     the single equation's :class:`~rattle.model.System`; the δ-crossings by the scalar path's own search
     (``_first_exit`` on the mode table)."""
 
+    _MODE_ROWS = 1  # :meth:`solutions` is the mode table already
+
     def __init__(self, system: System, options: FlowOptions | None = None) -> None:
         ExactIntegrator.__init__(self, system, options)
         self.model = None  # the modes' table stands for the model (:meth:`solutions`)
         self.max_segments = self.options.budget(events=True)
-        self._solution_cache: Recent = Recent(SOLUTION_CACHE)  # Ω → StageSolutions
         self._memo: Recent = Recent(MEMO)  # (x0, t0, t1, Ω) → NonsmoothTrajectory
-        self._template: StageSolutions | None = None
         st = system.law.stages
         self._d = st.breakpoints.tolist()
         self._s = st.slopes.tolist()
@@ -353,24 +348,14 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
         self._J = st.jumps.tolist()
         self._r = system.law.friction_levels.tolist()
         self._L = float(system.length_scale())
-        # the compiled march (:mod:`._event_kernel`) where every mode's segment has the modal form
-        # (decided with the first stage solutions: :meth:`_use_compiled`)
-        self._compiled: bool | None = None if _event_kernel.AVAILABLE else False
-        self._stage_table: FloatArray | None = None
         self._law_arrays = tuple(np.asarray(x, dtype=float) for x in (self._d, self._s, self._e, self._J, self._r))
-        self._capacity = 64  # segments and events of a record (grown when a march needs more)
+        self._x_lock = self.options.lock_excursion * self._L
+        self._init_scalar()  # the solutions kept, the compiled march where every mode has the modal form
 
-    def solutions(self, omega: float) -> StageSolutions:
-        """The closed-form solutions of every mode at ``omega`` (the last :data:`SOLUTION_CACHE`
-        frequencies cached: a shooting continuation evaluates the period map at Ω and at Ω + h)."""
-        sol = self._solution_cache.get(omega)
-        if sol is not None:
-            return sol
-        if self._template is None:
-            sol = self._template = _mode_solutions(self.system, omega, self.samples_per_scale)
-        else:  # only the forcing's parts depend on Ω
-            sol = self._template.at_omega(omega)
-        return self._solution_cache.put(float(omega), sol)
+    def _stage_solutions(self, omega: float) -> StageSolutions:
+        """The closed-form solutions of every mode (:func:`_mode_solutions`): the first of
+        :meth:`solutions`, the others made from it."""
+        return _mode_solutions(self.system, omega, self.samples_per_scale)
 
     def velocity_scale(self, omega: float) -> float:
         """L ν: the length scale times the larger of Ω and the stiffest stage's natural frequency."""
@@ -448,14 +433,6 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
         return traj.state1.copy(), (traj.sensitivity.copy() if sensitivity else None)
 
     # --- the march ---------------------------------------------------------------------------
-    def _use_compiled(self, sol: StageSolutions) -> bool:
-        """Whether the march runs compiled: numba there and every mode's segment in modal form
-        (the mode table's Ω-independent rows, ``sol._stage_l``, decide once)."""
-        if self._compiled is None:
-            self._stage_table = np.array([[float(x) for x in row] for row in sol._stage_l], dtype=float)
-            self._compiled = _event_kernel.supported(self._stage_table, float(sol.sigma))
-        return self._compiled
-
     def _budget_error(self, t0: float, t1: float) -> ConvergenceError:
         return ConvergenceError(
             f"more than `max_events` = {self.max_segments} switching events between t0 = {t0!r} "
@@ -466,34 +443,14 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
                         t1: float) -> tuple[float, float, tuple[float, float, float, float], dict]:
         """:meth:`_march_events` by the compiled march (:mod:`._event_kernel`, the same steps):
         the final state, the sensitivity and the record (arrays, as the Python march's lists)."""
-        kept = sol.__dict__.get("_kernel_args")  # an at_omega copy starts with its template's: Ω tells
-        if kept is not None and kept[0] == sol.omega:
-            args = kept[1]
-        else:
-            args = (
-                np.ascontiguousarray(self._stage_table), float(sol.sigma), np.ascontiguousarray(sol.xr),
-                np.ascontiguousarray(sol.xi), np.ascontiguousarray(sol.nw, dtype=float),
-                np.ascontiguousarray(sol.fc, dtype=float), np.ascontiguousarray(sol.fs, dtype=float),
-                float(sol.mean), np.ascontiguousarray(sol.grid_step, dtype=float), float(self.samples_per_scale))
-            sol._kernel_args = (sol.omega, args)
         kind, j, sigma = self._classify(sol, t0, d, v)
-        cap = self._capacity
-        while True:
-            rec_t, rec_i, rec_x = np.empty(cap), np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4))
-            ev_t, ev_k = np.empty(cap), np.empty(cap, dtype=np.int64)
-            status, ns, ne, d1, v1, m11, m12, m21, m22 = _event_kernel.march(
-                *args, *self._law_arrays, self.system.k, self.system.c, self.options.lock_excursion * self._L,
-                self.max_segments, kind, j, sigma, d, v, t0, t1, rec_t, rec_i, rec_x, ev_t, ev_k)
-            if status != _event_kernel.FULL:
-                break
-            cap *= 4  # a longer record than any so far: again with room for it
-            self._capacity = cap
-        if status == _event_kernel.BUDGET:
-            raise self._budget_error(t0, t1)
+        ns, ne, d1, v1, m, rec_t, rec_i, rec_x, ev_t, ev_k = self._run_compiled(sol, kind, j, sigma, d, v, t0, t1)
         names = _event_kernel.EVENT_NAMES
-        rec = {"t": rec_t[:ns], "kind": rec_i[:ns, 0], "stage": rec_i[:ns, 1], "sign": rec_i[:ns, 2],
-               "x": rec_x[:ns, :2], "h": rec_x[:ns, 2:], "et": ev_t[:ne], "ek": [names[e] for e in ev_k[:ne].tolist()]}
-        return d1, v1, (m11, m12, m21, m22), rec
+        rec_i = rec_i[:ns].copy()  # the flow's record arrays are written again by the next march
+        rec = {"t": rec_t[:ns].copy(), "kind": rec_i[:, 0], "stage": rec_i[:, 1], "sign": rec_i[:, 2],
+               "x": rec_x[:ns, :2].copy(), "h": rec_x[:ns, 2:].copy(), "et": ev_t[:ne].copy(),
+               "ek": [names[e] for e in ev_k[:ne].tolist()]}
+        return d1, v1, m, rec
 
     def _march_events(self, sol: StageSolutions, d: float, v: float, t0: float, t1: float, omega: float,
                rec: dict[str, list]) -> tuple[float, float, tuple[float, float, float, float]]:
@@ -556,10 +513,11 @@ class _ScalarEventFlow(_ScalarFlow, takes=takes_single_equation, kind="the singl
                         m11, m12, m21, m22 = (0.0, 0.0, 0.0, 0.0) if self._J[i] > 0.0 else (m11, m12, 0.0, 0.0)
                         self._event(rec, t, "lock")
                     else:
-                        a_m = F - c * v - k * (self._f(j, d) + self._r[j] * sigma)
-                        a_p = F - c * v - k * (self._f(jn, d) + self._r[jn] * sn)
-                        q = (a_p - a_m) / v if v != 0.0 else 0.0
-                        m21, m22 = m21 + q * m11, m22 + q * m12
+                        if self._J[i] > 0.0 or self._r[i] != self._r[i + 1]:  # the field jumps: saltation
+                            a_m = F - c * v - k * (self._f(j, d) + self._r[j] * sigma)
+                            a_p = F - c * v - k * (self._f(jn, d) + self._r[jn] * sn)
+                            q = (a_p - a_m) / v if v != 0.0 else 0.0
+                            m21, m22 = m21 + q * m11, m22 + q * m12
                         j, sigma = jn, sn
                         self._event(rec, t, "crossing")
                 else:  # δ' = 0 inside stage j with friction

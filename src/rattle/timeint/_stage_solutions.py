@@ -19,6 +19,7 @@ stiffness), the one shared with the stability layer.
 
 from __future__ import annotations
 
+import bisect
 import copy
 import math
 
@@ -53,6 +54,7 @@ class StageSolutions:
         self.samples_per_scale = samples_per_scale
         self.c = c
         self.breakpoints = np.asarray(st.breakpoints, dtype=float)
+        self._breakpoints_l = self.breakpoints.tolist()
         self.lower = np.concatenate(([-np.inf], self.breakpoints))
         self.upper = np.concatenate((self.breakpoints, [np.inf]))
         self.n_stages = len(st.slopes)
@@ -146,8 +148,8 @@ class StageSolutions:
     def stage_of(self, t: float, delta: float, velocity: float) -> int:
         """Stage holding the state (δ, δ') at time t; exactly on a breakpoint the direction of
         motion decides (sign of δ', then of δ'', the upper stage if both vanish)."""
-        j = int(np.searchsorted(self.breakpoints, delta, side="right"))
-        if j > 0 and delta == self.breakpoints[j - 1]:
+        j = bisect.bisect_right(self._breakpoints_l, delta)  # np.searchsorted(…, side="right")
+        if j > 0 and delta == self._breakpoints_l[j - 1]:
             acc = float(self.forcing(np.asarray(t))) - self.c * velocity - self.ks[j] * delta - self.ke[j]
             direction = velocity if velocity != 0.0 else acc
             if direction < 0.0:
