@@ -100,6 +100,11 @@ def test_kinks_of_the_branch_cost_one_step():
     found = sorted((s.kind, round(s.omega, 4)) for s in frf.special_points)
     assert found == sorted([("fold", 0.6534), ("fold", 0.6983), ("period_doubling", 0.726), ("period_doubling", 0.678),
                             ("neimark_sacker", 0.6115), ("neimark_sacker", 0.5819)])
+    # the sweep's period-1 motions over the HB's period-doubling stretch (a truncation artefact at
+    # H = 21: the exact flow settles there) are seeded once; those on the branch that seed gave are
+    # not seeded again (three identical branches before, 12.5 s of the run's CPU against 6.9 s)
+    check = frf.settings["sweep_check"]
+    assert check["seeded"] == [] and len(check["on_a_seeded_branch"]) >= 1
 
 
 def test_an_attractor_the_start_misses_is_continued_from_the_sweep():

@@ -304,11 +304,14 @@ def branch_from_seed(
                     settings=run.record(hb_opts, period=period, origin=f"seed at Ω = {omega:.6g}"))
 
 
-def explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rtol: float) -> bool:
-    """Whether a stable stretch of a period-``period`` branch crosses Ω with that rms."""
+def explained(frf: FrequencyResponse, period: int, omega: float, rms: float, rtol: float, *,
+              stable_only: bool = True) -> bool:
+    """Whether a stable stretch of a period-``period`` branch crosses Ω with that rms (with
+    ``stable_only=False``: any stretch of it)."""
     for b in np.unique(frf.branch[frf.period == period]):
         rows = np.nonzero(frf.branch == b)[0]
-        om, r, st = frf.omega[rows], frf.rms[rows], frf.stable[rows] | (frf.bifurcation[rows] != "")
+        om, r = frf.omega[rows], frf.rms[rows]
+        st = (frf.stable[rows] | (frf.bifurcation[rows] != "")) if stable_only else np.ones(rows.size, dtype=bool)
         lo, hi = om[:-1], om[1:]
         cross = ((lo - omega) * (hi - omega) <= 0) & st[:-1] & st[1:] & (lo != hi)
         for i in np.nonzero(cross)[0]:

@@ -73,7 +73,9 @@ def missed_branches(frf: FrequencyResponse, omega_range: tuple[float, float], ru
     H = run.hb.harmonics
     hb = HarmonicBalance(model, run.for_harmonics(H), period=1)
     out: list[FrequencyResponse] = []
-    record: dict[str, Any] = {"points": check.points, "attractors": 0, "unexplained": [], "seeded": []}
+    tried: list[FrequencyResponse] = []  # seeded branches that did not explain their attractor
+    record: dict[str, Any] = {"points": check.points, "attractors": 0, "unexplained": [], "seeded": [],
+                              "on_a_seeded_branch": []}
     for j, (traj, window) in enumerate(sweep.records()):
         if traj is None or int(sweep.period[j]) != 1:
             continue
@@ -85,12 +87,20 @@ def missed_branches(frf: FrequencyResponse, omega_range: tuple[float, float], ru
         record["unexplained"].append([w, rms])
         if len(out) >= check.max_branches:
             continue
+        if any(explained(b, 1, w, rms, check.rtol, stable_only=False) for b in tried):
+            # on a branch already seeded that the harmonic balance calls unstable there (its
+            # truncation: measured, NLvib's unilateral example at H = 21, where the HB has a period
+            # doubling the exact flow has not): seeding it again gives the same branch
+            record["on_a_seeded_branch"].append([w, rms])
+            continue
         q = trajectory_coefficients(traj, 2.0 * math.pi / w, hb)
         branch = branch_from_seed(model, w, q, 1, (lo, hi), H, run=run, branch_id=first_branch + len(out))
         if branch is not None and len(branch) and explained(FrequencyResponse.concatenate([frf, *out, branch]), 1, w,
                                                             rms, check.rtol):
             out.append(branch)
             record["seeded"].append([w, rms])
+        elif branch is not None and len(branch):
+            tried.append(branch)
     return out, record
 
 
