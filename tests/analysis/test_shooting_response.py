@@ -268,17 +268,21 @@ def test_an_attractor_next_to_an_unstable_orbit_is_found_and_continued():
     period (rms 0.0299) lives over Ω 0.344–0.353, between the sweep check's frequencies. The
     unstable orbit pushed along its unstable eigenvector settles on it; it is continued, and the
     exact simulation started next to a row settles back on that row (rms to 1e-6)."""
-    from rattle.analysis import SteadyStateOptions, steady_state
-
     system = _preload_case(0.0277, 0.0455, 0.0311, 0.0482)
     res = nonsmooth_response(system, (0.3, 2.0))
     rows = [(b, i) for b in (res, *res.branches) for i in np.flatnonzero(
         b.stable & (b.omega > 0.345) & (b.omega < 0.352) & (np.abs(b.rms - 0.0299) < 0.01 * 0.0299))]
     assert len(rows) >= 3, "the stable orbit of rms 0.0299 over Ω 0.344–0.353 is not on the response"
-    b, i = rows[len(rows) // 2]
-    settled = steady_state(system, float(b.omega[i]), x0=tuple(b.states[i] * (1.0 + 1e-3)),
+    _settles_back(system, *rows[len(rows) // 2])
+
+
+def _settles_back(system, branch, i):
+    """The exact simulation started next to row i of ``branch`` settles back on that row (rms to 1e-6)."""
+    from rattle.analysis import SteadyStateOptions, steady_state
+
+    settled = steady_state(system, float(branch.omega[i]), x0=tuple(branch.states[i] * (1.0 + 1e-3)),
                            options=SteadyStateOptions(max_period_multiple=1))
-    assert settled.period == 1 and settled.rms == pytest.approx(float(b.rms[i]), rel=1e-6)
+    assert settled.period == 1 and settled.rms == pytest.approx(float(branch.rms[i]), rel=1e-6)
 
 
 @pytest.mark.slow
@@ -300,17 +304,12 @@ def test_a_window_of_periodic_motion_between_chaotic_ones_is_found():
     a way see as non-periodic only (missed before). Its steps with a motion that is not period 1
     are swept again more finely, the state carried: the window's orbit is found and continued,
     and the exact simulation from next to its row settles back on it."""
-    from rattle.analysis import SteadyStateOptions, steady_state
-
     system = _preload_case(0.0431, 0.0311, 0.0281, 0.038, clearance=0.0435, friction=(0.0036, 0.0034, 0.0032))
     res = nonsmooth_response(system, (0.3, 2.0))
     rows = [(b, i) for b in (res, *res.branches) for i in np.flatnonzero(
         b.stable & (np.abs(b.omega - 0.47435) < 0.004) & (np.abs(b.rms - 0.058222) < 0.01 * 0.058222))]
     assert rows, "the stable orbit of rms 0.0582 at Ω 0.474 is not on the response"
-    b, i = rows[len(rows) // 2]
-    settled = steady_state(system, float(b.omega[i]), x0=tuple(b.states[i] * (1.0 + 1e-3)),
-                           options=SteadyStateOptions(max_period_multiple=1))
-    assert settled.period == 1 and settled.rms == pytest.approx(float(b.rms[i]), rel=1e-6)
+    _settles_back(system, *rows[len(rows) // 2])
 
 
 @pytest.mark.slow
