@@ -79,3 +79,30 @@ def test_a_collector_switched_off_stays_off(fresh_module: str, collector: None,
     with loading():
         __import__(fresh_module)
     assert not gc.isenabled()
+
+
+def test_an_interrupted_command_writes_no_output_set(tmp_path, monkeypatch) -> None:
+    """A signal whose Interrupted some code swallowed (the command went on) still stops the output
+    set: before it is opened, and at the last moment before it lands — nothing is left, not even
+    the output folder (seen on a fresh install: a parallel sweep Ctrl-C'd twice ran to its end and
+    left `out`)."""
+    from rattle import _signals
+    from rattle.cli import output
+
+    received: list[int] = []
+    monkeypatch.setattr(_signals, "interrupted_by", lambda: received[0] if received else None)
+    out = tmp_path / "deep" / "out"
+
+    def write(path):
+        path.write_text("x", encoding="utf-8")
+        received.append(2)  # the signal arrives while the set is being written, and is swallowed
+
+    with pytest.raises(_signals.Interrupted):
+        output.write_set(out, ["a.txt"], [("a.txt", write)])
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    with pytest.raises(_signals.Interrupted):  # received before: the set is never opened
+        output.write_set(out, ["a.txt"], [("a.txt", lambda p: p.write_text("x", encoding="utf-8"))])
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    received.clear()
+    assert output.write_set(out, ["a.txt"], [("a.txt", lambda p: p.write_text("x", encoding="utf-8"))]) == ["a.txt"]
+    assert (out / "a.txt").read_text(encoding="utf-8") == "x"
