@@ -178,18 +178,14 @@ def frequency_response(
     """
     _limits.check_callback(progress, "progress")
     if getattr(model, "discontinuous", False):  # a law with jumps or friction: exact shooting or regularised HB
-        given = {name: value for name, value, default in (
+        refuse_hb_arguments((
             ("harmonics", harmonics, DEFAULT_HARMONICS), ("samples", samples, None), ("hb", hb, None),
             ("period", period, 1), ("start", start, "low"), ("adaptive", adaptive, AdaptiveHarmonics()),
             ("check", check, SweepCheck()), ("stability", stability, "monodromy"), ("max_period", max_period, 4),
             ("sweep", sweep, None), ("seeds", tuple(seeds), ()), ("callback", callback, None),
-            ("confirm_tori", confirm_tori, True)) if not _same(value, default)}
-        if given:
-            raise TypeError(
-                f"{', '.join(f'`{k}`' for k in given)} must be left at the default for a law with jumps or friction "
-                "(they set the harmonic balance of a continuous law); choose its method with `options`: "
-                "ShootingOptions() (exact shooting continuation, the default) or "
-                "RegularisationOptions(harmonics=…, regularisation=…)")
+            ("confirm_tori", confirm_tori, True)),
+            "choose its method with `options`: ShootingOptions() (exact shooting continuation, the default) or "
+            "RegularisationOptions(harmonics=…, regularisation=…)")
         return discontinuous_response(model, omega, options, continuation=continuation, newton=newton,
                                       subharmonics=_validate.check_bool(subharmonics, "subharmonics"),
                                       throw=_validate.check_bool(throw, "throw"), progress=progress)
@@ -232,6 +228,18 @@ def frequency_response(
         result = replace(result, regions=_confirm(result), timings={
             **result.timings, "torus_simulations": time.perf_counter() - t0})
     return result
+
+
+def refuse_hb_arguments(arguments: Sequence[tuple[str, object, object]], method: str) -> None:
+    """TypeError naming every (name, value, default) of ``arguments`` not left at its default
+    (:func:`_same`): they set the harmonic balance of a continuous law, and a law with jumps or
+    friction is solved otherwise (``method`` says how to choose it). The one rule of
+    :func:`frequency_response` and :func:`~rattle.analysis.periodic_orbit`."""
+    given = [name for name, value, default in arguments if not _same(value, default)]
+    if given:
+        raise TypeError(
+            f"{', '.join(f'`{k}`' for k in given)} must be left at the default for a law with jumps or friction "
+            f"(they set the harmonic balance of a continuous law); {method}")
 
 
 def _same(value: object, default: object) -> bool:

@@ -47,7 +47,7 @@ from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, OrbitSolution, PeriodicOrbit, SteadyState
 from ..stability import UNIT_CIRCLE_TOL, FloquetMonitor, stability_method
 from ..timeint import ExactIntegrator, check_system_state, shoot_periodic_orbit, shoot_system_orbit
-from ._frequency_response import check_range, frequency_response
+from ._frequency_response import check_range, frequency_response, refuse_hb_arguments
 from ._settings import DEFAULT_HARMONICS, StabilityMethod, check_stability, resolve_hb
 from ._steady import SteadyStateOptions, make_integrator, steady_state
 
@@ -419,16 +419,13 @@ def periodic_orbit(
         If no periodic solution could be found at all.
     """
     if getattr(model, "discontinuous", False):  # a law with jumps or friction: the exact orbits
-        given = [name for name, value, default in (
+        refuse_hb_arguments((
             ("harmonics", harmonics, DEFAULT_HARMONICS), ("hb", hb, None), ("stability", stability, "monodromy"),
             ("simulate", simulate, True), ("search_range", search_range, None), ("frf", frf, None),
             ("samples", samples, None), ("newton", newton, None), ("continuation", continuation, None),
-            ("steady_options", steady_options, None)) if not (value is default or value == default)]
-        if given:
-            raise TypeError(
-                f"{', '.join(f'`{k}`' for k in given)} must be left at the default for a law with jumps or friction "
-                "(they set the harmonic balance of a continuous law); its orbits are exact, and `options` "
-                "(RegularisationOptions(harmonics=…, regularisation=…)) sets the harmonic balance beside them")
+            ("steady_options", steady_options, None)),
+            "its orbits are exact, and `options` (RegularisationOptions(harmonics=…, regularisation=…)) sets the "
+            "harmonic balance beside them")
         from ..model import Chain
         from ._nonsmooth_orbit import nonsmooth_orbit
 
