@@ -906,15 +906,15 @@ def _from_rest(problem: ShootingProblem, sweep: Any) -> list[tuple[float, FloatA
 
     out: list[tuple[float, FloatArray]] = []
     budget = SteadyStateOptions().max_periods
-    for d in dict.fromkeys(str(x) for x in sweep.direction):
-        j = next(j for j in range(len(sweep.omega)) if str(sweep.direction[j]) == d)
-        spent = int(sweep.periods[j])
-        if int(sweep.period[j]) != 0 or spent >= budget or not np.all(np.isfinite(sweep.final_state[j])):
+    for d in sweep.directions:
+        one = sweep.select(d)  # its first row started from rest
+        spent = int(one.periods[0])
+        if int(one.period[0]) != 0 or spent >= budget or not np.all(np.isfinite(one.final_state[0])):
             continue
-        w = float(sweep.omega[j])
+        w = float(one.omega[0])
         more = SteadyStateOptions(max_periods=budget - spent, max_period_multiple=1, record_periods=1)
         try:
-            s = steady_state(problem.system, w, x0=np.asarray(sweep.final_state[j], dtype=float), options=more,
+            s = steady_state(problem.system, w, x0=np.asarray(one.final_state[0], dtype=float), options=more,
                              integrator=problem.integrator)
         except RattleError:
             continue
@@ -936,16 +936,16 @@ def _refined(problem: ShootingProblem, sweep: Any, settle: Any, budget: int) -> 
     from ._steady import steady_state
 
     out: list[tuple[float, FloatArray]] = []
-    for d in dict.fromkeys(str(x) for x in sweep.direction):
-        rows = [j for j in range(len(sweep.omega)) if str(sweep.direction[j]) == d]
-        steps = [(j, k) for j, k in zip(rows, rows[1:])
-                 if not (int(sweep.period[j]) == 1 and int(sweep.period[k]) == 1) and np.all(np.isfinite(sweep.final_state[j]))]
+    for d in sweep.directions:
+        one = sweep.select(d)  # its rows in sweep order
+        steps = [j for j in range(len(one) - 1)
+                 if not (one.period[j] == 1 and one.period[j + 1] == 1) and np.all(np.isfinite(one.final_state[j]))]
         if not steps:
             continue
         inner = max(1, min(REFINE_POINTS, budget // len(steps)))
-        for j, k in steps[: budget // inner]:
-            x = np.asarray(sweep.final_state[j], dtype=float)
-            w0, w1 = float(sweep.omega[j]), float(sweep.omega[k])
+        for j in steps[: budget // inner]:
+            x = np.asarray(one.final_state[j], dtype=float)
+            w0, w1 = float(one.omega[j]), float(one.omega[j + 1])
             for i in range(1, inner + 1):
                 w = w0 + (w1 - w0) * i / (inner + 1)
                 try:
