@@ -26,8 +26,9 @@ SRC = Path(rattle.__file__).resolve().parent
 def test_the_continuation_layer_knows_no_problem():
     """rattle.continuation imports none of the layers that define problems (Fourier series,
     flows, models) nor the stability layer above it: only the package's shared helpers (Brent's
-    root finder among them; ``_lazy.import_held`` for the compiled monitor scan loaded on first use)."""
-    allowed = {"rattle._typing", "rattle.errors", "rattle._limits", "rattle._validate", "rattle._brent", "rattle._lazy"}
+    root finder among them; ``_lazy.import_held`` for the compiled monitor scan loaded on first use, ``_jit`` its compile setting)."""
+    allowed = {"rattle._typing", "rattle.errors", "rattle._limits", "rattle._validate", "rattle._brent", "rattle._lazy",
+               "rattle._jit"}
     for path in sorted((SRC / "continuation").glob("*.py")):
         tree = ast.parse(path.read_text(encoding="utf-8"))
         for node in ast.walk(tree):

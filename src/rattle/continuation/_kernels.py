@@ -18,10 +18,7 @@ from __future__ import annotations
 
 import math
 
-try:  # numba is a dependency; the array code stays the fallback (and the reference)
-    import numba
-except ImportError:  # pragma: no cover - exercised only without numba
-    numba = None
+from .._jit import njit, numba  # numba is a dependency; the array code stays the fallback (and the reference)
 
 AVAILABLE = numba is not None
 
@@ -68,7 +65,7 @@ def _hermite_scan(pa, ga, pb, gb, L, sign, tolerance, X, X2):
 
 
 if AVAILABLE:
-    hermite_scan = numba.njit(cache=True, error_model="numpy", nogil=True)(_hermite_scan)
+    hermite_scan = njit(_hermite_scan)
 else:  # pragma: no cover
     hermite_scan = None
 

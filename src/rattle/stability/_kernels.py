@@ -19,10 +19,7 @@ import math
 
 import numpy as np
 
-try:  # numba is a dependency; the array code stays the fallback (and the reference)
-    import numba
-except ImportError:  # pragma: no cover - exercised only without numba
-    numba = None
+from .._jit import njit, numba  # numba is a dependency; the array code stays the fallback (and the reference)
 
 from ..model import stage_constants, transition_scalar
 
@@ -167,7 +164,7 @@ def _monodromies(Q, omega, samples, bp, kappa, sigma, under, wd, gamma, lam1, la
 
 
 if AVAILABLE:
-    _jit = numba.njit(cache=True, error_model="numpy", nogil=True)
+    _jit = njit  # rattle._jit: the one compile setting
     _transition = _jit(transition_scalar)  # the one closed form of exp(A τ), compiled
     _series = _jit(_series)
     _refine = _jit(_refine)

@@ -36,10 +36,7 @@ import math
 
 import numpy as np
 
-try:  # numba is a dependency; the Python march stays the fallback (and the reference)
-    import numba
-except ImportError:  # pragma: no cover - exercised only without numba
-    numba = None
+from .._jit import njit, numba  # numba is a dependency; the Python march stays the fallback (and the reference)
 
 AVAILABLE = numba is not None
 
@@ -688,7 +685,7 @@ def _march(st, sigma, xr, xi, nw, fc, fs, mean, grid_step, sps, bp, slope, offse
 
 
 if AVAILABLE:
-    _jit = numba.njit(cache=True, error_model="numpy", nogil=True)
+    _jit = njit  # rattle._jit: the one compile setting
     _force, _forcing, _transition = _jit(_force), _jit(_forcing), _jit(_transition)
     _seg_init, _seg_state, _seg_scan, _grid_chunk = _jit(_seg_init), _jit(_seg_state), _jit(_seg_scan), _jit(_grid_chunk)
     _fx, _newton, _polish = _jit(_fx), _jit(_newton), _jit(_polish)
