@@ -48,7 +48,8 @@ if TYPE_CHECKING:  # annotations only
     from typing import Any
 
 __all__ = ["FORCE_AFTER", "HANDLED", "Interrupted", "install_at_start", "is_command_line", "installed_at_start",
-           "raising", "handle", "message", "mark_reported", "interrupted_by", "exit_now", "signal_name"]
+           "raising", "handle", "message", "mark_reported", "interrupted_by", "raise_received", "exit_now",
+           "signal_name"]
 
 #: The signals handled, number → name (those the platform has).
 HANDLED: dict[int, str] = {getattr(_signal, name): name for name in ("SIGINT", "SIGTERM", "SIGHUP")
@@ -421,3 +422,12 @@ def mark_reported() -> None:
 def interrupted_by() -> int | None:
     """The first signal received during the last :func:`raising` body (None if none)."""
     return _State.first
+
+
+def raise_received() -> None:
+    """Raise the :class:`Interrupted` of a signal received whose Interrupted never reached the
+    command (code that caught it and went on): the signal decides — at the command's end, and
+    before an output set is opened or lands, so that an interrupted run writes nothing."""
+    signum = _State.first
+    if signum is not None:
+        raise Interrupted(int(signum))

@@ -89,13 +89,12 @@ def test_an_interrupted_command_writes_no_output_set(tmp_path, monkeypatch) -> N
     from rattle import _signals
     from rattle.cli import output
 
-    received: list[int] = []
-    monkeypatch.setattr(_signals, "interrupted_by", lambda: received[0] if received else None)
+    monkeypatch.setattr(_signals._State, "first", None)
     out = tmp_path / "deep" / "out"
 
     def write(path):
         path.write_text("x", encoding="utf-8")
-        received.append(2)  # the signal arrives while the set is being written, and is swallowed
+        _signals._State.first = 2  # the signal arrives while the set is being written, and is swallowed
 
     with pytest.raises(_signals.Interrupted):
         output.write_set(out, ["a.txt"], [("a.txt", write)])
@@ -103,6 +102,6 @@ def test_an_interrupted_command_writes_no_output_set(tmp_path, monkeypatch) -> N
     with pytest.raises(_signals.Interrupted):  # received before: the set is never opened
         output.write_set(out, ["a.txt"], [("a.txt", lambda p: p.write_text("x", encoding="utf-8"))])
     assert sorted(p.name for p in tmp_path.iterdir()) == []
-    received.clear()
+    _signals._State.first = None
     assert output.write_set(out, ["a.txt"], [("a.txt", lambda p: p.write_text("x", encoding="utf-8"))]) == ["a.txt"]
     assert (out / "a.txt").read_text(encoding="utf-8") == "x"

@@ -127,9 +127,7 @@ class RattleGroup(click.Group):
             try:
                 with _signals.raising(), _warnings_as_lines():
                     code = self._invoke(args, prog_name, complete_var, **extra)
-                    late = _signals.interrupted_by()
-                    if late is not None:  # a signal came and its Interrupted never reached the command
-                        raise Interrupted(late)  # (swallowed by code that went on): the signal decides
+                    _signals.raise_received()  # a signal whose Interrupted never reached the command
                     return code
             finally:
                 reset_verbose()

@@ -20,6 +20,8 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from .. import _signals
+
 if TYPE_CHECKING:  # annotations only: the numpy-based layers are imported when a command runs
     from ..io import AnalysisSettings
 
@@ -67,8 +69,6 @@ def loading() -> Iterator[None]:
     with this). The computation itself runs with
     the collector on. Outside the command-line process (the CLI's functions called by another
     program, ``CliRunner``) and when the collector is off already, the body runs as it is."""
-    from .. import _signals
-
     if not (gc.isenabled() and _signals.installed_at_start()):
         yield
         return
@@ -230,18 +230,6 @@ def save_plot(result: Any, path: Path) -> bool:
 Writer = Callable[[Path], Any]
 
 
-def _not_interrupted() -> None:
-    """Raise the Interrupted of a signal the command received whose Interrupted never reached it
-    (code that caught it and went on: measured on a fresh install, a parallel sweep Ctrl-C'd twice
-    ran to its end and wrote its output folder before the command ended with the signal's status):
-    an interrupted run writes nothing, whoever swallowed the signal."""
-    from .._signals import Interrupted, interrupted_by
-
-    signum = interrupted_by()
-    if signum is not None:
-        raise Interrupted(int(signum))
-
-
 def write_set(output: Path, names: Sequence[str], steps: Sequence[tuple[str, Writer]]) -> list[str]:
     """Write one output set: each ``(name, writer)`` writes ``name`` into a staging folder inside
     ``output``, then all are moved into place together (:class:`rattle.io.OutputSet`); return
@@ -253,14 +241,16 @@ def write_set(output: Path, names: Sequence[str], steps: Sequence[tuple[str, Wri
     drawing) leaves ``output`` as it was: the staging folder is removed, and so are the folders
     the run created.
     """
-    _not_interrupted()
+    # a signal whose Interrupted some code swallowed (measured on a fresh install: a parallel sweep
+    # Ctrl-C'd twice ran to its end and wrote its output folder): an interrupted run writes nothing
+    _signals.raise_received()
     try:
         with loading(), _io().OutputSet(output, names) as staged:
             logger.info("staging %s in %s", ", ".join(n for n, _ in steps), staged.staging)
             for name, writer in steps:
                 logger.info("writing %s", name)
                 writer(staged.path(name))
-            _not_interrupted()  # the last moment before the set lands (the staging is then removed)
+            _signals.raise_received()  # the last moment before the set lands (the staging is then removed)
             written = staged.commit()
     except OSError as exc:  # no space, no permission, a member that cannot be replaced: exit 1, one line
         from ..files import WriteError, describe_os_error
