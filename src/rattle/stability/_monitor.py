@@ -33,7 +33,6 @@ from ..continuation import MonitorReading
 from ..hb import HarmonicBalance
 from .. import hb as fft  # its compiled rfft/irfft
 from ..model import System
-from . import _kernels
 from ._classify import critical_distance
 from ._floquet import (
     TEST_FUNCTIONS, element_monodromy_batch, floquet_test_functions, monodromy_and_crossings_batch,
@@ -118,12 +117,8 @@ class FloquetMonitor:
         hb = self.hb
         w = Om / hb.period
         if self._single:
-            samples = self._samples(Q)
-            if _kernels.AVAILABLE:  # the compiled kernel, straight (as monodromy_and_crossings_batch)
-                M, counts = _kernels.monodromies(Q, w, samples, self._breakpoints, self._stiffness, self._damping)
-            else:
-                M, counts = monodromy_and_crossings_batch(Q, w, samples, self._breakpoints, self._stiffness,
-                                                          self._damping)
+            M, counts = monodromy_and_crossings_batch(Q, w, self._samples(Q), self._breakpoints, self._stiffness,
+                                                      self._damping)
             return M, counts[:, None, :]
         S = np.einsum("en,pnk->pek", self._rows, Q.reshape(Q.shape[0], self.system.n, -1))
         return element_monodromy_batch(self.system, S, w, hb.basis.synthesize(S), cache=self._cache)
