@@ -18,7 +18,7 @@ from ..hb import HarmonicBalance, HBOptions, NewtonOptions, solve_harmonic_balan
 from ..model import Model, check_analysable_model
 from ..results import FrequencyResponse, SpeedText
 from ..stability import stability_method
-from ._assemble import assemble, monitor_of
+from ._assemble import assemble
 from ._exact_branch import ShootingOptions
 from ._nonsmooth import discontinuous_response
 from ._regularisation import RegularisationOptions
